@@ -76,9 +76,8 @@ impl Topology for Dnsom {
     fn counts(&self) -> NeuronCounts {
         NeuronCounts { non: self.net.non(), nov: self.net.nov(), nor: self.net.nor() }
     }
-    #[inline]
-    fn may_update(&self, winner: usize, unit: usize) -> bool {
-        (self.lattice.index_vector(winner)[2] - self.lattice.index_vector(unit)[2]).abs() != 2
+    fn frozen_k_distance(&self) -> Option<i32> {
+        Some(2)
     }
     fn adjacent(&self, a: usize, b: usize) -> bool {
         self.adjacency[a].binary_search(&(b as u32)).is_ok()

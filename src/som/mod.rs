@@ -116,9 +116,15 @@ pub trait Topology: Send + Sync {
     fn sigma0(&self) -> f64;
     /// Neuron counts (NON, NOV, NOR).
     fn counts(&self) -> NeuronCounts;
-    /// Whether `unit` may learn when `winner` wins (DNSOM: never the opposite view's interior).
-    fn may_update(&self, _winner: usize, _unit: usize) -> bool {
-        true
+    /// A winner never moves units whose k index differs from its own by exactly this much
+    /// (DNSOM: K = 2, the opposite view's interior; Section 4.2.4). `None`: no such rule.
+    fn frozen_k_distance(&self) -> Option<i32> {
+        None
+    }
+    /// Whether `unit` may learn when `winner` wins.
+    fn may_update(&self, winner: usize, unit: usize) -> bool {
+        let (w, u) = (self.lattice().index_vector(winner), self.lattice().index_vector(unit));
+        self.frozen_k_distance() != Some((w[2] - u[2]).abs())
     }
     /// Whether two units are adjacent for the topographic error.
     fn adjacent(&self, a: usize, b: usize) -> bool {

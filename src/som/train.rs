@@ -72,15 +72,17 @@ impl Weights {
         }
     }
 
-    /// (winner, its squared distance, second winner).
+    /// (winner, its squared distance, second winner); ties go to the lower unit index.
     #[inline]
     fn two_best(&mut self, p: Point3) -> (usize, f64, usize) {
-        for (((d, x), y), z) in self.d.iter_mut().zip(&self.x).zip(&self.y).zip(&self.z) {
-            let (dx, dy, dz) = (p[0] - x, p[1] - y, p[2] - z);
-            *d = dx * dx + dy * dy + dz * dz;
+        let n = self.d.len();
+        let (xs, ys, zs, ds) = (&self.x[..n], &self.y[..n], &self.z[..n], &mut self.d[..n]);
+        for u in 0..n {
+            let (dx, dy, dz) = (p[0] - xs[u], p[1] - ys[u], p[2] - zs[u]);
+            ds[u] = dx * dx + dy * dy + dz * dz;
         }
         let (mut b1, mut d1, mut b2, mut d2) = (0, f64::INFINITY, 0, f64::INFINITY);
-        for (u, &d) in self.d.iter().enumerate() {
+        for (u, &d) in ds.iter().enumerate() {
             if d < d2 {
                 if d < d1 {
                     b2 = b1;
@@ -128,6 +130,8 @@ pub fn train(
     let mut w = Weights::from_points(&init);
 
     let (mut sum_err, mut not_adjacent) = (0.0, 0usize);
+    let mut gains: Vec<f64> = Vec::new();
+    let frozen = topology.frozen_k_distance();
     let (mut min_err, mut max_err) = (f64::INFINITY, 0.0f64);
     for t in 1..=t_max {
         let x = data[rng.gen_range(0..data.len())];
@@ -143,13 +147,15 @@ pub fn train(
         let alpha = params.alpha0 * decay;
         let sigma = sigma0 * decay;
         let inv_two_sigma2 = 1.0 / (2.0 * sigma * sigma);
-        lattice.for_each_within(win, sigma, |u, dist2| {
-            if topology.may_update(win, u) {
-                let g = alpha * (-(dist2 as f64) * inv_two_sigma2).exp();
-                w.x[u] += g * (x[0] - w.x[u]);
-                w.y[u] += g * (x[1] - w.y[u]);
-                w.z[u] += g * (x[2] - w.z[u]);
-            }
+        // dist^2 is an integer below sigma^2: tabulate the gains once per iteration (the same
+        // expression, so the same bits, as computing each one on its own).
+        gains.clear();
+        gains.extend((0..=(sigma * sigma).ceil() as usize).map(|d2| alpha * (-(d2 as f64) * inv_two_sigma2).exp()));
+        lattice.for_each_within(win, sigma, frozen, |u, dist2| {
+            let g = gains[dist2 as usize];
+            w.x[u] += g * (x[0] - w.x[u]);
+            w.y[u] += g * (x[1] - w.y[u]);
+            w.z[u] += g * (x[2] - w.z[u]);
         });
     }
     let weights = (0..units).map(|u| [w.x[u], w.y[u], w.z[u]]).collect();

@@ -1,0 +1,72 @@
+//! Command-line definitions (clap). Help text and parsing come from the same definitions.
+
+use clap::{Args, Parser, Subcommand};
+use std::path::PathBuf;
+
+const EXAMPLES: &str = "\
+Examples:
+  somnurbs run experiments/ch4_models.toml                 # Appendix B/C, Tables 4.9/4.13/4.14
+  somnurbs run experiments/ch4_models.toml --profile quick # the same, T = 3000 (seconds)
+  somnurbs run experiments/ch4_bunny.toml --data-dir ../shared/data
+  somnurbs run experiments/ch4_grids.toml --dry-run        # list cells and their seeds
+  somnurbs datasets list
+  somnurbs datasets export sphere sphere.xyz
+
+Data directory (bunny, talus): --data-dir, else $SOMNURBS_DATA, else ./data";
+
+#[derive(Debug, Parser)]
+#[command(name = "somnurbs", version, about = "Reproduce SOM + cubic B-spline surface reconstruction experiments from seeds", after_help = EXAMPLES)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Run an experiment spec (TOML): every cell on its own seeded stream, then tables, pictures,
+    /// REPORT.md and manifest.toml in the output folder.
+    #[command(after_help = EXAMPLES)]
+    Run(RunArgs),
+    /// List, describe or export the data sets (generated primitives and data files).
+    Datasets(DatasetsArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct RunArgs {
+    /// The experiment spec, e.g. experiments/ch4_models.toml.
+    pub spec: PathBuf,
+    /// A profile defined in the spec ([profiles.NAME]), e.g. quick.
+    #[arg(long)]
+    pub profile: Option<String>,
+    /// Output folder (default: the spec's `output`, else results/<spec name>).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Worker threads (default: all cores). Results do not depend on it.
+    #[arg(long, short = 'j')]
+    pub jobs: Option<usize>,
+    /// Folder holding bun_zipper.ply and talus_r.stl (default: $SOMNURBS_DATA, else ./data).
+    #[arg(long)]
+    pub data_dir: Option<PathBuf>,
+    /// List the cells and their seeds without running them.
+    #[arg(long)]
+    pub dry_run: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct DatasetsArgs {
+    #[command(subcommand)]
+    pub action: Option<DatasetsAction>,
+    /// Folder holding the data files (default: $SOMNURBS_DATA, else ./data).
+    #[arg(long, global = true)]
+    pub data_dir: Option<PathBuf>,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum DatasetsAction {
+    /// List the built-in data sets (default).
+    List,
+    /// Load one data set and print its size and bounds.
+    Show { name: String },
+    /// Write a data set's normalised points to FILE (.csv: comma-separated with header; else XYZ).
+    Export { name: String, file: PathBuf },
+}

@@ -1,0 +1,154 @@
+//! Named data sets and user files: the one place in `data` that reads files.
+
+use super::{generators, normalise_min_max, ply, stl, validate, xyz, DataError, PointCloud};
+use crate::geom::Point3;
+use rand::SeedableRng;
+use std::path::Path;
+
+/// Built-in data-set names.
+pub const BUILTIN: &[&str] = &["cube", "sphere", "spindle", "oiltank", "talus", "bunny", "cylinder", "semi_sphere", "saddle"];
+
+/// Number of points sampled on the talus mesh (the thesis' talus has 5253 points).
+pub const TALUS_POINTS: usize = 5253;
+/// Seed of the talus sample (the thesis' own scan points are not public).
+pub const TALUS_SAMPLE_SEED: u64 = 5253;
+/// Points sampled from a user's STL file unless `path.stl:N` says otherwise.
+pub const DEFAULT_STL_POINTS: usize = 5000;
+
+pub const BUNNY_FILE: &str = "bun_zipper.ply";
+pub const TALUS_FILE: &str = "talus_r.stl";
+
+/// One line about a built-in data set.
+pub fn describe(name: &str) -> Option<&'static str> {
+    Some(match name {
+        "cube" => "7352 points, unit-cube surface lattice (generated)",
+        "sphere" => "7082 points, sphere rings at 3-degree steps (generated)",
+        "spindle" => "7552 points, spindle of revolution, 151 rings x 50 (generated)",
+        "oiltank" => "5942 points, capsule with spherical-cap domes, 99 rings x 60 (generated)",
+        "talus" => "5253 points sampled on talus_r.stl (TLEM 2.0 talus bone; data file)",
+        "bunny" => "35947 vertices of bun_zipper.ply (Stanford bunny; data file)",
+        "cylinder" => "3876 points, cylinder r = 5, h = 5, 51 rings x 76 (seed 004; generated)",
+        "semi_sphere" => "3601 points, upper hemisphere (seed 001; generated)",
+        "saddle" => "3600 points, z = x^2 - y^2 on a 60 x 60 lattice (seed 001; generated)",
+        _ => return None,
+    })
+}
+
+fn read(path: &Path, hint: &str) -> Result<Vec<u8>, DataError> {
+    std::fs::read(path).map_err(|e| {
+        if e.kind() == std::io::ErrorKind::NotFound {
+            DataError::Missing { path: path.display().to_string(), hint: hint.to_string() }
+        } else {
+            DataError::Io { path: path.display().to_string(), source: e }
+        }
+    })
+}
+
+fn where_to_get(file: &str) -> String {
+    let source = match file {
+        BUNNY_FILE => "the Stanford 3D Scanning Repository, bunny/reconstruction/bun_zipper.ply",
+        _ => "the TLEM 2.0 data set as redistributed in the STAPLE toolbox, bone_datasets/TLEM2/talus_r.stl",
+    };
+    format!("Download {file} from {source} and name its folder with --data-dir or SOMNURBS_DATA.")
+}
+
+fn sample_stl(bytes: &[u8], n: usize, seed: u64, shown: &str) -> Result<Vec<Point3>, DataError> {
+    let tris = stl::parse_stl(bytes).map_err(|e| e.in_file(shown))?;
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    stl::sample_surface(&tris, n, &mut rng).map_err(|e| e.in_file(shown))
+}
+
+/// Load a data set by name (`somnurbs datasets list`) or a point file path (.ply, .xyz, .csv, .txt,
+/// or .stl, sampled with `path.stl:N` points, default 5000). Points are validated (finite, at
+/// least 4) and normalised per axis to [0, 1].
+pub fn load_dataset(name: &str, data_dir: &Path) -> Result<PointCloud, DataError> {
+    let mut points = match name {
+        "cube" => generators::cube(),
+        "sphere" => generators::sphere(),
+        "spindle" => generators::spindle(),
+        "oiltank" => generators::oiltank(),
+        "cylinder" => generators::cylinder(),
+        "semi_sphere" => generators::semi_sphere(),
+        "saddle" => generators::saddle(),
+        "bunny" => {
+            let path = data_dir.join(BUNNY_FILE);
+            let shown = path.display().to_string();
+            ply::parse_ply(&read(&path, &where_to_get(BUNNY_FILE))?).map_err(|e| e.in_file(&shown))?
+        }
+        "talus" => {
+            let path = data_dir.join(TALUS_FILE);
+            let shown = path.display().to_string();
+            sample_stl(&read(&path, &where_to_get(TALUS_FILE))?, TALUS_POINTS, TALUS_SAMPLE_SEED, &shown)?
+        }
+        other => {
+            let (file, count) = match other.rsplit_once(':') {
+                Some((f, n)) if f.to_ascii_lowercase().ends_with(".stl") => {
+                    (f, Some(n.parse::<usize>().map_err(|_| DataError::Invalid(format!("{other}: `{n}` is not a point count")))?))
+                }
+                _ => (other, None),
+            };
+            let lower = file.to_ascii_lowercase();
+            let known = [".ply", ".stl", ".xyz", ".csv", ".txt"];
+            if !known.iter().any(|e| lower.ends_with(e)) {
+                return Err(DataError::Invalid(format!(
+                    "unknown data set `{other}` (built-in: {}; or a .ply/.stl/.xyz/.csv/.txt file)",
+                    BUILTIN.join(", ")
+                )));
+            }
+            let path = Path::new(file);
+            let bytes = read(path, "Check the path in the spec.")?;
+            if lower.ends_with(".ply") {
+                ply::parse_ply(&bytes).map_err(|e| e.in_file(file))?
+            } else if lower.ends_with(".stl") {
+                sample_stl(&bytes, count.unwrap_or(DEFAULT_STL_POINTS), TALUS_SAMPLE_SEED, file)?
+            } else {
+                let text = String::from_utf8_lossy(&bytes);
+                xyz::parse_xyz(&text).map_err(|e| e.in_file(file))?
+            }
+        }
+    };
+    validate(&points, 4).map_err(|e| e.in_file(name))?;
+    normalise_min_max(&mut points);
+    Ok(PointCloud { name: name.to_string(), points })
+}
+
+/// The data folder the tests use: `SOMNURBS_DATA`, else `../shared/data` beside the crate.
+#[cfg(test)]
+pub fn test_data_dir() -> std::path::PathBuf {
+    match std::env::var_os("SOMNURBS_DATA") {
+        Some(v) if !v.is_empty() => v.into(),
+        _ => Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bunny_first_point_after_normalisation() {
+        let b = load_dataset("bunny", &test_data_dir()).expect("bun_zipper.ply in SOMNURBS_DATA or ../shared/data");
+        assert_eq!(b.points.len(), 35947);
+        let want = [0.365193, 0.615243, 0.549817];
+        for k in 0..3 {
+            assert!((b.points[0][k] - want[k]).abs() < 1e-6, "{:?}", b.points[0]);
+        }
+    }
+
+    #[test]
+    fn talus_is_a_fixed_sample() {
+        let a = load_dataset("talus", &test_data_dir()).expect("talus_r.stl in SOMNURBS_DATA or ../shared/data");
+        assert_eq!(a.points.len(), TALUS_POINTS);
+        let b = load_dataset("talus", &test_data_dir()).unwrap();
+        assert_eq!(a, b);
+        assert!(a.points.iter().all(|p| p.iter().all(|v| (0.0..=1.0).contains(v))));
+    }
+
+    #[test]
+    fn missing_files_say_where_to_get_them() {
+        let e = load_dataset("bunny", Path::new("/nonexistent")).unwrap_err().to_string();
+        assert!(e.contains("/nonexistent/bun_zipper.ply") && e.contains("Stanford") && e.contains("SOMNURBS_DATA"), "{e}");
+        let e = load_dataset("teapot", Path::new(".")).unwrap_err().to_string();
+        assert!(e.contains("teapot") && e.contains("cube"), "{e}");
+    }
+}

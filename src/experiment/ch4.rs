@@ -1,0 +1,125 @@
+//! Chapter 4 wiring: load the data sets, train every SOM cell on its own stream, log each finished
+//! cell at once, and hand the runs to the report.
+
+use super::spec::{SomCell, Spec};
+use super::{runner, seeds, RunContext};
+use crate::data::PointCloud;
+use crate::geom::Point3;
+use crate::report::fsio::PartialLog;
+use crate::som::{self, FinalMetrics, NeuronCounts, OnlineMetrics, SomParams};
+use anyhow::{Context, Result};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::sync::{Arc, Mutex};
+
+/// One trained SOM cell.
+#[derive(Debug, Clone)]
+pub struct SomRun {
+    pub cell: SomCell,
+    pub row: SomRow,
+    /// Trained weights, one per unit.
+    pub weights: Vec<Point3>,
+}
+
+/// One row of `runs.csv` (tidy: one row per cell x repeat).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct SomRow {
+    pub cell: String,
+    pub dataset: String,
+    pub model: String,
+    pub nx: usize,
+    pub ny: usize,
+    pub repeat: usize,
+    pub seed: String,
+    pub iterations: usize,
+    pub non: usize,
+    pub nov: usize,
+    pub nor: usize,
+    pub min_error: f64,
+    pub max_error: f64,
+    pub qe: f64,
+    pub te: f64,
+    pub qe_final: f64,
+    pub te_final: f64,
+    pub cpu_s: f64,
+}
+
+/// Columns of `runs.csv` that hold timings (reported, never compared for drift).
+pub const TIMING_COLUMNS: &[&str] = &["cpu_s"];
+
+impl SomRow {
+    fn new(cell: &SomCell, seed: String, iterations: usize, c: NeuronCounts, o: OnlineMetrics, f: FinalMetrics, cpu_s: f64) -> SomRow {
+        SomRow {
+            cell: cell.key(),
+            dataset: cell.dataset.clone(),
+            model: cell.model.key().into(),
+            nx: cell.grid.nx,
+            ny: cell.grid.ny,
+            repeat: cell.repeat,
+            seed,
+            iterations,
+            non: c.non,
+            nov: c.nov,
+            nor: c.nor,
+            min_error: o.min_error,
+            max_error: o.max_error,
+            qe: o.qe,
+            te: o.te,
+            qe_final: f.qe,
+            te_final: f.te,
+            cpu_s,
+        }
+    }
+}
+
+/// Load every data set a spec names, once.
+pub fn load_datasets(names: &[String], ctx: &RunContext) -> Result<BTreeMap<String, Arc<PointCloud>>> {
+    let mut out = BTreeMap::new();
+    for name in names {
+        if !out.contains_key(name) {
+            let cloud = crate::data::registry::load_dataset(name, &ctx.data_dir)?;
+            out.insert(name.clone(), Arc::new(cloud));
+        }
+    }
+    Ok(out)
+}
+
+/// Train one cell (pure apart from the CPU clock).
+pub fn run_cell(cell: &SomCell, data: &[Point3], params: &SomParams, master_seed: u64) -> Result<SomRun> {
+    let key = cell.key();
+    let topo = cell.model.topology(cell.grid.nx, cell.grid.ny).map_err(anyhow::Error::msg)?;
+    let mut rng = seeds::cell_rng(master_seed, &key);
+    let t0 = runner::thread_cpu_seconds();
+    let trained = som::train(topo.as_ref(), data, params, &mut rng).map_err(|e| anyhow::anyhow!("{key}: {e}"))?;
+    let cpu_s = runner::thread_cpu_seconds() - t0;
+    let fin = som::final_map_metrics(topo.as_ref(), &trained.weights, data);
+    let row = SomRow::new(cell, seeds::seed_hex(master_seed, &key), params.iterations, topo.counts(), trained.online, fin, cpu_s);
+    Ok(SomRun { cell: cell.clone(), row, weights: trained.weights })
+}
+
+/// Run every SOM cell of a spec, logging each finished row to `runs.csv.partial`.
+pub fn run(spec: &Spec, ctx: &RunContext) -> Result<Vec<SomRun>> {
+    let som_spec = spec.file.som.as_ref().context("spec has no [som] section")?;
+    let data = load_datasets(&som_spec.datasets, ctx)?;
+    let params = SomParams { iterations: som_spec.iterations, alpha0: som_spec.alpha0, sigma0: som_spec.sigma0 };
+    let cells = spec.som_cells();
+    let header = csv_header::<SomRow>();
+    let log = Mutex::new(PartialLog::create(&ctx.out.join("runs.csv.partial"), &header)?);
+    runner::run_cells(
+        &cells,
+        ctx.jobs,
+        &spec.file.name,
+        |cell| run_cell(cell, &data[&cell.dataset].points, &params, spec.file.master_seed),
+        |_, run| {
+            let line = crate::report::fsio::csv_text(std::slice::from_ref(&run.row))?;
+            let body = line.lines().nth(1).unwrap_or_default().to_string();
+            log.lock().map_err(|_| anyhow::anyhow!("log lock poisoned"))?.push(&body)
+        },
+    )
+}
+
+/// The CSV header line of a row type.
+pub fn csv_header<T: Serialize + Default>() -> String {
+    let text = crate::report::fsio::csv_text(&[T::default()]).unwrap_or_default();
+    text.lines().next().unwrap_or_default().to_string()
+}

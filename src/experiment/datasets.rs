@@ -1,0 +1,45 @@
+//! `somnurbs datasets`: list, describe and export data sets.
+
+use crate::cli::DatasetsAction;
+use crate::data::registry;
+use anyhow::Result;
+use std::fmt::Write;
+use std::path::Path;
+
+pub fn datasets(action: DatasetsAction, data_dir: &Path) -> Result<()> {
+    match action {
+        DatasetsAction::List => {
+            for name in registry::BUILTIN {
+                println!("{name:<12} {}", registry::describe(name).unwrap_or(""));
+            }
+            println!("\nAny .ply/.stl/.xyz/.csv/.txt path is accepted as a data set too. Data directory: {}", data_dir.display());
+        }
+        DatasetsAction::Show { name } => {
+            let cloud = registry::load_dataset(&name, data_dir)?;
+            let (lo, hi) = crate::geom::bounding_box(&cloud.points).unwrap_or(([0.0; 3], [0.0; 3]));
+            println!("{}: {} points (normalised per axis to [0,1])", cloud.name, cloud.points.len());
+            println!("bounds x [{:.6}, {:.6}] y [{:.6}, {:.6}] z [{:.6}, {:.6}]", lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]);
+            for p in cloud.points.iter().take(5) {
+                println!("  {:.6} {:.6} {:.6}", p[0], p[1], p[2]);
+            }
+        }
+        DatasetsAction::Export { name, file } => {
+            let cloud = registry::load_dataset(&name, data_dir)?;
+            let csv = file.extension().map(|e| e.eq_ignore_ascii_case("csv")).unwrap_or(false);
+            let mut text = String::new();
+            if csv {
+                text.push_str("x,y,z\n");
+            }
+            for p in &cloud.points {
+                if csv {
+                    let _ = writeln!(text, "{:?},{:?},{:?}", p[0], p[1], p[2]);
+                } else {
+                    let _ = writeln!(text, "{:?} {:?} {:?}", p[0], p[1], p[2]);
+                }
+            }
+            crate::report::fsio::write_atomic(&file, text.as_bytes())?;
+            eprintln!("somnurbs: wrote {} points to {}", cloud.points.len(), file.display());
+        }
+    }
+    Ok(())
+}

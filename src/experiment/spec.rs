@@ -1,0 +1,388 @@
+//! Experiment specs: TOML text -> raw serde structs (unknown keys rejected) -> a validated plan.
+//!
+//! A spec may carry named profiles (`[profiles.quick]`): tables deep-merged over the spec before it
+//! is read, so a profile can change any key (e.g. `som.iterations = 3000`) and nothing else.
+//! Errors are one line and name the file, the line and column, and the key at fault.
+
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::fmt;
+use std::path::Path;
+use std::str::FromStr;
+
+/// A spec error: one line, naming the file and (where known) line:column and key.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SpecError(pub String);
+
+impl fmt::Display for SpecError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for SpecError {}
+
+/// Grid or control-net size `nx x ny`, written "20x12" (or "20" for 20x20).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct GridSize {
+    pub nx: usize,
+    pub ny: usize,
+}
+
+impl fmt::Display for GridSize {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}x{}", self.nx, self.ny)
+    }
+}
+
+impl FromStr for GridSize {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        let bad = || format!("`{s}` is not a grid size (write NXxNY, e.g. \"20x12\")");
+        let parts: Vec<&str> = s.trim().split(['x', 'X']).collect();
+        let num = |p: &str| p.trim().parse::<usize>().map_err(|_| bad());
+        match parts.as_slice() {
+            [n] => {
+                let n = num(n)?;
+                Ok(GridSize { nx: n, ny: n })
+            }
+            [a, b] => Ok(GridSize { nx: num(a)?, ny: num(b)? }),
+            _ => Err(bad()),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for GridSize {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        #[derive(Deserialize)]
+        #[serde(untagged)]
+        enum Raw {
+            Text(String),
+            Square(usize),
+        }
+        match Raw::deserialize(d)? {
+            Raw::Text(s) => s.parse().map_err(serde::de::Error::custom),
+            Raw::Square(n) => Ok(GridSize { nx: n, ny: n }),
+        }
+    }
+}
+
+impl serde::Serialize for GridSize {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(&self.to_string())
+    }
+}
+
+/// The whole spec file as written.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpecFile {
+    /// Experiment name; the default output folder is `results/<name>`.
+    pub name: String,
+    #[serde(default)]
+    pub description: String,
+    /// Master seed every (cell, repeat) stream is derived from.
+    pub master_seed: u64,
+    /// Output folder (overridden by `--out`).
+    #[serde(default)]
+    pub output: Option<String>,
+    /// Chapter 4: SOM models.
+    #[serde(default)]
+    pub som: Option<SomSpec>,
+    /// Named overrides, merged over the spec by `--profile NAME`.
+    #[serde(default)]
+    pub profiles: BTreeMap<String, toml::Table>,
+}
+
+fn default_iterations() -> usize {
+    30_000
+}
+fn default_alpha0() -> f64 {
+    0.9
+}
+fn default_repeats() -> usize {
+    1
+}
+fn default_true() -> bool {
+    true
+}
+
+/// Chapter 4 section: data sets x groups of (models x grids) x repeats.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SomSpec {
+    /// Data-set names (`somnurbs datasets list`) or paths to point files.
+    pub datasets: Vec<String>,
+    /// Maximum iteration T (Table 4.1).
+    #[serde(default = "default_iterations")]
+    pub iterations: usize,
+    /// Initial learning rate alpha0 (Table 4.1).
+    #[serde(default = "default_alpha0")]
+    pub alpha0: f64,
+    /// Initial radius; default half the smaller grid side (Table 4.1).
+    #[serde(default)]
+    pub sigma0: Option<f64>,
+    #[serde(default = "default_repeats")]
+    pub repeats: usize,
+    /// Which models at which grid sizes.
+    #[serde(rename = "group")]
+    pub groups: Vec<SomGroup>,
+    /// DNSOM grid sizes whose organised maps are saved as `maps/dnsom_<data>_<nx>x<ny>.csv`.
+    #[serde(default)]
+    pub save_maps: Vec<GridSize>,
+    /// One PNG per cell and the overview pictures.
+    #[serde(default = "default_true")]
+    pub pictures: bool,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SomGroup {
+    pub models: Vec<String>,
+    pub grids: Vec<GridSize>,
+}
+
+/// A spec read from a file, with the profile applied.
+#[derive(Debug, Clone)]
+pub struct Spec {
+    pub file: SpecFile,
+    /// The spec's text as read (kept in the manifest).
+    pub text: String,
+    pub path: String,
+    pub profile: Option<String>,
+}
+
+fn line_col(text: &str, offset: usize) -> (usize, usize) {
+    let before = &text[..offset.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let col = before.len() - before.rfind('\n').map(|p| p + 1).unwrap_or(0) + 1;
+    (line, col)
+}
+
+fn toml_error(path: &str, text: &str, e: &toml::de::Error) -> SpecError {
+    let msg = e.message().replace('\n', " ");
+    match e.span() {
+        Some(span) => {
+            let (l, c) = line_col(text, span.start);
+            SpecError(format!("{path}:{l}:{c}: {msg}"))
+        }
+        None => SpecError(format!("{path}: {msg}")),
+    }
+}
+
+/// Deep-merge `over` into `base` (tables merge, everything else replaces).
+fn merge(base: &mut toml::Table, over: &toml::Table) {
+    for (k, v) in over {
+        match (base.get_mut(k), v) {
+            (Some(toml::Value::Table(b)), toml::Value::Table(o)) => merge(b, o),
+            _ => {
+                base.insert(k.clone(), v.clone());
+            }
+        }
+    }
+}
+
+impl Spec {
+    /// Parse spec text; `path` is used in messages only.
+    pub fn parse(path: &str, text: &str, profile: Option<&str>) -> Result<Spec, SpecError> {
+        let file: SpecFile = toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
+        let file = match profile {
+            None => file,
+            Some(name) => {
+                let over = file.profiles.get(name).ok_or_else(|| {
+                    let known: Vec<&str> = file.profiles.keys().map(|s| s.as_str()).collect();
+                    SpecError(format!(
+                        "{path}: no profile `{name}` (the spec defines: {})",
+                        if known.is_empty() { "none".to_string() } else { known.join(", ") }
+                    ))
+                })?;
+                let mut table: toml::Table = toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
+                merge(&mut table, over);
+                let merged = toml::to_string(&table).map_err(|e| SpecError(format!("{path}: {e}")))?;
+                toml::from_str(&merged).map_err(|e| {
+                    SpecError(format!("{path}: [profiles.{name}]: {}", e.message().replace('\n', " ")))
+                })?
+            }
+        };
+        let spec = Spec { file, text: text.to_string(), path: path.to_string(), profile: profile.map(String::from) };
+        spec.validate()?;
+        Ok(spec)
+    }
+
+    /// Read and parse a spec file.
+    pub fn load(path: &Path, profile: Option<&str>) -> Result<Spec, SpecError> {
+        let shown = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| SpecError(format!("{shown}: cannot read spec: {e}")))?;
+        Spec::parse(&shown, &text, profile)
+    }
+
+    fn err(&self, key: &str, msg: impl fmt::Display) -> SpecError {
+        SpecError(format!("{}: {key}: {msg}", self.path))
+    }
+
+    /// Checks every value once, so that a run never starts on a spec it would fail on later.
+    pub fn validate(&self) -> Result<(), SpecError> {
+        let f = &self.file;
+        if f.name.trim().is_empty() || f.name.contains(['/', '\\']) {
+            return Err(self.err("name", "must be a non-empty name without slashes"));
+        }
+        let Some(som) = &f.som else {
+            return Err(SpecError(format!("{}: the spec has no experiment section (add [som])", self.path)));
+        };
+        if som.datasets.is_empty() {
+            return Err(self.err("som.datasets", "is empty"));
+        }
+        if som.iterations == 0 {
+            return Err(self.err("som.iterations", "must be at least 1"));
+        }
+        if !(som.alpha0 > 0.0 && som.alpha0 <= 1.0) {
+            return Err(self.err("som.alpha0", format!("must be in (0, 1], got {}", som.alpha0)));
+        }
+        if let Some(s) = som.sigma0 {
+            if !(s > 1.0) {
+                return Err(self.err("som.sigma0", format!("must exceed 1 (tau = T / ln sigma0), got {s}")));
+            }
+        }
+        if som.repeats == 0 {
+            return Err(self.err("som.repeats", "must be at least 1"));
+        }
+        if som.groups.is_empty() {
+            return Err(self.err("som.group", "no [[som.group]] given"));
+        }
+        for (g, group) in som.groups.iter().enumerate() {
+            let key = format!("som.group[{g}]");
+            if group.models.is_empty() {
+                return Err(self.err(&format!("{key}.models"), "is empty"));
+            }
+            if group.grids.is_empty() {
+                return Err(self.err(&format!("{key}.grids"), "is empty"));
+            }
+            for m in &group.models {
+                let model: crate::som::Model = m.parse().map_err(|e| self.err(&format!("{key}.models"), e))?;
+                for grid in &group.grids {
+                    if som.sigma0.is_none() && grid.nx.min(grid.ny) < 3 {
+                        return Err(self.err(
+                            &format!("{key}.grids"),
+                            format!("grid {grid} is too small: sigma0 = min(nx,ny)/2 must exceed 1"),
+                        ));
+                    }
+                    model.topology(grid.nx, grid.ny).map_err(|e| self.err(&format!("{key}.grids"), e))?;
+                }
+            }
+        }
+        for grid in &som.save_maps {
+            let has = self.som_cells().iter().any(|c| c.model == crate::som::Model::Dnsom && c.grid == *grid);
+            if !has {
+                return Err(self.err("som.save_maps", format!("no DNSOM cell at grid {grid} to save")));
+            }
+        }
+        Ok(())
+    }
+
+    /// The flat list of SOM cells (data set x group x grid x model x repeat), in report order.
+    pub fn som_cells(&self) -> Vec<SomCell> {
+        let Some(som) = &self.file.som else { return Vec::new() };
+        let mut cells = Vec::new();
+        for dataset in &som.datasets {
+            for group in &som.groups {
+                for grid in &group.grids {
+                    for m in &group.models {
+                        let Ok(model) = m.parse() else { continue };
+                        for repeat in 0..som.repeats {
+                            let cell = SomCell { dataset: dataset.clone(), model, grid: *grid, repeat };
+                            if !cells.contains(&cell) {
+                                cells.push(cell);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        cells
+    }
+
+    /// Output folder: `--out`, else the spec's `output`, else `results/<name>`.
+    pub fn output_dir(&self, out: Option<&Path>) -> std::path::PathBuf {
+        match (out, &self.file.output) {
+            (Some(o), _) => o.to_path_buf(),
+            (None, Some(o)) => o.into(),
+            (None, None) => Path::new("results").join(&self.file.name),
+        }
+    }
+}
+
+/// One SOM cell: a model trained once on a data set at a grid size.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SomCell {
+    pub dataset: String,
+    pub model: crate::som::Model,
+    pub grid: GridSize,
+    pub repeat: usize,
+}
+
+impl SomCell {
+    /// Stable key from which the cell's random stream is derived.
+    pub fn key(&self) -> String {
+        format!("som/{}/{}/{}/r{}", self.dataset, self.model.key(), self.grid, self.repeat)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SPEC: &str = r#"
+name = "t"
+master_seed = 1
+[som]
+datasets = ["cube"]
+iterations = 100
+[[som.group]]
+models = ["som2d", "dnsom"]
+grids = ["10x10", "18x30"]
+[profiles.quick.som]
+iterations = 7
+"#;
+
+    #[test]
+    fn parses_expands_and_applies_profile() {
+        let s = Spec::parse("t.toml", SPEC, None).unwrap();
+        assert_eq!(s.som_cells().len(), 4);
+        assert_eq!(s.file.som.as_ref().unwrap().iterations, 100);
+        let q = Spec::parse("t.toml", SPEC, Some("quick")).unwrap();
+        assert_eq!(q.file.som.as_ref().unwrap().iterations, 7);
+        assert_eq!(q.som_cells()[3].key(), "som/cube/dnsom/18x30/r0");
+    }
+
+    #[test]
+    fn unknown_key_names_line_and_key() {
+        let bad = SPEC.replace("iterations = 100", "iteratons = 100");
+        let e = Spec::parse("t.toml", &bad, None).unwrap_err().0;
+        assert!(e.starts_with("t.toml:6:1:") && e.contains("iteratons"), "{e}");
+        assert!(!e.contains('\n'));
+    }
+
+    #[test]
+    fn bad_values_name_their_key() {
+        for (from, to, key) in [
+            ("\"som2d\", \"dnsom\"", "\"som2d\", \"kohonen\"", "som.group[0].models"),
+            ("iterations = 100", "iterations = 0", "som.iterations"),
+            ("\"10x10\", \"18x30\"", "\"2x2\"", "som.group[0].grids"),
+            ("datasets = [\"cube\"]", "datasets = []", "som.datasets"),
+        ] {
+            let e = Spec::parse("t.toml", &SPEC.replace(from, to), None).unwrap_err().0;
+            assert!(e.contains(key), "{e}");
+        }
+        let e = Spec::parse("t.toml", "name = \"x\"\nmaster_seed = -1\n", None).unwrap_err().0;
+        assert!(e.starts_with("t.toml:2:"), "{e}");
+        let e = Spec::parse("t.toml", SPEC, Some("full")).unwrap_err().0;
+        assert!(e.contains("no profile `full`") && e.contains("quick"), "{e}");
+    }
+
+    #[test]
+    fn grid_sizes() {
+        assert_eq!("20x12".parse::<GridSize>().unwrap(), GridSize { nx: 20, ny: 12 });
+        assert_eq!("7".parse::<GridSize>().unwrap(), GridSize { nx: 7, ny: 7 });
+        assert!("20y12".parse::<GridSize>().is_err());
+    }
+}

@@ -1,0 +1,425 @@
+//! Chapter 4 outputs: runs.csv, the Appendix B/C tables, the neuron-count tables 4.9/4.13/4.14, the
+//! saved DNSOM maps, the pictures and the Chapter 4 section of REPORT.md. Reads only the runs.
+
+use super::claims::Claim;
+use super::fsio::{csv_records, csv_text, write_atomic};
+use super::markdown::{beside, geometric_mean, num, table};
+use super::reference::{self, RefTable};
+use crate::double_net::View;
+use crate::experiment::ch4::SomRun;
+use crate::experiment::spec::{GridSize, Spec};
+use crate::som::Model;
+use anyhow::Result;
+use std::fmt::Write;
+use std::path::Path;
+
+/// Metrics of Appendix B/C, as (column stem, label, runs.csv field).
+const METRICS: [(&str, &str); 5] =
+    [("min_error", "Min error"), ("max_error", "Max error"), ("qe", "QE"), ("te", "TE"), ("cpu_s", "CPU time (s)")];
+
+fn metric(run: &SomRun, stem: &str) -> f64 {
+    let r = &run.row;
+    match stem {
+        "min_error" => r.min_error,
+        "max_error" => r.max_error,
+        "qe" => r.qe,
+        "te" => r.te,
+        _ => r.cpu_s,
+    }
+}
+
+/// Mean of a metric over repeats of (data, model, grid).
+fn mean_of(runs: &[SomRun], data: &str, model: Model, grid: GridSize, stem: &str) -> Option<f64> {
+    let v: Vec<f64> = runs
+        .iter()
+        .filter(|r| r.cell.dataset == data && r.cell.model == model && r.cell.grid == grid)
+        .map(|r| metric(r, stem))
+        .collect();
+    (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+}
+
+fn datasets(runs: &[SomRun]) -> Vec<String> {
+    let mut out: Vec<String> = Vec::new();
+    for r in runs {
+        if !out.contains(&r.cell.dataset) {
+            out.push(r.cell.dataset.clone());
+        }
+    }
+    out
+}
+
+fn grids(runs: &[SomRun], square: bool) -> Vec<GridSize> {
+    let mut out: Vec<GridSize> = Vec::new();
+    for r in runs {
+        let g = r.cell.grid;
+        if (g.nx == g.ny) == square && !out.contains(&g) {
+            out.push(g);
+        }
+    }
+    out
+}
+
+/// Appendix B (square grids, four models) or C (nx != ny, CKSOM and DNSOM) with the reference's
+/// exact columns. Returns (header, rows) or None when the runs hold no such cell.
+pub fn appendix_table(runs: &[SomRun], square: bool) -> Option<(Vec<String>, Vec<Vec<String>>)> {
+    let name = if square { "appendix_b" } else { "appendix_c" };
+    let header = reference::table(name)?.header;
+    let models: Vec<Model> = if square { Model::ALL.to_vec() } else { vec![Model::Cksom, Model::Dnsom] };
+    let mut rows = Vec::new();
+    for data in datasets(runs) {
+        for grid in grids(runs, square) {
+            if !models.iter().any(|&m| mean_of(runs, &data, m, grid, "qe").is_some()) {
+                continue;
+            }
+            let mut row = vec![data.clone()];
+            if square {
+                row.push(grid.nx.to_string());
+            } else {
+                row.push(grid.nx.to_string());
+                row.push(grid.ny.to_string());
+            }
+            for (stem, _) in METRICS {
+                for &m in &models {
+                    row.push(num(mean_of(runs, &data, m, grid, stem), 6).replace('-', ""));
+                }
+            }
+            rows.push(row);
+        }
+    }
+    (!rows.is_empty()).then_some((header, rows))
+}
+
+fn counts(model: Model, g: GridSize) -> Option<crate::som::NeuronCounts> {
+    model.topology(g.nx, g.ny).ok().map(|t| t.counts())
+}
+
+/// Table 4.9 for the square grids given.
+pub fn table_4_9(grids: &[GridSize]) -> (Vec<String>, Vec<Vec<String>>) {
+    let header = ["n", "som2d", "som3d", "cksom_non", "cksom_nor", "cksom_nov", "dnsom_non", "dnsom_nor", "dnsom_nov"];
+    let rows = grids
+        .iter()
+        .filter(|g| g.nx == g.ny)
+        .map(|&g| {
+            let ck = counts(Model::Cksom, g).unwrap();
+            let dn = counts(Model::Dnsom, g).unwrap();
+            vec![g.nx, g.nx * g.nx, g.nx.pow(3), ck.non, ck.nor, ck.nov, dn.non, dn.nor, dn.nov]
+                .into_iter()
+                .map(|v| v.to_string())
+                .collect()
+        })
+        .collect();
+    (header.iter().map(|s| s.to_string()).collect(), rows)
+}
+
+/// Table 4.13 (CKSOM and DNSOM counts at nx x ny).
+pub fn table_4_13(grids: &[GridSize]) -> (Vec<String>, Vec<Vec<String>>) {
+    let header = ["n_x", "n_y", "cksom_non", "cksom_nov", "cksom_nor", "dnsom_non", "dnsom_nov", "dnsom_nor"];
+    let rows = grids
+        .iter()
+        .map(|&g| {
+            let ck = counts(Model::Cksom, g).unwrap();
+            let dn = counts(Model::Dnsom, g).unwrap();
+            vec![g.nx, g.ny, ck.non, ck.nov, ck.nor, dn.non, dn.nov, dn.nor].into_iter().map(|v| v.to_string()).collect()
+        })
+        .collect();
+    (header.iter().map(|s| s.to_string()).collect(), rows)
+}
+
+/// Table 4.14 (DNSOM counts for the thesis' small grids).
+pub fn table_4_14() -> (Vec<String>, Vec<Vec<String>>) {
+    let rows = [(2, 3), (3, 4), (4, 5), (5, 6), (6, 7), (7, 8)]
+        .iter()
+        .map(|&(nx, ny)| {
+            let net = crate::double_net::DoubleNet::new(nx, ny).unwrap();
+            vec![nx, ny, net.non(), net.nov(), net.nor()].into_iter().map(|v| v.to_string()).collect()
+        })
+        .collect();
+    (["n_x", "n_y", "non", "nov", "nor"].iter().map(|s| s.to_string()).collect(), rows)
+}
+
+/// The DNSOM map as CSV: i, j, view, class (1-based class number), x, y, z; one row per neuron of
+/// both views (NON rows), bottom view first.
+pub fn dnsom_map_csv(run: &SomRun) -> Result<String> {
+    let net = crate::double_net::DoubleNet::new(run.cell.grid.nx, run.cell.grid.ny).ok_or_else(|| anyhow::anyhow!("grid {} is too small", run.cell.grid))?;
+    let mut rows = Vec::with_capacity(net.non());
+    for view in View::BOTH {
+        for i in 0..net.nx {
+            for j in 0..net.ny {
+                let c = net.class(view, i, j);
+                let w = run.weights[c];
+                rows.push(vec![
+                    i.to_string(),
+                    j.to_string(),
+                    view.name().to_string(),
+                    (c + 1).to_string(),
+                    format!("{:?}", w[0]),
+                    format!("{:?}", w[1]),
+                    format!("{:?}", w[2]),
+                ]);
+            }
+        }
+    }
+    let header: Vec<String> = ["i", "j", "view", "class", "x", "y", "z"].iter().map(|s| s.to_string()).collect();
+    csv_records(&header, &rows)
+}
+
+/// Write every Chapter 4 file; returns the REPORT.md section.
+pub fn write(spec: &Spec, runs: &[SomRun], out: &Path) -> Result<String> {
+    let rows: Vec<_> = runs.iter().map(|r| r.row.clone()).collect();
+    write_atomic(&out.join("runs.csv"), csv_text(&rows)?.as_bytes())?;
+    let mut written = vec!["runs.csv".to_string()];
+    for square in [true, false] {
+        if let Some((h, r)) = appendix_table(runs, square) {
+            let name = if square { "appendix_b.csv" } else { "appendix_c.csv" };
+            write_atomic(&out.join(name), csv_records(&h, &r)?.as_bytes())?;
+            written.push(name.into());
+        }
+    }
+    let sq = grids(runs, true);
+    let nsq = grids(runs, false);
+    if !sq.is_empty() {
+        let (h, r) = table_4_9(&sq);
+        write_atomic(&out.join("table_4_9.csv"), csv_records(&h, &r)?.as_bytes())?;
+        written.push("table_4_9.csv".into());
+    }
+    if !nsq.is_empty() {
+        let (h, r) = table_4_13(&nsq);
+        write_atomic(&out.join("table_4_13.csv"), csv_records(&h, &r)?.as_bytes())?;
+        written.push("table_4_13.csv".into());
+    }
+    let (h, r) = table_4_14();
+    write_atomic(&out.join("table_4_14.csv"), csv_records(&h, &r)?.as_bytes())?;
+    written.push("table_4_14.csv".into());
+
+    let save = &spec.file.som.as_ref().map(|s| s.save_maps.clone()).unwrap_or_default();
+    let mut maps = Vec::new();
+    for run in runs.iter().filter(|r| r.cell.model == Model::Dnsom && r.cell.repeat == 0 && save.contains(&r.cell.grid)) {
+        let name = format!("maps/dnsom_{}_{}.csv", run.cell.dataset, run.cell.grid);
+        write_atomic(&out.join(&name), dnsom_map_csv(run)?.as_bytes())?;
+        maps.push(name);
+    }
+    let pictures = if spec.file.som.as_ref().map(|s| s.pictures).unwrap_or(false) {
+        super::ch4_pictures::write(runs, out)?
+    } else {
+        Vec::new()
+    };
+    Ok(section(runs, &written, &maps, &pictures))
+}
+
+/// Chapter 4 claims, checked on the runs and on the thesis' own Appendix B/C.
+pub fn claims(runs: &[SomRun]) -> Vec<Claim> {
+    let thesis_b = reference::table("appendix_b");
+    let thesis_c = reference::table("appendix_c");
+    let ours = |d: &str, m: Model, g: GridSize, s: &str| mean_of(runs, d, m, g, s);
+    let theirs = |d: &str, m: Model, g: GridSize, s: &str| -> Option<f64> {
+        if g.nx == g.ny {
+            thesis_b.as_ref()?.value(&["data", "n"], &[d.to_string(), g.nx.to_string()], &format!("{s}_{}", m.key()))
+        } else {
+            thesis_c.as_ref()?.value(&["data", "n_x", "n_y"], &[d.to_string(), g.nx.to_string(), g.ny.to_string()], &format!("{s}_{}", m.key()))
+        }
+    };
+    let data = datasets(runs);
+    let sq = grids(runs, true);
+    let nsq = grids(runs, false);
+
+    // Count (data, grid) cases where `pred` holds, over a value source.
+    type Src<'a> = &'a dyn Fn(&str, Model, GridSize, &str) -> Option<f64>;
+    let count = |src: Src, gs: &[GridSize], pred: &dyn Fn(&dyn Fn(Model, &str) -> Option<f64>) -> Option<bool>| -> (usize, usize) {
+        let (mut yes, mut all) = (0, 0);
+        for d in &data {
+            for &g in gs {
+                let get = |m: Model, s: &str| src(d, m, g, s);
+                if let Some(h) = pred(&get) {
+                    all += 1;
+                    yes += h as usize;
+                }
+            }
+        }
+        (yes, all)
+    };
+    let extreme = |models: &[Model], stem: &'static str, target: Model, highest: bool| {
+        let models = models.to_vec();
+        move |get: &dyn Fn(Model, &str) -> Option<f64>| -> Option<bool> {
+            let vals: Option<Vec<f64>> = models.iter().map(|&m| get(m, stem)).collect();
+            let vals = vals?;
+            let t = get(target, stem)?;
+            Some(vals.iter().all(|&v| if highest { t >= v } else { t <= v }))
+        }
+    };
+    let mut claims = Vec::new();
+    let mut add = |statement: &str, gs: &[GridSize], pred: &dyn Fn(&dyn Fn(Model, &str) -> Option<f64>) -> Option<bool>, note: &str| {
+        let o = count(&ours, gs, pred);
+        let t = count(&theirs, gs, pred);
+        claims.push(Claim {
+            chapter: "4".into(),
+            statement: statement.into(),
+            ours: o,
+            thesis: (t.1 > 0).then_some(t),
+            note: note.into(),
+        });
+    };
+    let all = Model::ALL;
+    add("3-D SOM has the highest TE", &sq, &extreme(&all, "te", Model::Som3d, true), "per (data, n)");
+    add("DNSOM has the lowest TE", &sq, &extreme(&all, "te", Model::Dnsom, false), "per (data, n)");
+    add("2-D SOM has the highest QE", &sq, &extreme(&all, "qe", Model::Som2d, true), "per (data, n)");
+    add("3-D SOM has the lowest QE", &sq, &extreme(&all, "qe", Model::Som3d, false), "per (data, n)");
+    add("2-D SOM is the fastest", &sq, &extreme(&all, "cpu_s", Model::Som2d, false), "CPU time per (data, n)");
+    add(
+        "DNSOM is faster than 3-D SOM and CKSOM",
+        &sq,
+        &extreme(&[Model::Som3d, Model::Cksom, Model::Dnsom], "cpu_s", Model::Dnsom, false),
+        "CPU time per (data, n)",
+    );
+    add("DNSOM has a lower TE than CKSOM at nx != ny", &nsq, &extreme(&[Model::Cksom, Model::Dnsom], "te", Model::Dnsom, false), "Appendix C, per (data, grid)");
+    add("CKSOM has a lower QE than DNSOM at nx != ny", &nsq, &extreme(&[Model::Cksom, Model::Dnsom], "qe", Model::Cksom, false), "Appendix C, per (data, grid)");
+    // QE falls as n grows: per (data, model) series over the square grids.
+    let falls = |src: Src| -> (usize, usize) {
+        let (mut yes, mut all_) = (0, 0);
+        let mut sorted = sq.clone();
+        sorted.sort();
+        for d in &data {
+            for m in Model::ALL {
+                let v: Option<Vec<f64>> = sorted.iter().map(|&g| src(d, m, g, "qe")).collect();
+                if let Some(v) = v.filter(|v| v.len() >= 2) {
+                    all_ += 1;
+                    yes += v.windows(2).all(|w| w[1] < w[0]) as usize;
+                }
+            }
+        }
+        (yes, all_)
+    };
+    let o = falls(&ours);
+    let t = falls(&theirs);
+    claims.insert(0, Claim { chapter: "4".into(), statement: "QE falls as n grows, for every model".into(), ours: o, thesis: (t.1 > 0).then_some(t), note: "per (data, model) series".into() });
+    claims
+}
+
+fn side_by_side(runs: &[SomRun], square: bool, thesis: Option<&RefTable>) -> String {
+    let models: Vec<Model> = if square { Model::ALL.to_vec() } else { vec![Model::Cksom, Model::Dnsom] };
+    let mut s = String::new();
+    for (stem, label) in METRICS {
+        let mut header = vec!["data".to_string(), "grid".to_string()];
+        header.extend(models.iter().map(|m| m.label().to_string()));
+        let mut rows = Vec::new();
+        for d in datasets(runs) {
+            for g in grids(runs, square) {
+                let mut row = vec![d.clone(), g.to_string()];
+                for &m in &models {
+                    let key: Vec<String> = if square { vec![d.clone(), g.nx.to_string()] } else { vec![d.clone(), g.nx.to_string(), g.ny.to_string()] };
+                    let cols: Vec<&str> = if square { vec!["data", "n"] } else { vec!["data", "n_x", "n_y"] };
+                    let t = thesis.and_then(|t| t.value(&cols, &key, &format!("{stem}_{}", m.key())));
+                    row.push(beside(mean_of(runs, &d, m, g, stem), t, if stem == "cpu_s" { 3 } else { 4 }));
+                }
+                rows.push(row);
+            }
+        }
+        let _ = write!(s, "\n**{label}** — ours (thesis)\n\n{}", table(&header, &rows));
+    }
+    s
+}
+
+fn speed_section(runs: &[SomRun]) -> String {
+    let tb = reference::table("appendix_b");
+    let tc = reference::table("appendix_c");
+    let mut rows = Vec::new();
+    for m in Model::ALL {
+        let mut ratios = Vec::new();
+        let (mut ours_sum, mut theirs_sum) = (0.0, 0.0);
+        for r in runs.iter().filter(|r| r.cell.model == m) {
+            let g = r.cell.grid;
+            let t = if g.nx == g.ny {
+                tb.as_ref().and_then(|t| t.value(&["data", "n"], &[r.cell.dataset.clone(), g.nx.to_string()], &format!("cpu_s_{}", m.key())))
+            } else {
+                tc.as_ref().and_then(|t| t.value(&["data", "n_x", "n_y"], &[r.cell.dataset.clone(), g.nx.to_string(), g.ny.to_string()], &format!("cpu_s_{}", m.key())))
+            };
+            if let Some(t) = t {
+                // Scale the thesis' time to this run's iteration count (the thesis used T = 30000).
+                let t_scaled = t * r.row.iterations as f64 / 30_000.0;
+                if r.row.cpu_s > 0.0 {
+                    ratios.push(t_scaled / r.row.cpu_s);
+                    ours_sum += r.row.cpu_s;
+                    theirs_sum += t_scaled;
+                }
+            }
+        }
+        if !ratios.is_empty() {
+            rows.push(vec![
+                m.label().to_string(),
+                ratios.len().to_string(),
+                format!("{theirs_sum:.2}"),
+                format!("{ours_sum:.3}"),
+                num(geometric_mean(&ratios), 0),
+            ]);
+        }
+    }
+    if rows.is_empty() {
+        return String::new();
+    }
+    let header: Vec<String> = ["model", "cells", "thesis CPU s (scaled to T)", "ours CPU s", "speed-up (geometric mean)"].iter().map(|s| s.to_string()).collect();
+    format!(
+        "\n### Speed against the thesis' CPU times\n\nCPU seconds of the training loop on one core (thread CPU clock), against Appendix B/C; the thesis' times are scaled to this run's iteration count when it is not 30000.\n\n{}",
+        table(&header, &rows)
+    )
+}
+
+fn section(runs: &[SomRun], written: &[String], maps: &[String], pictures: &[String]) -> String {
+    let mut s = String::from("## Chapter 4: SOM models (Appendices A-D)\n\n");
+    let iters: Vec<usize> = runs.iter().map(|r| r.row.iterations).collect();
+    let _ = writeln!(
+        s,
+        "{} cells, T = {} iterations. Files: {}.\n",
+        runs.len(),
+        iters.first().copied().unwrap_or(0),
+        written.iter().map(|w| format!("`{w}`")).collect::<Vec<_>>().join(", ")
+    );
+    s.push_str(DEFINITIONS);
+    s.push_str("\n### Claims\n\n");
+    s.push_str(&super::claims::markdown(&claims(runs)));
+    if appendix_table(runs, true).is_some() {
+        s.push_str("\n### Appendix B, side by side\n");
+        s.push_str(&side_by_side(runs, true, reference::table("appendix_b").as_ref()));
+    }
+    if appendix_table(runs, false).is_some() {
+        s.push_str("\n### Appendix C, side by side\n");
+        s.push_str(&side_by_side(runs, false, reference::table("appendix_c").as_ref()));
+    }
+    s.push_str(&speed_section(runs));
+    let sq = grids(runs, true);
+    if !sq.is_empty() {
+        let (h, r) = table_4_9(&sq);
+        let _ = write!(s, "\n### Table 4.9: neurons representing the surface\n\n{}", table(&h, &r));
+    }
+    let nsq = grids(runs, false);
+    if !nsq.is_empty() {
+        let (h, r) = table_4_13(&nsq);
+        let _ = write!(
+            s,
+            "\n### Table 4.13: CKSOM and DNSOM at nx x ny\n\nDNSOM counts equal the thesis' (160/128/32, 480/420/60, 1080/988/92). The CKSOM counts at nx != ny follow this harness' documented construction (six nx x ny faces on a cube of side max(nx, ny)); the thesis' own construction (400/1308/3040 output neurons) is not published.\n\n{}",
+            table(&h, &r)
+        );
+    }
+    let (h, r) = table_4_14();
+    let _ = write!(s, "\n### Table 4.14: DNSOM neuron counts\n\n{}", table(&h, &r));
+    if !maps.is_empty() {
+        let _ = writeln!(s, "\nDNSOM maps saved for Chapter 5: {}.", maps.iter().map(|m| format!("`{m}`")).collect::<Vec<_>>().join(", "));
+    }
+    if !pictures.is_empty() {
+        s.push_str("\n### Pictures\n\n");
+        for p in pictures.iter().filter(|p| !p.starts_with("png/")) {
+            let _ = writeln!(s, "![{p}]({p})\n");
+        }
+        let per_cell = pictures.iter().filter(|p| p.starts_with("png/")).count();
+        let _ = writeln!(s, "One picture per cell ({per_cell}) in `png/`.");
+    }
+    s
+}
+
+/// Exact metric definitions, stated because libraries disagree.
+pub const DEFINITIONS: &str = "\
+### Metric definitions
+
+- **QE (online, the thesis' Eq. 4.15)**: mean over the T training iterations of the Euclidean distance |X(t) - W_c(t)| between the drawn input and its winner, measured before that iteration's update. **Min/max error**: the minimum and maximum of the same distance over the iterations.
+- **TE (online, Eq. 4.16)**: share of the T iterations whose first and second winners are not adjacent. Adjacent = index-space distance 1: the 4-neighbourhood on a 2-D map, the 6-neighbourhood in the 3-D lattice and on the CKSOM cube surface (across merged edges), and for DNSOM the 4-neighbourhood on either view taken over class numbers (a border neuron is adjacent to its interior neighbours on both views).
+- **qe_final / te_final (runs.csv)**: the same two quantities over every data point for the trained map: mean Euclidean (not squared) distance to the best-matching unit, as MiniSom's `quantization_error`; share of points whose two best units are not adjacent with the adjacency above (MiniSom's `topographic_error` instead counts the 8-neighbourhood as adjacent on rectangular maps).
+- **CPU time**: CPU seconds of the training loop on its thread (initialisation and T iterations; not data loading or final metrics).
+";

@@ -1,0 +1,110 @@
+//! All file output goes through here: every error carries its path, and every finished file is
+//! written to a temporary name in the same folder and renamed, so a reader never sees half a file.
+
+use anyhow::{Context, Result};
+use std::fs::{self, File, OpenOptions};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// Create a folder (and parents), naming it on failure.
+pub fn ensure_dir(dir: &Path) -> Result<()> {
+    fs::create_dir_all(dir).with_context(|| format!("cannot create folder {}", dir.display()))
+}
+
+/// The temporary sibling a file is written to before it is renamed into place.
+pub fn temp_sibling(path: &Path) -> PathBuf {
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    path.with_file_name(format!(".{name}.tmp"))
+}
+
+/// Write `bytes` to `path` atomically (temporary file + rename).
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
+        ensure_dir(parent)?;
+    }
+    let tmp = temp_sibling(path);
+    let result = (|| -> std::io::Result<()> {
+        let mut f = File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        fs::rename(&tmp, path)
+    })();
+    if result.is_err() {
+        let _ = fs::remove_file(&tmp);
+    }
+    result.with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// Read a whole file as text, naming it on failure.
+pub fn read_text(path: &Path) -> Result<String> {
+    fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))
+}
+
+/// An append-only log of finished rows (`runs.csv.partial`): each row is flushed as soon as its
+/// cell finishes, so a killed run loses nothing it had finished.
+pub struct PartialLog {
+    path: PathBuf,
+    file: File,
+}
+
+impl PartialLog {
+    /// Start a new log with a header line (replacing an old one).
+    pub fn create(path: &Path, header: &str) -> Result<PartialLog> {
+        let mut file = File::create(path).with_context(|| format!("cannot write {}", path.display()))?;
+        writeln!(file, "{header}").with_context(|| format!("cannot write {}", path.display()))?;
+        Ok(PartialLog { path: path.to_path_buf(), file })
+    }
+
+    /// Open an existing log for appending.
+    pub fn append(path: &Path) -> Result<PartialLog> {
+        let file = OpenOptions::new().append(true).open(path).with_context(|| format!("cannot append to {}", path.display()))?;
+        Ok(PartialLog { path: path.to_path_buf(), file })
+    }
+
+    /// Append one line and flush it to the OS.
+    pub fn push(&mut self, line: &str) -> Result<()> {
+        writeln!(self.file, "{line}")
+            .and_then(|_| self.file.flush())
+            .with_context(|| format!("cannot write {}", self.path.display()))
+    }
+
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+}
+
+/// Serialise rows to CSV text (header from the struct's field names).
+pub fn csv_text<T: serde::Serialize>(rows: &[T]) -> Result<String> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    for r in rows {
+        w.serialize(r)?;
+    }
+    Ok(String::from_utf8(w.into_inner().map_err(|e| anyhow::anyhow!("{e}"))?)?)
+}
+
+/// CSV text from a header and string records.
+pub fn csv_records(header: &[String], rows: &[Vec<String>]) -> Result<String> {
+    let mut w = csv::Writer::from_writer(Vec::new());
+    w.write_record(header)?;
+    for r in rows {
+        w.write_record(r)?;
+    }
+    Ok(String::from_utf8(w.into_inner().map_err(|e| anyhow::anyhow!("{e}"))?)?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn atomic_write_leaves_no_temp_and_names_path_on_error() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("a/b.csv");
+        write_atomic(&p, b"x,y\n").unwrap();
+        assert_eq!(fs::read_to_string(&p).unwrap(), "x,y\n");
+        assert!(!temp_sibling(&p).exists());
+        let blocked = dir.path().join("a/b.csv/c.csv");
+        let e = format!("{:#}", write_atomic(&blocked, b"1").unwrap_err());
+        assert!(e.contains("b.csv"), "{e}");
+    }
+}

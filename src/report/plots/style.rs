@@ -1,0 +1,170 @@
+//! Fonts, colours and sizes shared by every chart, so a report's pictures look like one family.
+//!
+//! Colours follow the Okabe-Ito palette (distinguishable with the common colour-vision
+//! deficiencies); the DNSOM bottom and top views (thesis Section 4.2.3) use its blue and
+//! vermillion, the two hues furthest apart in it.
+
+use super::DrawError;
+use plotters::style::IntoFont;
+use plotters::style::{register_font, FontStyle, RGBColor, TextStyle};
+use std::sync::OnceLock;
+
+/// The font family name every chart asks plotters for.
+pub const FONT: &str = "sans-serif";
+
+/// Registers DejaVu Sans (regular and bold) as `sans-serif` once per process.
+pub fn ensure_fonts() -> Result<(), DrawError> {
+    static REGISTERED: OnceLock<bool> = OnceLock::new();
+    let ok = *REGISTERED.get_or_init(|| {
+        register_font(FONT, FontStyle::Normal, dejavu::sans::regular()).is_ok()
+            && register_font(FONT, FontStyle::Bold, dejavu::sans::bold()).is_ok()
+    });
+    if ok {
+        Ok(())
+    } else {
+        Err(DrawError::Font)
+    }
+}
+
+// Sizes are even: plotters 0.3.7's ab_glyph text places each glyph at
+// `(size / 2 + glyph top) as i32`, which at odd sizes rounds glyphs above and below the middle
+// in opposite directions (a decimal point then floats a pixel above the baseline).
+
+/// Chart title size (pixels).
+pub const TITLE_PX: f64 = 22.0;
+/// Axis description size (pixels).
+pub const AXIS_DESC_PX: f64 = 16.0;
+/// Tick label and legend size (pixels).
+pub const LABEL_PX: f64 = 14.0;
+/// Caption size of an overview panel (pixels).
+pub const CAPTION_PX: f64 = 16.0;
+
+/// Size of a 2-D chart (line chart, box plot) in pixels.
+pub const CHART_SIZE: (u32, u32) = (960, 600);
+/// Side of one overview panel (pixels), caption included.
+pub const PANEL_PX: u32 = 300;
+/// Default size of a single mesh picture.
+pub const MESH_SIZE: (u32, u32) = (800, 700);
+
+/// Okabe-Ito black.
+pub const BLACK: RGBColor = RGBColor(0, 0, 0);
+/// Okabe-Ito orange.
+pub const ORANGE: RGBColor = RGBColor(230, 159, 0);
+/// Okabe-Ito sky blue.
+pub const SKY_BLUE: RGBColor = RGBColor(86, 180, 233);
+/// Okabe-Ito bluish green.
+pub const GREEN: RGBColor = RGBColor(0, 158, 115);
+/// Okabe-Ito yellow (too light for thin lines on white; used last).
+pub const YELLOW: RGBColor = RGBColor(240, 228, 66);
+/// Okabe-Ito blue.
+pub const BLUE: RGBColor = RGBColor(0, 114, 178);
+/// Okabe-Ito vermillion.
+pub const VERMILLION: RGBColor = RGBColor(213, 94, 0);
+/// Okabe-Ito reddish purple.
+pub const PURPLE: RGBColor = RGBColor(204, 121, 167);
+/// Neutral grey for baselines.
+pub const GREY: RGBColor = RGBColor(110, 110, 110);
+/// Axis panels and grid lines.
+pub const GRID: RGBColor = RGBColor(225, 225, 225);
+
+/// DNSOM bottom view (k = 0 side, thesis Figure 4.4).
+pub const DNSOM_BOTTOM: RGBColor = BLUE;
+/// DNSOM top view (k = 2 side, thesis Figure 4.4).
+pub const DNSOM_TOP: RGBColor = VERMILLION;
+
+/// Series colours in the order they are handed out for unnamed series.
+pub const CYCLE: [RGBColor; 8] = [
+    BLUE, VERMILLION, GREEN, ORANGE, PURPLE, SKY_BLUE, BLACK, GREY,
+];
+
+/// The `i`-th colour of [`CYCLE`] (wrapping).
+pub fn cycle_colour(i: usize) -> RGBColor {
+    CYCLE[i % CYCLE.len()]
+}
+
+/// One colour per optimiser (case-insensitive): ga, de, pso, csa, icsa, exact (the certified
+/// convex optimum) and b (approach B's least-squares control points, the starting point).
+/// Unknown names get `None`; use [`cycle_colour`] for them.
+pub fn optimiser_colour(name: &str) -> Option<RGBColor> {
+    match name.trim().to_ascii_lowercase().as_str() {
+        "ga" => Some(ORANGE),
+        "de" => Some(BLUE),
+        "pso" => Some(GREEN),
+        "csa" => Some(PURPLE),
+        "icsa" => Some(VERMILLION),
+        "exact" => Some(BLACK),
+        "b" => Some(GREY),
+        _ => None,
+    }
+}
+
+/// Regular text of `px` pixels.
+pub fn text(px: f64) -> TextStyle<'static> {
+    (FONT, px).into_font().into()
+}
+
+/// Bold text of `px` pixels.
+pub fn bold(px: f64) -> TextStyle<'static> {
+    (FONT, px).into_font().style(FontStyle::Bold).into()
+}
+
+/// Pixel width of `text` in `style` on `area`.
+pub(crate) fn text_width<
+    DB: plotters::prelude::DrawingBackend,
+    CT: plotters::coord::CoordTranslate,
+>(
+    area: &plotters::prelude::DrawingArea<DB, CT>,
+    text: &str,
+    style: &TextStyle,
+) -> Result<i32, DrawError>
+where
+    DB::ErrorType: Send + Sync,
+{
+    area.estimate_text_size(text, style)
+        .map(|(w, _)| w as i32)
+        .map_err(|e| DrawError::Backend(e.to_string()))
+}
+
+/// `text` cut to at most `max` characters (an ellipsis marks the cut).
+pub fn truncate(text: &str, max: usize) -> String {
+    if text.chars().count() <= max {
+        text.to_string()
+    } else {
+        let mut s: String = text.chars().take(max.saturating_sub(1)).collect();
+        s.push('…');
+        s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fonts_register_and_are_idempotent() {
+        ensure_fonts().unwrap();
+        ensure_fonts().unwrap();
+    }
+
+    #[test]
+    fn optimiser_colours_are_distinct() {
+        let names = ["ga", "de", "pso", "csa", "icsa", "exact", "b"];
+        let cs: Vec<RGBColor> = names.iter().map(|n| optimiser_colour(n).unwrap()).collect();
+        for i in 0..cs.len() {
+            for j in 0..i {
+                assert_ne!(cs[i], cs[j], "{} and {} share a colour", names[i], names[j]);
+            }
+        }
+        assert_eq!(optimiser_colour(" DE "), Some(BLUE));
+        assert_eq!(optimiser_colour("sa"), None);
+    }
+
+    #[test]
+    fn dnsom_views_are_far_apart() {
+        let d = |a: RGBColor, b: RGBColor| {
+            let f = |x: u8, y: u8| (x as f64 - y as f64).powi(2);
+            (f(a.0, b.0) + f(a.1, b.1) + f(a.2, b.2)).sqrt()
+        };
+        assert!(d(DNSOM_BOTTOM, DNSOM_TOP) > 200.0);
+    }
+}

@@ -1,0 +1,62 @@
+//! The thesis' published tables (transcribed CSV, `experiments/reference/`), compiled in so that a
+//! report can always set a reproduction beside them.
+
+use std::collections::BTreeMap;
+
+/// One published table: its header and rows keyed by column name.
+#[derive(Debug, Clone)]
+pub struct RefTable {
+    pub header: Vec<String>,
+    pub rows: Vec<BTreeMap<String, String>>,
+}
+
+impl RefTable {
+    pub fn parse(text: &str) -> RefTable {
+        let mut r = csv::Reader::from_reader(text.as_bytes());
+        let header: Vec<String> = r.headers().map(|h| h.iter().map(String::from).collect()).unwrap_or_default();
+        let rows = r
+            .records()
+            .filter_map(|rec| rec.ok())
+            .map(|rec| header.iter().cloned().zip(rec.iter().map(String::from)).collect())
+            .collect();
+        RefTable { header, rows }
+    }
+
+    /// The row whose key columns equal `key` (in order).
+    pub fn find(&self, key_cols: &[&str], key: &[String]) -> Option<&BTreeMap<String, String>> {
+        self.rows.iter().find(|row| key_cols.iter().zip(key).all(|(c, k)| row.get(*c).map(|v| v == k).unwrap_or(false)))
+    }
+
+    /// A numeric cell.
+    pub fn value(&self, key_cols: &[&str], key: &[String], col: &str) -> Option<f64> {
+        self.find(key_cols, key)?.get(col)?.parse().ok()
+    }
+}
+
+/// Appendix B (SOM models at n x n), Appendix C (CKSOM vs DNSOM at nx x ny), E/F (surface error),
+/// K/L (optimised surface error), M/N (optimiser CPU time).
+pub fn table(name: &str) -> Option<RefTable> {
+    let text = match name {
+        "appendix_b" => include_str!("../../experiments/reference/appendix_b.csv"),
+        "appendix_c" => include_str!("../../experiments/reference/appendix_c.csv"),
+        "appendix_e" => include_str!("../../experiments/reference/appendix_e.csv"),
+        "appendix_f" => include_str!("../../experiments/reference/appendix_f.csv"),
+        "appendix_k" => include_str!("../../experiments/reference/appendix_k.csv"),
+        "appendix_l" => include_str!("../../experiments/reference/appendix_l.csv"),
+        "appendix_m" => include_str!("../../experiments/reference/appendix_m.csv"),
+        "appendix_n" => include_str!("../../experiments/reference/appendix_n.csv"),
+        _ => return None,
+    };
+    Some(RefTable::parse(text))
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn published_tables_load() {
+        let b = super::table("appendix_b").unwrap();
+        assert_eq!(b.rows.len(), 15);
+        assert_eq!(b.value(&["data", "n"], &["spindle".into(), "30".into()], "cpu_s_dnsom"), Some(5.309147));
+        assert_eq!(super::table("appendix_k").unwrap().rows.len(), 140);
+    }
+}
