@@ -9,3 +9,4 @@ pub mod experiment;
 pub mod geom;
 pub mod report;
 pub mod som;
+pub mod spline;

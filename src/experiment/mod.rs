@@ -1,6 +1,7 @@
 //! Experiments: spec -> cells -> runs (on per-cell random streams) -> report files and manifest.
 
 pub mod ch4;
+pub mod ch5;
 pub mod datasets;
 pub mod runner;
 pub mod seeds;
@@ -22,10 +23,9 @@ pub struct RunContext {
 
 /// One line per cell for `--dry-run`: key and seed.
 pub fn dry_run_listing(spec: &Spec) -> Vec<(String, String)> {
-    spec.som_cells()
-        .iter()
-        .map(|c| {
-            let k = c.key();
+    let keys: Vec<String> = spec.som_cells().iter().map(|c| c.key()).chain(spec.fit_cells().iter().map(|c| c.key())).collect();
+    keys.into_iter()
+        .map(|k| {
             let s = seeds::seed_hex(spec.file.master_seed, &k);
             (k, s)
         })
@@ -99,10 +99,18 @@ pub fn run_spec(spec: &Spec, ctx: &RunContext) -> Result<PathBuf> {
     let started = Instant::now();
     let started_unix = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map(|d| d.as_secs()).unwrap_or(0);
 
-    let runs = ch4::run(spec, ctx)?;
-    let section = crate::report::ch4::write(spec, &runs, &ctx.out)?;
-    let cpu: f64 = runs.iter().map(|r| r.row.cpu_s).sum();
-    let cells = runs.len();
+    let (section, cpu, cells) = if spec.file.som.is_some() {
+        let runs = ch4::run(spec, ctx)?;
+        let section = crate::report::ch4::write(spec, &runs, &ctx.out)?;
+        (section, runs.iter().map(|r| r.row.cpu_s).sum::<f64>(), runs.len())
+    } else {
+        let maps = ch5::maps(spec, ctx)?;
+        let runs = ch5::run(spec, ctx, &maps)?;
+        let origins: Vec<(String, String)> = maps.iter().map(|(d, m)| (d.clone(), m.origin.clone())).collect();
+        let pictures = spec.file.fit.as_ref().map(|f| f.pictures).unwrap_or(false);
+        let section = crate::report::ch5::write(&runs, &ctx.out, &origins, pictures)?;
+        (section, runs.iter().map(|r| r.row.cpu_s).sum::<f64>(), runs.len())
+    };
 
     let manifest = Manifest {
         spec_name: spec.file.name.clone(),

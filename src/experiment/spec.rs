@@ -89,6 +89,9 @@ pub struct SpecFile {
     /// Chapter 4: SOM models.
     #[serde(default)]
     pub som: Option<SomSpec>,
+    /// Chapter 5: cubic B-spline fits of saved DNSOM maps.
+    #[serde(default)]
+    pub fit: Option<FitSpec>,
     /// Named overrides, merged over the spec by `--profile NAME`.
     #[serde(default)]
     pub profiles: BTreeMap<String, toml::Table>,
@@ -133,6 +136,44 @@ pub struct SomSpec {
     /// One PNG per cell and the overview pictures.
     #[serde(default = "default_true")]
     pub pictures: bool,
+}
+
+/// Chapter 5 section: data sets x control nets x parameterisations x approaches on one grid size.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FitSpec {
+    pub datasets: Vec<String>,
+    /// DNSOM grid size the maps were organised at (20x20: Appendix E; 18x30: Appendix F).
+    pub grid: GridSize,
+    /// Control-net sizes CNx x CNy.
+    pub control_nets: Vec<GridSize>,
+    /// uniform, chord_length, centripetal, exponential.
+    pub parameterisations: Vec<String>,
+    /// A (conventional) and/or B (improved).
+    pub approaches: Vec<String>,
+    /// Folder holding `dnsom_<data>_<nx>x<ny>.csv` (Chapter 4's `maps/`); a missing map is
+    /// recomputed from the same seed and settings as Chapter 4 (see `[fit.som]`).
+    #[serde(default)]
+    pub maps: Option<String>,
+    /// How a missing map is recomputed (defaults: this spec's master seed, T = 30000, alpha0 0.9).
+    #[serde(default)]
+    pub som: Option<FitSom>,
+    /// Pictures like Appendices G/H and the error-vs-control-net chart.
+    #[serde(default = "default_true")]
+    pub pictures: bool,
+}
+
+/// Settings of the DNSOM run that recomputes a missing map (the cell key is Chapter 4's,
+/// `som/<data>/dnsom/<grid>/r0`, so the same seed gives the same map).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FitSom {
+    #[serde(default)]
+    pub master_seed: Option<u64>,
+    #[serde(default = "default_iterations")]
+    pub iterations: usize,
+    #[serde(default = "default_alpha0")]
+    pub alpha0: f64,
 }
 
 #[derive(Debug, Clone, Deserialize)]
@@ -226,9 +267,15 @@ impl Spec {
         if f.name.trim().is_empty() || f.name.contains(['/', '\\']) {
             return Err(self.err("name", "must be a non-empty name without slashes"));
         }
-        let Some(som) = &f.som else {
-            return Err(SpecError(format!("{}: the spec has no experiment section (add [som])", self.path)));
-        };
+        match (f.som.is_some(), f.fit.is_some()) {
+            (false, false) => return Err(SpecError(format!("{}: the spec has no experiment section (add [som] or [fit])", self.path))),
+            (true, true) => return Err(SpecError(format!("{}: one experiment section per spec: [som] and [fit] write the same files (split the spec)", self.path))),
+            _ => {}
+        }
+        if let Some(fit) = &f.fit {
+            self.validate_fit(fit)?;
+        }
+        let Some(som) = &f.som else { return Ok(()) };
         if som.datasets.is_empty() {
             return Err(self.err("som.datasets", "is empty"));
         }
@@ -279,6 +326,65 @@ impl Spec {
         Ok(())
     }
 
+    fn validate_fit(&self, fit: &FitSpec) -> Result<(), SpecError> {
+        if fit.datasets.is_empty() {
+            return Err(self.err("fit.datasets", "is empty"));
+        }
+        if fit.grid.nx.min(fit.grid.ny) < 3 {
+            return Err(self.err("fit.grid", format!("grid {} is too small (each side at least 3)", fit.grid)));
+        }
+        if fit.control_nets.is_empty() {
+            return Err(self.err("fit.control_nets", "is empty"));
+        }
+        for cn in &fit.control_nets {
+            if cn.nx < 4 || cn.ny < 4 {
+                return Err(self.err("fit.control_nets", format!("control net {cn} is smaller than 4 (cubic needs p + 1 = 4 control points a side)")));
+            }
+            if cn.nx > fit.grid.nx || cn.ny > fit.grid.ny {
+                return Err(self.err("fit.control_nets", format!("control net {cn} is larger than the grid {}", fit.grid)));
+            }
+        }
+        if fit.parameterisations.is_empty() {
+            return Err(self.err("fit.parameterisations", "is empty"));
+        }
+        for p in &fit.parameterisations {
+            p.parse::<crate::spline::Parameterisation>().map_err(|e| self.err("fit.parameterisations", e))?;
+        }
+        if fit.approaches.is_empty() {
+            return Err(self.err("fit.approaches", "is empty"));
+        }
+        for a in &fit.approaches {
+            a.parse::<crate::spline::Approach>().map_err(|e| self.err("fit.approaches", e))?;
+        }
+        if let Some(som) = &fit.som {
+            if som.iterations == 0 {
+                return Err(self.err("fit.som.iterations", "must be at least 1"));
+            }
+            if !(som.alpha0 > 0.0 && som.alpha0 <= 1.0) {
+                return Err(self.err("fit.som.alpha0", format!("must be in (0, 1], got {}", som.alpha0)));
+            }
+        }
+        Ok(())
+    }
+
+    /// The flat list of fit cells (data set x control net x parameterisation x approach).
+    pub fn fit_cells(&self) -> Vec<FitCell> {
+        let Some(fit) = &self.file.fit else { return Vec::new() };
+        let mut cells = Vec::new();
+        for dataset in &fit.datasets {
+            for cn in &fit.control_nets {
+                for p in &fit.parameterisations {
+                    let Ok(param) = p.parse() else { continue };
+                    for a in &fit.approaches {
+                        let Ok(approach) = a.parse() else { continue };
+                        cells.push(FitCell { dataset: dataset.clone(), grid: fit.grid, cn: *cn, param, approach });
+                    }
+                }
+            }
+        }
+        cells
+    }
+
     /// The flat list of SOM cells (data set x group x grid x model x repeat), in report order.
     pub fn som_cells(&self) -> Vec<SomCell> {
         let Some(som) = &self.file.som else { return Vec::new() };
@@ -308,6 +414,22 @@ impl Spec {
             (None, Some(o)) => o.into(),
             (None, None) => Path::new("results").join(&self.file.name),
         }
+    }
+}
+
+/// One Chapter 5 cell: a two-surface fit of one DNSOM map (deterministic: no random stream).
+#[derive(Debug, Clone, PartialEq)]
+pub struct FitCell {
+    pub dataset: String,
+    pub grid: GridSize,
+    pub cn: GridSize,
+    pub param: crate::spline::Parameterisation,
+    pub approach: crate::spline::Approach,
+}
+
+impl FitCell {
+    pub fn key(&self) -> String {
+        format!("fit/{}/{}/{}/{}/{}", self.dataset, self.grid, self.cn, self.param.name(), self.approach.letter())
     }
 }
 

@@ -137,21 +137,24 @@ pub fn table_4_14() -> (Vec<String>, Vec<Vec<String>>) {
     (["n_x", "n_y", "non", "nov", "nor"].iter().map(|s| s.to_string()).collect(), rows)
 }
 
-/// The DNSOM map as CSV: i, j, view, class (1-based class number), x, y, z; one row per neuron of
-/// both views (NON rows), bottom view first.
-pub fn dnsom_map_csv(run: &SomRun) -> Result<String> {
-    let net = crate::double_net::DoubleNet::new(run.cell.grid.nx, run.cell.grid.ny).ok_or_else(|| anyhow::anyhow!("grid {} is too small", run.cell.grid))?;
+/// A two-view grid as CSV: i, j, view, class (1-based class number), x, y, z; one row per
+/// position of both views (NON rows), bottom view first. Chapter 5 and `somnurbs fit` read it back.
+pub fn two_view_grid_csv(grid: &crate::spline::TwoViewGrid) -> Result<String> {
+    let net = crate::double_net::DoubleNet::new(grid.nx, grid.ny).ok_or_else(|| anyhow::anyhow!("grid {}x{} is too small", grid.nx, grid.ny))?;
     let mut rows = Vec::with_capacity(net.non());
     for view in View::BOTH {
+        let points = match view {
+            View::Bottom => &grid.bottom,
+            View::Top => &grid.top,
+        };
         for i in 0..net.nx {
             for j in 0..net.ny {
-                let c = net.class(view, i, j);
-                let w = run.weights[c];
+                let w = points[net.at(i, j)];
                 rows.push(vec![
                     i.to_string(),
                     j.to_string(),
                     view.name().to_string(),
-                    (c + 1).to_string(),
+                    (net.class(view, i, j) + 1).to_string(),
                     format!("{:?}", w[0]),
                     format!("{:?}", w[1]),
                     format!("{:?}", w[2]),
@@ -161,6 +164,12 @@ pub fn dnsom_map_csv(run: &SomRun) -> Result<String> {
     }
     let header: Vec<String> = ["i", "j", "view", "class", "x", "y", "z"].iter().map(|s| s.to_string()).collect();
     csv_records(&header, &rows)
+}
+
+/// The saved DNSOM map of a run.
+pub fn dnsom_map_csv(run: &SomRun) -> Result<String> {
+    let g = run.cell.grid;
+    two_view_grid_csv(&crate::experiment::ch5::grid_from_weights(g.nx, g.ny, &run.weights))
 }
 
 /// Write every Chapter 4 file; returns the REPORT.md section.

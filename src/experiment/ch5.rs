@@ -1,0 +1,143 @@
+//! Chapter 5 wiring: read (or recompute) the DNSOM maps, fit every cell, log each at once.
+
+use super::spec::{FitCell, Spec};
+use super::{ch4, runner, RunContext};
+use crate::double_net::{DoubleNet, View};
+use crate::experiment::spec::{GridSize, SomCell};
+use crate::report::fsio::{write_atomic, PartialLog};
+use crate::som::{Model, SomParams};
+use crate::spline::{fit_two_view, TwoSurfaceFit, TwoViewGrid};
+use anyhow::{Context, Result};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+
+/// One row of a Chapter 5 `runs.csv`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct FitRow {
+    pub cell: String,
+    pub dataset: String,
+    pub grid_x: usize,
+    pub grid_y: usize,
+    pub cn_x: usize,
+    pub cn_y: usize,
+    pub parameterisation: String,
+    pub approach: String,
+    /// Eq. 5.13 over the NOV grid classes.
+    pub surface_error: f64,
+    /// Largest distance between the two fitted surfaces along the shared border.
+    pub gap: f64,
+    pub cpu_s: f64,
+}
+
+/// One fitted cell.
+#[derive(Debug, Clone)]
+pub struct FitRun {
+    pub cell: FitCell,
+    pub row: FitRow,
+    pub fit: TwoSurfaceFit,
+}
+
+/// Where a map came from.
+#[derive(Debug, Clone)]
+pub struct MapSource {
+    pub grid: TwoViewGrid,
+    pub origin: String,
+}
+
+/// The map file name Chapter 4 writes and Chapter 5 reads.
+pub fn map_file_name(dataset: &str, grid: GridSize) -> String {
+    format!("dnsom_{dataset}_{grid}.csv")
+}
+
+/// A trained DNSOM's weights as a two-view grid (border positions share their class's weight).
+pub fn grid_from_weights(nx: usize, ny: usize, weights: &[crate::geom::Point3]) -> TwoViewGrid {
+    let net = DoubleNet::new(nx, ny).expect("grid sides at least 2");
+    let view = |v: View| (0..nx).flat_map(|i| (0..ny).map(move |j| (i, j))).map(|(i, j)| weights[net.class(v, i, j)]).collect();
+    TwoViewGrid { nx, ny, bottom: view(View::Bottom), top: view(View::Top) }
+}
+
+/// Read each data set's map from the maps folder, or recompute it exactly as Chapter 4 does (same
+/// cell key, seed and settings); every map used is copied into `<out>/maps/`.
+pub fn maps(spec: &Spec, ctx: &RunContext) -> Result<BTreeMap<String, MapSource>> {
+    let fit = spec.file.fit.as_ref().context("spec has no [fit] section")?;
+    let dir: Option<PathBuf> = fit.maps.as_ref().map(PathBuf::from);
+    let mut out = BTreeMap::new();
+    for data in &fit.datasets {
+        if out.contains_key(data) {
+            continue;
+        }
+        let name = map_file_name(data, fit.grid);
+        let from_file = dir.as_ref().map(|d| d.join(&name)).filter(|p| p.exists());
+        let source = match from_file {
+            Some(path) => read_map(&path, fit.grid)?,
+            None => recompute_map(spec, ctx, data, fit.grid)?,
+        };
+        let text = crate::report::ch4::two_view_grid_csv(&source.grid)?;
+        write_atomic(&ctx.out.join("maps").join(&name), text.as_bytes())?;
+        out.insert(data.clone(), source);
+    }
+    Ok(out)
+}
+
+fn read_map(path: &Path, grid: GridSize) -> Result<MapSource> {
+    let text = crate::report::fsio::read_text(path)?;
+    let g = crate::data::grid_csv::parse_two_view_grid(&text).with_context(|| path.display().to_string())?;
+    if (g.nx, g.ny) != (grid.nx, grid.ny) {
+        anyhow::bail!("{}: map is {}x{}, the spec's grid is {grid}", path.display(), g.nx, g.ny);
+    }
+    Ok(MapSource { grid: TwoViewGrid { nx: g.nx, ny: g.ny, bottom: g.bottom, top: g.top }, origin: path.display().to_string() })
+}
+
+fn recompute_map(spec: &Spec, ctx: &RunContext, data: &str, grid: GridSize) -> Result<MapSource> {
+    let fit = spec.file.fit.as_ref().context("spec has no [fit] section")?;
+    let (seed, params) = match &fit.som {
+        Some(s) => (s.master_seed.unwrap_or(spec.file.master_seed), SomParams { iterations: s.iterations, alpha0: s.alpha0, sigma0: None }),
+        None => (spec.file.master_seed, SomParams::default()),
+    };
+    let clouds = ch4::load_datasets(&[data.to_string()], ctx)?;
+    let cell = SomCell { dataset: data.to_string(), model: Model::Dnsom, grid, repeat: 0 };
+    let run = ch4::run_cell(&cell, &clouds[data].points, &params, seed)?;
+    Ok(MapSource {
+        grid: grid_from_weights(grid.nx, grid.ny, &run.weights),
+        origin: format!("recomputed: {} with master seed {seed}, T = {}", cell.key(), params.iterations),
+    })
+}
+
+/// Fit one cell.
+pub fn run_cell(cell: &FitCell, grid: &TwoViewGrid) -> Result<FitRun> {
+    let t0 = runner::thread_cpu_seconds();
+    let fit = fit_two_view(grid, cell.cn.nx, cell.cn.ny, cell.param, cell.approach).map_err(|e| anyhow::anyhow!("{}: {e}", cell.key()))?;
+    let cpu_s = runner::thread_cpu_seconds() - t0;
+    let row = FitRow {
+        cell: cell.key(),
+        dataset: cell.dataset.clone(),
+        grid_x: cell.grid.nx,
+        grid_y: cell.grid.ny,
+        cn_x: cell.cn.nx,
+        cn_y: cell.cn.ny,
+        parameterisation: cell.param.name().into(),
+        approach: cell.approach.letter().into(),
+        surface_error: fit.surface_error,
+        gap: fit.gap,
+        cpu_s,
+    };
+    Ok(FitRun { cell: cell.clone(), row, fit })
+}
+
+/// Run every fit cell of a spec.
+pub fn run(spec: &Spec, ctx: &RunContext, maps: &BTreeMap<String, MapSource>) -> Result<Vec<FitRun>> {
+    let cells = spec.fit_cells();
+    let log = Mutex::new(PartialLog::create(&ctx.out.join("runs.csv.partial"), &ch4::csv_header::<FitRow>())?);
+    runner::run_cells(
+        &cells,
+        ctx.jobs,
+        &spec.file.name,
+        |cell| run_cell(cell, &maps[&cell.dataset].grid),
+        |_, run| {
+            let line = crate::report::fsio::csv_text(std::slice::from_ref(&run.row))?;
+            log.lock().map_err(|_| anyhow::anyhow!("log lock poisoned"))?.push(line.lines().nth(1).unwrap_or_default())
+        },
+    )
+}

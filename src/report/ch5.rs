@@ -1,0 +1,255 @@
+//! Chapter 5 outputs: runs.csv, Appendix E/F (surface error of A and B per parameterisation), the
+//! win-count tables 5.4-5.9, the gap table, the charts and pictures and the REPORT.md section.
+
+use super::claims::Claim;
+use super::fsio::{csv_records, csv_text, write_atomic};
+use super::markdown::{beside, num, table};
+use super::reference::{self, RefTable};
+use crate::experiment::ch5::FitRun;
+use crate::experiment::spec::GridSize;
+use crate::spline::{Approach, Parameterisation};
+use anyhow::Result;
+use std::fmt::Write;
+use std::path::Path;
+
+/// Names of a grid's tables: (appendix, param wins for A, param wins for B, A vs B).
+fn table_names(grid: GridSize) -> (String, String, String, String) {
+    match (grid.nx, grid.ny) {
+        (20, 20) => ("appendix_e".into(), "table_5_4".into(), "table_5_5".into(), "table_5_6".into()),
+        (18, 30) => ("appendix_f".into(), "table_5_7".into(), "table_5_8".into(), "table_5_9".into()),
+        _ => (format!("surface_error_{grid}"), format!("param_wins_A_{grid}"), format!("param_wins_B_{grid}"), format!("approach_wins_{grid}")),
+    }
+}
+
+fn ordered<T: PartialEq + Clone>(items: impl Iterator<Item = T>) -> Vec<T> {
+    let mut out = Vec::new();
+    for x in items {
+        if !out.contains(&x) {
+            out.push(x);
+        }
+    }
+    out
+}
+
+/// Surface error of a (data, cn, param, approach) cell, from the runs or from a published table.
+type ErrorOf<'a> = dyn Fn(&str, GridSize, Parameterisation, Approach) -> Option<f64> + 'a;
+
+fn runs_error(runs: &[FitRun]) -> impl Fn(&str, GridSize, Parameterisation, Approach) -> Option<f64> + '_ {
+    move |d, cn, p, a| runs.iter().find(|r| r.cell.dataset == d && r.cell.cn == cn && r.cell.param == p && r.cell.approach == a).map(|r| r.row.surface_error)
+}
+
+fn thesis_error(t: &RefTable) -> impl Fn(&str, GridSize, Parameterisation, Approach) -> Option<f64> + '_ {
+    move |d, cn, p, a| t.value(&["data", "cn_x", "cn_y"], &[d.to_string(), cn.nx.to_string(), cn.ny.to_string()], &format!("{}_{}", p.name(), a.letter()))
+}
+
+/// Per data set: how many control nets each parameterisation had the least error for approach `a`.
+fn param_wins(err: &ErrorOf, data: &[String], cns: &[GridSize], params: &[Parameterisation], a: Approach) -> Vec<(String, Vec<usize>, usize)> {
+    data.iter()
+        .map(|d| {
+            let mut wins = vec![0; params.len()];
+            let mut cells = 0;
+            for &cn in cns {
+                let v: Option<Vec<f64>> = params.iter().map(|&p| err(d, cn, p, a)).collect();
+                if let Some(v) = v {
+                    cells += 1;
+                    let best = v.iter().cloned().fold(f64::INFINITY, f64::min);
+                    if let Some(k) = v.iter().position(|&x| x == best) {
+                        wins[k] += 1;
+                    }
+                }
+            }
+            (d.clone(), wins, cells)
+        })
+        .collect()
+}
+
+/// Per (data, param): control nets where A had less error than B, and where B had less (ties to neither).
+fn approach_wins(err: &ErrorOf, data: &[String], cns: &[GridSize], params: &[Parameterisation]) -> Vec<(String, Parameterisation, usize, usize, usize)> {
+    let mut out = Vec::new();
+    for d in data {
+        for &p in params {
+            let (mut a_w, mut b_w, mut cells) = (0, 0, 0);
+            for &cn in cns {
+                if let (Some(a), Some(b)) = (err(d, cn, p, Approach::Conventional), err(d, cn, p, Approach::Improved)) {
+                    cells += 1;
+                    a_w += (a < b) as usize;
+                    b_w += (b < a) as usize;
+                }
+            }
+            out.push((d.clone(), p, a_w, b_w, cells));
+        }
+    }
+    out
+}
+
+/// Write every Chapter 5 file; returns the REPORT.md section.
+pub fn write(runs: &[FitRun], out: &Path, maps_origin: &[(String, String)], pictures: bool) -> Result<String> {
+    let rows: Vec<_> = runs.iter().map(|r| r.row.clone()).collect();
+    write_atomic(&out.join("runs.csv"), csv_text(&rows)?.as_bytes())?;
+    let mut s = String::from("## Chapter 5: cubic B-spline approximation, conventional (A) vs improved (B)\n\n");
+    let _ = writeln!(s, "{} fits. Maps: {}.\n", runs.len(), maps_origin.iter().map(|(d, o)| format!("{d} from {o}")).collect::<Vec<_>>().join("; "));
+    s.push_str(METHOD);
+    let mut claims = Vec::new();
+    for grid in ordered(runs.iter().map(|r| r.cell.grid)) {
+        let g_runs: Vec<FitRun> = runs.iter().filter(|r| r.cell.grid == grid).cloned().collect();
+        let data = ordered(g_runs.iter().map(|r| r.cell.dataset.clone()));
+        let cns = ordered(g_runs.iter().map(|r| r.cell.cn));
+        let params = ordered(g_runs.iter().map(|r| r.cell.param));
+        let approaches = ordered(g_runs.iter().map(|r| r.cell.approach));
+        let (app_name, wa_name, wb_name, ab_name) = table_names(grid);
+        let thesis = reference::table(&app_name);
+        let ours = runs_error(&g_runs);
+
+        // Appendix E/F: the reference's column order where there is one.
+        let header: Vec<String> = match &thesis {
+            Some(t) => t.header.clone(),
+            None => {
+                let mut h = vec!["data".to_string(), "cn_x".into(), "cn_y".into()];
+                for p in Parameterisation::ALL {
+                    for a in [Approach::Conventional, Approach::Improved] {
+                        h.push(format!("{}_{}", p.name(), a.letter()));
+                    }
+                }
+                h
+            }
+        };
+        let mut app_rows = Vec::new();
+        for d in &data {
+            for &cn in &cns {
+                let mut row = vec![d.clone(), cn.nx.to_string(), cn.ny.to_string()];
+                for col in &header[3..] {
+                    let v = Parameterisation::ALL.iter().flat_map(|&p| [Approach::Conventional, Approach::Improved].map(move |a| (p, a))).find(|(p, a)| format!("{}_{}", p.name(), a.letter()) == *col).and_then(|(p, a)| ours(d, cn, p, a));
+                    row.push(v.map(|x| format!("{x:.6}")).unwrap_or_default());
+                }
+                app_rows.push(row);
+            }
+        }
+        write_atomic(&out.join(format!("{app_name}.csv")), csv_records(&header, &app_rows)?.as_bytes())?;
+
+        // Win counts.
+        let mut wins_md = String::new();
+        for (a, name) in [(Approach::Conventional, &wa_name), (Approach::Improved, &wb_name)] {
+            if !approaches.contains(&a) {
+                continue;
+            }
+            let w = param_wins(&ours, &data, &cns, &params, a);
+            let mut h = vec!["data".to_string()];
+            h.extend(params.iter().map(|p| p.name().to_string()));
+            h.push("cells".into());
+            let mut rows: Vec<Vec<String>> = w.iter().map(|(d, v, c)| std::iter::once(d.clone()).chain(v.iter().map(|x| x.to_string())).chain(std::iter::once(c.to_string())).collect()).collect();
+            let totals: Vec<usize> = (0..params.len()).map(|k| w.iter().map(|x| x.1[k]).sum()).collect();
+            let cells: usize = w.iter().map(|x| x.2).sum();
+            rows.push(std::iter::once("total".to_string()).chain(totals.iter().map(|x| x.to_string())).chain(std::iter::once(cells.to_string())).collect());
+            write_atomic(&out.join(format!("{name}.csv")), csv_records(&h, &rows)?.as_bytes())?;
+            let _ = write!(wins_md, "\n**`{name}.csv`**: control nets where each parameterisation gives approach {} the least surface error\n\n{}", a.letter(), table(&h, &rows));
+            // Claim: the thesis' best parameterisation per approach.
+            let thesis_best = if a == Approach::Conventional { Parameterisation::Exponential } else { Parameterisation::ChordLength };
+            if let Some(k) = params.iter().position(|&p| p == thesis_best) {
+                let best_ours = totals.iter().max().copied().unwrap_or(0);
+                let t_counts = thesis.as_ref().map(|t| {
+                    let te = thesis_error(t);
+                    let tw = param_wins(&te, &data, &cns, &params, a);
+                    let tt: Vec<usize> = (0..params.len()).map(|k| tw.iter().map(|x| x.1[k]).sum()).collect();
+                    (tt[k], tw.iter().map(|x| x.2).sum::<usize>())
+                });
+                claims.push(Claim {
+                    chapter: "5".into(),
+                    statement: format!("{} is the best parameterisation for approach {} (grid {grid})", thesis_best.name(), a.letter()),
+                    ours: ((totals[k] == best_ours) as usize, 1),
+                    thesis: t_counts.map(|(w, c)| (w, c)),
+                    note: format!("wins here: {}", params.iter().zip(&totals).map(|(p, t)| format!("{} {t}", p.name())).collect::<Vec<_>>().join(", ")),
+                });
+            }
+        }
+        if approaches.contains(&Approach::Conventional) && approaches.contains(&Approach::Improved) {
+            let ab = approach_wins(&ours, &data, &cns, &params);
+            let h: Vec<String> = ["data", "parameterisation", "a_wins", "b_wins", "cells"].iter().map(|s| s.to_string()).collect();
+            let mut rows: Vec<Vec<String>> = ab.iter().map(|(d, p, a, b, c)| vec![d.clone(), p.name().into(), a.to_string(), b.to_string(), c.to_string()]).collect();
+            let (ta, tb, tc) = ab.iter().fold((0, 0, 0), |acc, x| (acc.0 + x.2, acc.1 + x.3, acc.2 + x.4));
+            rows.push(vec!["total".into(), String::new(), ta.to_string(), tb.to_string(), tc.to_string()]);
+            write_atomic(&out.join(format!("{ab_name}.csv")), csv_records(&h, &rows)?.as_bytes())?;
+            let _ = write!(wins_md, "\n**`{ab_name}.csv`**: control nets where A or B has the smaller surface error\n\n{}", table(&h, &rows));
+            let thesis_ab = thesis.as_ref().map(|t| {
+                let te = thesis_error(t);
+                approach_wins(&te, &data, &cns, &params).iter().fold((0, 0), |acc, x| (acc.0 + x.3, acc.1 + x.4))
+            });
+            claims.push(Claim { chapter: "5".into(), statement: format!("B beats A in most cells (grid {grid})"), ours: (tb, tc), thesis: thesis_ab, note: "cells where B has the smaller surface error; verdict 'mostly holds' when more than half".into() });
+            // Gaps.
+            let gh: Vec<String> = ["data", "cn_x", "cn_y", "parameterisation", "gap_A", "gap_B"].iter().map(|s| s.to_string()).collect();
+            let mut gap_rows = Vec::new();
+            let (mut b_zero, mut b_all, mut a_pos) = (0, 0, 0);
+            for d in &data {
+                for &cn in &cns {
+                    for &p in &params {
+                        let find = |a: Approach| g_runs.iter().find(|r| &r.cell.dataset == d && r.cell.cn == cn && r.cell.param == p && r.cell.approach == a).map(|r| r.row.gap);
+                        let (ga, gb) = (find(Approach::Conventional), find(Approach::Improved));
+                        if let Some(gb) = gb {
+                            b_all += 1;
+                            b_zero += (gb == 0.0) as usize;
+                        }
+                        a_pos += ga.map(|g| (g > 0.0) as usize).unwrap_or(0);
+                        gap_rows.push(vec![d.clone(), cn.nx.to_string(), cn.ny.to_string(), p.name().into(), num(ga, 9), num(gb, 9)]);
+                    }
+                }
+            }
+            write_atomic(&out.join(format!("gaps_{grid}.csv")), csv_records(&gh, &gap_rows)?.as_bytes())?;
+            claims.push(Claim { chapter: "5".into(), statement: format!("The improved approach B leaves no gap (grid {grid})"), ours: (b_zero, b_all), thesis: None, note: format!("gap exactly 0; A has a positive gap in {a_pos} cells (`gaps_{grid}.csv`)") });
+        }
+        // Error falls as the control net grows.
+        let mut sorted = cns.clone();
+        sorted.sort();
+        let series = |err: &ErrorOf| -> (usize, usize) {
+            let (mut yes, mut all) = (0, 0);
+            for d in &data {
+                for &p in &params {
+                    for &a in &approaches {
+                        let v: Option<Vec<f64>> = sorted.iter().map(|&cn| err(d, cn, p, a)).collect();
+                        if let Some(v) = v.filter(|v| v.len() > 1) {
+                            all += 1;
+                            yes += v.windows(2).all(|w| w[1] < w[0]) as usize;
+                        }
+                    }
+                }
+            }
+            (yes, all)
+        };
+        let t_series = thesis.as_ref().map(|t| series(&thesis_error(t)));
+        claims.push(Claim { chapter: "5".into(), statement: format!("Surface error falls as the control net grows (grid {grid})"), ours: series(&ours), thesis: t_series, note: "per (data, parameterisation, approach) series".into() });
+
+        let _ = write!(s, "\n### Grid {grid}: `{app_name}.csv`, ours (thesis)\n\n");
+        let mut md_rows = Vec::new();
+        for d in &data {
+            for &cn in &cns {
+                let mut row = vec![d.clone(), cn.to_string()];
+                for &p in &params {
+                    for &a in &approaches {
+                        let t = thesis.as_ref().and_then(|t| thesis_error(t)(d, cn, p, a));
+                        row.push(beside(ours(d, cn, p, a), t, 3));
+                    }
+                }
+                md_rows.push(row);
+            }
+        }
+        let mut mh = vec!["data".to_string(), "CN".into()];
+        for &p in &params {
+            for &a in &approaches {
+                mh.push(format!("{} {}", p.name(), a.letter()));
+            }
+        }
+        s.push_str(&table(&mh, &md_rows));
+        s.push_str(&wins_md);
+        if pictures {
+            for name in super::ch5_pictures::write(&g_runs, grid, out)? {
+                let _ = writeln!(s, "\n![{name}]({name})");
+            }
+        }
+    }
+    let mut out_s = String::from(&s[..]);
+    out_s.push_str("\n### Claims\n\n");
+    out_s.push_str(&super::claims::markdown(&claims));
+    Ok(out_s)
+}
+
+const METHOD: &str = "\
+Method (SPEC 3; every choice is documented in `src/spline/`): cubic in both directions; parameters per grid row and column by the chosen method, averaged over rows/columns (Eq. 5.1, 5.2), and for B also over the two views (Eq. 5.3, 5.4); clamped knots by averaging, generalised by The NURBS Book eq. 9.68-9.69 when the net is smaller than the grid; control net by least squares per coordinate; the four corner control points set to the corner data points; for B the shared border control points of the two nets replaced by their mean (Eq. 5.7). Surface error (Eq. 5.13) is the sum over the NOV grid class numbers of the Euclidean distance between the map point and the fitted point (a border class uses the bottom surface). The gap is the largest distance between the two fitted surfaces at the shared border positions.
+";

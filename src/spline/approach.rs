@@ -1,0 +1,370 @@
+//! The two ways of fitting the two DNSOM surfaces (thesis Section 5.2): conventional (A), each
+//! view alone, and improved (B), shared parameters and averaged border control points.
+//!
+//! Every choice, so that an independent implementation gets the same surface errors:
+//! - Grids are row-major (i * ny + j); u runs along i (nx values), v along j (ny values).
+//! - Parameters: per column j the polyline over i, per row i the polyline over j (Eq. 2.7/2.8),
+//!   averaged (Eq. 5.1, 5.2). B averages the two views' averaged parameters (Eq. 5.3, 5.4).
+//! - Knots: clamped cubic; averaging when the net is as large as the grid, else The NURBS Book
+//!   9.68-9.69 (see `knots`). A and B differ only through the parameters they are built from.
+//! - Control nets: least squares per coordinate (`fit`), then for B every border control point
+//!   (a = 0, cn_x - 1, b = 0, cn_y - 1: one class number in the double net) becomes the mean of
+//!   the two nets' (Eq. 5.7); then the corner rule on each net (corner control point := corner data
+//!   point; corners are border data, the same in both views, so the order of the two steps does not
+//!   change them).
+//! - Surface error (Eq. 5.13): sum over the NOV grid class numbers of |D - D^G|, a border class
+//!   taken at its first allocation (the bottom view). Gap: the largest |D^G_bottom - D^G_top| over
+//!   the border positions; B has gap 0 exactly, since its border rows and columns of D^G are
+//!   copies of the same shared control points.
+
+use super::basis::{basis_matrix, SparseBasis};
+use super::fit::{fitted_grid, least_squares_net, pin_corners};
+use super::knots::knot_vector;
+use super::param::{grid_params, Parameterisation};
+use super::surface::BSplineSurface;
+use super::SplineError;
+use crate::double_net::{DoubleNet, View};
+use crate::geom::{self, Point3};
+use std::fmt;
+use std::str::FromStr;
+
+/// Conventional (A) or improved (B).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Approach {
+    Conventional,
+    Improved,
+}
+
+impl Approach {
+    /// "A" or "B", as the thesis' tables.
+    pub fn letter(self) -> &'static str {
+        match self {
+            Approach::Conventional => "A",
+            Approach::Improved => "B",
+        }
+    }
+}
+
+impl fmt::Display for Approach {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.letter())
+    }
+}
+
+impl FromStr for Approach {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.to_ascii_lowercase().as_str() {
+            "a" | "conventional" => Ok(Approach::Conventional),
+            "b" | "improved" => Ok(Approach::Improved),
+            _ => Err(format!("unknown approach `{s}` (expected A/conventional or B/improved)")),
+        }
+    }
+}
+
+/// The two organised surfaces of a DNSOM map: row-major `nx x ny` views sharing their border.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TwoViewGrid {
+    pub nx: usize,
+    pub ny: usize,
+    pub bottom: Vec<Point3>,
+    pub top: Vec<Point3>,
+}
+
+impl TwoViewGrid {
+    /// Sizes, finiteness and the shared border.
+    pub fn validate(&self) -> Result<(), SplineError> {
+        if self.nx < 2 || self.ny < 2 {
+            return Err(SplineError::Grid(format!("the grid is {}x{}; both sides must be at least 2", self.nx, self.ny)));
+        }
+        for (name, v) in [("bottom", &self.bottom), ("top", &self.top)] {
+            if v.len() != self.nx * self.ny {
+                return Err(SplineError::Grid(format!("the {name} view has {} points, {}x{} needs {}", v.len(), self.nx, self.ny, self.nx * self.ny)));
+            }
+            if let Some(k) = v.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
+                return Err(SplineError::Grid(format!("the {name} view has a non-finite point at ({}, {})", k / self.ny, k % self.ny)));
+            }
+        }
+        for i in 0..self.nx {
+            for j in 0..self.ny {
+                if (i == 0 || j == 0 || i + 1 == self.nx || j + 1 == self.ny) && self.bottom[i * self.ny + j] != self.top[i * self.ny + j] {
+                    return Err(SplineError::Grid(format!("the views differ at border position ({i}, {j}); a two-view grid shares its border")));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn view(&self, v: View) -> &[Point3] {
+        match v {
+            View::Bottom => &self.bottom,
+            View::Top => &self.top,
+        }
+    }
+}
+
+/// A fitted pair of surfaces and its measures.
+#[derive(Debug, Clone)]
+pub struct TwoSurfaceFit {
+    pub approach: Approach,
+    pub param: Parameterisation,
+    /// Data parameters per view (for B both views hold the same).
+    pub params_u: [Vec<f64>; 2],
+    pub params_v: [Vec<f64>; 2],
+    pub bottom: BSplineSurface,
+    pub top: BSplineSurface,
+    /// D^G of each view at its data parameters, row-major.
+    pub fitted_bottom: Vec<Point3>,
+    pub fitted_top: Vec<Point3>,
+    /// Eq. 5.13.
+    pub surface_error: f64,
+    /// Largest distance between the two fitted surfaces at the shared border positions.
+    pub gap: f64,
+}
+
+struct ViewFit {
+    u: Vec<f64>,
+    v: Vec<f64>,
+    knots_u: Vec<f64>,
+    knots_v: Vec<f64>,
+    net: Vec<Point3>,
+}
+
+/// Fit both views of `grid` with a `cn_x x cn_y` cubic control net each.
+pub fn fit_two_view(grid: &TwoViewGrid, cn_x: usize, cn_y: usize, param: Parameterisation, approach: Approach) -> Result<TwoSurfaceFit, SplineError> {
+    grid.validate()?;
+    if cn_x < 4 || cn_y < 4 {
+        return Err(SplineError::ControlNet(format!("control net {cn_x}x{cn_y} is smaller than 4 (cubic needs p + 1 = 4 a side)")));
+    }
+    if cn_x > grid.nx || cn_y > grid.ny {
+        return Err(SplineError::ControlNet(format!("control net {cn_x}x{cn_y} is larger than the grid {}x{}", grid.nx, grid.ny)));
+    }
+    let (nx, ny) = (grid.nx, grid.ny);
+    let own = [grid_params(&grid.bottom, nx, ny, param), grid_params(&grid.top, nx, ny, param)];
+    let params: [(Vec<f64>, Vec<f64>); 2] = match approach {
+        Approach::Conventional => own,
+        Approach::Improved => {
+            let mean = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| (x + y) / 2.0).collect::<Vec<f64>>();
+            let u = mean(&own[0].0, &own[1].0);
+            let v = mean(&own[0].1, &own[1].1);
+            [(u.clone(), v.clone()), (u, v)]
+        }
+    };
+    let mut fits = Vec::with_capacity(2);
+    for (k, view) in View::BOTH.iter().enumerate() {
+        let (u, v) = params[k].clone();
+        let knots_u = knot_vector(&u, cn_x, 3).map_err(SplineError::ControlNet)?;
+        let knots_v = knot_vector(&v, cn_y, 3).map_err(SplineError::ControlNet)?;
+        let nu = basis_matrix(&u, &knots_u, 3, cn_x);
+        let nv = basis_matrix(&v, &knots_v, 3, cn_y);
+        let net = least_squares_net(grid.view(*view), &nu, &nv).map_err(SplineError::Singular)?;
+        fits.push(ViewFit { u, v, knots_u, knots_v, net });
+    }
+    if approach == Approach::Improved {
+        for a in 0..cn_x {
+            for b in 0..cn_y {
+                if a == 0 || b == 0 || a + 1 == cn_x || b + 1 == cn_y {
+                    let at = a * cn_y + b;
+                    let mean = geom::scale(geom::add(fits[0].net[at], fits[1].net[at]), 0.5);
+                    fits[0].net[at] = mean;
+                    fits[1].net[at] = mean;
+                }
+            }
+        }
+    }
+    for (k, view) in View::BOTH.iter().enumerate() {
+        pin_corners(&mut fits[k].net, cn_x, cn_y, grid.view(*view), nx, ny);
+    }
+    let fitted: Vec<Vec<Point3>> = fits
+        .iter()
+        .map(|f| fitted_grid(&f.net, &basis_matrix(&f.u, &f.knots_u, 3, cn_x), &basis_matrix(&f.v, &f.knots_v, 3, cn_y)))
+        .collect();
+    let net = DoubleNet::new(nx, ny).expect("validated sides");
+    let surface_error = surface_error(grid, &net, &fitted[0], &fitted[1]);
+    let gap = border_gap(&net, &fitted[0], &fitted[1]);
+    let surface = |f: &ViewFit| BSplineSurface { p: 3, q: 3, knots_u: f.knots_u.clone(), knots_v: f.knots_v.clone(), cn_x, cn_y, control: f.net.clone() };
+    let (bottom, top) = (surface(&fits[0]), surface(&fits[1]));
+    let mut fitted = fitted.into_iter();
+    Ok(TwoSurfaceFit {
+        approach,
+        param,
+        params_u: [fits[0].u.clone(), fits[1].u.clone()],
+        params_v: [fits[0].v.clone(), fits[1].v.clone()],
+        bottom,
+        top,
+        fitted_bottom: fitted.next().unwrap_or_default(),
+        fitted_top: fitted.next().unwrap_or_default(),
+        surface_error,
+        gap,
+    })
+}
+
+/// Eq. 5.13: sum over the NOV grid classes of |D - D^G| at each class's first allocation.
+pub fn surface_error(grid: &TwoViewGrid, net: &DoubleNet, fitted_bottom: &[Point3], fitted_top: &[Point3]) -> f64 {
+    (0..net.nov())
+        .map(|c| {
+            let (view, i, j) = net.first_allocation(c);
+            let at = net.at(i, j);
+            match view {
+                View::Bottom => geom::dist(grid.bottom[at], fitted_bottom[at]),
+                View::Top => geom::dist(grid.top[at], fitted_top[at]),
+            }
+        })
+        .sum()
+}
+
+/// Largest distance between the fitted surfaces over the shared border positions.
+pub fn border_gap(net: &DoubleNet, fitted_bottom: &[Point3], fitted_top: &[Point3]) -> f64 {
+    let mut gap = 0.0f64;
+    for i in 0..net.nx {
+        for j in 0..net.ny {
+            if net.is_border(i, j) {
+                gap = gap.max(geom::dist(fitted_bottom[net.at(i, j)], fitted_top[net.at(i, j)]));
+            }
+        }
+    }
+    gap
+}
+
+/// What Chapter 6 optimises: approach B's shared data parameters as sparse cubic bases, the grid,
+/// and the distinct control points by control-net class (xyz interleaved).
+#[derive(Debug, Clone)]
+pub struct ControlNetParts {
+    pub nx: usize,
+    pub ny: usize,
+    pub cn_x: usize,
+    pub cn_y: usize,
+    pub nu: SparseBasis,
+    pub nv: SparseBasis,
+    pub data_bottom: Vec<Point3>,
+    pub data_top: Vec<Point3>,
+    pub x0: Vec<f64>,
+}
+
+impl TwoSurfaceFit {
+    /// The control-net problem of Chapter 6 (approach B only: one set of knots and parameters).
+    pub fn control_net_parts(&self, grid: &TwoViewGrid) -> Result<ControlNetParts, SplineError> {
+        if self.approach != Approach::Improved {
+            return Err(SplineError::ControlNet("the control-net problem is defined on approach B".into()));
+        }
+        let (cn_x, cn_y) = (self.bottom.cn_x, self.bottom.cn_y);
+        let cn = DoubleNet::new(cn_x, cn_y).expect("control nets at least 4 a side");
+        let mut x0 = vec![0.0; 3 * cn.nov()];
+        for c in 0..cn.nov() {
+            let (view, a, b) = cn.first_allocation(c);
+            let p = match view {
+                View::Bottom => self.bottom.control[a * cn_y + b],
+                View::Top => self.top.control[a * cn_y + b],
+            };
+            x0[3 * c..3 * c + 3].copy_from_slice(&p);
+        }
+        Ok(ControlNetParts {
+            nx: grid.nx,
+            ny: grid.ny,
+            cn_x,
+            cn_y,
+            nu: SparseBasis::cubic(&self.params_u[0], &self.bottom.knots_u, cn_x),
+            nv: SparseBasis::cubic(&self.params_v[0], &self.bottom.knots_v, cn_y),
+            data_bottom: grid.bottom.clone(),
+            data_top: grid.top.clone(),
+            x0,
+        })
+    }
+}
+
+impl ControlNetParts {
+    /// Eq. 6.2 (= Eq. 5.13) for a decision vector x, the plain dense way (the reference the fast
+    /// fitness of Chapter 6 is tested against).
+    pub fn surface_error(&self, x: &[f64]) -> f64 {
+        let cn = DoubleNet::new(self.cn_x, self.cn_y).expect("sides at least 4");
+        let grid_net = DoubleNet::new(self.nx, self.ny).expect("sides at least 2");
+        let nu = self.nu.dense(self.cn_x);
+        let nv = self.nv.dense(self.cn_y);
+        let net_of = |view: View| -> Vec<Point3> {
+            (0..self.cn_x * self.cn_y)
+                .map(|k| {
+                    let c = cn.class(view, k / self.cn_y, k % self.cn_y);
+                    [x[3 * c], x[3 * c + 1], x[3 * c + 2]]
+                })
+                .collect()
+        };
+        let fb = fitted_grid(&net_of(View::Bottom), &nu, &nv);
+        let ft = fitted_grid(&net_of(View::Top), &nu, &nv);
+        let grid = TwoViewGrid { nx: self.nx, ny: self.ny, bottom: self.data_bottom.clone(), top: self.data_top.clone() };
+        surface_error(&grid, &grid_net, &fb, &ft)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A lumpy closed two-view grid: a noisy sphere cut at the equator, built on the shared border.
+    pub fn test_grid(nx: usize, ny: usize, noise: f64) -> TwoViewGrid {
+        let net = DoubleNet::new(nx, ny).unwrap();
+        let mut bottom = vec![[0.0; 3]; nx * ny];
+        let mut top = vec![[0.0; 3]; nx * ny];
+        for i in 0..nx {
+            for j in 0..ny {
+                let (s, t) = (i as f64 / (nx - 1) as f64 * 2.0 - 1.0, j as f64 / (ny - 1) as f64 * 2.0 - 1.0);
+                let r = s.abs().max(t.abs());
+                let h = if net.is_border(i, j) { 0.0 } else { (1.0 - r * r).sqrt() * 0.5 };
+                let wobble = if net.is_border(i, j) { 0.0 } else { noise * ((7 * i + 3 * j) as f64).sin() };
+                bottom[i * ny + j] = [0.5 + 0.5 * s, 0.5 + 0.5 * t, 0.5 - h - wobble];
+                top[i * ny + j] = [0.5 + 0.5 * s, 0.5 + 0.5 * t, 0.5 + h + 0.7 * wobble];
+            }
+        }
+        TwoViewGrid { nx, ny, bottom, top }
+    }
+
+    #[test]
+    fn improved_has_no_gap_conventional_has_one() {
+        let g = test_grid(20, 20, 0.02);
+        for p in Parameterisation::ALL {
+            for cn in [6, 10, 18] {
+                let b = fit_two_view(&g, cn, cn, p, Approach::Improved).unwrap();
+                assert_eq!(b.gap, 0.0, "{p} {cn}");
+                let a = fit_two_view(&g, cn, cn, p, Approach::Conventional).unwrap();
+                assert!(a.gap > 0.0, "{p} {cn}");
+                assert!(a.surface_error > 0.0 && b.surface_error > 0.0);
+            }
+        }
+        let g = test_grid(18, 30, 0.02);
+        assert_eq!(fit_two_view(&g, 16, 28, Parameterisation::ChordLength, Approach::Improved).unwrap().gap, 0.0);
+    }
+
+    #[test]
+    fn error_is_zero_when_the_net_is_as_large_as_the_grid() {
+        // n_ctrl = n_params: the least squares interpolates every data point.
+        let g = test_grid(9, 11, 0.03);
+        let a = fit_two_view(&g, 9, 11, Parameterisation::ChordLength, Approach::Conventional).unwrap();
+        assert!(a.surface_error < 1e-9, "{}", a.surface_error);
+    }
+
+    #[test]
+    fn bad_sizes_are_refused() {
+        let g = test_grid(10, 10, 0.0);
+        assert!(fit_two_view(&g, 3, 8, Parameterisation::Uniform, Approach::Improved).unwrap_err().to_string().contains("smaller than 4"));
+        assert!(fit_two_view(&g, 11, 8, Parameterisation::Uniform, Approach::Improved).unwrap_err().to_string().contains("larger than the grid"));
+        let mut bad = g.clone();
+        bad.top[17][1] = f64::NAN;
+        assert!(fit_two_view(&bad, 6, 6, Parameterisation::Uniform, Approach::Improved).unwrap_err().to_string().contains("non-finite"));
+        let mut bad = g.clone();
+        bad.top[0][0] += 1.0;
+        assert!(fit_two_view(&bad, 6, 6, Parameterisation::Uniform, Approach::Improved).unwrap_err().to_string().contains("border position (0, 0)"));
+        bad.top.pop();
+        assert!(fit_two_view(&bad, 6, 6, Parameterisation::Uniform, Approach::Improved).is_err());
+    }
+
+    #[test]
+    fn control_net_parts_reproduce_the_surface_error() {
+        let g = test_grid(20, 20, 0.02);
+        for cn in [(6, 6), (12, 9), (18, 18)] {
+            let b = fit_two_view(&g, cn.0, cn.1, Parameterisation::Centripetal, Approach::Improved).unwrap();
+            let parts = b.control_net_parts(&g).unwrap();
+            assert_eq!(parts.x0.len(), 3 * DoubleNet::new(cn.0, cn.1).unwrap().nov());
+            let e = parts.surface_error(&parts.x0);
+            assert!((e - b.surface_error).abs() <= 1e-12 * b.surface_error, "{e} vs {}", b.surface_error);
+        }
+    }
+}

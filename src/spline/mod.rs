@@ -1,0 +1,30 @@
+//! Cubic B-spline ("NURBS with all weights 1") approximation of the DNSOM surfaces (thesis
+//! Chapter 5): basis functions, parameterisation, knots, least-squares control nets, the
+//! conventional and improved two-surface approaches, and CAD export. Pure: no file I/O.
+
+pub mod approach;
+pub mod basis;
+pub mod export;
+pub mod fit;
+pub mod knots;
+pub mod param;
+pub mod surface;
+
+pub use approach::{fit_two_view, Approach, ControlNetParts, TwoSurfaceFit, TwoViewGrid};
+pub use basis::SparseBasis;
+pub use param::Parameterisation;
+pub use surface::BSplineSurface;
+
+use thiserror::Error;
+
+#[derive(Debug, Error, PartialEq)]
+pub enum SplineError {
+    #[error("grid: {0}")]
+    Grid(String),
+    #[error("control net: {0}")]
+    ControlNet(String),
+    #[error("least squares: {0}")]
+    Singular(String),
+    #[error("IGES: {0}")]
+    Iges(String),
+}
