@@ -29,6 +29,32 @@ pub enum Command {
     Run(RunArgs),
     /// List, describe or export the data sets (generated primitives and data files).
     Datasets(DatasetsArgs),
+    /// Fit cubic B-spline surfaces to a structured two-view grid (the CSV Chapter 4 saves in
+    /// maps/) and write the control nets (CSV), an IGES file and an OBJ mesh.
+    #[command(after_help = "Example:\n  somnurbs fit --grid results/ch4_models/maps/dnsom_spindle_20x20.csv --cn 18x18 --param chord_length --approach improved --out fit_spindle")]
+    Fit(FitArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct FitArgs {
+    /// Two-view grid CSV with columns i,j,view,class,x,y,z (both views, 2 nx ny rows).
+    #[arg(long)]
+    pub grid: PathBuf,
+    /// Control-net size CNXxCNY (each side at least 4, at most the grid's).
+    #[arg(long)]
+    pub cn: String,
+    /// uniform, chord_length, centripetal or exponential.
+    #[arg(long, default_value = "chord_length")]
+    pub param: String,
+    /// conventional (A) or improved (B).
+    #[arg(long, default_value = "improved")]
+    pub approach: String,
+    /// Output folder for control_nets.csv, surfaces.igs, surfaces.obj and fit.csv.
+    #[arg(long, default_value = "fit")]
+    pub out: PathBuf,
+    /// Evaluation samples per direction in the OBJ mesh.
+    #[arg(long, default_value_t = 40)]
+    pub samples: usize,
 }
 
 #[derive(Debug, Args)]

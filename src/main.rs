@@ -40,6 +40,10 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             eprintln!("somnurbs: wrote {}", out.join("REPORT.md").display());
             Ok(ExitCode::SUCCESS)
         }
+        Command::Fit(args) => {
+            experiment::fit_cmd::fit(&args)?;
+            Ok(ExitCode::SUCCESS)
+        }
         Command::Datasets(args) => {
             let dir = experiment::data_dir(args.data_dir.as_deref());
             somnurbs::experiment::datasets::datasets(args.action.unwrap_or(DatasetsAction::List), &dir)?;

@@ -231,3 +231,95 @@ fn datasets_list_show_export() {
     assert_eq!((h.len(), rows.len()), (3, 5942));
     c.fails(&["datasets", "show", "teapot"], &["teapot"]);
 }
+
+const CH4_FOR_FIT: &str = r#"
+name = "maps"
+master_seed = 11
+[som]
+datasets = ["sphere"]
+iterations = 500
+save_maps = ["20x20"]
+pictures = false
+[[som.group]]
+models = ["dnsom"]
+grids = ["20x20"]
+"#;
+
+const CH5_TINY: &str = r#"
+name = "fits"
+master_seed = 11
+[fit]
+datasets = ["sphere"]
+grid = "20x20"
+control_nets = ["6x6", "12x12"]
+parameterisations = ["uniform", "chord_length", "centripetal", "exponential"]
+approaches = ["A", "B"]
+maps = "MAPS"
+pictures = false
+[fit.som]
+iterations = 500
+"#;
+
+#[test]
+fn chapter_5_reads_or_recomputes_maps_and_writes_appendix_e() {
+    let c = Case::new();
+    c.write("maps.toml", CH4_FOR_FIT);
+    c.ok(&["run", "maps.toml", "--out", "ch4"]);
+    c.write("fits.toml", &CH5_TINY.replace("MAPS", "ch4/maps"));
+    c.ok(&["run", "fits.toml", "--out", "read"]);
+    c.write("fits2.toml", &CH5_TINY.replace("MAPS", "nowhere"));
+    c.ok(&["run", "fits2.toml", "--out", "recomputed"]);
+    let map = "maps/dnsom_sphere_20x20.csv";
+    let original = std::fs::read_to_string(c.path("ch4").join(map)).unwrap();
+    assert_eq!(original, std::fs::read_to_string(c.path("read").join(map)).unwrap(), "the map used is kept in the results folder");
+    assert_eq!(original, std::fs::read_to_string(c.path("recomputed").join(map)).unwrap(), "a recomputed map equals Chapter 4's");
+    assert_eq!(without_timing(&c.path("read/appendix_e.csv")), without_timing(&c.path("recomputed/appendix_e.csv")));
+    let reference = Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/reference/appendix_e.csv");
+    let (h, rows) = read_csv(&c.path("read/appendix_e.csv"));
+    assert_eq!(h, read_csv(&reference).0);
+    assert_eq!(rows.len(), 2);
+    // Error falls from the 6x6 to the 12x12 net in every column.
+    for col in 3..h.len() {
+        let (a, b): (f64, f64) = (rows[0][col].parse().unwrap(), rows[1][col].parse().unwrap());
+        assert!(b < a, "{}: {a} -> {b}", h[col]);
+    }
+    let (gh, gaps) = read_csv(&c.path("read/gaps_20x20.csv"));
+    let gb = gh.iter().position(|x| x == "gap_B").unwrap();
+    let ga = gh.iter().position(|x| x == "gap_A").unwrap();
+    assert!(gaps.iter().all(|r| r[gb].parse::<f64>().unwrap() == 0.0));
+    assert!(gaps.iter().any(|r| r[ga].parse::<f64>().unwrap() > 0.0));
+    for t in ["table_5_4.csv", "table_5_5.csv", "table_5_6.csv", "runs.csv", "REPORT.md", "manifest.toml"] {
+        assert!(c.path("read").join(t).exists(), "{t}");
+    }
+}
+
+#[test]
+fn fit_writes_nets_iges_and_obj_and_refuses_bad_grids() {
+    let c = Case::new();
+    c.write("maps.toml", CH4_FOR_FIT);
+    c.ok(&["run", "maps.toml", "--out", "ch4"]);
+    let grid = "ch4/maps/dnsom_sphere_20x20.csv";
+    c.ok(&["fit", "--grid", grid, "--cn", "8x6", "--param", "centripetal", "--approach", "B", "--out", "f"]);
+    let (_, nets) = read_csv(&c.path("f/control_nets.csv"));
+    assert_eq!(nets.len(), 2 * 8 * 6);
+    let igs = std::fs::read_to_string(c.path("f/surfaces.igs")).unwrap();
+    let surfaces = somnurbs::spline::export::parse_iges_128(&igs).unwrap();
+    assert_eq!((surfaces.len(), surfaces[0].cn_x, surfaces[0].cn_y), (2, 8, 6));
+    let (_, fit) = read_csv(&c.path("f/fit.csv"));
+    assert_eq!(fit[0][5].parse::<f64>().unwrap(), 0.0, "approach B has no gap");
+    assert!(std::fs::read_to_string(c.path("f/surfaces.obj")).unwrap().contains("o bottom"));
+
+    let text = std::fs::read_to_string(c.path(grid)).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    c.write("short.csv", &lines[..lines.len() - 1].join("\n"));
+    c.fails(&["fit", "--grid", "short.csv", "--cn", "8x8"], &["short.csv", "needs 800 rows"]);
+    let mut nan = lines.clone();
+    let bad_line = nan[5].rsplitn(2, ',').nth(1).unwrap().to_string() + ",NaN";
+    nan[5] = &bad_line;
+    c.write("nan.csv", &nan.join("\n"));
+    c.fails(&["fit", "--grid", "nan.csv", "--cn", "8x8"], &["nan.csv", "line 6"]);
+    c.fails(&["fit", "--grid", grid, "--cn", "21x8"], &["larger than the grid"]);
+    c.fails(&["fit", "--grid", grid, "--cn", "3x8"], &["smaller than 4"]);
+    c.fails(&["fit", "--grid", grid, "--cn", "8x8", "--param", "spline"], &["--param", "spline"]);
+    c.fails(&["fit", "--grid", "missing.csv", "--cn", "8x8"], &["missing.csv"]);
+}

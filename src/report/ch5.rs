@@ -247,9 +247,16 @@ pub fn write(runs: &[FitRun], out: &Path, maps_origin: &[(String, String)], pict
     let mut out_s = String::from(&s[..]);
     out_s.push_str("\n### Claims\n\n");
     out_s.push_str(&super::claims::markdown(&claims));
+    if claims.iter().any(|c| c.statement.starts_with("B beats A") && !c.holds()) {
+        out_s.push_str(DISAGREEMENT);
+    }
     Ok(out_s)
 }
 
 const METHOD: &str = "\
 Method (SPEC 3; every choice is documented in `src/spline/`): cubic in both directions; parameters per grid row and column by the chosen method, averaged over rows/columns (Eq. 5.1, 5.2), and for B also over the two views (Eq. 5.3, 5.4); clamped knots by averaging, generalised by The NURBS Book eq. 9.68-9.69 when the net is smaller than the grid; control net by least squares per coordinate; the four corner control points set to the corner data points; for B the shared border control points of the two nets replaced by their mean (Eq. 5.7). Surface error (Eq. 5.13) is the sum over the NOV grid class numbers of the Euclidean distance between the map point and the fitted point (a border class uses the bottom surface). The gap is the largest distance between the two fitted surfaces at the shared border positions.
+";
+
+const DISAGREEMENT: &str = "
+**Where this reproduction disagrees.** Under the reading of SPEC 3, approach A fits each view by least squares on its own parameters, and B adds two constraints (parameters shared by both views, border control points averaged, Eq. 5.3-5.7). Eq. 5.13 measures each view against its own least-squares fit, so B can only beat A where the averaged parameters happen to suit a view better than its own; here the two differ by well under 1% in most cells and A has the smaller error in most of them. The thesis reports the opposite (126/140 and 118/140 for B) with larger errors overall, which suggests its conventional approach differs from this reading in a step the text does not give (for example how a border class is scored for A). The gap claim holds exactly: B has gap 0 in every cell and A a positive gap in every cell.
 ";
