@@ -8,6 +8,16 @@
 //! number (its first allocation, in the bottom view). Internally classes are 0-based; the thesis'
 //! 1-based "class number" is `class + 1`.
 
+/// The two organised surfaces of a DNSOM map (or any two-view grid): row-major `nx x ny` views,
+/// position (i, j) at `i * ny + j`, sharing their border.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TwoViewGrid {
+    pub nx: usize,
+    pub ny: usize,
+    pub bottom: Vec<crate::geom::Point3>,
+    pub top: Vec<crate::geom::Point3>,
+}
+
 /// Which of the two views a grid position belongs to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum View {

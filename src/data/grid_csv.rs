@@ -2,18 +2,11 @@
 //! columns i, j, view, class, x, y, z; one row per position of both views (2 nx ny rows).
 
 use super::DataError;
+use crate::double_net::TwoViewGrid;
 use crate::geom::Point3;
 
-/// A parsed two-view grid: views row-major (i * ny + j).
-#[derive(Debug, Clone, PartialEq)]
-pub struct ParsedGrid {
-    pub nx: usize,
-    pub ny: usize,
-    pub bottom: Vec<Point3>,
-    pub top: Vec<Point3>,
-}
-
-pub fn parse_two_view_grid(text: &str) -> Result<ParsedGrid, DataError> {
+/// Parse the grid CSV (sizes from the largest i and j; every position of both views exactly once).
+pub fn parse_two_view_grid(text: &str) -> Result<TwoViewGrid, DataError> {
     let mut r = csv::ReaderBuilder::new().trim(csv::Trim::All).from_reader(text.as_bytes());
     let header: Vec<String> = r.headers().map_err(|e| DataError::parse("line 1", e.to_string()))?.iter().map(|s| s.to_string()).collect();
     let col = |name: &str| header.iter().position(|h| h == name).ok_or_else(|| DataError::parse("line 1", format!("no `{name}` column (expected i,j,view,class,x,y,z)")));
@@ -61,7 +54,7 @@ pub fn parse_two_view_grid(text: &str) -> Result<ParsedGrid, DataError> {
     }
     let bottom: Vec<Point3> = bottom.into_iter().map(|p| p.expect("every position filled: counts match and no duplicates")).collect();
     let top: Vec<Point3> = top.into_iter().map(|p| p.expect("every position filled")).collect();
-    Ok(ParsedGrid { nx, ny, bottom, top })
+    Ok(TwoViewGrid { nx, ny, bottom, top })
 }
 
 #[cfg(test)]

@@ -87,7 +87,7 @@ fn read_map(path: &Path, grid: GridSize) -> Result<MapSource> {
     if (g.nx, g.ny) != (grid.nx, grid.ny) {
         anyhow::bail!("{}: map is {}x{}, the spec's grid is {grid}", path.display(), g.nx, g.ny);
     }
-    Ok(MapSource { grid: TwoViewGrid { nx: g.nx, ny: g.ny, bottom: g.bottom, top: g.top }, origin: path.display().to_string() })
+    Ok(MapSource { grid: g, origin: path.display().to_string() })
 }
 
 fn recompute_map(spec: &Spec, ctx: &RunContext, data: &str, grid: GridSize) -> Result<MapSource> {

@@ -3,7 +3,7 @@
 use crate::cli::FitArgs;
 use crate::experiment::spec::GridSize;
 use crate::report::fsio::{csv_records, read_text, write_atomic};
-use crate::spline::{export, fit_two_view, Approach, Parameterisation, TwoViewGrid};
+use crate::spline::{export, fit_two_view, Approach, Parameterisation};
 use anyhow::{Context, Result};
 
 pub fn fit(args: &FitArgs) -> Result<()> {
@@ -12,8 +12,7 @@ pub fn fit(args: &FitArgs) -> Result<()> {
     let approach: Approach = args.approach.parse().map_err(|e| anyhow::anyhow!("--approach: {e}"))?;
     let shown = args.grid.display().to_string();
     let text = read_text(&args.grid)?;
-    let g = crate::data::grid_csv::parse_two_view_grid(&text).with_context(|| shown.clone())?;
-    let grid = TwoViewGrid { nx: g.nx, ny: g.ny, bottom: g.bottom, top: g.top };
+    let grid = crate::data::grid_csv::parse_two_view_grid(&text).with_context(|| shown.clone())?;
     let fit = fit_two_view(&grid, cn.nx, cn.ny, param, approach).with_context(|| format!("{shown}: {}x{} grid", grid.nx, grid.ny))?;
 
     let header: Vec<String> = ["view", "a", "b", "x", "y", "z"].iter().map(|s| s.to_string()).collect();

@@ -23,6 +23,7 @@ use super::knots::knot_vector;
 use super::param::{grid_params, Parameterisation};
 use super::surface::BSplineSurface;
 use super::SplineError;
+pub use crate::double_net::TwoViewGrid;
 use crate::double_net::{DoubleNet, View};
 use crate::geom::{self, Point3};
 use std::fmt;
@@ -60,15 +61,6 @@ impl FromStr for Approach {
             _ => Err(format!("unknown approach `{s}` (expected A/conventional or B/improved)")),
         }
     }
-}
-
-/// The two organised surfaces of a DNSOM map: row-major `nx x ny` views sharing their border.
-#[derive(Debug, Clone, PartialEq)]
-pub struct TwoViewGrid {
-    pub nx: usize,
-    pub ny: usize,
-    pub bottom: Vec<Point3>,
-    pub top: Vec<Point3>,
 }
 
 impl TwoViewGrid {
