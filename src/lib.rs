@@ -7,6 +7,7 @@ pub mod data;
 pub mod double_net;
 pub mod experiment;
 pub mod geom;
+pub mod optim;
 pub mod report;
 pub mod som;
 pub mod spline;

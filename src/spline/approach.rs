@@ -288,7 +288,7 @@ impl ControlNetParts {
 }
 
 #[cfg(test)]
-mod tests {
+pub mod tests {
     use super::*;
 
     /// A lumpy closed two-view grid: a noisy sphere cut at the equator, built on the shared border.

@@ -1,0 +1,50 @@
+//! Chapter 6 speed (run: `cargo bench --bench optim`): the control-net fitness for an 18x18 net on
+//! the 20x20 DNSOM map of the spindle (target: at most 1.5 us per evaluation on one core; numpy
+//! with BLAS 8.3 us; the thesis' DE about 600 us), one full DE run (2000 generations x 40) on it
+//! (target under 0.2 s; scipy's differential_evolution 2.75 s; the thesis 48 s), and GA and PSO runs.
+
+use somnurbs::experiment::{ch4, ch5, runner, spec::{GridSize, SomCell}, RunContext};
+use somnurbs::optim::{control_net::ControlNetProblem, de::De, ga::Ga, pso::Pso, Budget, Optimiser, Problem};
+use somnurbs::som::{Model, SomParams};
+use somnurbs::spline::{fit_two_view, Approach, Parameterisation};
+use std::time::Instant;
+
+fn main() {
+    let ctx = RunContext { out: std::env::temp_dir(), jobs: 1, data_dir: somnurbs::experiment::data_dir(None) };
+    let data = ch4::load_datasets(&["spindle".to_string()], &ctx).unwrap();
+    let cell = SomCell { dataset: "spindle".into(), model: Model::Dnsom, grid: GridSize { nx: 20, ny: 20 }, repeat: 0 };
+    let run = ch4::run_cell(&cell, &data["spindle"].points, &SomParams::default(), 2023).unwrap();
+    let grid = ch5::grid_from_weights(20, 20, &run.weights);
+    let fit = fit_two_view(&grid, 18, 18, Parameterisation::ChordLength, Approach::Improved).unwrap();
+    let problem = ControlNetProblem::new(fit.control_net_parts(&grid).unwrap(), 0.0);
+    let x0 = problem.initial_point().to_vec();
+    println!("control-net problem 18x18 on 20x20: {} variables, B = {:.6}", problem.dim(), problem.fitness(&x0));
+    let reps = 200_000;
+    let t0 = runner::thread_cpu_seconds();
+    let mut acc = 0.0;
+    for k in 0..reps {
+        let mut x = x0.clone();
+        x[k % x0.len()] += 1e-9;
+        acc += problem.fitness(std::hint::black_box(&x));
+    }
+    std::hint::black_box(acc);
+    let clone_cost = {
+        let t = runner::thread_cpu_seconds();
+        for k in 0..reps {
+            let mut x = x0.clone();
+            x[k % x0.len()] += 1e-9;
+            std::hint::black_box(&x);
+        }
+        runner::thread_cpu_seconds() - t
+    };
+    let per = (runner::thread_cpu_seconds() - t0 - clone_cost) / reps as f64;
+    println!("fitness: {:.3} us per evaluation ({:.2} M evaluations/s; target 1.5 us, numpy 8.3 us: {:.1}x, thesis DE ~600 us: {:.0}x)", per * 1e6, 1e-6 / per, 8.3e-6 / per, 600e-6 / per);
+    let budget = Budget { generations: 2000, population: 40, init_range: 5e-6 };
+    for opt in [&De::default() as &dyn Optimiser, &Ga::default(), &Pso::default()] {
+        let mut rng = somnurbs::experiment::seeds::cell_rng(1, "bench");
+        let t = Instant::now();
+        let r = opt.run(&problem, &budget, &mut rng);
+        let s = t.elapsed().as_secs_f64();
+        println!("{} 2000 x 40: {:.3} s, {} evaluations ({:.2} M/s), best {:.6}", opt.name(), s, r.evaluations, r.evaluations as f64 / s / 1e6, r.best_fitness);
+    }
+}

@@ -1,0 +1,248 @@
+//! The thesis' control-net problem (Chapter 6; fitness Eq. 6.2 = Eq. 5.13) with a fast fitness.
+//!
+//! Decision vector: the distinct control points of approach B, one per control-net class number,
+//! xyz interleaved. A surface point depends on only 4 x 4 control points, so the fitness is the
+//! separable sparse tensor product D^G = Nu (P Nv^T): first Q = P Nv^T over the four non-zeros of
+//! each v-row, then each grid row as four scaled rows of Q (contiguous, so it vectorises), in
+//! structure-of-arrays layout with no allocation per call. The top view is evaluated only at its
+//! interior, since a border class is scored once, on the bottom view (Eq. 5.13).
+
+use super::problem::Problem;
+use crate::double_net::{DoubleNet, View};
+use crate::geom::Point3;
+use crate::spline::ControlNetParts;
+use std::cell::RefCell;
+
+/// The control-net problem: the parts from the spline fit, and a box.
+pub struct ControlNetProblem {
+    parts: ControlNetParts,
+    class: [Vec<u32>; 2],
+    data: [[Vec<f64>; 3]; 2],
+    lo: Vec<f64>,
+    hi: Vec<f64>,
+    /// Per-axis box the bounds were made from (lower, upper).
+    pub box_axes: (Point3, Point3),
+}
+
+#[derive(Default)]
+struct Scratch {
+    p: [Vec<f64>; 3],
+    q: [Vec<f64>; 3],
+    row: [Vec<f64>; 3],
+}
+
+thread_local! {
+    static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
+}
+
+impl ControlNetProblem {
+    /// Bounds per axis: the smallest box holding the grid data and the initial control points,
+    /// widened on each side by `margin` times its size (0: exactly that box).
+    pub fn new(parts: ControlNetParts, margin: f64) -> ControlNetProblem {
+        let cn = DoubleNet::new(parts.cn_x, parts.cn_y).expect("control net sides at least 4");
+        let class = View::BOTH.map(|v| cn.classes(v).iter().map(|&c| c as u32).collect::<Vec<u32>>());
+        let data = [&parts.data_bottom, &parts.data_top].map(|d| [0, 1, 2].map(|c| d.iter().map(|p| p[c]).collect::<Vec<f64>>()));
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        let points = parts.data_bottom.iter().chain(&parts.data_top).copied().chain(parts.x0.chunks(3).map(|c| [c[0], c[1], c[2]]));
+        for p in points {
+            for c in 0..3 {
+                lo[c] = lo[c].min(p[c]);
+                hi[c] = hi[c].max(p[c]);
+            }
+        }
+        for c in 0..3 {
+            let w = (hi[c] - lo[c]) * margin;
+            lo[c] -= w;
+            hi[c] += w;
+        }
+        let n = parts.x0.len();
+        ControlNetProblem { class, data, lo: (0..n).map(|k| lo[k % 3]).collect(), hi: (0..n).map(|k| hi[k % 3]).collect(), box_axes: (lo, hi), parts }
+    }
+
+    pub fn parts(&self) -> &ControlNetParts {
+        &self.parts
+    }
+
+    /// Walk every scored position: `visit(view, i, j, fitted point)`.
+    fn forward(&self, x: &[f64], mut visit: impl FnMut(usize, usize, usize, [f64; 3])) {
+        let p = &self.parts;
+        let (nx, ny, cn_x, cn_y) = (p.nx, p.ny, p.cn_x, p.cn_y);
+        SCRATCH.with(|s| {
+            let mut s = s.borrow_mut();
+            let s = &mut *s;
+            for c in 0..3 {
+                s.p[c].resize(cn_x * cn_y, 0.0);
+                s.q[c].resize(cn_x * ny, 0.0);
+                s.row[c].resize(ny, 0.0);
+            }
+            for view in 0..2 {
+                for (k, &cls) in self.class[view].iter().enumerate() {
+                    let at = 3 * cls as usize;
+                    s.p[0][k] = x[at];
+                    s.p[1][k] = x[at + 1];
+                    s.p[2][k] = x[at + 2];
+                }
+                // Q = P Nv^T.
+                for c in 0..3 {
+                    let (pc, qc) = (&s.p[c], &mut s.q[c]);
+                    for a in 0..cn_x {
+                        let prow = &pc[a * cn_y..(a + 1) * cn_y];
+                        let qrow = &mut qc[a * ny..(a + 1) * ny];
+                        for j in 0..ny {
+                            let f = p.nv.first[j];
+                            let w = &p.nv.w[j];
+                            qrow[j] = w[0] * prow[f] + w[1] * prow[f + 1] + w[2] * prow[f + 2] + w[3] * prow[f + 3];
+                        }
+                    }
+                }
+                let rows = if view == 0 { 0..nx } else { 1..nx - 1 };
+                let cols = if view == 0 { 0..ny } else { 1..ny - 1 };
+                for i in rows {
+                    let f = p.nu.first[i];
+                    let w = p.nu.w[i];
+                    for c in 0..3 {
+                        let q = &s.q[c];
+                        let (q0, q1, q2, q3) = (&q[f * ny..(f + 1) * ny], &q[(f + 1) * ny..(f + 2) * ny], &q[(f + 2) * ny..(f + 3) * ny], &q[(f + 3) * ny..(f + 4) * ny]);
+                        let row = &mut s.row[c];
+                        for j in 0..ny {
+                            row[j] = w[0] * q0[j] + w[1] * q1[j] + w[2] * q2[j] + w[3] * q3[j];
+                        }
+                    }
+                    for j in cols.clone() {
+                        visit(view, i, j, [s.row[0][j], s.row[1][j], s.row[2][j]]);
+                    }
+                }
+            }
+        });
+    }
+}
+
+impl Problem for ControlNetProblem {
+    fn dim(&self) -> usize {
+        self.parts.x0.len()
+    }
+    fn initial_point(&self) -> &[f64] {
+        &self.parts.x0
+    }
+    fn bounds(&self) -> (&[f64], &[f64]) {
+        (&self.lo, &self.hi)
+    }
+    /// Eq. 6.2: sum over the NOV grid classes of |D - D^G|.
+    fn fitness(&self, x: &[f64]) -> f64 {
+        let ny = self.parts.ny;
+        let mut e = 0.0;
+        self.forward(x, |view, i, j, g| {
+            let d = &self.data[view];
+            let at = i * ny + j;
+            let (dx, dy, dz) = (g[0] - d[0][at], g[1] - d[1][at], g[2] - d[2][at]);
+            e += (dx * dx + dy * dy + dz * dz).sqrt();
+        });
+        e
+    }
+}
+
+impl ControlNetProblem {
+    /// Number of scored positions (NOV of the grid): the residual terms of the fitness.
+    pub fn terms(&self) -> usize {
+        let (nx, ny) = (self.parts.nx, self.parts.ny);
+        nx * ny + (nx - 2) * (ny - 2)
+    }
+
+    /// The residuals D^G - D at every scored position (bottom view, then the top interior).
+    pub fn residuals(&self, x: &[f64], out: &mut Vec<[f64; 3]>) {
+        out.clear();
+        let ny = self.parts.ny;
+        self.forward(x, |view, i, j, g| {
+            let d = &self.data[view];
+            let at = i * ny + j;
+            out.push([g[0] - d[0][at], g[1] - d[1][at], g[2] - d[2][at]]);
+        });
+    }
+
+    /// The adjoint of x -> D^G: g = sum_k A_k^T y_k.
+    pub fn apply_transpose(&self, y: &[[f64; 3]], out: &mut [f64]) {
+        let p = &self.parts;
+        let (nx, ny, cn_x, cn_y) = (p.nx, p.ny, p.cn_x, p.cn_y);
+        out.iter_mut().for_each(|v| *v = 0.0);
+        let mut k = 0;
+        for view in 0..2 {
+            // Adjoint of the row stage: yq = Nu^T Y.
+            let mut yq = vec![[0.0; 3]; cn_x * ny];
+            let rows = if view == 0 { 0..nx } else { 1..nx - 1 };
+            let cols = if view == 0 { 0..ny } else { 1..ny - 1 };
+            for i in rows {
+                let (f, w) = (p.nu.first[i], p.nu.w[i]);
+                for j in cols.clone() {
+                    let yy = y[k];
+                    k += 1;
+                    for t in 0..4 {
+                        for c in 0..3 {
+                            yq[(f + t) * ny + j][c] += w[t] * yy[c];
+                        }
+                    }
+                }
+            }
+            // Adjoint of Q = P Nv^T, then of the gather by class.
+            for a in 0..cn_x {
+                for j in 0..ny {
+                    let (f, w) = (p.nv.first[j], p.nv.w[j]);
+                    let yy = yq[a * ny + j];
+                    for t in 0..4 {
+                        let cls = self.class[view][a * cn_y + f + t] as usize;
+                        for c in 0..3 {
+                            out[3 * cls + c] += w[t] * yy[c];
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+pub mod tests {
+    use super::*;
+    use crate::spline::{fit_two_view, Approach, Parameterisation};
+
+    pub fn problem(nx: usize, ny: usize, cn_x: usize, cn_y: usize) -> ControlNetProblem {
+        let g = crate::spline::approach::tests::test_grid(nx, ny, 0.03);
+        let fit = fit_two_view(&g, cn_x, cn_y, Parameterisation::ChordLength, Approach::Improved).unwrap();
+        ControlNetProblem::new(fit.control_net_parts(&g).unwrap(), 0.0)
+    }
+
+    #[test]
+    fn fast_fitness_equals_the_dense_reference() {
+        for (nx, ny, cx, cy) in [(20, 20, 18, 18), (18, 30, 4, 16), (12, 9, 6, 5)] {
+            let pr = problem(nx, ny, cx, cy);
+            let mut x = pr.parts().x0.clone();
+            for (k, v) in x.iter_mut().enumerate() {
+                *v += 1e-3 * ((k * 7919) % 13) as f64;
+            }
+            for point in [pr.parts().x0.clone(), x] {
+                let fast = pr.fitness(&point);
+                let dense = pr.parts().surface_error(&point);
+                assert!((fast - dense).abs() <= 1e-12 * dense, "{nx}x{ny} {cx}x{cy}: {fast} vs {dense}");
+            }
+        }
+    }
+
+    #[test]
+    fn transpose_is_the_adjoint() {
+        let pr = problem(12, 10, 7, 6);
+        let n = pr.dim();
+        let x: Vec<f64> = (0..n).map(|k| ((k * 31) % 17) as f64 / 17.0).collect();
+        let zero = vec![0.0; n];
+        let (mut r, mut r0) = (Vec::new(), Vec::new());
+        pr.residuals(&x, &mut r);
+        pr.residuals(&zero, &mut r0);
+        let y: Vec<[f64; 3]> = (0..r.len()).map(|k| [((k * 3) % 7) as f64 - 3.0, ((k * 5) % 11) as f64 - 5.0, (k % 3) as f64]).collect();
+        // <A x, y> = <x, A^T y> with A x = r(x) - r(0).
+        let lhs: f64 = r.iter().zip(&r0).zip(&y).map(|((a, b), yy)| (0..3).map(|c| (a[c] - b[c]) * yy[c]).sum::<f64>()).sum();
+        let mut g = vec![0.0; n];
+        pr.apply_transpose(&y, &mut g);
+        let rhs: f64 = g.iter().zip(&x).map(|(a, b)| a * b).sum();
+        assert!((lhs - rhs).abs() < 1e-9 * lhs.abs().max(1.0), "{lhs} vs {rhs}");
+        assert_eq!(r.len(), pr.terms());
+    }
+}
