@@ -323,3 +323,67 @@ fn fit_writes_nets_iges_and_obj_and_refuses_bad_grids() {
     c.fails(&["fit", "--grid", grid, "--cn", "8x8", "--param", "spline"], &["--param", "spline"]);
     c.fails(&["fit", "--grid", "missing.csv", "--cn", "8x8"], &["missing.csv"]);
 }
+
+const CH6_TINY: &str = r#"
+name = "opt"
+master_seed = 5
+[optim]
+datasets = ["sphere"]
+grid = "20x20"
+control_nets = ["6x6", "8x8"]
+parameterisations = ["chord_length"]
+optimisers = ["ga", "de", "pso"]
+repeats = 2
+generations = 15
+population = 8
+maps = "nowhere"
+[optim.som]
+iterations = 500
+"#;
+
+#[test]
+fn chapter_6_is_deterministic_paired_and_each_cell_reruns_alone() {
+    let c = Case::new();
+    c.write("opt.toml", CH6_TINY);
+    c.ok(&["run", "opt.toml", "--out", "j1", "--jobs", "1"]);
+    c.ok(&["run", "opt.toml", "--out", "j2", "--jobs", "2"]);
+    for f in ["runs.csv", "appendix_k.csv", "table_6_4.csv"] {
+        assert_eq!(without_timing(&c.path("j1").join(f)), without_timing(&c.path("j2").join(f)), "{f}");
+    }
+    let reference = Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/reference/appendix_k.csv");
+    assert_eq!(read_csv(&c.path("j1/appendix_k.csv")).0, read_csv(&reference).0);
+    assert_eq!(read_csv(&c.path("j1/appendix_m.csv")).0, read_csv(&Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/reference/appendix_m.csv")).0);
+    let (h, rows) = read_csv(&c.path("j1/runs.csv"));
+    assert_eq!(rows.len(), 2 * 3 * 2);
+    let col = |n: &str| h.iter().position(|x| x == n).unwrap();
+    for r in &rows {
+        let (best, init): (f64, f64) = (r[col("best")].parse().unwrap(), r[col("initial_best")].parse().unwrap());
+        assert!(best <= init, "{r:?}");
+    }
+    // Paired: every optimiser of a cell starts from the same B.
+    for cn in ["6", "8"] {
+        let bs: std::collections::BTreeSet<&str> = rows.iter().filter(|r| r[col("cn_x")] == cn).map(|r| r[col("b")].as_str()).collect();
+        assert_eq!(bs.len(), 1);
+    }
+    // One optimiser alone gives the same numbers as inside the full run.
+    c.write("de.toml", &CH6_TINY.replace("optimisers = [\"ga\", \"de\", \"pso\"]", "optimisers = [\"de\"]"));
+    c.ok(&["run", "de.toml", "--out", "alone"]);
+    let alone = without_timing(&c.path("alone/runs.csv"));
+    let full: Vec<Vec<String>> = without_timing(&c.path("j1/runs.csv")).into_iter().filter(|r| r[col("optimiser")] == "de").collect();
+    assert_eq!(alone, full);
+}
+
+#[test]
+fn bad_optimiser_specs_are_refused_before_any_run() {
+    let c = Case::new();
+    for (from, to, needle) in [
+        ("optimisers = [\"ga\", \"de\", \"pso\"]", "optimisers = [\"ga\", \"sa\"]", "optim.optimisers"),
+        ("population = 8", "population = -1", "opt.toml:"),
+        ("iterations = 500", "iterations = 500\n[optim.de]\ncr = 1.5", "de.cr"),
+        ("control_nets = [\"6x6\", \"8x8\"]", "control_nets = []", "optim.control_nets"),
+    ] {
+        c.write("opt.toml", &CH6_TINY.replace(from, to));
+        c.fails(&["run", "opt.toml", "--out", "o"], &[needle]);
+        assert!(!c.path("o/runs.csv.partial").exists() && !c.path("o/maps").exists(), "{needle}: something ran");
+    }
+}

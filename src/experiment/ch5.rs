@@ -3,7 +3,7 @@
 use super::spec::{FitCell, Spec};
 use super::{ch4, runner, RunContext};
 use crate::double_net::{DoubleNet, View};
-use crate::experiment::spec::{GridSize, SomCell};
+use crate::experiment::spec::{FitSom, GridSize, SomCell};
 use crate::report::fsio::{write_atomic, PartialLog};
 use crate::som::{Model, SomParams};
 use crate::spline::{fit_two_view, TwoSurfaceFit, TwoViewGrid};
@@ -62,17 +62,22 @@ pub fn grid_from_weights(nx: usize, ny: usize, weights: &[crate::geom::Point3]) 
 /// cell key, seed and settings); every map used is copied into `<out>/maps/`.
 pub fn maps(spec: &Spec, ctx: &RunContext) -> Result<BTreeMap<String, MapSource>> {
     let fit = spec.file.fit.as_ref().context("spec has no [fit] section")?;
-    let dir: Option<PathBuf> = fit.maps.as_ref().map(PathBuf::from);
+    maps_for(spec, ctx, &fit.datasets, fit.grid, fit.maps.as_deref(), fit.som.as_ref())
+}
+
+/// The maps of `datasets` at `grid`, from `maps_dir` or recomputed with `som` settings.
+pub fn maps_for(spec: &Spec, ctx: &RunContext, datasets: &[String], grid: GridSize, maps_dir: Option<&str>, som: Option<&FitSom>) -> Result<BTreeMap<String, MapSource>> {
+    let dir: Option<PathBuf> = maps_dir.map(PathBuf::from);
     let mut out = BTreeMap::new();
-    for data in &fit.datasets {
+    for data in datasets {
         if out.contains_key(data) {
             continue;
         }
-        let name = map_file_name(data, fit.grid);
+        let name = map_file_name(data, grid);
         let from_file = dir.as_ref().map(|d| d.join(&name)).filter(|p| p.exists());
         let source = match from_file {
-            Some(path) => read_map(&path, fit.grid)?,
-            None => recompute_map(spec, ctx, data, fit.grid)?,
+            Some(path) => read_map(&path, grid)?,
+            None => recompute_map(spec, ctx, data, grid, som)?,
         };
         let text = crate::report::ch4::two_view_grid_csv(&source.grid)?;
         write_atomic(&ctx.out.join("maps").join(&name), text.as_bytes())?;
@@ -90,9 +95,8 @@ fn read_map(path: &Path, grid: GridSize) -> Result<MapSource> {
     Ok(MapSource { grid: g, origin: path.display().to_string() })
 }
 
-fn recompute_map(spec: &Spec, ctx: &RunContext, data: &str, grid: GridSize) -> Result<MapSource> {
-    let fit = spec.file.fit.as_ref().context("spec has no [fit] section")?;
-    let (seed, params) = match &fit.som {
+fn recompute_map(spec: &Spec, ctx: &RunContext, data: &str, grid: GridSize, som: Option<&FitSom>) -> Result<MapSource> {
+    let (seed, params) = match som {
         Some(s) => (s.master_seed.unwrap_or(spec.file.master_seed), SomParams { iterations: s.iterations, alpha0: s.alpha0, sigma0: None }),
         None => (spec.file.master_seed, SomParams::default()),
     };

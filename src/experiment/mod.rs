@@ -2,6 +2,7 @@
 
 pub mod ch4;
 pub mod ch5;
+pub mod ch6;
 pub mod datasets;
 pub mod fit_cmd;
 pub mod runner;
@@ -24,7 +25,7 @@ pub struct RunContext {
 
 /// One line per cell for `--dry-run`: key and seed.
 pub fn dry_run_listing(spec: &Spec) -> Vec<(String, String)> {
-    let keys: Vec<String> = spec.som_cells().iter().map(|c| c.key()).chain(spec.fit_cells().iter().map(|c| c.key())).collect();
+    let keys: Vec<String> = spec.som_cells().iter().map(|c| c.key()).chain(spec.fit_cells().iter().map(|c| c.key())).chain(spec.optim_cells().iter().map(|c| c.key())).collect();
     keys.into_iter()
         .map(|k| {
             let s = seeds::seed_hex(spec.file.master_seed, &k);
@@ -103,6 +104,11 @@ pub fn run_spec(spec: &Spec, ctx: &RunContext) -> Result<PathBuf> {
     let (section, cpu, cells) = if spec.file.som.is_some() {
         let runs = ch4::run(spec, ctx)?;
         let section = crate::report::ch4::write(spec, &runs, &ctx.out)?;
+        (section, runs.iter().map(|r| r.row.cpu_s).sum::<f64>(), runs.len())
+    } else if spec.file.optim.is_some() {
+        let problems = ch6::problems(spec, ctx)?;
+        let runs = ch6::run(spec, ctx, &problems)?;
+        let section = crate::report::ch6::write(&runs, &ctx.out)?;
         (section, runs.iter().map(|r| r.row.cpu_s).sum::<f64>(), runs.len())
     } else {
         let maps = ch5::maps(spec, ctx)?;

@@ -92,6 +92,9 @@ pub struct SpecFile {
     /// Chapter 5: cubic B-spline fits of saved DNSOM maps.
     #[serde(default)]
     pub fit: Option<FitSpec>,
+    /// Chapter 6: optimisation of approach B's control points.
+    #[serde(default)]
+    pub optim: Option<OptimSpec>,
     /// Named overrides, merged over the spec by `--profile NAME`.
     #[serde(default)]
     pub profiles: BTreeMap<String, toml::Table>,
@@ -161,6 +164,58 @@ pub struct FitSpec {
     /// Pictures like Appendices G/H and the error-vs-control-net chart.
     #[serde(default = "default_true")]
     pub pictures: bool,
+}
+
+/// Chapter 6 section: data sets x control nets x parameterisations x optimisers x repeats, every
+/// optimiser started from approach B's control net of its cell.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OptimSpec {
+    pub datasets: Vec<String>,
+    pub grid: GridSize,
+    pub control_nets: Vec<GridSize>,
+    pub parameterisations: Vec<String>,
+    /// ga, de, pso, csa, icsa.
+    pub optimisers: Vec<String>,
+    #[serde(default = "default_ten")]
+    pub repeats: usize,
+    #[serde(default = "default_generations")]
+    pub generations: usize,
+    #[serde(default = "default_population")]
+    pub population: usize,
+    /// Half-width of the initial range around B (Table 6.1: 5e-6).
+    #[serde(default = "default_init_range")]
+    pub init_range: f64,
+    /// The search box: the data and B's control points, widened by this share of its size.
+    #[serde(default)]
+    pub bounds_margin: f64,
+    #[serde(default)]
+    pub maps: Option<String>,
+    #[serde(default)]
+    pub som: Option<FitSom>,
+    #[serde(default)]
+    pub ga: crate::optim::ga::Ga,
+    #[serde(default)]
+    pub de: crate::optim::de::De,
+    #[serde(default)]
+    pub pso: crate::optim::pso::Pso,
+    #[serde(default = "crate::optim::cuckoo::Cuckoo::csa")]
+    pub csa: crate::optim::cuckoo::Cuckoo,
+    #[serde(default = "crate::optim::cuckoo::Cuckoo::icsa")]
+    pub icsa: crate::optim::cuckoo::Cuckoo,
+}
+
+fn default_ten() -> usize {
+    10
+}
+fn default_generations() -> usize {
+    2000
+}
+fn default_population() -> usize {
+    40
+}
+fn default_init_range() -> f64 {
+    5e-6
 }
 
 /// Settings of the DNSOM run that recomputes a missing map (the cell key is Chapter 4's,
@@ -267,10 +322,13 @@ impl Spec {
         if f.name.trim().is_empty() || f.name.contains(['/', '\\']) {
             return Err(self.err("name", "must be a non-empty name without slashes"));
         }
-        match (f.som.is_some(), f.fit.is_some()) {
-            (false, false) => return Err(SpecError(format!("{}: the spec has no experiment section (add [som] or [fit])", self.path))),
-            (true, true) => return Err(SpecError(format!("{}: one experiment section per spec: [som] and [fit] write the same files (split the spec)", self.path))),
-            _ => {}
+        match f.som.is_some() as u8 + f.fit.is_some() as u8 + f.optim.is_some() as u8 {
+            0 => return Err(SpecError(format!("{}: the spec has no experiment section (add [som], [fit] or [optim])", self.path))),
+            1 => {}
+            _ => return Err(SpecError(format!("{}: one experiment section per spec: [som], [fit] and [optim] write the same files (split the spec)", self.path))),
+        }
+        if let Some(o) = &f.optim {
+            self.validate_optim(o)?;
         }
         if let Some(fit) = &f.fit {
             self.validate_fit(fit)?;
@@ -367,6 +425,68 @@ impl Spec {
         Ok(())
     }
 
+    fn validate_optim(&self, o: &OptimSpec) -> Result<(), SpecError> {
+        let as_fit = FitSpec {
+            datasets: o.datasets.clone(),
+            grid: o.grid,
+            control_nets: o.control_nets.clone(),
+            parameterisations: o.parameterisations.clone(),
+            approaches: vec!["B".into()],
+            maps: o.maps.clone(),
+            som: o.som.clone(),
+            pictures: false,
+        };
+        self.validate_fit(&as_fit).map_err(|e| SpecError(e.0.replace(": fit.", ": optim.")))?;
+        if o.optimisers.is_empty() {
+            return Err(self.err("optim.optimisers", "is empty"));
+        }
+        for name in &o.optimisers {
+            if !["ga", "de", "pso", "csa", "icsa"].contains(&name.as_str()) {
+                return Err(self.err("optim.optimisers", format!("unknown optimiser `{name}` (expected ga, de, pso, csa or icsa)")));
+            }
+        }
+        if o.repeats == 0 {
+            return Err(self.err("optim.repeats", "must be at least 1"));
+        }
+        if o.generations == 0 {
+            return Err(self.err("optim.generations", "must be at least 1"));
+        }
+        if o.population < 4 {
+            return Err(self.err("optim.population", format!("must be at least 4 (DE/rand/1 needs four), got {}", o.population)));
+        }
+        if !(o.init_range >= 0.0 && o.init_range.is_finite()) {
+            return Err(self.err("optim.init_range", format!("must be a non-negative number, got {}", o.init_range)));
+        }
+        if !(o.bounds_margin >= 0.0 && o.bounds_margin.is_finite()) {
+            return Err(self.err("optim.bounds_margin", format!("must be a non-negative number, got {}", o.bounds_margin)));
+        }
+        o.ga.validate().map_err(|e| self.err("optim", e))?;
+        o.de.validate().map_err(|e| self.err("optim", e))?;
+        o.pso.validate().map_err(|e| self.err("optim", e))?;
+        o.csa.validate("csa").map_err(|e| self.err("optim", e))?;
+        o.icsa.validate("icsa").map_err(|e| self.err("optim", e))?;
+        Ok(())
+    }
+
+    /// The flat list of optimisation cells (data x net x parameterisation x optimiser x repeat).
+    pub fn optim_cells(&self) -> Vec<OptimCell> {
+        let Some(o) = &self.file.optim else { return Vec::new() };
+        let mut cells = Vec::new();
+        for dataset in &o.datasets {
+            for cn in &o.control_nets {
+                for p in &o.parameterisations {
+                    let Ok(param) = p.parse() else { continue };
+                    for opt in &o.optimisers {
+                        for repeat in 0..o.repeats {
+                            cells.push(OptimCell { dataset: dataset.clone(), grid: o.grid, cn: *cn, param, optimiser: opt.clone(), repeat });
+                        }
+                    }
+                }
+            }
+        }
+        cells
+    }
+
     /// The flat list of fit cells (data set x control net x parameterisation x approach).
     pub fn fit_cells(&self) -> Vec<FitCell> {
         let Some(fit) = &self.file.fit else { return Vec::new() };
@@ -430,6 +550,23 @@ pub struct FitCell {
 impl FitCell {
     pub fn key(&self) -> String {
         format!("fit/{}/{}/{}/{}/{}", self.dataset, self.grid, self.cn, self.param.name(), self.approach.letter())
+    }
+}
+
+/// One Chapter 6 cell: one optimiser run from approach B's control net.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OptimCell {
+    pub dataset: String,
+    pub grid: GridSize,
+    pub cn: GridSize,
+    pub param: crate::spline::Parameterisation,
+    pub optimiser: String,
+    pub repeat: usize,
+}
+
+impl OptimCell {
+    pub fn key(&self) -> String {
+        format!("optim/{}/{}/{}/{}/{}/r{}", self.dataset, self.grid, self.cn, self.param.name(), self.optimiser, self.repeat)
     }
 }
 

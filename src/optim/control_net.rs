@@ -66,6 +66,15 @@ impl ControlNetProblem {
 
     /// Walk every scored position: `visit(view, i, j, fitted point)`.
     fn forward(&self, x: &[f64], mut visit: impl FnMut(usize, usize, usize, [f64; 3])) {
+        self.forward_rows(x, |view, i, cols, row| {
+            for j in cols {
+                visit(view, i, j, [row[0][j], row[1][j], row[2][j]]);
+            }
+        });
+    }
+
+    /// Walk every scored grid row: `visit(view, i, scored columns, fitted x/y/z of the row)`.
+    fn forward_rows(&self, x: &[f64], mut visit: impl FnMut(usize, usize, std::ops::Range<usize>, &[Vec<f64>; 3])) {
         let p = &self.parts;
         let (nx, ny, cn_x, cn_y) = (p.nx, p.ny, p.cn_x, p.cn_y);
         SCRATCH.with(|s| {
@@ -109,9 +118,7 @@ impl ControlNetProblem {
                             row[j] = w[0] * q0[j] + w[1] * q1[j] + w[2] * q2[j] + w[3] * q3[j];
                         }
                     }
-                    for j in cols.clone() {
-                        visit(view, i, j, [s.row[0][j], s.row[1][j], s.row[2][j]]);
-                    }
+                    visit(view, i, cols.clone(), &s.row);
                 }
             }
         });
@@ -132,11 +139,17 @@ impl Problem for ControlNetProblem {
     fn fitness(&self, x: &[f64]) -> f64 {
         let ny = self.parts.ny;
         let mut e = 0.0;
-        self.forward(x, |view, i, j, g| {
+        self.forward_rows(x, |view, i, cols, row| {
             let d = &self.data[view];
-            let at = i * ny + j;
-            let (dx, dy, dz) = (g[0] - d[0][at], g[1] - d[1][at], g[2] - d[2][at]);
-            e += (dx * dx + dy * dy + dz * dz).sqrt();
+            let (lo, hi) = (i * ny + cols.start, i * ny + cols.end);
+            let (dx, dy, dz) = (&d[0][lo..hi], &d[1][lo..hi], &d[2][lo..hi]);
+            let (gx, gy, gz) = (&row[0][cols.clone()], &row[1][cols.clone()], &row[2][cols.clone()]);
+            let mut sum = 0.0;
+            for j in 0..gx.len() {
+                let (a, b, c) = (gx[j] - dx[j], gy[j] - dy[j], gz[j] - dz[j]);
+                sum += (a * a + b * b + c * c).sqrt();
+            }
+            e += sum;
         });
         e
     }

@@ -4,6 +4,7 @@ pub mod ch4;
 pub mod ch4_pictures;
 pub mod ch5;
 pub mod ch5_pictures;
+pub mod ch6;
 pub mod claims;
 pub mod fsio;
 pub mod markdown;

@@ -1,0 +1,128 @@
+//! Chapter 6 wiring: one approach-B fit per (data, net, parameterisation), cached, so every
+//! optimiser of a cell starts from the same control net (paired comparisons); each (cell, repeat)
+//! runs on its own stream and is logged at once.
+
+use super::spec::{OptimCell, Spec};
+use super::{ch4, ch5, runner, seeds, RunContext};
+use crate::experiment::spec::GridSize;
+use crate::optim::control_net::ControlNetProblem;
+use crate::optim::{cuckoo::Cuckoo, Budget, Optimiser, Problem, RunResult};
+use crate::report::fsio::PartialLog;
+use crate::spline::{fit_two_view, Approach, Parameterisation};
+use anyhow::{Context, Result};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::sync::Mutex;
+
+/// One row of a Chapter 6 `runs.csv`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct OptimRow {
+    pub cell: String,
+    pub dataset: String,
+    pub grid_x: usize,
+    pub grid_y: usize,
+    pub cn_x: usize,
+    pub cn_y: usize,
+    pub parameterisation: String,
+    pub optimiser: String,
+    pub repeat: usize,
+    pub seed: String,
+    pub dimension: usize,
+    /// Surface error of approach B (the start).
+    pub b: f64,
+    /// Best fitness of the initial population.
+    pub initial_best: f64,
+    /// Best fitness found (Eq. 6.2).
+    pub best: f64,
+    pub evaluations: u64,
+    pub cpu_s: f64,
+}
+
+/// One optimiser run.
+#[derive(Debug, Clone)]
+pub struct OptimRun {
+    pub cell: OptimCell,
+    pub row: OptimRow,
+    pub trace: Vec<(u64, f64)>,
+}
+
+type ProblemKey = (String, GridSize, Parameterisation);
+
+/// Build the optimiser a cell names, with the spec's parameters.
+pub fn optimiser(spec: &Spec, name: &str) -> Result<Box<dyn Optimiser>> {
+    let o = spec.file.optim.as_ref().context("spec has no [optim] section")?;
+    Ok(match name {
+        "ga" => Box::new(o.ga.clone()),
+        "de" => Box::new(o.de.clone()),
+        "pso" => Box::new(o.pso.clone()),
+        "csa" => Box::new(Cuckoo { pa_min: None, ..o.csa.clone() }),
+        "icsa" => Box::new(Cuckoo { pa_min: o.icsa.pa_min.or(Some(0.1)), ..o.icsa.clone() }),
+        other => anyhow::bail!("unknown optimiser `{other}`"),
+    })
+}
+
+/// The control-net problems of every (data, net, parameterisation), from approach B's fit.
+pub fn problems(spec: &Spec, ctx: &RunContext) -> Result<BTreeMap<ProblemKey, ControlNetProblem>> {
+    let o = spec.file.optim.as_ref().context("spec has no [optim] section")?;
+    let maps = ch5::maps_for(spec, ctx, &o.datasets, o.grid, o.maps.as_deref(), o.som.as_ref())?;
+    let mut out = BTreeMap::new();
+    for d in &o.datasets {
+        for &cn in &o.control_nets {
+            for p in &o.parameterisations {
+                let param: Parameterisation = p.parse().map_err(anyhow::Error::msg)?;
+                let grid = &maps[d].grid;
+                let fit = fit_two_view(grid, cn.nx, cn.ny, param, Approach::Improved).map_err(|e| anyhow::anyhow!("{d} {cn} {p}: {e}"))?;
+                let parts = fit.control_net_parts(grid).map_err(|e| anyhow::anyhow!("{e}"))?;
+                out.insert((d.clone(), cn, param), ControlNetProblem::new(parts, o.bounds_margin));
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// Run one cell (also alone: the same numbers as inside the full run).
+pub fn run_cell(spec: &Spec, cell: &OptimCell, problem: &ControlNetProblem) -> Result<OptimRun> {
+    let o = spec.file.optim.as_ref().context("spec has no [optim] section")?;
+    let opt = optimiser(spec, &cell.optimiser)?;
+    let budget = Budget { generations: o.generations, population: o.population, init_range: o.init_range };
+    let key = cell.key();
+    let mut rng = seeds::cell_rng(spec.file.master_seed, &key);
+    let t0 = runner::thread_cpu_seconds();
+    let r: RunResult = opt.run(problem, &budget, &mut rng);
+    let cpu_s = runner::thread_cpu_seconds() - t0;
+    let row = OptimRow {
+        cell: key.clone(),
+        dataset: cell.dataset.clone(),
+        grid_x: cell.grid.nx,
+        grid_y: cell.grid.ny,
+        cn_x: cell.cn.nx,
+        cn_y: cell.cn.ny,
+        parameterisation: cell.param.name().into(),
+        optimiser: cell.optimiser.clone(),
+        repeat: cell.repeat,
+        seed: seeds::seed_hex(spec.file.master_seed, &key),
+        dimension: problem.dim(),
+        b: problem.fitness(problem.initial_point()),
+        initial_best: r.initial_best,
+        best: r.best_fitness,
+        evaluations: r.evaluations,
+        cpu_s,
+    };
+    Ok(OptimRun { cell: cell.clone(), row, trace: r.trace })
+}
+
+/// Run every optimisation cell of a spec.
+pub fn run(spec: &Spec, ctx: &RunContext, problems: &BTreeMap<ProblemKey, ControlNetProblem>) -> Result<Vec<OptimRun>> {
+    let cells = spec.optim_cells();
+    let log = Mutex::new(PartialLog::create(&ctx.out.join("runs.csv.partial"), &ch4::csv_header::<OptimRow>())?);
+    runner::run_cells(
+        &cells,
+        ctx.jobs,
+        &spec.file.name,
+        |cell| run_cell(spec, cell, &problems[&(cell.dataset.clone(), cell.cn, cell.param)]),
+        |_, run| {
+            let line = crate::report::fsio::csv_text(std::slice::from_ref(&run.row))?;
+            log.lock().map_err(|_| anyhow::anyhow!("log lock poisoned"))?.push(line.lines().nth(1).unwrap_or_default())
+        },
+    )
+}

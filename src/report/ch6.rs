@@ -1,0 +1,209 @@
+//! Chapter 6 outputs: runs.csv, Appendix K/L (AVG/MIN/MAX optimised surface error per optimiser
+//! beside B) and M/N (CPU seconds), the win-count tables 6.4-6.9, each optimiser's count of cells
+//! where it beats B, convergence curves and box plots, and the REPORT.md section.
+
+use super::claims::Claim;
+use super::fsio::{csv_records, csv_text, write_atomic};
+use super::markdown::table;
+use super::plots::{self, style, Series};
+use super::reference;
+use crate::experiment::ch6::OptimRun;
+use crate::experiment::spec::GridSize;
+use crate::spline::Parameterisation;
+use anyhow::Result;
+use std::fmt::Write;
+use std::path::Path;
+
+fn ordered<T: PartialEq + Clone>(items: impl Iterator<Item = T>) -> Vec<T> {
+    let mut out = Vec::new();
+    for x in items {
+        if !out.contains(&x) {
+            out.push(x);
+        }
+    }
+    out
+}
+
+fn stats(v: &[f64]) -> Option<(f64, f64, f64)> {
+    if v.is_empty() {
+        return None;
+    }
+    let avg = v.iter().sum::<f64>() / v.len() as f64;
+    Some((avg, v.iter().cloned().fold(f64::INFINITY, f64::min), v.iter().cloned().fold(f64::NEG_INFINITY, f64::max)))
+}
+
+type CellKey = (String, Parameterisation, GridSize);
+
+/// Write every Chapter 6 file; returns the REPORT.md section.
+pub fn write(runs: &[OptimRun], out: &Path) -> Result<String> {
+    let rows: Vec<_> = runs.iter().map(|r| r.row.clone()).collect();
+    write_atomic(&out.join("runs.csv"), csv_text(&rows)?.as_bytes())?;
+    let mut s = String::from("## Chapter 6: optimisation of the control points\n\n");
+    let reps = runs.iter().map(|r| r.cell.repeat).max().map(|m| m + 1).unwrap_or(0);
+    let _ = writeln!(s, "{} runs ({} repeats per cell), every optimiser of a cell started from the same approach-B control net; fitness Eq. 6.2 (= Eq. 5.13).\n", runs.len(), reps);
+    let mut claims = Vec::new();
+    for grid in ordered(runs.iter().map(|r| r.cell.grid)) {
+        let g: Vec<&OptimRun> = runs.iter().filter(|r| r.cell.grid == grid).collect();
+        let opts = ordered(g.iter().map(|r| r.cell.optimiser.clone()));
+        let cells: Vec<CellKey> = ordered(g.iter().map(|r| (r.cell.dataset.clone(), r.cell.param, r.cell.cn)));
+        let (err_name, time_name, t_err, t_time) = match (grid.nx, grid.ny) {
+            (20, 20) => ("appendix_k", "appendix_m", "table_6_4", "table_6_6"),
+            (18, 30) => ("appendix_l", "appendix_n", "table_6_5", "table_6_7"),
+            _ => ("optimised_error", "optimiser_cpu", "wins_error", "wins_time"),
+        };
+        let of = |c: &CellKey, o: &str, f: &dyn Fn(&OptimRun) -> f64| -> Vec<f64> {
+            g.iter().filter(|r| r.cell.dataset == c.0 && r.cell.param == c.1 && r.cell.cn == c.2 && r.cell.optimiser == o).map(|r| f(r)).collect()
+        };
+        let mut eh = vec!["data".to_string(), "parameterisation".into(), "cn_x".into(), "cn_y".into()];
+        let mut th = eh.clone();
+        for o in &opts {
+            for m in ["avg", "min", "max"] {
+                eh.push(format!("{o}_{m}"));
+                th.push(format!("{o}_{m}_s"));
+            }
+        }
+        eh.push("b".into());
+        let (mut erows, mut trows) = (Vec::new(), Vec::new());
+        let mut err_wins = vec![0usize; opts.len()];
+        let mut time_wins = vec![0usize; opts.len()];
+        let mut beats_b = vec![0usize; opts.len()];
+        let mut per_dp: Vec<(String, Parameterisation, Vec<usize>, Vec<usize>)> = Vec::new();
+        for c in &cells {
+            let key = vec![c.0.clone(), c.1.name().to_string(), c.2.nx.to_string(), c.2.ny.to_string()];
+            let (mut er, mut tr) = (key.clone(), key);
+            let mut avgs = Vec::new();
+            let mut tavgs = Vec::new();
+            let mut b = f64::NAN;
+            for (k, o) in opts.iter().enumerate() {
+                let best = of(c, o, &|r| r.row.best);
+                b = of(c, o, &|r| r.row.b).first().copied().unwrap_or(b);
+                let (a, mn, mx) = stats(&best).unwrap_or((f64::NAN, f64::NAN, f64::NAN));
+                er.extend([a, mn, mx].iter().map(|v| format!("{v:.6}")));
+                let (ta, tmn, tmx) = stats(&of(c, o, &|r| r.row.cpu_s)).unwrap_or((f64::NAN, f64::NAN, f64::NAN));
+                tr.extend([ta, tmn, tmx].iter().map(|v| format!("{v:.6}")));
+                avgs.push(a);
+                tavgs.push(ta);
+                beats_b[k] += (a < b) as usize;
+            }
+            er.push(format!("{b:.6}"));
+            erows.push(er);
+            trows.push(tr);
+            let argmin = |v: &[f64]| v.iter().enumerate().min_by(|x, y| x.1.total_cmp(y.1)).map(|(i, _)| i);
+            let dp = match per_dp.iter().position(|x| x.0 == c.0 && x.1 == c.1) {
+                Some(i) => i,
+                None => {
+                    per_dp.push((c.0.clone(), c.1, vec![0; opts.len()], vec![0; opts.len()]));
+                    per_dp.len() - 1
+                }
+            };
+            if let Some(k) = argmin(&avgs) {
+                err_wins[k] += 1;
+                per_dp[dp].2[k] += 1;
+            }
+            if let Some(k) = argmin(&tavgs) {
+                time_wins[k] += 1;
+                per_dp[dp].3[k] += 1;
+            }
+        }
+        write_atomic(&out.join(format!("{err_name}.csv")), csv_records(&eh, &erows)?.as_bytes())?;
+        write_atomic(&out.join(format!("{time_name}.csv")), csv_records(&th, &trows)?.as_bytes())?;
+        let mut wh = vec!["data".to_string(), "parameterisation".into()];
+        wh.extend(opts.iter().cloned());
+        wh.push("cells".into());
+        let per_cells = |d: &str, p: Parameterisation| cells.iter().filter(|c| c.0 == d && c.1 == p).count();
+        for (name, idx) in [(t_err, 2usize), (t_time, 3usize)] {
+            let mut rows: Vec<Vec<String>> = per_dp
+                .iter()
+                .map(|x| {
+                    let w = if idx == 2 { &x.2 } else { &x.3 };
+                    let mut r = vec![x.0.clone(), x.1.name().to_string()];
+                    r.extend(w.iter().map(|v| v.to_string()));
+                    r.push(per_cells(&x.0, x.1).to_string());
+                    r
+                })
+                .collect();
+            let tot = if idx == 2 { &err_wins } else { &time_wins };
+            let mut r = vec!["total".to_string(), String::new()];
+            r.extend(tot.iter().map(|v| v.to_string()));
+            r.push(cells.len().to_string());
+            rows.push(r);
+            write_atomic(&out.join(format!("{name}.csv")), csv_records(&wh, &rows)?.as_bytes())?;
+        }
+        let _ = writeln!(s, "\n### Grid {grid}: `{err_name}.csv`, `{time_name}.csv`, `{t_err}.csv`, `{t_time}.csv`\n");
+        let h: Vec<String> = ["optimiser", "least AVG error (cells)", "least AVG CPU time (cells)", "AVG below B (cells)", "CPU s, all runs"].iter().map(|x| x.to_string()).collect();
+        let mut sum_rows = Vec::new();
+        for (k, o) in opts.iter().enumerate() {
+            let cpu: f64 = g.iter().filter(|r| &r.cell.optimiser == o).map(|r| r.row.cpu_s).sum();
+            sum_rows.push(vec![o.clone(), format!("{}/{}", err_wins[k], cells.len()), format!("{}/{}", time_wins[k], cells.len()), format!("{}/{}", beats_b[k], cells.len()), format!("{cpu:.2}")]);
+        }
+        s.push_str(&table(&h, &sum_rows));
+        // Claims against the thesis' own tables.
+        let thesis = reference::table(err_name);
+        let thesis_time = reference::table(time_name);
+        let thesis_wins = |t: Option<&reference::RefTable>, suffix: &str, o: &str| -> Option<(usize, usize)> {
+            let t = t?;
+            let names = ["ga", "de", "pso"];
+            let mut w = 0;
+            for row in &t.rows {
+                let v: Vec<f64> = names.iter().filter_map(|n| row.get(&format!("{n}_avg{suffix}")).and_then(|x| x.parse().ok())).collect();
+                if v.len() == 3 {
+                    let k = v.iter().enumerate().min_by(|a, b| a.1.total_cmp(b.1)).map(|x| x.0).unwrap_or(0);
+                    w += (names[k] == o) as usize;
+                }
+            }
+            Some((w, t.rows.len()))
+        };
+        if let Some(k) = opts.iter().position(|o| o == "de") {
+            claims.push(Claim { chapter: "6".into(), statement: format!("DE gives the least average error in most cells (grid {grid})"), ours: (err_wins[k], cells.len()), thesis: thesis_wins(thesis.as_ref(), "", "de"), note: "thesis: 126/140 and 117/140 (Tables 6.4, 6.5); verdict 'mostly holds' when more than half".into() });
+        }
+        if let Some(k) = opts.iter().position(|o| o == "ga") {
+            claims.push(Claim { chapter: "6".into(), statement: format!("GA is the fastest (grid {grid})"), ours: (time_wins[k], cells.len()), thesis: thesis_wins(thesis_time.as_ref(), "_s", "ga"), note: "least AVG CPU time per cell; thesis 140/140 (Tables 6.6, 6.7); GA makes 2 evaluations per generation, DE and PSO 40".into() });
+        }
+        for (k, o) in opts.iter().enumerate() {
+            claims.push(Claim { chapter: "6".into(), statement: format!("{o} lowers the surface error below B (grid {grid})"), ours: (beats_b[k], cells.len()), thesis: None, note: "AVG over repeats below B's error; the +-5e-6 start can leave an optimiser above B".into() });
+        }
+        // Pictures: convergence (median and quartiles over repeats) and box plots for the
+        // largest net with the first parameterisation, per data set.
+        if let Some(&cn) = cells.iter().map(|c| &c.2).max() {
+            let p0 = cells[0].1;
+            for d in ordered(cells.iter().map(|c| c.0.clone())) {
+                let mut series = Vec::new();
+                let mut groups = Vec::new();
+                for (k, o) in opts.iter().enumerate() {
+                    let rs: Vec<&&OptimRun> = g.iter().filter(|r| r.cell.dataset == d && r.cell.param == p0 && r.cell.cn == cn && &r.cell.optimiser == o).collect();
+                    groups.push((o.clone(), rs.iter().map(|r| r.row.best).collect::<Vec<f64>>()));
+                    let marks: Vec<u64> = rs.first().map(|r| r.trace.iter().map(|t| t.0).collect()).unwrap_or_default();
+                    let mut pts = Vec::new();
+                    let mut band = Vec::new();
+                    for (m, &e) in marks.iter().enumerate() {
+                        let mut v: Vec<f64> = rs.iter().filter_map(|r| r.trace.get(m).map(|t| t.1)).collect();
+                        v.sort_by(|a, b| a.total_cmp(b));
+                        if v.is_empty() {
+                            continue;
+                        }
+                        let q = |p: f64| plots::boxplot::quantile_type7(&v, p);
+                        pts.push((e as f64, q(0.5)));
+                        band.push((e as f64, q(0.25), q(0.75)));
+                    }
+                    series.push(Series { label: o.clone(), colour: style::optimiser_colour(o).unwrap_or_else(|| style::cycle_colour(k)), points: pts, band: Some(band) });
+                }
+                let conv = format!("png/convergence_{grid}_{d}_{}_{cn}.png", p0.name());
+                super::fsio::ensure_dir(&out.join("png"))?;
+                if let Err(e) = plots::line_chart_png(&out.join(&conv), &format!("{d}, {} {cn} on {grid}: best fitness (median, quartiles)", p0.name()), "evaluations", "surface error", &series, false) {
+                    eprintln!("somnurbs: warning: picture skipped: {e}");
+                } else {
+                    let _ = writeln!(s, "\n![{conv}]({conv})");
+                }
+                let bx = format!("png/boxplot_{grid}_{d}_{}_{cn}.png", p0.name());
+                if let Err(e) = plots::box_plot_png(&out.join(&bx), &format!("{d}, {} {cn} on {grid}: best surface error per repeat", p0.name()), "surface error", &groups) {
+                    eprintln!("somnurbs: warning: picture skipped: {e}");
+                } else {
+                    let _ = writeln!(s, "\n![{bx}]({bx})");
+                }
+            }
+        }
+    }
+    s.push_str("\n### Claims\n\n");
+    s.push_str(&super::claims::markdown(&claims));
+    Ok(s)
+}
