@@ -26,8 +26,8 @@ pub struct ControlNetProblem {
 
 #[derive(Default)]
 struct Scratch {
-    p: [Vec<f64>; 3],
-    q: [Vec<f64>; 3],
+    p: Vec<[f64; 3]>,
+    q: Vec<[f64; 3]>,
     row: [Vec<f64>; 3],
 }
 
@@ -80,29 +80,23 @@ impl ControlNetProblem {
         SCRATCH.with(|s| {
             let mut s = s.borrow_mut();
             let s = &mut *s;
+            s.p.resize(cn_x * cn_y, [0.0; 3]);
+            s.q.resize(cn_x * ny, [0.0; 3]);
             for c in 0..3 {
-                s.p[c].resize(cn_x * cn_y, 0.0);
-                s.q[c].resize(cn_x * ny, 0.0);
                 s.row[c].resize(ny, 0.0);
             }
             for view in 0..2 {
-                for (k, &cls) in self.class[view].iter().enumerate() {
+                for (pk, &cls) in s.p.iter_mut().zip(&self.class[view]) {
                     let at = 3 * cls as usize;
-                    s.p[0][k] = x[at];
-                    s.p[1][k] = x[at + 1];
-                    s.p[2][k] = x[at + 2];
+                    *pk = [x[at], x[at + 1], x[at + 2]];
                 }
-                // Q = P Nv^T.
-                for c in 0..3 {
-                    let (pc, qc) = (&s.p[c], &mut s.q[c]);
-                    for a in 0..cn_x {
-                        let prow = &pc[a * cn_y..(a + 1) * cn_y];
-                        let qrow = &mut qc[a * ny..(a + 1) * ny];
-                        for j in 0..ny {
-                            let f = p.nv.first[j];
-                            let w = &p.nv.w[j];
-                            qrow[j] = w[0] * prow[f] + w[1] * prow[f + 1] + w[2] * prow[f + 2] + w[3] * prow[f + 3];
-                        }
+                // Q = P Nv^T, the three coordinates at once.
+                for a in 0..cn_x {
+                    let prow = &s.p[a * cn_y..(a + 1) * cn_y];
+                    let qrow = &mut s.q[a * ny..(a + 1) * ny];
+                    for ((q, &f), w) in qrow.iter_mut().zip(&p.nv.first).zip(&p.nv.w) {
+                        let b = &prow[f..f + 4];
+                        *q = [0, 1, 2].map(|c| w[0] * b[0][c] + w[1] * b[1][c] + w[2] * b[2][c] + w[3] * b[3][c]);
                     }
                 }
                 let rows = if view == 0 { 0..nx } else { 1..nx - 1 };
@@ -110,13 +104,16 @@ impl ControlNetProblem {
                 for i in rows {
                     let f = p.nu.first[i];
                     let w = p.nu.w[i];
-                    for c in 0..3 {
-                        let q = &s.q[c];
-                        let (q0, q1, q2, q3) = (&q[f * ny..(f + 1) * ny], &q[(f + 1) * ny..(f + 2) * ny], &q[(f + 2) * ny..(f + 3) * ny], &q[(f + 3) * ny..(f + 4) * ny]);
-                        let row = &mut s.row[c];
-                        for j in 0..ny {
-                            row[j] = w[0] * q0[j] + w[1] * q1[j] + w[2] * q2[j] + w[3] * q3[j];
-                        }
+                    let q = &s.q[f * ny..(f + 4) * ny];
+                    let (q0, rest) = q.split_at(ny);
+                    let (q1, rest) = rest.split_at(ny);
+                    let (q2, q3) = rest.split_at(ny);
+                    let [rx, ry, rz] = &mut s.row;
+                    for j in 0..ny {
+                        let (a, b, c, d) = (q0[j], q1[j], q2[j], q3[j]);
+                        rx[j] = w[0] * a[0] + w[1] * b[0] + w[2] * c[0] + w[3] * d[0];
+                        ry[j] = w[0] * a[1] + w[1] * b[1] + w[2] * c[1] + w[3] * d[1];
+                        rz[j] = w[0] * a[2] + w[1] * b[2] + w[2] * c[2] + w[3] * d[2];
                     }
                     visit(view, i, cols.clone(), &s.row);
                 }
