@@ -11,3 +11,4 @@ pub mod optim;
 pub mod report;
 pub mod som;
 pub mod spline;
+pub mod stats;

@@ -1,0 +1,63 @@
+//! Nonparametric statistics for comparing optimisers: Wilcoxon signed-rank (paired), Wilcoxon
+//! rank-sum / Mann-Whitney U (independent), Friedman with Holm-corrected post-hoc comparisons and
+//! Nemenyi's critical difference, and the Vargha-Delaney A12 effect size. Pure functions over
+//! slices; distributions from statrs.
+
+pub mod effect;
+pub mod friedman;
+pub mod holm;
+pub mod ranks;
+pub mod rank_sum;
+pub mod wilcoxon;
+
+use thiserror::Error;
+
+/// The alternative hypothesis, for x relative to y.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Alternative {
+    TwoSided,
+    /// x tends to be smaller than y.
+    Less,
+    /// x tends to be larger than y.
+    Greater,
+}
+
+/// How a p-value was computed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Method {
+    Exact,
+    Normal,
+}
+
+#[derive(Debug, Error, PartialEq)]
+pub enum StatsError {
+    #[error("samples differ in length ({0} and {1}) for a paired test")]
+    LengthMismatch(usize, usize),
+    #[error("too few observations: {0}")]
+    TooFew(String),
+    #[error("all differences are zero")]
+    AllZero,
+    #[error("non-finite value in the data")]
+    NonFinite,
+}
+
+fn check_finite(v: &[f64]) -> Result<(), StatsError> {
+    if v.iter().all(|x| x.is_finite()) {
+        Ok(())
+    } else {
+        Err(StatsError::NonFinite)
+    }
+}
+
+/// Standard normal upper tail P(Z >= z).
+fn normal_sf(z: f64) -> f64 {
+    use statrs::distribution::{ContinuousCDF, Normal};
+    let n = Normal::new(0.0, 1.0).expect("standard normal");
+    1.0 - n.cdf(z)
+}
+
+/// Standard normal lower tail P(Z <= z).
+fn normal_cdf(z: f64) -> f64 {
+    use statrs::distribution::{ContinuousCDF, Normal};
+    Normal::new(0.0, 1.0).expect("standard normal").cdf(z)
+}
