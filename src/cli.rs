@@ -33,6 +33,19 @@ pub enum Command {
     /// maps/) and write the control nets (CSV), an IGES file and an OBJ mesh.
     #[command(after_help = "Example:\n  somnurbs fit --grid results/ch4_models/maps/dnsom_spindle_20x20.csv --cn 18x18 --param chord_length --approach improved --out fit_spindle")]
     Fit(FitArgs),
+    /// Compare the optimisers of a Chapter 6 results folder: per cell Wilcoxon signed-rank
+    /// (repeats paired by index) and rank-sum tests with A12, and overall Friedman with
+    /// Holm-corrected pairwise tests and a critical-difference diagram.
+    Compare(CompareArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct CompareArgs {
+    /// A results folder written by a spec with an [optim] section (reads its runs.csv).
+    pub results: PathBuf,
+    /// Significance level for the h columns.
+    #[arg(long, default_value_t = 0.05)]
+    pub alpha: f64,
 }
 
 #[derive(Debug, Args)]

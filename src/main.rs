@@ -40,6 +40,10 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             eprintln!("somnurbs: wrote {}", out.join("REPORT.md").display());
             Ok(ExitCode::SUCCESS)
         }
+        Command::Compare(args) => {
+            experiment::compare::compare(&args)?;
+            Ok(ExitCode::SUCCESS)
+        }
         Command::Fit(args) => {
             experiment::fit_cmd::fit(&args)?;
             Ok(ExitCode::SUCCESS)

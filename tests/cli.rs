@@ -387,3 +387,25 @@ fn bad_optimiser_specs_are_refused_before_any_run() {
         assert!(!c.path("o/runs.csv.partial").exists() && !c.path("o/maps").exists(), "{needle}: something ran");
     }
 }
+
+#[test]
+fn compare_writes_statistics_and_refuses_bad_folders() {
+    let c = Case::new();
+    c.write("opt.toml", &CH6_TINY.replace("repeats = 2", "repeats = 6"));
+    c.ok(&["run", "opt.toml", "--out", "o"]);
+    let out = c.ok(&["compare", "o"]);
+    assert!(String::from_utf8_lossy(&out.stdout).contains("Friedman over 2 cells x 3 optimisers"));
+    let (h, rows) = read_csv(&c.path("o/compare_cells.csv"));
+    assert_eq!(rows.len(), 2 * 3);
+    let p = h.iter().position(|x| x == "rank_sum_p").unwrap();
+    assert!(rows.iter().all(|r| (0.0..=1.0).contains(&r[p].parse::<f64>().unwrap())));
+    let (_, overall) = read_csv(&c.path("o/compare_overall.csv"));
+    assert_eq!(overall.len(), 3);
+    assert!(c.path("o/cd_diagram.png").exists());
+    c.fails(&["compare", "missing"], &["missing/runs.csv"]);
+    let text = std::fs::read_to_string(c.path("o/runs.csv")).unwrap();
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    lines[3] = lines[3].replacen(",", ",,", 1);
+    c.write("bad/runs.csv", &lines.join("\n"));
+    c.fails(&["compare", "bad"], &["bad/runs.csv", "line 4"]);
+}

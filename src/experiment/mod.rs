@@ -3,6 +3,7 @@
 pub mod ch4;
 pub mod ch5;
 pub mod ch6;
+pub mod compare;
 pub mod datasets;
 pub mod fit_cmd;
 pub mod runner;
