@@ -5,10 +5,10 @@
 //! to the bounds. Table 6.1 gives CR = 0.8, F = 0.3 (the default); the prose's F = 0.01, CR = 0.8
 //! reading is `f = 0.01`.
 //!
-//! Crossover draws no uniform per gene: the genes kept from the target are reached by geometric
-//! skips with rate 1 - CR, which is the same distribution as one Bernoulli(CR) draw per gene.
+//! Crossover draws 32 random bits per gene (two genes per 64-bit draw): a gene comes from the
+//! mutant when its bits are below CR * 2^32, a Bernoulli(CR) draw with CR rounded to 2^-32.
 
-use super::problem::{clamp_into, geometric_skip, initial_population, Budget, Optimiser, Problem, RunResult, Tracker};
+use super::problem::{clamp_into, initial_population, Budget, Optimiser, Problem, RunResult, Tracker};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use serde::Deserialize;
@@ -54,7 +54,7 @@ impl Optimiser for De {
         if np < 4 {
             return tracker.finish(initial_best);
         }
-        let ln_keep_target = self.cr.ln(); // ln(1 - (1 - CR)): skips over mutant genes
+        let threshold = (self.cr * 4_294_967_296.0).min(4_294_967_296.0) as u64;
         let mut next = pop.clone();
         let mut next_fit = fit.clone();
         let mut trial = vec![0.0; n];
@@ -69,17 +69,17 @@ impl Optimiser for De {
                 let r1 = pick(rng, &[i]);
                 let r2 = pick(rng, &[i, r1]);
                 let r3 = pick(rng, &[i, r1, r2]);
-                let (a, b, c) = (&pop[r1], &pop[r2], &pop[r3]);
-                for g in 0..n {
-                    trial[g] = a[g] + self.f * (b[g] - c[g]);
-                }
+                let (a, b, c, target) = (&pop[r1], &pop[r2], &pop[r3], &pop[i]);
                 let jrand = rng.gen_range(0..n);
-                let mut g = geometric_skip(rng, ln_keep_target);
-                while g < n {
-                    if g != jrand {
-                        trial[g] = pop[i][g];
-                    }
-                    g = g.saturating_add(1).saturating_add(geometric_skip(rng, ln_keep_target));
+                let mut bits = 0u64;
+                for g in 0..n {
+                    let u = if g % 2 == 0 {
+                        bits = rng.gen();
+                        bits >> 32
+                    } else {
+                        bits & 0xffff_ffff
+                    };
+                    trial[g] = if u < threshold || g == jrand { a[g] + self.f * (b[g] - c[g]) } else { target[g] };
                 }
                 clamp_into(&mut trial, lo, hi);
                 let ft = tracker.eval(&trial);
