@@ -5,12 +5,11 @@ use super::spec::{SomCell, Spec};
 use super::{runner, seeds, RunContext};
 use crate::data::PointCloud;
 use crate::geom::Point3;
-use crate::report::fsio::PartialLog;
 use crate::som::{self, FinalMetrics, NeuronCounts, OnlineMetrics, SomParams};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 
 /// One trained SOM cell.
 #[derive(Debug, Clone)]
@@ -103,23 +102,6 @@ pub fn run(spec: &Spec, ctx: &RunContext) -> Result<Vec<SomRun>> {
     let data = load_datasets(&som_spec.datasets, ctx)?;
     let params = SomParams { iterations: som_spec.iterations, alpha0: som_spec.alpha0, sigma0: som_spec.sigma0 };
     let cells = spec.som_cells();
-    let header = csv_header::<SomRow>();
-    let log = Mutex::new(PartialLog::create(&ctx.out.join("runs.csv.partial"), &header)?);
-    runner::run_cells(
-        &cells,
-        ctx.jobs,
-        &spec.file.name,
-        |cell| run_cell(cell, &data[&cell.dataset].points, &params, spec.file.master_seed),
-        |_, run| {
-            let line = crate::report::fsio::csv_text(std::slice::from_ref(&run.row))?;
-            let body = line.lines().nth(1).unwrap_or_default().to_string();
-            log.lock().map_err(|_| anyhow::anyhow!("log lock poisoned"))?.push(&body)
-        },
-    )
+    runner::run_logged(&cells, ctx, &spec.file.name, |cell| run_cell(cell, &data[&cell.dataset].points, &params, spec.file.master_seed), |run: &SomRun| &run.row)
 }
 
-/// The CSV header line of a row type.
-pub fn csv_header<T: Serialize + Default>() -> String {
-    let text = crate::report::fsio::csv_text(&[T::default()]).unwrap_or_default();
-    text.lines().next().unwrap_or_default().to_string()
-}

@@ -4,14 +4,13 @@ use super::spec::{FitCell, Spec};
 use super::{ch4, runner, RunContext};
 use crate::double_net::{DoubleNet, View};
 use crate::experiment::spec::{FitSom, GridSize, SomCell};
-use crate::report::fsio::{write_atomic, PartialLog};
+use crate::report::fsio::write_atomic;
 use crate::som::{Model, SomParams};
 use crate::spline::{fit_two_view, TwoSurfaceFit, TwoViewGrid};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
 
 /// One row of a Chapter 5 `runs.csv`.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
@@ -133,15 +132,5 @@ pub fn run_cell(cell: &FitCell, grid: &TwoViewGrid) -> Result<FitRun> {
 /// Run every fit cell of a spec.
 pub fn run(spec: &Spec, ctx: &RunContext, maps: &BTreeMap<String, MapSource>) -> Result<Vec<FitRun>> {
     let cells = spec.fit_cells();
-    let log = Mutex::new(PartialLog::create(&ctx.out.join("runs.csv.partial"), &ch4::csv_header::<FitRow>())?);
-    runner::run_cells(
-        &cells,
-        ctx.jobs,
-        &spec.file.name,
-        |cell| run_cell(cell, &maps[&cell.dataset].grid),
-        |_, run| {
-            let line = crate::report::fsio::csv_text(std::slice::from_ref(&run.row))?;
-            log.lock().map_err(|_| anyhow::anyhow!("log lock poisoned"))?.push(line.lines().nth(1).unwrap_or_default())
-        },
-    )
+    runner::run_logged(&cells, ctx, &spec.file.name, |cell| run_cell(cell, &maps[&cell.dataset].grid), |run: &FitRun| &run.row)
 }

@@ -3,16 +3,14 @@
 //! runs on its own stream and is logged at once.
 
 use super::spec::{OptimCell, Spec};
-use super::{ch4, ch5, runner, seeds, RunContext};
+use super::{ch5, runner, seeds, RunContext};
 use crate::experiment::spec::GridSize;
 use crate::optim::control_net::ControlNetProblem;
 use crate::optim::{cuckoo::Cuckoo, Budget, Optimiser, Problem, RunResult};
-use crate::report::fsio::PartialLog;
 use crate::spline::{fit_two_view, Approach, Parameterisation};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
-use std::sync::Mutex;
 
 /// One row of a Chapter 6 `runs.csv`.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
@@ -114,15 +112,5 @@ pub fn run_cell(spec: &Spec, cell: &OptimCell, problem: &ControlNetProblem) -> R
 /// Run every optimisation cell of a spec.
 pub fn run(spec: &Spec, ctx: &RunContext, problems: &BTreeMap<ProblemKey, ControlNetProblem>) -> Result<Vec<OptimRun>> {
     let cells = spec.optim_cells();
-    let log = Mutex::new(PartialLog::create(&ctx.out.join("runs.csv.partial"), &ch4::csv_header::<OptimRow>())?);
-    runner::run_cells(
-        &cells,
-        ctx.jobs,
-        &spec.file.name,
-        |cell| run_cell(spec, cell, &problems[&(cell.dataset.clone(), cell.cn, cell.param)]),
-        |_, run| {
-            let line = crate::report::fsio::csv_text(std::slice::from_ref(&run.row))?;
-            log.lock().map_err(|_| anyhow::anyhow!("log lock poisoned"))?.push(line.lines().nth(1).unwrap_or_default())
-        },
-    )
+    runner::run_logged(&cells, ctx, &spec.file.name, |cell| run_cell(spec, cell, &problems[&(cell.dataset.clone(), cell.cn, cell.param)]), |run: &OptimRun| &run.row)
 }

@@ -40,6 +40,23 @@ where
     results
 }
 
+/// Run `work` over `cells` and append each finished cell's row to `<out>/runs.csv.partial` at
+/// once (header first), so a killed run keeps every row it finished.
+pub fn run_logged<C, R, Row>(cells: &[C], ctx: &super::RunContext, label: &str, work: impl Fn(&C) -> Result<R> + Sync, row: impl Fn(&R) -> &Row + Sync) -> Result<Vec<R>>
+where
+    C: Sync,
+    R: Send,
+    Row: serde::Serialize + Default,
+{
+    let header = crate::report::fsio::csv_text(&[Row::default()])?;
+    let header = header.lines().next().unwrap_or_default().to_string();
+    let log = std::sync::Mutex::new(crate::report::fsio::PartialLog::create(&ctx.out.join("runs.csv.partial"), &header)?);
+    run_cells(cells, ctx.jobs, label, work, |_, r| {
+        let text = crate::report::fsio::csv_text(std::slice::from_ref(row(r)))?;
+        log.lock().map_err(|_| anyhow::anyhow!("log lock poisoned"))?.push(text.lines().nth(1).unwrap_or_default())
+    })
+}
+
 /// CPU seconds used by the calling thread so far (CLOCK_THREAD_CPUTIME_ID).
 pub fn thread_cpu_seconds() -> f64 {
     let mut ts = libc::timespec { tv_sec: 0, tv_nsec: 0 };

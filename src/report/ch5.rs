@@ -2,6 +2,7 @@
 //! win-count tables 5.4-5.9, the gap table, the charts and pictures and the REPORT.md section.
 
 use super::claims::Claim;
+use super::ordered;
 use super::fsio::{csv_records, csv_text, write_atomic};
 use super::markdown::{beside, num, table};
 use super::reference::{self, RefTable};
@@ -19,16 +20,6 @@ fn table_names(grid: GridSize) -> (String, String, String, String) {
         (18, 30) => ("appendix_f".into(), "table_5_7".into(), "table_5_8".into(), "table_5_9".into()),
         _ => (format!("surface_error_{grid}"), format!("param_wins_A_{grid}"), format!("param_wins_B_{grid}"), format!("approach_wins_{grid}")),
     }
-}
-
-fn ordered<T: PartialEq + Clone>(items: impl Iterator<Item = T>) -> Vec<T> {
-    let mut out = Vec::new();
-    for x in items {
-        if !out.contains(&x) {
-            out.push(x);
-        }
-    }
-    out
 }
 
 /// Surface error of a (data, cn, param, approach) cell, from the runs or from a published table.

@@ -3,6 +3,7 @@
 //! where it beats B, convergence curves and box plots, and the REPORT.md section.
 
 use super::claims::Claim;
+use super::ordered;
 use super::fsio::{csv_records, csv_text, write_atomic};
 use super::markdown::table;
 use super::plots::{self, style, Series};
@@ -13,16 +14,6 @@ use crate::spline::Parameterisation;
 use anyhow::Result;
 use std::fmt::Write;
 use std::path::Path;
-
-fn ordered<T: PartialEq + Clone>(items: impl Iterator<Item = T>) -> Vec<T> {
-    let mut out = Vec::new();
-    for x in items {
-        if !out.contains(&x) {
-            out.push(x);
-        }
-    }
-    out
-}
 
 fn stats(v: &[f64]) -> Option<(f64, f64, f64)> {
     if v.is_empty() {

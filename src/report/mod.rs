@@ -47,3 +47,14 @@ pub fn report_md(spec: &Spec, m: &Manifest, sections: &[String]) -> String {
     }
     s
 }
+
+/// The distinct items in order of first appearance.
+pub fn ordered<T: PartialEq + Clone>(items: impl Iterator<Item = T>) -> Vec<T> {
+    let mut out = Vec::new();
+    for x in items {
+        if !out.contains(&x) {
+            out.push(x);
+        }
+    }
+    out
+}

@@ -61,3 +61,20 @@ fn normal_cdf(z: f64) -> f64 {
     use statrs::distribution::{ContinuousCDF, Normal};
     Normal::new(0.0, 1.0).expect("standard normal").cdf(z)
 }
+
+/// Normal approximation with continuity correction: (z, p) for a statistic `diff` = S - E[S] with
+/// variance `var`, as R's wilcox.test computes it.
+fn normal_approximation(diff: f64, var: f64, alt: Alternative) -> (f64, f64) {
+    let correction = match alt {
+        Alternative::TwoSided => 0.5 * diff.signum(),
+        Alternative::Greater => 0.5,
+        Alternative::Less => -0.5,
+    };
+    let z = (diff - correction) / var.sqrt();
+    let p = match alt {
+        Alternative::Greater => normal_sf(z),
+        Alternative::Less => normal_cdf(z),
+        Alternative::TwoSided => (2.0 * normal_cdf(-z.abs())).min(1.0),
+    };
+    (z, p)
+}

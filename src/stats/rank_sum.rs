@@ -4,7 +4,7 @@
 //! corrections.
 
 use super::ranks::{midranks, tie_sum};
-use super::{check_finite, normal_cdf, normal_sf, Alternative, Method, StatsError};
+use super::{check_finite, normal_approximation, Alternative, Method, StatsError};
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct RankSum {
@@ -66,18 +66,7 @@ pub fn rank_sum(x: &[f64], y: &[f64], alt: Alternative) -> Result<RankSum, Stats
     let n = a + b;
     let mean = a * b / 2.0;
     let var = a * b / 12.0 * ((n + 1.0) - tie_sum(&ties) / (n * (n - 1.0)));
-    let diff = w - mean;
-    let correction = match alt {
-        Alternative::TwoSided => 0.5 * diff.signum(),
-        Alternative::Greater => 0.5,
-        Alternative::Less => -0.5,
-    };
-    let z = (diff - correction) / var.sqrt();
-    let p = match alt {
-        Alternative::Greater => normal_sf(z),
-        Alternative::Less => normal_cdf(z),
-        Alternative::TwoSided => (2.0 * normal_cdf(-z.abs())).min(1.0),
-    };
+    let (z, p) = normal_approximation(w - mean, var, alt);
     Ok(RankSum { w, z: Some(z), p_value: p, method: Method::Normal })
 }
 
