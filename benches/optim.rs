@@ -19,7 +19,7 @@ fn main() {
     let problem = ControlNetProblem::new(fit.control_net_parts(&grid).unwrap(), 0.0);
     let x0 = problem.initial_point().to_vec();
     println!("control-net problem 18x18 on 20x20: {} variables, B = {:.6}", problem.dim(), problem.fitness(&x0));
-    let reps = 200_000;
+    let reps: usize = std::env::var("BENCH_REPS").ok().and_then(|v| v.parse().ok()).unwrap_or(200_000);
     let t0 = runner::thread_cpu_seconds();
     let mut acc = 0.0;
     for k in 0..reps {
@@ -39,7 +39,8 @@ fn main() {
     };
     let per = (runner::thread_cpu_seconds() - t0 - clone_cost) / reps as f64;
     println!("fitness: {:.3} us per evaluation ({:.2} M evaluations/s; target 1.5 us, numpy 8.3 us: {:.1}x, thesis DE ~600 us: {:.0}x)", per * 1e6, 1e-6 / per, 8.3e-6 / per, 600e-6 / per);
-    let budget = Budget { generations: 2000, population: 40, init_range: 5e-6 };
+    let generations: usize = std::env::var("BENCH_GENERATIONS").ok().and_then(|v| v.parse().ok()).unwrap_or(2000);
+    let budget = Budget { generations, population: 40, init_range: 5e-6 };
     for opt in [&De::default() as &dyn Optimiser, &Ga::default(), &Pso::default()] {
         let mut rng = somnurbs::experiment::seeds::cell_rng(1, "bench");
         let t = Instant::now();

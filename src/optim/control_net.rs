@@ -26,9 +26,15 @@ pub struct ControlNetProblem {
 
 #[derive(Default)]
 struct Scratch {
-    p: Vec<[f64; 3]>,
-    q: Vec<[f64; 3]>,
-    row: [Vec<f64>; 3],
+    /// P of one view, per coordinate, row-major (a * cn_y + b).
+    p: [Vec<f64>; 3],
+    /// S = Nu P, per coordinate, row-major (i * cn_y + b).
+    s: [Vec<f64>; 3],
+    /// S transposed (b * nx + i).
+    st: [Vec<f64>; 3],
+    /// One column of D^G (over i) per coordinate.
+    col: [Vec<f64>; 3],
+    dist: Vec<f64>,
 }
 
 thread_local! {
@@ -41,7 +47,9 @@ impl ControlNetProblem {
     pub fn new(parts: ControlNetParts, margin: f64) -> ControlNetProblem {
         let cn = DoubleNet::new(parts.cn_x, parts.cn_y).expect("control net sides at least 4");
         let class = View::BOTH.map(|v| cn.classes(v).iter().map(|&c| c as u32).collect::<Vec<u32>>());
-        let data = [&parts.data_bottom, &parts.data_top].map(|d| [0, 1, 2].map(|c| d.iter().map(|p| p[c]).collect::<Vec<f64>>()));
+        let (nx, ny) = (parts.nx, parts.ny);
+        // Data transposed (j * nx + i), the order the columns of D^G come in.
+        let data = [&parts.data_bottom, &parts.data_top].map(|d| [0, 1, 2].map(|c| (0..nx * ny).map(|k| d[(k % nx) * ny + k / nx][c]).collect::<Vec<f64>>()));
         let mut lo = [f64::INFINITY; 3];
         let mut hi = [f64::NEG_INFINITY; 3];
         let points = parts.data_bottom.iter().chain(&parts.data_top).copied().chain(parts.x0.chunks(3).map(|c| [c[0], c[1], c[2]]));
@@ -64,58 +72,76 @@ impl ControlNetProblem {
         &self.parts
     }
 
-    /// Walk every scored position: `visit(view, i, j, fitted point)`.
+    /// Walk every scored position: `visit(view, i, j, fitted point)`, column by column (j outer).
     fn forward(&self, x: &[f64], mut visit: impl FnMut(usize, usize, usize, [f64; 3])) {
-        self.forward_rows(x, |view, i, cols, row| {
-            for j in cols {
-                visit(view, i, j, [row[0][j], row[1][j], row[2][j]]);
+        self.forward_columns(x, |view, j, rows, col| {
+            for i in rows {
+                visit(view, i, j, [col[0][i], col[1][i], col[2][i]]);
             }
         });
     }
 
-    /// Walk every scored grid row: `visit(view, i, scored columns, fitted x/y/z of the row)`.
-    fn forward_rows(&self, x: &[f64], mut visit: impl FnMut(usize, usize, std::ops::Range<usize>, &[Vec<f64>; 3])) {
+    /// Walk every scored grid column j of each view: `visit(view, j, scored rows, fitted x/y/z of
+    /// the column indexed by i)`. S = Nu P runs along contiguous rows of P, then S is transposed so
+    /// that each column of D^G = S Nv^T is four scaled contiguous rows of S^T.
+    fn forward_columns(&self, x: &[f64], mut visit: impl FnMut(usize, usize, std::ops::Range<usize>, &[Vec<f64>; 3])) {
         let p = &self.parts;
         let (nx, ny, cn_x, cn_y) = (p.nx, p.ny, p.cn_x, p.cn_y);
         SCRATCH.with(|s| {
             let mut s = s.borrow_mut();
             let s = &mut *s;
-            s.p.resize(cn_x * cn_y, [0.0; 3]);
-            s.q.resize(cn_x * ny, [0.0; 3]);
-            for c in 0..3 {
-                s.row[c].resize(ny, 0.0);
+            if s.p[0].len() != cn_x * cn_y || s.s[0].len() != nx * cn_y {
+                for c in 0..3 {
+                    s.p[c] = vec![0.0; cn_x * cn_y];
+                    s.s[c] = vec![0.0; nx * cn_y];
+                    s.st[c] = vec![0.0; cn_y * nx];
+                    s.col[c] = vec![0.0; nx];
+                }
             }
             for view in 0..2 {
-                for (pk, &cls) in s.p.iter_mut().zip(&self.class[view]) {
+                for (k, &cls) in self.class[view].iter().enumerate() {
                     let at = 3 * cls as usize;
-                    *pk = [x[at], x[at + 1], x[at + 2]];
-                }
-                // Q = P Nv^T, the three coordinates at once.
-                for a in 0..cn_x {
-                    let prow = &s.p[a * cn_y..(a + 1) * cn_y];
-                    let qrow = &mut s.q[a * ny..(a + 1) * ny];
-                    for ((q, &f), w) in qrow.iter_mut().zip(&p.nv.first).zip(&p.nv.w) {
-                        let b = &prow[f..f + 4];
-                        *q = [0, 1, 2].map(|c| w[0] * b[0][c] + w[1] * b[1][c] + w[2] * b[2][c] + w[3] * b[3][c]);
-                    }
+                    s.p[0][k] = x[at];
+                    s.p[1][k] = x[at + 1];
+                    s.p[2][k] = x[at + 2];
                 }
                 let rows = if view == 0 { 0..nx } else { 1..nx - 1 };
-                let cols = if view == 0 { 0..ny } else { 1..ny - 1 };
-                for i in rows {
-                    let f = p.nu.first[i];
-                    let w = p.nu.w[i];
-                    let q = &s.q[f * ny..(f + 4) * ny];
-                    let (q0, rest) = q.split_at(ny);
-                    let (q1, rest) = rest.split_at(ny);
-                    let (q2, q3) = rest.split_at(ny);
-                    let [rx, ry, rz] = &mut s.row;
-                    for j in 0..ny {
-                        let (a, b, c, d) = (q0[j], q1[j], q2[j], q3[j]);
-                        rx[j] = w[0] * a[0] + w[1] * b[0] + w[2] * c[0] + w[3] * d[0];
-                        ry[j] = w[0] * a[1] + w[1] * b[1] + w[2] * c[1] + w[3] * d[1];
-                        rz[j] = w[0] * a[2] + w[1] * b[2] + w[2] * c[2] + w[3] * d[2];
+                for c in 0..3 {
+                    let (pc, sc) = (&s.p[c], &mut s.s[c]);
+                    for i in rows.clone() {
+                        let (f, w) = (p.nu.first[i], p.nu.w[i]);
+                        let block = &pc[f * cn_y..(f + 4) * cn_y];
+                        let (p0, rest) = block.split_at(cn_y);
+                        let (p1, rest) = rest.split_at(cn_y);
+                        let (p2, p3) = rest.split_at(cn_y);
+                        let out = &mut sc[i * cn_y..(i + 1) * cn_y];
+                        for ((((o, a), b), c), d) in out.iter_mut().zip(p0).zip(p1).zip(p2).zip(p3) {
+                            *o = w[0] * a + w[1] * b + w[2] * c + w[3] * d;
+                        }
                     }
-                    visit(view, i, cols.clone(), &s.row);
+                    let st = &mut s.st[c];
+                    for i in rows.clone() {
+                        for b in 0..cn_y {
+                            st[b * nx + i] = sc[i * cn_y + b];
+                        }
+                    }
+                }
+                let cols = if view == 0 { 0..ny } else { 1..ny - 1 };
+                for j in cols {
+                    let (f, w) = (p.nv.first[j], p.nv.w[j]);
+                    for c in 0..3 {
+                        let block = &s.st[c][f * nx..(f + 4) * nx];
+                        let (s0, rest) = block.split_at(nx);
+                        let (s1, rest) = rest.split_at(nx);
+                        let (s2, s3) = rest.split_at(nx);
+                        let r = rows.clone();
+                        let col = &mut s.col[c][r.clone()];
+                        let (s0, s1, s2, s3) = (&s0[r.clone()], &s1[r.clone()], &s2[r.clone()], &s3[r]);
+                        for ((((o, a), b), c), d) in col.iter_mut().zip(s0).zip(s1).zip(s2).zip(s3) {
+                            *o = w[0] * a + w[1] * b + w[2] * c + w[3] * d;
+                        }
+                    }
+                    visit(view, j, rows.clone(), &s.col);
                 }
             }
         });
@@ -134,19 +160,28 @@ impl Problem for ControlNetProblem {
     }
     /// Eq. 6.2: sum over the NOV grid classes of |D - D^G|.
     fn fitness(&self, x: &[f64]) -> f64 {
-        let ny = self.parts.ny;
+        let nx = self.parts.nx;
         let mut e = 0.0;
-        self.forward_rows(x, |view, i, cols, row| {
+        self.forward_columns(x, |view, j, rows, col| {
             let d = &self.data[view];
-            let (lo, hi) = (i * ny + cols.start, i * ny + cols.end);
+            let (lo, hi) = (j * nx + rows.start, j * nx + rows.end);
             let (dx, dy, dz) = (&d[0][lo..hi], &d[1][lo..hi], &d[2][lo..hi]);
-            let (gx, gy, gz) = (&row[0][cols.clone()], &row[1][cols.clone()], &row[2][cols.clone()]);
-            let mut sum = 0.0;
-            for j in 0..gx.len() {
-                let (a, b, c) = (gx[j] - dx[j], gy[j] - dy[j], gz[j] - dz[j]);
-                sum += (a * a + b * b + c * c).sqrt();
+            let (gx, gy, gz) = (&col[0][rows.clone()], &col[1][rows.clone()], &col[2][rows.clone()]);
+            // Four partial sums in a fixed order: the square roots vectorise, the result is the same
+            // whatever the thread.
+            let mut acc = [0.0f64; 4];
+            let n4 = gx.len() / 4 * 4;
+            for k in (0..n4).step_by(4) {
+                for l in 0..4 {
+                    let (a, b, c) = (gx[k + l] - dx[k + l], gy[k + l] - dy[k + l], gz[k + l] - dz[k + l]);
+                    acc[l] += (a * a + b * b + c * c).sqrt();
+                }
             }
-            e += sum;
+            for k in n4..gx.len() {
+                let (a, b, c) = (gx[k] - dx[k], gy[k] - dy[k], gz[k] - dz[k]);
+                acc[k - n4] += (a * a + b * b + c * c).sqrt();
+            }
+            e += (acc[0] + acc[1]) + (acc[2] + acc[3]);
         });
         e
     }
@@ -159,13 +194,14 @@ impl ControlNetProblem {
         nx * ny + (nx - 2) * (ny - 2)
     }
 
-    /// The residuals D^G - D at every scored position (bottom view, then the top interior).
+    /// The residuals D^G - D at every scored position (bottom view, then the top interior;
+    /// column by column).
     pub fn residuals(&self, x: &[f64], out: &mut Vec<[f64; 3]>) {
         out.clear();
-        let ny = self.parts.ny;
+        let nx = self.parts.nx;
         self.forward(x, |view, i, j, g| {
             let d = &self.data[view];
-            let at = i * ny + j;
+            let at = j * nx + i;
             out.push([g[0] - d[0][at], g[1] - d[1][at], g[2] - d[2][at]]);
         });
     }
@@ -181,9 +217,9 @@ impl ControlNetProblem {
             let mut yq = vec![[0.0; 3]; cn_x * ny];
             let rows = if view == 0 { 0..nx } else { 1..nx - 1 };
             let cols = if view == 0 { 0..ny } else { 1..ny - 1 };
-            for i in rows {
-                let (f, w) = (p.nu.first[i], p.nu.w[i]);
-                for j in cols.clone() {
+            for j in cols {
+                for i in rows.clone() {
+                    let (f, w) = (p.nu.first[i], p.nu.w[i]);
                     let yy = y[k];
                     k += 1;
                     for t in 0..4 {
