@@ -40,6 +40,9 @@ fn main() {
     let per = (runner::thread_cpu_seconds() - t0 - clone_cost) / reps as f64;
     println!("fitness: {:.3} us per evaluation ({:.2} M evaluations/s; target 1.5 us, numpy 8.3 us: {:.1}x, thesis DE ~600 us: {:.0}x)", per * 1e6, 1e-6 / per, 8.3e-6 / per, 600e-6 / per);
     let generations: usize = std::env::var("BENCH_GENERATIONS").ok().and_then(|v| v.parse().ok()).unwrap_or(2000);
+    let t = Instant::now();
+    let ex = somnurbs::optim::exact::solve(&problem, 1e-6, 200_000);
+    println!("exact optimum (PDHG): f {:.9}, certified lower bound {:.9}, gap {:.2e} ({:.1e} relative), {} iterations, {:.2} s; B is {:.3e} above it", ex.f, ex.lower_bound, ex.gap, ex.gap / ex.f, ex.iterations, t.elapsed().as_secs_f64(), problem.fitness(&x0) - ex.f);
     let budget = Budget { generations, population: 40, init_range: 5e-6 };
     for opt in [&De::default() as &dyn Optimiser, &Ga::default(), &Pso::default()] {
         let mut rng = somnurbs::experiment::seeds::cell_rng(1, "bench");

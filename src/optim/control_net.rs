@@ -34,7 +34,6 @@ struct Scratch {
     st: [Vec<f64>; 3],
     /// One column of D^G (over i) per coordinate.
     col: [Vec<f64>; 3],
-    dist: Vec<f64>,
 }
 
 thread_local! {
@@ -204,6 +203,35 @@ impl ControlNetProblem {
             let at = j * nx + i;
             out.push([g[0] - d[0][at], g[1] - d[1][at], g[2] - d[2][at]]);
         });
+    }
+
+    /// The sparse rows of x -> D^G, one per scored position (same order as `residuals`): the
+    /// (control-net class, weight) pairs and the data point, so that r_k = sum w P_class - d_k.
+    pub fn rows(&self) -> Vec<(Vec<(u32, f64)>, [f64; 3])> {
+        let p = &self.parts;
+        let (nx, ny, cn_y) = (p.nx, p.ny, p.cn_y);
+        let mut out = Vec::new();
+        for view in 0..2 {
+            let cols = if view == 0 { 0..ny } else { 1..ny - 1 };
+            for j in cols {
+                let rows = if view == 0 { 0..nx } else { 1..nx - 1 };
+                for i in rows {
+                    let mut entries = Vec::with_capacity(16);
+                    for s in 0..4 {
+                        for t in 0..4 {
+                            let w = p.nu.w[i][s] * p.nv.w[j][t];
+                            if w != 0.0 {
+                                entries.push((self.class[view][(p.nu.first[i] + s) * cn_y + p.nv.first[j] + t], w));
+                            }
+                        }
+                    }
+                    let at = j * nx + i;
+                    let d = &self.data[view];
+                    out.push((entries, [d[0][at], d[1][at], d[2][at]]));
+                }
+            }
+        }
+        out
     }
 
     /// The adjoint of x -> D^G: g = sum_k A_k^T y_k.

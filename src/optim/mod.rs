@@ -5,6 +5,7 @@
 pub mod control_net;
 pub mod cuckoo;
 pub mod de;
+pub mod exact;
 pub mod ga;
 pub mod problem;
 pub mod pso;
