@@ -409,3 +409,24 @@ fn compare_writes_statistics_and_refuses_bad_folders() {
     c.write("bad/runs.csv", &lines.join("\n"));
     c.fails(&["compare", "bad"], &["bad/runs.csv", "line 4"]);
 }
+
+#[test]
+fn exact_optimum_bounds_every_run_from_below() {
+    let c = Case::new();
+    c.write("opt.toml", &CH6_TINY.replace("maps = \"nowhere\"", "maps = \"nowhere\"\nexact = true\ninit_range = 1e-3"));
+    c.ok(&["run", "opt.toml", "--out", "o"]);
+    let (h, rows) = read_csv(&c.path("o/exact_20x20.csv"));
+    let col = |n: &str| h.iter().position(|x| x == n).unwrap();
+    let (_, runs) = read_csv(&c.path("o/runs.csv"));
+    let (rh, _) = read_csv(&c.path("o/runs.csv"));
+    let best = rh.iter().position(|x| x == "best").unwrap();
+    let cn = rh.iter().position(|x| x == "cn_x").unwrap();
+    for r in &rows {
+        let (f, lb): (f64, f64) = (r[col("exact_f")].parse().unwrap(), r[col("lower_bound")].parse().unwrap());
+        let b: f64 = r[col("b")].parse().unwrap();
+        assert!(lb <= f && f <= b, "{r:?}");
+        for run in runs.iter().filter(|x| x[cn] == r[col("cn_x")]) {
+            assert!(run[best].parse::<f64>().unwrap() >= lb, "{run:?} beats the certified bound {lb}");
+        }
+    }
+}

@@ -44,7 +44,19 @@ pub struct OptimRun {
     pub trace: Vec<(u64, f64)>,
 }
 
-type ProblemKey = (String, GridSize, Parameterisation);
+pub type ProblemKey = (String, GridSize, Parameterisation);
+
+/// The certified exact optimum of every problem, when the spec asks for it (deterministic, so
+/// computed once per problem and in parallel).
+pub fn exact_optima(spec: &Spec, ctx: &RunContext, problems: &BTreeMap<ProblemKey, ControlNetProblem>) -> Result<BTreeMap<ProblemKey, crate::optim::exact::ExactResult>> {
+    let o = spec.file.optim.as_ref().context("spec has no [optim] section")?;
+    if !o.exact {
+        return Ok(BTreeMap::new());
+    }
+    let keys: Vec<&ProblemKey> = problems.keys().collect();
+    let solved = runner::run_cells(&keys, ctx.jobs, "exact optima", |k| Ok(crate::optim::exact::solve(&problems[*k], 1e-6, o.exact_iterations)), |_, _| Ok(()))?;
+    Ok(keys.into_iter().cloned().zip(solved).collect())
+}
 
 /// Build the optimiser a cell names, with the spec's parameters.
 pub fn optimiser(spec: &Spec, name: &str) -> Result<Box<dyn Optimiser>> {

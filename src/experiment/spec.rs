@@ -193,6 +193,13 @@ pub struct OptimSpec {
     pub maps: Option<String>,
     #[serde(default)]
     pub som: Option<FitSom>,
+    /// Also solve each cell's convex problem exactly in the box (certified) and report every
+    /// optimiser's gap to it.
+    #[serde(default)]
+    pub exact: bool,
+    /// Iteration cap of the exact solver.
+    #[serde(default = "default_exact_iterations")]
+    pub exact_iterations: usize,
     #[serde(default)]
     pub ga: crate::optim::ga::Ga,
     #[serde(default)]
@@ -213,6 +220,9 @@ fn default_generations() -> usize {
 }
 fn default_population() -> usize {
     40
+}
+fn default_exact_iterations() -> usize {
+    50_000
 }
 fn default_init_range() -> f64 {
     5e-6
