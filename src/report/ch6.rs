@@ -220,6 +220,8 @@ pub fn write(runs: &[OptimRun], exact: &BTreeMap<ProblemKey, ExactResult>, out: 
             }
         }
     }
+    let n_ioh = super::ioh::write(runs, out)?;
+    let _ = writeln!(s, "\nConvergence traces of every run in the IOHprofiler format (`ioh/<optimiser>/`, {n_ioh} problem files), loadable by IOHanalyzer.");
     let kept = runs.iter().filter(|r| r.row.best <= r.row.initial_best).count();
     claims.push(Claim { chapter: "6".into(), statement: "Every run's best is no worse than its initial population's best".into(), ours: (kept, runs.len()), thesis: None, note: "elitism check over all runs".into() });
     s.push_str("\n### Claims\n\n");

@@ -7,6 +7,7 @@ pub mod ch5_pictures;
 pub mod ch6;
 pub mod claims;
 pub mod fsio;
+pub mod ioh;
 pub mod markdown;
 pub mod plots;
 pub mod reference;
