@@ -11,6 +11,24 @@ use std::collections::BTreeMap;
 
 type CellKey = (String, usize, usize, usize, usize, String);
 
+/// The blocks x treatments table of the Friedman test: one row per cell (data, grid, net,
+/// parameterisation) that every optimiser ran, the mean best fitness over repeats of each
+/// optimiser (in order of first appearance).
+pub fn friedman_table(rows: &[OptimRow]) -> (Vec<String>, Vec<Vec<f64>>) {
+    let mut opts: Vec<String> = Vec::new();
+    let mut cells: BTreeMap<CellKey, BTreeMap<String, (f64, usize)>> = BTreeMap::new();
+    for r in rows {
+        if !opts.contains(&r.optimiser) {
+            opts.push(r.optimiser.clone());
+        }
+        let e = cells.entry((r.dataset.clone(), r.grid_x, r.grid_y, r.cn_x, r.cn_y, r.parameterisation.clone())).or_default().entry(r.optimiser.clone()).or_default();
+        e.0 += r.best;
+        e.1 += 1;
+    }
+    let table = cells.values().filter(|per| opts.iter().all(|o| per.contains_key(o))).map(|per| opts.iter().map(|o| per[o].0 / per[o].1 as f64).collect()).collect();
+    (opts, table)
+}
+
 pub fn compare(args: &CompareArgs) -> Result<()> {
     let path = args.results.join("runs.csv");
     let mut reader = csv::Reader::from_path(&path).with_context(|| format!("cannot read {}", path.display()))?;
@@ -81,11 +99,7 @@ pub fn compare(args: &CompareArgs) -> Result<()> {
     }
     write_atomic(&args.results.join("compare_cells.csv"), csv_records(&header, &out)?.as_bytes())?;
     // Overall: Friedman over cells on the mean best of each optimiser.
-    let table: Vec<Vec<f64>> = cells
-        .values()
-        .filter(|per| opts.iter().all(|o| per.contains_key(o)))
-        .map(|per| opts.iter().map(|o| per[o].iter().map(|x| x.1).sum::<f64>() / per[o].len() as f64).collect())
-        .collect();
+    let (_, table) = friedman_table(&rows);
     let f = friedman(&table).map_err(|e| anyhow::anyhow!("{}: Friedman test: {e}", path.display()))?;
     let oh: Vec<String> = ["x", "y", "mean_rank_x", "mean_rank_y", "z", "p", "p_holm", "cells_x_better", "cells_y_better"].iter().map(|s| s.to_string()).collect();
     let orows: Vec<Vec<String>> = f

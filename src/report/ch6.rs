@@ -220,6 +220,17 @@ pub fn write(runs: &[OptimRun], exact: &BTreeMap<ProblemKey, ExactResult>, out: 
             }
         }
     }
+    let all_rows: Vec<crate::experiment::ch6::OptimRow> = runs.iter().map(|r| r.row.clone()).collect();
+    let (fopts, ftable) = crate::experiment::compare::friedman_table(&all_rows);
+    if fopts.len() > 1 {
+        if let Ok(f) = crate::stats::friedman::friedman(&ftable) {
+            let _ = writeln!(s, "\n### Statistics over all cells\n\nFriedman test over {} cells (mean best per optimiser): chi-squared {:.3}, df {}, p = {:.3e}. Mean ranks (1 = least error): {}.{}\n", f.blocks, f.chi_squared, f.df, f.p_value, fopts.iter().zip(&f.mean_ranks).map(|(o, r)| format!("{o} {r:.2}")).collect::<Vec<_>>().join(", "), f.critical_difference.map(|cd| format!(" Nemenyi critical difference (alpha 0.05): {cd:.3}.")).unwrap_or_default());
+            let h: Vec<String> = ["pair", "z", "p", "p (Holm)"].iter().map(|x| x.to_string()).collect();
+            let rows: Vec<Vec<String>> = f.pairwise.iter().map(|&(i, j, z, p, ph)| vec![format!("{} vs {}", fopts[i], fopts[j]), format!("{z:.3}"), format!("{p:.3e}"), format!("{ph:.3e}")]).collect();
+            s.push_str(&table(&h, &rows));
+            s.push_str("\nPer-cell Wilcoxon signed-rank and rank-sum tests with A12 effect sizes and a critical-difference diagram: `somnurbs compare <this folder>`.\n");
+        }
+    }
     let n_ioh = super::ioh::write(runs, out)?;
     let _ = writeln!(s, "\nConvergence traces of every run in the IOHprofiler format (`ioh/<optimiser>/`, {n_ioh} problem files), loadable by IOHanalyzer.");
     let kept = runs.iter().filter(|r| r.row.best <= r.row.initial_best).count();
