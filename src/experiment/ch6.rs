@@ -42,6 +42,8 @@ pub struct OptimRun {
     pub cell: OptimCell,
     pub row: OptimRow,
     pub trace: Vec<(u64, f64)>,
+    /// The best control points found (for the pictures of Appendices I/J).
+    pub best_x: Vec<f64>,
 }
 
 pub type ProblemKey = (String, GridSize, Parameterisation);
@@ -118,7 +120,7 @@ pub fn run_cell(spec: &Spec, cell: &OptimCell, problem: &ControlNetProblem) -> R
         evaluations: r.evaluations,
         cpu_s,
     };
-    Ok(OptimRun { cell: cell.clone(), row, trace: r.trace })
+    Ok(OptimRun { cell: cell.clone(), row, trace: r.trace, best_x: r.best_x })
 }
 
 /// Run every optimisation cell of a spec.

@@ -110,7 +110,7 @@ pub fn run_spec(spec: &Spec, ctx: &RunContext) -> Result<PathBuf> {
         let problems = ch6::problems(spec, ctx)?;
         let exact = ch6::exact_optima(spec, ctx, &problems)?;
         let runs = ch6::run(spec, ctx, &problems)?;
-        let section = crate::report::ch6::write(&runs, &exact, &ctx.out)?;
+        let section = crate::report::ch6::write(&runs, &problems, &exact, &ctx.out)?;
         (section, runs.iter().map(|r| r.row.cpu_s).sum::<f64>(), runs.len())
     } else {
         let maps = ch5::maps(spec, ctx)?;

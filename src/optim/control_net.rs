@@ -197,6 +197,29 @@ impl ControlNetProblem {
         nx * ny + (nx - 2) * (ny - 2)
     }
 
+    /// The fitted two-view grid D^G of a decision vector (the top view's border is the bottom's:
+    /// both views share their border control points).
+    pub fn fitted_grid(&self, x: &[f64]) -> crate::double_net::TwoViewGrid {
+        let (nx, ny) = (self.parts.nx, self.parts.ny);
+        let mut bottom = vec![[0.0; 3]; nx * ny];
+        let mut top = vec![[0.0; 3]; nx * ny];
+        self.forward(x, |view, i, j, g| {
+            if view == 0 {
+                bottom[i * ny + j] = g;
+            } else {
+                top[i * ny + j] = g;
+            }
+        });
+        for i in 0..nx {
+            for j in 0..ny {
+                if i == 0 || j == 0 || i + 1 == nx || j + 1 == ny {
+                    top[i * ny + j] = bottom[i * ny + j];
+                }
+            }
+        }
+        crate::double_net::TwoViewGrid { nx, ny, bottom, top }
+    }
+
     /// The residuals D^G - D at every scored position (bottom view, then the top interior;
     /// column by column).
     pub fn residuals(&self, x: &[f64], out: &mut Vec<[f64; 3]>) {
@@ -301,6 +324,19 @@ pub mod tests {
                 let fast = pr.fitness(&point);
                 let dense = pr.parts().surface_error(&point);
                 assert!((fast - dense).abs() <= 1e-12 * dense, "{nx}x{ny} {cx}x{cy}: {fast} vs {dense}");
+            }
+        }
+    }
+
+    #[test]
+    fn fitted_grid_is_approach_b_at_the_start() {
+        let g = crate::spline::approach::tests::test_grid(14, 11, 0.03);
+        let fit = fit_two_view(&g, 8, 7, Parameterisation::ChordLength, Approach::Improved).unwrap();
+        let pr = ControlNetProblem::new(fit.control_net_parts(&g).unwrap(), 0.0);
+        let grid = pr.fitted_grid(pr.initial_point());
+        for (a, b) in grid.bottom.iter().chain(&grid.top).zip(fit.fitted_bottom.iter().chain(&fit.fitted_top)) {
+            for c in 0..3 {
+                assert!((a[c] - b[c]).abs() < 1e-12, "{a:?} vs {b:?}");
             }
         }
     }

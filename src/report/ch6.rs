@@ -9,7 +9,9 @@ use super::markdown::table;
 use super::plots::{self, style, Series};
 use super::reference;
 use crate::experiment::ch6::{OptimRun, ProblemKey};
+use crate::optim::control_net::ControlNetProblem;
 use crate::optim::exact::ExactResult;
+use crate::optim::Problem;
 use std::collections::BTreeMap;
 use crate::experiment::spec::GridSize;
 use crate::spline::Parameterisation;
@@ -28,7 +30,7 @@ fn stats(v: &[f64]) -> Option<(f64, f64, f64)> {
 type CellKey = (String, Parameterisation, GridSize);
 
 /// Write every Chapter 6 file; returns the REPORT.md section.
-pub fn write(runs: &[OptimRun], exact: &BTreeMap<ProblemKey, ExactResult>, out: &Path) -> Result<String> {
+pub fn write(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProblem>, exact: &BTreeMap<ProblemKey, ExactResult>, out: &Path) -> Result<String> {
     let rows: Vec<_> = runs.iter().map(|r| r.row.clone()).collect();
     write_atomic(&out.join("runs.csv"), csv_text(&rows)?.as_bytes())?;
     let mut s = String::from("## Chapter 6: optimisation of the control points\n\n");
@@ -178,6 +180,47 @@ pub fn write(runs: &[OptimRun], exact: &BTreeMap<ProblemKey, ExactResult>, out: 
             write_atomic(&out.join(&name), csv_records(&h, &rows)?.as_bytes())?;
             let _ = writeln!(s, "\n`{name}`: the convex problem solved in its box (primal-dual hybrid gradient) with a proven lower bound; each optimiser's best minus the exact value.\n\n{}", table(&h, &rows));
             claims.push(Claim { chapter: "6 (beyond)".into(), statement: format!("No optimiser beats the certified lower bound (grid {grid})"), ours: (checked - below, checked), thesis: None, note: "a sanity check of the bound and the fitness".into() });
+        }
+        // Appendix I/J: B beside the MIN-error surface of each optimiser, largest net, per data set.
+        if let Some(&cn) = cells.iter().map(|c| &c.2).max() {
+            let appendix = match (grid.nx, grid.ny) {
+                (20, 20) => "appendix_i",
+                (18, 30) => "appendix_j",
+                _ => "optimised_surfaces",
+            };
+            let params: Vec<Parameterisation> = ordered(cells.iter().map(|c| c.1));
+            for d in ordered(cells.iter().map(|c| c.0.clone())) {
+                let mut panels = Vec::new();
+                for &p in &params {
+                    let Some(problem) = problems.get(&(d.clone(), cn, p)) else { continue };
+                    let meshes = |x: &[f64]| {
+                        let g = problem.fitted_grid(x);
+                        let edges = plots::grid_edges(g.nx, g.ny);
+                        vec![
+                            plots::LineMesh { points: g.bottom, edges: edges.clone(), colour: style::DNSOM_BOTTOM, label: "bottom surface".into() },
+                            plots::LineMesh { points: g.top, edges, colour: style::DNSOM_TOP, label: "top surface".into() },
+                        ]
+                    };
+                    panels.push(plots::Panel { title: format!("{} {cn} B ({:.4})", p.name(), problem.fitness(problem.initial_point())), meshes: meshes(problem.initial_point()) });
+                    for o in &opts {
+                        let min = g.iter().filter(|r| r.cell.dataset == d && r.cell.param == p && r.cell.cn == cn && &r.cell.optimiser == o).min_by(|a, b| a.row.best.total_cmp(&b.row.best));
+                        if let Some(r) = min {
+                            panels.push(plots::Panel { title: format!("{} MIN {} ({:.4})", o.to_uppercase(), p.name(), r.row.best), meshes: meshes(&r.best_x) });
+                        }
+                    }
+                }
+                if panels.is_empty() {
+                    continue;
+                }
+                super::fsio::ensure_dir(&out.join("png"))?;
+                let name = format!("png/{appendix}_{d}.png");
+                match plots::overview_png(&out.join(&name), &format!("{d}, {cn} on {grid}: approach B and the MIN-error surface of each optimiser"), &panels, opts.len() + 1) {
+                    Ok(()) => {
+                        let _ = writeln!(s, "\n![{name}]({name})");
+                    }
+                    Err(e) => eprintln!("somnurbs: warning: picture skipped: {e}"),
+                }
+            }
         }
         // Pictures: convergence (median and quartiles over repeats) and box plots for the
         // largest net with the first parameterisation, per data set.

@@ -71,6 +71,7 @@ mod tests {
             cell: OptimCell { dataset: "cube".into(), grid: GridSize { nx: 20, ny: 20 }, cn: GridSize { nx: 6, ny: 6 }, param: crate::spline::Parameterisation::Uniform, optimiser: "de".into(), repeat: rep },
             row: OptimRow { evaluations: 80, best, dimension: 156, ..Default::default() },
             trace: vec![(1, 3.0), (50, 2.5), (80, best)],
+            best_x: Vec::new(),
         };
         let (a, b) = (run(0, 2.0), run(1, 1.5));
         let (info, dat) = texts(4, "cube_x", "de", 156, &[&a, &b]);
