@@ -4,7 +4,7 @@
 //! (target under 0.2 s; scipy's differential_evolution 2.75 s; the thesis 48 s), and GA and PSO runs.
 
 use somnurbs::experiment::{ch4, ch5, runner, spec::{GridSize, SomCell}, RunContext};
-use somnurbs::optim::{control_net::ControlNetProblem, de::De, ga::Ga, pso::Pso, Budget, Optimiser, Problem};
+use somnurbs::optim::{control_net::ControlNetProblem, default_optimiser, BoxSpec, Budget, ExactOptions, Problem};
 use somnurbs::som::{Model, SomParams};
 use somnurbs::spline::{fit_two_view, Approach, Parameterisation};
 use std::time::Instant;
@@ -16,7 +16,7 @@ fn main() {
     let run = ch4::run_cell(&cell, &data["spindle"].points, &SomParams::default(), 2023).unwrap();
     let grid = ch5::grid_from_weights(20, 20, &run.weights);
     let fit = fit_two_view(&grid, 18, 18, Parameterisation::ChordLength, Approach::Improved).unwrap();
-    let problem = ControlNetProblem::new(fit.control_net_parts(&grid).unwrap(), 0.0);
+    let problem = ControlNetProblem::new(fit.control_net_parts(&grid).unwrap(), BoxSpec::Cover { fraction: 0.0 }).unwrap();
     let x0 = problem.initial_point().to_vec();
     println!("control-net problem 18x18 on 20x20: {} variables, B = {:.6}", problem.dim(), problem.fitness(&x0));
     let reps: usize = std::env::var("BENCH_REPS").ok().and_then(|v| v.parse().ok()).unwrap_or(200_000);
@@ -40,15 +40,29 @@ fn main() {
     let per = (runner::thread_cpu_seconds() - t0 - clone_cost) / reps as f64;
     println!("fitness: {:.3} us per evaluation ({:.2} M evaluations/s; target 1.5 us, numpy 8.3 us: {:.1}x, thesis DE ~600 us: {:.0}x)", per * 1e6, 1e-6 / per, 8.3e-6 / per, 600e-6 / per);
     let generations: usize = std::env::var("BENCH_GENERATIONS").ok().and_then(|v| v.parse().ok()).unwrap_or(2000);
-    let t = Instant::now();
-    let ex = somnurbs::optim::exact::solve(&problem, 1e-6, 200_000);
-    println!("exact optimum (PDHG): f {:.9}, certified lower bound {:.9}, gap {:.2e} ({:.1e} relative), {} iterations, {:.2} s; B is {:.3e} above it", ex.f, ex.lower_bound, ex.gap, ex.gap / ex.f, ex.iterations, t.elapsed().as_secs_f64(), problem.fitness(&x0) - ex.f);
-    let budget = Budget { generations, population: 40, init_range: 5e-6 };
-    for opt in [&De::default() as &dyn Optimiser, &Ga::default(), &Pso::default()] {
+    for (label, bounds) in [("optimisers' box (data and B)", BoxSpec::Cover { fraction: 0.0 }), ("data range", BoxSpec::DataRange)] {
+        let pb = ControlNetProblem::new(problem.parts().clone(), bounds).unwrap();
+        let t = Instant::now();
+        let ex = pb.exact_optimum(&ExactOptions::default()).unwrap();
+        println!(
+            "exact optimum in the {label}: f {:.9}, certified lower bound {:.9}, gap {:.2e} ({:.1e} relative), {} Newton steps, {:.2} s; B is {:.3e} above it",
+            ex.f,
+            ex.lower_bound,
+            ex.gap,
+            ex.gap / ex.f,
+            ex.iterations,
+            t.elapsed().as_secs_f64(),
+            problem.fitness(&x0) - ex.f
+        );
+    }
+    let budget = Budget { generations: generations as u64, population: 40, init_range: 5e-6, trace_every_evals: 400 };
+    for name in ["de", "ga", "pso", "csa", "icsa"] {
+        let opt = default_optimiser(name).unwrap();
         let mut rng = somnurbs::experiment::seeds::cell_rng(1, "bench");
         let t = Instant::now();
-        let r = opt.run(&problem, &budget, &mut rng);
+        let r = opt.run(&problem, &budget, &mut rng).unwrap();
         let s = t.elapsed().as_secs_f64();
-        println!("{} 2000 x 40: {:.3} s, {} evaluations ({:.2} M/s), best {:.6}", opt.name(), s, r.evaluations, r.evaluations as f64 / s / 1e6, r.best_fitness);
+        let target = if name == "de" { format!(" (target 0.2 s; scipy 2.75 s: {:.1}x; thesis 48 s: {:.0}x)", 2.75 / s, 48.0 / s) } else { String::new() };
+        println!("{name} {generations} x 40: {s:.3} s, {} evaluations ({:.2} M/s), best {:.6}{target}", r.evaluations, r.evaluations as f64 / s / 1e6, r.best_fitness);
     }
 }

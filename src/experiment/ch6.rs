@@ -6,7 +6,7 @@ use super::spec::{OptimCell, Spec};
 use super::{ch5, runner, seeds, RunContext};
 use crate::experiment::spec::GridSize;
 use crate::optim::control_net::ControlNetProblem;
-use crate::optim::{cuckoo::Cuckoo, Budget, Optimiser, Problem, RunResult};
+use crate::optim::{BoxSpec, Budget, ExactOptions, Optimiser, Problem, RunResult};
 use crate::spline::{fit_two_view, Approach, Parameterisation};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
@@ -56,7 +56,10 @@ pub fn exact_optima(spec: &Spec, ctx: &RunContext, problems: &BTreeMap<ProblemKe
         return Ok(BTreeMap::new());
     }
     let keys: Vec<&ProblemKey> = problems.keys().collect();
-    let solved = runner::run_cells(&keys, ctx.jobs, "exact optima", |k| Ok(crate::optim::exact::solve(&problems[*k], 1e-6, o.exact_iterations)), |_, _| Ok(()))?;
+    let solved = runner::run_cells(&keys, ctx.jobs, "exact optima", |k| {
+        let opts = ExactOptions { tol_rel_gap: o.exact_tol, max_newton_steps: o.exact_newton_steps, ..ExactOptions::default() };
+        problems[*k].exact_optimum(&opts).map_err(|e| anyhow::anyhow!("exact optimum of {} {} {}: {e}", k.0, k.1, k.2.name()))
+    }, |_, _| Ok(()))?;
     Ok(keys.into_iter().cloned().zip(solved).collect())
 }
 
@@ -67,8 +70,8 @@ pub fn optimiser(spec: &Spec, name: &str) -> Result<Box<dyn Optimiser>> {
         "ga" => Box::new(o.ga.clone()),
         "de" => Box::new(o.de.clone()),
         "pso" => Box::new(o.pso.clone()),
-        "csa" => Box::new(Cuckoo { pa_min: None, ..o.csa.clone() }),
-        "icsa" => Box::new(Cuckoo { pa_min: o.icsa.pa_min.or(Some(0.1)), ..o.icsa.clone() }),
+        "csa" => Box::new(o.csa.clone()),
+        "icsa" => Box::new(o.icsa.clone()),
         other => anyhow::bail!("unknown optimiser `{other}`"),
     })
 }
@@ -85,7 +88,8 @@ pub fn problems(spec: &Spec, ctx: &RunContext) -> Result<BTreeMap<ProblemKey, Co
                 let grid = &maps[d].grid;
                 let fit = fit_two_view(grid, cn.nx, cn.ny, param, Approach::Improved).map_err(|e| anyhow::anyhow!("{d} {cn} {p}: {e}"))?;
                 let parts = fit.control_net_parts(grid).map_err(|e| anyhow::anyhow!("{e}"))?;
-                out.insert((d.clone(), cn, param), ControlNetProblem::new(parts, o.bounds_margin));
+                let problem = ControlNetProblem::new(parts, BoxSpec::Cover { fraction: o.bounds_margin }).map_err(|e| anyhow::anyhow!("{d} {cn} {p}: {e}"))?;
+                out.insert((d.clone(), cn, param), problem);
             }
         }
     }
@@ -96,11 +100,11 @@ pub fn problems(spec: &Spec, ctx: &RunContext) -> Result<BTreeMap<ProblemKey, Co
 pub fn run_cell(spec: &Spec, cell: &OptimCell, problem: &ControlNetProblem) -> Result<OptimRun> {
     let o = spec.file.optim.as_ref().context("spec has no [optim] section")?;
     let opt = optimiser(spec, &cell.optimiser)?;
-    let budget = Budget { generations: o.generations, population: o.population, init_range: o.init_range };
+    let budget = Budget { generations: o.generations as u64, population: o.population, init_range: o.init_range, trace_every_evals: o.trace_every_evals };
     let key = cell.key();
     let mut rng = seeds::cell_rng(spec.file.master_seed, &key);
     let t0 = runner::thread_cpu_seconds();
-    let r: RunResult = opt.run(problem, &budget, &mut rng);
+    let r: RunResult = opt.run(problem, &budget, &mut rng).map_err(|e| anyhow::anyhow!("{key}: {e}"))?;
     let cpu_s = runner::thread_cpu_seconds() - t0;
     let row = OptimRow {
         cell: key.clone(),
@@ -115,7 +119,7 @@ pub fn run_cell(spec: &Spec, cell: &OptimCell, problem: &ControlNetProblem) -> R
         seed: seeds::seed_hex(spec.file.master_seed, &key),
         dimension: problem.dim(),
         b: problem.fitness(problem.initial_point()),
-        initial_best: r.initial_best,
+        initial_best: r.initial_best_fitness,
         best: r.best_fitness,
         evaluations: r.evaluations,
         cpu_s,

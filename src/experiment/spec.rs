@@ -197,19 +197,25 @@ pub struct OptimSpec {
     /// optimiser's gap to it.
     #[serde(default)]
     pub exact: bool,
-    /// Iteration cap of the exact solver.
-    #[serde(default = "default_exact_iterations")]
-    pub exact_iterations: usize,
+    /// Newton-step cap of the exact solver.
+    #[serde(default = "default_exact_newton_steps")]
+    pub exact_newton_steps: usize,
+    /// The exact solver stops when its certified gap is at most this share of the optimum.
+    #[serde(default = "default_exact_tol")]
+    pub exact_tol: f64,
+    /// Trace checkpoint: the best fitness so far is recorded every this many evaluations.
+    #[serde(default = "default_trace_every")]
+    pub trace_every_evals: u64,
     #[serde(default)]
     pub ga: crate::optim::ga::Ga,
     #[serde(default)]
     pub de: crate::optim::de::De,
     #[serde(default)]
     pub pso: crate::optim::pso::Pso,
-    #[serde(default = "crate::optim::cuckoo::Cuckoo::csa")]
-    pub csa: crate::optim::cuckoo::Cuckoo,
-    #[serde(default = "crate::optim::cuckoo::Cuckoo::icsa")]
-    pub icsa: crate::optim::cuckoo::Cuckoo,
+    #[serde(default)]
+    pub csa: crate::optim::cuckoo::Csa,
+    #[serde(default)]
+    pub icsa: crate::optim::cuckoo::Icsa,
 }
 
 fn default_ten() -> usize {
@@ -221,8 +227,14 @@ fn default_generations() -> usize {
 fn default_population() -> usize {
     40
 }
-fn default_exact_iterations() -> usize {
-    50_000
+fn default_exact_newton_steps() -> usize {
+    300
+}
+fn default_exact_tol() -> f64 {
+    1e-7
+}
+fn default_trace_every() -> u64 {
+    400
 }
 fn default_init_range() -> f64 {
     5e-6
@@ -470,11 +482,21 @@ impl Spec {
         if !(o.bounds_margin >= 0.0 && o.bounds_margin.is_finite()) {
             return Err(self.err("optim.bounds_margin", format!("must be a non-negative number, got {}", o.bounds_margin)));
         }
-        o.ga.validate().map_err(|e| self.err("optim", e))?;
-        o.de.validate().map_err(|e| self.err("optim", e))?;
-        o.pso.validate().map_err(|e| self.err("optim", e))?;
-        o.csa.validate("csa").map_err(|e| self.err("optim", e))?;
-        o.icsa.validate("icsa").map_err(|e| self.err("optim", e))?;
+        if o.trace_every_evals == 0 {
+            return Err(self.err("optim.trace_every_evals", "must be at least 1"));
+        }
+        if !(o.exact_tol > 0.0 && o.exact_tol < 1.0) {
+            return Err(self.err("optim.exact_tol", format!("must be in (0,1), got {}", o.exact_tol)));
+        }
+        let optim_err = |e: crate::optim::OptimError| match e {
+            crate::optim::OptimError::InvalidParameter { key, message } => self.err(&format!("optim.{key}"), message),
+            other => self.err("optim", other),
+        };
+        o.ga.validate().map_err(optim_err)?;
+        o.de.validate().map_err(optim_err)?;
+        o.pso.validate().map_err(optim_err)?;
+        o.csa.validate().map_err(optim_err)?;
+        o.icsa.validate().map_err(optim_err)?;
         Ok(())
     }
 

@@ -1,44 +1,173 @@
-//! The thesis' control-net problem (Chapter 6; fitness Eq. 6.2 = Eq. 5.13) with a fast fitness.
+//! The thesis' control-net problem (Chapter 6; fitness Eq. 6.2 = Eq. 5.13) with a fitness fast
+//! enough for 80 000 - 160 000 evaluations per run.
 //!
-//! Decision vector: the distinct control points of approach B, one per control-net class number,
-//! xyz interleaved. A surface point depends on only 4 x 4 control points, so the fitness is the
-//! separable sparse tensor product D^G = Nu (P Nv^T): first Q = P Nv^T over the four non-zeros of
-//! each v-row, then each grid row as four scaled rows of Q (contiguous, so it vectorises), in
-//! structure-of-arrays layout with no allocation per call. The top view is evaluated only at its
-//! interior, since a border class is scored once, on the bottom view (Eq. 5.13).
+//! Decision vector: the distinct control points of the double control net, one per 0-based
+//! control-net class, xyz interleaved (thesis Fig. 6.2). The fitted surface of view V at grid
+//! point (i, j) is sum_ab Nu[i][a] Nv[j][b] P_V[a][b], and only 4 x 4 control points are
+//! non-zero there, so the surface is the separable sparse tensor product Nu (P Nv^T) done in two
+//! passes of four scaled rows each. A band product can be vectorised only across the index it
+//! does not reduce, and the two passes reduce different axes, so one transpose is unavoidable:
+//! the first pass runs along control rows (contiguous in x), its result is transposed once, and
+//! the second pass and the distances run with grid rows i as vector lanes (structure of arrays:
+//! x, y, z apart; chunks of 4 lanes, padded with zeros), accumulating per lane in registers. No
+//! allocation per call; the summation order is fixed and no fused multiply-add is used, so the
+//! baseline and the AVX2 copy of the kernel (picked at run time) give bit-identical results.
+//!
+//! A border grid class is scored once, on the bottom view (Eq. 5.13): the top view is evaluated
+//! at its interior grid points only.
 
+use super::exact::{solve_exact, ExactOptions, ExactResult, SumOfNorms, Term};
 use super::problem::Problem;
-use crate::double_net::{DoubleNet, View};
+use super::OptimError;
+use crate::double_net::{DoubleNet, TwoViewGrid, View};
 use crate::geom::Point3;
-use crate::spline::ControlNetParts;
+pub use crate::spline::{ControlNetParts, SparseBasis};
 use std::cell::RefCell;
+use std::ops::Range;
 
-/// The control-net problem: the parts from the spline fit, and a box.
+/// The search box of the control-point coordinates, per axis.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub enum BoxSpec {
+    /// Min/max of the grid data per axis (thesis: "the range of the dataset").
+    #[default]
+    DataRange,
+    /// The data range grown by `fraction` of its width on each side.
+    Widened { fraction: f64 },
+    /// The smallest box holding the data and the initial control points x0, grown by
+    /// `fraction` of its width on each side: x0 is always feasible (the data range alone can cut
+    /// through approach B's control points, which a cubic fit places outside the data near
+    /// the ends and for near-square nets).
+    Cover { fraction: f64 },
+    /// An explicit box.
+    Axes { lower: Point3, upper: Point3 },
+}
+
+/// Which compiled copy of the fitness kernel runs. (An AVX-512 copy was measured slower than
+/// AVX2 on the development machine, an AMD Zen 5: LLVM turns the transpose into scatters.)
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Isa {
+    Baseline,
+    Avx2,
+}
+
+impl Isa {
+    /// The fastest copy this CPU supports.
+    pub fn detect() -> Isa {
+        if Isa::Avx2.supported() {
+            Isa::Avx2
+        } else {
+            Isa::Baseline
+        }
+    }
+
+    fn supported(self) -> bool {
+        match self {
+            Isa::Baseline => true,
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx2 => std::arch::is_x86_feature_detected!("avx2"),
+            #[cfg(not(target_arch = "x86_64"))]
+            Isa::Avx2 => false,
+        }
+    }
+}
+
+/// The control-net problem: minimise Eq. 6.2 over the distinct control points inside a box.
+#[derive(Debug, Clone)]
 pub struct ControlNetProblem {
     parts: ControlNetParts,
-    class: [Vec<u32>; 2],
-    data: [[Vec<f64>; 3]; 2],
-    lo: Vec<f64>,
-    hi: Vec<f64>,
-    /// Per-axis box the bounds were made from (lower, upper).
-    pub box_axes: (Point3, Point3),
+    net: DoubleNet,
+    lower: Vec<f64>,
+    upper: Vec<f64>,
+    box_axes: (Point3, Point3),
+    /// Copy runs (destination, source, length) building the top view's P from x.
+    top_runs: Vec<(usize, usize, usize)>,
+    /// Grid data, per grid column j, per coordinate, over the lanes i: bottom all (i, j), top
+    /// the interior only.
+    data_b: Vec<f64>,
+    data_t: Vec<f64>,
+    isa: Isa,
+    /// Sparse rows of the sum-of-norms form (16 control points per grid class).
+    term_points: Vec<[usize; 16]>,
+    term_coef: Vec<[f64; 16]>,
+    term_data: Vec<Point3>,
 }
 
-#[derive(Default)]
-struct Scratch {
-    /// P of one view, per coordinate, row-major (a * cn_y + b).
-    p: [Vec<f64>; 3],
-    /// S = Nu P, per coordinate, row-major (i * cn_y + b).
-    s: [Vec<f64>; 3],
-    /// S transposed (b * nx + i).
-    st: [Vec<f64>; 3],
-    /// One column of D^G (over i) per coordinate.
-    col: [Vec<f64>; 3],
+/// Work space of one evaluation (one per thread through [`Problem::fitness`]).
+#[derive(Debug, Clone, Default)]
+pub struct Scratch {
+    /// (nx, ny, cn_x, cn_y) the buffers are laid out for.
+    key: (usize, usize, usize, usize),
+    pt: Vec<f64>,
+    r_b: Vec<f64>,
+    r_t: Vec<f64>,
+    rt_b: Vec<f64>,
+    rt_t: Vec<f64>,
 }
 
-/// out = w0 a + w1 b + w2 c + w3 d, element-wise (equal lengths, so the loop vectorises).
+thread_local! {
+    static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
+}
+
+fn finite(p: &Point3) -> bool {
+    p.iter().all(|v| v.is_finite())
+}
+
+fn check_basis(name: &str, b: &SparseBasis, n_grid: usize, n_ctrl: usize) -> Result<(), OptimError> {
+    if b.first.len() != n_grid || b.w.len() != n_grid {
+        return Err(OptimError::ControlNet(format!(
+            "{name} must have {n_grid} entries (one per grid index), has {} first indices and {} weight sets",
+            b.first.len(),
+            b.w.len()
+        )));
+    }
+    for (k, (&f, w)) in b.first.iter().zip(&b.w).enumerate() {
+        if f + 4 > n_ctrl {
+            return Err(OptimError::ControlNet(format!("{name}[{k}]: first basis index {f} + 4 exceeds {n_ctrl} control points")));
+        }
+        if !w.iter().all(|v| v.is_finite()) {
+            return Err(OptimError::ControlNet(format!("{name}[{k}]: weights {w:?} are not finite")));
+        }
+    }
+    Ok(())
+}
+
+/// Check that the parts of a control-net problem fit together.
+fn validate_parts(p: &ControlNetParts) -> Result<(), OptimError> {
+    if p.nx < 2 || p.ny < 2 {
+        return Err(OptimError::ControlNet(format!("grid {}x{} is smaller than 2x2", p.nx, p.ny)));
+    }
+    if p.cn_x < 4 || p.cn_y < 4 {
+        return Err(OptimError::ControlNet(format!("control net {}x{} is smaller than 4x4 (cubic)", p.cn_x, p.cn_y)));
+    }
+    check_basis("nu", &p.nu, p.nx, p.cn_x)?;
+    check_basis("nv", &p.nv, p.ny, p.cn_y)?;
+    for (name, d) in [("data_bottom", &p.data_bottom), ("data_top", &p.data_top)] {
+        if d.len() != p.nx * p.ny {
+            return Err(OptimError::ControlNet(format!("{name} has {} points, the {}x{} grid needs {}", d.len(), p.nx, p.ny, p.nx * p.ny)));
+        }
+        if let Some(k) = d.iter().position(|p| !finite(p)) {
+            return Err(OptimError::ControlNet(format!("{name}[{k}] = {:?} is not finite", d[k])));
+        }
+    }
+    let nov = 2 * (p.cn_x * p.cn_y - p.cn_x - p.cn_y + 2);
+    if p.x0.len() != 3 * nov {
+        return Err(OptimError::ControlNet(format!(
+            "x0 has {} values, a {}x{} double control net has NOV = {nov} classes, so 3 * NOV = {}",
+            p.x0.len(),
+            p.cn_x,
+            p.cn_y,
+            3 * nov
+        )));
+    }
+    if let Some(k) = p.x0.iter().position(|v| !v.is_finite()) {
+        return Err(OptimError::ControlNet(format!("x0[{k}] = {} is not finite", p.x0[k])));
+    }
+    Ok(())
+}
+
+/// out[k] = w0 a[k] + w1 b[k] + w2 c[k] + w3 d[k] over equal-length rows (vectorises).
 #[inline(always)]
-fn lin4(out: &mut [f64], a: &[f64], b: &[f64], c: &[f64], d: &[f64], w: [f64; 4]) {
+fn lin4(out: &mut [f64], a: &[f64], b: &[f64], c: &[f64], d: &[f64], w: &[f64; 4]) {
     let n = out.len();
     let (a, b, c, d) = (&a[..n], &b[..n], &c[..n], &d[..n]);
     for k in 0..n {
@@ -46,317 +175,579 @@ fn lin4(out: &mut [f64], a: &[f64], b: &[f64], c: &[f64], d: &[f64], w: [f64; 4]
     }
 }
 
-thread_local! {
-    static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
+/// Vector lanes (grid rows) are processed in chunks of this many; lane counts are padded to a
+/// multiple, and padded lanes hold zeros, so they add exact zeros.
+const CHUNK: usize = 4;
+
+fn padded(n: usize) -> usize {
+    n.div_ceil(CHUNK) * CHUNK
+}
+
+/// Sum of distances |D - D^G| of one view over `lanes` grid rows (starting at `row0`) and the
+/// grid columns `cols`. `p`: control points of the view, row-major ([a][b*3 + c], rows of
+/// k3 = 3 cn_y); `data`: chunk-major [chunk][column][c][lane]; `r` (rows padded to k3p) and `rt`
+/// are this view's buffers, with zeros in every padded place.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn view_error(
+    p: &[f64],
+    nu: &SparseBasis,
+    nv: &SparseBasis,
+    row0: usize,
+    lanes: usize,
+    cols: Range<usize>,
+    k3: usize,
+    data: &[f64],
+    r: &mut [f64],
+    rt: &mut [f64],
+) -> f64 {
+    let nc = cols.len();
+    if lanes == 0 || nc == 0 {
+        return 0.0;
+    }
+    let chunks = lanes.div_ceil(CHUNK);
+    let k3p = padded(k3);
+    // Pass 1: R[i] = sum_t Nu[i][t] P[first_i + t], whole control rows at a time (R's rows
+    // are padded to k3p; the padding is never written and stays zero).
+    for li in 0..lanes {
+        let i = row0 + li;
+        let f = nu.first[i] * k3;
+        let row = &mut r[li * k3p..li * k3p + k3];
+        lin4(row, &p[f..f + k3], &p[f + k3..f + 2 * k3], &p[f + 2 * k3..f + 3 * k3], &p[f + 3 * k3..f + 4 * k3], &nu.w[i]);
+    }
+    // Transpose into chunk-major RT[chunk][b*3 + c][lane], eight lanes per store (rows past
+    // `lanes` are zero rows of R).
+    for ch in 0..chunks {
+        let src: [&[f64]; CHUNK] = std::array::from_fn(|l| &r[(ch * CHUNK + l) * k3p..(ch * CHUNK + l + 1) * k3p]);
+        let dst = &mut rt[ch * k3p * CHUNK..(ch + 1) * k3p * CHUNK];
+        for (k, out) in dst.chunks_exact_mut(CHUNK).enumerate() {
+            for l in 0..CHUNK {
+                out[l] = src[l][k];
+            }
+        }
+    }
+    // Pass 2 and distances: per chunk of lanes, over all grid columns, in registers.
+    let mut total = 0.0;
+    for ch in 0..chunks {
+        let block = &rt[ch * k3p * CHUNK..(ch + 1) * k3p * CHUNK];
+        let dchunk = &data[ch * nc * 3 * CHUNK..(ch + 1) * nc * 3 * CHUNK];
+        let mut acc = [0.0; CHUNK];
+        for (lj, j) in cols.clone().enumerate() {
+            let base = nv.first[j] * 3 * CHUNK;
+            let q: &[f64; 12 * CHUNK] = block[base..base + 12 * CHUNK].try_into().expect("12 rows");
+            let d: &[f64; 3 * CHUNK] = dchunk[lj * 3 * CHUNK..(lj + 1) * 3 * CHUNK].try_into().expect("3 rows");
+            let w = &nv.w[j];
+            // Row (t, c) of the 4 x 3 block starts at (3 t + c) * CHUNK.
+            for l in 0..CHUNK {
+                let ex = w[0] * q[l] + w[1] * q[3 * CHUNK + l] + w[2] * q[6 * CHUNK + l] + w[3] * q[9 * CHUNK + l] - d[l];
+                let ey = w[0] * q[CHUNK + l] + w[1] * q[4 * CHUNK + l] + w[2] * q[7 * CHUNK + l] + w[3] * q[10 * CHUNK + l] - d[CHUNK + l];
+                let ez = w[0] * q[2 * CHUNK + l] + w[1] * q[5 * CHUNK + l] + w[2] * q[8 * CHUNK + l] + w[3] * q[11 * CHUNK + l] - d[2 * CHUNK + l];
+                acc[l] += (ex * ex + ey * ey + ez * ez).sqrt();
+            }
+        }
+        for a in acc {
+            total += a;
+        }
+    }
+    total
+}
+
+#[inline(always)]
+fn kernel(pb: &ControlNetProblem, x: &[f64], s: &mut Scratch) -> f64 {
+    let parts = &pb.parts;
+    let (nx, ny, k3) = (parts.nx, parts.ny, 3 * parts.cn_y);
+    // Bottom view: its classes are 0..cn_x*cn_y in row-major order, so P is a prefix of x.
+    let bottom = view_error(&x[..parts.cn_x * k3], &parts.nu, &parts.nv, 0, nx, 0..ny, k3, &pb.data_b, &mut s.r_b, &mut s.rt_b);
+    // Top view: gather its P (border classes are shared with the bottom view).
+    for &(dst, src, len) in &pb.top_runs {
+        if len == 3 {
+            s.pt[dst] = x[src];
+            s.pt[dst + 1] = x[src + 1];
+            s.pt[dst + 2] = x[src + 2];
+        } else {
+            s.pt[dst..dst + len].copy_from_slice(&x[src..src + len]);
+        }
+    }
+    let top = view_error(&s.pt, &parts.nu, &parts.nv, 1, nx - 2, 1..ny - 1, k3, &pb.data_t, &mut s.r_t, &mut s.rt_t);
+    bottom + top
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn kernel_avx2(pb: &ControlNetProblem, x: &[f64], s: &mut Scratch) -> f64 {
+    kernel(pb, x, s)
 }
 
 impl ControlNetProblem {
-    /// Bounds per axis: the smallest box holding the grid data and the initial control points,
-    /// widened on each side by `margin` times its size (0: exactly that box).
-    pub fn new(parts: ControlNetParts, margin: f64) -> ControlNetProblem {
-        let cn = DoubleNet::new(parts.cn_x, parts.cn_y).expect("control net sides at least 4");
-        let class = View::BOTH.map(|v| cn.classes(v).iter().map(|&c| c as u32).collect::<Vec<u32>>());
-        let (nx, ny) = (parts.nx, parts.ny);
-        // Data transposed (j * nx + i), the order the columns of D^G come in.
-        let data = [&parts.data_bottom, &parts.data_top].map(|d| [0, 1, 2].map(|c| (0..nx * ny).map(|k| d[(k % nx) * ny + k / nx][c]).collect::<Vec<f64>>()));
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
-        let points = parts.data_bottom.iter().chain(&parts.data_top).copied().chain(parts.x0.chunks(3).map(|c| [c[0], c[1], c[2]]));
-        for p in points {
-            for c in 0..3 {
-                lo[c] = lo[c].min(p[c]);
-                hi[c] = hi[c].max(p[c]);
+    /// Check the parts, lay out the kernel's data and build the box.
+    pub fn new(parts: ControlNetParts, bounds: BoxSpec) -> Result<ControlNetProblem, OptimError> {
+        validate_parts(&parts)?;
+        let net = DoubleNet::new(parts.cn_x, parts.cn_y).expect("control net checked to be at least 4x4");
+        let (nx, ny, cn_x, cn_y) = (parts.nx, parts.ny, parts.cn_x, parts.cn_y);
+        let all: Vec<Point3> = parts.data_bottom.iter().chain(&parts.data_top).copied().collect();
+        let (dlo, dhi) = crate::geom::bounding_box(&all).expect("grid has points");
+        let box_axes = match bounds {
+            BoxSpec::DataRange => (dlo, dhi),
+            BoxSpec::Widened { fraction } | BoxSpec::Cover { fraction } => {
+                if !(fraction >= 0.0 && fraction.is_finite()) {
+                    return Err(OptimError::param("bounds.fraction", format!("must be finite and >= 0, got {fraction}")));
+                }
+                let (mut lo, mut hi) = (dlo, dhi);
+                if matches!(bounds, BoxSpec::Cover { .. }) {
+                    for (k, &v) in parts.x0.iter().enumerate() {
+                        lo[k % 3] = lo[k % 3].min(v);
+                        hi[k % 3] = hi[k % 3].max(v);
+                    }
+                }
+                for a in 0..3 {
+                    let w = hi[a] - lo[a];
+                    lo[a] -= fraction * w;
+                    hi[a] += fraction * w;
+                }
+                (lo, hi)
+            }
+            BoxSpec::Axes { lower, upper } => {
+                if let Some(a) = (0..3).find(|&a| lower[a].partial_cmp(&upper[a]).is_none_or(|o| o.is_gt())) {
+                    return Err(OptimError::param("bounds", format!("axis {a}: lower {} is not <= upper {}", lower[a], upper[a])));
+                }
+                (lower, upper)
+            }
+        };
+        let nov = net.nov();
+        let lower: Vec<f64> = (0..3 * nov).map(|k| box_axes.0[k % 3]).collect();
+        let upper: Vec<f64> = (0..3 * nov).map(|k| box_axes.1[k % 3]).collect();
+        // The top view's P from x: contiguous runs of classes.
+        let mut top_runs: Vec<(usize, usize, usize)> = Vec::new();
+        for a in 0..cn_x {
+            for b in 0..cn_y {
+                let dst = 3 * (a * cn_y + b);
+                let src = 3 * net.class(View::Top, a, b);
+                match top_runs.last_mut() {
+                    Some(last) if last.0 + last.2 == dst && last.1 + last.2 == src => last.2 += 3,
+                    _ => top_runs.push((dst, src, 3)),
+                }
             }
         }
-        for c in 0..3 {
-            let w = (hi[c] - lo[c]) * margin;
-            lo[c] -= w;
-            hi[c] += w;
+        // Grid data chunk-major: [chunk of 8 grid rows][grid column][xyz][lane], zero padded.
+        let layout = |d: &[Point3], rows: Range<usize>, cols: Range<usize>| {
+            let (lanes, nc) = (rows.len(), cols.len());
+            let mut out = vec![0.0; padded(lanes) * nc * 3];
+            for (lj, j) in cols.enumerate() {
+                for c in 0..3 {
+                    for (li, i) in rows.clone().enumerate() {
+                        let (ch, l) = (li / CHUNK, li % CHUNK);
+                        out[((ch * nc + lj) * 3 + c) * CHUNK + l] = d[i * ny + j][c];
+                    }
+                }
+            }
+            out
+        };
+        let data_b = layout(&parts.data_bottom, 0..nx, 0..ny);
+        let data_t = layout(&parts.data_top, 1..nx - 1, 1..ny - 1);
+        // Sum-of-norms rows, in grid class order (bottom all, then top interior).
+        let mut term_points = Vec::new();
+        let mut term_coef = Vec::new();
+        let mut term_data = Vec::new();
+        for (view, data) in [(View::Bottom, &parts.data_bottom), (View::Top, &parts.data_top)] {
+            for i in 0..nx {
+                for j in 0..ny {
+                    let border = i == 0 || j == 0 || i + 1 == nx || j + 1 == ny;
+                    if view == View::Top && border {
+                        continue;
+                    }
+                    let (fu, fv) = (parts.nu.first[i], parts.nv.first[j]);
+                    let mut pts = [0usize; 16];
+                    let mut cf = [0.0; 16];
+                    for ta in 0..4 {
+                        for tb in 0..4 {
+                            pts[ta * 4 + tb] = net.class(view, fu + ta, fv + tb);
+                            cf[ta * 4 + tb] = parts.nu.w[i][ta] * parts.nv.w[j][tb];
+                        }
+                    }
+                    term_points.push(pts);
+                    term_coef.push(cf);
+                    term_data.push(data[i * ny + j]);
+                }
+            }
         }
-        let n = parts.x0.len();
-        ControlNetProblem { class, data, lo: (0..n).map(|k| lo[k % 3]).collect(), hi: (0..n).map(|k| hi[k % 3]).collect(), box_axes: (lo, hi), parts }
+        Ok(ControlNetProblem {
+            parts,
+            net,
+            lower,
+            upper,
+            box_axes,
+            top_runs,
+            data_b,
+            data_t,
+            isa: Isa::detect(),
+            term_points,
+            term_coef,
+            term_data,
+        })
+    }
+
+    /// Use another compiled copy of the kernel (ignored if this CPU lacks it); for tests and
+    /// measurements.
+    pub fn with_isa(mut self, isa: Isa) -> ControlNetProblem {
+        if isa.supported() {
+            self.isa = isa;
+        }
+        self
+    }
+
+    pub fn isa(&self) -> Isa {
+        self.isa
     }
 
     pub fn parts(&self) -> &ControlNetParts {
         &self.parts
     }
 
-    /// Walk every scored position: `visit(view, i, j, fitted point)`, column by column (j outer).
-    fn forward(&self, x: &[f64], mut visit: impl FnMut(usize, usize, usize, [f64; 3])) {
-        self.forward_columns(x, |view, j, rows, col| {
-            for i in rows {
-                visit(view, i, j, [col[0][i], col[1][i], col[2][i]]);
-            }
-        });
+    /// The class layout of the double control net.
+    pub fn net(&self) -> &DoubleNet {
+        &self.net
     }
 
-    /// Walk every scored grid column j of each view: `visit(view, j, scored rows, fitted x/y/z of
-    /// the column indexed by i)`. S = Nu P runs along contiguous rows of P, then S is transposed so
-    /// that each column of D^G = S Nv^T is four scaled contiguous rows of S^T.
-    fn forward_columns(&self, x: &[f64], mut visit: impl FnMut(usize, usize, std::ops::Range<usize>, &[Vec<f64>; 3])) {
+    /// The search box per axis (lower, upper).
+    pub fn box_axes(&self) -> (Point3, Point3) {
+        self.box_axes
+    }
+
+    /// How many coordinates of x0 lie outside the box (they are clamped in the initial
+    /// population; a box that cuts x0 changes the problem, so report it).
+    pub fn initial_outside_box(&self) -> usize {
+        self.parts.x0.iter().enumerate().filter(|(k, v)| **v < self.lower[*k] || **v > self.upper[*k]).count()
+    }
+
+    /// Eq. 6.2 with caller-owned scratch (no thread-local look-up). NaN if `x` has the wrong
+    /// length.
+    pub fn fitness_with(&self, x: &[f64], scratch: &mut Scratch) -> f64 {
+        if x.len() != self.lower.len() {
+            return f64::NAN;
+        }
         let p = &self.parts;
-        let (nx, ny, cn_x, cn_y) = (p.nx, p.ny, p.cn_x, p.cn_y);
-        SCRATCH.with(|s| {
-            let mut s = s.borrow_mut();
-            let s = &mut *s;
-            if s.p[0].len() != cn_x * cn_y || s.s[0].len() != nx * cn_y {
-                for c in 0..3 {
-                    s.p[c] = vec![0.0; cn_x * cn_y];
-                    s.s[c] = vec![0.0; nx * cn_y];
-                    s.st[c] = vec![0.0; cn_y * nx];
-                    s.col[c] = vec![0.0; nx];
-                }
-            }
-            for view in 0..2 {
-                for (k, &cls) in self.class[view].iter().enumerate() {
-                    let at = 3 * cls as usize;
-                    s.p[0][k] = x[at];
-                    s.p[1][k] = x[at + 1];
-                    s.p[2][k] = x[at + 2];
-                }
-                let rows = if view == 0 { 0..nx } else { 1..nx - 1 };
-                for c in 0..3 {
-                    let (pc, sc) = (&s.p[c], &mut s.s[c]);
-                    for i in rows.clone() {
-                        let (f, w) = (p.nu.first[i], p.nu.w[i]);
-                        let block = &pc[f * cn_y..(f + 4) * cn_y];
-                        let (p0, rest) = block.split_at(cn_y);
-                        let (p1, rest) = rest.split_at(cn_y);
-                        let (p2, p3) = rest.split_at(cn_y);
-                        let out = &mut sc[i * cn_y..(i + 1) * cn_y];
-                        lin4(out, p0, p1, p2, p3, w);
-                    }
-                    let st = &mut s.st[c];
-                    for i in rows.clone() {
-                        for b in 0..cn_y {
-                            st[b * nx + i] = sc[i * cn_y + b];
+        let key = (p.nx, p.ny, p.cn_x, p.cn_y);
+        if scratch.key != key {
+            // Fresh zeroed buffers: the padded lanes of RT must stay zero.
+            let k3p = padded(3 * p.cn_y);
+            let (lb, lt) = (padded(p.nx), padded(p.nx - 2));
+            *scratch = Scratch {
+                key,
+                pt: vec![0.0; p.cn_x * 3 * p.cn_y],
+                r_b: vec![0.0; lb * k3p],
+                r_t: vec![0.0; lt * k3p],
+                rt_b: vec![0.0; lb * k3p],
+                rt_t: vec![0.0; lt * k3p],
+            };
+        }
+        match self.isa {
+            // SAFETY: `with_isa` and `Isa::detect` only select AVX2 when this CPU reports it.
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx2 => unsafe { kernel_avx2(self, x, scratch) },
+            _ => kernel(self, x, scratch),
+        }
+    }
+
+    /// The exact optimum of Eq. 6.2 inside this problem's box, from x0 (clamped), with its
+    /// certificate (see `exact`).
+    pub fn exact_optimum(&self, opts: &ExactOptions) -> Result<ExactResult, OptimError> {
+        solve_exact(self, &self.lower, &self.upper, &self.parts.x0, opts)
+    }
+
+    /// The fitted surface points D^G of both views (row-major, i * ny + j) for control points x.
+    pub fn surface(&self, x: &[f64]) -> TwoViewGrid {
+        let p = &self.parts;
+        let mut out = [vec![[0.0; 3]; p.nx * p.ny], vec![[0.0; 3]; p.nx * p.ny]];
+        for (v, view) in View::BOTH.iter().enumerate() {
+            for i in 0..p.nx {
+                for j in 0..p.ny {
+                    let mut s = [0.0; 3];
+                    for ta in 0..4 {
+                        for tb in 0..4 {
+                            let w = p.nu.w[i][ta] * p.nv.w[j][tb];
+                            let cl = self.net.class(*view, p.nu.first[i] + ta, p.nv.first[j] + tb);
+                            for c in 0..3 {
+                                s[c] += w * x[3 * cl + c];
+                            }
                         }
                     }
-                }
-                let cols = if view == 0 { 0..ny } else { 1..ny - 1 };
-                for j in cols {
-                    let (f, w) = (p.nv.first[j], p.nv.w[j]);
-                    for c in 0..3 {
-                        let block = &s.st[c][f * nx..(f + 4) * nx];
-                        let (s0, rest) = block.split_at(nx);
-                        let (s1, rest) = rest.split_at(nx);
-                        let (s2, s3) = rest.split_at(nx);
-                        let r = rows.clone();
-                        lin4(&mut s.col[c][r.clone()], &s0[r.clone()], &s1[r.clone()], &s2[r.clone()], &s3[r], w);
-                    }
-                    visit(view, j, rows.clone(), &s.col);
+                    out[v][i * p.ny + j] = s;
                 }
             }
-        });
+        }
+        let [bottom, top] = out;
+        TwoViewGrid { nx: p.nx, ny: p.ny, bottom, top }
     }
 }
 
 impl Problem for ControlNetProblem {
     fn dim(&self) -> usize {
-        self.parts.x0.len()
+        self.lower.len()
     }
+
     fn initial_point(&self) -> &[f64] {
         &self.parts.x0
     }
+
     fn bounds(&self) -> (&[f64], &[f64]) {
-        (&self.lo, &self.hi)
+        (&self.lower, &self.upper)
     }
-    /// Eq. 6.2: sum over the NOV grid classes of |D - D^G|.
+
     fn fitness(&self, x: &[f64]) -> f64 {
-        let nx = self.parts.nx;
-        let mut e = 0.0;
-        self.forward_columns(x, |view, j, rows, col| {
-            let d = &self.data[view];
-            let (lo, hi) = (j * nx + rows.start, j * nx + rows.end);
-            let (dx, dy, dz) = (&d[0][lo..hi], &d[1][lo..hi], &d[2][lo..hi]);
-            let (gx, gy, gz) = (&col[0][rows.clone()], &col[1][rows.clone()], &col[2][rows.clone()]);
-            // Four partial sums in a fixed order: the square roots vectorise, the result is the same
-            // whatever the thread.
-            let mut acc = [0.0f64; 4];
-            let n4 = gx.len() / 4 * 4;
-            for k in (0..n4).step_by(4) {
-                for l in 0..4 {
-                    let (a, b, c) = (gx[k + l] - dx[k + l], gy[k + l] - dy[k + l], gz[k + l] - dz[k + l]);
-                    acc[l] += (a * a + b * b + c * c).sqrt();
-                }
-            }
-            for k in n4..gx.len() {
-                let (a, b, c) = (gx[k] - dx[k], gy[k] - dy[k], gz[k] - dz[k]);
-                acc[k - n4] += (a * a + b * b + c * c).sqrt();
-            }
-            e += (acc[0] + acc[1]) + (acc[2] + acc[3]);
-        });
-        e
+        SCRATCH.with(|s| self.fitness_with(x, &mut s.borrow_mut()))
     }
 }
 
-impl ControlNetProblem {
-    /// Number of scored positions (NOV of the grid): the residual terms of the fitness.
-    pub fn terms(&self) -> usize {
-        let (nx, ny) = (self.parts.nx, self.parts.ny);
-        nx * ny + (nx - 2) * (ny - 2)
+impl SumOfNorms for ControlNetProblem {
+    fn n_points(&self) -> usize {
+        self.net.nov()
     }
 
-    /// The fitted two-view grid D^G of a decision vector (the top view's border is the bottom's:
-    /// both views share their border control points).
-    pub fn fitted_grid(&self, x: &[f64]) -> crate::double_net::TwoViewGrid {
-        let (nx, ny) = (self.parts.nx, self.parts.ny);
-        let mut bottom = vec![[0.0; 3]; nx * ny];
-        let mut top = vec![[0.0; 3]; nx * ny];
-        self.forward(x, |view, i, j, g| {
-            if view == 0 {
-                bottom[i * ny + j] = g;
-            } else {
-                top[i * ny + j] = g;
+    fn n_terms(&self) -> usize {
+        self.term_data.len()
+    }
+
+    fn term(&self, k: usize) -> Term<'_> {
+        Term { points: &self.term_points[k], coefs: &self.term_coef[k], data: self.term_data[k] }
+    }
+
+    /// Elimination order with a narrow profile: the double net is a closed surface (two discs
+    /// glued along their border), cut into slices across its longer control-net axis; each slice
+    /// is a ring of about 2 x (shorter side) points, and a point couples only with points at most
+    /// 3 slices away.
+    fn point_order(&self) -> Option<Vec<usize>> {
+        let (cx, cy) = (self.parts.cn_x, self.parts.cn_y);
+        let net = &self.net;
+        let mut order = Vec::with_capacity(net.nov());
+        let mut seen = vec![false; net.nov()];
+        let mut push = |c: usize, order: &mut Vec<usize>| {
+            if !seen[c] {
+                seen[c] = true;
+                order.push(c);
             }
-        });
-        for i in 0..nx {
-            for j in 0..ny {
-                if i == 0 || j == 0 || i + 1 == nx || j + 1 == ny {
-                    top[i * ny + j] = bottom[i * ny + j];
+        };
+        if cx >= cy {
+            for a in 0..cx {
+                for b in 0..cy {
+                    push(net.class(View::Bottom, a, b), &mut order);
+                }
+                for b in (0..cy).rev() {
+                    push(net.class(View::Top, a, b), &mut order);
+                }
+            }
+        } else {
+            for b in 0..cy {
+                for a in 0..cx {
+                    push(net.class(View::Bottom, a, b), &mut order);
+                }
+                for a in (0..cx).rev() {
+                    push(net.class(View::Top, a, b), &mut order);
                 }
             }
         }
-        crate::double_net::TwoViewGrid { nx, ny, bottom, top }
+        Some(order)
+    }
+}
+
+/// Synthetic control-net problems for tests: the spline module's lumpy two-view test grid, fitted
+/// by approach B (chord length), shared by the tests of this module and of `exact`.
+#[cfg(test)]
+pub(crate) mod test_support {
+    use super::*;
+    use crate::spline::{fit_two_view, Approach, Parameterisation};
+
+    /// Approach B's parts for a `cn_x` x `cn_y` net on an `nx` x `ny` test grid.
+    pub fn test_parts(nx: usize, ny: usize, cn_x: usize, cn_y: usize) -> ControlNetParts {
+        let grid = crate::spline::approach::tests::test_grid(nx, ny, 0.02);
+        let fit = fit_two_view(&grid, cn_x, cn_y, Parameterisation::ChordLength, Approach::Improved).expect("test fit");
+        fit.control_net_parts(&grid).expect("approach B")
     }
 
-    /// The residuals D^G - D at every scored position (bottom view, then the top interior;
-    /// column by column).
-    pub fn residuals(&self, x: &[f64], out: &mut Vec<[f64; 3]>) {
-        out.clear();
-        let nx = self.parts.nx;
-        self.forward(x, |view, i, j, g| {
-            let d = &self.data[view];
-            let at = j * nx + i;
-            out.push([g[0] - d[0][at], g[1] - d[1][at], g[2] - d[2][at]]);
-        });
-    }
-
-    /// The sparse rows of x -> D^G, one per scored position (same order as `residuals`): the
-    /// (control-net class, weight) pairs and the data point, so that r_k = sum w P_class - d_k.
-    pub fn rows(&self) -> Vec<(Vec<(u32, f64)>, [f64; 3])> {
-        let p = &self.parts;
-        let (nx, ny, cn_y) = (p.nx, p.ny, p.cn_y);
-        let mut out = Vec::new();
-        for view in 0..2 {
-            let cols = if view == 0 { 0..ny } else { 1..ny - 1 };
-            for j in cols {
-                let rows = if view == 0 { 0..nx } else { 1..nx - 1 };
-                for i in rows {
-                    let mut entries = Vec::with_capacity(16);
-                    for s in 0..4 {
-                        for t in 0..4 {
-                            let w = p.nu.w[i][s] * p.nv.w[j][t];
-                            if w != 0.0 {
-                                entries.push((self.class[view][(p.nu.first[i] + s) * cn_y + p.nv.first[j] + t], w));
-                            }
-                        }
-                    }
-                    let at = j * nx + i;
-                    let d = &self.data[view];
-                    out.push((entries, [d[0][at], d[1][at], d[2][at]]));
-                }
-            }
-        }
-        out
-    }
-
-    /// The adjoint of x -> D^G: g = sum_k A_k^T y_k.
-    pub fn apply_transpose(&self, y: &[[f64; 3]], out: &mut [f64]) {
-        let p = &self.parts;
-        let (nx, ny, cn_x, cn_y) = (p.nx, p.ny, p.cn_x, p.cn_y);
-        out.iter_mut().for_each(|v| *v = 0.0);
-        let mut k = 0;
-        for view in 0..2 {
-            // Adjoint of the row stage: yq = Nu^T Y.
-            let mut yq = vec![[0.0; 3]; cn_x * ny];
-            let rows = if view == 0 { 0..nx } else { 1..nx - 1 };
-            let cols = if view == 0 { 0..ny } else { 1..ny - 1 };
-            for j in cols {
-                for i in rows.clone() {
-                    let (f, w) = (p.nu.first[i], p.nu.w[i]);
-                    let yy = y[k];
-                    k += 1;
-                    for t in 0..4 {
-                        for c in 0..3 {
-                            yq[(f + t) * ny + j][c] += w[t] * yy[c];
-                        }
-                    }
-                }
-            }
-            // Adjoint of Q = P Nv^T, then of the gather by class.
-            for a in 0..cn_x {
-                for j in 0..ny {
-                    let (f, w) = (p.nv.first[j], p.nv.w[j]);
-                    let yy = yq[a * ny + j];
-                    for t in 0..4 {
-                        let cls = self.class[view][a * cn_y + f + t] as usize;
-                        for c in 0..3 {
-                            out[3 * cls + c] += w[t] * yy[c];
-                        }
-                    }
-                }
-            }
-        }
+    /// The control-net problem of [`test_parts`] in the given box.
+    pub fn sphere_problem(nx: usize, ny: usize, cn_x: usize, cn_y: usize, bounds: BoxSpec) -> ControlNetProblem {
+        ControlNetProblem::new(test_parts(nx, ny, cn_x, cn_y), bounds).unwrap()
     }
 }
 
 #[cfg(test)]
-pub mod tests {
+mod tests {
+    use super::test_support::*;
     use super::*;
-    use crate::spline::{fit_two_view, Approach, Parameterisation};
 
-    pub fn problem(nx: usize, ny: usize, cn_x: usize, cn_y: usize) -> ControlNetProblem {
-        let g = crate::spline::approach::tests::test_grid(nx, ny, 0.03);
-        let fit = fit_two_view(&g, cn_x, cn_y, Parameterisation::ChordLength, Approach::Improved).unwrap();
-        ControlNetProblem::new(fit.control_net_parts(&g).unwrap(), 0.0)
+    /// The obvious reference: every grid class of Eq. 5.13, each surface point as the dense
+    /// double sum over all control points of the view.
+    fn dense_reference(pb: &ControlNetProblem, x: &[f64]) -> f64 {
+        let p = pb.parts();
+        let net = pb.net();
+        let dense = |b: &SparseBasis, g: usize, a: usize| {
+            let f = b.first[g];
+            if a >= f && a < f + 4 {
+                b.w[g][a - f]
+            } else {
+                0.0
+            }
+        };
+        let mut total = 0.0;
+        for (view, data) in [(View::Bottom, &p.data_bottom), (View::Top, &p.data_top)] {
+            for i in 0..p.nx {
+                for j in 0..p.ny {
+                    let border = i == 0 || j == 0 || i + 1 == p.nx || j + 1 == p.ny;
+                    if view == View::Top && border {
+                        continue;
+                    }
+                    let mut s = [0.0; 3];
+                    for a in 0..p.cn_x {
+                        for b in 0..p.cn_y {
+                            let w = dense(&p.nu, i, a) * dense(&p.nv, j, b);
+                            let cl = net.class(view, a, b);
+                            for c in 0..3 {
+                                s[c] += w * x[3 * cl + c];
+                            }
+                        }
+                    }
+                    total += crate::geom::dist(s, data[i * p.ny + j]);
+                }
+            }
+        }
+        total
     }
 
     #[test]
     fn fast_fitness_equals_the_dense_reference() {
-        for (nx, ny, cx, cy) in [(20, 20, 18, 18), (18, 30, 4, 16), (12, 9, 6, 5)] {
-            let pr = problem(nx, ny, cx, cy);
-            let mut x = pr.parts().x0.clone();
+        for (nx, ny, cx, cy) in [(20, 20, 18, 18), (18, 30, 16, 28), (9, 7, 4, 5), (5, 5, 4, 4), (4, 4, 4, 4)] {
+            let pb = sphere_problem(nx, ny, cx, cy, BoxSpec::DataRange);
+            let mut x = pb.initial_point().to_vec();
             for (k, v) in x.iter_mut().enumerate() {
-                *v += 1e-3 * ((k * 7919) % 13) as f64;
+                *v += 1e-3 * ((k * 7919) % 101) as f64 / 101.0;
             }
-            for point in [pr.parts().x0.clone(), x] {
-                let fast = pr.fitness(&point);
-                let dense = pr.parts().surface_error(&point);
-                assert!((fast - dense).abs() <= 1e-12 * dense, "{nx}x{ny} {cx}x{cy}: {fast} vs {dense}");
-            }
-        }
-    }
-
-    #[test]
-    fn fitted_grid_is_approach_b_at_the_start() {
-        let g = crate::spline::approach::tests::test_grid(14, 11, 0.03);
-        let fit = fit_two_view(&g, 8, 7, Parameterisation::ChordLength, Approach::Improved).unwrap();
-        let pr = ControlNetProblem::new(fit.control_net_parts(&g).unwrap(), 0.0);
-        let grid = pr.fitted_grid(pr.initial_point());
-        for (a, b) in grid.bottom.iter().chain(&grid.top).zip(fit.fitted_bottom.iter().chain(&fit.fitted_top)) {
-            for c in 0..3 {
-                assert!((a[c] - b[c]).abs() < 1e-12, "{a:?} vs {b:?}");
+            for xs in [pb.initial_point().to_vec(), x] {
+                let want = dense_reference(&pb, &xs);
+                for isa in [Isa::Baseline, Isa::Avx2] {
+                    let q = pb.clone().with_isa(isa);
+                    let got = q.fitness(&xs);
+                    // 1e-12 relative; near interpolation (least-squares x0 of a large net) the
+                    // sum itself is ~1e-5 and both sides carry ~1e-16 absolute rounding per term.
+                    let tol = 1e-12 * want + 1e-15 * pb.n_terms() as f64;
+                    assert!((got - want).abs() < tol, "{nx}x{ny} cn {cx}x{cy} {isa:?}: {got} vs {want}");
+                }
             }
         }
     }
 
     #[test]
-    fn transpose_is_the_adjoint() {
-        let pr = problem(12, 10, 7, 6);
-        let n = pr.dim();
-        let x: Vec<f64> = (0..n).map(|k| ((k * 31) % 17) as f64 / 17.0).collect();
-        let zero = vec![0.0; n];
-        let (mut r, mut r0) = (Vec::new(), Vec::new());
-        pr.residuals(&x, &mut r);
-        pr.residuals(&zero, &mut r0);
-        let y: Vec<[f64; 3]> = (0..r.len()).map(|k| [((k * 3) % 7) as f64 - 3.0, ((k * 5) % 11) as f64 - 5.0, (k % 3) as f64]).collect();
-        // <A x, y> = <x, A^T y> with A x = r(x) - r(0).
-        let lhs: f64 = r.iter().zip(&r0).zip(&y).map(|((a, b), yy)| (0..3).map(|c| (a[c] - b[c]) * yy[c]).sum::<f64>()).sum();
-        let mut g = vec![0.0; n];
-        pr.apply_transpose(&y, &mut g);
-        let rhs: f64 = g.iter().zip(&x).map(|(a, b)| a * b).sum();
-        assert!((lhs - rhs).abs() < 1e-9 * lhs.abs().max(1.0), "{lhs} vs {rhs}");
-        assert_eq!(r.len(), pr.terms());
+    fn all_kernel_copies_are_bit_identical() {
+        let pb = sphere_problem(20, 20, 18, 18, BoxSpec::DataRange);
+        let x: Vec<f64> = pb.initial_point().iter().enumerate().map(|(k, v)| v + 1e-4 * (k % 5) as f64).collect();
+        let base = pb.clone().with_isa(Isa::Baseline).fitness(&x);
+        assert_eq!(pb.clone().with_isa(Isa::Avx2).fitness(&x).to_bits(), base.to_bits());
+    }
+
+    #[test]
+    fn surface_and_sum_of_norms_agree_with_the_fitness() {
+        let pb = sphere_problem(12, 10, 6, 5, BoxSpec::DataRange);
+        let x = pb.initial_point();
+        let TwoViewGrid { bottom: sb, top: st, .. } = pb.surface(x);
+        let p = pb.parts();
+        // Border grid points of the two views coincide (shared border classes).
+        for i in 0..p.nx {
+            for j in 0..p.ny {
+                if i == 0 || j == 0 || i + 1 == p.nx || j + 1 == p.ny {
+                    assert!(crate::geom::dist(sb[i * p.ny + j], st[i * p.ny + j]) < 1e-14);
+                }
+            }
+        }
+        let mut r = vec![[0.0; 3]; pb.n_terms()];
+        pb.residuals(x, &mut r);
+        let f: f64 = r.iter().map(|v| crate::geom::norm(*v)).sum();
+        assert!((f - pb.fitness(x)).abs() < 1e-12 * f);
+        assert_eq!(pb.n_terms(), DoubleNet::new(p.nx, p.ny).unwrap().nov());
+        let order = pb.point_order().unwrap();
+        let mut sorted = order.clone();
+        sorted.sort();
+        assert_eq!(sorted, (0..pb.n_points()).collect::<Vec<_>>());
+    }
+
+    #[test]
+    fn box_defaults_to_the_data_range_and_can_widen() {
+        let pb = sphere_problem(10, 10, 6, 6, BoxSpec::DataRange);
+        let (lo, hi) = pb.box_axes();
+        let all: Vec<Point3> = pb.parts().data_bottom.iter().chain(&pb.parts().data_top).copied().collect();
+        assert_eq!(crate::geom::bounding_box(&all).unwrap(), (lo, hi));
+        let (l, u) = pb.bounds();
+        assert_eq!((l[4], u[4]), (lo[1], hi[1]));
+        let wide = ControlNetProblem::new(pb.parts().clone(), BoxSpec::Widened { fraction: 0.5 }).unwrap();
+        let (wl, wh) = wide.box_axes();
+        for a in 0..3 {
+            assert!((wh[a] - wl[a] - 2.0 * (hi[a] - lo[a])).abs() < 1e-12);
+        }
+        assert!(wide.initial_outside_box() <= pb.initial_outside_box());
+        // Cover always holds x0; with fraction 0 it is the hull of data and x0 per axis.
+        let big = sphere_problem(20, 20, 18, 18, BoxSpec::DataRange);
+        assert!(big.initial_outside_box() > 0, "a near-square least-squares net overshoots the data");
+        let cover = ControlNetProblem::new(big.parts().clone(), BoxSpec::Cover { fraction: 0.0 }).unwrap();
+        assert_eq!(cover.initial_outside_box(), 0);
+        let (cl, ch) = cover.box_axes();
+        let x0 = big.initial_point();
+        for a in 0..3 {
+            let lo = x0.iter().skip(a).step_by(3).fold(big.box_axes().0[a], |m, &v| m.min(v));
+            let hi = x0.iter().skip(a).step_by(3).fold(big.box_axes().1[a], |m, &v| m.max(v));
+            assert_eq!((cl[a], ch[a]), (lo, hi));
+        }
+    }
+
+    #[test]
+    fn malformed_parts_are_named() {
+        let pb = sphere_problem(6, 6, 4, 4, BoxSpec::DataRange);
+        let mut parts = pb.parts().clone();
+        parts.x0.pop();
+        let e = ControlNetProblem::new(parts, BoxSpec::DataRange).unwrap_err().to_string();
+        assert!(e.contains("x0 has 59 values") && e.contains("NOV = 20"), "{e}");
+        let mut parts = pb.parts().clone();
+        parts.nu.first[2] = 1;
+        let e = ControlNetProblem::new(parts, BoxSpec::DataRange).unwrap_err().to_string();
+        assert!(e.contains("nu[2]"), "{e}");
+        let mut parts = pb.parts().clone();
+        parts.data_top[5][1] = f64::NAN;
+        let e = ControlNetProblem::new(parts, BoxSpec::DataRange).unwrap_err().to_string();
+        assert!(e.contains("data_top[5]"), "{e}");
+        let e = ControlNetProblem::new(pb.parts().clone(), BoxSpec::Axes { lower: [0.0; 3], upper: [1.0, -1.0, 1.0] }).unwrap_err().to_string();
+        assert!(e.contains("axis 1"), "{e}");
+        assert!(pb.fitness(&[0.0; 5]).is_nan());
+    }
+}
+
+/// Measurements (run with `cargo test --release -- --ignored --nocapture fitness_timing`).
+#[cfg(test)]
+mod timing {
+    use super::test_support::sphere_problem;
+    use super::*;
+    use std::time::Instant;
+
+    #[test]
+    #[ignore]
+    fn fitness_timing() {
+        for (nx, ny, cx, cy) in [(20, 20, 18, 18), (18, 30, 16, 28), (20, 20, 6, 6)] {
+            let pb = sphere_problem(nx, ny, cx, cy, BoxSpec::DataRange);
+            let x = pb.initial_point().to_vec();
+            for isa in [Isa::Baseline, Isa::Avx2] {
+                let q = pb.clone().with_isa(isa);
+                if q.isa() != isa {
+                    continue;
+                }
+                let mut s = Scratch::default();
+                let mut acc = 0.0;
+                let n = 40_000;
+                // Best of 7 batches (the machine is shared).
+                let mut per = f64::INFINITY;
+                for _ in 0..7 {
+                    let t = Instant::now();
+                    for k in 0..n {
+                        acc += q.fitness_with(&x, &mut s) * (k & 1) as f64;
+                    }
+                    per = per.min(t.elapsed().as_secs_f64() / n as f64);
+                }
+                println!("grid {nx}x{ny} cn {cx}x{cy} dim {} {isa:?}: {:.3} us per evaluation ({acc:.3e})", q.dim(), per * 1e6);
+            }
+        }
     }
 }

@@ -1,137 +1,321 @@
-//! Cuckoo search (Yang & Deb 2009) as seed 003 uses it: each generation every nest makes a new
-//! solution by a Levy flight, x + alpha L (x - best) N(0,1), with L from Mantegna's algorithm
-//! (beta = 1.5) and alpha = 0.01, kept if not worse than that nest; then each coordinate of each
-//! nest is, with probability pa, moved by r (x_perm1 - x_perm2) (one uniform r per nest), again
-//! kept if not worse. Two evaluations per nest and generation. ICSA (seed 003, after Valian et
-//! al. 2011) lets pa fall linearly from pa_max = 0.5 to pa_min = 0.1 over the generations.
+//! Cuckoo search via Levy flights (Yang & Deb 2009) as seed 003 uses it (Section 4, following
+//! the vectorised reference implementation it cites), and its variant ICSA (seed 003 Section 7.1,
+//! after Valian et al. 2011).
+//!
+//! One generation, two sweeps over the N nests (2 N evaluations; `N (1 + 2 generations)` in all):
+//! 1. Levy flights (seed 003 Eq. 6-10): every nest x makes a new solution
+//!    x + alpha * s * (x - x_best) * psi per coordinate, with psi ~ N(0,1), alpha = 0.01 and the
+//!    Mantegna step s = u / |v|^(1/beta), u ~ N(0, sigma_u^2), v ~ N(0,1), beta = 1.5 (Eq. 8-9);
+//!    x_best is the best nest at the start of the sweep. The new solution replaces its nest if
+//!    not worse.
+//! 2. Discovery: with r ~ U[0,1) per nest and two random permutations p1, p2 of the nests, each
+//!    coordinate of nest i is, with probability pa, moved to x_i + r (x_p1(i) - x_p2(i)) (the
+//!    "biased random walk" of the reference code); all candidates are built from the nests as they
+//!    were before the sweep, then each replaces its nest if not worse.
+//!
+//! Readings where the paper leaves room: the reference code marks a coordinate for the random
+//! walk when rand > pa, i.e. with probability 1 - pa; seed 003 calls pa "the probability rate" of
+//! discovery and has ICSA start from a *high* pa "to perform extensive exploration", which only
+//! makes sense if pa is the probability that a coordinate is rebuilt, so that is what pa is here.
+//! ICSA: seed 003 changes only pa, linearly from pa_max = 0.5 to pa_min = 0.1 over the
+//! generations (pa_t = pa_max - (pa_max - pa_min) t / (G - 1), t = 0..G-1), with the step size
+//! fixed; Valian et al. also let alpha fall exponentially, available as `alpha_min`. All new
+//! coordinates are clamped to the bounds (a NaN step, from 0 * inf, leaves the coordinate).
+//! The normal draws of the Levy flights (3 per coordinate and nest) come from the run's bulk
+//! generator ([`super::sampling::Bulk`]); every other draw from the run's ChaCha8 stream.
 
-use super::problem::{clamp_into, initial_population, Budget, Optimiser, Problem, RunResult, Tracker};
-use rand::seq::SliceRandom;
+// Index loops over several parallel arrays read more plainly than zipped iterators here.
+#![allow(clippy::needless_range_loop)]
+
+use super::problem::{check_problem, Budget, Evaluator, Optimiser, Population, Problem, RunResult};
+use super::sampling::{bulk_from, index, inv_abs_pow_two_thirds, mantegna_sigma_u, unit, BitPool, Bulk, Geometric};
+use super::{check_range, OptimError};
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+/// CSA parameters (defaults: seed 003, pa = 0.25, alpha = 0.01, beta = 1.5).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
-pub struct Cuckoo {
-    /// Discovery rate pa (CSA); ICSA's start value when `pa_min` is set.
+pub struct Csa {
+    /// Discovery probability pa.
     pub pa: f64,
-    /// ICSA: pa falls linearly from `pa` to `pa_min` over the generations.
-    pub pa_min: Option<f64>,
-    /// Step scale alpha.
-    pub step: f64,
-    /// Levy exponent beta.
+    /// Step size alpha of the Levy flight.
+    pub alpha: f64,
+    /// Levy exponent beta of Mantegna's algorithm.
     pub beta: f64,
 }
 
-impl Cuckoo {
-    pub fn csa() -> Cuckoo {
-        Cuckoo { pa: 0.25, pa_min: None, step: 0.01, beta: 1.5 }
+impl Default for Csa {
+    fn default() -> Csa {
+        Csa { pa: 0.25, alpha: 0.01, beta: 1.5 }
     }
+}
 
-    pub fn icsa() -> Cuckoo {
-        Cuckoo { pa: 0.5, pa_min: Some(0.1), step: 0.01, beta: 1.5 }
+/// ICSA parameters (defaults: seed 003, pa from 0.5 down to 0.1, alpha fixed at 0.01).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Icsa {
+    pub pa_max: f64,
+    pub pa_min: f64,
+    /// Step size at the first generation.
+    pub alpha: f64,
+    /// If set, alpha falls exponentially to this value at the last generation (Valian et al.);
+    /// seed 003 keeps alpha fixed (unset).
+    pub alpha_min: Option<f64>,
+    pub beta: f64,
+}
+
+impl Default for Icsa {
+    fn default() -> Icsa {
+        Icsa { pa_max: 0.5, pa_min: 0.1, alpha: 0.01, alpha_min: None, beta: 1.5 }
     }
+}
 
-    pub fn validate(&self, key: &str) -> Result<(), String> {
-        if !(0.0..=1.0).contains(&self.pa) || self.pa_min.map(|p| !(0.0..=1.0).contains(&p)).unwrap_or(false) {
-            return Err(format!("{key}.pa must be in [0,1]"));
-        }
-        if !(self.beta > 0.0 && self.beta <= 2.0) {
-            return Err(format!("{key}.beta must be in (0,2], got {}", self.beta));
-        }
-        if !(self.step > 0.0) {
-            return Err(format!("{key}.step must be positive, got {}", self.step));
+fn check_alpha_beta(prefix: &str, alpha: f64, beta: f64) -> Result<(), OptimError> {
+    if !(alpha > 0.0 && alpha.is_finite()) {
+        return Err(OptimError::param(&format!("{prefix}.alpha"), format!("must be finite and > 0, got {alpha}")));
+    }
+    if !(beta > 0.0 && beta < 2.0) {
+        return Err(OptimError::param(&format!("{prefix}.beta"), format!("must be in (0,2), got {beta}")));
+    }
+    Ok(())
+}
+
+impl Csa {
+    pub fn validate(&self) -> Result<(), OptimError> {
+        check_range("csa.pa", self.pa, 0.0, 1.0)?;
+        check_alpha_beta("csa", self.alpha, self.beta)
+    }
+}
+
+impl Icsa {
+    pub fn validate(&self) -> Result<(), OptimError> {
+        check_range("icsa.pa_max", self.pa_max, 0.0, 1.0)?;
+        check_range("icsa.pa_min", self.pa_min, 0.0, 1.0)?;
+        check_alpha_beta("icsa", self.alpha, self.beta)?;
+        if let Some(a) = self.alpha_min {
+            if !(a > 0.0 && a.is_finite()) {
+                return Err(OptimError::param("icsa.alpha_min", format!("must be finite and > 0, got {a}")));
+            }
         }
         Ok(())
     }
 
-    /// Mantegna's sigma_u for the Levy exponent beta.
-    pub fn mantegna_sigma(beta: f64) -> f64 {
-        let g = |x: f64| statrs::function::gamma::gamma(x);
-        ((g(1.0 + beta) * (std::f64::consts::PI * beta / 2.0).sin()) / (g((1.0 + beta) / 2.0) * beta * 2f64.powf((beta - 1.0) / 2.0))).powf(1.0 / beta)
+    /// (pa, alpha) of generation t of g (t = 0..g-1).
+    pub fn schedule(&self, t: u64, g: u64) -> (f64, f64) {
+        let frac = if g > 1 { t as f64 / (g - 1) as f64 } else { 0.0 };
+        let pa = self.pa_max - (self.pa_max - self.pa_min) * frac;
+        let alpha = match self.alpha_min {
+            Some(a_min) => self.alpha * (a_min / self.alpha).powf(frac),
+            None => self.alpha,
+        };
+        (pa, alpha)
     }
 }
 
-impl Default for Cuckoo {
-    fn default() -> Self {
-        Cuckoo::csa()
-    }
-}
-
-impl Optimiser for Cuckoo {
+impl Optimiser for Csa {
     fn name(&self) -> &'static str {
-        if self.pa_min.is_some() {
-            "icsa"
-        } else {
-            "csa"
-        }
+        "csa"
     }
 
-    fn run(&self, problem: &dyn Problem, budget: &Budget, rng: &mut ChaCha8Rng) -> RunResult {
-        let n = problem.dim();
-        let np = budget.population;
-        let (lo, hi) = problem.bounds();
-        let sigma = Cuckoo::mantegna_sigma(self.beta);
-        let mut tracker = Tracker::new(problem, (np * (2 * budget.generations + 1)) as u64);
-        let mut nest = initial_population(problem, budget, rng);
-        let mut fit: Vec<f64> = nest.iter().map(|x| tracker.eval(x)).collect();
-        let initial_best = tracker.best_fitness;
-        let mut new = vec![0.0; n];
-        let mut perm1: Vec<usize> = (0..np).collect();
-        let mut perm2: Vec<usize> = (0..np).collect();
-        for gen in 0..budget.generations {
-            let best = tracker.best_x.clone();
-            for i in 0..np {
-                for d in 0..n {
-                    let u: f64 = rng.sample::<f64, _>(StandardNormal) * sigma;
-                    let v: f64 = rng.sample(StandardNormal);
-                    let levy = u / v.abs().powf(1.0 / self.beta);
-                    let z: f64 = rng.sample(StandardNormal);
-                    new[d] = nest[i][d] + self.step * levy * (nest[i][d] - best[d]) * z;
-                }
-                clamp_into(&mut new, lo, hi);
-                let f = tracker.eval(&new);
-                if f <= fit[i] {
-                    nest[i].copy_from_slice(&new);
-                    fit[i] = f;
-                }
+    fn run(&self, problem: &dyn Problem, budget: &Budget, rng: &mut ChaCha8Rng) -> Result<RunResult, OptimError> {
+        self.validate()?;
+        cuckoo_search(problem, budget, rng, self.beta, &|_| (self.pa, self.alpha))
+    }
+}
+
+impl Optimiser for Icsa {
+    fn name(&self) -> &'static str {
+        "icsa"
+    }
+
+    fn run(&self, problem: &dyn Problem, budget: &Budget, rng: &mut ChaCha8Rng) -> Result<RunResult, OptimError> {
+        self.validate()?;
+        cuckoo_search(problem, budget, rng, self.beta, &|t| self.schedule(t, budget.generations))
+    }
+}
+
+/// A uniformly random permutation of 0..n (Fisher-Yates).
+fn permutation(n: usize, rng: &mut ChaCha8Rng) -> Vec<usize> {
+    let mut p: Vec<usize> = (0..n).collect();
+    for i in (1..n).rev() {
+        p.swap(i, index(rng, i + 1));
+    }
+    p
+}
+
+/// Fill `out` with Mantegna steps u / |v|^(1/beta), all u drawn first, then all v (the order
+/// of the reference code).
+fn mantegna_steps(out: &mut [f64], v_buf: &mut [f64], sigma_u: f64, beta: f64, rng: &mut Bulk) {
+    for u in out.iter_mut() {
+        *u = sigma_u * rng.sample::<f64, _>(StandardNormal);
+    }
+    for v in v_buf.iter_mut() {
+        *v = rng.sample(StandardNormal);
+    }
+    if beta == 1.5 {
+        for (u, v) in out.iter_mut().zip(v_buf.iter()) {
+            *u *= inv_abs_pow_two_thirds(*v);
+        }
+    } else {
+        let e = -1.0 / beta;
+        for (u, v) in out.iter_mut().zip(v_buf.iter()) {
+            *u *= v.abs().powf(e);
+        }
+    }
+}
+
+/// The shared loop of CSA and ICSA; `schedule(t)` gives (pa, alpha) of generation t.
+fn cuckoo_search(
+    problem: &dyn Problem,
+    budget: &Budget,
+    rng: &mut ChaCha8Rng,
+    beta: f64,
+    schedule: &dyn Fn(u64) -> (f64, f64),
+) -> Result<RunResult, OptimError> {
+    budget.validate(2)?;
+    check_problem(problem)?;
+    let d = problem.dim();
+    let (lo, hi) = problem.bounds();
+    let sigma_u = mantegna_sigma_u(beta);
+    let mut eval = Evaluator::new(problem, budget);
+    let mut pop = Population::initial(problem, budget, &mut eval, rng);
+    let n = pop.x.len();
+    let initial_best = pop.best_fitness();
+    let mut best = pop.x[pop.best()].clone();
+    let mut step = vec![0.0; d];
+    let mut v_buf = vec![0.0; d];
+    let mut psi = vec![0.0; d];
+    let mut cand: Vec<Vec<f64>> = vec![vec![0.0; d]; n];
+    let mut cand_f = vec![0.0; n];
+    let mut pool = BitPool::new();
+    let mut bulk = bulk_from(rng);
+    for t in 0..budget.generations {
+        let (pa, alpha) = schedule(t);
+        // 1. Levy flights around each nest, scaled by its distance to the best.
+        for i in 0..n {
+            mantegna_steps(&mut step, &mut v_buf, sigma_u, beta, &mut bulk);
+            for p in psi.iter_mut() {
+                *p = bulk.sample(StandardNormal);
             }
-            let pa = match self.pa_min {
-                Some(min) if budget.generations > 1 => self.pa - (self.pa - min) * gen as f64 / (budget.generations - 1) as f64,
-                _ => self.pa,
-            };
-            perm1.shuffle(rng);
-            perm2.shuffle(rng);
-            for i in 0..np {
-                let r: f64 = rng.gen();
-                let (a, b) = (&nest[perm1[i]], &nest[perm2[i]]);
-                for d in 0..n {
-                    let moved = rng.gen::<f64>() < pa;
-                    new[d] = nest[i][d] + if moved { r * (a[d] - b[d]) } else { 0.0 };
-                }
-                clamp_into(&mut new, lo, hi);
-                let f = tracker.eval(&new);
-                if f <= fit[i] {
-                    nest[i].copy_from_slice(&new);
-                    fit[i] = f;
-                }
+            let (x, c) = (&pop.x[i][..d], &mut cand[i][..d]);
+            let (b, s, ps, lo, hi) = (&best[..d], &step[..d], &psi[..d], &lo[..d], &hi[..d]);
+            for j in 0..d {
+                let nj = x[j] + alpha * s[j] * (x[j] - b[j]) * ps[j];
+                c[j] = if nj.is_nan() { x[j] } else { nj.max(lo[j]).min(hi[j]) };
+            }
+            let f = eval.eval(c);
+            if f <= pop.f[i] {
+                std::mem::swap(&mut pop.x[i], &mut cand[i]);
+                pop.f[i] = f;
             }
         }
-        tracker.finish(initial_best)
+        // 2. Discovery: a fraction pa of the coordinates take a biased random walk.
+        let p1 = permutation(n, rng);
+        let p2 = permutation(n, rng);
+        let walk = Geometric::new(pa);
+        for i in 0..n {
+            let r = unit(rng);
+            let (x, c) = (&pop.x[i][..d], &mut cand[i][..d]);
+            let (a, b) = (&pop.x[p1[i]][..d], &pop.x[p2[i]][..d]);
+            c.copy_from_slice(x);
+            let mut j = walk.skip(&mut pool, rng);
+            while j < d {
+                let nj = x[j] + r * (a[j] - b[j]);
+                c[j] = nj.max(lo[j]).min(hi[j]);
+                j = walk.next_after(j, &mut pool, rng);
+            }
+        }
+        for i in 0..n {
+            cand_f[i] = eval.eval(&cand[i]);
+        }
+        for i in 0..n {
+            if cand_f[i] <= pop.f[i] {
+                std::mem::swap(&mut pop.x[i], &mut cand[i]);
+                pop.f[i] = cand_f[i];
+            }
+        }
+        best.copy_from_slice(&pop.x[pop.best()]);
     }
+    let b = pop.best();
+    Ok(eval.finish(pop.x.swap_remove(b), initial_best))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::optim::optimiser_tests::check;
+    use rand::SeedableRng;
 
     #[test]
-    fn cuckoo_contract_and_mantegna_sigma() {
-        super::super::problem::tests::check_optimiser(&Cuckoo::csa(), 40);
-        super::super::problem::tests::check_optimiser(&Cuckoo::icsa(), 40);
-        // sigma_u(1.5) = 0.6966 (Yang 2010, Nature-Inspired Metaheuristic Algorithms).
-        assert!((Cuckoo::mantegna_sigma(1.5) - 0.696574).abs() < 1e-5);
+    fn csa_and_icsa_pass_the_common_checks() {
+        let evals = |b: &Budget| b.population as u64 * (1 + 2 * b.generations);
+        // The sphere's coordinates are not all at the best, so the Levy flights move; use a larger
+        // step than the paper's 0.01 to see clear progress within the short test budget.
+        check(&Csa { alpha: 0.5, ..Csa::default() }, evals);
+        check(&Icsa { alpha: 0.5, ..Icsa::default() }, evals);
+        check(&Icsa { alpha: 0.5, alpha_min: Some(0.01), ..Icsa::default() }, evals);
+    }
+
+    #[test]
+    fn parameters_are_validated_by_key() {
+        assert_eq!(Csa { pa: 2.0, ..Csa::default() }.validate().unwrap_err().to_string(), "csa.pa must be in [0,1], got 2");
+        assert!(Icsa { pa_min: -0.5, ..Icsa::default() }.validate().unwrap_err().to_string().starts_with("icsa.pa_min"));
+        assert!(Csa { beta: 2.5, ..Csa::default() }.validate().unwrap_err().to_string().starts_with("csa.beta"));
+        assert!(Icsa { alpha_min: Some(0.0), ..Icsa::default() }.validate().unwrap_err().to_string().starts_with("icsa.alpha_min"));
+    }
+
+    #[test]
+    fn icsa_schedule_runs_from_pa_max_to_pa_min() {
+        let icsa = Icsa::default();
+        assert_eq!(icsa.schedule(0, 2000), (0.5, 0.01));
+        let (pa, alpha) = icsa.schedule(1999, 2000);
+        assert!((pa - 0.1).abs() < 1e-15 && alpha == 0.01);
+        assert!((icsa.schedule(999, 1999).0 - 0.3).abs() < 1e-15);
+        let v = Icsa { alpha_min: Some(1e-4), ..Icsa::default() };
+        assert!((v.schedule(1999, 2000).1 - 1e-4).abs() < 1e-18);
+        assert!((v.schedule(999, 1999).1 - 1e-3).abs() < 1e-15);
+    }
+
+    #[test]
+    fn permutations_are_permutations() {
+        let mut rng = ChaCha8Rng::seed_from_u64(2);
+        let mut first = [0usize; 5];
+        for _ in 0..20_000 {
+            let mut p = permutation(5, &mut rng);
+            first[p[0]] += 1;
+            p.sort();
+            assert_eq!(p, vec![0, 1, 2, 3, 4]);
+        }
+        assert!(first.iter().all(|&c| (c as f64 - 4000.0).abs() < 300.0), "{first:?}");
+    }
+
+    /// Mantegna's steps for beta = 1.5: symmetric, and heavy tailed as |s| ~ |u| / |v|^(2/3).
+    /// P(|s| > t) for large t is dominated by small |v|: P(|v|^(2/3) < |u|/t), checked against a
+    /// direct simulation with powf (same law, independent code path).
+    #[test]
+    fn mantegna_steps_have_the_right_law() {
+        let mut rng = bulk_from(&mut ChaCha8Rng::seed_from_u64(3));
+        let n = 200_000;
+        let mut s = vec![0.0; n];
+        let mut v = vec![0.0; n];
+        let sigma = mantegna_sigma_u(1.5);
+        mantegna_steps(&mut s, &mut v, sigma, 1.5, &mut rng);
+        let mut s2 = vec![0.0; n];
+        mantegna_steps(&mut s2, &mut v, sigma, 1.4999999999, &mut rng);
+        let frac = |s: &[f64], t: f64| s.iter().filter(|x| x.abs() > t).count() as f64 / s.len() as f64;
+        for t in [0.5, 2.0, 10.0] {
+            let (a, b) = (frac(&s, t), frac(&s2, t));
+            let sd = (a * (1.0 - a) / n as f64).sqrt() * 2f64.sqrt();
+            assert!((a - b).abs() < 5.0 * sd + 1e-4, "t {t}: {a} vs {b}");
+        }
+        let pos = s.iter().filter(|x| **x > 0.0).count() as f64 / n as f64;
+        assert!((pos - 0.5).abs() < 0.005, "{pos}");
+        // Tail: P(|s| > t) = P(|v| < (sigma |z| / t)^1.5) ~ sqrt(2/pi) (sigma/t)^1.5 E|z|^1.5 for
+        // large t, with E|z|^1.5 = 2^0.75 Gamma(1.25) / sqrt(pi) = 0.8600: 0.01263 at t = 10.
+        let want = (2.0 / std::f64::consts::PI).sqrt() * (sigma / 10.0).powf(1.5) * 0.8600;
+        assert!((frac(&s, 10.0) / want - 1.0).abs() < 0.1, "{} vs {want}", frac(&s, 10.0));
     }
 }

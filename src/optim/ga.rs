@@ -1,116 +1,192 @@
-//! Steady-state genetic algorithm (thesis 6.2.4.1, Table 6.1; SPEC 4): two parents by tournaments
-//! of 4, uniform crossover (each gene swapped with probability 0.5) applied with probability Pc,
-//! uniform mutation with probability Pm per gene (a mutated gene becomes x0 + U[-r, r]), and each
-//! offspring replaces its parent only if strictly better. Two evaluations per generation.
+//! Steady-state genetic algorithm of thesis 6.2.4.1 (value encoding, tournament selection,
+//! uniform crossover, uniform mutation, weak-parent replacement; Table 6.1: Pc = 0.7,
+//! Pm = 0.01).
+//!
+//! One generation: two tournaments of 4 distinct individuals each pick the parents (least
+//! fitness wins, the first drawn on ties); with probability Pc uniform crossover swaps each gene
+//! between the two offspring with probability 0.5; each gene of each offspring is then mutated
+//! with probability Pm to x0 + U[-r, r] (the initialisation range, clamped to the bounds);
+//! offspring 1 replaces parent 1 and offspring 2 replaces parent 2, each only if strictly
+//! better (when both parents are the same individual, offspring 2 competes with whatever holds
+//! the slot after offspring 1). Both offspring are always evaluated: 2 evaluations per
+//! generation, `population + 2 * generations` in all.
+//!
+//! Random bits: one fair bit per gene for the crossover (64 genes per draw) and geometric skips
+//! for the mutation (one draw per mutated gene, not per gene; see `sampling::Geometric`).
 
-use super::problem::{clamp_into, geometric_skip, initial_population, Budget, Optimiser, Problem, RunResult, Tracker};
-use rand::Rng;
+use super::problem::{check_problem, Budget, Evaluator, Optimiser, Population, Problem, RunResult};
+use super::sampling::{index, symmetric, unit, BitPool, Geometric};
+use super::{check_range, OptimError};
+use rand::RngCore;
 use rand_chacha::ChaCha8Rng;
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+/// GA parameters (defaults: thesis Table 6.1).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct Ga {
     /// Crossover probability Pc.
     pub pc: f64,
-    /// Mutation probability Pm per gene.
+    /// Per-gene mutation probability Pm.
     pub pm: f64,
     /// Tournament size.
     pub tournament: usize,
+    /// Per-gene swap probability of the uniform crossover (only 0.5 is implemented: one fair
+    /// bit per gene).
+    pub swap: f64,
 }
 
 impl Default for Ga {
-    fn default() -> Self {
-        Ga { pc: 0.7, pm: 0.01, tournament: 4 }
+    fn default() -> Ga {
+        Ga { pc: 0.7, pm: 0.01, tournament: 4, swap: 0.5 }
     }
 }
 
 impl Ga {
-    pub fn validate(&self) -> Result<(), String> {
-        if !(0.0..=1.0).contains(&self.pc) {
-            return Err(format!("ga.pc must be in [0,1], got {}", self.pc));
+    pub fn validate(&self) -> Result<(), OptimError> {
+        check_range("ga.pc", self.pc, 0.0, 1.0)?;
+        check_range("ga.pm", self.pm, 0.0, 1.0)?;
+        if !(1..=MAX_TOURNAMENT).contains(&self.tournament) {
+            return Err(OptimError::param("ga.tournament", format!("must be in [1,{MAX_TOURNAMENT}], got {}", self.tournament)));
         }
-        if !(0.0..=1.0).contains(&self.pm) {
-            return Err(format!("ga.pm must be in [0,1], got {}", self.pm));
-        }
-        if self.tournament == 0 {
-            return Err("ga.tournament must be at least 1".into());
+        if self.swap != 0.5 {
+            return Err(OptimError::param("ga.swap", format!("must be 0.5 (uniform crossover), got {}", self.swap)));
         }
         Ok(())
     }
 
-    fn tournament(&self, fit: &[f64], rng: &mut ChaCha8Rng) -> usize {
-        let mut best = rng.gen_range(0..fit.len());
-        for _ in 1..self.tournament {
-            let c = rng.gen_range(0..fit.len());
-            if fit[c] < fit[best] {
-                best = c;
+    /// Tournament among `self.tournament` distinct individuals (needs population >= size).
+    fn tournament(&self, f: &[f64], rng: &mut ChaCha8Rng) -> usize {
+        let mut drawn = [0usize; MAX_TOURNAMENT];
+        let mut winner = usize::MAX;
+        let mut n = 0;
+        while n < self.tournament {
+            let c = index(rng, f.len());
+            if drawn[..n].contains(&c) {
+                continue;
+            }
+            drawn[n] = c;
+            n += 1;
+            if winner == usize::MAX || f[c] < f[winner] {
+                winner = c;
             }
         }
-        best
+        winner
     }
 }
+
+const MAX_TOURNAMENT: usize = 16;
 
 impl Optimiser for Ga {
     fn name(&self) -> &'static str {
         "ga"
     }
 
-    fn run(&self, problem: &dyn Problem, budget: &Budget, rng: &mut ChaCha8Rng) -> RunResult {
-        let n = problem.dim();
-        let (lo, hi) = problem.bounds();
+    fn run(&self, problem: &dyn Problem, budget: &Budget, rng: &mut ChaCha8Rng) -> Result<RunResult, OptimError> {
+        self.validate()?;
+        budget.validate(self.tournament)?;
+        check_problem(problem)?;
+        let d = problem.dim();
         let x0 = problem.initial_point();
-        let mut tracker = Tracker::new(problem, (budget.population + 2 * budget.generations) as u64);
-        let mut pop = initial_population(problem, budget, rng);
-        let mut fit: Vec<f64> = pop.iter().map(|x| tracker.eval(x)).collect();
-        let initial_best = tracker.best_fitness;
-        let ln_keep = (1.0 - self.pm).ln();
-        let (mut c1, mut c2) = (vec![0.0; n], vec![0.0; n]);
+        let (lo, hi) = problem.bounds();
+        let mut eval = Evaluator::new(problem, budget);
+        let mut pop = Population::initial(problem, budget, &mut eval, rng);
+        let initial_best = pop.best_fitness();
+        let mutation = Geometric::new(self.pm);
+        let mut pool = BitPool::new();
+        let mut c1 = vec![0.0; d];
+        let mut c2 = vec![0.0; d];
         for _ in 0..budget.generations {
-            let p1 = self.tournament(&fit, rng);
-            let p2 = self.tournament(&fit, rng);
-            c1.copy_from_slice(&pop[p1]);
-            c2.copy_from_slice(&pop[p2]);
-            if rng.gen::<f64>() < self.pc {
-                let mut bits = 0u64;
-                for g in 0..n {
-                    if g % 64 == 0 {
-                        bits = rng.gen();
+            let a = self.tournament(&pop.f, rng);
+            let b = self.tournament(&pop.f, rng);
+            if unit(rng) < self.pc {
+                // Uniform crossover: gene j is swapped when its bit is set.
+                let (pa, pb) = (&pop.x[a], &pop.x[b]);
+                for start in (0..d).step_by(64) {
+                    let bits = rng.next_u64();
+                    let end = (start + 64).min(d);
+                    for j in start..end {
+                        let swap = (bits >> (j - start)) & 1 == 1;
+                        let (u, v) = (pa[j], pb[j]);
+                        c1[j] = if swap { v } else { u };
+                        c2[j] = if swap { u } else { v };
                     }
-                    if bits & 1 == 1 {
-                        std::mem::swap(&mut c1[g], &mut c2[g]);
-                    }
-                    bits >>= 1;
                 }
+            } else {
+                c1.copy_from_slice(&pop.x[a]);
+                c2.copy_from_slice(&pop.x[b]);
             }
             for child in [&mut c1, &mut c2] {
-                let mut g = geometric_skip(rng, ln_keep);
-                while g < n {
-                    child[g] = x0[g] + budget.init_range * (2.0 * rng.gen::<f64>() - 1.0);
-                    g = g.saturating_add(1).saturating_add(geometric_skip(rng, ln_keep));
+                let mut j = mutation.skip(&mut pool, rng);
+                while j < d {
+                    child[j] = (x0[j] + symmetric(rng, budget.init_range)).max(lo[j]).min(hi[j]);
+                    j = mutation.next_after(j, &mut pool, rng);
                 }
-                clamp_into(child, lo, hi);
             }
-            let f1 = tracker.eval(&c1);
-            if f1 < fit[p1] {
-                pop[p1].copy_from_slice(&c1);
-                fit[p1] = f1;
+            let f1 = eval.eval(&c1);
+            if f1 < pop.f[a] {
+                std::mem::swap(&mut pop.x[a], &mut c1);
+                pop.f[a] = f1;
             }
-            let f2 = tracker.eval(&c2);
-            if f2 < fit[p2] {
-                pop[p2].copy_from_slice(&c2);
-                fit[p2] = f2;
+            let f2 = eval.eval(&c2);
+            if f2 < pop.f[b] {
+                std::mem::swap(&mut pop.x[b], &mut c2);
+                pop.f[b] = f2;
             }
         }
-        tracker.finish(initial_best)
+        let best = pop.best();
+        Ok(eval.finish(pop.x.swap_remove(best), initial_best))
     }
 }
 
 #[cfg(test)]
 mod tests {
+    use super::*;
+    use crate::optim::optimiser_tests::check;
+
     #[test]
-    fn ga_contract() {
-        super::super::problem::tests::check_optimiser(&super::Ga { pm: 0.1, ..Default::default() }, 2);
-        assert!(super::Ga { pc: 1.5, ..Default::default() }.validate().unwrap_err().contains("ga.pc"));
+    fn ga_passes_the_common_checks() {
+        check(&Ga::default(), |b| b.population as u64 + 2 * b.generations);
+    }
+
+    #[test]
+    fn parameters_are_validated_by_key() {
+        let e = Ga { pc: 1.5, ..Ga::default() }.validate().unwrap_err().to_string();
+        assert_eq!(e, "ga.pc must be in [0,1], got 1.5");
+        assert!(Ga { pm: -0.1, ..Ga::default() }.validate().unwrap_err().to_string().starts_with("ga.pm"));
+        assert!(Ga { tournament: 0, ..Ga::default() }.validate().unwrap_err().to_string().starts_with("ga.tournament"));
+        let g: Ga = toml::from_str("pc = 0.9").unwrap();
+        assert_eq!(g, Ga { pc: 0.9, ..Ga::default() });
+        assert!(toml::from_str::<Ga>("pcc = 0.9").is_err());
+    }
+
+    #[test]
+    fn tournament_picks_the_best_of_distinct_draws() {
+        use rand::SeedableRng;
+        let ga = Ga::default();
+        let f = [5.0, 4.0, 3.0, 2.0];
+        let mut rng = ChaCha8Rng::seed_from_u64(1);
+        // With 4 of 4 distinct individuals drawn, the best always wins.
+        for _ in 0..100 {
+            assert_eq!(ga.tournament(&f, &mut rng), 3);
+        }
+        // With 4 distinct of 40, P(the winner is one of the 4 best) = 1 - C(36,4)/C(40,4)
+        // = 1 - 58905/91390 = 0.35546.
+        let f: Vec<f64> = (0..40).map(|i| i as f64).collect();
+        let n = 40_000;
+        let top = (0..n).filter(|_| ga.tournament(&f, &mut rng) < 4).count() as f64 / n as f64;
+        assert!((top - 0.35546).abs() < 0.01, "{top}");
+    }
+
+    #[test]
+    fn mutation_only_ga_resamples_around_x0() {
+        use crate::optim::problem::tests::Sphere;
+        use rand::SeedableRng;
+        // Pc = 0, Pm = 1: every offspring is x0 + U[-r, r], so the best stays within r of x0.
+        let p = Sphere::new(5);
+        let ga = Ga { pc: 0.0, pm: 1.0, ..Ga::default() };
+        let budget = Budget { generations: 50, population: 8, init_range: 0.01, trace_every_evals: 10 };
+        let r = ga.run(&p, &budget, &mut ChaCha8Rng::seed_from_u64(3)).unwrap();
+        assert!(r.best_x.iter().zip(&p.x0).all(|(a, b)| (a - b).abs() <= 0.01));
     }
 }

@@ -1,12 +1,16 @@
-//! The problem and optimiser traits (argmin's split: a problem says what to minimise, an optimiser
-//! how), the evaluation budget, and the tracker that counts evaluations and records the
-//! convergence trace at fixed evaluation counts, so that the traces of repeats line up.
+//! The problem/optimiser split (as in argmin): a [`Problem`] says what to minimise inside which
+//! box, an [`Optimiser`] says how, and an [`Evaluator`] between them counts every evaluation and
+//! records the convergence trace at fixed evaluation counts, so that budgets are measured outside
+//! the algorithms and the traces of repeats line up checkpoint by checkpoint.
 
-use rand::Rng;
+use super::sampling::symmetric;
+use super::OptimError;
 use rand_chacha::ChaCha8Rng;
+use serde::{Deserialize, Serialize};
 
 /// A box-constrained minimisation problem.
 pub trait Problem: Sync {
+    /// Number of coordinates of a decision vector.
     fn dim(&self) -> usize;
     /// Where the search starts (the thesis: approach B's control points).
     fn initial_point(&self) -> &[f64];
@@ -16,145 +20,195 @@ pub trait Problem: Sync {
     fn fitness(&self, x: &[f64]) -> f64;
 }
 
-/// How much an optimiser may do.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// A population-based optimiser; parameters inside, randomness only from the stream given.
+pub trait Optimiser: Send + Sync {
+    /// "ga" | "de" | "pso" | "csa" | "icsa".
+    fn name(&self) -> &'static str;
+    /// One run. Errors only for a malformed problem, budget or parameter set (checked before the
+    /// first evaluation).
+    fn run(&self, problem: &dyn Problem, budget: &Budget, rng: &mut ChaCha8Rng) -> Result<RunResult, OptimError>;
+}
+
+/// How much one run may do (thesis Table 6.1: 2000 generations of 40, initial range 5e-6).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
 pub struct Budget {
-    pub generations: usize,
+    pub generations: u64,
     pub population: usize,
-    /// Half-width r of the initial range: each initial individual is x0 + U[-r, r] per coordinate
-    /// (the thesis: 5e-6), clamped to the bounds.
+    /// Half-width r of the initial range: each initial individual is x0 + U[-r, r] per
+    /// coordinate, clamped to the bounds (the GA's mutation draws from the same range).
     pub init_range: f64,
+    /// Trace checkpoints: the best-so-far fitness is recorded after every multiple of this many
+    /// evaluations, and once more after the last evaluation.
+    pub trace_every_evals: u64,
+}
+
+impl Default for Budget {
+    fn default() -> Budget {
+        Budget { generations: 2000, population: 40, init_range: 5e-6, trace_every_evals: 400 }
+    }
+}
+
+impl Budget {
+    /// Check the budget for an optimiser that needs at least `min_population` individuals.
+    pub fn validate(&self, min_population: usize) -> Result<(), OptimError> {
+        if self.population < min_population {
+            return Err(OptimError::param(
+                "budget.population",
+                format!("must be at least {min_population} for this optimiser, got {}", self.population),
+            ));
+        }
+        if !(self.init_range >= 0.0 && self.init_range.is_finite()) {
+            return Err(OptimError::param("budget.init_range", format!("must be finite and >= 0, got {}", self.init_range)));
+        }
+        if self.trace_every_evals == 0 {
+            return Err(OptimError::param("budget.trace_every_evals", "must be at least 1, got 0".to_string()));
+        }
+        Ok(())
+    }
 }
 
 /// The outcome of one run.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RunResult {
     pub best_x: Vec<f64>,
     pub best_fitness: f64,
     /// Best fitness of the initial population.
-    pub initial_best: f64,
+    pub initial_best_fitness: f64,
+    /// Number of fitness evaluations, initial population included.
     pub evaluations: u64,
-    /// (evaluations, best fitness so far) at the checkpoints of [`checkpoints`] and at the end.
+    /// (evaluations, best fitness so far) at every multiple of `Budget::trace_every_evals` and at
+    /// the end.
     pub trace: Vec<(u64, f64)>,
 }
 
-/// An optimiser: parameters inside, randomness only from the stream it is given.
-pub trait Optimiser: Send + Sync {
-    fn name(&self) -> &'static str;
-    fn run(&self, problem: &dyn Problem, budget: &Budget, rng: &mut ChaCha8Rng) -> RunResult;
-}
-
-/// Fixed trace checkpoints: 1, 2, 5 x 10^k evaluations up to `max`.
-pub fn checkpoints(max: u64) -> Vec<u64> {
-    let mut out = Vec::new();
-    let mut base = 1u64;
-    'outer: loop {
-        for m in [1, 2, 5] {
-            let c = m * base;
-            if c > max {
-                break 'outer;
-            }
-            out.push(c);
-        }
-        base *= 10;
+/// Check a problem's shapes and box before a run.
+pub fn check_problem(problem: &dyn Problem) -> Result<(), OptimError> {
+    let d = problem.dim();
+    if d == 0 {
+        return Err(OptimError::Problem("dimension is 0".into()));
     }
-    out
+    let x0 = problem.initial_point();
+    let (lo, hi) = problem.bounds();
+    if x0.len() != d || lo.len() != d || hi.len() != d {
+        return Err(OptimError::Problem(format!(
+            "dimension {d} but initial point has {}, lower bounds {}, upper bounds {}",
+            x0.len(),
+            lo.len(),
+            hi.len()
+        )));
+    }
+    if let Some(j) = x0.iter().position(|v| !v.is_finite()) {
+        return Err(OptimError::Problem(format!("initial point coordinate {j} is not finite ({})", x0[j])));
+    }
+    if let Some(j) = (0..d).find(|&j| lo[j].is_nan() || hi[j].is_nan() || lo[j] > hi[j]) {
+        return Err(OptimError::Problem(format!("bounds of coordinate {j} are not an interval: [{}, {}]", lo[j], hi[j])));
+    }
+    Ok(())
 }
 
-/// Counts evaluations, keeps the best point, and records the trace.
-pub struct Tracker<'a> {
+/// Counts evaluations, keeps the best value, and records the trace (the argmin-style counting
+/// wrapper). A NaN fitness is recorded as +inf so that it never wins a comparison.
+pub struct Evaluator<'a> {
     problem: &'a dyn Problem,
-    pub evaluations: u64,
-    pub best_fitness: f64,
-    pub best_x: Vec<f64>,
+    evaluations: u64,
+    best: f64,
+    every: u64,
     trace: Vec<(u64, f64)>,
-    next: usize,
-    marks: Vec<u64>,
 }
 
-impl<'a> Tracker<'a> {
-    pub fn new(problem: &'a dyn Problem, max_evaluations: u64) -> Tracker<'a> {
-        Tracker { problem, evaluations: 0, best_fitness: f64::INFINITY, best_x: problem.initial_point().to_vec(), trace: Vec::new(), next: 0, marks: checkpoints(max_evaluations) }
+impl<'a> Evaluator<'a> {
+    pub fn new(problem: &'a dyn Problem, budget: &Budget) -> Evaluator<'a> {
+        Evaluator { problem, evaluations: 0, best: f64::INFINITY, every: budget.trace_every_evals.max(1), trace: Vec::new() }
     }
 
-    /// Evaluate `x`, updating the best and the trace.
+    /// Evaluate `x`, counting it and updating the best and the trace.
+    #[inline]
     pub fn eval(&mut self, x: &[f64]) -> f64 {
         let f = self.problem.fitness(x);
+        let f = if f.is_nan() { f64::INFINITY } else { f };
         self.evaluations += 1;
-        if f < self.best_fitness {
-            self.best_fitness = f;
-            self.best_x.copy_from_slice(x);
+        if f < self.best {
+            self.best = f;
         }
-        while self.next < self.marks.len() && self.marks[self.next] <= self.evaluations {
-            self.trace.push((self.marks[self.next], self.best_fitness));
-            self.next += 1;
+        if self.evaluations.is_multiple_of(self.every) {
+            self.trace.push((self.evaluations, self.best));
         }
         f
     }
 
-    pub fn finish(mut self, initial_best: f64) -> RunResult {
+    pub fn evaluations(&self) -> u64 {
+        self.evaluations
+    }
+
+    pub fn best(&self) -> f64 {
+        self.best
+    }
+
+    /// Close the run: `best_x` is the optimiser's best individual (whose fitness is the best
+    /// value seen, since every optimiser here keeps its best).
+    pub fn finish(mut self, best_x: Vec<f64>, initial_best_fitness: f64) -> RunResult {
         if self.trace.last().map(|t| t.0) != Some(self.evaluations) {
-            self.trace.push((self.evaluations, self.best_fitness));
+            self.trace.push((self.evaluations, self.best));
         }
-        RunResult { best_x: self.best_x, best_fitness: self.best_fitness, initial_best, evaluations: self.evaluations, trace: self.trace }
+        RunResult { best_x, best_fitness: self.best, initial_best_fitness, evaluations: self.evaluations, trace: self.trace }
     }
 }
 
-/// Clamp every coordinate into the problem's box.
+/// Clamp every coordinate into the box.
 #[inline]
 pub fn clamp_into(x: &mut [f64], lo: &[f64], hi: &[f64]) {
-    for ((v, &l), &h) in x.iter_mut().zip(lo).zip(hi) {
-        *v = v.clamp(l, h);
+    let n = x.len();
+    let (lo, hi) = (&lo[..n], &hi[..n]);
+    for j in 0..n {
+        x[j] = x[j].max(lo[j]).min(hi[j]);
     }
 }
 
-/// The initial population: x0 + U[-r, r] per coordinate, clamped.
-pub fn initial_population(problem: &dyn Problem, budget: &Budget, rng: &mut ChaCha8Rng) -> Vec<Vec<f64>> {
-    let x0 = problem.initial_point();
-    let (lo, hi) = problem.bounds();
-    (0..budget.population)
-        .map(|_| {
-            let mut x: Vec<f64> = x0.iter().map(|&c| c + budget.init_range * (2.0 * rng.gen::<f64>() - 1.0)).collect();
-            clamp_into(&mut x, lo, hi);
-            x
-        })
-        .collect()
+/// A population: one vector per individual and its fitness.
+pub struct Population {
+    pub x: Vec<Vec<f64>>,
+    pub f: Vec<f64>,
 }
 
-/// Number of trials until the first success of a Bernoulli(p) sequence, minus one (the count of
-/// failures before it): the geometric skip that replaces one uniform draw per gene by one draw
-/// per success, with exactly the same distribution.
-#[inline]
-pub fn geometric_skip(rng: &mut ChaCha8Rng, ln_one_minus_p: f64) -> usize {
-    if ln_one_minus_p == f64::NEG_INFINITY {
-        return 0;
+impl Population {
+    /// The thesis' initialisation (6.2.4.1 step 1): x0 + U[-r, r] per coordinate, clamped to the
+    /// bounds, each individual evaluated once.
+    pub fn initial(problem: &dyn Problem, budget: &Budget, eval: &mut Evaluator, rng: &mut ChaCha8Rng) -> Population {
+        let x0 = problem.initial_point();
+        let (lo, hi) = problem.bounds();
+        let mut x = Vec::with_capacity(budget.population);
+        let mut f = Vec::with_capacity(budget.population);
+        for _ in 0..budget.population {
+            let mut v: Vec<f64> = x0.iter().map(|&c| c + symmetric(rng, budget.init_range)).collect();
+            clamp_into(&mut v, lo, hi);
+            f.push(eval.eval(&v));
+            x.push(v);
+        }
+        Population { x, f }
     }
-    if ln_one_minus_p == 0.0 {
-        return usize::MAX;
-    }
-    let u: f64 = 1.0 - rng.gen::<f64>(); // (0, 1]
-    let k = (u.ln() / ln_one_minus_p).floor();
-    if k >= usize::MAX as f64 {
-        usize::MAX
-    } else {
-        k as usize
-    }
-}
 
-/// Two uniforms in [0, 1) from one 64-bit draw (32 bits each), for coordinate-wise factors.
-#[inline]
-pub fn two_uniforms(rng: &mut ChaCha8Rng) -> (f64, f64) {
-    let r: u64 = rng.gen();
-    const SCALE: f64 = 1.0 / 4_294_967_296.0;
-    ((r >> 32) as f64 * SCALE, (r & 0xffff_ffff) as f64 * SCALE)
+    /// Index of the best individual (the first one on ties).
+    pub fn best(&self) -> usize {
+        let mut b = 0;
+        for i in 1..self.f.len() {
+            if self.f[i] < self.f[b] {
+                b = i;
+            }
+        }
+        b
+    }
+
+    pub fn best_fitness(&self) -> f64 {
+        self.f[self.best()]
+    }
 }
 
 #[cfg(test)]
-pub mod tests {
+pub(crate) mod tests {
     use super::*;
-    use rand::SeedableRng;
 
-    /// The sphere function around `centre`, in a box.
+    /// The sphere function sum (x_j - c_j)^2 in a box: a known convex problem with optimum 0.
     pub struct Sphere {
         pub centre: Vec<f64>,
         pub x0: Vec<f64>,
@@ -164,7 +218,12 @@ pub mod tests {
 
     impl Sphere {
         pub fn new(dim: usize) -> Sphere {
-            Sphere { centre: (0..dim).map(|k| 0.1 * k as f64 - 0.3).collect(), x0: vec![0.5; dim], lo: vec![-2.0; dim], hi: vec![2.0; dim] }
+            Sphere {
+                centre: (0..dim).map(|k| 0.05 * (k % 13) as f64 - 0.3).collect(),
+                x0: vec![0.5; dim],
+                lo: vec![-2.0; dim],
+                hi: vec![2.0; dim],
+            }
         }
     }
 
@@ -184,42 +243,37 @@ pub mod tests {
     }
 
     #[test]
-    fn checkpoints_are_1_2_5() {
-        assert_eq!(checkpoints(600), vec![1, 2, 5, 10, 20, 50, 100, 200, 500]);
+    fn trace_checkpoints_and_final_point() {
+        let p = Sphere::new(3);
+        let budget = Budget { trace_every_evals: 4, ..Budget::default() };
+        let mut e = Evaluator::new(&p, &budget);
+        for k in 0..10 {
+            e.eval(&[k as f64 * 0.1, 0.0, 0.0]);
+        }
+        let r = e.finish(vec![0.0; 3], 1.0);
+        assert_eq!(r.evaluations, 10);
+        assert_eq!(r.trace.iter().map(|t| t.0).collect::<Vec<_>>(), vec![4, 8, 10]);
+        // Best so far is monotone.
+        assert!(r.trace.windows(2).all(|w| w[1].1 <= w[0].1));
     }
 
     #[test]
-    fn geometric_skip_has_the_bernoulli_rate() {
-        let mut rng = ChaCha8Rng::seed_from_u64(3);
-        let p: f64 = 0.2;
-        let (mut hits, mut pos) = (0usize, 0usize);
-        let n = 200_000;
-        loop {
-            pos += geometric_skip(&mut rng, (1.0 - p).ln());
-            if pos >= n {
-                break;
-            }
-            hits += 1;
-            pos += 1;
-        }
-        let rate = hits as f64 / n as f64;
-        assert!((rate - p).abs() < 0.005, "{rate}");
+    fn malformed_problems_and_budgets_are_named() {
+        let mut p = Sphere::new(3);
+        p.lo[1] = 3.0;
+        let e = check_problem(&p).unwrap_err().to_string();
+        assert!(e.contains("coordinate 1"), "{e}");
+        let b = Budget { population: 3, ..Budget::default() };
+        let e = b.validate(4).unwrap_err().to_string();
+        assert!(e.contains("budget.population"), "{e}");
+        let b = Budget { init_range: -1.0, ..Budget::default() };
+        assert!(b.validate(1).unwrap_err().to_string().contains("budget.init_range"));
     }
 
-    /// Shared checks for every optimiser: determinism, never worse than the initial population,
-    /// bounds respected, evaluations as documented, progress on a convex problem.
-    pub fn check_optimiser(opt: &dyn Optimiser, evals_per_generation: u64) {
-        let p = Sphere::new(12);
-        let budget = Budget { generations: 300, population: 20, init_range: 0.3 };
-        let a = opt.run(&p, &budget, &mut ChaCha8Rng::seed_from_u64(9));
-        let b = opt.run(&p, &budget, &mut ChaCha8Rng::seed_from_u64(9));
-        assert_eq!(a, b, "{} is not deterministic", opt.name());
-        assert!(a.best_fitness <= a.initial_best);
-        assert!(a.best_fitness < 0.5 * a.initial_best, "{}: {} from {}", opt.name(), a.best_fitness, a.initial_best);
-        assert_eq!(a.evaluations, 20 + evals_per_generation * 300, "{}", opt.name());
-        assert!(a.best_x.iter().all(|&v| (-2.0..=2.0).contains(&v)));
-        assert!((p.fitness(&a.best_x) - a.best_fitness).abs() < 1e-15);
-        assert!(a.trace.windows(2).all(|w| w[0].0 < w[1].0 && w[1].1 <= w[0].1));
-        assert_eq!(a.trace.last().unwrap(), &(a.evaluations, a.best_fitness));
+    #[test]
+    fn budget_deserialises_with_defaults_and_rejects_unknown_keys() {
+        let b: Budget = toml::from_str("generations = 10").unwrap();
+        assert_eq!(b, Budget { generations: 10, ..Budget::default() });
+        assert!(toml::from_str::<Budget>("generation = 10").is_err());
     }
 }

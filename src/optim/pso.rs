@@ -1,36 +1,51 @@
-//! Particle swarm optimisation with Clerc's constriction (thesis 6.2.4.3; SPEC 4):
-//! v <- K (v + c1 r1 (p_i - x) + c2 r2 (g - x)), K = 0.729, c1 = c2 = 2.05, r1, r2 uniform per
-//! coordinate; v0 = 0; |v| clamped to half the range of each coordinate; positions clamped to the
-//! bounds; global-best topology, personal bests updated when strictly better.
+//! Particle swarm optimisation with constriction factor and velocity clamping (Clerc & Kennedy
+//! 2002; thesis 6.2.4.3, Table 6.1: K = 0.729, c1 = c2 = 2.05, v0 = 0, |v| at most half the
+//! range, positions kept in the range), global-best topology.
+//!
+//! Per coordinate: v <- K (v + c1 r1 (pbest - x) + c2 r2 (gbest - x)), r1, r2 ~ U[0, 1) drawn
+//! anew for every coordinate; v is clamped to +-(upper - lower)/2 and x + v to [lower, upper]
+//! (the velocity is kept when the position is clamped). Updates are synchronous: all particles
+//! move with the global best of the previous iteration, then all are evaluated, then personal
+//! and global bests are updated (a personal best moves only on strict improvement).
+//! `population * (1 + generations)` evaluations.
+//!
+//! Random numbers: r1 and r2 are the two 32-bit halves of one 64-bit draw (resolution 2^-32),
+//! drawn in bulk for a whole particle from the run's bulk generator ([`super::sampling::Bulk`]).
 
-use super::problem::{initial_population, two_uniforms, Budget, Optimiser, Problem, RunResult, Tracker};
+use super::problem::{check_problem, Budget, Evaluator, Optimiser, Population, Problem, RunResult};
+use super::kernels::{pso_move, PsoCoefficients};
+use super::sampling::bulk_from;
+use super::{check_range, OptimError};
+use rand::Rng;
 use rand_chacha::ChaCha8Rng;
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+/// PSO parameters (defaults: thesis Table 6.1).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct Pso {
     /// Constriction factor K.
     pub k: f64,
+    /// Cognitive acceleration c1.
     pub c1: f64,
+    /// Social acceleration c2.
     pub c2: f64,
+    /// Velocity clamp as a fraction of the range (upper - lower) per coordinate.
+    pub vmax_fraction: f64,
 }
 
 impl Default for Pso {
-    fn default() -> Self {
-        Pso { k: 0.729, c1: 2.05, c2: 2.05 }
+    fn default() -> Pso {
+        Pso { k: 0.729, c1: 2.05, c2: 2.05, vmax_fraction: 0.5 }
     }
 }
 
 impl Pso {
-    pub fn validate(&self) -> Result<(), String> {
-        if !(self.k > 0.0 && self.k <= 1.0) {
-            return Err(format!("pso.k must be in (0,1], got {}", self.k));
-        }
-        if self.c1 < 0.0 || self.c2 < 0.0 {
-            return Err("pso.c1 and pso.c2 must be non-negative".into());
-        }
-        Ok(())
+    pub fn validate(&self) -> Result<(), OptimError> {
+        check_range("pso.k", self.k, 0.0, 1.0)?;
+        check_range("pso.c1", self.c1, 0.0, 10.0)?;
+        check_range("pso.c2", self.c2, 0.0, 10.0)?;
+        check_range("pso.vmax_fraction", self.vmax_fraction, 0.0, 1.0)
     }
 }
 
@@ -39,50 +54,80 @@ impl Optimiser for Pso {
         "pso"
     }
 
-    fn run(&self, problem: &dyn Problem, budget: &Budget, rng: &mut ChaCha8Rng) -> RunResult {
-        let n = problem.dim();
-        let np = budget.population;
+    fn run(&self, problem: &dyn Problem, budget: &Budget, rng: &mut ChaCha8Rng) -> Result<RunResult, OptimError> {
+        self.validate()?;
+        budget.validate(1)?;
+        check_problem(problem)?;
+        let d = problem.dim();
         let (lo, hi) = problem.bounds();
-        let vmax: Vec<f64> = lo.iter().zip(hi).map(|(l, h)| 0.5 * (h - l)).collect();
-        let mut tracker = Tracker::new(problem, (np * (budget.generations + 1)) as u64);
-        let mut x = initial_population(problem, budget, rng);
-        let mut v = vec![vec![0.0; n]; np];
-        let mut pbest = x.clone();
-        let mut pfit: Vec<f64> = x.iter().map(|p| tracker.eval(p)).collect();
-        let initial_best = tracker.best_fitness;
-        let mut g = pfit.iter().enumerate().min_by(|a, b| a.1.total_cmp(b.1)).map(|(i, _)| i).unwrap_or(0);
+        let vmax: Vec<f64> = lo.iter().zip(hi).map(|(l, h)| self.vmax_fraction * (h - l)).collect();
+        let mut eval = Evaluator::new(problem, budget);
+        let Population { x: mut pos, f: mut fit } = Population::initial(problem, budget, &mut eval, rng);
+        let n = pos.len();
+        let mut vel = vec![vec![0.0; d]; n];
+        let mut pbest = pos.clone();
+        let mut pbest_f = fit.clone();
+        let mut g = argmin(&pbest_f);
+        let initial_best = pbest_f[g];
         let mut gbest = pbest[g].clone();
-        let mut gfit = pfit[g];
+        let mut words = vec![0u64; d];
+        let mut bulk = bulk_from(rng);
+        let co = PsoCoefficients { k: self.k, c1: self.c1, c2: self.c2 };
         for _ in 0..budget.generations {
-            for i in 0..np {
-                let (xi, vi, pi) = (&mut x[i], &mut v[i], &pbest[i]);
-                for d in 0..n {
-                    let (r1, r2) = two_uniforms(rng);
-                    let vel = self.k * (vi[d] + self.c1 * r1 * (pi[d] - xi[d]) + self.c2 * r2 * (gbest[d] - xi[d]));
-                    vi[d] = vel.clamp(-vmax[d], vmax[d]);
-                    xi[d] = (xi[d] + vi[d]).clamp(lo[d], hi[d]);
-                }
-                let f = tracker.eval(xi);
-                if f < pfit[i] {
-                    pfit[i] = f;
-                    pbest[i].copy_from_slice(xi);
-                    if f < gfit {
-                        gfit = f;
-                        g = i;
-                        gbest.copy_from_slice(&pbest[g]);
-                    }
+            for i in 0..n {
+                bulk.fill(&mut words[..]);
+                pso_move(&mut pos[i], &mut vel[i], &pbest[i], &gbest, &words, co, &vmax, lo, hi);
+            }
+            for i in 0..n {
+                fit[i] = eval.eval(&pos[i]);
+                if fit[i] < pbest_f[i] {
+                    pbest_f[i] = fit[i];
+                    pbest[i].copy_from_slice(&pos[i]);
                 }
             }
+            g = argmin(&pbest_f);
+            gbest.copy_from_slice(&pbest[g]);
         }
-        tracker.finish(initial_best)
+        Ok(eval.finish(pbest.swap_remove(g), initial_best))
     }
+}
+
+fn argmin(f: &[f64]) -> usize {
+    let mut b = 0;
+    for i in 1..f.len() {
+        if f[i] < f[b] {
+            b = i;
+        }
+    }
+    b
 }
 
 #[cfg(test)]
 mod tests {
+    use super::*;
+    use crate::optim::optimiser_tests::check;
+
     #[test]
-    fn pso_contract() {
-        super::super::problem::tests::check_optimiser(&super::Pso::default(), 20);
-        assert!(super::Pso { k: 0.0, ..Default::default() }.validate().unwrap_err().contains("pso.k"));
+    fn pso_passes_the_common_checks() {
+        check(&Pso::default(), |b| b.population as u64 * (1 + b.generations));
+    }
+
+    #[test]
+    fn parameters_are_validated_by_key() {
+        assert_eq!(Pso { k: 1.2, ..Pso::default() }.validate().unwrap_err().to_string(), "pso.k must be in [0,1], got 1.2");
+        assert!(Pso { c2: -1.0, ..Pso::default() }.validate().unwrap_err().to_string().starts_with("pso.c2"));
+    }
+
+    /// A single particle with v0 = 0 at its own best stays put: the velocity update is
+    /// K (0 + c1 r1 0 + c2 r2 0) = 0 (checks the sign conventions of the update).
+    #[test]
+    fn lone_particle_at_its_best_does_not_move() {
+        use crate::optim::problem::tests::Sphere;
+        use rand::SeedableRng;
+        let p = Sphere::new(4);
+        let budget = Budget { generations: 20, population: 1, init_range: 0.0, trace_every_evals: 5 };
+        let r = Pso::default().run(&p, &budget, &mut ChaCha8Rng::seed_from_u64(1)).unwrap();
+        assert_eq!(r.best_x, p.x0);
+        assert_eq!(r.evaluations, 21);
     }
 }

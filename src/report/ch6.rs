@@ -178,7 +178,7 @@ pub fn write(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProble
             }
             let name = format!("exact_{grid}.csv");
             write_atomic(&out.join(&name), csv_records(&h, &rows)?.as_bytes())?;
-            let _ = writeln!(s, "\n`{name}`: the convex problem solved in its box (primal-dual hybrid gradient) with a proven lower bound; each optimiser's best minus the exact value.\n\n{}", table(&h, &rows));
+            let _ = writeln!(s, "\n`{name}`: the convex problem solved in its box (projected Newton on the smoothed sum of norms) with a proven lower bound; each optimiser's best minus the exact value.\n\n{}", table(&h, &rows));
             claims.push(Claim { chapter: "6 (beyond)".into(), statement: format!("No optimiser beats the certified lower bound (grid {grid})"), ours: (checked - below, checked), thesis: None, note: "a sanity check of the bound and the fitness".into() });
         }
         // Appendix I/J: B beside the MIN-error surface of each optimiser, largest net, per data set.
@@ -194,7 +194,7 @@ pub fn write(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProble
                 for &p in &params {
                     let Some(problem) = problems.get(&(d.clone(), cn, p)) else { continue };
                     let meshes = |x: &[f64]| {
-                        let g = problem.fitted_grid(x);
+                        let g = problem.surface(x);
                         let edges = plots::grid_edges(g.nx, g.ny);
                         vec![
                             plots::LineMesh { points: g.bottom, edges: edges.clone(), colour: style::DNSOM_BOTTOM, label: "bottom surface".into() },

@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# The full thesis Chapter 6 protocol (ch6_same + ch6_diff: 2 grids x 5 data sets x 4
+# parameterisations x 7 nets x {GA, DE, PSO} x 10 repeats = 8,400 runs of 2000 x 40), timed.
+# Prints the wall time of each spec and of both, our summed CPU time, and the ratios to the
+# thesis' CPU time (Appendices M and N: AVG seconds per run x 10 repeats, summed).
+#
+#   scripts/bench_ch6_protocol.sh [OUT_DIR] [JOBS]      (defaults: a temporary folder, nproc)
+#
+# Needs the Chapter 4 maps (results/ch4_models/maps, from the README's main job); missing maps are
+# recomputed. SOMNURBS_DATA must name the folder with the talus mesh (e.g. ../shared/data).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+out="${1:-$(mktemp -d)}"
+jobs="${2:-$(nproc)}"
+cargo build --release --quiet
+total_start=$(date +%s.%N)
+for s in ch6_same ch6_diff; do
+  t0=$(date +%s.%N)
+  ./target/release/somnurbs run "experiments/$s.toml" --out "$out/$s" --jobs "$jobs" > "$out/$s.log" 2>&1
+  t1=$(date +%s.%N)
+  echo "$s: $(echo "$t1 - $t0" | bc) s wall ($(($(wc -l < "$out/$s/runs.csv") - 1)) runs, $jobs threads)"
+done
+total_end=$(date +%s.%N)
+wall=$(echo "$total_end - $total_start" | bc)
+# Our CPU: the cpu_s column of every run.
+ours=$(awk -F, 'FNR == 1 { for (i = 1; i <= NF; i++) if ($i == "cpu_s") c = i; next } { s += $c } END { printf "%.1f", s }' "$out/ch6_same/runs.csv" "$out/ch6_diff/runs.csv")
+# The thesis' CPU: 10 repeats x the AVG columns of Appendices M and N.
+thesis=$(awk -F, 'FNR == 1 { for (i = 1; i <= NF; i++) { if ($i == "ga_avg_s") g = i; if ($i == "de_avg_s") d = i; if ($i == "pso_avg_s") p = i }; next } { s += 10 * ($g + $d + $p) } END { printf "%.1f", s }' experiments/reference/appendix_m.csv experiments/reference/appendix_n.csv)
+echo "both: $wall s wall ($(echo "scale=2; $wall / 60" | bc) min; target 10 min)"
+echo "CPU: ours $ours s, thesis $thesis s ($(echo "scale=1; $thesis / 3600" | bc) h)"
+echo "ratio thesis CPU / our CPU: $(echo "scale=0; $thesis / $ours" | bc)x; thesis CPU / our wall: $(echo "scale=0; $thesis / $wall" | bc)x"
+echo "results in $out"
