@@ -10,7 +10,7 @@ use somnurbs::spline::{fit_two_view, Approach, Parameterisation};
 use std::time::Instant;
 
 fn main() {
-    let ctx = RunContext { out: std::env::temp_dir(), jobs: 1, data_dir: somnurbs::experiment::data_dir(None) };
+    let ctx = RunContext::new(std::env::temp_dir(), 1, somnurbs::experiment::data_dir(None));
     let data = ch4::load_datasets(&["spindle".to_string()], &ctx).unwrap();
     let cell = SomCell { dataset: "spindle".into(), model: Model::Dnsom, grid: GridSize { nx: 20, ny: 20 }, repeat: 0 };
     let run = ch4::run_cell(&cell, &data["spindle"].points, &SomParams::default(), 2023).unwrap();

@@ -9,7 +9,7 @@ use std::time::Instant;
 
 fn main() {
     let data_dir = somnurbs::experiment::data_dir(None);
-    let ctx = RunContext { out: std::env::temp_dir(), jobs: 1, data_dir: data_dir.clone() };
+    let ctx = RunContext::new(std::env::temp_dir(), 1, data_dir.clone());
     let spindle = ch4::load_datasets(&["spindle".to_string()], &ctx).expect("spindle")["spindle"].clone();
 
     // 1. DNSOM 30x30, T = 30000, one core: median of 5 seeds.

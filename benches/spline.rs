@@ -9,7 +9,7 @@ use somnurbs::spline::{fit_two_view, Approach, Parameterisation, TwoViewGrid};
 use std::time::Instant;
 
 fn maps(grid: (usize, usize)) -> Vec<TwoViewGrid> {
-    let ctx = RunContext { out: std::env::temp_dir(), jobs: 1, data_dir: somnurbs::experiment::data_dir(None) };
+    let ctx = RunContext::new(std::env::temp_dir(), 1, somnurbs::experiment::data_dir(None));
     let names: Vec<String> = ["cube", "sphere", "spindle", "oiltank", "talus"].iter().map(|s| s.to_string()).collect();
     let data = ch4::load_datasets(&names, &ctx).expect("data sets (talus needs SOMNURBS_DATA)");
     names

@@ -12,6 +12,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 out="${1:-$(mktemp -d)}"
 jobs="${2:-$(nproc)}"
+mkdir -p "$out"
 cargo build --release --quiet
 total_start=$(date +%s.%N)
 for s in ch6_same ch6_diff; do

@@ -37,6 +37,14 @@ pub enum Command {
     /// (repeats paired by index) and rank-sum tests with A12, and overall Friedman with
     /// Holm-corrected pairwise tests and a critical-difference diagram.
     Compare(CompareArgs),
+    /// Regenerate the thesis: Chapters 4, 5 and 6 in order (each chapter's maps feed the next),
+    /// then one REPORT.md with every table and picture, the thesis' figures beside ours, Tables
+    /// 6.8/6.9 and the table of the thesis' claims with verdicts.
+    #[command(after_help = "Examples:\n  somnurbs reproduce --profile quick   # minutes\n  somnurbs reproduce                   # the full protocol")]
+    Reproduce(ReproduceArgs),
+    /// Combine the shard folders of one spec (`run --shard I/N`) into one folder with its tables,
+    /// identical to a one-machine run apart from timing.
+    Merge(MergeArgs),
 }
 
 #[derive(Debug, Args)]
@@ -89,6 +97,49 @@ pub struct RunArgs {
     /// List the cells and their seeds without running them.
     #[arg(long)]
     pub dry_run: bool,
+    /// Keep the cells an earlier, interrupted run of the same spec, profile and seed finished in
+    /// the output folder (its cells.jsonl) and run only the rest; refused if the folder holds
+    /// another run.
+    #[arg(long)]
+    pub resume: bool,
+    /// Run only the I-th of N deterministic slices of the cells (1-based, e.g. 3/8) and write no
+    /// tables; `somnurbs merge` combines the N shard folders into one.
+    #[arg(long, value_name = "I/N")]
+    pub shard: Option<String>,
+}
+
+#[derive(Debug, Args)]
+pub struct MergeArgs {
+    /// The shard folders (each written by `somnurbs run SPEC --shard I/N`), all N of them.
+    #[arg(required = true)]
+    pub shards: Vec<PathBuf>,
+    /// The folder to write the combined run to (must not hold a run yet).
+    #[arg(long)]
+    pub out: PathBuf,
+    #[arg(long, short = 'j')]
+    pub jobs: Option<usize>,
+    #[arg(long)]
+    pub data_dir: Option<PathBuf>,
+}
+
+#[derive(Debug, Args)]
+pub struct ReproduceArgs {
+    /// quick (minutes; CI) or full (the thesis' protocol).
+    #[arg(long, default_value = "full", value_parser = ["quick", "full"])]
+    pub profile: String,
+    /// Output folder (default results/thesis, or results/thesis_quick).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Folder of the experiment specs.
+    #[arg(long, default_value = "experiments")]
+    pub specs: PathBuf,
+    #[arg(long, short = 'j')]
+    pub jobs: Option<usize>,
+    #[arg(long)]
+    pub data_dir: Option<PathBuf>,
+    /// Keep what an interrupted reproduction finished (per chapter, as `run --resume`).
+    #[arg(long)]
+    pub resume: bool,
 }
 
 #[derive(Debug, Args)]

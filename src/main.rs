@@ -2,7 +2,7 @@
 
 use clap::Parser;
 use somnurbs::cli::{Cli, Command, DatasetsAction};
-use somnurbs::experiment::{self, spec::Spec, RunContext};
+use somnurbs::experiment::{self, log::Shard, spec::Spec, RunContext};
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
@@ -17,6 +17,15 @@ fn main() -> ExitCode {
     }
 }
 
+/// Worker threads: the flag, else every core.
+fn jobs(flag: Option<usize>) -> anyhow::Result<usize> {
+    let jobs = flag.unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1));
+    if jobs == 0 {
+        anyhow::bail!("--jobs must be at least 1");
+    }
+    Ok(jobs)
+}
+
 fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
         Command::Run(args) => {
@@ -27,17 +36,26 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
                 }
                 return Ok(ExitCode::SUCCESS);
             }
-            let jobs = args.jobs.unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1));
-            if jobs == 0 {
-                anyhow::bail!("--jobs must be at least 1");
-            }
-            let ctx = RunContext {
-                out: spec.output_dir(args.out.as_deref()),
-                jobs,
-                data_dir: experiment::data_dir(args.data_dir.as_deref()),
-            };
+            let shard = args.shard.as_deref().map(Shard::parse).transpose()?;
+            let ctx = RunContext { resume: args.resume, shard, ..RunContext::new(spec.output_dir(args.out.as_deref()), jobs(args.jobs)?, experiment::data_dir(args.data_dir.as_deref())) };
             let out = experiment::run_spec(&spec, &ctx)?;
-            eprintln!("somnurbs: wrote {}", out.join("REPORT.md").display());
+            match shard {
+                Some(s) => eprintln!("somnurbs: wrote shard {s} to {} (combine the shards with `somnurbs merge`)", out.display()),
+                None => eprintln!("somnurbs: wrote {}", out.join("REPORT.md").display()),
+            }
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Merge(args) => {
+            let ctx = RunContext::new(args.out.clone(), jobs(args.jobs)?, experiment::data_dir(args.data_dir.as_deref()));
+            let out = experiment::merge(&args.shards, &ctx)?;
+            eprintln!("somnurbs: merged {} shards into {}", args.shards.len(), out.join("REPORT.md").display());
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Reproduce(args) => {
+            let out = args.out.clone().unwrap_or_else(|| if args.profile == "quick" { "results/thesis_quick".into() } else { "results/thesis".into() });
+            let ctx = RunContext { resume: args.resume, ..RunContext::new(out, jobs(args.jobs)?, experiment::data_dir(args.data_dir.as_deref())) };
+            let report = experiment::reproduce::reproduce(&args.specs, &args.profile, &ctx)?;
+            eprintln!("somnurbs: wrote {}", report.display());
             Ok(ExitCode::SUCCESS)
         }
         Command::Compare(args) => {

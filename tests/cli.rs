@@ -1,85 +1,9 @@
 //! Integration tests: run the real binary on tiny specs in temporary folders and read what it
 //! writes. On failure each helper prints the command, the folder listing, stdout and stderr.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_somnurbs"))
-}
-
-fn shared_data() -> PathBuf {
-    match std::env::var_os("SOMNURBS_DATA") {
-        Some(v) if !v.is_empty() => PathBuf::from(v),
-        _ => Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data"),
-    }
-}
-
-struct Case {
-    dir: tempfile::TempDir,
-}
-
-impl Case {
-    fn new() -> Case {
-        Case { dir: tempfile::tempdir().unwrap() }
-    }
-    fn path(&self, p: &str) -> PathBuf {
-        self.dir.path().join(p)
-    }
-    fn write(&self, p: &str, text: &str) -> PathBuf {
-        let path = self.path(p);
-        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
-        std::fs::write(&path, text).unwrap();
-        path
-    }
-    fn run(&self, args: &[&str]) -> Output {
-        let out = bin().args(args).current_dir(self.dir.path()).env("SOMNURBS_DATA", shared_data()).output().unwrap();
-        out
-    }
-    fn explain(&self, args: &[&str], out: &Output) -> String {
-        let listing: Vec<String> = walk(self.dir.path()).iter().map(|p| p.strip_prefix(self.dir.path()).unwrap().display().to_string()).collect();
-        format!(
-            "command: somnurbs {}\nfolder: {:?}\nstatus: {}\nstdout:\n{}\nstderr:\n{}",
-            args.join(" "),
-            listing,
-            out.status,
-            String::from_utf8_lossy(&out.stdout),
-            String::from_utf8_lossy(&out.stderr)
-        )
-    }
-    fn ok(&self, args: &[&str]) -> Output {
-        let out = self.run(args);
-        assert!(out.status.success(), "{}", self.explain(args, &out));
-        out
-    }
-    /// Runs a command that must fail with a one-line error containing every `needle`.
-    fn fails(&self, args: &[&str], needles: &[&str]) -> String {
-        let out = self.run(args);
-        let err = String::from_utf8_lossy(&out.stderr).to_string();
-        assert!(!out.status.success(), "expected failure\n{}", self.explain(args, &out));
-        assert_eq!(err.trim_end().lines().count(), 1, "error is not one line\n{}", self.explain(args, &out));
-        for n in needles {
-            assert!(err.contains(n), "error lacks {n:?}\n{}", self.explain(args, &out));
-        }
-        err
-    }
-}
-
-fn walk(dir: &Path) -> Vec<PathBuf> {
-    let mut out = Vec::new();
-    if let Ok(rd) = std::fs::read_dir(dir) {
-        for e in rd.flatten() {
-            let p = e.path();
-            if p.is_dir() {
-                out.extend(walk(&p));
-            } else {
-                out.push(p);
-            }
-        }
-    }
-    out.sort();
-    out
-}
+mod common;
+use common::*;
+use std::path::Path;
 
 const TINY: &str = r#"
 name = "tiny"
@@ -97,21 +21,6 @@ models = ["cksom", "dnsom"]
 grids = ["6x5"]
 "#;
 
-fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
-    let mut r = csv::Reader::from_path(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let h = r.headers().unwrap().iter().map(String::from).collect();
-    let rows = r.records().map(|x| x.unwrap().iter().map(String::from).collect()).collect();
-    (h, rows)
-}
-
-/// A CSV with the timing columns blanked, for comparisons across runs.
-fn without_timing(path: &Path) -> Vec<Vec<String>> {
-    let (h, rows) = read_csv(path);
-    rows.into_iter()
-        .map(|r| r.into_iter().zip(&h).map(|(v, c)| if c.starts_with("cpu_s") { String::new() } else { v }).collect())
-        .collect()
-}
-
 #[test]
 fn run_writes_every_table_with_the_thesis_columns() {
     let c = Case::new();
@@ -121,7 +30,7 @@ fn run_writes_every_table_with_the_thesis_columns() {
     for f in ["runs.csv", "appendix_b.csv", "appendix_c.csv", "table_4_9.csv", "table_4_13.csv", "table_4_14.csv", "manifest.toml", "REPORT.md", "maps/dnsom_sphere_6x5.csv", "maps/dnsom_cube_6x5.csv"] {
         assert!(out.join(f).exists(), "missing {f}: {:?}", walk(&out));
     }
-    assert!(!out.join("runs.csv.partial").exists());
+    assert!(out.join("cells.jsonl").exists() && out.join("fingerprint.toml").exists());
     let reference = Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/reference");
     for t in ["appendix_b.csv", "appendix_c.csv"] {
         assert_eq!(read_csv(&out.join(t)).0, read_csv(&reference.join(t)).0, "{t} columns");
@@ -384,7 +293,7 @@ fn bad_optimiser_specs_are_refused_before_any_run() {
     ] {
         c.write("opt.toml", &CH6_TINY.replace(from, to));
         c.fails(&["run", "opt.toml", "--out", "o"], &[needle]);
-        assert!(!c.path("o/runs.csv.partial").exists() && !c.path("o/maps").exists(), "{needle}: something ran");
+        assert!(!c.path("o/cells.jsonl").exists() && !c.path("o/maps").exists(), "{needle}: something ran");
     }
 }
 

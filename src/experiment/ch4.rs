@@ -20,6 +20,13 @@ pub struct SomRun {
     pub weights: Vec<Point3>,
 }
 
+impl runner::Logged for SomRun {
+    type Record = (SomRow, Vec<Point3>);
+    fn record(&self) -> Self::Record {
+        (self.row.clone(), self.weights.clone())
+    }
+}
+
 /// One row of `runs.csv` (tidy: one row per cell x repeat).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct SomRow {
@@ -96,12 +103,12 @@ pub fn run_cell(cell: &SomCell, data: &[Point3], params: &SomParams, master_seed
     Ok(SomRun { cell: cell.clone(), row, weights: trained.weights })
 }
 
-/// Run every SOM cell of a spec, logging each finished row to `runs.csv.partial`.
+/// Run every SOM cell of a spec, logging each finished cell to the folder's cell log.
 pub fn run(spec: &Spec, ctx: &RunContext) -> Result<Vec<SomRun>> {
     let som_spec = spec.file.som.as_ref().context("spec has no [som] section")?;
     let data = load_datasets(&som_spec.datasets, ctx)?;
     let params = SomParams { iterations: som_spec.iterations, alpha0: som_spec.alpha0, sigma0: som_spec.sigma0 };
     let cells = spec.som_cells();
-    runner::run_logged(&cells, ctx, &spec.file.name, |cell| run_cell(cell, &data[&cell.dataset].points, &params, spec.file.master_seed), |run: &SomRun| &run.row)
+    runner::run_logged(&cells, ctx, &spec.file.name, |cell| run_cell(cell, &data[&cell.dataset].points, &params, spec.file.master_seed), |cell, (row, weights)| Ok(SomRun { cell: cell.clone(), row, weights }))
 }
 

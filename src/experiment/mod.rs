@@ -6,6 +6,8 @@ pub mod ch6;
 pub mod compare;
 pub mod datasets;
 pub mod fit_cmd;
+pub mod log;
+pub mod reproduce;
 pub mod runner;
 pub mod seeds;
 pub mod spec;
@@ -13,6 +15,7 @@ pub mod spec;
 use anyhow::{Context, Result};
 use serde::Serialize;
 use spec::Spec;
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -22,6 +25,17 @@ pub struct RunContext {
     pub out: PathBuf,
     pub jobs: usize,
     pub data_dir: PathBuf,
+    /// Keep the cells already in the folder's cell log (same fingerprint required).
+    pub resume: bool,
+    /// Run only this slice of the cells (no tables: `somnurbs merge` makes them).
+    pub shard: Option<log::Shard>,
+}
+
+impl RunContext {
+    /// A plain run: fresh folder, all cells.
+    pub fn new(out: PathBuf, jobs: usize, data_dir: PathBuf) -> RunContext {
+        RunContext { out, jobs, data_dir, resume: false, shard: None }
+    }
 }
 
 /// One line per cell for `--dry-run`: key and seed.
@@ -43,6 +57,9 @@ pub struct Manifest {
     pub spec_sha256: String,
     pub profile: String,
     pub master_seed: u64,
+    /// `I/N` when this folder holds one shard of the cells (no tables).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub shard: Option<String>,
     pub crate_version: String,
     pub git_commit: String,
     pub git_dirty: bool,
@@ -88,45 +105,76 @@ fn host_name() -> String {
         .unwrap_or_else(|_| "unknown".into())
 }
 
+/// The fingerprint of a spec run in a folder (what `--resume` and `merge` compare).
+pub fn fingerprint(spec: &Spec, shard: Option<log::Shard>) -> log::Fingerprint {
+    log::Fingerprint {
+        spec_name: spec.file.name.clone(),
+        spec_path: spec.path.clone(),
+        spec_sha256: hex::encode(<sha2::Sha256 as sha2::Digest>::digest(spec.text.as_bytes())),
+        profile: spec.profile.clone().unwrap_or_else(|| "default".into()),
+        master_seed: spec.file.master_seed,
+        cells: spec.som_cells().len() + spec.fit_cells().len() + spec.optim_cells().len(),
+        shard: shard.map(|s| s.to_string()),
+        spec_text: spec.text.clone(),
+    }
+}
+
 /// Run a whole spec: cells, tables, pictures, REPORT.md, and last the manifest (its presence marks
-/// a complete run; an old one is removed first).
+/// a complete run; an old one is removed first). With a shard, only its cells run and no tables
+/// are written (`merge` writes them). With `resume`, the cells in the folder's log are kept if
+/// the folder's fingerprint matches, else the run is refused before anything is touched.
 pub fn run_spec(spec: &Spec, ctx: &RunContext) -> Result<PathBuf> {
     crate::report::fsio::ensure_dir(&ctx.out)?;
     let probe = ctx.out.join(".somnurbs-write-test");
     std::fs::write(&probe, b"").with_context(|| format!("output folder {} is not writable", ctx.out.display()))?;
     let _ = std::fs::remove_file(&probe);
+    let fp = fingerprint(spec, ctx.shard);
+    if ctx.resume {
+        match log::Fingerprint::read(&ctx.out)? {
+            Some(old) => {
+                if let Some(diff) = old.difference(&fp) {
+                    anyhow::bail!("cannot resume in {}: it holds a different run ({diff}); use another --out or drop --resume", ctx.out.display());
+                }
+            }
+            None if ctx.out.join(log::LOG_FILE).exists() => anyhow::bail!("cannot resume in {}: it has a cell log but no {}", ctx.out.display(), log::FINGERPRINT_FILE),
+            None => {}
+        }
+    }
     let manifest_path = ctx.out.join("manifest.toml");
     if manifest_path.exists() {
         std::fs::remove_file(&manifest_path).with_context(|| format!("cannot remove {}", manifest_path.display()))?;
     }
+    fp.write(&ctx.out)?;
     let started = Instant::now();
     let started_unix = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map(|d| d.as_secs()).unwrap_or(0);
+    let tables = ctx.shard.is_none();
 
     let (section, cpu, cells) = if spec.file.som.is_some() {
         let runs = ch4::run(spec, ctx)?;
-        let section = crate::report::ch4::write(spec, &runs, &ctx.out)?;
+        let section = if tables { Some(crate::report::ch4::write(spec, &runs, &ctx.out)?) } else { None };
         (section, runs.iter().map(|r| r.row.cpu_s).sum::<f64>(), runs.len())
     } else if spec.file.optim.is_some() {
         let problems = ch6::problems(spec, ctx)?;
-        let exact = ch6::exact_optima(spec, ctx, &problems)?;
+        let exact = if tables { ch6::exact_optima(spec, ctx, &problems)? } else { BTreeMap::new() };
         let runs = ch6::run(spec, ctx, &problems)?;
-        let section = crate::report::ch6::write(&runs, &problems, &exact, &ctx.out)?;
+        let section = if tables { Some(crate::report::ch6::write(&runs, &problems, &exact, &ctx.out)?) } else { None };
         (section, runs.iter().map(|r| r.row.cpu_s).sum::<f64>(), runs.len())
     } else {
         let maps = ch5::maps(spec, ctx)?;
         let runs = ch5::run(spec, ctx, &maps)?;
         let origins: Vec<(String, String)> = maps.iter().map(|(d, m)| (d.clone(), m.origin.clone())).collect();
         let pictures = spec.file.fit.as_ref().map(|f| f.pictures).unwrap_or(false);
-        let section = crate::report::ch5::write(&runs, &ctx.out, &origins, pictures)?;
+        let section = if tables { Some(crate::report::ch5::write(&runs, &ctx.out, &origins, pictures)?) } else { None };
         (section, runs.iter().map(|r| r.row.cpu_s).sum::<f64>(), runs.len())
     };
 
     let manifest = Manifest {
         spec_name: spec.file.name.clone(),
         spec_path: spec.path.clone(),
-        spec_sha256: hex::encode(<sha2::Sha256 as sha2::Digest>::digest(spec.text.as_bytes())),
-        profile: spec.profile.clone().unwrap_or_else(|| "default".into()),
+        spec_sha256: fp.spec_sha256.clone(),
+        profile: fp.profile.clone(),
         master_seed: spec.file.master_seed,
+        shard: fp.shard.clone(),
         crate_version: env!("CARGO_PKG_VERSION").into(),
         git_commit: env!("SOMNURBS_GIT_COMMIT").into(),
         git_dirty: env!("SOMNURBS_GIT_DIRTY") == "true",
@@ -140,12 +188,73 @@ pub fn run_spec(spec: &Spec, ctx: &RunContext) -> Result<PathBuf> {
         definitions: Definitions::default(),
         spec_text: spec.text.clone(),
     };
-    let report = crate::report::report_md(spec, &manifest, &[section]);
-    crate::report::fsio::write_atomic(&ctx.out.join("REPORT.md"), report.as_bytes())?;
-    let _ = std::fs::remove_file(ctx.out.join("runs.csv.partial"));
+    if let Some(section) = section {
+        let report = crate::report::report_md(spec, &manifest, &[section]);
+        crate::report::fsio::write_atomic(&ctx.out.join("REPORT.md"), report.as_bytes())?;
+    }
     let text = toml::to_string_pretty(&manifest).context("cannot serialise the manifest")?;
     crate::report::fsio::write_atomic(&manifest_path, text.as_bytes())?;
     Ok(ctx.out.clone())
+}
+
+/// Combine shard folders of one spec into `out` and write its tables: the shards' fingerprints
+/// must agree (apart from the shard) and cover 1..N once; their cell logs are joined and the spec
+/// is run in `out` with every cell restored from the log, so the tables equal a one-machine run's.
+pub fn merge(shards: &[PathBuf], ctx: &RunContext) -> Result<PathBuf> {
+    if shards.is_empty() {
+        anyhow::bail!("merge: no shard folders given");
+    }
+    let mut first: Option<log::Fingerprint> = None;
+    let mut seen: BTreeMap<usize, PathBuf> = BTreeMap::new();
+    let mut count = 0;
+    let mut records: BTreeMap<String, serde_json::Value> = BTreeMap::new();
+    for dir in shards {
+        let fp = log::Fingerprint::read(dir)?.with_context(|| format!("merge: {} has no {} (not a somnurbs output folder?)", dir.display(), log::FINGERPRINT_FILE))?;
+        let shard = fp.shard.as_deref().with_context(|| format!("merge: {} is not a shard (it was run without --shard)", dir.display()))?;
+        let shard = log::Shard::parse(shard).with_context(|| format!("merge: {}", dir.display()))?;
+        if !dir.join("manifest.toml").exists() {
+            anyhow::bail!("merge: shard {shard} in {} did not finish (no manifest.toml); resume it with --resume first", dir.display());
+        }
+        let plain = log::Fingerprint { shard: None, ..fp.clone() };
+        match &first {
+            None => {
+                first = Some(plain);
+                count = shard.count;
+            }
+            Some(f) => {
+                if let Some(diff) = f.difference(&plain) {
+                    anyhow::bail!("merge: {} belongs to another run than {} ({diff})", dir.display(), shards[0].display());
+                }
+                if shard.count != count {
+                    anyhow::bail!("merge: {} is shard {shard} but {} has {count} shards", dir.display(), shards[0].display());
+                }
+            }
+        }
+        if let Some(other) = seen.insert(shard.index, dir.clone()) {
+            anyhow::bail!("merge: shard {shard} given twice ({} and {})", other.display(), dir.display());
+        }
+        records.extend(log::read_records::<serde_json::Value>(dir)?);
+    }
+    if let Some(missing) = (1..=count).find(|i| !seen.contains_key(i)) {
+        anyhow::bail!("merge: shard {missing}/{count} is missing");
+    }
+    let fp = first.expect("at least one shard");
+    if records.len() != fp.cells {
+        anyhow::bail!("merge: the shards hold {} cells, the spec has {}", records.len(), fp.cells);
+    }
+    let spec = Spec::parse(&fp.spec_path, &fp.spec_text, if fp.profile == "default" { None } else { Some(fp.profile.as_str()) }).map_err(|e| anyhow::anyhow!("{e}"))?;
+    crate::report::fsio::ensure_dir(&ctx.out)?;
+    if ctx.out.join(log::LOG_FILE).exists() || ctx.out.join("manifest.toml").exists() {
+        anyhow::bail!("merge: {} already holds a run; choose an empty folder", ctx.out.display());
+    }
+    {
+        let mut out_log = log::CellLog::open(&ctx.out, false)?;
+        for (key, rec) in &records {
+            out_log.push(key, rec)?;
+        }
+    }
+    fingerprint(&spec, None).write(&ctx.out)?;
+    run_spec(&spec, &RunContext { resume: true, shard: None, ..ctx.clone() })
 }
 
 /// Resolve the data directory: flag, else `SOMNURBS_DATA`, else `./data`.

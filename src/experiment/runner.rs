@@ -4,6 +4,8 @@
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
+use serde::{de::DeserializeOwned, Serialize};
+use std::collections::BTreeMap;
 
 /// Run `work` over `cells` on `jobs` threads.
 pub fn run_cells<C, R>(
@@ -40,21 +42,49 @@ where
     results
 }
 
-/// Run `work` over `cells` and append each finished cell's row to `<out>/runs.csv.partial` at
-/// once (header first), so a killed run keeps every row it finished.
-pub fn run_logged<C, R, Row>(cells: &[C], ctx: &super::RunContext, label: &str, work: impl Fn(&C) -> Result<R> + Sync, row: impl Fn(&R) -> &Row + Sync) -> Result<Vec<R>>
+/// A cell of a spec: its stable key names its random stream and its line in the cell log.
+pub trait Cell: Sync {
+    fn key(&self) -> String;
+}
+
+/// A cell's result as the cell log keeps it: `record` is what a resumed run or a merge reads
+/// back instead of recomputing the cell.
+pub trait Logged: Send + Sized {
+    type Record: Serialize + DeserializeOwned;
+    fn record(&self) -> Self::Record;
+}
+
+/// Run the cells of this folder's slice (all, or the shard's) and return their results in cell
+/// order. Each finished cell is appended to the folder's cell log at once; with `ctx.resume`,
+/// cells already in the log are not run again but rebuilt by `restore` from their record, so a
+/// resumed run gives the results of an uninterrupted one.
+pub fn run_logged<C, R>(cells: &[C], ctx: &super::RunContext, label: &str, work: impl Fn(&C) -> Result<R> + Sync, restore: impl Fn(&C, R::Record) -> Result<R>) -> Result<Vec<R>>
 where
-    C: Sync,
-    R: Send,
-    Row: serde::Serialize + Default,
+    C: Cell,
+    R: Logged,
 {
-    let header = crate::report::fsio::csv_text(&[Row::default()])?;
-    let header = header.lines().next().unwrap_or_default().to_string();
-    let log = std::sync::Mutex::new(crate::report::fsio::PartialLog::create(&ctx.out.join("runs.csv.partial"), &header)?);
-    run_cells(cells, ctx.jobs, label, work, |_, r| {
-        let text = crate::report::fsio::csv_text(std::slice::from_ref(row(r)))?;
-        log.lock().map_err(|_| anyhow::anyhow!("log lock poisoned"))?.push(text.lines().nth(1).unwrap_or_default())
-    })
+    let mut logged: BTreeMap<String, R::Record> = if ctx.resume { super::log::read_records(&ctx.out)? } else { BTreeMap::new() };
+    let slice: Vec<&C> = cells.iter().enumerate().filter(|(k, _)| ctx.shard.is_none_or(|s| s.contains(*k))).map(|(_, c)| c).collect();
+    let todo: Vec<&C> = slice.iter().copied().filter(|c| !logged.contains_key(&c.key())).collect();
+    if ctx.resume && todo.len() < slice.len() {
+        eprintln!("somnurbs: resuming {}: {} of {} cells already done", ctx.out.display(), slice.len() - todo.len(), slice.len());
+    }
+    let log = std::sync::Mutex::new(super::log::CellLog::open(&ctx.out, ctx.resume)?);
+    let computed = run_cells(&todo, ctx.jobs, label, |c| work(c), |c, r: &R| log.lock().map_err(|_| anyhow::anyhow!("cell log lock poisoned"))?.push(&c.key(), &r.record()))?;
+    let mut computed: BTreeMap<String, R> = todo.iter().map(|c| c.key()).zip(computed).collect();
+    slice
+        .into_iter()
+        .map(|c| {
+            let key = c.key();
+            match computed.remove(&key) {
+                Some(r) => Ok(r),
+                None => {
+                    let rec = logged.remove(&key).with_context(|| format!("cell {key} is neither logged nor computed"))?;
+                    restore(c, rec).with_context(|| format!("cannot restore cell {key} from the cell log"))
+                }
+            }
+        })
+        .collect()
 }
 
 /// CPU seconds used by the calling thread so far (CLOCK_THREAD_CPUTIME_ID).

@@ -579,6 +579,12 @@ pub struct FitCell {
     pub approach: crate::spline::Approach,
 }
 
+impl crate::experiment::runner::Cell for FitCell {
+    fn key(&self) -> String {
+        FitCell::key(self)
+    }
+}
+
 impl FitCell {
     pub fn key(&self) -> String {
         format!("fit/{}/{}/{}/{}/{}", self.dataset, self.grid, self.cn, self.param.name(), self.approach.letter())
@@ -596,6 +602,12 @@ pub struct OptimCell {
     pub repeat: usize,
 }
 
+impl crate::experiment::runner::Cell for OptimCell {
+    fn key(&self) -> String {
+        OptimCell::key(self)
+    }
+}
+
 impl OptimCell {
     pub fn key(&self) -> String {
         format!("optim/{}/{}/{}/{}/{}/r{}", self.dataset, self.grid, self.cn, self.param.name(), self.optimiser, self.repeat)
@@ -609,6 +621,12 @@ pub struct SomCell {
     pub model: crate::som::Model,
     pub grid: GridSize,
     pub repeat: usize,
+}
+
+impl crate::experiment::runner::Cell for SomCell {
+    fn key(&self) -> String {
+        SomCell::key(self)
+    }
 }
 
 impl SomCell {

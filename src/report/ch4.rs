@@ -212,7 +212,8 @@ pub fn write(spec: &Spec, runs: &[SomRun], out: &Path) -> Result<String> {
     } else {
         Vec::new()
     };
-    Ok(section(runs, &written, &maps, &pictures))
+    let claims_md = super::claims::write(out, &claims(runs))?;
+    Ok(section(runs, &written, &maps, &pictures, &claims_md))
 }
 
 /// Chapter 4 claims, checked on the runs and on the thesis' own Appendix B/C.
@@ -371,7 +372,7 @@ fn speed_section(runs: &[SomRun]) -> String {
     )
 }
 
-fn section(runs: &[SomRun], written: &[String], maps: &[String], pictures: &[String]) -> String {
+fn section(runs: &[SomRun], written: &[String], maps: &[String], pictures: &[String], claims_md: &str) -> String {
     let mut s = String::from("## Chapter 4: SOM models (Appendices A-D)\n\n");
     let iters: Vec<usize> = runs.iter().map(|r| r.row.iterations).collect();
     let _ = writeln!(
@@ -383,7 +384,7 @@ fn section(runs: &[SomRun], written: &[String], maps: &[String], pictures: &[Str
     );
     s.push_str(DEFINITIONS);
     s.push_str("\n### Claims\n\n");
-    s.push_str(&super::claims::markdown(&claims(runs)));
+    s.push_str(claims_md);
     if appendix_table(runs, true).is_some() {
         s.push_str("\n### Appendix B, side by side\n");
         s.push_str(&side_by_side(runs, true, reference::table("appendix_b").as_ref()));

@@ -237,7 +237,7 @@ pub fn write(runs: &[FitRun], out: &Path, maps_origin: &[(String, String)], pict
     }
     let mut out_s = String::from(&s[..]);
     out_s.push_str("\n### Claims\n\n");
-    out_s.push_str(&super::claims::markdown(&claims));
+    out_s.push_str(&super::claims::write(out, &claims)?);
     if claims.iter().any(|c| c.statement.starts_with("B beats A") && !c.holds()) {
         out_s.push_str(DISAGREEMENT);
     }

@@ -279,6 +279,6 @@ pub fn write(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProble
     let kept = runs.iter().filter(|r| r.row.best <= r.row.initial_best).count();
     claims.push(Claim { chapter: "6".into(), statement: "Every run's best is no worse than its initial population's best".into(), ours: (kept, runs.len()), thesis: None, note: "elitism check over all runs".into() });
     s.push_str("\n### Claims\n\n");
-    s.push_str(&super::claims::markdown(&claims));
+    s.push_str(&super::claims::write(out, &claims)?);
     Ok(s)
 }

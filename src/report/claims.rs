@@ -29,6 +29,36 @@ impl Claim {
     }
 }
 
+/// The columns of `claims.csv`, which every chapter's report writes (and `reproduce` collects).
+pub const CSV_HEADER: [&str; 8] = ["chapter", "claim", "verdict", "holds_here", "checked_here", "holds_thesis", "checked_thesis", "note"];
+
+/// Write `claims.csv` into `out` and return the markdown table of the same claims.
+pub fn write(out: &std::path::Path, claims: &[Claim]) -> anyhow::Result<String> {
+    let rows: Vec<Vec<String>> = claims
+        .iter()
+        .map(|c| {
+            let (ht, ct) = c.thesis.map(|(a, b)| (a.to_string(), b.to_string())).unwrap_or_default();
+            vec![c.chapter.clone(), c.statement.clone(), c.verdict().to_string(), c.ours.0.to_string(), c.ours.1.to_string(), ht, ct, c.note.clone()]
+        })
+        .collect();
+    let header: Vec<String> = CSV_HEADER.iter().map(|h| h.to_string()).collect();
+    super::fsio::write_atomic(&out.join("claims.csv"), super::fsio::csv_records(&header, &rows)?.as_bytes())?;
+    Ok(markdown(claims))
+}
+
+/// Claims read back from a `claims.csv` (for the combined report of `reproduce`).
+pub fn read(path: &std::path::Path) -> anyhow::Result<Vec<Claim>> {
+    let mut rd = csv::Reader::from_path(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let mut out = Vec::new();
+    for (n, rec) in rd.records().enumerate() {
+        let rec = rec.map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        let num = |k: usize| -> anyhow::Result<usize> { rec.get(k).unwrap_or("").parse().map_err(|_| anyhow::anyhow!("{}: line {}: column {} is not a count", path.display(), n + 2, CSV_HEADER[k])) };
+        let thesis = if rec.get(5).unwrap_or("").is_empty() { None } else { Some((num(5)?, num(6)?)) };
+        out.push(Claim { chapter: rec.get(0).unwrap_or("").into(), statement: rec.get(1).unwrap_or("").into(), ours: (num(3)?, num(4)?), thesis, note: rec.get(7).unwrap_or("").into() });
+    }
+    Ok(out)
+}
+
 /// Markdown table of claims.
 pub fn markdown(claims: &[Claim]) -> String {
     let mut s = String::from("| chapter | claim | verdict here | here | thesis' own figures | note |\n|---|---|---|---|---|---|\n");
@@ -37,4 +67,25 @@ pub fn markdown(claims: &[Claim]) -> String {
         let _ = writeln!(s, "| {} | {} | **{}** | {}/{} | {} | {} |", c.chapter, c.statement, c.verdict(), c.ours.0, c.ours.1, thesis, c.note);
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn claims_round_trip_through_csv_with_verdicts() {
+        let dir = tempfile::tempdir().unwrap();
+        let claims = vec![
+            Claim { chapter: "4".into(), statement: "DNSOM has the lowest TE, \"always\"".into(), ours: (10, 15), thesis: Some((15, 15)), note: "a, b".into() },
+            Claim { chapter: "6".into(), statement: "x".into(), ours: (3, 3), thesis: None, note: String::new() },
+        ];
+        let md = write(dir.path(), &claims).unwrap();
+        assert!(md.contains("**mostly holds**") && md.contains("**holds**"));
+        let back = read(&dir.path().join("claims.csv")).unwrap();
+        assert_eq!(back.len(), 2);
+        assert_eq!((back[0].statement.as_str(), back[0].ours, back[0].thesis), (claims[0].statement.as_str(), (10, 15), Some((15, 15))));
+        assert_eq!((back[1].ours, back[1].thesis), ((3, 3), None));
+        assert_eq!(back[0].verdict(), "mostly holds");
+    }
 }

@@ -2,7 +2,7 @@
 //! written to a temporary name in the same folder and renamed, so a reader never sees half a file.
 
 use anyhow::{Context, Result};
-use std::fs::{self, File, OpenOptions};
+use std::fs::{self, File};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -40,38 +40,6 @@ pub fn read_text(path: &Path) -> Result<String> {
     fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))
 }
 
-/// An append-only log of finished rows (`runs.csv.partial`): each row is flushed as soon as its
-/// cell finishes, so a killed run loses nothing it had finished.
-pub struct PartialLog {
-    path: PathBuf,
-    file: File,
-}
-
-impl PartialLog {
-    /// Start a new log with a header line (replacing an old one).
-    pub fn create(path: &Path, header: &str) -> Result<PartialLog> {
-        let mut file = File::create(path).with_context(|| format!("cannot write {}", path.display()))?;
-        writeln!(file, "{header}").with_context(|| format!("cannot write {}", path.display()))?;
-        Ok(PartialLog { path: path.to_path_buf(), file })
-    }
-
-    /// Open an existing log for appending.
-    pub fn append(path: &Path) -> Result<PartialLog> {
-        let file = OpenOptions::new().append(true).open(path).with_context(|| format!("cannot append to {}", path.display()))?;
-        Ok(PartialLog { path: path.to_path_buf(), file })
-    }
-
-    /// Append one line and flush it to the OS.
-    pub fn push(&mut self, line: &str) -> Result<()> {
-        writeln!(self.file, "{line}")
-            .and_then(|_| self.file.flush())
-            .with_context(|| format!("cannot write {}", self.path.display()))
-    }
-
-    pub fn path(&self) -> &Path {
-        &self.path
-    }
-}
 
 /// Serialise rows to CSV text (header from the struct's field names).
 pub fn csv_text<T: serde::Serialize>(rows: &[T]) -> Result<String> {

@@ -1,0 +1,220 @@
+//! The durable cell log of an output folder, and the fingerprint that says which run it belongs to.
+//!
+//! `cells.jsonl` holds one JSON line per finished cell, `{"key": …, "record": …}`, appended and
+//! flushed the moment the cell finishes. A run killed at any instant leaves every finished cell on
+//! disk and at most one torn last line (a write cut short has no trailing newline), which a resumed
+//! run drops. `fingerprint.toml` is written before the first cell: a resumed run (`--resume`) or a
+//! merge of shards compares it with its own and refuses, naming the field, when they differ.
+
+use anyhow::{bail, Context, Result};
+use serde::{de::DeserializeOwned, Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::fs::{File, OpenOptions};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+pub const LOG_FILE: &str = "cells.jsonl";
+pub const FINGERPRINT_FILE: &str = "fingerprint.toml";
+
+/// The `I`-th of `N` deterministic slices of a spec's cells (1-based): cell number k belongs to
+/// shard (k mod N) + 1, so every shard gets a mix of small and large cells.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Shard {
+    pub index: usize,
+    pub count: usize,
+}
+
+impl Shard {
+    /// Parse `I/N` with 1 <= I <= N.
+    pub fn parse(s: &str) -> Result<Shard> {
+        let (i, n) = s.split_once('/').with_context(|| format!("--shard `{s}`: expected I/N, e.g. 2/8"))?;
+        let (index, count): (usize, usize) = (i.trim().parse().with_context(|| format!("--shard `{s}`: I is not a number"))?, n.trim().parse().with_context(|| format!("--shard `{s}`: N is not a number"))?);
+        if count == 0 || index == 0 || index > count {
+            bail!("--shard `{s}`: need 1 <= I <= N");
+        }
+        Ok(Shard { index, count })
+    }
+
+    /// Whether cell number `k` (0-based, in the spec's cell order) is in this shard.
+    pub fn contains(&self, k: usize) -> bool {
+        k % self.count == self.index - 1
+    }
+}
+
+impl std::fmt::Display for Shard {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}/{}", self.index, self.count)
+    }
+}
+
+/// What makes two runs the same run: the spec (text after which profile), the seed, the shard.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Fingerprint {
+    pub spec_name: String,
+    pub spec_path: String,
+    pub spec_sha256: String,
+    pub profile: String,
+    pub master_seed: u64,
+    /// Cells in the whole spec (all shards).
+    pub cells: usize,
+    /// `I/N` when the folder holds one shard.
+    #[serde(default)]
+    pub shard: Option<String>,
+    /// The spec's text, so that a merge can re-read it.
+    pub spec_text: String,
+}
+
+impl Fingerprint {
+    /// The first field in which `other` differs, as `name: ours vs theirs` (None if equal).
+    pub fn difference(&self, other: &Fingerprint) -> Option<String> {
+        let pairs = [
+            ("spec name", self.spec_name.clone(), other.spec_name.clone()),
+            ("master seed", self.master_seed.to_string(), other.master_seed.to_string()),
+            ("profile", self.profile.clone(), other.profile.clone()),
+            ("spec text (sha256)", self.spec_sha256.clone(), other.spec_sha256.clone()),
+            ("cell count", self.cells.to_string(), other.cells.to_string()),
+            ("shard", self.shard.clone().unwrap_or_else(|| "none".into()), other.shard.clone().unwrap_or_else(|| "none".into())),
+        ];
+        pairs.into_iter().find(|(_, a, b)| a != b).map(|(name, a, b)| format!("{name}: {a} vs {b}"))
+    }
+
+    pub fn read(dir: &Path) -> Result<Option<Fingerprint>> {
+        let path = dir.join(FINGERPRINT_FILE);
+        if !path.exists() {
+            return Ok(None);
+        }
+        let text = std::fs::read_to_string(&path).with_context(|| format!("cannot read {}", path.display()))?;
+        let fp = toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {}", path.display(), e.message()))?;
+        Ok(Some(fp))
+    }
+
+    pub fn write(&self, dir: &Path) -> Result<()> {
+        let text = toml::to_string(self).context("cannot serialise the fingerprint")?;
+        crate::report::fsio::write_atomic(&dir.join(FINGERPRINT_FILE), text.as_bytes())
+    }
+}
+
+#[derive(Serialize, Deserialize)]
+struct Line<T> {
+    key: String,
+    record: T,
+}
+
+/// The finished cells a folder's log holds, by key (the last line wins if a key repeats). A torn
+/// last line (no newline: the write was cut short) is dropped and cut off the file; any other
+/// malformed line is an error naming the file and line.
+pub fn read_records<T: DeserializeOwned>(dir: &Path) -> Result<BTreeMap<String, T>> {
+    let path = dir.join(LOG_FILE);
+    let mut out = BTreeMap::new();
+    if !path.exists() {
+        return Ok(out);
+    }
+    let text = std::fs::read_to_string(&path).with_context(|| format!("cannot read {}", path.display()))?;
+    let complete = match text.rfind('\n') {
+        Some(k) => k + 1,
+        None => 0,
+    };
+    for (n, line) in text[..complete].lines().enumerate() {
+        if line.trim().is_empty() {
+            continue;
+        }
+        let l: Line<T> = serde_json::from_str(line).map_err(|e| anyhow::anyhow!("{}:{}: malformed cell record: {e}", path.display(), n + 1))?;
+        out.insert(l.key, l.record);
+    }
+    if complete < text.len() {
+        let f = OpenOptions::new().write(true).open(&path).with_context(|| format!("cannot open {}", path.display()))?;
+        f.set_len(complete as u64).with_context(|| format!("cannot cut the torn last line of {}", path.display()))?;
+    }
+    Ok(out)
+}
+
+/// Appends one line per finished cell, flushed at once.
+pub struct CellLog {
+    file: File,
+    path: PathBuf,
+}
+
+impl CellLog {
+    /// Open the folder's log: appending to it when resuming, else starting it empty.
+    pub fn open(dir: &Path, resume: bool) -> Result<CellLog> {
+        let path = dir.join(LOG_FILE);
+        let file = if resume {
+            OpenOptions::new().create(true).append(true).open(&path)
+        } else {
+            File::create(&path)
+        }
+        .with_context(|| format!("cannot open {}", path.display()))?;
+        Ok(CellLog { file, path })
+    }
+
+    pub fn push<T: Serialize>(&mut self, key: &str, record: &T) -> Result<()> {
+        let mut line = serde_json::to_string(&Line { key: key.to_string(), record }).context("cannot serialise a cell record")?;
+        line.push('\n');
+        self.file.write_all(line.as_bytes()).with_context(|| format!("cannot append to {}", self.path.display()))?;
+        self.file.flush().with_context(|| format!("cannot flush {}", self.path.display()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shards_partition_the_cells() {
+        let n = 3;
+        let shards: Vec<Shard> = (1..=n).map(|i| Shard::parse(&format!("{i}/{n}")).unwrap()).collect();
+        for k in 0..20 {
+            assert_eq!(shards.iter().filter(|s| s.contains(k)).count(), 1);
+        }
+        for bad in ["0/3", "4/3", "1/0", "x/2", "3"] {
+            assert!(Shard::parse(bad).is_err(), "{bad}");
+        }
+        assert_eq!(Shard::parse("2/5").unwrap().to_string(), "2/5");
+    }
+
+    #[test]
+    fn log_survives_a_torn_last_line_and_names_a_bad_one() {
+        let dir = tempfile::tempdir().unwrap();
+        {
+            let mut log = CellLog::open(dir.path(), false).unwrap();
+            log.push("a", &vec![1.0, 2.0]).unwrap();
+            log.push("b", &vec![3.0]).unwrap();
+        }
+        // A write cut short.
+        let path = dir.path().join(LOG_FILE);
+        let mut f = OpenOptions::new().append(true).open(&path).unwrap();
+        f.write_all(b"{\"key\":\"c\",\"rec").unwrap();
+        drop(f);
+        let got: BTreeMap<String, Vec<f64>> = read_records(dir.path()).unwrap();
+        assert_eq!(got.len(), 2);
+        assert_eq!(got["b"], vec![3.0]);
+        // The torn line is gone, so appending continues on a clean line.
+        let mut log = CellLog::open(dir.path(), true).unwrap();
+        log.push("c", &vec![4.0]).unwrap();
+        let got: BTreeMap<String, Vec<f64>> = read_records(dir.path()).unwrap();
+        assert_eq!(got.keys().cloned().collect::<Vec<_>>(), vec!["a", "b", "c"]);
+        std::fs::write(&path, "{\"key\":\"a\",\"record\":[1]}\nnot json\n").unwrap();
+        let e = read_records::<Vec<f64>>(dir.path()).unwrap_err().to_string();
+        assert!(e.contains("cells.jsonl:2"), "{e}");
+    }
+
+    #[test]
+    fn records_keep_every_bit_of_a_float() {
+        let dir = tempfile::tempdir().unwrap();
+        let xs: Vec<f64> = vec![10.552161934452197, 0.1 + 0.2, 1e-300, f64::MIN_POSITIVE, 2.0f64.sqrt(), -1.0 / 3.0];
+        CellLog::open(dir.path(), false).unwrap().push("k", &xs).unwrap();
+        let back: BTreeMap<String, Vec<f64>> = read_records(dir.path()).unwrap();
+        assert_eq!(back["k"].iter().map(|v| v.to_bits()).collect::<Vec<_>>(), xs.iter().map(|v| v.to_bits()).collect::<Vec<_>>());
+    }
+
+    #[test]
+    fn fingerprint_names_the_first_difference() {
+        let a = Fingerprint { spec_name: "s".into(), spec_path: "s.toml".into(), spec_sha256: "ab".into(), profile: "quick".into(), master_seed: 1, cells: 4, shard: None, spec_text: String::new() };
+        assert_eq!(a.difference(&a.clone()), None);
+        let b = Fingerprint { master_seed: 2, ..a.clone() };
+        assert_eq!(a.difference(&b).unwrap(), "master seed: 1 vs 2");
+        let c = Fingerprint { profile: "default".into(), ..a.clone() };
+        assert!(a.difference(&c).unwrap().starts_with("profile"));
+    }
+}

@@ -1,0 +1,117 @@
+//! Helpers shared by the integration tests: run the real binary in a temporary folder, print the
+//! command, folder listing, stdout and stderr on failure, and read the CSVs it writes.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+pub fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_somnurbs"))
+}
+
+pub fn shared_data() -> PathBuf {
+    match std::env::var_os("SOMNURBS_DATA") {
+        Some(v) if !v.is_empty() => PathBuf::from(v),
+        _ => Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data"),
+    }
+}
+
+pub struct Case {
+    pub dir: tempfile::TempDir,
+}
+
+impl Case {
+    pub fn new() -> Case {
+        Case { dir: tempfile::tempdir().unwrap() }
+    }
+    pub fn path(&self, p: &str) -> PathBuf {
+        self.dir.path().join(p)
+    }
+    pub fn write(&self, p: &str, text: &str) -> PathBuf {
+        let path = self.path(p);
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        std::fs::write(&path, text).unwrap();
+        path
+    }
+    pub fn run(&self, args: &[&str]) -> Output {
+        let out = bin().args(args).current_dir(self.dir.path()).env("SOMNURBS_DATA", shared_data()).output().unwrap();
+        out
+    }
+    pub fn explain(&self, args: &[&str], out: &Output) -> String {
+        let listing: Vec<String> = walk(self.dir.path()).iter().map(|p| p.strip_prefix(self.dir.path()).unwrap().display().to_string()).collect();
+        format!(
+            "command: somnurbs {}\nfolder: {:?}\nstatus: {}\nstdout:\n{}\nstderr:\n{}",
+            args.join(" "),
+            listing,
+            out.status,
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr)
+        )
+    }
+    pub fn ok(&self, args: &[&str]) -> Output {
+        let out = self.run(args);
+        assert!(out.status.success(), "{}", self.explain(args, &out));
+        out
+    }
+    /// Runs a command that must fail with a one-line error containing every `needle`.
+    pub fn fails(&self, args: &[&str], needles: &[&str]) -> String {
+        let out = self.run(args);
+        let err = String::from_utf8_lossy(&out.stderr).to_string();
+        assert!(!out.status.success(), "expected failure\n{}", self.explain(args, &out));
+        assert_eq!(err.trim_end().lines().count(), 1, "error is not one line\n{}", self.explain(args, &out));
+        for n in needles {
+            assert!(err.contains(n), "error lacks {n:?}\n{}", self.explain(args, &out));
+        }
+        err
+    }
+}
+
+pub fn walk(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    if let Ok(rd) = std::fs::read_dir(dir) {
+        for e in rd.flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                out.extend(walk(&p));
+            } else {
+                out.push(p);
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+pub fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
+    let mut r = csv::Reader::from_path(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let h = r.headers().unwrap().iter().map(String::from).collect();
+    let rows = r.records().map(|x| x.unwrap().iter().map(String::from).collect()).collect();
+    (h, rows)
+}
+
+/// A CSV with the timing columns blanked, for comparisons across runs.
+pub fn without_timing(path: &Path) -> Vec<Vec<String>> {
+    let (h, rows) = read_csv(path);
+    rows.into_iter()
+        .map(|r| r.into_iter().zip(&h).map(|(v, c)| if is_timing(c) { String::new() } else { v }).collect())
+        .collect()
+}
+
+
+/// Timing columns: measured, never identical across runs.
+pub fn is_timing(column: &str) -> bool {
+    column.starts_with("cpu_s") || column.ends_with("_s") || column == "wall_seconds"
+}
+
+/// Every CSV under `a` equals the one at the same place under `b` apart from timing columns
+/// (and `b` has no CSV that `a` lacks); returns how many tables were compared.
+pub fn same_tables(a: &Path, b: &Path) -> usize {
+    let csvs = |d: &Path| -> Vec<PathBuf> { walk(d).into_iter().filter(|p| p.extension().is_some_and(|e| e == "csv")).map(|p| p.strip_prefix(d).unwrap().to_path_buf()).collect() };
+    let (ta, tb) = (csvs(a), csvs(b));
+    assert_eq!(ta, tb, "different tables in {} and {}", a.display(), b.display());
+    for t in &ta {
+        assert_eq!(read_csv(&a.join(t)).0, read_csv(&b.join(t)).0, "{}: header", t.display());
+        assert_eq!(without_timing(&a.join(t)), without_timing(&b.join(t)), "{}", t.display());
+    }
+    ta.len()
+}

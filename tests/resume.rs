@@ -1,0 +1,110 @@
+//! Resume after SIGKILL, shards merged back into one run, refusals, and `reproduce`.
+
+mod common;
+use common::*;
+use std::collections::BTreeSet;
+use std::time::{Duration, Instant};
+
+/// Long enough (a few seconds on one thread) to be killed part-way.
+const SLOW: &str = r#"
+name = "slow"
+master_seed = 11
+[optim]
+datasets = ["sphere"]
+grid = "20x20"
+control_nets = ["10x10", "12x12"]
+parameterisations = ["chord_length"]
+optimisers = ["ga", "de", "pso"]
+repeats = 12
+generations = 600
+population = 20
+maps = "nowhere"
+[optim.som]
+iterations = 500
+"#;
+
+fn log_keys(path: &std::path::Path) -> Vec<String> {
+    std::fs::read_to_string(path)
+        .unwrap_or_default()
+        .lines()
+        .filter_map(|l| serde_json::from_str::<serde_json::Value>(l).ok())
+        .map(|v| v["key"].as_str().unwrap().to_string())
+        .collect()
+}
+
+#[test]
+fn a_killed_run_resumes_to_the_same_tables() {
+    let c = Case::new();
+    c.write("slow.toml", SLOW);
+    c.ok(&["run", "slow.toml", "--out", "plain", "--jobs", "2"]);
+    // Start again in another folder and kill it (SIGKILL) once some cells are logged.
+    let mut child = bin().args(["run", "slow.toml", "--out", "killed", "--jobs", "1"]).current_dir(c.dir.path()).env("SOMNURBS_DATA", shared_data()).stderr(std::process::Stdio::null()).spawn().unwrap();
+    let log = c.path("killed/cells.jsonl");
+    let t0 = Instant::now();
+    while log_keys(&log).len() < 8 {
+        assert!(t0.elapsed() < Duration::from_secs(120), "no progress");
+        assert!(child.try_wait().unwrap().is_none(), "finished before it could be killed; make SLOW slower");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let before = log_keys(&log).len();
+    assert!(before < 72, "killed after {before} of 72 cells");
+    assert!(!c.path("killed/manifest.toml").exists() && !c.path("killed/runs.csv").exists());
+    // A different seed may not resume there.
+    c.write("other.toml", &SLOW.replace("master_seed = 11", "master_seed = 12"));
+    c.fails(&["run", "other.toml", "--out", "killed", "--resume"], &["cannot resume", "master seed: 11 vs 12"]);
+    c.fails(&["run", "slow.toml", "--out", "killed", "--resume", "--profile", "quick"], &["profile"]);
+    // Resume: the rest runs, nothing is duplicated or lost, the tables equal the plain run's.
+    let out = c.ok(&["run", "slow.toml", "--out", "killed", "--resume", "--jobs", "2"]);
+    assert!(String::from_utf8_lossy(&out.stderr).contains(&format!("{before} of 72 cells already done")) || before == 0);
+    let keys = log_keys(&log);
+    assert_eq!(keys.len(), 72, "every cell logged once");
+    assert_eq!(keys.iter().collect::<BTreeSet<_>>().len(), 72);
+    let compared = same_tables(&c.path("plain"), &c.path("killed"));
+    assert!(compared >= 5, "{compared} tables");
+}
+
+#[test]
+fn shards_merge_into_the_one_machine_run() {
+    let c = Case::new();
+    let spec = SLOW.replace("repeats = 12", "repeats = 2").replace("generations = 600", "generations = 40");
+    c.write("s.toml", &spec);
+    c.ok(&["run", "s.toml", "--out", "one"]);
+    for i in 1..=3 {
+        c.ok(&["run", "s.toml", "--out", &format!("shard{i}"), "--shard", &format!("{i}/3")]);
+        assert!(!c.path(&format!("shard{i}/runs.csv")).exists(), "a shard writes no tables");
+    }
+    let sizes: Vec<usize> = (1..=3).map(|i| log_keys(&c.path(&format!("shard{i}/cells.jsonl"))).len()).collect();
+    assert_eq!(sizes.iter().sum::<usize>(), 12);
+    c.fails(&["merge", "shard1", "shard2", "--out", "m"], &["shard 3/3 is missing"]);
+    c.fails(&["merge", "shard1", "shard1", "shard2", "--out", "m2"], &["given twice"]);
+    c.fails(&["merge", "one", "--out", "m3"], &["not a shard"]);
+    c.ok(&["merge", "shard3", "shard1", "shard2", "--out", "merged"]);
+    let compared = same_tables(&c.path("one"), &c.path("merged"));
+    assert!(compared >= 5);
+    c.fails(&["run", "s.toml", "--shard", "4/3"], &["--shard"]);
+}
+
+#[test]
+fn reproduce_quick_writes_one_report_with_claims_and_tables_6_8_6_9() {
+    let c = Case::new();
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let specs = root.join("experiments");
+    c.ok(&["reproduce", "--profile", "quick", "--out", "thesis", "--specs", specs.to_str().unwrap(), "--jobs", "2"]);
+    let report = std::fs::read_to_string(c.path("thesis/REPORT.md")).unwrap();
+    for needle in ["## The thesis' claims", "B beats A in most cells", "DNSOM has the lowest TE", "Table 6.8", "Table 6.9", "](ch4_models/"] {
+        assert!(report.contains(needle), "REPORT.md lacks {needle:?}");
+    }
+    let (h, rows) = read_csv(&c.path("thesis/table_6_8.csv"));
+    assert_eq!(h, vec!["table", "ga", "de", "pso"]);
+    assert_eq!(rows.last().unwrap()[0], "overall");
+    // The overall wins add up to the cells of Tables 6.4 and 6.5.
+    let cells: usize = rows.last().unwrap()[1].split('/').nth(1).unwrap().parse().unwrap();
+    let wins: usize = rows.last().unwrap()[1..].iter().map(|v| v.split('/').next().unwrap().parse::<usize>().unwrap()).sum();
+    assert!(wins >= cells && cells > 0, "{wins} wins over {cells} cells (ties count for each)");
+    let (h, claims) = read_csv(&c.path("thesis/claims.csv"));
+    let verdict = h.iter().position(|x| x == "verdict").unwrap();
+    assert!(claims.len() >= 15);
+    assert!(claims.iter().all(|r| ["holds", "mostly holds", "does not hold"].contains(&r[verdict].as_str())), "{claims:?}");
+}
