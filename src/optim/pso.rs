@@ -16,7 +16,7 @@ use super::problem::{check_problem, Budget, Evaluator, Optimiser, Population, Pr
 use super::kernels::{pso_move, PsoCoefficients};
 use super::sampling::bulk_from;
 use super::{check_range, OptimError};
-use rand::Rng;
+use rand::RngCore;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
@@ -75,7 +75,9 @@ impl Optimiser for Pso {
         let co = PsoCoefficients { k: self.k, c1: self.c1, c2: self.c2 };
         for _ in 0..budget.generations {
             for i in 0..n {
-                bulk.fill(&mut words[..]);
+                for w in words.iter_mut() {
+                    *w = bulk.next_u64();
+                }
                 pso_move(&mut pos[i], &mut vel[i], &pbest[i], &gbest, &words, co, &vmax, lo, hi);
             }
             for i in 0..n {
