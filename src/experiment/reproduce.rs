@@ -177,18 +177,10 @@ fn combined_report(out: &Path, specs: &[Spec], done: &[(String, f64)], profile: 
     }
     all.retain(|c| c.ours.1 > 0);
     all.extend(overall_claims(&all));
-    let header: Vec<String> = claims::CSV_HEADER.iter().map(|h| h.to_string()).collect();
-    let rows: Vec<Vec<String>> = all
-        .iter()
-        .map(|c| {
-            let (ht, ct) = c.thesis.map(|(a, b)| (a.to_string(), b.to_string())).unwrap_or_default();
-            vec![c.chapter.clone(), c.statement.clone(), c.verdict().to_string(), c.ours.0.to_string(), c.ours.1.to_string(), ht, ct, c.note.clone()]
-        })
-        .collect();
-    write_atomic(&out.join("claims.csv"), csv_records(&header, &rows)?.as_bytes())?;
+    let table = claims::write(out, &all)?;
     let holding = all.iter().filter(|c| c.holds()).count();
     let _ = writeln!(s, "\n## The thesis' claims\n\nEach claim is counted on this reproduction (`here`) and, where the published tables allow, on the thesis' own figures; {holding} of {} hold in every case checked here. Also in `claims.csv`.\n", all.len());
-    s.push_str(&claims::markdown(&all));
+    s.push_str(&table);
     let names: Vec<&str> = specs.iter().map(|sp| sp.file.name.as_str()).collect();
     let find = |grid_same: bool| names.iter().copied().find(|n| n.starts_with("ch6") && n.ends_with(if grid_same { "same" } else { "diff" }));
     let (same, diff) = (find(true), find(false));

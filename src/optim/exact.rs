@@ -671,21 +671,6 @@ pub fn solve_exact(pb: &dyn SumOfNorms, lower: &[f64], upper: &[f64], x_start: &
         }
         let lb_dual = lower_bound_with(&mut y_dual, &r, &x, lower, upper, pb, &mut g_scratch);
         best_lb = best_lb.max(lb_dual);
-        // Dual Newton step: linearising y(r) = r / s gives y + B_k A_k d, whose A^T-image is
-        // g + H d ~ 0 on the free variables, even when the primal step is below the resolution
-        // of f. Certify it too.
-        pb.residuals(&d, &mut r_new);
-        for k in 0..m {
-            let data = pb.term(k).data;
-            let u = [r_new[k][0] + data[0], r_new[k][1] + data[1], r_new[k][2] + data[2]];
-            let v = r[k];
-            let s2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + mu * mu;
-            let s = s2.sqrt();
-            let vu = (v[0] * u[0] + v[1] * u[1] + v[2] * u[2]) / s2;
-            y_dual[k] = [y[k][0] + (u[0] - v[0] * vu) / s, y[k][1] + (u[1] - v[1] * vu) / s, y[k][2] + (u[2] - v[2] * vu) / s];
-        }
-        let lb_dual = lower_bound_with(&mut y_dual, &r, &x, lower, upper, pb, &mut g_scratch);
-        best_lb = best_lb.max(lb_dual);
         // Armijo search along the projection arc.
         let f_mu = smooth(&r, mu);
         let mut alpha = 1.0;
