@@ -53,7 +53,7 @@ fn check_finite(v: &[f64]) -> Result<(), StatsError> {
 fn normal_sf(z: f64) -> f64 {
     use statrs::distribution::{ContinuousCDF, Normal};
     let n = Normal::new(0.0, 1.0).expect("standard normal");
-    1.0 - n.cdf(z)
+    n.sf(z)
 }
 
 /// Standard normal lower tail P(Z <= z).
