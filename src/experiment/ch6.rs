@@ -88,7 +88,11 @@ pub fn problems(spec: &Spec, ctx: &RunContext) -> Result<BTreeMap<ProblemKey, Co
                 let grid = &maps[d].grid;
                 let fit = fit_two_view(grid, cn.nx, cn.ny, param, Approach::Improved).map_err(|e| anyhow::anyhow!("{d} {cn} {p}: {e}"))?;
                 let parts = fit.control_net_parts(grid).map_err(|e| anyhow::anyhow!("{e}"))?;
-                let problem = ControlNetProblem::new(parts, BoxSpec::Cover { fraction: o.bounds_margin }).map_err(|e| anyhow::anyhow!("{d} {cn} {p}: {e}"))?;
+                let bounds = match o.search_range {
+                    Some(half_width) => BoxSpec::AroundStart { half_width },
+                    None => BoxSpec::Cover { fraction: o.bounds_margin },
+                };
+                let problem = ControlNetProblem::new(parts, bounds).map_err(|e| anyhow::anyhow!("{d} {cn} {p}: {e}"))?;
                 out.insert((d.clone(), cn, param), problem);
             }
         }
@@ -188,4 +192,15 @@ fn picture_points<'a>(spec: &Spec, runs: &mut [OptimRun], largest: GridSize, pro
         }
     }
     Ok(())
+}
+
+/// One sentence on the start and the search box of a spec's runs, for the report.
+pub fn setting(spec: &Spec) -> String {
+    let Some(o) = spec.file.optim.as_ref() else { return String::new() };
+    let start = format!("Each individual starts at B + U[-{r:e}, {r:e}] per coordinate", r = o.init_range);
+    match o.search_range {
+        Some(r) => format!("{start}; the search box is B +- {r:e} per coordinate (Table 6.1's \"control point coordinate range [-5e-6, 5e-6]\" read as the search space, as the thesis' tiny improvements over B imply; PSO's maximum velocity is half that box)."),
+        None if o.bounds_margin == 0.0 => format!("{start}; the search box is the smallest per-axis box holding the data and B's control points."),
+        None => format!("{start}; the search box is the smallest per-axis box holding the data and B's control points, widened by {} of its size on each side.", o.bounds_margin),
+    }
 }

@@ -157,7 +157,7 @@ pub fn run_spec(spec: &Spec, ctx: &RunContext) -> Result<PathBuf> {
         let problems = ch6::problems(spec, ctx)?;
         let exact = if tables { ch6::exact_optima(spec, ctx, &problems)? } else { BTreeMap::new() };
         let runs = ch6::run(spec, ctx, &problems)?;
-        let section = if tables { Some(crate::report::ch6::write(&runs, &problems, &exact, &ctx.out)?) } else { None };
+        let section = if tables { Some(crate::report::ch6::write(&runs, &problems, &exact, &ch6::setting(spec), &ctx.out)?) } else { None };
         (section, runs.iter().map(|r| r.row.cpu_s).sum::<f64>(), runs.len())
     } else {
         let maps = ch5::maps(spec, ctx)?;

@@ -189,6 +189,10 @@ pub struct OptimSpec {
     /// The search box: the data and B's control points, widened by this share of its size.
     #[serde(default)]
     pub bounds_margin: f64,
+    /// If set, the search box is instead B's control points +- this per coordinate (Table 6.1's
+    /// "control point coordinate range", 5e-6).
+    #[serde(default)]
+    pub search_range: Option<f64>,
     #[serde(default)]
     pub maps: Option<String>,
     #[serde(default)]
@@ -478,6 +482,14 @@ impl Spec {
         }
         if !(o.init_range >= 0.0 && o.init_range.is_finite()) {
             return Err(self.err("optim.init_range", format!("must be a non-negative number, got {}", o.init_range)));
+        }
+        if let Some(r) = o.search_range {
+            if !(r > 0.0 && r.is_finite()) {
+                return Err(self.err("optim.search_range", format!("must be a positive number, got {r}")));
+            }
+            if o.init_range > r {
+                return Err(self.err("optim.init_range", format!("{} is wider than optim.search_range {r}", o.init_range)));
+            }
         }
         if !(o.bounds_margin >= 0.0 && o.bounds_margin.is_finite()) {
             return Err(self.err("optim.bounds_margin", format!("must be a non-negative number, got {}", o.bounds_margin)));

@@ -40,6 +40,9 @@ pub enum BoxSpec {
     Cover { fraction: f64 },
     /// An explicit box.
     Axes { lower: Point3, upper: Point3 },
+    /// Every coordinate within `half_width` of its value in x0 (approach B): the thesis' reading
+    /// of Table 6.1's "control point coordinate range [-5e-6, 5e-6]", a search space around B.
+    AroundStart { half_width: f64 },
 }
 
 /// Which compiled copy of the fitness kernel runs. (An AVX-512 copy was measured slower than
@@ -306,6 +309,17 @@ impl ControlNetProblem {
                 }
                 (lo, hi)
             }
+            BoxSpec::AroundStart { half_width } => {
+                if !(half_width > 0.0 && half_width.is_finite()) {
+                    return Err(OptimError::param("search_range", format!("must be finite and > 0, got {half_width}")));
+                }
+                let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+                for (k, &v) in parts.x0.iter().enumerate() {
+                    lo[k % 3] = lo[k % 3].min(v - half_width);
+                    hi[k % 3] = hi[k % 3].max(v + half_width);
+                }
+                (lo, hi)
+            }
             BoxSpec::Axes { lower, upper } => {
                 if let Some(a) = (0..3).find(|&a| lower[a].partial_cmp(&upper[a]).is_none_or(|o| o.is_gt())) {
                     return Err(OptimError::param("bounds", format!("axis {a}: lower {} is not <= upper {}", lower[a], upper[a])));
@@ -314,8 +328,10 @@ impl ControlNetProblem {
             }
         };
         let nov = net.nov();
-        let lower: Vec<f64> = (0..3 * nov).map(|k| box_axes.0[k % 3]).collect();
-        let upper: Vec<f64> = (0..3 * nov).map(|k| box_axes.1[k % 3]).collect();
+        let (lower, upper): (Vec<f64>, Vec<f64>) = match bounds {
+            BoxSpec::AroundStart { half_width } => parts.x0.iter().map(|&v| (v - half_width, v + half_width)).unzip(),
+            _ => ((0..3 * nov).map(|k| box_axes.0[k % 3]).collect(), (0..3 * nov).map(|k| box_axes.1[k % 3]).collect()),
+        };
         // The top view's P from x: contiguous runs of classes.
         let mut top_runs: Vec<(usize, usize, usize)> = Vec::new();
         for a in 0..cn_x {
@@ -408,7 +424,8 @@ impl ControlNetProblem {
         &self.net
     }
 
-    /// The search box per axis (lower, upper).
+    /// The search box per axis (lower, upper); for `AroundStart`, the hull of the per-coordinate
+    /// boxes.
     pub fn box_axes(&self) -> (Point3, Point3) {
         self.box_axes
     }
@@ -693,6 +710,17 @@ mod tests {
             let hi = x0.iter().skip(a).step_by(3).fold(big.box_axes().1[a], |m, &v| m.max(v));
             assert_eq!((cl[a], ch[a]), (lo, hi));
         }
+    }
+
+    #[test]
+    fn box_around_the_start_holds_each_coordinate_near_b() {
+        let pb = sphere_problem(10, 10, 6, 6, BoxSpec::AroundStart { half_width: 5e-6 });
+        let (lo, hi) = pb.bounds();
+        for (k, &v) in pb.initial_point().iter().enumerate() {
+            assert_eq!((lo[k], hi[k]), (v - 5e-6, v + 5e-6));
+        }
+        assert_eq!(pb.initial_outside_box(), 0);
+        assert!(ControlNetProblem::new(pb.parts().clone(), BoxSpec::AroundStart { half_width: 0.0 }).unwrap_err().to_string().contains("search_range"));
     }
 
     #[test]

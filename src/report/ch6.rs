@@ -30,12 +30,12 @@ fn stats(v: &[f64]) -> Option<(f64, f64, f64)> {
 type CellKey = (String, Parameterisation, GridSize);
 
 /// Write every Chapter 6 file; returns the REPORT.md section.
-pub fn write(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProblem>, exact: &BTreeMap<ProblemKey, ExactResult>, out: &Path) -> Result<String> {
+pub fn write(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProblem>, exact: &BTreeMap<ProblemKey, ExactResult>, setting: &str, out: &Path) -> Result<String> {
     let rows: Vec<_> = runs.iter().map(|r| r.row.clone()).collect();
     write_atomic(&out.join("runs.csv"), csv_text(&rows)?.as_bytes())?;
     let mut s = String::from("## Chapter 6: optimisation of the control points\n\n");
     let reps = runs.iter().map(|r| r.cell.repeat).max().map(|m| m + 1).unwrap_or(0);
-    let _ = writeln!(s, "{} runs ({} repeats per cell), every optimiser of a cell started from the same approach-B control net; fitness Eq. 6.2 (= Eq. 5.13).\n", runs.len(), reps);
+    let _ = writeln!(s, "{} runs ({} repeats per cell), every optimiser of a cell started from the same approach-B control net; fitness Eq. 6.2 (= Eq. 5.13). {setting}\n", runs.len(), reps);
     let mut claims = Vec::new();
     for grid in ordered(runs.iter().map(|r| r.cell.grid)) {
         let g: Vec<&OptimRun> = runs.iter().filter(|r| r.cell.grid == grid).collect();
