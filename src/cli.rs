@@ -42,6 +42,11 @@ pub enum Command {
     /// 6.8/6.9 and the table of the thesis' claims with verdicts.
     #[command(after_help = "Examples:\n  somnurbs reproduce --profile quick   # minutes\n  somnurbs reproduce                   # the full protocol")]
     Reproduce(ReproduceArgs),
+    /// Compare every table of a results folder with a baseline folder: numbers to per-column
+    /// tolerances, timing columns reported but not judged. Exit 0: no drift; 1: drift (the moved
+    /// cells are named, and all differences written to drift.csv); 2: bad input.
+    #[command(after_help = "Examples:\n  somnurbs drift results/baselines/quick results/thesis_quick\n  somnurbs drift results/baselines/quick results/thesis_quick --tol 'de_*=1e-6'\n  somnurbs drift --accept results/baselines/quick results/thesis_quick   # update the baseline on purpose")]
+    Drift(DriftArgs),
     /// Combine the shard folders of one spec (`run --shard I/N`) into one folder with its tables,
     /// identical to a one-machine run apart from timing.
     Merge(MergeArgs),
@@ -106,6 +111,28 @@ pub struct RunArgs {
     /// tables; `somnurbs merge` combines the N shard folders into one.
     #[arg(long, value_name = "I/N")]
     pub shard: Option<String>,
+}
+
+#[derive(Debug, Args)]
+pub struct DriftArgs {
+    /// The baseline folder (e.g. results/baselines/quick); its drift.toml, if any, names
+    /// timing-dependent tables and rows and per-column tolerances.
+    pub baseline: PathBuf,
+    /// The folder of the run to check.
+    pub current: PathBuf,
+    /// Tolerance of the columns matching COLUMN (a glob): |a - b| <= ABS + REL max(|a|, |b|).
+    /// Repeatable. Default 1e-9 absolute and 1e-9 relative.
+    #[arg(long, value_name = "COLUMN=ABS[,REL]")]
+    pub tol: Vec<String>,
+    /// Where to write the per-cell diff CSV (default CURRENT/drift.csv).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Compare even when the two folders were made by different specs, seeds or profiles.
+    #[arg(long)]
+    pub allow_spec_change: bool,
+    /// Make the baseline hold the current tables (on purpose, after a change that moves results).
+    #[arg(long)]
+    pub accept: bool,
 }
 
 #[derive(Debug, Args)]

@@ -45,6 +45,27 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             }
             Ok(ExitCode::SUCCESS)
         }
+        Command::Drift(args) => {
+            use somnurbs::report::drift;
+            if args.accept {
+                let said = drift::accept(&args.baseline, &args.current)?;
+                for l in &said {
+                    println!("{l}");
+                }
+                println!("baseline {} now holds the tables of {} ({} files changed)", args.baseline.display(), args.current.display(), said.len());
+                return Ok(ExitCode::SUCCESS);
+            }
+            let mut columns = args.tol.iter().map(|t| drift::parse_tol(t)).collect::<anyhow::Result<Vec<_>>>()?;
+            let config = drift::read_config(&args.baseline)?;
+            columns.extend(config.tolerance.iter().map(|c| (c.column.clone(), drift::Tolerance { abs: c.abs, rel: c.rel })));
+            let opts = drift::DriftOptions { columns, config, ..Default::default() };
+            let report = drift::compare_dirs(&args.baseline, &args.current, &opts, args.allow_spec_change)?;
+            let out = args.out.clone().unwrap_or_else(|| args.current.join("drift.csv"));
+            somnurbs::report::fsio::write_atomic(&out, report.csv()?.as_bytes())?;
+            println!("{}
+per-cell differences: {}", report.summary(10), out.display());
+            Ok(if report.drifted() { ExitCode::from(1) } else { ExitCode::SUCCESS })
+        }
         Command::Merge(args) => {
             let ctx = RunContext::new(args.out.clone(), jobs(args.jobs)?, experiment::data_dir(args.data_dir.as_deref()));
             let out = experiment::merge(&args.shards, &ctx)?;

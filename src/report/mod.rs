@@ -6,6 +6,7 @@ pub mod ch5;
 pub mod ch5_pictures;
 pub mod ch6;
 pub mod claims;
+pub mod drift;
 pub mod fsio;
 pub mod ioh;
 pub mod markdown;

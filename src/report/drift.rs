@@ -1,0 +1,527 @@
+//! Result drift: every table cell of a results folder compared with a committed baseline folder.
+//!
+//! Tables are the CSV files under the baseline (not under `png/`, `ioh/`, `maps/`), matched by
+//! relative path; columns by name; rows by position, and a row whose key (its non-numeric cells and
+//! identity columns such as `cn_x` or `repeat`) differs is a moved row, not a set of moved numbers.
+//! Numbers are equal within `abs + rel * max(|a|, |b|)`; timing columns (CPU or wall seconds) and
+//! the tables and rows the baseline's `drift.toml` declares timing-dependent are compared and
+//! reported but never judged. Bad input (a folder or CSV that cannot be read, a malformed CSV, a
+//! run of another spec, seed or profile) is an error, not drift.
+
+use super::fsio::{csv_records, write_atomic};
+use anyhow::{bail, Context, Result};
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::fmt::Write;
+use std::path::{Path, PathBuf};
+
+/// Equality of two numbers: |a - b| <= abs + rel * max(|a|, |b|).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Tolerance {
+    pub abs: f64,
+    pub rel: f64,
+}
+
+impl Default for Tolerance {
+    fn default() -> Tolerance {
+        Tolerance { abs: 1e-9, rel: 1e-9 }
+    }
+}
+
+impl Tolerance {
+    pub fn equal(&self, a: f64, b: f64) -> bool {
+        if a.is_nan() || b.is_nan() {
+            return a.is_nan() && b.is_nan();
+        }
+        if a == b {
+            return true;
+        }
+        (a - b).abs() <= self.abs + self.rel * a.abs().max(b.abs())
+    }
+}
+
+/// `drift.toml` in a baseline folder: what is timing-dependent and per-column tolerances.
+#[derive(Debug, Clone, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DriftConfig {
+    /// Tables (glob over the relative path, `*` any run of characters) whose every cell is
+    /// timing-dependent (e.g. win counts of CPU time).
+    #[serde(default)]
+    pub timing_tables: Vec<String>,
+    /// Rows holding any of these strings in a cell are timing-dependent (e.g. claims about speed).
+    #[serde(default)]
+    pub timing_rows: Vec<String>,
+    /// Per-column tolerances (`column` is a glob over column names).
+    #[serde(default)]
+    pub tolerance: Vec<ColumnTolerance>,
+}
+
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ColumnTolerance {
+    pub column: String,
+    pub abs: f64,
+    #[serde(default)]
+    pub rel: f64,
+}
+
+/// How to compare.
+#[derive(Debug, Clone, Default)]
+pub struct DriftOptions {
+    pub default: Tolerance,
+    /// Per-column tolerances (globs); the first match wins; command-line ones come first.
+    pub columns: Vec<(String, Tolerance)>,
+    pub config: DriftConfig,
+}
+
+impl DriftOptions {
+    fn tolerance(&self, column: &str) -> Tolerance {
+        self.columns.iter().find(|(g, _)| glob(g, column)).map(|(_, t)| *t).unwrap_or(self.default)
+    }
+}
+
+/// Parse `--tol COLUMN=ABS[,REL]`.
+pub fn parse_tol(s: &str) -> Result<(String, Tolerance)> {
+    let (col, v) = s.split_once('=').with_context(|| format!("--tol `{s}`: expected COLUMN=ABS[,REL]"))?;
+    let mut it = v.split(',');
+    let num = |x: Option<&str>, what: &str| -> Result<f64> {
+        let x = x.unwrap_or("0").trim();
+        let v: f64 = x.parse().map_err(|_| anyhow::anyhow!("--tol `{s}`: {what} `{x}` is not a number"))?;
+        if !(v >= 0.0 && v.is_finite()) {
+            bail!("--tol `{s}`: {what} must be a finite number >= 0");
+        }
+        Ok(v)
+    };
+    let abs = num(it.next(), "ABS")?;
+    let rel = num(it.next(), "REL")?;
+    Ok((col.trim().to_string(), Tolerance { abs, rel }))
+}
+
+/// `*` matches any run of characters; everything else literally.
+pub fn glob(pattern: &str, s: &str) -> bool {
+    let parts: Vec<&str> = pattern.split('*').collect();
+    if parts.len() == 1 {
+        return pattern == s;
+    }
+    let (first, last) = (parts[0], parts[parts.len() - 1]);
+    if !s.starts_with(first) || !s[first.len()..].ends_with(last) || s.len() < first.len() + last.len() {
+        return false;
+    }
+    let mut rest = &s[first.len()..s.len() - last.len()];
+    for p in &parts[1..parts.len() - 1] {
+        match rest.find(p) {
+            Some(k) => rest = &rest[k + p.len()..],
+            None => return false,
+        }
+    }
+    true
+}
+
+/// Columns that hold measured time: reported, never judged.
+pub fn is_timing_column(name: &str) -> bool {
+    name.ends_with("_s") || name.contains("cpu") || name.contains("seconds") || name.starts_with("time")
+}
+
+/// Columns that identify a row even when numeric.
+const IDENTITY: [&str; 9] = ["cn_x", "cn_y", "grid_x", "grid_y", "nx", "ny", "repeat", "n", "cells"];
+
+/// One difference.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Finding {
+    MissingTable { table: String },
+    ExtraTable { table: String },
+    MissingColumn { table: String, column: String },
+    ExtraColumn { table: String, column: String },
+    RowCount { table: String, baseline: usize, current: usize },
+    RowKey { table: String, row: usize, baseline: String, current: String },
+    Cell { table: String, row: String, column: String, baseline: String, current: String, abs: f64, rel: f64, judged: bool },
+}
+
+impl Finding {
+    /// Whether it counts as drift (an extra table or a timing cell does not).
+    pub fn drifted(&self) -> bool {
+        match self {
+            Finding::ExtraTable { .. } | Finding::ExtraColumn { .. } => false,
+            Finding::Cell { judged, .. } => *judged,
+            _ => true,
+        }
+    }
+
+    fn describe(&self) -> String {
+        match self {
+            Finding::MissingTable { table } => format!("{table}: missing in the current folder"),
+            Finding::ExtraTable { table } => format!("{table}: new table (not in the baseline)"),
+            Finding::MissingColumn { table, column } => format!("{table}: column {column} is missing"),
+            Finding::ExtraColumn { table, column } => format!("{table}: new column {column}"),
+            Finding::RowCount { table, baseline, current } => format!("{table}: {baseline} rows in the baseline, {current} now"),
+            Finding::RowKey { table, row, baseline, current } => format!("{table}: row {row} is {current}, the baseline has {baseline}"),
+            Finding::Cell { table, row, column, baseline, current, rel, judged, .. } => {
+                format!("{table}:{row}:{column} {baseline} -> {current} (rel {rel:.2e}){}", if *judged { "" } else { " [timing, not judged]" })
+            }
+        }
+    }
+}
+
+/// The outcome of a comparison.
+#[derive(Debug, Clone, Default)]
+pub struct DriftReport {
+    pub tables: usize,
+    pub cells: usize,
+    pub findings: Vec<Finding>,
+}
+
+impl DriftReport {
+    pub fn drifted(&self) -> bool {
+        self.findings.iter().any(Finding::drifted)
+    }
+
+    /// The summary printed by `somnurbs drift`.
+    pub fn summary(&self, most: usize) -> String {
+        let drifted: Vec<&Finding> = self.findings.iter().filter(|f| f.drifted()).collect();
+        let mut s = format!("compared {} tables, {} cells: ", self.tables, self.cells);
+        if drifted.is_empty() {
+            s.push_str("no drift");
+        } else {
+            let mut per_table: BTreeMap<&str, (usize, f64)> = BTreeMap::new();
+            for f in &drifted {
+                let (t, rel) = match f {
+                    Finding::MissingTable { table } | Finding::MissingColumn { table, .. } | Finding::RowCount { table, .. } | Finding::RowKey { table, .. } => (table.as_str(), f64::INFINITY),
+                    Finding::Cell { table, rel, .. } => (table.as_str(), *rel),
+                    Finding::ExtraTable { table } | Finding::ExtraColumn { table, .. } => (table.as_str(), 0.0),
+                };
+                let e = per_table.entry(t).or_insert((0, 0.0));
+                e.0 += 1;
+                e.1 = e.1.max(rel);
+            }
+            let _ = write!(s, "DRIFT in {} places", drifted.len());
+            for (t, (n, rel)) in &per_table {
+                let _ = write!(s, "\n  {t}: {n} moved (largest relative change {rel:.2e})");
+            }
+            s.push_str("\nfirst moves:");
+            for f in drifted.iter().take(most) {
+                let _ = write!(s, "\n  {}", f.describe());
+            }
+        }
+        let timing = self.findings.iter().filter(|f| matches!(f, Finding::Cell { judged: false, .. })).count();
+        if timing > 0 {
+            let _ = write!(s, "\n{timing} timing cells differ (reported in the diff CSV, not judged)");
+        }
+        for f in self.findings.iter().filter(|f| matches!(f, Finding::ExtraTable { .. } | Finding::ExtraColumn { .. })) {
+            let _ = write!(s, "\nnote: {}", f.describe());
+        }
+        s
+    }
+
+    /// The per-cell diff CSV.
+    pub fn csv(&self) -> Result<String> {
+        let header: Vec<String> = ["table", "row", "column", "baseline", "current", "abs_diff", "rel_diff", "judged", "drifted", "what"].iter().map(|h| h.to_string()).collect();
+        let rows: Vec<Vec<String>> = self
+            .findings
+            .iter()
+            .map(|f| match f {
+                Finding::Cell { table, row, column, baseline, current, abs, rel, judged } => {
+                    vec![table.clone(), row.clone(), column.clone(), baseline.clone(), current.clone(), format!("{abs:e}"), format!("{rel:e}"), yes(*judged), yes(f.drifted()), "cell".into()]
+                }
+                other => {
+                    let table = match other {
+                        Finding::MissingTable { table } | Finding::ExtraTable { table } | Finding::MissingColumn { table, .. } | Finding::ExtraColumn { table, .. } | Finding::RowCount { table, .. } | Finding::RowKey { table, .. } => table.clone(),
+                        Finding::Cell { .. } => unreachable!(),
+                    };
+                    vec![table, String::new(), String::new(), String::new(), String::new(), String::new(), String::new(), "yes".into(), yes(other.drifted()), other.describe()]
+                }
+            })
+            .collect();
+        csv_records(&header, &rows)
+    }
+}
+
+fn yes(b: bool) -> String {
+    if b { "yes" } else { "no" }.into()
+}
+
+/// A parsed CSV table.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Table {
+    pub header: Vec<String>,
+    pub rows: Vec<Vec<String>>,
+}
+
+impl Table {
+    pub fn parse(name: &str, text: &str) -> Result<Table> {
+        let mut rd = csv::ReaderBuilder::new().has_headers(true).from_reader(text.as_bytes());
+        let header: Vec<String> = rd.headers().map_err(|e| anyhow::anyhow!("{name}: malformed CSV header: {e}"))?.iter().map(String::from).collect();
+        let mut rows = Vec::new();
+        for rec in rd.records() {
+            let rec = rec.map_err(|e| {
+                let line = e.position().map(|p| p.line()).unwrap_or(0);
+                anyhow::anyhow!("{name}: line {line}: malformed CSV: {e}")
+            })?;
+            rows.push(rec.iter().map(String::from).collect());
+        }
+        Ok(Table { header, rows })
+    }
+}
+
+/// Compare one table (pure).
+pub fn compare_table(name: &str, base: &Table, cur: &Table, opts: &DriftOptions, report: &mut DriftReport) {
+    report.tables += 1;
+    let timing_table = opts.config.timing_tables.iter().any(|g| glob(g, name));
+    for c in &base.header {
+        if !cur.header.contains(c) {
+            report.findings.push(Finding::MissingColumn { table: name.into(), column: c.clone() });
+        }
+    }
+    for c in &cur.header {
+        if !base.header.contains(c) {
+            report.findings.push(Finding::ExtraColumn { table: name.into(), column: c.clone() });
+        }
+    }
+    if base.rows.len() != cur.rows.len() {
+        report.findings.push(Finding::RowCount { table: name.into(), baseline: base.rows.len(), current: cur.rows.len() });
+    }
+    let cols: Vec<(usize, usize, &String)> = base.header.iter().enumerate().filter_map(|(i, c)| cur.header.iter().position(|d| d == c).map(|j| (i, j, c))).collect();
+    let is_key = |c: &str, v: &str| IDENTITY.contains(&c) || (!v.is_empty() && v.parse::<f64>().is_err());
+    for (r, (b, c)) in base.rows.iter().zip(&cur.rows).enumerate() {
+        let key_cols: Vec<(usize, usize)> = cols.iter().filter(|(i, _, name)| is_key(name, b.get(*i).map(String::as_str).unwrap_or(""))).map(|(i, j, _)| (*i, *j)).collect();
+        let kb = key_cols.iter().map(|(i, _)| b.get(*i).cloned().unwrap_or_default()).collect::<Vec<_>>().join("/");
+        let kc = key_cols.iter().map(|(_, j)| c.get(*j).cloned().unwrap_or_default()).collect::<Vec<_>>().join("/");
+        if kb != kc {
+            report.findings.push(Finding::RowKey { table: name.into(), row: r + 1, baseline: kb, current: kc });
+            continue;
+        }
+        let key = if kb.is_empty() { format!("row {}", r + 1) } else { kb };
+        let timing_row = opts.config.timing_rows.iter().any(|t| b.iter().any(|v| v.contains(t.as_str())));
+        for &(i, j, col) in &cols {
+            let (vb, vc) = (b.get(i).map(String::as_str).unwrap_or(""), c.get(j).map(String::as_str).unwrap_or(""));
+            report.cells += 1;
+            if vb == vc {
+                continue;
+            }
+            let judged = !(timing_table || timing_row || is_timing_column(col));
+            match (vb.parse::<f64>(), vc.parse::<f64>()) {
+                (Ok(x), Ok(y)) => {
+                    if judged && opts.tolerance(col).equal(x, y) {
+                        continue;
+                    }
+                    let abs = (x - y).abs();
+                    let rel = abs / x.abs().max(y.abs()).max(f64::MIN_POSITIVE);
+                    report.findings.push(Finding::Cell { table: name.into(), row: key.clone(), column: col.clone(), baseline: vb.into(), current: vc.into(), abs, rel, judged });
+                }
+                _ => report.findings.push(Finding::Cell { table: name.into(), row: key.clone(), column: col.clone(), baseline: vb.into(), current: vc.into(), abs: f64::NAN, rel: f64::INFINITY, judged }),
+            }
+        }
+    }
+}
+
+/// The tables of a folder: relative paths of its CSVs outside `png/`, `ioh/` and `maps/`.
+pub fn tables(dir: &Path) -> Result<Vec<PathBuf>> {
+    fn walk(root: &Path, dir: &Path, out: &mut Vec<PathBuf>) -> Result<()> {
+        for e in std::fs::read_dir(dir).with_context(|| format!("cannot read folder {}", dir.display()))? {
+            let p = e.with_context(|| format!("cannot read folder {}", dir.display()))?.path();
+            let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("");
+            if p.is_dir() {
+                if !["png", "ioh", "maps"].contains(&name) {
+                    walk(root, &p, out)?;
+                }
+            } else if name.ends_with(".csv") && name != "drift.csv" {
+                out.push(p.strip_prefix(root).expect("under root").to_path_buf());
+            }
+        }
+        Ok(())
+    }
+    if !dir.is_dir() {
+        bail!("{} is not a folder", dir.display());
+    }
+    let mut out = Vec::new();
+    walk(dir, dir, &mut out)?;
+    out.sort();
+    Ok(out)
+}
+
+/// The run identity of every `manifest.toml` under a folder, by relative folder.
+fn identities(dir: &Path) -> Result<BTreeMap<PathBuf, (String, String, String)>> {
+    #[derive(Deserialize)]
+    struct Id {
+        spec_sha256: String,
+        profile: String,
+        master_seed: u64,
+    }
+    let mut out = BTreeMap::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        let m = d.join("manifest.toml");
+        if m.exists() {
+            let text = std::fs::read_to_string(&m).with_context(|| format!("cannot read {}", m.display()))?;
+            let id: Id = toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {}", m.display(), e.message()))?;
+            out.insert(d.strip_prefix(dir).expect("under root").to_path_buf(), (id.spec_sha256, id.profile, id.master_seed.to_string()));
+        }
+        for e in std::fs::read_dir(&d).with_context(|| format!("cannot read folder {}", d.display()))?.flatten() {
+            if e.path().is_dir() {
+                stack.push(e.path());
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// Read `drift.toml` of a baseline folder (absent: defaults).
+pub fn read_config(baseline: &Path) -> Result<DriftConfig> {
+    let p = baseline.join("drift.toml");
+    if !p.exists() {
+        return Ok(DriftConfig::default());
+    }
+    let text = std::fs::read_to_string(&p).with_context(|| format!("cannot read {}", p.display()))?;
+    toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {}", p.display(), e.message().trim()))
+}
+
+/// Compare two folders. `allow_spec_change`: runs of other specs are compared anyway.
+pub fn compare_dirs(baseline: &Path, current: &Path, opts: &DriftOptions, allow_spec_change: bool) -> Result<DriftReport> {
+    let (tb, tc) = (tables(baseline)?, tables(current)?);
+    if tb.is_empty() {
+        bail!("{} holds no tables (*.csv): not a baseline", baseline.display());
+    }
+    if !allow_spec_change {
+        let (ib, ic) = (identities(baseline)?, identities(current)?);
+        for (dir, (sb, pb, mb)) in &ib {
+            if let Some((sc, pc, mc)) = ic.get(dir) {
+                let what = if mb != mc {
+                    Some(format!("master seed {mb} vs {mc}"))
+                } else if pb != pc {
+                    Some(format!("profile {pb} vs {pc}"))
+                } else if sb != sc {
+                    Some(format!("spec sha256 {} vs {}", &sb[..12.min(sb.len())], &sc[..12.min(sc.len())]))
+                } else {
+                    None
+                };
+                if let Some(w) = what {
+                    bail!("{}: the baseline and the current run differ in their spec ({w}): drift is expected; compare with --allow-spec-change", if dir.as_os_str().is_empty() { ".".to_string() } else { dir.display().to_string() });
+                }
+            }
+        }
+    }
+    let mut report = DriftReport::default();
+    for t in &tb {
+        let name = t.to_string_lossy().to_string();
+        if !tc.contains(t) {
+            report.findings.push(Finding::MissingTable { table: name });
+            continue;
+        }
+        let read = |root: &Path| -> Result<Table> {
+            let p = root.join(t);
+            let text = std::fs::read_to_string(&p).with_context(|| format!("cannot read {}", p.display()))?;
+            Table::parse(&p.display().to_string(), &text)
+        };
+        compare_table(&name, &read(baseline)?, &read(current)?, opts, &mut report);
+    }
+    for t in tc.iter().filter(|t| !tb.contains(t)) {
+        report.findings.push(Finding::ExtraTable { table: t.to_string_lossy().to_string() });
+    }
+    Ok(report)
+}
+
+/// Make `baseline` hold the current tables (and manifests): each file written atomically; tables
+/// the current folder lacks are removed. Returns one line per file changed.
+pub fn accept(baseline: &Path, current: &Path) -> Result<Vec<String>> {
+    let tc = tables(current)?;
+    if tc.is_empty() {
+        bail!("{} holds no tables (*.csv)", current.display());
+    }
+    let tb = if baseline.is_dir() { tables(baseline)? } else { Vec::new() };
+    let mut said = Vec::new();
+    let mut files: Vec<PathBuf> = tc.clone();
+    files.extend(identities(current)?.keys().map(|d| d.join("manifest.toml")));
+    for f in &files {
+        let text = std::fs::read(current.join(f)).with_context(|| format!("cannot read {}", current.join(f).display()))?;
+        let target = baseline.join(f);
+        let old = std::fs::read(&target).ok();
+        if old.as_deref() != Some(&text[..]) {
+            write_atomic(&target, &text)?;
+            said.push(format!("{} {}", if old.is_some() { "replaced" } else { "added" }, f.display()));
+        }
+    }
+    for f in tb.iter().filter(|f| !tc.contains(f)) {
+        std::fs::remove_file(baseline.join(f)).with_context(|| format!("cannot remove {}", baseline.join(f).display()))?;
+        said.push(format!("removed {}", f.display()));
+    }
+    Ok(said)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn t(text: &str) -> Table {
+        Table::parse("t.csv", text).unwrap()
+    }
+
+    fn cmp(a: &str, b: &str, opts: &DriftOptions) -> DriftReport {
+        let mut r = DriftReport::default();
+        compare_table("t.csv", &t(a), &t(b), opts, &mut r);
+        r
+    }
+
+    const BASE: &str = "data,cn_x,err,cpu_s\ncube,6,1.5,0.01\ncube,8,1.25,0.02\n";
+
+    #[test]
+    fn identical_tables_do_not_drift() {
+        let r = cmp(BASE, BASE, &DriftOptions::default());
+        assert!(!r.drifted() && r.findings.is_empty());
+        assert_eq!((r.tables, r.cells), (1, 8));
+    }
+
+    #[test]
+    fn a_moved_number_is_named_and_small_noise_is_not() {
+        let moved = BASE.replace("1.25,", "1.2500001,");
+        let r = cmp(BASE, &moved, &DriftOptions::default());
+        assert!(r.drifted());
+        assert_eq!(r.findings.len(), 1);
+        let Finding::Cell { row, column, baseline, current, .. } = &r.findings[0] else { panic!() };
+        assert_eq!((row.as_str(), column.as_str(), baseline.as_str(), current.as_str()), ("cube/8", "err", "1.25", "1.2500001"));
+        assert!(r.summary(5).contains("t.csv:cube/8:err 1.25 -> 1.2500001"));
+        let tiny = BASE.replace("1.25,", "1.25000000000001,");
+        assert!(!cmp(BASE, &tiny, &DriftOptions::default()).drifted());
+        let loose = DriftOptions { columns: vec![("e*".into(), Tolerance { abs: 1e-3, rel: 0.0 })], ..DriftOptions::default() };
+        assert!(!cmp(BASE, &moved, &loose).drifted());
+    }
+
+    #[test]
+    fn timing_is_reported_not_judged() {
+        let slower = BASE.replace("0.02", "0.5");
+        let r = cmp(BASE, &slower, &DriftOptions::default());
+        assert!(!r.drifted());
+        assert!(matches!(&r.findings[0], Finding::Cell { judged: false, .. }));
+        assert!(r.summary(5).contains("1 timing cells differ"));
+        // A table declared timing-dependent.
+        let opts = DriftOptions { config: DriftConfig { timing_tables: vec!["t.*".into()], ..DriftConfig::default() }, ..DriftOptions::default() };
+        assert!(!cmp(BASE, &BASE.replace("1.25,", "9,"), &opts).drifted());
+        let rows = DriftOptions { config: DriftConfig { timing_rows: vec!["cube".into()], ..DriftConfig::default() }, ..DriftOptions::default() };
+        assert!(!cmp(BASE, &BASE.replace("1.25,", "9,"), &rows).drifted());
+    }
+
+    #[test]
+    fn missing_columns_rows_and_moved_keys_drift() {
+        let r = cmp(BASE, "data,cn_x,cpu_s\ncube,6,0.01\n", &DriftOptions::default());
+        assert!(r.findings.iter().any(|f| matches!(f, Finding::MissingColumn { column, .. } if column == "err")));
+        assert!(r.findings.iter().any(|f| matches!(f, Finding::RowCount { baseline: 2, current: 1, .. })));
+        let r = cmp(BASE, &BASE.replace("cube,8", "cube,10"), &DriftOptions::default());
+        assert!(matches!(&r.findings[0], Finding::RowKey { row: 2, .. }), "{:?}", r.findings);
+        let r = cmp(BASE, "data,cn_x,err,cpu_s,new\ncube,6,1.5,0.01,1\ncube,8,1.25,0.02,2\n", &DriftOptions::default());
+        assert!(!r.drifted(), "a new column is noted, not drift");
+    }
+
+    #[test]
+    fn malformed_csv_names_file_and_line() {
+        let e = Table::parse("x/appendix_k.csv", "a,b\n1,2\n3\n").unwrap_err().to_string();
+        assert!(e.contains("x/appendix_k.csv: line 3"), "{e}");
+    }
+
+    #[test]
+    fn tolerances_and_globs_parse() {
+        assert_eq!(parse_tol("err=1e-6").unwrap(), ("err".into(), Tolerance { abs: 1e-6, rel: 0.0 }));
+        assert_eq!(parse_tol("*_avg=0,1e-3").unwrap().1, Tolerance { abs: 0.0, rel: 1e-3 });
+        assert!(parse_tol("err").is_err() && parse_tol("err=-1").is_err() && parse_tol("err=x").is_err());
+        assert!(glob("*_avg", "de_avg") && glob("ch6*/table_6_6.csv", "ch6_same/table_6_6.csv") && !glob("a*b", "ac") && glob("x", "x"));
+        assert!(Tolerance::default().equal(f64::NAN, f64::NAN) && !Tolerance::default().equal(1.0, f64::NAN));
+    }
+}
