@@ -8,6 +8,7 @@ pub mod export;
 pub mod fit;
 pub mod knots;
 pub mod param;
+pub mod rational_bezier;
 pub mod surface;
 
 pub use approach::{fit_two_view, Approach, ControlNetParts, TwoSurfaceFit, TwoViewGrid};
