@@ -7,6 +7,7 @@ pub mod compare;
 pub mod datasets;
 pub mod fit_cmd;
 pub mod runner;
+pub mod seed002;
 pub mod seeds;
 pub mod spec;
 
@@ -105,6 +106,10 @@ pub fn run_spec(spec: &Spec, ctx: &RunContext) -> Result<PathBuf> {
     let (section, cpu, cells) = if spec.file.som.is_some() {
         let runs = ch4::run(spec, ctx)?;
         let section = crate::report::ch4::write(spec, &runs, &ctx.out)?;
+        (section, runs.iter().map(|r| r.row.cpu_s).sum::<f64>(), runs.len())
+    } else if let Some(s2) = &spec.file.seed002 {
+        let runs = seed002::run(spec, ctx)?;
+        let section = crate::report::seed002::write(&runs, s2.population, &ctx.out)?;
         (section, runs.iter().map(|r| r.row.cpu_s).sum::<f64>(), runs.len())
     } else if spec.file.optim.is_some() {
         let problems = ch6::problems(spec, ctx)?;

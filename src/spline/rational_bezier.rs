@@ -190,6 +190,77 @@ impl GridData {
     }
 }
 
+/// The four test surfaces of SPEC 7 on the domains we chose (the paper gives none): data are the
+/// exact function values (no noise) on a uniform n x n grid of the domain.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum TestSurface {
+    /// f = sin(x) cos(y) + 0.91 on [0, pi]^2 (paper's Surface 1 of Chapter 4).
+    Surface1,
+    /// f = (1 + 2 exp(-3 (sqrt(x^2+y^2) - 6.7)))^-0.5 on [-10, 10]^2 (Surface 2 of Chapter 4).
+    Surface2,
+    /// f = 24.234 r2 (0.75 - r2), r2 = (x-0.5)^2 + (y-0.5)^2 on [0, 1]^2 (Surface 1 of Chapter 5).
+    Surface3,
+    /// f = 2 (x^2 + y^2) on [-1, 1]^2 (Surface 2 of Chapter 5).
+    Surface4,
+}
+
+impl TestSurface {
+    pub const ALL: [TestSurface; 4] = [TestSurface::Surface1, TestSurface::Surface2, TestSurface::Surface3, TestSurface::Surface4];
+
+    pub fn by_name(name: &str) -> Option<TestSurface> {
+        TestSurface::ALL.into_iter().find(|s| s.name() == name)
+    }
+    pub fn name(self) -> &'static str {
+        match self {
+            TestSurface::Surface1 => "surface1",
+            TestSurface::Surface2 => "surface2",
+            TestSurface::Surface3 => "surface3",
+            TestSurface::Surface4 => "surface4",
+        }
+    }
+    pub fn formula(self) -> &'static str {
+        match self {
+            TestSurface::Surface1 => "sin(x)cos(y)+0.91 on [0,pi]^2",
+            TestSurface::Surface2 => "(1+2exp(-3(sqrt(x^2+y^2)-6.7)))^-0.5 on [-10,10]^2",
+            TestSurface::Surface3 => "24.234 r2(0.75-r2), r2=(x-.5)^2+(y-.5)^2 on [0,1]^2",
+            TestSurface::Surface4 => "2(x^2+y^2) on [-1,1]^2",
+        }
+    }
+    /// (lower, upper) of the square domain.
+    pub fn domain(self) -> (f64, f64) {
+        match self {
+            TestSurface::Surface1 => (0.0, std::f64::consts::PI),
+            TestSurface::Surface2 => (-10.0, 10.0),
+            TestSurface::Surface3 => (0.0, 1.0),
+            TestSurface::Surface4 => (-1.0, 1.0),
+        }
+    }
+    pub fn eval(self, x: f64, y: f64) -> f64 {
+        match self {
+            TestSurface::Surface1 => x.sin() * y.cos() + 0.91,
+            TestSurface::Surface2 => (1.0 + 2.0 * (-3.0 * ((x * x + y * y).sqrt() - 6.7)).exp()).powf(-0.5),
+            TestSurface::Surface3 => {
+                let r2 = (x - 0.5).powi(2) + (y - 0.5).powi(2);
+                24.234 * r2 * (0.75 - r2)
+            }
+            TestSurface::Surface4 => 2.0 * (x * x + y * y),
+        }
+    }
+    /// n x n samples; grid index i runs along x, j along y.
+    pub fn grid(self, n: usize) -> GridData {
+        let (lo, hi) = self.domain();
+        let m = (n - 1) as f64;
+        let points = (0..n * n)
+            .map(|k| {
+                let x = lo + (hi - lo) * (k / n) as f64 / m;
+                let y = lo + (hi - lo) * (k % n) as f64 / m;
+                [x, y, self.eval(x, y)]
+            })
+            .collect();
+        GridData { n, points }
+    }
+}
+
 /// Sum of squared errors between the data grid and the four-patch surface at the same
 /// parameters; variables: the 7 free points and w11 (22 numbers).
 pub struct SurfaceSse {

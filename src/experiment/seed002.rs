@@ -1,0 +1,132 @@
+//! Seed 002 wiring (Yahya): each (surface, optimiser, repeat) fits the four-patch G1 rational
+//! bi-quadratic Bezier surface to the surface's grid by minimising the sum of squared errors over
+//! the seven free control points and w11, on its own stream, logged at once.
+
+use super::spec::{Seed002Spec, Spec};
+use super::{runner, seeds, RunContext};
+use crate::optim::{Budget, Optimiser, Problem, RunResult};
+use crate::spline::rational_bezier::{SurfaceSse, TestSurface};
+use anyhow::{Context, Result};
+use serde::{Deserialize, Serialize};
+
+/// One (surface, optimiser, repeat).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Cell {
+    pub surface: String,
+    pub optimiser: String,
+    pub repeat: usize,
+}
+
+impl Cell {
+    pub fn key(&self) -> String {
+        format!("seed002/{}/{}/r{}", self.surface, self.optimiser, self.repeat)
+    }
+}
+
+/// One row of runs.csv.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Row {
+    pub cell: String,
+    pub surface: String,
+    pub optimiser: String,
+    pub repeat: usize,
+    pub seed: String,
+    pub dimension: usize,
+    pub n_points: usize,
+    /// SSE of the start (free points on the data, w11 = 1).
+    pub start_sse: f64,
+    pub initial_best: f64,
+    /// Best sum of squared errors found.
+    pub best_sse: f64,
+    /// sqrt(best_sse / n_points).
+    pub rmse: f64,
+    pub w11: f64,
+    pub evaluations: u64,
+    pub cpu_s: f64,
+}
+
+/// One run with its convergence trace.
+#[derive(Debug, Clone)]
+pub struct Run {
+    pub cell: Cell,
+    pub row: Row,
+    pub trace: Vec<(u64, f64)>,
+    pub best_x: Vec<f64>,
+}
+
+fn section(spec: &Spec) -> Result<&Seed002Spec> {
+    spec.file.seed002.as_ref().context("spec has no [seed002] section")
+}
+
+/// The flat list of cells.
+pub fn cells(spec: &Spec) -> Vec<Cell> {
+    let Some(s) = &spec.file.seed002 else { return Vec::new() };
+    let mut out = Vec::new();
+    for surface in &s.surfaces {
+        for opt in &s.optimisers {
+            for repeat in 0..s.repeats {
+                out.push(Cell { surface: surface.clone(), optimiser: opt.clone(), repeat });
+            }
+        }
+    }
+    out
+}
+
+/// The SSE problem of a surface with the spec's grid and box.
+pub fn problem(s: &Seed002Spec, surface: &str) -> Result<SurfaceSse> {
+    let ts = TestSurface::by_name(surface).with_context(|| format!("seed002.surfaces: unknown surface `{surface}`"))?;
+    Ok(SurfaceSse::new(ts.grid(s.grid), s.bounds_margin, s.w_min))
+}
+
+fn optimiser(s: &Seed002Spec, name: &str) -> Result<Box<dyn Optimiser>> {
+    Ok(match name {
+        "ga" => Box::new(s.ga.clone()),
+        "de" => Box::new(s.de.clone()),
+        "pso" => Box::new(s.pso.clone()),
+        other => anyhow::bail!("seed002.optimisers: unknown optimiser `{other}`"),
+    })
+}
+
+/// Run one cell (alone it gives the same numbers as inside the full run).
+pub fn run_cell(spec: &Spec, cell: &Cell) -> Result<Run> {
+    let s = section(spec)?;
+    let problem = problem(s, &cell.surface)?;
+    let opt = optimiser(s, &cell.optimiser)?;
+    // init_range is a share of the data's largest bounding-box extent (the domains differ in scale).
+    let extent = (0..3)
+        .map(|k| {
+            let (lo, hi) = problem.data.points.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| (a.min(p[k]), b.max(p[k])));
+            hi - lo
+        })
+        .fold(0.0, f64::max);
+    let budget = Budget { generations: s.generations as u64, population: s.population, init_range: s.init_range * extent, trace_every_evals: s.trace_every_evals };
+    let key = cell.key();
+    let mut rng = seeds::cell_rng(spec.file.master_seed, &key);
+    let t0 = runner::thread_cpu_seconds();
+    let r: RunResult = opt.run(&problem, &budget, &mut rng).map_err(|e| anyhow::anyhow!("{key}: {e}"))?;
+    let cpu_s = runner::thread_cpu_seconds() - t0;
+    let n = problem.n_points();
+    let row = Row {
+        cell: key.clone(),
+        surface: cell.surface.clone(),
+        optimiser: cell.optimiser.clone(),
+        repeat: cell.repeat,
+        seed: seeds::seed_hex(spec.file.master_seed, &key),
+        dimension: problem.dim(),
+        n_points: n,
+        start_sse: problem.fitness(problem.initial_point()),
+        initial_best: r.initial_best_fitness,
+        best_sse: r.best_fitness,
+        rmse: (r.best_fitness / n as f64).sqrt(),
+        w11: r.best_x[21],
+        evaluations: r.evaluations,
+        cpu_s,
+    };
+    Ok(Run { cell: cell.clone(), row, trace: r.trace, best_x: r.best_x })
+}
+
+/// Run every cell of the spec.
+pub fn run(spec: &Spec, ctx: &RunContext) -> Result<Vec<Run>> {
+    let cells = cells(spec);
+    runner::run_logged(&cells, ctx, &spec.file.name, |cell| run_cell(spec, cell), |run: &Run| &run.row)
+}
