@@ -30,6 +30,17 @@ fn median(mut v: Vec<f64>) -> f64 {
 
 /// Write runs.csv-derived tables and charts; return the REPORT.md section.
 pub fn write(runs: &[Run], population: usize, out: &Path) -> Result<String> {
+    let rows: Vec<_> = runs.iter().map(|r| r.row.clone()).collect();
+    super::fsio::write_atomic(&out.join("runs.csv"), super::fsio::csv_text(&rows)?.as_bytes())?;
+    // Error versus iteration, every trace point of every run.
+    let trace_header: Vec<String> = ["cell", "surface", "optimiser", "repeat", "evaluations", "iteration", "best_sse"].iter().map(|h| h.to_string()).collect();
+    let mut trace_rows = Vec::new();
+    for r in runs {
+        for &(e, f) in &r.trace {
+            trace_rows.push(vec![r.row.cell.clone(), r.row.surface.clone(), r.row.optimiser.clone(), r.row.repeat.to_string(), e.to_string(), format!("{}", e as f64 / population as f64), format!("{f:e}")]);
+        }
+    }
+    super::fsio::write_atomic(&out.join("seed002_traces.csv"), super::fsio::csv_records(&trace_header, &trace_rows)?.as_bytes())?;
     let surfaces = super::ordered(runs.iter().map(|r| r.row.surface.clone()));
     let optimisers = super::ordered(runs.iter().map(|r| r.row.optimiser.clone()));
     let mut s = String::new();
