@@ -65,6 +65,25 @@ fn seed002_quick_profile_writes_consistent_tables() {
             assert!(pair[1][v].parse::<f64>().unwrap() <= pair[0][v].parse::<f64>().unwrap());
         }
     }
+    // Curves: SAM06 finds every generated corner; conics = 2 per corner; best <= mean.
+    let (h, rows) = read_csv(&out.join("seed002_curve_runs.csv"));
+    assert_eq!(rows.len(), 3 * 3 * 2);
+    let (t, f, m, c, sse) = (col(&h, "true_corners"), col(&h, "corners_found"), col(&h, "corners_matched"), col(&h, "conics"), col(&h, "sse"));
+    for r in &rows {
+        assert_eq!(r[t], r[f], "{r:?}");
+        assert_eq!(r[t], r[m], "{r:?}");
+        assert_eq!(r[c].parse::<usize>().unwrap(), 2 * r[t].parse::<usize>().unwrap());
+        assert!(r[sse].parse::<f64>().unwrap() >= 0.0);
+    }
+    let (h, rows) = read_csv(&out.join("seed002_curves.csv"));
+    assert_eq!(rows.len(), 9);
+    let (b, mn) = (col(&h, "best_sse"), col(&h, "mean_sse"));
+    for r in &rows {
+        assert!(r[b].parse::<f64>().unwrap() <= r[mn].parse::<f64>().unwrap() * (1.0 + 1e-12), "{r:?}");
+    }
+    for f in ["png/seed002_outline_square.png", "png/seed002_outline_letter_d.png", "png/seed002_outline_letter_p.png"] {
+        assert!(out.join(f).is_file(), "{f} missing");
+    }
     // Same seeds, one thread: identical runs (timing aside).
     let out1 = dir.path().join("res1");
     let o = run(&out1, &["-j", "1"]);
@@ -78,6 +97,7 @@ fn seed002_quick_profile_writes_consistent_tables() {
         }).collect::<Vec<_>>()
     };
     assert_eq!(strip(&out.join("runs.csv")), strip(&out1.join("runs.csv")));
+    assert_eq!(strip(&out.join("seed002_curve_runs.csv")), strip(&out1.join("seed002_curve_runs.csv")));
 }
 
 #[test]

@@ -109,8 +109,9 @@ pub fn run_spec(spec: &Spec, ctx: &RunContext) -> Result<PathBuf> {
         (section, runs.iter().map(|r| r.row.cpu_s).sum::<f64>(), runs.len())
     } else if let Some(s2) = &spec.file.seed002 {
         let runs = seed002::run(spec, ctx)?;
-        let section = crate::report::seed002::write(&runs, s2.population, &ctx.out)?;
-        (section, runs.iter().map(|r| r.row.cpu_s).sum::<f64>(), runs.len())
+        let curves = seed002::run_curves(spec, ctx)?;
+        let section = crate::report::seed002::write(&runs, &curves, s2.population, &ctx.out)?;
+        (section, runs.iter().map(|r| r.row.cpu_s).chain(curves.iter().map(|c| c.row.cpu_s)).sum::<f64>(), runs.len() + curves.len())
     } else if spec.file.optim.is_some() {
         let problems = ch6::problems(spec, ctx)?;
         let exact = ch6::exact_optima(spec, ctx, &problems)?;

@@ -100,6 +100,21 @@ fn default_s2_w_min() -> f64 {
 fn default_s2_trace() -> u64 {
     400
 }
+fn default_s2_outlines() -> Vec<String> {
+    crate::spline::conic::OUTLINES.iter().map(|s| s.to_string()).collect()
+}
+fn default_one() -> f64 {
+    1.0
+}
+fn default_s2_l() -> usize {
+    14
+}
+fn default_s2_d() -> f64 {
+    2.6
+}
+fn default_s2_curve_generations() -> usize {
+    200
+}
 
 /// Seed 002 section: surfaces x optimisers x repeats. The paper's settings tables did not survive
 /// in the seed text, so the defaults are stated choices (see experiments/seed002_rational.toml).
@@ -134,6 +149,24 @@ pub struct Seed002Spec {
     pub w_min: f64,
     #[serde(default = "default_s2_trace")]
     pub trace_every_evals: u64,
+    /// Generated 2-D outlines for the conic curve fits (square, letter_d, letter_p); empty: none.
+    #[serde(default = "default_s2_outlines")]
+    pub outlines: Vec<String>,
+    /// Arc-length spacing of the outline samples (one point per unit, pixel-like).
+    #[serde(default = "default_one")]
+    pub outline_spacing: f64,
+    /// SAM06 length parameter L (default 14).
+    #[serde(default = "default_s2_l")]
+    pub sam06_l: usize,
+    /// SAM06 distance threshold D (default 2.6).
+    #[serde(default = "default_s2_d")]
+    pub sam06_d: f64,
+    /// SAM06 domination range R (default L).
+    #[serde(default)]
+    pub sam06_r: Option<usize>,
+    /// Iterations of each conic fit (the paper's curve charts show 100 and 200).
+    #[serde(default = "default_s2_curve_generations")]
+    pub curve_generations: usize,
     #[serde(default)]
     pub ga: crate::optim::ga::Ga,
     #[serde(default)]
@@ -562,6 +595,23 @@ impl Spec {
         }
         if s.trace_every_evals == 0 {
             return Err(self.err("seed002.trace_every_evals", "must be at least 1"));
+        }
+        for name in &s.outlines {
+            if crate::spline::conic::outline(name).is_none() {
+                return Err(self.err("seed002.outlines", format!("unknown outline `{name}` (expected square, letter_d or letter_p)")));
+            }
+        }
+        if !(s.outline_spacing > 0.0 && s.outline_spacing <= 10.0) {
+            return Err(self.err("seed002.outline_spacing", format!("must be in (0, 10], got {}", s.outline_spacing)));
+        }
+        if s.sam06_l < 2 {
+            return Err(self.err("seed002.sam06_l", format!("must be at least 2, got {}", s.sam06_l)));
+        }
+        if !(s.sam06_d > 0.0 && s.sam06_d.is_finite()) {
+            return Err(self.err("seed002.sam06_d", format!("must be a positive number, got {}", s.sam06_d)));
+        }
+        if s.curve_generations == 0 {
+            return Err(self.err("seed002.curve_generations", "must be at least 1"));
         }
         let optim_err = |e: crate::optim::OptimError| match e {
             crate::optim::OptimError::InvalidParameter { key, message } => self.err(&format!("seed002.{key}"), message),

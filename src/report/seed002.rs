@@ -5,7 +5,8 @@
 //! so no reference column can be typed in; the section says so.
 
 use super::plots::{self, style, Series};
-use crate::experiment::seed002::Run;
+use crate::experiment::seed002::{CurveRun, Run};
+use crate::spline::rational_bezier::conic_point;
 use crate::spline::rational_bezier::TestSurface;
 use anyhow::Result;
 use std::fmt::Write;
@@ -29,7 +30,7 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 /// Write runs.csv-derived tables and charts; return the REPORT.md section.
-pub fn write(runs: &[Run], population: usize, out: &Path) -> Result<String> {
+pub fn write(runs: &[Run], curves: &[CurveRun], population: usize, out: &Path) -> Result<String> {
     let rows: Vec<_> = runs.iter().map(|r| r.row.clone()).collect();
     super::fsio::write_atomic(&out.join("runs.csv"), super::fsio::csv_text(&rows)?.as_bytes())?;
     // Error versus iteration, every trace point of every run.
@@ -108,5 +109,56 @@ pub fn write(runs: &[Run], population: usize, out: &Path) -> Result<String> {
             let _ = writeln!(s, "\n![{png}]({png})");
         }
     }
+    write_curves(curves, out, &mut s)?;
     Ok(s)
+}
+
+/// The conic curve part: runs CSV, table per (outline, optimiser), and one picture per outline
+/// (the outline, the detected corners and the conics of the lowest-SSE run).
+fn write_curves(curves: &[CurveRun], out: &Path, s: &mut String) -> Result<()> {
+    if curves.is_empty() {
+        return Ok(());
+    }
+    let rows: Vec<_> = curves.iter().map(|c| c.row.clone()).collect();
+    super::fsio::write_atomic(&out.join("seed002_curve_runs.csv"), super::fsio::csv_text(&rows)?.as_bytes())?;
+    let outlines = super::ordered(curves.iter().map(|c| c.row.outline.clone()));
+    let optimisers = super::ordered(curves.iter().map(|c| c.row.optimiser.clone()));
+    let _ = writeln!(s, "\n### Conic curve fitting on generated outlines\n");
+    let _ = writeln!(s, "The paper's outlines are scanned images (R, beta, S, Kanji, face); here they are generated from lines and circular arcs (square 60x60; letter D: stem 80, bars 20, half circle r = 40; letter P: stem 100, foot 20, bowl half circle r = 25 on bars of 15), sampled at one point per unit of arc length. Corners: SAM06 (L, D, R from the spec); between consecutive corners the outline is split at its middle data point and each half is one rational quadratic (conic) with its ends on the data, b1 and w optimised, SSE at chord-length parameters.\n");
+    let _ = writeln!(s, "| outline | optimiser | runs | points | true corners | found | matched | conics | start SSE | best SSE | mean SSE | mean CPU s |");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let header: Vec<String> = ["outline", "optimiser", "runs", "points", "true_corners", "corners_found", "corners_matched", "conics", "start_sse", "best_sse", "mean_sse", "mean_cpu_s"].iter().map(|h| h.to_string()).collect();
+    let mut table = Vec::new();
+    for ol in &outlines {
+        for o in &optimisers {
+            let sel: Vec<&CurveRun> = curves.iter().filter(|c| &c.row.outline == ol && &c.row.optimiser == o).collect();
+            if sel.is_empty() {
+                continue;
+            }
+            let r0 = &sel[0].row;
+            let sse: Vec<f64> = sel.iter().map(|c| c.row.sse).collect();
+            let best = sse.iter().cloned().fold(f64::INFINITY, f64::min);
+            let (m, _) = mean_std(&sse);
+            let (cpu, _) = mean_std(&sel.iter().map(|c| c.row.cpu_s).collect::<Vec<_>>());
+            table.push(vec![ol.clone(), o.clone(), sel.len().to_string(), r0.n_points.to_string(), r0.true_corners.to_string(), r0.corners_found.to_string(), r0.corners_matched.to_string(), r0.conics.to_string(), format!("{:e}", r0.start_sse), format!("{best:e}"), format!("{m:e}"), format!("{cpu}")]);
+            let _ = writeln!(s, "| {ol} | {o} | {} | {} | {} | {} | {} | {} | {:.4e} | {best:.4e} | {m:.4e} | {cpu:.4} |", sel.len(), r0.n_points, r0.true_corners, r0.corners_found, r0.corners_matched, r0.conics, r0.start_sse);
+        }
+    }
+    super::fsio::write_atomic(&out.join("seed002_curves.csv"), super::fsio::csv_records(&header, &table)?.as_bytes())?;
+    for ol in &outlines {
+        let Some(best) = curves.iter().filter(|c| &c.row.outline == ol).min_by(|a, b| a.row.sse.total_cmp(&b.row.sse)) else { continue };
+        let mut series = vec![Series { label: "outline (data)".into(), colour: plotters::style::RGBColor(170, 170, 170), points: best.points.iter().chain(best.points.first()).map(|p| (p[0], p[1])).collect(), band: None }];
+        let fitted: Vec<(f64, f64)> = best.conics.iter().flat_map(|(b, w)| (0..=40).map(move |k| conic_point(b, *w, k as f64 / 40.0)).map(|p| (p[0], p[1]))).collect();
+        series.push(Series { label: format!("conics ({}, SSE {:.3e})", best.row.optimiser, best.row.sse), colour: style::cycle_colour(0), points: fitted, band: None });
+        for (k, &i) in best.corners.iter().enumerate() {
+            series.push(Series { label: format!("corner {}", k + 1), colour: plotters::style::RGBColor(200, 0, 0), points: vec![(best.points[i][0], best.points[i][1])], band: None });
+        }
+        let png = format!("png/seed002_outline_{ol}.png");
+        if let Err(e) = plots::line_chart_png(&out.join(&png), &format!("{ol}: SAM06 corners and fitted conics (best run)"), "x", "y", &series, false) {
+            eprintln!("somnurbs: warning: picture skipped: {e}");
+        } else {
+            let _ = writeln!(s, "\n![{png}]({png})");
+        }
+    }
+    Ok(())
 }
