@@ -581,7 +581,7 @@ impl Spec {
         if s.population < 4 {
             return Err(self.err("seed002.population", format!("must be at least 4 (DE/rand/1 needs four), got {}", s.population)));
         }
-        if s.grid < 5 || s.grid % 2 == 0 {
+        if s.grid < 5 || s.grid.is_multiple_of(2) {
             return Err(self.err("seed002.grid", format!("must be odd and at least 5, got {}", s.grid)));
         }
         if !(s.init_range >= 0.0 && s.init_range.is_finite()) {

@@ -6,6 +6,8 @@
 //! with its end points on the data; the variables are the middle control point b1 and the weight w,
 //! the objective the sum of squared distances at the chord-length parameters. Pure: no I/O.
 
+#![allow(clippy::needless_range_loop)] // index loops over 3x3 nets and coordinates read clearer
+
 use super::rational_bezier::conic_point;
 use crate::optim::Problem;
 

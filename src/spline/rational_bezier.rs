@@ -9,6 +9,8 @@
 //! This is exactly the paper's list of free entries (its section 2.1); the reflection rule is our
 //! reading, the surviving text stops before its section 3.2. Pure: no I/O.
 
+#![allow(clippy::needless_range_loop)] // index loops over 3x3 nets and coordinates read clearer
+
 use crate::optim::Problem;
 
 /// Quadratic Bernstein basis at t.
