@@ -439,6 +439,27 @@ mod tests {
     }
 
     #[test]
+    fn paraboloid_is_recovered_exactly_by_its_free_points() {
+        // f = 2(x^2 + y^2) on [-1,1]^2 is a C1 piecewise quadratic: with knots X_0..X_4 (even =
+        // patch ends, odd = midpoints) its Bezier ordinates are 2(cx_i + cy_j), cx = X_i^2 at even
+        // i and X_{i-1} X_{i+1} at odd i, w11 = 1. Giving only the seven free points, the joins
+        // must rebuild the rest so that the SSE is zero.
+        let n = 9;
+        let prob = SurfaceSse::new(TestSurface::Surface4.grid(n), 0.25, 0.01);
+        let knot = |i: usize| -1.0 + 0.5 * i as f64;
+        let c = |i: usize| if i % 2 == 0 { knot(i) * knot(i) } else { knot(i - 1) * knot(i + 1) };
+        let mut x = Vec::new();
+        for &(i, j) in FREE_ENTRIES.iter() {
+            x.extend_from_slice(&[knot(i), knot(j), 2.0 * (c(i) + c(j))]);
+        }
+        x.push(1.0);
+        assert!(prob.fitness(&x) < 1e-26, "{}", prob.fitness(&x));
+        // A wrong free ordinate is seen.
+        x[2] += 1e-3;
+        assert!(prob.fitness(&x) > 1e-9);
+    }
+
+    #[test]
     fn rational_quadratic_reproduces_circular_arc() {
         // Arc of radius 2 centred at the origin, half-angle theta: b1 on the tangents'
         // intersection, w = cos(theta).
