@@ -34,11 +34,11 @@ pub fn write(runs: &[Run], curves: &[CurveRun], population: usize, out: &Path) -
     let rows: Vec<_> = runs.iter().map(|r| r.row.clone()).collect();
     super::fsio::write_atomic(&out.join("runs.csv"), super::fsio::csv_text(&rows)?.as_bytes())?;
     // Error versus iteration, every trace point of every run.
-    let trace_header: Vec<String> = ["cell", "surface", "optimiser", "repeat", "evaluations", "iteration", "best_sse"].iter().map(|h| h.to_string()).collect();
+    let trace_header: Vec<String> = ["cell", "surface", "optimiser", "repeat", "evaluations", "best_sse"].iter().map(|h| h.to_string()).collect();
     let mut trace_rows = Vec::new();
     for r in runs {
         for &(e, f) in &r.trace {
-            trace_rows.push(vec![r.row.cell.clone(), r.row.surface.clone(), r.row.optimiser.clone(), r.row.repeat.to_string(), e.to_string(), format!("{}", e as f64 / population as f64), format!("{f:e}")]);
+            trace_rows.push(vec![r.row.cell.clone(), r.row.surface.clone(), r.row.optimiser.clone(), r.row.repeat.to_string(), e.to_string(), format!("{f:e}")]);
         }
     }
     super::fsio::write_atomic(&out.join("seed002_traces.csv"), super::fsio::csv_records(&trace_header, &trace_rows)?.as_bytes())?;
@@ -100,11 +100,11 @@ pub fn write(runs: &[Run], curves: &[CurveRun], population: usize, out: &Path) -
                 continue;
             }
             let len = sel.iter().map(|r| r.trace.len()).min().unwrap_or(0);
-            let pts: Vec<(f64, f64)> = (0..len).map(|i| (sel[0].trace[i].0 as f64 / population as f64, median(sel.iter().map(|r| r.trace[i].1).collect()))).collect();
+            let pts: Vec<(f64, f64)> = (0..len).map(|i| (sel[0].trace[i].0 as f64, median(sel.iter().map(|r| r.trace[i].1).collect()))).collect();
             series.push(Series { label: o.clone(), colour: style::optimiser_colour(o).unwrap_or_else(|| style::cycle_colour(k)), points: pts, band: None });
         }
         let png = format!("png/seed002_convergence_{sf}.png");
-        if let Err(e) = plots::line_chart_png(&out.join(&png), &format!("{sf}: best SSE (median over repeats) vs iteration"), "iteration (evaluations / population)", "sum of squared errors", &series, true) {
+        if let Err(e) = plots::line_chart_png(&out.join(&png), &format!("{sf}: best SSE (median over repeats) vs evaluations ({population} per DE/PSO iteration)"), "fitness evaluations", "sum of squared errors", &series, true) {
             eprintln!("somnurbs: warning: picture skipped: {e}");
         } else {
             let _ = writeln!(s, "\n![{png}]({png})");
