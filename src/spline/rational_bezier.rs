@@ -447,7 +447,7 @@ mod tests {
         let n = 9;
         let prob = SurfaceSse::new(TestSurface::Surface4.grid(n), 0.25, 0.01);
         let knot = |i: usize| -1.0 + 0.5 * i as f64;
-        let c = |i: usize| if i % 2 == 0 { knot(i) * knot(i) } else { knot(i - 1) * knot(i + 1) };
+        let c = |i: usize| if i.is_multiple_of(2) { knot(i) * knot(i) } else { knot(i - 1) * knot(i + 1) };
         let mut x = Vec::new();
         for &(i, j) in FREE_ENTRIES.iter() {
             x.extend_from_slice(&[knot(i), knot(j), 2.0 * (c(i) + c(j))]);
