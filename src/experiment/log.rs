@@ -136,7 +136,8 @@ pub struct CellLog {
 }
 
 impl CellLog {
-    /// Open the folder's log: appending to it when resuming, else starting it empty.
+    /// Open the folder's log: appending to it when resuming, else starting it empty. A run
+    /// opens it once, empty or not, and every cell family of the spec appends (`append`).
     pub fn open(dir: &Path, resume: bool) -> Result<CellLog> {
         let path = dir.join(LOG_FILE);
         let file = if resume {
@@ -146,6 +147,11 @@ impl CellLog {
         }
         .with_context(|| format!("cannot open {}", path.display()))?;
         Ok(CellLog { file, path })
+    }
+
+    /// Append to the folder's log (created if missing).
+    pub fn append(dir: &Path) -> Result<CellLog> {
+        CellLog::open(dir, true)
     }
 
     pub fn push<T: Serialize>(&mut self, key: &str, record: &T) -> Result<()> {

@@ -9,6 +9,7 @@ pub mod fit_cmd;
 pub mod log;
 pub mod reproduce;
 pub mod runner;
+pub mod seed002;
 pub mod seeds;
 pub mod spec;
 
@@ -145,6 +146,8 @@ pub fn run_spec(spec: &Spec, ctx: &RunContext) -> Result<PathBuf> {
         std::fs::remove_file(&manifest_path).with_context(|| format!("cannot remove {}", manifest_path.display()))?;
     }
     fp.write(&ctx.out)?;
+    // Start the cell log (kept when resuming); the cell families of the spec append to it.
+    drop(log::CellLog::open(&ctx.out, ctx.resume)?);
     let started = Instant::now();
     let started_unix = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map(|d| d.as_secs()).unwrap_or(0);
     let tables = ctx.shard.is_none();
@@ -153,6 +156,11 @@ pub fn run_spec(spec: &Spec, ctx: &RunContext) -> Result<PathBuf> {
         let runs = ch4::run(spec, ctx)?;
         let section = if tables { Some(crate::report::ch4::write(spec, &runs, &ctx.out)?) } else { None };
         (section, runs.iter().map(|r| r.row.cpu_s).sum::<f64>(), runs.len())
+    } else if let Some(s2) = &spec.file.seed002 {
+        let runs = seed002::run(spec, ctx)?;
+        let curves = seed002::run_curves(spec, ctx)?;
+        let section = if tables { Some(crate::report::seed002::write(&runs, &curves, s2.population, &ctx.out)?) } else { None };
+        (section, runs.iter().map(|r| r.row.cpu_s).chain(curves.iter().map(|c| c.row.cpu_s)).sum::<f64>(), runs.len() + curves.len())
     } else if spec.file.optim.is_some() {
         let problems = ch6::problems(spec, ctx)?;
         let exact = if tables { ch6::exact_optima(spec, ctx, &problems)? } else { BTreeMap::new() };

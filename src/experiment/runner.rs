@@ -63,13 +63,15 @@ where
     C: Cell,
     R: Logged,
 {
-    let mut logged: BTreeMap<String, R::Record> = if ctx.resume { super::log::read_records(&ctx.out)? } else { BTreeMap::new() };
+    // The log may hold other cell families of the same spec: only this family's keys are read.
+    let mut logged: BTreeMap<String, serde_json::Value> = if ctx.resume { super::log::read_records(&ctx.out)? } else { BTreeMap::new() };
     let slice: Vec<&C> = cells.iter().enumerate().filter(|(k, _)| ctx.shard.is_none_or(|s| s.contains(*k))).map(|(_, c)| c).collect();
     let todo: Vec<&C> = slice.iter().copied().filter(|c| !logged.contains_key(&c.key())).collect();
     if ctx.resume && todo.len() < slice.len() {
         eprintln!("somnurbs: resuming {}: {} of {} cells already done", ctx.out.display(), slice.len() - todo.len(), slice.len());
     }
-    let log = std::sync::Mutex::new(super::log::CellLog::open(&ctx.out, ctx.resume)?);
+    // `run_spec` started the log (empty unless resuming); every family appends.
+    let log = std::sync::Mutex::new(super::log::CellLog::append(&ctx.out)?);
     let computed = run_cells(&todo, ctx.jobs, label, |c| work(c), |c, r: &R| log.lock().map_err(|_| anyhow::anyhow!("cell log lock poisoned"))?.push(&c.key(), &r.record()))?;
     let mut computed: BTreeMap<String, R> = todo.iter().map(|c| c.key()).zip(computed).collect();
     slice
@@ -80,6 +82,7 @@ where
                 Some(r) => Ok(r),
                 None => {
                     let rec = logged.remove(&key).with_context(|| format!("cell {key} is neither logged nor computed"))?;
+                    let rec: R::Record = serde_json::from_value(rec).with_context(|| format!("cell {key}: its logged record does not fit this version's record"))?;
                     restore(c, rec).with_context(|| format!("cannot restore cell {key} from the cell log"))
                 }
             }

@@ -12,6 +12,7 @@ pub mod ioh;
 pub mod markdown;
 pub mod plots;
 pub mod reference;
+pub mod seed002;
 
 use crate::experiment::spec::Spec;
 use crate::experiment::Manifest;

@@ -4,10 +4,12 @@
 
 pub mod approach;
 pub mod basis;
+pub mod conic;
 pub mod export;
 pub mod fit;
 pub mod knots;
 pub mod param;
+pub mod rational_bezier;
 pub mod surface;
 
 pub use approach::{fit_two_view, Approach, ControlNetParts, TwoSurfaceFit, TwoViewGrid};

@@ -1,0 +1,255 @@
+//! Seed 002 wiring (Yahya): each (surface, optimiser, repeat) fits the four-patch G1 rational
+//! bi-quadratic Bezier surface to the surface's grid by minimising the sum of squared errors over
+//! the seven free control points and w11, on its own stream, logged at once.
+
+use super::spec::{Seed002Spec, Spec};
+use super::{runner, seeds, RunContext};
+use crate::optim::{Budget, Optimiser, Problem, RunResult};
+use crate::spline::conic::{self, ConicProblem, P2};
+use crate::spline::rational_bezier::{SurfaceSse, TestSurface};
+use anyhow::{Context, Result};
+use serde::{Deserialize, Serialize};
+
+/// One (surface, optimiser, repeat).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Cell {
+    pub surface: String,
+    pub optimiser: String,
+    pub repeat: usize,
+}
+
+impl Cell {
+    pub fn key(&self) -> String {
+        format!("seed002/{}/{}/r{}", self.surface, self.optimiser, self.repeat)
+    }
+}
+
+/// One row of runs.csv.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Row {
+    pub cell: String,
+    pub surface: String,
+    pub optimiser: String,
+    pub repeat: usize,
+    pub seed: String,
+    pub dimension: usize,
+    pub n_points: usize,
+    /// SSE of the start (free points on the data, w11 = 1).
+    pub start_sse: f64,
+    pub initial_best: f64,
+    /// Best sum of squared errors found.
+    pub best_sse: f64,
+    /// sqrt(best_sse / n_points).
+    pub rmse: f64,
+    pub w11: f64,
+    pub evaluations: u64,
+    pub cpu_s: f64,
+}
+
+/// One run with its convergence trace.
+#[derive(Debug, Clone)]
+pub struct Run {
+    pub cell: Cell,
+    pub row: Row,
+    pub trace: Vec<(u64, f64)>,
+    pub best_x: Vec<f64>,
+}
+
+impl runner::Cell for Cell {
+    fn key(&self) -> String {
+        Cell::key(self)
+    }
+}
+
+impl runner::Logged for Run {
+    /// The row and the trace (the report needs no control points).
+    type Record = (Row, Vec<(u64, f64)>);
+    fn record(&self) -> Self::Record {
+        (self.row.clone(), self.trace.clone())
+    }
+}
+
+fn section(spec: &Spec) -> Result<&Seed002Spec> {
+    spec.file.seed002.as_ref().context("spec has no [seed002] section")
+}
+
+/// The flat list of cells.
+pub fn cells(spec: &Spec) -> Vec<Cell> {
+    let Some(s) = &spec.file.seed002 else { return Vec::new() };
+    let mut out = Vec::new();
+    for surface in &s.surfaces {
+        for opt in &s.optimisers {
+            for repeat in 0..s.repeats {
+                out.push(Cell { surface: surface.clone(), optimiser: opt.clone(), repeat });
+            }
+        }
+    }
+    out
+}
+
+/// The SSE problem of a surface with the spec's grid and box.
+pub fn problem(s: &Seed002Spec, surface: &str) -> Result<SurfaceSse> {
+    let ts = TestSurface::by_name(surface).with_context(|| format!("seed002.surfaces: unknown surface `{surface}`"))?;
+    Ok(SurfaceSse::new(ts.grid(s.grid), s.bounds_margin, s.w_min))
+}
+
+fn optimiser(s: &Seed002Spec, name: &str) -> Result<Box<dyn Optimiser>> {
+    Ok(match name {
+        "ga" => Box::new(s.ga.clone()),
+        "de" => Box::new(s.de.clone()),
+        "pso" => Box::new(s.pso.clone()),
+        other => anyhow::bail!("seed002.optimisers: unknown optimiser `{other}`"),
+    })
+}
+
+/// Run one cell (alone it gives the same numbers as inside the full run).
+pub fn run_cell(spec: &Spec, cell: &Cell) -> Result<Run> {
+    let s = section(spec)?;
+    let problem = problem(s, &cell.surface)?;
+    let opt = optimiser(s, &cell.optimiser)?;
+    // init_range is a share of the data's largest bounding-box extent (the domains differ in scale).
+    let extent = (0..3)
+        .map(|k| {
+            let (lo, hi) = problem.data.points.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| (a.min(p[k]), b.max(p[k])));
+            hi - lo
+        })
+        .fold(0.0, f64::max);
+    let budget = Budget { generations: s.generations as u64, population: s.population, init_range: s.init_range * extent, trace_every_evals: s.trace_every_evals };
+    let key = cell.key();
+    let mut rng = seeds::cell_rng(spec.file.master_seed, &key);
+    let t0 = runner::thread_cpu_seconds();
+    let r: RunResult = opt.run(&problem, &budget, &mut rng).map_err(|e| anyhow::anyhow!("{key}: {e}"))?;
+    let cpu_s = runner::thread_cpu_seconds() - t0;
+    let n = problem.n_points();
+    let row = Row {
+        cell: key.clone(),
+        surface: cell.surface.clone(),
+        optimiser: cell.optimiser.clone(),
+        repeat: cell.repeat,
+        seed: seeds::seed_hex(spec.file.master_seed, &key),
+        dimension: problem.dim(),
+        n_points: n,
+        start_sse: problem.fitness(problem.initial_point()),
+        initial_best: r.initial_best_fitness,
+        best_sse: r.best_fitness,
+        rmse: (r.best_fitness / n as f64).sqrt(),
+        w11: r.best_x[21],
+        evaluations: r.evaluations,
+        cpu_s,
+    };
+    Ok(Run { cell: cell.clone(), row, trace: r.trace, best_x: r.best_x })
+}
+
+/// Run every cell of the spec.
+pub fn run(spec: &Spec, ctx: &RunContext) -> Result<Vec<Run>> {
+    let cells = cells(spec);
+    runner::run_logged(&cells, ctx, &spec.file.name, |cell| run_cell(spec, cell), |cell, (row, trace)| Ok(Run { cell: cell.clone(), row, trace, best_x: Vec::new() }))
+}
+
+/// One conic curve fit: (outline, optimiser, repeat).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct CurveCell {
+    pub outline: String,
+    pub optimiser: String,
+    pub repeat: usize,
+}
+
+impl CurveCell {
+    pub fn key(&self) -> String {
+        format!("seed002/curve/{}/{}/r{}", self.outline, self.optimiser, self.repeat)
+    }
+}
+
+/// One row of seed002_curve_runs.csv.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct CurveRow {
+    pub cell: String,
+    pub outline: String,
+    pub optimiser: String,
+    pub repeat: usize,
+    pub seed: String,
+    pub n_points: usize,
+    pub true_corners: usize,
+    pub corners_found: usize,
+    /// Found corners within one spacing of a true corner.
+    pub corners_matched: usize,
+    pub conics: usize,
+    /// Sum over conics of the best SSE (data points shared by two conics count in both).
+    pub sse: f64,
+    /// SSE of the starts (b1 by least squares at w = 1).
+    pub start_sse: f64,
+    pub evaluations: u64,
+    pub cpu_s: f64,
+}
+
+/// A curve run: its row, the outline, the corners and each conic (b0, b1, b2, w).
+#[derive(Debug, Clone)]
+pub struct CurveRun {
+    pub row: CurveRow,
+    pub points: Vec<P2>,
+    pub corners: Vec<usize>,
+    pub conics: Vec<([P2; 3], f64)>,
+}
+
+pub fn curve_cells(spec: &Spec) -> Vec<CurveCell> {
+    let Some(s) = &spec.file.seed002 else { return Vec::new() };
+    let mut out = Vec::new();
+    for outline in &s.outlines {
+        for opt in &s.optimisers {
+            for repeat in 0..s.repeats {
+                out.push(CurveCell { outline: outline.clone(), optimiser: opt.clone(), repeat });
+            }
+        }
+    }
+    out
+}
+
+/// Sample the outline, detect its corners (SAM06), cut it into conic runs and fit each run's
+/// conic with the cell's optimiser, all on the cell's stream in run order.
+pub fn run_curve_cell(spec: &Spec, cell: &CurveCell) -> Result<CurveRun> {
+    let s = section(spec)?;
+    let (pieces, truth) = conic::outline(&cell.outline).with_context(|| format!("seed002.outlines: unknown outline `{}`", cell.outline))?;
+    let points = conic::sample_closed(&pieces, s.outline_spacing);
+    let corners = conic::sam06(&points, s.sam06_l, s.sam06_d, s.sam06_r.unwrap_or(s.sam06_l));
+    let matched = truth.iter().filter(|c| corners.iter().any(|&i| ((points[i][0] - c[0]).powi(2) + (points[i][1] - c[1]).powi(2)).sqrt() <= s.outline_spacing)).count();
+    let opt = optimiser(s, &cell.optimiser)?;
+    let key = cell.key();
+    let mut rng = seeds::cell_rng(spec.file.master_seed, &key);
+    let t0 = runner::thread_cpu_seconds();
+    let (mut sse, mut start_sse, mut evals, mut conics) = (0.0, 0.0, 0u64, Vec::new());
+    for run in conic::conic_runs(&points, &corners) {
+        let problem = ConicProblem::new(run, s.bounds_margin, s.w_min, 10.0);
+        let ext = problem.bounds().1[0] - problem.bounds().0[0];
+        let budget = Budget { generations: s.curve_generations as u64, population: s.population, init_range: s.init_range * ext, trace_every_evals: s.trace_every_evals };
+        let r = opt.run(&problem, &budget, &mut rng).map_err(|e| anyhow::anyhow!("{key}: {e}"))?;
+        start_sse += problem.fitness(problem.initial_point());
+        sse += r.best_fitness;
+        evals += r.evaluations;
+        conics.push(problem.control(&r.best_x));
+    }
+    let cpu_s = runner::thread_cpu_seconds() - t0;
+    let row = CurveRow {
+        cell: key.clone(),
+        outline: cell.outline.clone(),
+        optimiser: cell.optimiser.clone(),
+        repeat: cell.repeat,
+        seed: seeds::seed_hex(spec.file.master_seed, &key),
+        n_points: points.len(),
+        true_corners: truth.len(),
+        corners_found: corners.len(),
+        corners_matched: matched,
+        conics: conics.len(),
+        sse,
+        start_sse,
+        evaluations: evals,
+        cpu_s,
+    };
+    Ok(CurveRun { row, points, corners, conics })
+}
+
+/// The curve cells (a fraction of a second in all; not logged: a resumed run or a merge runs
+/// them again, deterministically).
+pub fn run_curves(spec: &Spec, ctx: &RunContext) -> Result<Vec<CurveRun>> {
+    let cells = curve_cells(spec);
+    runner::run_cells(&cells, ctx.jobs, "seed002 curves", |c| run_curve_cell(spec, c), |_, _| Ok(()))
+}
