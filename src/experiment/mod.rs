@@ -7,6 +7,7 @@ pub mod compare;
 pub mod datasets;
 pub mod fit_cmd;
 pub mod runner;
+pub mod seed001;
 pub mod seeds;
 pub mod spec;
 
@@ -26,7 +27,7 @@ pub struct RunContext {
 
 /// One line per cell for `--dry-run`: key and seed.
 pub fn dry_run_listing(spec: &Spec) -> Vec<(String, String)> {
-    let keys: Vec<String> = spec.som_cells().iter().map(|c| c.key()).chain(spec.fit_cells().iter().map(|c| c.key())).chain(spec.optim_cells().iter().map(|c| c.key())).collect();
+    let keys: Vec<String> = spec.som_cells().iter().map(|c| c.key()).chain(spec.fit_cells().iter().map(|c| c.key())).chain(spec.optim_cells().iter().map(|c| c.key())).chain(seed001::cells(spec).iter().map(|c| c.key())).collect();
     keys.into_iter()
         .map(|k| {
             let s = seeds::seed_hex(spec.file.master_seed, &k);
@@ -106,6 +107,12 @@ pub fn run_spec(spec: &Spec, ctx: &RunContext) -> Result<PathBuf> {
         let runs = ch4::run(spec, ctx)?;
         let section = crate::report::ch4::write(spec, &runs, &ctx.out)?;
         (section, runs.iter().map(|r| r.row.cpu_s).sum::<f64>(), runs.len())
+    } else if spec.file.growing_grid.is_some() {
+        let maps = seed001::maps(spec, ctx)?;
+        let problems = seed001::problems(spec, &maps)?;
+        let runs = seed001::run(spec, ctx, &problems)?;
+        let section = crate::report::seed001::write(&maps, &problems, &runs, &ctx.out)?;
+        (section, maps.iter().map(|m| m.cpu_s).sum::<f64>() + runs.iter().map(|r| r.row.cpu_s).sum::<f64>(), runs.len())
     } else if spec.file.optim.is_some() {
         let problems = ch6::problems(spec, ctx)?;
         let exact = ch6::exact_optima(spec, ctx, &problems)?;

@@ -11,6 +11,7 @@ pub mod ioh;
 pub mod markdown;
 pub mod plots;
 pub mod reference;
+pub mod seed001;
 
 use crate::experiment::spec::Spec;
 use crate::experiment::Manifest;
