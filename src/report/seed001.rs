@@ -141,7 +141,7 @@ pub fn write(maps: &[MapRun], problems: &BTreeMap<ProblemKey, OpenSurfaceProblem
         }
         let name = format!("png/seed001_{}.png", m.dataset);
         let cols = panels.len().min(4);
-        match plots::overview_png(&out.join(&name), &format!("{}: growing grid and the lowest-error fitted surface per control net", m.dataset), &panels, cols) {
+        match plots::overview_png(&out.join(&name), &format!("{}: growing grid, best surface per net", m.dataset), &panels, cols) {
             Ok(()) => {
                 let _ = writeln!(md, "![{}]({name})\n", m.dataset);
             }
