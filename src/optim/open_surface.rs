@@ -71,10 +71,10 @@ impl OpenSurfaceProblem {
             for j in 0..ny {
                 let (f, w) = (self.bv.first[j], self.bv.w[j]);
                 let mut s = [0.0; 3];
-                for l in 0..4 {
+                for (l, wl) in w.iter().enumerate() {
                     let o = 3 * (a * cy + f + l);
                     for c in 0..3 {
-                        s[c] += w[l] * x[o + c];
+                        s[c] += wl * x[o + c];
                     }
                 }
                 q[a * ny + j] = s;

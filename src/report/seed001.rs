@@ -125,7 +125,7 @@ pub fn write(maps: &[MapRun], problems: &BTreeMap<ProblemKey, OpenSurfaceProblem
 
     // Pictures: per data set, the map and, per net, the surface of the lowest-error run.
     ensure_dir(&out.join("png"))?;
-    let _ = writeln!(md, "### Pictures\n");
+    let _ = writeln!(md, "### Pictures\n\nPer data set: the grown map and, per control net, the surface of the lowest-error run evaluated at the data parameters.\n");
     for m in maps {
         let mut panels = vec![Panel { title: format!("growing grid {}x{}", m.map.nx, m.map.ny), meshes: vec![LineMesh { points: m.map.weights.clone(), edges: grid_edges(m.map.nx, m.map.ny), colour: style::BLUE, label: "map".into() }] }];
         let mut nets: Vec<_> = problems.keys().filter(|k| k.0 == m.dataset).map(|k| k.1).collect();
@@ -134,9 +134,10 @@ pub fn write(maps: &[MapRun], problems: &BTreeMap<ProblemKey, OpenSurfaceProblem
             let best = runs.iter().filter(|r| r.cell.dataset == m.dataset && r.cell.cn == cn).min_by(|a, b| a.row.best.total_cmp(&b.row.best));
             if let Some(r) = best {
                 let pr = &problems[&(r.cell.dataset.clone(), r.cell.cn, r.cell.param)];
-                let t: Vec<f64> = (0..=24).map(|k| k as f64 / 24.0).collect();
-                let pts = pr.surface(&r.best_x).eval_grid(&t, &t);
-                panels.push(Panel { title: format!("{cn} {} {} ({:.4})", r.cell.param.name(), r.cell.optimiser.to_uppercase(), r.row.best), meshes: vec![LineMesh { points: pts, edges: grid_edges(25, 25), colour: style::VERMILLION, label: "surface".into() }] });
+                // At the data parameters, as Chapter 5's pictures (between them a near-square net
+                // is free to oscillate: only the grid points are fitted).
+                let pts = pr.fitted(&r.best_x);
+                panels.push(Panel { title: format!("{cn} {} {} ({:.4})", r.cell.param.name(), r.cell.optimiser.to_uppercase(), r.row.best), meshes: vec![LineMesh { points: pts, edges: grid_edges(pr.nx, pr.ny), colour: style::VERMILLION, label: "surface at the data parameters".into() }] });
             }
         }
         let name = format!("png/seed001_{}.png", m.dataset);

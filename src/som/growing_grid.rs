@@ -203,7 +203,7 @@ pub fn grow(data: &[Point3], p: &GrowingGridParams, rng: &mut ChaCha8Rng) -> Res
         let mut best: Option<(f64, usize, usize)> = None; // (distance, axis, lower index)
         let mut consider = |axis: usize, ni: usize, nj: usize, low: usize| {
             let d = geom::dist2(s.w[q], s.w[ni * s.ny + nj]);
-            if best.map_or(true, |b| d > b.0) {
+            if best.is_none_or(|b| d > b.0) {
                 best = Some((d, axis, low));
             }
         };
