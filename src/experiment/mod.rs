@@ -10,6 +10,7 @@ pub mod log;
 pub mod reproduce;
 pub mod runner;
 pub mod seed002;
+pub mod seed001;
 pub mod seeds;
 pub mod spec;
 
@@ -41,7 +42,7 @@ impl RunContext {
 
 /// One line per cell for `--dry-run`: key and seed.
 pub fn dry_run_listing(spec: &Spec) -> Vec<(String, String)> {
-    let keys: Vec<String> = spec.som_cells().iter().map(|c| c.key()).chain(spec.fit_cells().iter().map(|c| c.key())).chain(spec.optim_cells().iter().map(|c| c.key())).collect();
+    let keys: Vec<String> = spec.som_cells().iter().map(|c| c.key()).chain(spec.fit_cells().iter().map(|c| c.key())).chain(spec.optim_cells().iter().map(|c| c.key())).chain(seed001::cells(spec).iter().map(|c| c.key())).collect();
     keys.into_iter()
         .map(|k| {
             let s = seeds::seed_hex(spec.file.master_seed, &k);
@@ -161,6 +162,12 @@ pub fn run_spec(spec: &Spec, ctx: &RunContext) -> Result<PathBuf> {
         let curves = seed002::run_curves(spec, ctx)?;
         let section = if tables { Some(crate::report::seed002::write(&runs, &curves, s2.population, &ctx.out)?) } else { None };
         (section, runs.iter().map(|r| r.row.cpu_s).chain(curves.iter().map(|c| c.row.cpu_s)).sum::<f64>(), runs.len() + curves.len())
+    } else if spec.file.growing_grid.is_some() {
+        let maps = seed001::maps(spec, ctx)?;
+        let problems = seed001::problems(spec, &maps)?;
+        let runs = seed001::run(spec, ctx, &problems)?;
+        let section = if tables { Some(crate::report::seed001::write(&maps, &problems, &runs, &ctx.out)?) } else { None };
+        (section, maps.iter().map(|m| m.cpu_s).sum::<f64>() + runs.iter().map(|r| r.row.cpu_s).sum::<f64>(), runs.len())
     } else if spec.file.optim.is_some() {
         let problems = ch6::problems(spec, ctx)?;
         let exact = if tables { ch6::exact_optima(spec, ctx, &problems)? } else { BTreeMap::new() };

@@ -200,6 +200,9 @@ pub struct SpecFile {
     /// Seed 002 (Yahya): four-patch G1 rational bi-quadratic Bezier surfaces by GA/DE/PSO.
     #[serde(default)]
     pub seed002: Option<Seed002Spec>,
+    /// Seed 001: growing grid on open surfaces, one B-spline surface, GA/DE/PSO.
+    #[serde(default)]
+    pub growing_grid: Option<GrowingGridSpec>,
     /// Named overrides, merged over the spec by `--profile NAME`.
     #[serde(default)]
     pub profiles: BTreeMap<String, toml::Table>,
@@ -325,6 +328,71 @@ pub struct OptimSpec {
     pub csa: crate::optim::cuckoo::Csa,
     #[serde(default)]
     pub icsa: crate::optim::cuckoo::Icsa,
+}
+
+/// Seed 001 section: a Growing Grid (Fritzke 1995) per open-surface data set, one cubic B-spline
+/// surface per (net, parameterisation) from its least-squares fit, then GA/DE/PSO on the control
+/// points (Table 6.1 settings by default).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GrowingGridSpec {
+    pub datasets: Vec<String>,
+    /// Target size of the grown map.
+    pub grid: GridSize,
+    pub control_nets: Vec<GridSize>,
+    pub parameterisations: Vec<String>,
+    /// ga, de, pso.
+    pub optimisers: Vec<String>,
+    #[serde(default = "default_ten")]
+    pub repeats: usize,
+    #[serde(default = "default_generations")]
+    pub generations: usize,
+    #[serde(default = "default_population")]
+    pub population: usize,
+    #[serde(default = "default_init_range")]
+    pub init_range: f64,
+    /// The search box: the data and the least-squares control points, widened by this share.
+    #[serde(default)]
+    pub bounds_margin: f64,
+    #[serde(default = "default_trace_every")]
+    pub trace_every_evals: u64,
+    /// Constants of the growing grid (defaults: `som::growing_grid::GrowingGridParams`).
+    #[serde(default)]
+    pub growth: GrowthSpec,
+    #[serde(default)]
+    pub ga: crate::optim::ga::Ga,
+    #[serde(default)]
+    pub de: crate::optim::de::De,
+    #[serde(default)]
+    pub pso: crate::optim::pso::Pso,
+}
+
+/// The growing grid's constants in a spec.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct GrowthSpec {
+    pub lambda_g: usize,
+    pub eps_g: f64,
+    pub lambda_f: usize,
+    pub eps_f0: f64,
+    pub eps_f1: f64,
+    pub sigma: f64,
+    pub reach2: i32,
+}
+
+impl Default for GrowthSpec {
+    fn default() -> Self {
+        let p = crate::som::growing_grid::GrowingGridParams::default();
+        GrowthSpec { lambda_g: p.lambda_g, eps_g: p.eps_g, lambda_f: p.lambda_f, eps_f0: p.eps_f0, eps_f1: p.eps_f1, sigma: p.sigma, reach2: p.reach2 }
+    }
+}
+
+impl GrowingGridSpec {
+    /// The growing grid's parameters for the target grid.
+    pub fn params(&self) -> crate::som::growing_grid::GrowingGridParams {
+        let g = &self.growth;
+        crate::som::growing_grid::GrowingGridParams { nx: self.grid.nx, ny: self.grid.ny, lambda_g: g.lambda_g, eps_g: g.eps_g, lambda_f: g.lambda_f, eps_f0: g.eps_f0, eps_f1: g.eps_f1, sigma: g.sigma, reach2: g.reach2 }
+    }
 }
 
 fn default_ten() -> usize {
@@ -453,10 +521,13 @@ impl Spec {
         if f.name.trim().is_empty() || f.name.contains(['/', '\\']) {
             return Err(self.err("name", "must be a non-empty name without slashes"));
         }
-        match f.som.is_some() as u8 + f.fit.is_some() as u8 + f.optim.is_some() as u8 + f.seed002.is_some() as u8 {
-            0 => return Err(SpecError(format!("{}: the spec has no experiment section (add [som], [fit], [optim] or [seed002])", self.path))),
+        match f.som.is_some() as u8 + f.fit.is_some() as u8 + f.optim.is_some() as u8 + f.seed002.is_some() as u8 + f.growing_grid.is_some() as u8 {
+            0 => return Err(SpecError(format!("{}: the spec has no experiment section (add [som], [fit], [optim], [seed002] or [growing_grid])", self.path))),
             1 => {}
-            _ => return Err(SpecError(format!("{}: one experiment section per spec: [som], [fit] and [optim] write the same files (split the spec)", self.path))),
+            _ => return Err(SpecError(format!("{}: one experiment section per spec: [som], [fit], [optim] and [growing_grid] write the same files (split the spec)", self.path))),
+        }
+        if let Some(g) = &f.growing_grid {
+            return self.validate_growing_grid(g);
         }
         if let Some(o) = &f.optim {
             self.validate_optim(o)?;
@@ -624,6 +695,57 @@ impl Spec {
         s.ga.validate().map_err(optim_err)?;
         s.de.validate().map_err(optim_err)?;
         s.pso.validate().map_err(optim_err)?;
+        Ok(())
+    }
+
+    fn validate_growing_grid(&self, g: &GrowingGridSpec) -> Result<(), SpecError> {
+        if g.datasets.is_empty() {
+            return Err(self.err("growing_grid.datasets", "is empty"));
+        }
+        if let Some(d) = g.datasets.iter().find(|d| d.trim().is_empty()) {
+            return Err(self.err("growing_grid.datasets", format!("empty data set name `{d}`")));
+        }
+        g.params().validate().map_err(|e| self.err("growing_grid.growth", e))?;
+        if g.control_nets.is_empty() {
+            return Err(self.err("growing_grid.control_nets", "is empty"));
+        }
+        for cn in &g.control_nets {
+            if cn.nx < 4 || cn.ny < 4 || cn.nx > g.grid.nx || cn.ny > g.grid.ny {
+                return Err(self.err("growing_grid.control_nets", format!("net {cn} must be at least 4x4 (cubic) and at most the grid {}", g.grid)));
+            }
+        }
+        if g.parameterisations.is_empty() {
+            return Err(self.err("growing_grid.parameterisations", "is empty"));
+        }
+        for p in &g.parameterisations {
+            p.parse::<crate::spline::Parameterisation>().map_err(|e| self.err("growing_grid.parameterisations", e))?;
+        }
+        if g.optimisers.is_empty() {
+            return Err(self.err("growing_grid.optimisers", "is empty"));
+        }
+        for name in &g.optimisers {
+            if !["ga", "de", "pso"].contains(&name.as_str()) {
+                return Err(self.err("growing_grid.optimisers", format!("unknown optimiser `{name}` (expected ga, de or pso)")));
+            }
+        }
+        if g.repeats == 0 {
+            return Err(self.err("growing_grid.repeats", "must be at least 1"));
+        }
+        if g.generations == 0 {
+            return Err(self.err("growing_grid.generations", "must be at least 1"));
+        }
+        if g.population < 4 {
+            return Err(self.err("growing_grid.population", format!("must be at least 4 (DE/rand/1 needs four), got {}", g.population)));
+        }
+        if !(g.init_range >= 0.0 && g.init_range.is_finite()) {
+            return Err(self.err("growing_grid.init_range", format!("must be a non-negative number, got {}", g.init_range)));
+        }
+        if !(g.bounds_margin >= 0.0 && g.bounds_margin.is_finite()) {
+            return Err(self.err("growing_grid.bounds_margin", format!("must be a non-negative number, got {}", g.bounds_margin)));
+        }
+        if g.trace_every_evals == 0 {
+            return Err(self.err("growing_grid.trace_every_evals", "must be at least 1"));
+        }
         Ok(())
     }
 

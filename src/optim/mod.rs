@@ -11,6 +11,7 @@ pub mod exact;
 pub mod ga;
 pub mod ioh;
 pub mod kernels;
+pub mod open_surface;
 pub mod problem;
 pub mod pso;
 pub mod sampling;

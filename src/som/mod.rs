@@ -7,6 +7,7 @@
 
 pub mod cksom;
 pub mod dnsom;
+pub mod growing_grid;
 pub mod lattice;
 pub mod som2d;
 pub mod som3d;

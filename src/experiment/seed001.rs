@@ -1,0 +1,196 @@
+//! Seed 001 wiring: one Growing Grid per data set (its own stream `seed001/map/<data>`), one open
+//! cubic B-spline problem per (data, net, parameterisation) from the least-squares fit of that map,
+//! then every (problem, optimiser, repeat) cell on its own stream, logged at once.
+
+use super::spec::{GridSize, GrowingGridSpec, Spec};
+use super::{runner, seeds, RunContext};
+use crate::data::registry;
+use crate::geom::Point3;
+use crate::optim::open_surface::OpenSurfaceProblem;
+use crate::optim::{Budget, Optimiser, Problem};
+use crate::som::growing_grid::{grow, GrowingGrid};
+use crate::spline::Parameterisation;
+use anyhow::{Context, Result};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// One grown map.
+#[derive(Debug, Clone)]
+pub struct MapRun {
+    pub dataset: String,
+    pub points: usize,
+    pub map: GrowingGrid,
+    pub qe: f64,
+    pub te: f64,
+    pub cpu_s: f64,
+}
+
+/// One optimisation cell.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Cell {
+    pub dataset: String,
+    pub cn: GridSize,
+    pub param: Parameterisation,
+    pub optimiser: String,
+    pub repeat: usize,
+}
+
+impl Cell {
+    pub fn key(&self) -> String {
+        format!("seed001/{}/{}/{}/{}/r{}", self.dataset, self.cn, self.param.name(), self.optimiser, self.repeat)
+    }
+}
+
+/// One row of `runs.csv`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Row {
+    pub cell: String,
+    pub dataset: String,
+    pub grid_x: usize,
+    pub grid_y: usize,
+    pub cn_x: usize,
+    pub cn_y: usize,
+    pub parameterisation: String,
+    pub optimiser: String,
+    pub repeat: usize,
+    pub seed: String,
+    pub dimension: usize,
+    /// Surface error (Eq. 5.13, one view) of the least-squares net, the start.
+    pub lsq: f64,
+    pub initial_best: f64,
+    /// Best surface error found.
+    pub best: f64,
+    /// best / number of grid points: mean distance per grid point.
+    pub best_per_point: f64,
+    pub evaluations: u64,
+    pub cpu_s: f64,
+}
+
+#[derive(Debug, Clone)]
+pub struct Run {
+    pub cell: Cell,
+    pub row: Row,
+    pub best_x: Vec<f64>,
+}
+
+impl runner::Cell for Cell {
+    fn key(&self) -> String {
+        Cell::key(self)
+    }
+}
+
+impl runner::Logged for Run {
+    /// The row and the best control points (the pictures draw the lowest-error surface).
+    type Record = (Row, Vec<f64>);
+    fn record(&self) -> Self::Record {
+        (self.row.clone(), self.best_x.clone())
+    }
+}
+
+pub type ProblemKey = (String, GridSize, Parameterisation);
+
+fn section(spec: &Spec) -> Result<&GrowingGridSpec> {
+    spec.file.growing_grid.as_ref().context("spec has no [growing_grid] section")
+}
+
+/// Every cell in a fixed order: data, net, parameterisation, optimiser, repeat.
+pub fn cells(spec: &Spec) -> Vec<Cell> {
+    let Some(g) = &spec.file.growing_grid else { return Vec::new() };
+    let mut out = Vec::new();
+    for d in &g.datasets {
+        for &cn in &g.control_nets {
+            for p in &g.parameterisations {
+                let Ok(param) = p.parse::<Parameterisation>() else { continue };
+                for o in &g.optimisers {
+                    for repeat in 0..g.repeats {
+                        out.push(Cell { dataset: d.clone(), cn, param, optimiser: o.clone(), repeat });
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Grow one map per data set (in parallel; each on its own stream).
+pub fn maps(spec: &Spec, ctx: &RunContext) -> Result<Vec<MapRun>> {
+    let g = section(spec)?;
+    let params = g.params();
+    let data: Vec<(String, Vec<Point3>)> = g
+        .datasets
+        .iter()
+        .map(|d| registry::load_dataset(d, &ctx.data_dir).map(|c| (d.clone(), c.points)).with_context(|| format!("growing_grid.datasets: `{d}`")))
+        .collect::<Result<_>>()?;
+    runner::run_cells(&data, ctx.jobs, "growing grids", |(d, points)| {
+        let mut rng = seeds::cell_rng(spec.file.master_seed, &format!("seed001/map/{d}"));
+        let t0 = runner::thread_cpu_seconds();
+        let map = grow(points, &params, &mut rng).map_err(|e| anyhow::anyhow!("growing grid on {d}: {e}"))?;
+        let cpu_s = runner::thread_cpu_seconds() - t0;
+        let m = map.metrics(points);
+        Ok(MapRun { dataset: d.clone(), points: points.len(), map, qe: m.qe, te: m.te, cpu_s })
+    }, |_, _| Ok(()))
+}
+
+/// The problem of every (data, net, parameterisation).
+pub fn problems(spec: &Spec, maps: &[MapRun]) -> Result<BTreeMap<ProblemKey, OpenSurfaceProblem>> {
+    let g = section(spec)?;
+    let mut out = BTreeMap::new();
+    for m in maps {
+        for &cn in &g.control_nets {
+            for p in &g.parameterisations {
+                let param: Parameterisation = p.parse().map_err(anyhow::Error::msg)?;
+                let pr = OpenSurfaceProblem::new(&m.map.weights, m.map.nx, m.map.ny, cn.nx, cn.ny, param, g.bounds_margin).map_err(|e| anyhow::anyhow!("{} {cn} {p}: {e}", m.dataset))?;
+                out.insert((m.dataset.clone(), cn, param), pr);
+            }
+        }
+    }
+    Ok(out)
+}
+
+fn optimiser(g: &GrowingGridSpec, name: &str) -> Result<Box<dyn Optimiser>> {
+    Ok(match name {
+        "ga" => Box::new(g.ga.clone()),
+        "de" => Box::new(g.de.clone()),
+        "pso" => Box::new(g.pso.clone()),
+        other => anyhow::bail!("unknown optimiser `{other}`"),
+    })
+}
+
+/// Run one cell (alone or inside the full run: the same numbers).
+pub fn run_cell(spec: &Spec, cell: &Cell, problem: &OpenSurfaceProblem) -> Result<Run> {
+    let g = section(spec)?;
+    let opt = optimiser(g, &cell.optimiser)?;
+    let budget = Budget { generations: g.generations as u64, population: g.population, init_range: g.init_range, trace_every_evals: g.trace_every_evals };
+    let key = cell.key();
+    let mut rng = seeds::cell_rng(spec.file.master_seed, &key);
+    let t0 = runner::thread_cpu_seconds();
+    let r = opt.run(problem, &budget, &mut rng).map_err(|e| anyhow::anyhow!("{key}: {e}"))?;
+    let cpu_s = runner::thread_cpu_seconds() - t0;
+    let n = (problem.nx * problem.ny) as f64;
+    let row = Row {
+        cell: key.clone(),
+        dataset: cell.dataset.clone(),
+        grid_x: problem.nx,
+        grid_y: problem.ny,
+        cn_x: cell.cn.nx,
+        cn_y: cell.cn.ny,
+        parameterisation: cell.param.name().into(),
+        optimiser: cell.optimiser.clone(),
+        repeat: cell.repeat,
+        seed: seeds::seed_hex(spec.file.master_seed, &key),
+        dimension: problem.dim(),
+        lsq: problem.fitness(problem.initial_point()),
+        initial_best: r.initial_best_fitness,
+        best: r.best_fitness,
+        best_per_point: r.best_fitness / n,
+        evaluations: r.evaluations,
+        cpu_s,
+    };
+    Ok(Run { cell: cell.clone(), row, best_x: r.best_x })
+}
+
+/// Run every cell of the spec.
+pub fn run(spec: &Spec, ctx: &RunContext, problems: &BTreeMap<ProblemKey, OpenSurfaceProblem>) -> Result<Vec<Run>> {
+    let cells = cells(spec);
+    runner::run_logged(&cells, ctx, &spec.file.name, |c| run_cell(spec, c, &problems[&(c.dataset.clone(), c.cn, c.param)]), |c, (row, best_x)| Ok(Run { cell: c.clone(), row, best_x }))
+}
