@@ -4,6 +4,7 @@
 
 pub mod approach;
 pub mod basis;
+pub mod bezier;
 pub mod export;
 pub mod fit;
 pub mod knots;
