@@ -305,4 +305,22 @@ mod tests {
             assert!((measured - snr).abs() < 0.2, "{measured} vs {snr}");
         }
     }
+
+    #[test]
+    fn csa_and_icsa_search_the_parameters() {
+        use crate::optim::{Budget, Csa, Icsa, Optimiser};
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let mut pts = height_grid(franke, 9, 0.0, 1.0);
+        add_noise(&mut pts, 20.75, &mut rng);
+        let uniform: Vec<f64> = (0..18).map(|k| (k % 9) as f64 / 8.0).collect();
+        let prob = BezierParamProblem::new(3, 3, Layout::Grid { nu: 9, nv: 9 }, pts, uniform).unwrap();
+        let budget = Budget { generations: 30, population: 10, init_range: 1.0, trace_every_evals: 50 };
+        let opts: [&dyn Optimiser; 2] = [&Csa::default(), &Icsa::default()];
+        for opt in opts {
+            let r = opt.run(&prob, &budget, &mut rng).unwrap();
+            assert!(r.best_fitness.is_finite() && r.best_fitness <= r.initial_best_fitness);
+            assert!(r.best_x.iter().all(|t| (0.0..=1.0).contains(t)));
+            assert_eq!(prob.fitness(&r.best_x), r.best_fitness);
+        }
+    }
 }
