@@ -27,9 +27,9 @@ pub fn bernstein(n: usize, t: f64) -> Vec<f64> {
     let s = 1.0 - t;
     for j in 1..=n {
         let mut saved = 0.0;
-        for k in 0..j {
-            let tmp = b[k];
-            b[k] = saved + s * tmp;
+        for bk in b.iter_mut().take(j) {
+            let tmp = *bk;
+            *bk = saved + s * tmp;
             saved = t * tmp;
         }
         b[j] = saved;
@@ -168,6 +168,15 @@ impl Problem for BezierParamProblem {
             _ => f64::INFINITY,
         }
     }
+}
+
+/// The classical (uniform, chordal, centripetal) start vector for grid data, in the problem's
+/// encoding (u of the nu columns, then v of the nv rows), from `param::grid_params`.
+pub fn classical_grid_start(points: &[Point3], nu: usize, nv: usize, method: super::Parameterisation) -> Vec<f64> {
+    // grid_params wants view[i * nv + j]; our layout is points[j * nu + i]
+    let view: Vec<Point3> = (0..nu).flat_map(|i| (0..nv).map(move |j| (i, j))).map(|(i, j)| points[j * nu + i]).collect();
+    let (u, v) = super::param::grid_params(&view, nu, nv, method);
+    u.into_iter().chain(v).collect()
 }
 
 /// Franke's function on [0, 1]^2.
@@ -322,5 +331,17 @@ mod tests {
             assert!(r.best_x.iter().all(|t| (0.0..=1.0).contains(t)));
             assert_eq!(prob.fitness(&r.best_x), r.best_fitness);
         }
+    }
+
+    #[test]
+    fn classical_starts_are_monotone_and_uniform_is_exact() {
+        let pts = height_grid(peaks, 11, -3.0, 3.0);
+        let uni = classical_grid_start(&pts, 11, 11, crate::spline::Parameterisation::Uniform);
+        for (k, t) in uni.iter().enumerate() {
+            assert!((t - (k % 11) as f64 / 10.0).abs() < 1e-12);
+        }
+        let cen = classical_grid_start(&pts, 11, 11, crate::spline::Parameterisation::Centripetal);
+        assert!(cen[..11].windows(2).all(|w| w[0] < w[1]) && cen[11..].windows(2).all(|w| w[0] < w[1]));
+        assert!(cen[0].abs() < 1e-12 && (cen[10] - 1.0).abs() < 1e-12);
     }
 }
