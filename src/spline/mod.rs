@@ -5,6 +5,7 @@
 pub mod approach;
 pub mod basis;
 pub mod conic;
+pub mod bezier;
 pub mod export;
 pub mod fit;
 pub mod knots;
