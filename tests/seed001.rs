@@ -1,33 +1,13 @@
 //! Seed 001 end to end: the quick profile of experiments/seed001_growing_grid.toml in a temp dir,
 //! then real properties of the CSVs it wrote.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_somnurbs"))
-}
-
-fn shared_data() -> PathBuf {
-    match std::env::var_os("SOMNURBS_DATA") {
-        Some(v) if !v.is_empty() => PathBuf::from(v),
-        _ => Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data"),
-    }
-}
+mod common;
+use common::{bin, col, read_csv, shared_data};
+use std::path::Path;
+use std::process::Output;
 
 fn run(dir: &Path, args: &[&str]) -> Output {
     bin().args(args).current_dir(dir).env("SOMNURBS_DATA", shared_data()).output().unwrap()
-}
-
-fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
-    let mut r = csv::Reader::from_path(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let h = r.headers().unwrap().iter().map(String::from).collect();
-    let rows = r.records().map(|x| x.unwrap().iter().map(String::from).collect()).collect();
-    (h, rows)
-}
-
-fn col(h: &[String], name: &str) -> usize {
-    h.iter().position(|c| c == name).unwrap_or_else(|| panic!("no column {name} in {h:?}"))
 }
 
 fn f(s: &str) -> f64 {

@@ -1,19 +1,10 @@
 //! Seed 002 integration test: the quick profile of experiments/seed002_rational.toml through the
 //! real binary, then the CSVs it wrote are read back and checked.
 
+mod common;
+use common::{col, read_csv};
 use std::path::{Path, PathBuf};
 use std::process::Command;
-
-fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
-    let mut r = csv::Reader::from_path(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    let h = r.headers().unwrap().iter().map(String::from).collect();
-    let rows = r.records().map(|x| x.unwrap().iter().map(String::from).collect()).collect();
-    (h, rows)
-}
-
-fn col(h: &[String], name: &str) -> usize {
-    h.iter().position(|c| c == name).unwrap_or_else(|| panic!("column {name} missing from {h:?}"))
-}
 
 fn spec() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/seed002_rational.toml")

@@ -66,14 +66,7 @@ pub fn exact_optima(spec: &Spec, ctx: &RunContext, problems: &BTreeMap<ProblemKe
 /// Build the optimiser a cell names, with the spec's parameters.
 pub fn optimiser(spec: &Spec, name: &str) -> Result<Box<dyn Optimiser>> {
     let o = spec.file.optim.as_ref().context("spec has no [optim] section")?;
-    Ok(match name {
-        "ga" => Box::new(o.ga.clone()),
-        "de" => Box::new(o.de.clone()),
-        "pso" => Box::new(o.pso.clone()),
-        "csa" => Box::new(o.csa.clone()),
-        "icsa" => Box::new(o.icsa.clone()),
-        other => anyhow::bail!("unknown optimiser `{other}`"),
-    })
+    crate::optim::named(name, &o.ga, &o.de, &o.pso, &o.csa, &o.icsa).with_context(|| format!("unknown optimiser `{name}`"))
 }
 
 /// The control-net problems of every (data, net, parameterisation), from approach B's fit.

@@ -148,12 +148,9 @@ pub fn problems(spec: &Spec, maps: &[MapRun]) -> Result<BTreeMap<ProblemKey, Ope
 }
 
 fn optimiser(g: &GrowingGridSpec, name: &str) -> Result<Box<dyn Optimiser>> {
-    Ok(match name {
-        "ga" => Box::new(g.ga.clone()),
-        "de" => Box::new(g.de.clone()),
-        "pso" => Box::new(g.pso.clone()),
-        other => anyhow::bail!("unknown optimiser `{other}`"),
-    })
+    // This section offers ga, de and pso only.
+    let (csa, icsa) = (crate::optim::Csa::default(), crate::optim::Icsa::default());
+    crate::optim::named(name, &g.ga, &g.de, &g.pso, &csa, &icsa).filter(|_| matches!(name, "ga" | "de" | "pso")).with_context(|| format!("unknown optimiser `{name}`"))
 }
 
 /// Run one cell (alone or inside the full run: the same numbers).

@@ -94,12 +94,9 @@ pub fn problem(s: &Seed002Spec, surface: &str) -> Result<SurfaceSse> {
 }
 
 fn optimiser(s: &Seed002Spec, name: &str) -> Result<Box<dyn Optimiser>> {
-    Ok(match name {
-        "ga" => Box::new(s.ga.clone()),
-        "de" => Box::new(s.de.clone()),
-        "pso" => Box::new(s.pso.clone()),
-        other => anyhow::bail!("seed002.optimisers: unknown optimiser `{other}`"),
-    })
+    // This section offers ga, de and pso only.
+    let (csa, icsa) = (crate::optim::Csa::default(), crate::optim::Icsa::default());
+    crate::optim::named(name, &s.ga, &s.de, &s.pso, &csa, &icsa).filter(|_| matches!(name, "ga" | "de" | "pso")).with_context(|| format!("seed002.optimisers: unknown optimiser `{name}`"))
 }
 
 /// Run one cell (alone it gives the same numbers as inside the full run).

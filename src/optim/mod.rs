@@ -53,16 +53,21 @@ pub(crate) fn check_range(key: &str, value: f64, lo: f64, hi: f64) -> Result<(),
     }
 }
 
-/// The optimisers by name with their default (Table 6.1 / seed 003) parameters.
-pub fn default_optimiser(name: &str) -> Option<Box<dyn Optimiser>> {
+/// The optimiser named `name` ("ga", "de", "pso", "csa", "icsa") with the given parameters.
+pub fn named(name: &str, ga: &Ga, de: &De, pso: &Pso, csa: &Csa, icsa: &Icsa) -> Option<Box<dyn Optimiser>> {
     Some(match name {
-        "ga" => Box::new(Ga::default()),
-        "de" => Box::new(De::default()),
-        "pso" => Box::new(Pso::default()),
-        "csa" => Box::new(Csa::default()),
-        "icsa" => Box::new(Icsa::default()),
+        "ga" => Box::new(ga.clone()),
+        "de" => Box::new(de.clone()),
+        "pso" => Box::new(pso.clone()),
+        "csa" => Box::new(csa.clone()),
+        "icsa" => Box::new(icsa.clone()),
         _ => return None,
     })
+}
+
+/// The optimisers by name with their default (Table 6.1 / seed 003) parameters.
+pub fn default_optimiser(name: &str) -> Option<Box<dyn Optimiser>> {
+    named(name, &Ga::default(), &De::default(), &Pso::default(), &Csa::default(), &Icsa::default())
 }
 
 /// Shared checks every optimiser must pass.

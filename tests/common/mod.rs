@@ -98,6 +98,11 @@ pub fn without_timing(path: &Path) -> Vec<Vec<String>> {
 }
 
 
+/// The index of a column, or a panic naming it and the header.
+pub fn col(h: &[String], name: &str) -> usize {
+    h.iter().position(|c| c == name).unwrap_or_else(|| panic!("no column {name} in {h:?}"))
+}
+
 /// Timing columns: measured, never identical across runs.
 pub fn is_timing(column: &str) -> bool {
     column.starts_with("cpu_s") || column.ends_with("_s") || column == "wall_seconds"
