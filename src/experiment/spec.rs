@@ -639,23 +639,7 @@ impl Spec {
                 return Err(self.err("seed002.surfaces", format!("unknown surface `{name}` (expected surface1, surface2, surface3 or surface4)")));
             }
         }
-        if s.optimisers.is_empty() {
-            return Err(self.err("seed002.optimisers", "is empty"));
-        }
-        for name in &s.optimisers {
-            if !["ga", "de", "pso"].contains(&name.as_str()) {
-                return Err(self.err("seed002.optimisers", format!("unknown optimiser `{name}` (expected ga, de or pso)")));
-            }
-        }
-        if s.repeats == 0 {
-            return Err(self.err("seed002.repeats", "must be at least 1"));
-        }
-        if s.generations == 0 {
-            return Err(self.err("seed002.generations", "must be at least 1"));
-        }
-        if s.population < 4 {
-            return Err(self.err("seed002.population", format!("must be at least 4 (DE/rand/1 needs four), got {}", s.population)));
-        }
+        self.validate_runs("seed002", &s.optimisers, &["ga", "de", "pso"], s.repeats, s.generations as u64, s.population)?;
         if s.grid < 5 || s.grid.is_multiple_of(2) {
             return Err(self.err("seed002.grid", format!("must be odd and at least 5, got {}", s.grid)));
         }
@@ -688,13 +672,7 @@ impl Spec {
         if s.curve_generations == 0 {
             return Err(self.err("seed002.curve_generations", "must be at least 1"));
         }
-        let optim_err = |e: crate::optim::OptimError| match e {
-            crate::optim::OptimError::InvalidParameter { key, message } => self.err(&format!("seed002.{key}"), message),
-            other => self.err("seed002", other),
-        };
-        s.ga.validate().map_err(optim_err)?;
-        s.de.validate().map_err(optim_err)?;
-        s.pso.validate().map_err(optim_err)?;
+        self.validate_optimiser_params("seed002", [s.ga.validate(), s.de.validate(), s.pso.validate()])?;
         Ok(())
     }
 
@@ -720,23 +698,7 @@ impl Spec {
         for p in &g.parameterisations {
             p.parse::<crate::spline::Parameterisation>().map_err(|e| self.err("growing_grid.parameterisations", e))?;
         }
-        if g.optimisers.is_empty() {
-            return Err(self.err("growing_grid.optimisers", "is empty"));
-        }
-        for name in &g.optimisers {
-            if !["ga", "de", "pso"].contains(&name.as_str()) {
-                return Err(self.err("growing_grid.optimisers", format!("unknown optimiser `{name}` (expected ga, de or pso)")));
-            }
-        }
-        if g.repeats == 0 {
-            return Err(self.err("growing_grid.repeats", "must be at least 1"));
-        }
-        if g.generations == 0 {
-            return Err(self.err("growing_grid.generations", "must be at least 1"));
-        }
-        if g.population < 4 {
-            return Err(self.err("growing_grid.population", format!("must be at least 4 (DE/rand/1 needs four), got {}", g.population)));
-        }
+        self.validate_runs("growing_grid", &g.optimisers, &["ga", "de", "pso"], g.repeats, g.generations as u64, g.population)?;
         if !(g.init_range >= 0.0 && g.init_range.is_finite()) {
             return Err(self.err("growing_grid.init_range", format!("must be a non-negative number, got {}", g.init_range)));
         }
@@ -745,6 +707,46 @@ impl Spec {
         }
         if g.trace_every_evals == 0 {
             return Err(self.err("growing_grid.trace_every_evals", "must be at least 1"));
+        }
+        Ok(())
+    }
+
+    /// The checks every optimisation section shares: its optimiser names (from `allowed`),
+    /// repeats, generations and population, each error naming `<section>.<key>`.
+    fn validate_runs(&self, section: &str, optimisers: &[String], allowed: &[&str], repeats: usize, generations: u64, population: usize) -> Result<(), SpecError> {
+        let key = |k: &str| format!("{section}.{k}");
+        if optimisers.is_empty() {
+            return Err(self.err(&key("optimisers"), "is empty"));
+        }
+        let expected = match allowed.split_last() {
+            Some((last, [])) => last.to_string(),
+            Some((last, rest)) => format!("{} or {last}", rest.join(", ")),
+            None => String::new(),
+        };
+        for name in optimisers {
+            if !allowed.contains(&name.as_str()) {
+                return Err(self.err(&key("optimisers"), format!("unknown optimiser `{name}` (expected {expected})")));
+            }
+        }
+        if repeats == 0 {
+            return Err(self.err(&key("repeats"), "must be at least 1"));
+        }
+        if generations == 0 {
+            return Err(self.err(&key("generations"), "must be at least 1"));
+        }
+        if population < 4 {
+            return Err(self.err(&key("population"), format!("must be at least 4 (DE/rand/1 needs four), got {population}")));
+        }
+        Ok(())
+    }
+
+    /// The optimisers' own parameter checks, their keys placed under `section`.
+    fn validate_optimiser_params<const N: usize>(&self, section: &str, checks: [Result<(), crate::optim::OptimError>; N]) -> Result<(), SpecError> {
+        for check in checks {
+            check.map_err(|e| match e {
+                crate::optim::OptimError::InvalidParameter { key, message } => self.err(&format!("{section}.{key}"), message),
+                other => self.err(section, other),
+            })?;
         }
         Ok(())
     }
@@ -761,23 +763,7 @@ impl Spec {
             pictures: false,
         };
         self.validate_fit(&as_fit).map_err(|e| SpecError(e.0.replace(": fit.", ": optim.")))?;
-        if o.optimisers.is_empty() {
-            return Err(self.err("optim.optimisers", "is empty"));
-        }
-        for name in &o.optimisers {
-            if !["ga", "de", "pso", "csa", "icsa"].contains(&name.as_str()) {
-                return Err(self.err("optim.optimisers", format!("unknown optimiser `{name}` (expected ga, de, pso, csa or icsa)")));
-            }
-        }
-        if o.repeats == 0 {
-            return Err(self.err("optim.repeats", "must be at least 1"));
-        }
-        if o.generations == 0 {
-            return Err(self.err("optim.generations", "must be at least 1"));
-        }
-        if o.population < 4 {
-            return Err(self.err("optim.population", format!("must be at least 4 (DE/rand/1 needs four), got {}", o.population)));
-        }
+        self.validate_runs("optim", &o.optimisers, &["ga", "de", "pso", "csa", "icsa"], o.repeats, o.generations as u64, o.population)?;
         if !(o.init_range >= 0.0 && o.init_range.is_finite()) {
             return Err(self.err("optim.init_range", format!("must be a non-negative number, got {}", o.init_range)));
         }
@@ -798,15 +784,7 @@ impl Spec {
         if !(o.exact_tol > 0.0 && o.exact_tol < 1.0) {
             return Err(self.err("optim.exact_tol", format!("must be in (0,1), got {}", o.exact_tol)));
         }
-        let optim_err = |e: crate::optim::OptimError| match e {
-            crate::optim::OptimError::InvalidParameter { key, message } => self.err(&format!("optim.{key}"), message),
-            other => self.err("optim", other),
-        };
-        o.ga.validate().map_err(optim_err)?;
-        o.de.validate().map_err(optim_err)?;
-        o.pso.validate().map_err(optim_err)?;
-        o.csa.validate().map_err(optim_err)?;
-        o.icsa.validate().map_err(optim_err)?;
+        self.validate_optimiser_params("optim", [o.ga.validate(), o.de.validate(), o.pso.validate(), o.csa.validate(), o.icsa.validate()])?;
         Ok(())
     }
 
