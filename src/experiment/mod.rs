@@ -42,13 +42,24 @@ impl RunContext {
 
 /// One line per cell for `--dry-run`: key and seed.
 pub fn dry_run_listing(spec: &Spec) -> Vec<(String, String)> {
-    let keys: Vec<String> = spec.som_cells().iter().map(|c| c.key()).chain(spec.fit_cells().iter().map(|c| c.key())).chain(spec.optim_cells().iter().map(|c| c.key())).chain(seed001::cells(spec).iter().map(|c| c.key())).collect();
+    let mut keys = logged_cell_keys(spec);
+    keys.extend(seed002::curve_cells(spec).iter().map(|c| c.key()));
     keys.into_iter()
         .map(|k| {
             let s = seeds::seed_hex(spec.file.master_seed, &k);
             (k, s)
         })
         .collect()
+}
+
+/// The keys of every cell of a spec that goes through the cell log (what a merge must find).
+pub fn logged_cell_keys(spec: &Spec) -> Vec<String> {
+    let mut keys: Vec<String> = spec.som_cells().iter().map(|c| c.key()).collect();
+    keys.extend(spec.fit_cells().iter().map(|c| c.key()));
+    keys.extend(spec.optim_cells().iter().map(|c| c.key()));
+    keys.extend(seed001::cells(spec).iter().map(|c| c.key()));
+    keys.extend(seed002::cells(spec).iter().map(|c| c.key()));
+    keys
 }
 
 /// The manifest: enough to re-run exactly.
@@ -115,7 +126,7 @@ pub fn fingerprint(spec: &Spec, shard: Option<log::Shard>) -> log::Fingerprint {
         spec_sha256: hex::encode(<sha2::Sha256 as sha2::Digest>::digest(spec.text.as_bytes())),
         profile: spec.profile.clone().unwrap_or_else(|| "default".into()),
         master_seed: spec.file.master_seed,
-        cells: spec.som_cells().len() + spec.fit_cells().len() + spec.optim_cells().len(),
+        cells: logged_cell_keys(spec).len(),
         shard: shard.map(|s| s.to_string()),
         spec_text: spec.text.clone(),
     }
