@@ -112,3 +112,23 @@ pub fn run(spec: &Spec, ctx: &RunContext) -> Result<Vec<SomRun>> {
     runner::run_logged(&cells, ctx, &spec.file.name, |cell| run_cell(cell, &data[&cell.dataset].points, &params, spec.file.master_seed), |cell, (row, weights)| Ok(SomRun { cell: cell.clone(), row, weights }))
 }
 
+
+/// Chapter 4's family: the `[som]` section.
+pub struct Som;
+
+impl super::family::Family for Som {
+    fn section(&self) -> &'static str {
+        "som"
+    }
+    fn present(&self, spec: &Spec) -> bool {
+        spec.file.som.is_some()
+    }
+    fn logged_keys(&self, spec: &Spec) -> Vec<String> {
+        spec.som_cells().iter().map(|c| c.key()).collect()
+    }
+    fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<super::family::Outcome> {
+        let runs = run(spec, ctx)?;
+        let section = if tables { Some(crate::report::ch4::write(spec, &runs, &ctx.out)?) } else { None };
+        Ok(super::family::Outcome { section, cpu_s: runs.iter().map(|r| r.row.cpu_s).sum(), cells: runs.len() })
+    }
+}

@@ -143,3 +143,26 @@ pub fn run(spec: &Spec, ctx: &RunContext, maps: &BTreeMap<String, MapSource>) ->
     // the logged row, with its CPU time, is kept.
     runner::run_logged(&cells, ctx, &spec.file.name, |cell| run_cell(cell, &maps[&cell.dataset].grid), |cell, row| Ok(FitRun { row, ..run_cell(cell, &maps[&cell.dataset].grid)? }))
 }
+
+/// Chapter 5's family: the `[fit]` section.
+pub struct Fit;
+
+impl super::family::Family for Fit {
+    fn section(&self) -> &'static str {
+        "fit"
+    }
+    fn present(&self, spec: &Spec) -> bool {
+        spec.file.fit.is_some()
+    }
+    fn logged_keys(&self, spec: &Spec) -> Vec<String> {
+        spec.fit_cells().iter().map(|c| c.key()).collect()
+    }
+    fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<super::family::Outcome> {
+        let maps = maps(spec, ctx)?;
+        let runs = run(spec, ctx, &maps)?;
+        let origins: Vec<(String, String)> = maps.iter().map(|(d, m)| (d.clone(), m.origin.clone())).collect();
+        let pictures = spec.file.fit.as_ref().map(|f| f.pictures).unwrap_or(false);
+        let section = if tables { Some(crate::report::ch5::write(&runs, &ctx.out, &origins, pictures)?) } else { None };
+        Ok(super::family::Outcome { section, cpu_s: runs.iter().map(|r| r.row.cpu_s).sum(), cells: runs.len() })
+    }
+}

@@ -197,3 +197,25 @@ pub fn setting(spec: &Spec) -> String {
         None => format!("{start}; the search box is the smallest per-axis box holding the data and B's control points, widened by {} of its size on each side.", o.bounds_margin),
     }
 }
+
+/// Chapter 6's family: the `[optim]` section.
+pub struct Optim;
+
+impl super::family::Family for Optim {
+    fn section(&self) -> &'static str {
+        "optim"
+    }
+    fn present(&self, spec: &Spec) -> bool {
+        spec.file.optim.is_some()
+    }
+    fn logged_keys(&self, spec: &Spec) -> Vec<String> {
+        spec.optim_cells().iter().map(|c| c.key()).collect()
+    }
+    fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<super::family::Outcome> {
+        let problems = problems(spec, ctx)?;
+        let exact = if tables { exact_optima(spec, ctx, &problems)? } else { BTreeMap::new() };
+        let runs = run(spec, ctx, &problems)?;
+        let section = if tables { Some(crate::report::ch6::write(&runs, &problems, &exact, &setting(spec), &ctx.out)?) } else { None };
+        Ok(super::family::Outcome { section, cpu_s: runs.iter().map(|r| r.row.cpu_s).sum(), cells: runs.len() })
+    }
+}

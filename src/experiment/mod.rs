@@ -5,6 +5,7 @@ pub mod ch5;
 pub mod ch6;
 pub mod compare;
 pub mod datasets;
+pub mod family;
 pub mod fit_cmd;
 pub mod log;
 pub mod reproduce;
@@ -43,7 +44,7 @@ impl RunContext {
 /// One line per cell for `--dry-run`: key and seed.
 pub fn dry_run_listing(spec: &Spec) -> Vec<(String, String)> {
     let mut keys = logged_cell_keys(spec);
-    keys.extend(seed002::curve_cells(spec).iter().map(|c| c.key()));
+    keys.extend(family::present(spec).iter().flat_map(|f| f.unlogged_keys(spec)));
     keys.into_iter()
         .map(|k| {
             let s = seeds::seed_hex(spec.file.master_seed, &k);
@@ -54,12 +55,7 @@ pub fn dry_run_listing(spec: &Spec) -> Vec<(String, String)> {
 
 /// The keys of every cell of a spec that goes through the cell log (what a merge must find).
 pub fn logged_cell_keys(spec: &Spec) -> Vec<String> {
-    let mut keys: Vec<String> = spec.som_cells().iter().map(|c| c.key()).collect();
-    keys.extend(spec.fit_cells().iter().map(|c| c.key()));
-    keys.extend(spec.optim_cells().iter().map(|c| c.key()));
-    keys.extend(seed001::cells(spec).iter().map(|c| c.key()));
-    keys.extend(seed002::cells(spec).iter().map(|c| c.key()));
-    keys
+    family::present(spec).iter().flat_map(|f| f.logged_keys(spec)).collect()
 }
 
 /// The manifest: enough to re-run exactly.
@@ -164,35 +160,8 @@ pub fn run_spec(spec: &Spec, ctx: &RunContext) -> Result<PathBuf> {
     let started_unix = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map(|d| d.as_secs()).unwrap_or(0);
     let tables = ctx.shard.is_none();
 
-    let (section, cpu, cells) = if spec.file.som.is_some() {
-        let runs = ch4::run(spec, ctx)?;
-        let section = if tables { Some(crate::report::ch4::write(spec, &runs, &ctx.out)?) } else { None };
-        (section, runs.iter().map(|r| r.row.cpu_s).sum::<f64>(), runs.len())
-    } else if let Some(s2) = &spec.file.seed002 {
-        let runs = seed002::run(spec, ctx)?;
-        let curves = seed002::run_curves(spec, ctx)?;
-        let section = if tables { Some(crate::report::seed002::write(&runs, &curves, s2.population, &ctx.out)?) } else { None };
-        (section, runs.iter().map(|r| r.row.cpu_s).chain(curves.iter().map(|c| c.row.cpu_s)).sum::<f64>(), runs.len() + curves.len())
-    } else if spec.file.growing_grid.is_some() {
-        let maps = seed001::maps(spec, ctx)?;
-        let problems = seed001::problems(spec, &maps)?;
-        let runs = seed001::run(spec, ctx, &problems)?;
-        let section = if tables { Some(crate::report::seed001::write(&maps, &problems, &runs, &ctx.out)?) } else { None };
-        (section, maps.iter().map(|m| m.cpu_s).sum::<f64>() + runs.iter().map(|r| r.row.cpu_s).sum::<f64>(), runs.len())
-    } else if spec.file.optim.is_some() {
-        let problems = ch6::problems(spec, ctx)?;
-        let exact = if tables { ch6::exact_optima(spec, ctx, &problems)? } else { BTreeMap::new() };
-        let runs = ch6::run(spec, ctx, &problems)?;
-        let section = if tables { Some(crate::report::ch6::write(&runs, &problems, &exact, &ch6::setting(spec), &ctx.out)?) } else { None };
-        (section, runs.iter().map(|r| r.row.cpu_s).sum::<f64>(), runs.len())
-    } else {
-        let maps = ch5::maps(spec, ctx)?;
-        let runs = ch5::run(spec, ctx, &maps)?;
-        let origins: Vec<(String, String)> = maps.iter().map(|(d, m)| (d.clone(), m.origin.clone())).collect();
-        let pictures = spec.file.fit.as_ref().map(|f| f.pictures).unwrap_or(false);
-        let section = if tables { Some(crate::report::ch5::write(&runs, &ctx.out, &origins, pictures)?) } else { None };
-        (section, runs.iter().map(|r| r.row.cpu_s).sum::<f64>(), runs.len())
-    };
+    let family = family::present(spec).into_iter().next().context("the spec has no experiment section")?;
+    let family::Outcome { section, cpu_s: cpu, cells } = family.run(spec, ctx, tables)?;
 
     let manifest = Manifest {
         spec_name: spec.file.name.clone(),

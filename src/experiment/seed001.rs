@@ -191,3 +191,26 @@ pub fn run(spec: &Spec, ctx: &RunContext, problems: &BTreeMap<ProblemKey, OpenSu
     let cells = cells(spec);
     runner::run_logged(&cells, ctx, &spec.file.name, |c| run_cell(spec, c, &problems[&(c.dataset.clone(), c.cn, c.param)]), |c, (row, best_x)| Ok(Run { cell: c.clone(), row, best_x }))
 }
+
+/// Seed 001's family: the `[growing_grid]` section.
+pub struct Seed001;
+
+impl super::family::Family for Seed001 {
+    fn section(&self) -> &'static str {
+        "growing_grid"
+    }
+    fn present(&self, spec: &Spec) -> bool {
+        spec.file.growing_grid.is_some()
+    }
+    fn logged_keys(&self, spec: &Spec) -> Vec<String> {
+        cells(spec).iter().map(|c| c.key()).collect()
+    }
+    fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<super::family::Outcome> {
+        let maps = maps(spec, ctx)?;
+        let problems = problems(spec, &maps)?;
+        let runs = run(spec, ctx, &problems)?;
+        let section = if tables { Some(crate::report::seed001::write(&maps, &problems, &runs, &ctx.out)?) } else { None };
+        let cpu_s = maps.iter().map(|m| m.cpu_s).sum::<f64>() + runs.iter().map(|r| r.row.cpu_s).sum::<f64>();
+        Ok(super::family::Outcome { section, cpu_s, cells: runs.len() })
+    }
+}

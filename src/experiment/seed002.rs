@@ -250,3 +250,29 @@ pub fn run_curves(spec: &Spec, ctx: &RunContext) -> Result<Vec<CurveRun>> {
     let cells = curve_cells(spec);
     runner::run_cells(&cells, ctx.jobs, "seed002 curves", |c| run_curve_cell(spec, c), |_, _| Ok(()))
 }
+
+/// Seed 002's family: the `[seed002]` section (surface cells logged, curve cells not).
+pub struct Seed002;
+
+impl super::family::Family for Seed002 {
+    fn section(&self) -> &'static str {
+        "seed002"
+    }
+    fn present(&self, spec: &Spec) -> bool {
+        spec.file.seed002.is_some()
+    }
+    fn logged_keys(&self, spec: &Spec) -> Vec<String> {
+        cells(spec).iter().map(|c| c.key()).collect()
+    }
+    fn unlogged_keys(&self, spec: &Spec) -> Vec<String> {
+        curve_cells(spec).iter().map(|c| c.key()).collect()
+    }
+    fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<super::family::Outcome> {
+        let s = section(spec)?;
+        let runs = run(spec, ctx)?;
+        let curves = run_curves(spec, ctx)?;
+        let section = if tables { Some(crate::report::seed002::write(&runs, &curves, s.population, &ctx.out)?) } else { None };
+        let cpu_s = runs.iter().map(|r| r.row.cpu_s).chain(curves.iter().map(|c| c.row.cpu_s)).sum();
+        Ok(super::family::Outcome { section, cpu_s, cells: runs.len() + curves.len() })
+    }
+}

@@ -521,10 +521,14 @@ impl Spec {
         if f.name.trim().is_empty() || f.name.contains(['/', '\\']) {
             return Err(self.err("name", "must be a non-empty name without slashes"));
         }
-        match f.som.is_some() as u8 + f.fit.is_some() as u8 + f.optim.is_some() as u8 + f.seed002.is_some() as u8 + f.growing_grid.is_some() as u8 {
-            0 => return Err(SpecError(format!("{}: the spec has no experiment section (add [som], [fit], [optim], [seed002] or [growing_grid])", self.path))),
+        let families = super::family::present(self);
+        match families.len() {
+            0 => return Err(SpecError(format!("{}: the spec has no experiment section (add one of {})", self.path, super::family::section_list()))),
             1 => {}
-            _ => return Err(SpecError(format!("{}: one experiment section per spec: [som], [fit], [optim] and [growing_grid] write the same files (split the spec)", self.path))),
+            _ => {
+                let names: Vec<String> = families.iter().map(|f| format!("[{}]", f.section())).collect();
+                return Err(SpecError(format!("{}: one experiment section per spec, this one has {} (they write the same files: split the spec)", self.path, names.join(" and "))));
+            }
         }
         if let Some(g) = &f.growing_grid {
             return self.validate_growing_grid(g);
@@ -949,6 +953,16 @@ iterations = 7
         let q = Spec::parse("t.toml", SPEC, Some("quick")).unwrap();
         assert_eq!(q.file.som.as_ref().unwrap().iterations, 7);
         assert_eq!(q.som_cells()[3].key(), "som/cube/dnsom/18x30/r0");
+    }
+
+    #[test]
+    fn exactly_one_experiment_section() {
+        let none = "name = \"t\"\nmaster_seed = 1\n";
+        let e = Spec::parse("t.toml", none, None).unwrap_err().0;
+        assert!(e.contains("no experiment section") && e.contains("[som]") && e.contains("[seed002]"), "{e}");
+        let two = format!("{SPEC}\n[seed002]\nsurfaces = [\"surface1\"]\n");
+        let e = Spec::parse("t.toml", &two, None).unwrap_err().0;
+        assert!(e.contains("[som] and [seed002]"), "{e}");
     }
 
     #[test]
