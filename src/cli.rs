@@ -40,7 +40,7 @@ pub enum Command {
     /// Regenerate the thesis: Chapters 4, 5 and 6 in order (each chapter's maps feed the next),
     /// then one REPORT.md with every table and picture, the thesis' figures beside ours, Tables
     /// 6.8/6.9 and the table of the thesis' claims with verdicts.
-    #[command(after_help = "Examples:\n  somnurbs reproduce --profile quick   # minutes\n  somnurbs reproduce                   # the full protocol")]
+    #[command(after_help = "Examples:\n  somnurbs reproduce --profile quick   # minutes\n  somnurbs reproduce                   # the full protocol\n  somnurbs reproduce --plan seeds      # the other seeds' experiments (001-004)")]
     Reproduce(ReproduceArgs),
     /// Compare every table of a results folder with a baseline folder: numbers to per-column
     /// tolerances, timing columns reported but not judged. Exit 0: no drift; 1: drift (the moved
@@ -154,7 +154,11 @@ pub struct ReproduceArgs {
     /// quick (minutes; CI) or full (the thesis' protocol).
     #[arg(long, default_value = "full", value_parser = ["quick", "full"])]
     pub profile: String,
-    /// Output folder (default results/thesis, or results/thesis_quick).
+    /// Which plan: `<specs>/<PLAN>.toml` lists the specs to run in order (thesis: Chapters 4-6;
+    /// seeds: the other seeds' experiments; all: both).
+    #[arg(long, default_value = "thesis")]
+    pub plan: String,
+    /// Output folder (default results/<PLAN>, or results/<PLAN>_quick).
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Folder of the experiment specs.

@@ -73,9 +73,9 @@ per-cell differences: {}", report.summary(10), out.display());
             Ok(ExitCode::SUCCESS)
         }
         Command::Reproduce(args) => {
-            let out = args.out.clone().unwrap_or_else(|| if args.profile == "quick" { "results/thesis_quick".into() } else { "results/thesis".into() });
+            let out = args.out.clone().unwrap_or_else(|| if args.profile == "quick" { format!("results/{}_quick", args.plan).into() } else { format!("results/{}", args.plan).into() });
             let ctx = RunContext { resume: args.resume, ..RunContext::new(out, jobs(args.jobs)?, experiment::data_dir(args.data_dir.as_deref())) };
-            let report = experiment::reproduce::reproduce(&args.specs, &args.profile, &ctx)?;
+            let report = experiment::reproduce::reproduce(&args.specs, &args.plan, &args.profile, &ctx)?;
             eprintln!("somnurbs: wrote {}", report.display());
             Ok(ExitCode::SUCCESS)
         }

@@ -93,7 +93,7 @@ fn reproduce_quick_writes_one_report_with_claims_and_tables_6_8_6_9() {
     let specs = root.join("experiments");
     c.ok(&["reproduce", "--profile", "quick", "--out", "thesis", "--specs", specs.to_str().unwrap(), "--jobs", "2"]);
     let report = std::fs::read_to_string(c.path("thesis/REPORT.md")).unwrap();
-    for needle in ["## The thesis' claims", "B beats A in most cells", "DNSOM has the lowest TE", "Table 6.8", "Table 6.9", "](ch4_models/"] {
+    for needle in ["## Claims", "B beats A in most cells", "DNSOM has the lowest TE", "Table 6.8", "Table 6.9", "](ch4_models/"] {
         assert!(report.contains(needle), "REPORT.md lacks {needle:?}");
     }
     let (h, rows) = read_csv(&c.path("thesis/table_6_8.csv"));
@@ -107,4 +107,21 @@ fn reproduce_quick_writes_one_report_with_claims_and_tables_6_8_6_9() {
     let verdict = h.iter().position(|x| x == "verdict").unwrap();
     assert!(claims.len() >= 15);
     assert!(claims.iter().all(|r| ["holds", "mostly holds", "does not hold"].contains(&r[verdict].as_str())), "{claims:?}");
+}
+
+#[test]
+fn reproduce_plan_seeds_runs_the_other_seeds_and_a_missing_plan_is_named() {
+    let c = Case::new();
+    let specs = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments");
+    let specs = specs.to_str().unwrap();
+    c.ok(&["reproduce", "--plan", "seeds", "--profile", "quick", "--out", "seeds", "--specs", specs, "--jobs", "2"]);
+    let report = std::fs::read_to_string(c.path("seeds/REPORT.md")).unwrap();
+    assert!(report.starts_with("# somnurbs: the other seeds' experiments"), "{}", &report[..200.min(report.len())]);
+    let plan: toml::Table = std::fs::read_to_string(format!("{specs}/seeds.toml")).unwrap().parse().unwrap();
+    for name in plan["specs"].as_array().unwrap() {
+        let name = name.as_str().unwrap();
+        assert!(c.path(&format!("seeds/{name}/manifest.toml")).exists(), "{name} did not finish");
+        assert!(report.contains(&format!("# {name}")), "REPORT.md lacks {name}");
+    }
+    c.fails(&["reproduce", "--plan", "nosuch", "--profile", "quick", "--out", "x", "--specs", specs], &["--plan nosuch", "nosuch.toml"]);
 }

@@ -14,14 +14,22 @@ use std::fmt::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-/// `experiments/thesis.toml`.
+/// A plan: `experiments/thesis.toml` (Chapters 4-6), `seeds.toml`, `all.toml`.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Plan {
+    /// The combined report's title.
+    #[serde(default = "default_title")]
+    pub title: String,
     /// Spec names (files `<name>.toml` beside the plan), run in this order.
     pub specs: Vec<String>,
-    /// The spec whose `maps/` folder the later specs read.
-    pub maps_from: String,
+    /// The spec whose `maps/` folder the later specs read (plans with Chapters 5 or 6).
+    #[serde(default)]
+    pub maps_from: Option<String>,
+}
+
+fn default_title() -> String {
+    "reproduction of the thesis".into()
 }
 
 impl Plan {
@@ -31,8 +39,8 @@ impl Plan {
         if plan.specs.is_empty() {
             anyhow::bail!("{}: specs: is empty", path.display());
         }
-        if !plan.specs.contains(&plan.maps_from) {
-            anyhow::bail!("{}: maps_from: `{}` is not one of the specs", path.display(), plan.maps_from);
+        if let Some(m) = plan.maps_from.as_ref().filter(|m| !plan.specs.contains(m)) {
+            anyhow::bail!("{}: maps_from: `{m}` is not one of the specs", path.display());
         }
         Ok(plan)
     }
@@ -41,17 +49,19 @@ impl Plan {
 /// Load every spec of the plan (all before any runs, so a bad one stops nothing half-way), with
 /// the maps of the later ones pointed at `<out>/<maps_from>/maps`.
 fn load_specs(dir: &Path, plan: &Plan, profile: Option<&str>, out: &Path) -> Result<Vec<Spec>> {
-    let maps = out.join(&plan.maps_from).join("maps").to_string_lossy().into_owned();
+    let maps = plan.maps_from.as_ref().map(|m| out.join(m).join("maps").to_string_lossy().into_owned());
     plan.specs
         .iter()
         .map(|name| {
             let path = dir.join(format!("{name}.toml"));
             let mut spec = Spec::load(&path, profile.filter(|p| has_profile(&path, p)))?;
-            if let Some(f) = spec.file.fit.as_mut() {
-                f.maps = Some(maps.clone());
-            }
-            if let Some(o) = spec.file.optim.as_mut() {
-                o.maps = Some(maps.clone());
+            if let Some(maps) = &maps {
+                if let Some(f) = spec.file.fit.as_mut() {
+                    f.maps = Some(maps.clone());
+                }
+                if let Some(o) = spec.file.optim.as_mut() {
+                    o.maps = Some(maps.clone());
+                }
             }
             Ok(spec)
         })
@@ -65,8 +75,12 @@ fn has_profile(path: &Path, profile: &str) -> bool {
 }
 
 /// Run the plan into `ctx.out` and write the combined REPORT.md; returns its path.
-pub fn reproduce(specs_dir: &Path, profile: &str, ctx: &RunContext) -> Result<PathBuf> {
-    let plan = Plan::load(&specs_dir.join("thesis.toml"))?;
+pub fn reproduce(specs_dir: &Path, plan_name: &str, profile: &str, ctx: &RunContext) -> Result<PathBuf> {
+    let plan_path = specs_dir.join(format!("{plan_name}.toml"));
+    if !plan_path.exists() {
+        anyhow::bail!("--plan {plan_name}: no plan file {}", plan_path.display());
+    }
+    let plan = Plan::load(&plan_path)?;
     let profile = if profile == "full" { None } else { Some(profile) };
     let specs = load_specs(specs_dir, &plan, profile, &ctx.out)?;
     crate::report::fsio::ensure_dir(&ctx.out)?;
@@ -79,7 +93,7 @@ pub fn reproduce(specs_dir: &Path, profile: &str, ctx: &RunContext) -> Result<Pa
         run_spec(spec, &sub)?;
         done.push((spec.file.name.clone(), t.elapsed().as_secs_f64()));
     }
-    let report = combined_report(&ctx.out, &specs, &done, profile.unwrap_or("full"), started.elapsed().as_secs_f64())?;
+    let report = combined_report(&ctx.out, &plan, plan_name, &specs, &done, profile.unwrap_or("full"), started.elapsed().as_secs_f64())?;
     let path = ctx.out.join("REPORT.md");
     write_atomic(&path, report.as_bytes())?;
     Ok(path)
@@ -154,12 +168,12 @@ fn markdown_table(header: &[String], rows: &[Vec<String>]) -> String {
 
 /// The combined REPORT.md: header, claims, Tables 6.8/6.9, then each chapter's report with its
 /// links pointed into its sub-folder.
-fn combined_report(out: &Path, specs: &[Spec], done: &[(String, f64)], profile: &str, wall: f64) -> Result<String> {
-    let mut s = String::from("# somnurbs: reproduction of the thesis\n\n");
+fn combined_report(out: &Path, plan: &Plan, plan_name: &str, specs: &[Spec], done: &[(String, f64)], profile: &str, wall: f64) -> Result<String> {
+    let mut s = format!("# somnurbs: {}\n\n", plan.title);
     let commit = env!("SOMNURBS_GIT_COMMIT");
     let _ = writeln!(
         s,
-        "Profile `{profile}`, somnurbs {} at commit {}{}, {}: {} specs in {:.1} s wall. Re-run: `somnurbs reproduce --profile {profile}`.\n",
+        "Plan `{plan_name}`, profile `{profile}`, somnurbs {} at commit {}{}, {}: {} specs in {:.1} s wall. Re-run: `somnurbs reproduce --plan {plan_name} --profile {profile}`.\n",
         env!("CARGO_PKG_VERSION"),
         &commit[..commit.len().min(12)],
         if env!("SOMNURBS_GIT_DIRTY") == "true" { " (dirty)" } else { "" },
@@ -195,8 +209,10 @@ fn combined_report(out: &Path, specs: &[Spec], done: &[(String, f64)], profile: 
     all.extend(overall_claims(&thesis_ch6));
     let table = claims::write(out, &all)?;
     let holding = all.iter().filter(|c| c.holds()).count();
-    let _ = writeln!(s, "\n## The thesis' claims\n\nEach claim is counted on this reproduction (`here`) and, where the published tables allow, on the thesis' own figures; {holding} of {} hold in every case checked here. Also in `claims.csv`.\n", all.len());
-    s.push_str(&table);
+    if !all.is_empty() {
+        let _ = writeln!(s, "\n## Claims\n\nEach claim of the thesis (or, for the other seeds, of the paper) is counted on this reproduction (`here`) and, where the published tables allow, on the source's own figures; {holding} of {} hold in every case checked here. Also in `claims.csv`.\n", all.len());
+        s.push_str(&table);
+    }
     let sources = |a: &'static str, b: &'static str| -> Vec<(&str, &str)> { same.map(|n| (n, a)).into_iter().chain(diff.map(|n| (n, b))).collect() };
     for (name, title, thesis, src) in [
         ("table_6_8", "Table 6.8: least average optimised surface error, overall", "thesis: GA 0/280, DE 243/280, PSO 37/280", sources("table_6_4", "table_6_5")),
