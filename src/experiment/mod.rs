@@ -11,6 +11,7 @@ pub mod reproduce;
 pub mod runner;
 pub mod seed002;
 pub mod seed001;
+pub mod seed004;
 pub mod seeds;
 pub mod spec;
 
@@ -59,6 +60,7 @@ pub fn logged_cell_keys(spec: &Spec) -> Vec<String> {
     keys.extend(spec.optim_cells().iter().map(|c| c.key()));
     keys.extend(seed001::cells(spec).iter().map(|c| c.key()));
     keys.extend(seed002::cells(spec).iter().map(|c| c.key()));
+    keys.extend(seed004::cells(spec).iter().map(|c| c.key()));
     keys
 }
 
@@ -173,6 +175,16 @@ pub fn run_spec(spec: &Spec, ctx: &RunContext) -> Result<PathBuf> {
         let curves = seed002::run_curves(spec, ctx)?;
         let section = if tables { Some(crate::report::seed002::write(&runs, &curves, s2.population, &ctx.out)?) } else { None };
         (section, runs.iter().map(|r| r.row.cpu_s).chain(curves.iter().map(|c| c.row.cpu_s)).sum::<f64>(), runs.len() + curves.len())
+    } else if let Some(s4) = &spec.file.seed004 {
+        let runs = seed004::run(spec, ctx)?;
+        let section = if tables {
+            let sweep = seed004::analytical_sweep(spec)?;
+            let top = seed004::top_view(spec, &runs, 7)?;
+            Some(crate::report::seed004::write(s4, &runs, &sweep, top.as_ref(), &ctx.out)?)
+        } else {
+            None
+        };
+        (section, runs.iter().map(|r| r.row.cpu_s).sum::<f64>(), runs.len())
     } else if spec.file.growing_grid.is_some() {
         let maps = seed001::maps(spec, ctx)?;
         let problems = seed001::problems(spec, &maps)?;
