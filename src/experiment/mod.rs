@@ -180,7 +180,7 @@ pub fn run_spec(spec: &Spec, ctx: &RunContext) -> Result<PathBuf> {
         let section = if tables {
             let sweep = seed004::analytical_sweep(spec)?;
             let top = seed004::top_view(spec, &runs, 7)?;
-            Some(crate::report::seed004::write(s4, &runs, &sweep, top.as_ref(), &ctx.out)?)
+            Some(crate::report::seed004::write(s4, &runs, &sweep, seed004::data_floor(spec)?, top.as_ref(), &ctx.out)?)
         } else {
             None
         };

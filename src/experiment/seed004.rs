@@ -153,6 +153,15 @@ pub fn analytical_sweep(spec: &Spec) -> Result<Vec<(usize, f64)>> {
     (lo..=hi).map(|n| Ok((n, fit_closed(&data, shape(s, n)).map_err(|e| anyhow::anyhow!("seed004, {n} control points: {e}"))?.rms))).collect()
 }
 
+/// RMS distance of the data to the exact cylinder (sqrt(x^2 + y^2) - radius): a floor under
+/// every fit's RMS error at the data's own radial scatter.
+pub fn data_floor(spec: &Spec) -> Result<f64> {
+    let s = section(spec)?;
+    let d = data(s);
+    let sse: f64 = d.points().map(|p| ((p[0] * p[0] + p[1] * p[1]).sqrt() - s.radius).powi(2)).sum();
+    Ok((sse / d.n_points().max(1) as f64).sqrt())
+}
+
 /// What the Fig. 2(a) analogue draws: the bottom ring of the data, the GA's best curve and its
 /// control polygon, and the analytical curve, all seen from the top (x, y).
 #[derive(Debug, Clone)]
