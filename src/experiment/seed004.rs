@@ -104,13 +104,17 @@ pub fn problem(s: &Seed004Spec, data: &RingData, control_points: usize) -> Resul
 
 /// Run one cell (alone it gives the same numbers as inside the full run).
 pub fn run_cell(spec: &Spec, data: &RingData, cell: &Cell) -> Result<Run> {
+    run_cell_on(spec, &problem(section(spec)?, data, cell.control_points)?, cell)
+}
+
+/// Run one cell on its number of control points' problem (built once for all its repeats).
+fn run_cell_on(spec: &Spec, problem: &RingNetProblem, cell: &Cell) -> Result<Run> {
     let s = section(spec)?;
-    let problem = problem(s, data, cell.control_points)?;
     let budget = Budget { generations: s.generations as u64, population: s.population, init_range: 0.0, trace_every_evals: s.population as u64 };
     let key = cell.key();
     let mut rng = seeds::cell_rng(spec.file.master_seed, &key);
     let t0 = runner::thread_cpu_seconds();
-    let r = s.ga.run_with_history(&problem, &budget, &mut rng).map_err(|e| anyhow::anyhow!("{key}: {e}"))?;
+    let r = s.ga.run_with_history(problem, &budget, &mut rng).map_err(|e| anyhow::anyhow!("{key}: {e}"))?;
     let cpu_s = runner::thread_cpu_seconds() - t0;
     let analytical = problem.analytical().rms;
     let row = Row {
@@ -136,12 +140,22 @@ pub fn run_cell(spec: &Spec, data: &RingData, cell: &Cell) -> Result<Run> {
     Ok(Run { cell: cell.clone(), row, population_best: r.population_best, best_so_far: r.best_so_far, best_x: r.result.best_x })
 }
 
-/// Run every cell of the spec.
+/// Run every cell of the spec (the analytical fit of each number of control points once, on
+/// the worker threads).
 pub fn run(spec: &Spec, ctx: &RunContext) -> Result<Vec<Run>> {
     let s = section(spec)?;
     let data = data(s);
+    let cps: Vec<usize> = crate::report::ordered(s.control_points.iter().copied());
+    let problems = runner::run_cells(&cps, ctx.jobs, "seed004 analytical fits", |&cp| problem(s, &data, cp), |_, _| Ok(()))?;
+    let by_cp: std::collections::BTreeMap<usize, &RingNetProblem> = cps.iter().copied().zip(problems.iter()).collect();
     let cells = cells(spec);
-    runner::run_logged(&cells, ctx, &spec.file.name, |cell| run_cell(spec, &data, cell), |cell, (row, population_best, best_so_far, best_x)| Ok(Run { cell: cell.clone(), row, population_best, best_so_far, best_x }))
+    runner::run_logged(
+        &cells,
+        ctx,
+        &spec.file.name,
+        |cell| run_cell_on(spec, by_cp.get(&cell.control_points).context("seed004: no problem for a cell's control points")?, cell),
+        |cell, (row, population_best, best_so_far, best_x)| Ok(Run { cell: cell.clone(), row, population_best, best_so_far, best_x }),
+    )
 }
 
 /// The analytical method alone at every number of control points from the smallest to the

@@ -201,9 +201,10 @@ pub fn fit_closed_at(points: &[Point3], uv: Vec<(f64, f64)>, shape: ClosedNetSha
 /// analytical column's (x, y) (averaged over its rows) +- `search_range`; fitness = RMS error.
 pub struct RingNetProblem {
     fit: ClosedFit,
-    /// Per point: first control index around and the `order_around` basis values.
-    first: Vec<usize>,
+    /// Per point: the `order_around` non-zero basis values and the positions 2 i of their
+    /// control columns' x in the decision vector (wrapped around once, here).
     w: Vec<f64>,
+    at: Vec<usize>,
     target: Vec<[f64; 2]>,
     /// Sum over the points of the squared z error (fixed by the analytical z of the net).
     z_sse: f64,
@@ -223,17 +224,17 @@ impl RingNetProblem {
                 [col.iter().map(|p| p[0]).sum::<f64>() / m, col.iter().map(|p| p[1]).sum::<f64>() / m]
             })
             .collect();
-        let (mut first, mut w, mut target, mut z_sse) = (Vec::new(), Vec::new(), Vec::new(), 0.0);
+        let (mut at, mut w, mut target, mut z_sse) = (Vec::new(), Vec::new(), Vec::new(), 0.0);
         for (p, &(u, v)) in data.points().zip(&fit.uv) {
             let (f, bu) = periodic_basis(n, k, u);
-            first.push(f);
+            at.extend((0..k).map(|l| 2 * ((f + l) % n)));
             w.extend_from_slice(&bu);
             target.push([p[0], p[1]]);
             z_sse += (s.eval(u, v)[2] - p[2]).powi(2);
         }
         let lo = x0.iter().map(|v| v - search_range).collect();
         let hi = x0.iter().map(|v| v + search_range).collect();
-        RingNetProblem { fit, first, w, target, z_sse, x0, lo, hi }
+        RingNetProblem { fit, w, at, target, z_sse, x0, lo, hi }
     }
 
     pub fn n_points(&self) -> usize {
@@ -268,15 +269,13 @@ impl Problem for RingNetProblem {
         (&self.lo, &self.hi)
     }
     fn fitness(&self, x: &[f64]) -> f64 {
-        let n = self.x0.len() / 2;
         let k = self.fit.surface.order_around;
         let mut sse = self.z_sse;
-        for (r, (&f, t)) in self.first.iter().zip(&self.target).enumerate() {
+        for ((t, w), at) in self.target.iter().zip(self.w.chunks_exact(k)).zip(self.at.chunks_exact(k)) {
             let (mut px, mut py) = (0.0, 0.0);
-            for (l, a) in self.w[r * k..(r + 1) * k].iter().enumerate() {
-                let i = if f + l >= n { f + l - n } else { f + l };
-                px += a * x[2 * i];
-                py += a * x[2 * i + 1];
+            for (a, &j) in w.iter().zip(at) {
+                px += a * x[j];
+                py += a * x[j + 1];
             }
             sse += (px - t[0]).powi(2) + (py - t[1]).powi(2);
         }
