@@ -171,7 +171,7 @@ pub fn write(s4: &Seed004Spec, runs: &[Run], sweep: &[(usize, f64)], floor: f64,
     s.push_str(&super::claims::write(out, &claims)?);
     let _ = writeln!(
         s,
-        "\nThe GA's error against the number of control points has a minimum that moves with the search box (`search_range`: the spec's `narrow` profile uses 0.02 instead of 0.25): with 10 individuals and 500 generations the GA cannot reach the analytical accuracy in 2N dimensions once N is large, so a middle optimum such as the paper's 25-30 is a property of the GA's budget and box, not of the surface.");
+        "\nThe GA's error against the number of control points has a minimum that moves with the search box (`search_range`; the spec's `narrow` profile uses 0.02 instead of 0.25). The box is centred on the least-squares minimiser, so a decoded point x0 + r d has SSE = SSE(x0) + r^2 q(d) with q independent of r: the GA's ranking, and so its whole run in bit space, is the same in every box (up to rounding), and its excess error over the analytical one scales with r^2. With 10 individuals and 500 generations that excess grows with the 2N dimensions while the analytical error falls, so a middle optimum such as the paper's 25-30 is a property of the GA's budget and box, not of the surface.");
     let _ = writeln!(
         s,
         "\nWhy the GA cannot beat the analytical net on this cost: with the data parameters fixed, the RMS error is a convex quadratic in the control points and the SVD least squares is its exact minimiser; the GA searches a subset of the same control nets (a {}-bit lattice in the box), so its RMS is at best equal up to the lattice's resolution. A GA result below the analytical one would need other data parameters or another error measure.",
