@@ -2,6 +2,7 @@
 //! (PLY, STL, XYZ/CSV), and the thesis' per-axis min-max normalisation. Pure apart from
 //! `registry`, the one place that reads files.
 
+pub mod cylinder;
 pub mod generators;
 pub mod grid_csv;
 pub mod ply;

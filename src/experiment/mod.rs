@@ -12,6 +12,7 @@ pub mod reproduce;
 pub mod runner;
 pub mod seed002;
 pub mod seed001;
+pub mod seed004;
 pub mod seeds;
 pub mod spec;
 

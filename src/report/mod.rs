@@ -14,6 +14,7 @@ pub mod plots;
 pub mod reference;
 pub mod seed002;
 pub mod seed001;
+pub mod seed004;
 
 use crate::experiment::spec::Spec;
 use crate::experiment::Manifest;

@@ -6,6 +6,7 @@ pub mod approach;
 pub mod basis;
 pub mod conic;
 pub mod bezier;
+pub mod closed;
 pub mod export;
 pub mod fit;
 pub mod knots;

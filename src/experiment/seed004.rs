@@ -1,0 +1,243 @@
+//! Seed 004 wiring (Chaurasiya & Agarwal): the lattice cylinder, sorted into rings, is fitted by
+//! the analytical method (chord length + SVD) for every number of control points around; each
+//! (control points, repeat) cell then runs the binary-coded GA on the columns' (x, y) in a box
+//! around the analytical net, on its own stream, logged at once.
+
+use super::spec::{Seed004Spec, Spec};
+use super::{runner, seeds, RunContext};
+use crate::data::cylinder::{lattice_cylinder, sort_into_rings};
+use crate::optim::{Budget, Problem};
+use crate::spline::closed::{fit_closed, ClosedNetShape, RingData, RingNetProblem};
+use anyhow::{Context, Result};
+use serde::{Deserialize, Serialize};
+
+/// One (number of control points around, repeat).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Cell {
+    pub control_points: usize,
+    pub repeat: usize,
+}
+
+impl Cell {
+    pub fn key(&self) -> String {
+        format!("seed004/cp{}/r{}", self.control_points, self.repeat)
+    }
+}
+
+impl runner::Cell for Cell {
+    fn key(&self) -> String {
+        Cell::key(self)
+    }
+}
+
+/// One row of runs.csv.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Row {
+    pub cell: String,
+    pub control_points: usize,
+    pub repeat: usize,
+    pub seed: String,
+    pub n_points: usize,
+    pub order_around: usize,
+    pub order_vertical: usize,
+    pub rows: usize,
+    /// GA decision variables (x, y per control column) and chromosome length in bits.
+    pub dimension: usize,
+    pub string_length: usize,
+    /// RMS error of the analytical (chord length + SVD) net.
+    pub analytical_rms: f64,
+    /// Best RMS of the GA's initial population (generation 0).
+    pub initial_best_rms: f64,
+    /// Best RMS the GA found (best so far at the end).
+    pub best_rms: f64,
+    /// First generation at which `best_rms` was reached.
+    pub best_generation: usize,
+    /// Best RMS in the final population (no elitism: may exceed `best_rms`).
+    pub final_population_best_rms: f64,
+    /// (analytical - best) / analytical * 100.
+    pub improvement_pct: f64,
+    pub evaluations: u64,
+    pub cpu_s: f64,
+}
+
+/// One run: its row, per-generation histories and best decision vector.
+#[derive(Debug, Clone)]
+pub struct Run {
+    pub cell: Cell,
+    pub row: Row,
+    pub population_best: Vec<f64>,
+    pub best_so_far: Vec<f64>,
+    pub best_x: Vec<f64>,
+}
+
+impl runner::Logged for Run {
+    type Record = (Row, Vec<f64>, Vec<f64>, Vec<f64>);
+    fn record(&self) -> Self::Record {
+        (self.row.clone(), self.population_best.clone(), self.best_so_far.clone(), self.best_x.clone())
+    }
+}
+
+fn section(spec: &Spec) -> Result<&Seed004Spec> {
+    spec.file.seed004.as_ref().context("spec has no [seed004] section")
+}
+
+/// The flat list of cells.
+pub fn cells(spec: &Spec) -> Vec<Cell> {
+    let Some(s) = &spec.file.seed004 else { return Vec::new() };
+    s.control_points.iter().flat_map(|&control_points| (0..s.repeats).map(move |repeat| Cell { control_points, repeat })).collect()
+}
+
+/// The paper's data: lattice cylinder sorted into rings.
+pub fn data(s: &Seed004Spec) -> RingData {
+    sort_into_rings(&lattice_cylinder(s.radius, s.height, s.grid_step, s.accuracy), s.grid_step * 1e-3)
+}
+
+pub fn shape(s: &Seed004Spec, control_points: usize) -> ClosedNetShape {
+    ClosedNetShape { order_around: s.order_around, order_up: s.order_vertical, n_around: control_points, rows: s.rows }
+}
+
+/// The GA problem (and analytical fit) for a number of control points.
+pub fn problem(s: &Seed004Spec, data: &RingData, control_points: usize) -> Result<RingNetProblem> {
+    let fit = fit_closed(data, shape(s, control_points)).map_err(|e| anyhow::anyhow!("seed004, {control_points} control points: {e}"))?;
+    Ok(RingNetProblem::new(data, fit, s.search_range))
+}
+
+/// Run one cell (alone it gives the same numbers as inside the full run).
+pub fn run_cell(spec: &Spec, data: &RingData, cell: &Cell) -> Result<Run> {
+    run_cell_on(spec, &problem(section(spec)?, data, cell.control_points)?, cell)
+}
+
+/// Run one cell on its number of control points' problem (built once for all its repeats).
+fn run_cell_on(spec: &Spec, problem: &RingNetProblem, cell: &Cell) -> Result<Run> {
+    let s = section(spec)?;
+    let budget = Budget { generations: s.generations as u64, population: s.population, init_range: 0.0, trace_every_evals: s.population as u64 };
+    let key = cell.key();
+    let mut rng = seeds::cell_rng(spec.file.master_seed, &key);
+    let t0 = runner::thread_cpu_seconds();
+    let r = s.ga.run_with_history(problem, &budget, &mut rng).map_err(|e| anyhow::anyhow!("{key}: {e}"))?;
+    let cpu_s = runner::thread_cpu_seconds() - t0;
+    let analytical = problem.analytical().rms;
+    let row = Row {
+        cell: key.clone(),
+        control_points: cell.control_points,
+        repeat: cell.repeat,
+        seed: seeds::seed_hex(spec.file.master_seed, &key),
+        n_points: problem.n_points(),
+        order_around: s.order_around,
+        order_vertical: s.order_vertical,
+        rows: s.rows,
+        dimension: problem.dim(),
+        string_length: problem.dim() * s.ga.bits as usize,
+        analytical_rms: analytical,
+        initial_best_rms: r.result.initial_best_fitness,
+        best_rms: r.result.best_fitness,
+        best_generation: r.best_generation(),
+        final_population_best_rms: *r.population_best.last().unwrap_or(&f64::NAN),
+        improvement_pct: (analytical - r.result.best_fitness) / analytical * 100.0,
+        evaluations: r.result.evaluations,
+        cpu_s,
+    };
+    Ok(Run { cell: cell.clone(), row, population_best: r.population_best, best_so_far: r.best_so_far, best_x: r.result.best_x })
+}
+
+/// Run every cell of the spec (the analytical fit of each number of control points once, on
+/// the worker threads).
+pub fn run(spec: &Spec, ctx: &RunContext) -> Result<Vec<Run>> {
+    let s = section(spec)?;
+    let data = data(s);
+    let cps: Vec<usize> = crate::report::ordered(s.control_points.iter().copied());
+    let problems = runner::run_cells(&cps, ctx.jobs, "seed004 analytical fits", |&cp| problem(s, &data, cp), |_, _| Ok(()))?;
+    let by_cp: std::collections::BTreeMap<usize, &RingNetProblem> = cps.iter().copied().zip(problems.iter()).collect();
+    let cells = cells(spec);
+    runner::run_logged(
+        &cells,
+        ctx,
+        &spec.file.name,
+        |cell| run_cell_on(spec, by_cp.get(&cell.control_points).context("seed004: no problem for a cell's control points")?, cell),
+        |cell, (row, population_best, best_so_far, best_x)| Ok(Run { cell: cell.clone(), row, population_best, best_so_far, best_x }),
+    )
+}
+
+/// The analytical method alone at every number of control points from the smallest to the
+/// largest of the spec's list (deterministic and cheap: not logged): (control points, RMS).
+pub fn analytical_sweep(spec: &Spec) -> Result<Vec<(usize, f64)>> {
+    let s = section(spec)?;
+    let data = data(s);
+    let (lo, hi) = (s.control_points.iter().min().copied().unwrap_or(0), s.control_points.iter().max().copied().unwrap_or(0));
+    (lo..=hi).map(|n| Ok((n, fit_closed(&data, shape(s, n)).map_err(|e| anyhow::anyhow!("seed004, {n} control points: {e}"))?.rms))).collect()
+}
+
+/// RMS distance of the data to the exact cylinder (sqrt(x^2 + y^2) - radius): a floor under
+/// every fit's RMS error at the data's own radial scatter.
+pub fn data_floor(spec: &Spec) -> Result<f64> {
+    let s = section(spec)?;
+    let d = data(s);
+    let sse: f64 = d.points().map(|p| ((p[0] * p[0] + p[1] * p[1]).sqrt() - s.radius).powi(2)).sum();
+    Ok((sse / d.n_points().max(1) as f64).sqrt())
+}
+
+/// What the Fig. 2(a) analogue draws: the bottom ring of the data, the GA's best curve and its
+/// control polygon, and the analytical curve, all seen from the top (x, y).
+#[derive(Debug, Clone)]
+pub struct TopView {
+    pub control_points: usize,
+    pub cell: String,
+    pub best_rms: f64,
+    pub analytical_rms: f64,
+    pub data: Vec<(f64, f64)>,
+    pub ga_curve: Vec<(f64, f64)>,
+    pub ga_control: Vec<(f64, f64)>,
+    pub analytical_curve: Vec<(f64, f64)>,
+}
+
+/// The top view of the lowest-RMS run at `control_points` (None if there is no such run).
+pub fn top_view(spec: &Spec, runs: &[Run], control_points: usize) -> Result<Option<TopView>> {
+    let s = section(spec)?;
+    let Some(best) = runs.iter().filter(|r| r.cell.control_points == control_points && !r.best_x.is_empty()).min_by(|a, b| a.row.best_rms.total_cmp(&b.row.best_rms)) else { return Ok(None) };
+    let data = data(s);
+    let problem = problem(s, &data, control_points)?;
+    let ga = problem.surface(&best.best_x);
+    let an = &problem.analytical().surface;
+    let curve = |surf: &crate::spline::closed::ClosedSurface| -> Vec<(f64, f64)> {
+        (0..=400).map(|k| surf.eval(k as f64 / 400.0 * control_points as f64, 0.0)).map(|p| (p[0], p[1])).collect()
+    };
+    let mut ga_control: Vec<(f64, f64)> = best.best_x.chunks(2).map(|c| (c[0], c[1])).collect();
+    ga_control.push(ga_control[0]);
+    Ok(Some(TopView {
+        control_points,
+        cell: best.row.cell.clone(),
+        best_rms: best.row.best_rms,
+        analytical_rms: best.row.analytical_rms,
+        data: data.rings.first().map(|r| r.iter().map(|p| (p[0], p[1])).collect()).unwrap_or_default(),
+        ga_curve: curve(&ga),
+        ga_control,
+        analytical_curve: curve(an),
+    }))
+}
+
+/// Seed 004's family: the `[seed004]` section.
+pub struct Seed004;
+
+impl super::family::Family for Seed004 {
+    fn section(&self) -> &'static str {
+        "seed004"
+    }
+    fn present(&self, spec: &Spec) -> bool {
+        spec.file.seed004.is_some()
+    }
+    fn logged_keys(&self, spec: &Spec) -> Vec<String> {
+        cells(spec).iter().map(|c| c.key()).collect()
+    }
+    fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<super::family::Outcome> {
+        let s4 = spec.file.seed004.as_ref().context("spec has no [seed004] section")?;
+        let runs = run(spec, ctx)?;
+        let section = if tables {
+            let sweep = analytical_sweep(spec)?;
+            let top = top_view(spec, &runs, 7)?;
+            Some(crate::report::seed004::write(s4, &runs, &sweep, data_floor(spec)?, top.as_ref(), &ctx.out)?)
+        } else {
+            None
+        };
+        Ok(super::family::Outcome { section, cpu_s: runs.iter().map(|r| r.row.cpu_s).sum(), cells: runs.len() })
+    }
+}
