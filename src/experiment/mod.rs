@@ -10,6 +10,7 @@ pub mod log;
 pub mod reproduce;
 pub mod runner;
 pub mod seed002;
+pub mod seed003;
 pub mod seed001;
 pub mod seeds;
 pub mod spec;
@@ -59,6 +60,7 @@ pub fn logged_cell_keys(spec: &Spec) -> Vec<String> {
     keys.extend(spec.optim_cells().iter().map(|c| c.key()));
     keys.extend(seed001::cells(spec).iter().map(|c| c.key()));
     keys.extend(seed002::cells(spec).iter().map(|c| c.key()));
+    keys.extend(seed003::cells(spec).iter().map(|c| c.key()));
     keys
 }
 
@@ -173,6 +175,10 @@ pub fn run_spec(spec: &Spec, ctx: &RunContext) -> Result<PathBuf> {
         let curves = seed002::run_curves(spec, ctx)?;
         let section = if tables { Some(crate::report::seed002::write(&runs, &curves, s2.population, &ctx.out)?) } else { None };
         (section, runs.iter().map(|r| r.row.cpu_s).chain(curves.iter().map(|c| c.row.cpu_s)).sum::<f64>(), runs.len() + curves.len())
+    } else if let Some(s3) = &spec.file.seed003 {
+        let runs = seed003::run(spec, ctx)?;
+        let section = if tables { Some(crate::report::seed003::write(s3, &runs, &ctx.out)?) } else { None };
+        (section, runs.iter().map(|r| r.row.cpu_s).sum::<f64>(), runs.len())
     } else if spec.file.growing_grid.is_some() {
         let maps = seed001::maps(spec, ctx)?;
         let problems = seed001::problems(spec, &maps)?;

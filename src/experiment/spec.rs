@@ -200,6 +200,9 @@ pub struct SpecFile {
     /// Seed 002 (Yahya): four-patch G1 rational bi-quadratic Bezier surfaces by GA/DE/PSO.
     #[serde(default)]
     pub seed002: Option<Seed002Spec>,
+    /// Seed 003 (Iglesias et al.): Bezier surfaces with CSA/ICSA-searched data parameters.
+    #[serde(default)]
+    pub seed003: Option<super::seed003::Seed003Spec>,
     /// Seed 001: growing grid on open surfaces, one B-spline surface, GA/DE/PSO.
     #[serde(default)]
     pub growing_grid: Option<GrowingGridSpec>,
@@ -521,13 +524,17 @@ impl Spec {
         if f.name.trim().is_empty() || f.name.contains(['/', '\\']) {
             return Err(self.err("name", "must be a non-empty name without slashes"));
         }
-        match f.som.is_some() as u8 + f.fit.is_some() as u8 + f.optim.is_some() as u8 + f.seed002.is_some() as u8 + f.growing_grid.is_some() as u8 {
-            0 => return Err(SpecError(format!("{}: the spec has no experiment section (add [som], [fit], [optim], [seed002] or [growing_grid])", self.path))),
+        match f.som.is_some() as u8 + f.fit.is_some() as u8 + f.optim.is_some() as u8 + f.seed002.is_some() as u8 + f.growing_grid.is_some() as u8 + f.seed003.is_some() as u8 {
+            0 => return Err(SpecError(format!("{}: the spec has no experiment section (add [som], [fit], [optim], [seed002], [seed003] or [growing_grid])", self.path))),
             1 => {}
             _ => return Err(SpecError(format!("{}: one experiment section per spec: [som], [fit], [optim] and [growing_grid] write the same files (split the spec)", self.path))),
         }
         if let Some(g) = &f.growing_grid {
             return self.validate_growing_grid(g);
+        }
+        if let Some(s) = &f.seed003 {
+            s.validate().map_err(|(key, msg)| self.err(&key, msg))?;
+            return self.validate_optimiser_params("seed003", [s.csa.validate(), s.icsa.validate()]);
         }
         if let Some(o) = &f.optim {
             self.validate_optim(o)?;
