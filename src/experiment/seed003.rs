@@ -186,15 +186,7 @@ fn section(spec: &Spec) -> Result<&Seed003Spec> {
 /// The flat list of cells: examples x methods x runs.
 pub fn cells(spec: &Spec) -> Vec<Cell> {
     let Some(s) = &spec.file.seed003 else { return Vec::new() };
-    let mut out = Vec::new();
-    for example in &s.examples {
-        for method in &s.methods {
-            for run in 0..s.runs {
-                out.push(Cell { example: example.clone(), method: method.clone(), run });
-            }
-        }
-    }
-    out
+    runner::product_cells(&s.examples, &s.methods, s.runs, |e, m, run| Cell { example: e.clone(), method: m.clone(), run })
 }
 
 /// Data of one run: the points, their layout, and the noise sigma.

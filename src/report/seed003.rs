@@ -150,6 +150,9 @@ pub fn write(s: &Seed003Spec, runs: &[Run], out: &Path) -> Result<String> {
     let mut header = vec!["example", "statistic"];
     header.extend(&methods);
     write_csv(out, "seed003_table4.csv", &header, &t4)?;
+    if let Some(r4) = &ref4 {
+        paper_consistency(r4, &examples, &methods, &mut md);
+    }
 
     // Table 5 and the agreement with the paper.
     let others: Vec<&str> = ["uniform", "chordal", "centripetal", "icsa"].into_iter().filter(|m| methods.contains(m)).collect();
@@ -172,6 +175,44 @@ pub fn write(s: &Seed003Spec, runs: &[Run], out: &Path) -> Result<String> {
     }
     convergence(s, runs, &examples, &methods, out, &mut md, &stats)?;
     Ok(md)
+}
+
+/// Where the transcribed Table 4 contradicts itself (computed from its own cells): std^2 against
+/// var (more than 5% apart), and the printed error rates against 100 x value / best of the row
+/// (more than 0.15 points apart).
+fn paper_consistency(r4: &RefTable, examples: &[&str], methods: &[&str], md: &mut String) {
+    let v = |e: &str, st: &str, m: &str| r4.value(&["example", "statistic"], &[e.to_string(), st.to_string()], m);
+    let mut notes = Vec::new();
+    for e in examples {
+        for m in methods {
+            if let (Some(var), Some(sd)) = (v(e, "y_var", m), v(e, "y_std", m)) {
+                if (sd * sd - var).abs() > 0.05 * var {
+                    notes.push(format!("{e} {m}: var {var:e} but std^2 = {:.6e}", sd * sd));
+                }
+            }
+        }
+        for st in RATED {
+            let best = methods.iter().filter_map(|m| v(e, st, m)).fold(f64::INFINITY, f64::min);
+            for m in methods {
+                if let (Some(x), Some(er)) = (v(e, st, m), v(e, &format!("er_{st}"), m)) {
+                    let want = 100.0 * x / best;
+                    if (want - er).abs() > 0.15 {
+                        notes.push(format!("{e} {m} er_{st}: printed {er} but 100 x {x:e} / {best:e} = {want:.1}"));
+                    }
+                }
+            }
+        }
+    }
+    if !notes.is_empty() {
+        let _ = writeln!(md, "
+The transcribed Table 4 is not consistent with itself in these cells (garbled in the seed text or in the paper; transcribed as printed):
+");
+        for n in notes {
+            let _ = writeln!(md, "- {n}");
+        }
+    }
+    let _ = writeln!(md, "
+Table 5's Example II cells for CSA vs centripetal are garbled: the sign test's h reads \"1 (alpha = 0.1)\", the sum test's \"1 (alpha = 0.15)\" (the text: h = 0 at 0.05), and its rank-sum p-value is printed \"0.148521 x 10^-1\" although the text says order 10^-1 (likely 1.48521e-1); the transcription keeps the printed number and h = 0.");
 }
 
 /// Table 5 (`seed003_table5.csv`), the agreement table (`seed003_agreement.csv`) and their
