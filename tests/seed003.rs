@@ -76,7 +76,9 @@ fn seed003_quick_profile_writes_the_papers_tables() {
     let (h, agree) = read_csv(&out2.join("seed003_agreement.csv"));
     assert_eq!(agree.len(), 12);
     let d = col(&h, "direction_agrees");
+    let (g, all) = (col(&h, "significance_agrees"), col(&h, "agrees"));
     assert!(agree.iter().all(|r| r[d] == "yes" || r[d] == "no"));
+    assert!(agree.iter().all(|r| (r[all] == "yes") == (r[d] == "yes" && r[g] == "yes")));
     let report = std::fs::read_to_string(out2.join("REPORT.md")).unwrap();
     assert!(report.contains("### Table 5") && report.contains("Direction agrees in"), "{report}");
 

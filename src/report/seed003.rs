@@ -247,8 +247,8 @@ fn write_tests(s: &Seed003Spec, runs: &[Run], examples: &[&str], others: &[&str]
 
     let _ = writeln!(md, "\n### Agreement with the paper (computed from our tables and the transcribed ones)\n");
     let _ = writeln!(md, "Better = lower mean Y (Table 4); h = significant at alpha = {}. The paper's h for CSA vs centripetal on Example II is 0 at 0.05 (its cells say 1 only at alpha 0.1 / 0.15).\n", s.alpha);
-    let _ = writeln!(md, "| comparison | example | better (ours) | better (paper) | h sign (ours / paper) | h sum (ours / paper) | direction agrees | significance agrees |");
-    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(md, "| comparison | example | better (ours) | better (paper) | h sign (ours / paper) | h sum (ours / paper) | direction agrees | significance agrees | agrees |");
+    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|");
     let better = |e: &str, o: &str, mean: &dyn Fn(&str) -> Option<f64>| -> String {
         match (mean("csa"), mean(o)) {
             (Some(c), Some(x)) if c < x => "csa".into(),
@@ -268,14 +268,15 @@ fn write_tests(s: &Seed003Spec, runs: &[Run], examples: &[&str], others: &[&str]
             let sig_ok = ph1 == Some(v[2]) && ph2 == Some(v[5]);
             let hs = |x: f64| if x.is_nan() { "-".to_string() } else { format!("{x}") };
             let pv = |x: Option<f64>| x.map(hs).unwrap_or_else(|| "-".into());
-            agree.push(vec![comp.clone(), e.to_string(), ours.clone(), paper.clone(), num(v[2]), ph1.map(num).unwrap_or_default(), num(v[5]), ph2.map(num).unwrap_or_default(), yes(dir_ok).into(), yes(sig_ok).into()]);
-            let _ = writeln!(md, "| {comp} | {e} | {ours} | {paper} | {} / {} | {} / {} | {} | {} |", hs(v[2]), pv(ph1), hs(v[5]), pv(ph2), yes(dir_ok), yes(sig_ok));
+            agree.push(vec![comp.clone(), e.to_string(), ours.clone(), paper.clone(), num(v[2]), ph1.map(num).unwrap_or_default(), num(v[5]), ph2.map(num).unwrap_or_default(), yes(dir_ok).into(), yes(sig_ok).into(), yes(dir_ok && sig_ok).into()]);
+            let _ = writeln!(md, "| {comp} | {e} | {ours} | {paper} | {} / {} | {} / {} | {} | {} | **{}** |", hs(v[2]), pv(ph1), hs(v[5]), pv(ph2), yes(dir_ok), yes(sig_ok), yes(dir_ok && sig_ok));
         }
     }
     let n_dir = agree.iter().filter(|r| r[8] == "yes").count();
     let n_sig = agree.iter().filter(|r| r[9] == "yes").count();
-    let _ = writeln!(md, "\nDirection agrees in {n_dir} of {} comparisons, significance (both tests) in {n_sig} of {}.", agree.len(), agree.len());
-    write_csv(out, "seed003_agreement.csv", &["comparison", "example", "better_ours", "better_paper", "h_sign_ours", "h_sign_paper", "h_sum_ours", "h_sum_paper", "direction_agrees", "significance_agrees"], &agree)
+    let n_all = agree.iter().filter(|r| r[10] == "yes").count();
+    let _ = writeln!(md, "\nDirection agrees in {n_dir} of {} comparisons, significance (both tests) in {n_sig}, both (agrees) in {n_all}.", agree.len());
+    write_csv(out, "seed003_agreement.csv", &["comparison", "example", "better_ours", "better_paper", "h_sign_ours", "h_sign_paper", "h_sum_ours", "h_sum_paper", "direction_agrees", "significance_agrees", "agrees"], &agree)
 }
 
 /// Convergence diagrams: per example, the median and quartiles over the runs of CSA's and ICSA's
@@ -313,7 +314,7 @@ fn convergence(s: &Seed003Spec, runs: &[Run], examples: &[&str], methods: &[&str
         }
         for (k, m) in ["uniform", "chordal", "centripetal"].iter().filter(|m| methods.contains(m)).enumerate() {
             if let Some(st) = stats(e, m) {
-                series.push(Series { label: format!("{m} (mean Y)"), colour: style::cycle_colour(k + 3), points: vec![(0.0, st.y_mean), (last.max(1.0), st.y_mean)], band: None });
+                series.push(Series { label: format!("{m} (mean Y)"), colour: [style::BLUE, style::GREEN, style::BLACK][k], points: vec![(0.0, st.y_mean), (last.max(1.0), st.y_mean)], band: None });
             }
         }
         if series.is_empty() {
