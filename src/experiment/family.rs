@@ -38,7 +38,7 @@ pub trait Family: Sync {
 }
 
 /// Every family the harness knows, in the order their sections are named in messages.
-pub static FAMILIES: &[&dyn Family] = &[&super::ch4::Som, &super::ch5::Fit, &super::ch6::Optim, &super::seed001::Seed001, &super::seed002::Seed002, &super::seed004::Seed004];
+pub static FAMILIES: &[&dyn Family] = &[&super::ch4::Som, &super::ch5::Fit, &super::ch6::Optim, &super::seed001::Seed001, &super::seed002::Seed002, &super::seed003::Seed003, &super::seed004::Seed004];
 
 /// The families whose sections the spec has (validation requires exactly one).
 pub fn present(spec: &Spec) -> Vec<&'static dyn Family> {

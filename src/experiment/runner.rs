@@ -42,6 +42,20 @@ where
     results
 }
 
+/// The cells of a two-list x repeats design in the specs' fixed order (a outer, b, then the
+/// repeat 0..repeats inner), built by `make`.
+pub fn product_cells<A, B, C>(a: &[A], b: &[B], repeats: usize, make: impl Fn(&A, &B, usize) -> C) -> Vec<C> {
+    let mut out = Vec::with_capacity(a.len() * b.len() * repeats);
+    for x in a {
+        for y in b {
+            for r in 0..repeats {
+                out.push(make(x, y, r));
+            }
+        }
+    }
+    out
+}
+
 /// A cell of a spec: its stable key names its random stream and its line in the cell log.
 pub trait Cell: Sync {
     fn key(&self) -> String;

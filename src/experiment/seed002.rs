@@ -76,15 +76,7 @@ fn section(spec: &Spec) -> Result<&Seed002Spec> {
 /// The flat list of cells.
 pub fn cells(spec: &Spec) -> Vec<Cell> {
     let Some(s) = &spec.file.seed002 else { return Vec::new() };
-    let mut out = Vec::new();
-    for surface in &s.surfaces {
-        for opt in &s.optimisers {
-            for repeat in 0..s.repeats {
-                out.push(Cell { surface: surface.clone(), optimiser: opt.clone(), repeat });
-            }
-        }
-    }
-    out
+    runner::product_cells(&s.surfaces, &s.optimisers, s.repeats, |sf, o, repeat| Cell { surface: sf.clone(), optimiser: o.clone(), repeat })
 }
 
 /// The SSE problem of a surface with the spec's grid and box.
@@ -190,15 +182,7 @@ pub struct CurveRun {
 
 pub fn curve_cells(spec: &Spec) -> Vec<CurveCell> {
     let Some(s) = &spec.file.seed002 else { return Vec::new() };
-    let mut out = Vec::new();
-    for outline in &s.outlines {
-        for opt in &s.optimisers {
-            for repeat in 0..s.repeats {
-                out.push(CurveCell { outline: outline.clone(), optimiser: opt.clone(), repeat });
-            }
-        }
-    }
-    out
+    runner::product_cells(&s.outlines, &s.optimisers, s.repeats, |ol, o, repeat| CurveCell { outline: ol.clone(), optimiser: o.clone(), repeat })
 }
 
 /// Sample the outline, detect its corners (SAM06), cut it into conic runs and fit each run's

@@ -272,6 +272,9 @@ pub struct SpecFile {
     /// Seed 002 (Yahya): four-patch G1 rational bi-quadratic Bezier surfaces by GA/DE/PSO.
     #[serde(default)]
     pub seed002: Option<Seed002Spec>,
+    /// Seed 003 (Iglesias et al.): Bezier surfaces with CSA/ICSA-searched data parameters.
+    #[serde(default)]
+    pub seed003: Option<super::seed003::Seed003Spec>,
     /// Seed 001: growing grid on open surfaces, one B-spline surface, GA/DE/PSO.
     #[serde(default)]
     pub growing_grid: Option<GrowingGridSpec>,
@@ -607,6 +610,10 @@ impl Spec {
         }
         if let Some(g) = &f.growing_grid {
             return self.validate_growing_grid(g);
+        }
+        if let Some(s) = &f.seed003 {
+            s.validate().map_err(|(key, msg)| self.err(&key, msg))?;
+            return self.validate_optimiser_params("seed003", [s.csa.validate(), s.icsa.validate()]);
         }
         if let Some(o) = &f.optim {
             self.validate_optim(o)?;

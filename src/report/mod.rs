@@ -13,6 +13,7 @@ pub mod markdown;
 pub mod plots;
 pub mod reference;
 pub mod seed002;
+pub mod seed003;
 pub mod seed001;
 pub mod seed004;
 

@@ -45,6 +45,9 @@ pub fn table(name: &str) -> Option<RefTable> {
         "appendix_l" => include_str!("../../experiments/reference/appendix_l.csv"),
         "appendix_m" => include_str!("../../experiments/reference/appendix_m.csv"),
         "appendix_n" => include_str!("../../experiments/reference/appendix_n.csv"),
+        "seed003_table3" => include_str!("../../experiments/reference/seed003_table3.csv"),
+        "seed003_table4" => include_str!("../../experiments/reference/seed003_table4.csv"),
+        "seed003_table5" => include_str!("../../experiments/reference/seed003_table5.csv"),
         _ => return None,
     };
     Some(RefTable::parse(text))

@@ -1,0 +1,325 @@
+//! Seed 003 wiring (Iglesias et al., cuckoo search for Bezier surface approximation): each
+//! (example, method, run) draws the run's noisy data, parameterises it (uniform, chordal,
+//! centripetal, or CSA/ICSA searching the parameters from a random start population), fits the
+//! poles by least squares and records Y; every cell on its own stream, logged at once.
+//!
+//! The data of run r of an example are the same for every method (the noise comes from the stream
+//! of the key `seed003/<example>/data/r<r>`), so the methods' runs pair by index for the signed-rank
+//! test; Example III's clean surface and its 628 sampling parameters come from the stream
+//! `seed003/example3/surface`, the same in every run.
+
+use super::spec::Spec;
+use super::{runner, seeds, RunContext};
+use crate::geom::Point3;
+use crate::optim::{Budget, Csa, Icsa, Optimiser, Problem};
+use crate::spline::bezier::{self, BezierParamProblem, Layout};
+use crate::spline::Parameterisation;
+use anyhow::{Context, Result};
+use serde::{Deserialize, Serialize};
+
+/// The three examples in order.
+pub const EXAMPLES: [&str; 3] = ["example1", "example2", "example3"];
+/// The five methods in the paper's Table 4 order.
+pub const METHODS: [&str; 5] = ["uniform", "chordal", "centripetal", "csa", "icsa"];
+
+/// One example's data and budget.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExampleSpec {
+    /// Grid side (Examples I, II: a size x size grid) or number of points (Example III).
+    pub size: usize,
+    /// Degree (eta, sigma) = (degree, degree) of the Bezier surface.
+    pub degree: usize,
+    /// Signal-to-noise ratio of the Gaussian noise, dB.
+    pub snr_db: f64,
+    /// CSA/ICSA iterations.
+    pub generations: usize,
+}
+
+/// The `[seed003]` section.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Seed003Spec {
+    /// example1 (Franke), example2 (peaks), example3 (self-intersecting Bezier surface).
+    pub examples: Vec<String>,
+    /// uniform, chordal, centripetal, csa, icsa.
+    pub methods: Vec<String>,
+    /// Independent executions per (example, method) (the paper: 50).
+    pub runs: usize,
+    /// Host nests N_p (the paper: 100).
+    pub nests: usize,
+    /// Convergence trace: one point every this many iterations.
+    pub trace_every: usize,
+    /// Significance level of the tests (Table 5: 0.05).
+    pub alpha: f64,
+    pub example1: ExampleSpec,
+    pub example2: ExampleSpec,
+    pub example3: ExampleSpec,
+    #[serde(default)]
+    pub csa: Csa,
+    #[serde(default)]
+    pub icsa: Icsa,
+}
+
+impl Seed003Spec {
+    pub fn example(&self, name: &str) -> Option<&ExampleSpec> {
+        match name {
+            "example1" => Some(&self.example1),
+            "example2" => Some(&self.example2),
+            "example3" => Some(&self.example3),
+            _ => None,
+        }
+    }
+
+    /// Checks of the section, as (key, message) of the first fault.
+    pub fn validate(&self) -> Result<(), (String, String)> {
+        let bad = |k: &str, m: String| Err((format!("seed003.{k}"), m));
+        if self.examples.is_empty() {
+            return bad("examples", "is empty".into());
+        }
+        if let Some(e) = self.examples.iter().find(|e| !EXAMPLES.contains(&e.as_str())) {
+            return bad("examples", format!("unknown example `{e}` (expected example1, example2 or example3)"));
+        }
+        if self.methods.is_empty() {
+            return bad("methods", "is empty".into());
+        }
+        if let Some(m) = self.methods.iter().find(|m| !METHODS.contains(&m.as_str())) {
+            return bad("methods", format!("unknown method `{m}` (expected uniform, chordal, centripetal, csa or icsa)"));
+        }
+        if self.runs == 0 {
+            return bad("runs", "must be at least 1".into());
+        }
+        if self.nests < 2 {
+            return bad("nests", format!("must be at least 2, got {}", self.nests));
+        }
+        if self.trace_every == 0 {
+            return bad("trace_every", "must be at least 1".into());
+        }
+        if !(self.alpha > 0.0 && self.alpha < 1.0) {
+            return bad("alpha", format!("must be in (0, 1), got {}", self.alpha));
+        }
+        for name in EXAMPLES {
+            let e = self.example(name).expect("known example");
+            let key = |k: &str| format!("{name}.{k}");
+            let min = if name == "example3" { (e.degree + 1) * (e.degree + 1) } else { e.degree + 1 };
+            if e.degree == 0 || e.size < min.max(3) {
+                return bad(&key("size"), format!("{} is too small for degree {} (at least {})", e.size, e.degree, min.max(3)));
+            }
+            if !(e.snr_db.is_finite()) {
+                return bad(&key("snr_db"), format!("must be a finite number of dB, got {}", e.snr_db));
+            }
+            if e.generations == 0 {
+                return bad(&key("generations"), "must be at least 1".into());
+            }
+        }
+        Ok(())
+    }
+}
+
+/// One (example, method, run).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Cell {
+    pub example: String,
+    pub method: String,
+    pub run: usize,
+}
+
+impl Cell {
+    pub fn key(&self) -> String {
+        format!("seed003/{}/{}/r{}", self.example, self.method, self.run)
+    }
+}
+
+impl runner::Cell for Cell {
+    fn key(&self) -> String {
+        Cell::key(self)
+    }
+}
+
+/// One row of runs.csv.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Row {
+    pub cell: String,
+    pub example: String,
+    pub method: String,
+    pub run: usize,
+    /// The cell's stream (CSA/ICSA start population and moves).
+    pub seed: String,
+    /// The stream of the run's noise (shared by the five methods).
+    pub data_seed: String,
+    pub n_points: usize,
+    pub degree: usize,
+    /// Parameters searched (grid: one per column and row; scattered: two per point).
+    pub dimension: usize,
+    pub snr_db: f64,
+    /// Standard deviation of the noise drawn for this run's data.
+    pub noise_sigma: f64,
+    /// Sum of squared distances of the data to the fitted surface (the paper's Eq. 4/5).
+    pub y: f64,
+    /// sqrt(Y / n_points) (the paper's Eq. 14/15).
+    pub rmse: f64,
+    /// Best Y of the start population (CSA/ICSA); Y itself for a classical parameterisation.
+    pub initial_best_y: f64,
+    pub evaluations: u64,
+    pub iterations: usize,
+    pub cpu_s: f64,
+}
+
+/// One run with its convergence trace (evaluations, best Y so far).
+#[derive(Debug, Clone)]
+pub struct Run {
+    pub row: Row,
+    pub trace: Vec<(u64, f64)>,
+}
+
+impl runner::Logged for Run {
+    type Record = (Row, Vec<(u64, f64)>);
+    fn record(&self) -> Self::Record {
+        (self.row.clone(), self.trace.clone())
+    }
+}
+
+fn section(spec: &Spec) -> Result<&Seed003Spec> {
+    spec.file.seed003.as_ref().context("spec has no [seed003] section")
+}
+
+/// The flat list of cells: examples x methods x runs.
+pub fn cells(spec: &Spec) -> Vec<Cell> {
+    let Some(s) = &spec.file.seed003 else { return Vec::new() };
+    runner::product_cells(&s.examples, &s.methods, s.runs, |e, m, run| Cell { example: e.clone(), method: m.clone(), run })
+}
+
+/// Data of one run: the points, their layout, and the noise sigma.
+pub struct Data {
+    pub points: Vec<Point3>,
+    pub layout: Layout,
+    pub sigma: f64,
+}
+
+/// The clean data of an example (Example III from its fixed stream).
+pub fn clean(master_seed: u64, example: &str, e: &ExampleSpec) -> Result<(Vec<Point3>, Layout)> {
+    Ok(match example {
+        "example1" => (bezier::height_grid(bezier::franke, e.size, 0.0, 1.0), Layout::Grid { nu: e.size, nv: e.size }),
+        "example2" => (bezier::height_grid(bezier::peaks, e.size, -3.0, 3.0), Layout::Grid { nu: e.size, nv: e.size }),
+        "example3" => {
+            let mut rng = seeds::cell_rng(master_seed, "seed003/example3/surface");
+            (bezier::example3(e.size, &mut rng).1, Layout::Scattered)
+        }
+        other => anyhow::bail!("seed003.examples: unknown example `{other}`"),
+    })
+}
+
+fn data_key(example: &str, run: usize) -> String {
+    format!("seed003/{example}/data/r{run}")
+}
+
+/// Run r's noisy data of an example.
+pub fn data(master_seed: u64, example: &str, e: &ExampleSpec, run: usize) -> Result<Data> {
+    let (mut points, layout) = clean(master_seed, example, e)?;
+    let mut rng = seeds::cell_rng(master_seed, &data_key(example, run));
+    let sigma = bezier::add_noise(&mut points, e.snr_db, &mut rng);
+    Ok(Data { points, layout, sigma })
+}
+
+fn classical(method: &str) -> Option<Parameterisation> {
+    match method {
+        "uniform" => Some(Parameterisation::Uniform),
+        "chordal" => Some(Parameterisation::ChordLength),
+        "centripetal" => Some(Parameterisation::Centripetal),
+        _ => None,
+    }
+}
+
+/// The decision vector of a classical parameterisation of the data.
+pub fn classical_start(d: &Data, p: Parameterisation) -> Vec<f64> {
+    match d.layout {
+        Layout::Grid { nu, nv } => bezier::classical_grid_start(&d.points, nu, nv, p),
+        Layout::Scattered => bezier::classical_scattered_start(&d.points, p),
+    }
+}
+
+/// The CSA/ICSA budget of an example: N nests, G iterations; the start population is uniform on
+/// [0, 1]^dim (centre 0.5, half-width 0.5), one trace point every `trace_every` iterations (2N
+/// evaluations per iteration).
+pub fn budget(s: &Seed003Spec, e: &ExampleSpec) -> Budget {
+    Budget { generations: e.generations as u64, population: s.nests, init_range: 0.5, trace_every_evals: (2 * s.nests * s.trace_every) as u64 }
+}
+
+/// Run one cell (alone it gives the same numbers as inside the full run).
+pub fn run_cell(spec: &Spec, cell: &Cell) -> Result<Run> {
+    let s = section(spec)?;
+    let e = s.example(&cell.example).with_context(|| format!("seed003.examples: unknown example `{}`", cell.example))?;
+    let key = cell.key();
+    let master = spec.file.master_seed;
+    let d = data(master, &cell.example, e, cell.run)?;
+    let n = d.points.len();
+    let t0 = runner::thread_cpu_seconds();
+    let (y, initial, evaluations, iterations, trace, dim) = if let Some(p) = classical(&cell.method) {
+        let x = classical_start(&d, p);
+        let prob = BezierParamProblem::new(e.degree, e.degree, d.layout, d.points, x.clone()).map_err(|err| anyhow::anyhow!("{key}: {err}"))?;
+        let y = prob.fitness(&x);
+        (y, y, 1, 0, Vec::new(), prob.dim())
+    } else {
+        let centre = vec![0.5; match d.layout {
+            Layout::Grid { nu, nv } => nu + nv,
+            Layout::Scattered => 2 * n,
+        }];
+        let prob = BezierParamProblem::new(e.degree, e.degree, d.layout, d.points, centre).map_err(|err| anyhow::anyhow!("{key}: {err}"))?;
+        let opt: Box<dyn Optimiser> = match cell.method.as_str() {
+            "csa" => Box::new(s.csa.clone()),
+            "icsa" => Box::new(s.icsa.clone()),
+            other => anyhow::bail!("seed003.methods: unknown method `{other}`"),
+        };
+        let mut rng = seeds::cell_rng(master, &key);
+        let r = opt.run(&prob, &budget(s, e), &mut rng).map_err(|err| anyhow::anyhow!("{key}: {err}"))?;
+        (r.best_fitness, r.initial_best_fitness, r.evaluations, e.generations, r.trace, prob.dim())
+    };
+    let cpu_s = runner::thread_cpu_seconds() - t0;
+    let row = Row {
+        cell: key.clone(),
+        example: cell.example.clone(),
+        method: cell.method.clone(),
+        run: cell.run,
+        seed: seeds::seed_hex(master, &key),
+        data_seed: seeds::seed_hex(master, &data_key(&cell.example, cell.run)),
+        n_points: n,
+        degree: e.degree,
+        dimension: dim,
+        snr_db: e.snr_db,
+        noise_sigma: d.sigma,
+        y,
+        rmse: (y / n as f64).sqrt(),
+        initial_best_y: initial,
+        evaluations,
+        iterations,
+        cpu_s,
+    };
+    Ok(Run { row, trace })
+}
+
+/// Run every cell of the spec.
+pub fn run(spec: &Spec, ctx: &RunContext) -> Result<Vec<Run>> {
+    let cells = cells(spec);
+    runner::run_logged(&cells, ctx, &spec.file.name, |cell| run_cell(spec, cell), |_, (row, trace)| Ok(Run { row, trace }))
+}
+
+/// Seed 003's family: the `[seed003]` section.
+pub struct Seed003;
+
+impl super::family::Family for Seed003 {
+    fn section(&self) -> &'static str {
+        "seed003"
+    }
+    fn present(&self, spec: &Spec) -> bool {
+        spec.file.seed003.is_some()
+    }
+    fn logged_keys(&self, spec: &Spec) -> Vec<String> {
+        cells(spec).iter().map(|c| c.key()).collect()
+    }
+    fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<super::family::Outcome> {
+        let s3 = spec.file.seed003.as_ref().context("spec has no [seed003] section")?;
+        let runs = run(spec, ctx)?;
+        let section = if tables { Some(crate::report::seed003::write(s3, &runs, &ctx.out)?) } else { None };
+        Ok(super::family::Outcome { section, cpu_s: runs.iter().map(|r| r.row.cpu_s).sum(), cells: runs.len() })
+    }
+}
