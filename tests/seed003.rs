@@ -85,7 +85,7 @@ fn seed003_quick_profile_writes_the_papers_tables() {
     // One thread: the same numbers.
     let out1 = case.path("j1");
     case.ok(&["run", spec.to_str().unwrap(), "--profile", "quick", "--out", out1.to_str().unwrap(), "--jobs", "1"]);
-    assert_eq!(same_tables(&out1, &out2), 6);
+    assert_eq!(same_tables(&out1, &out2), 7);
 }
 
 #[test]
