@@ -9,10 +9,6 @@
 //! and global bests are updated (a personal best moves only on strict improvement).
 //! `population * (1 + generations)` evaluations.
 //!
-//! Only the global best couples the particles within an iteration, so each particle is moved,
-//! evaluated and its personal best updated before the next one moves: the same updates in the same
-//! order as moving all, then evaluating all, with the particle's vectors still in L1 cache.
-//!
 //! Random numbers: r1 and r2 are the two 32-bit halves of one 64-bit word (resolution 2^-32),
 //! one word per coordinate from interleaved xoshiro256++ generators seeded from the run's
 //! stream ([`super::sampling::BulkLanes`]), generated and consumed in the vectorised move loop.
@@ -78,6 +74,8 @@ impl Optimiser for Pso {
         for _ in 0..budget.generations {
             for i in 0..n {
                 pso_move(&mut pos[i], &mut vel[i], &pbest[i], &gbest, &mut bulk, co, lo, hi);
+            }
+            for i in 0..n {
                 fit[i] = eval.eval(&pos[i]);
                 if fit[i] < pbest_f[i] {
                     pbest_f[i] = fit[i];
