@@ -15,12 +15,9 @@
 //! geometric skips: walking the genes with `j += 1 + skip`, skip ~ Geometric(p), visits each gene
 //! independently with probability p, which is exactly the law of the per-gene Bernoulli(p) draws
 //! it replaces; the forced position j_rand is then set from the mutant. With CR = 0.8 this draws
-//! about 0.2 d skips (12 random bits each, mostly) instead of d uniforms. The walk only marks a
-//! byte per gene (mutant or target, in a buffer that stays in L1); one vectorised pass then builds
-//! the trial from the mutant and the target, streaming through the donors and the target once
-//! instead of loading the target's genes one visited position at a time.
+//! about 0.2 d skips (12 random bits each, mostly) instead of d uniforms.
 
-use super::kernels::de_trial;
+use super::kernels::de_mutant;
 use super::problem::{check_problem, Budget, Evaluator, Optimiser, Population, Problem, RunResult};
 use super::sampling::{index, BitPool, Geometric};
 use super::{check_range, OptimError};
@@ -95,7 +92,6 @@ impl Optimiser for De {
         let mut spare: Vec<Vec<f64>> = Vec::with_capacity(n + 1);
         let mut accepted: Vec<(usize, Vec<f64>, f64)> = Vec::with_capacity(n);
         let mut t_buf = vec![0.0; d];
-        let mut from_mutant = vec![0u8; d];
         let fw = self.f;
         for _ in 0..budget.generations {
             for i in 0..n {
@@ -103,16 +99,26 @@ impl Optimiser for De {
                 let j_rand = index(rng, d);
                 let (a, b, c, x) = (&pop.x[r1][..d], &pop.x[r2][..d], &pop.x[r3][..d], &pop.x[i][..d]);
                 let t = &mut t_buf[..d];
-                // from_mutant[j]: the rarer source's genes are the walked positions.
-                let (common, rare_mark) = if from_target { (1, 0) } else { (0, 1) };
-                from_mutant.fill(common);
-                let mut j = rare.skip(&mut pool, rng);
-                while j < d {
-                    from_mutant[j] = rare_mark;
-                    j = rare.next_after(j, &mut pool, rng);
+                if from_target {
+                    // Start from the (clamped) mutant, put back the target's genes.
+                    de_mutant(t, a, b, c, fw, lo, hi);
+                    let mut j = rare.skip(&mut pool, rng);
+                    while j < d {
+                        if j != j_rand {
+                            t[j] = x[j];
+                        }
+                        j = rare.next_after(j, &mut pool, rng);
+                    }
+                } else {
+                    // Start from the target, take the mutant's genes.
+                    t.copy_from_slice(x);
+                    let mut j = rare.skip(&mut pool, rng);
+                    while j < d {
+                        t[j] = (a[j] + fw * (b[j] - c[j])).max(lo[j]).min(hi[j]);
+                        j = rare.next_after(j, &mut pool, rng);
+                    }
+                    t[j_rand] = (a[j_rand] + fw * (b[j_rand] - c[j_rand])).max(lo[j_rand]).min(hi[j_rand]);
                 }
-                from_mutant[j_rand] = 1;
-                de_trial(t, x, a, b, c, &from_mutant, fw, lo, hi);
                 let ft = eval.eval(t);
                 if ft <= pop.f[i] {
                     let next = spare.pop().unwrap_or_else(|| vec![0.0; d]);

@@ -3,12 +3,6 @@
 //! compare in the same order (no fused multiply-add), or exact integer arithmetic, only the vector
 //! width differs.
 //!
-//! Both loops stream through their vectors once, front to back, with no data-dependent loads or
-//! branches: a population of 40 x 1740 coordinates (0.5 MB, 1.7 MB with PSO's velocities and
-//! personal bests) lives in L2/L3, not L1, so random-access loads into it (DE's crossover used to
-//! fetch the target's genes one visited position at a time) cost a cache miss each, while a
-//! sequential stream is prefetched.
-//!
 //! Clamping is written as `if v < lo { lo } else { v }` then `if v > hi { hi } else { v }`: the
 //! same value as `max(lo).min(hi)` for every number (and NaN passes through), but it compiles to
 //! one vector max and one vector min instead of NaN-aware blends.
@@ -26,35 +20,30 @@ fn clamp(v: f64, lo: f64, hi: f64) -> f64 {
 }
 
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
-fn de_trial_generic(t: &mut [f64], x: &[f64], a: &[f64], b: &[f64], c: &[f64], from_mutant: &[u8], f: f64, lo: &[f64], hi: &[f64]) {
+fn de_mutant_generic(t: &mut [f64], a: &[f64], b: &[f64], c: &[f64], f: f64, lo: &[f64], hi: &[f64]) {
     let n = t.len();
-    let (x, a, b, c, m, lo, hi) = (&x[..n], &a[..n], &b[..n], &c[..n], &from_mutant[..n], &lo[..n], &hi[..n]);
+    let (a, b, c, lo, hi) = (&a[..n], &b[..n], &c[..n], &lo[..n], &hi[..n]);
     for j in 0..n {
-        let mutant = clamp(a[j] + f * (b[j] - c[j]), lo[j], hi[j]);
-        t[j] = if m[j] != 0 { mutant } else { x[j] };
+        t[j] = clamp(a[j] + f * (b[j] - c[j]), lo[j], hi[j]);
     }
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-#[allow(clippy::too_many_arguments)]
-fn de_trial_avx2(t: &mut [f64], x: &[f64], a: &[f64], b: &[f64], c: &[f64], from_mutant: &[u8], f: f64, lo: &[f64], hi: &[f64]) {
-    de_trial_generic(t, x, a, b, c, from_mutant, f, lo, hi)
+fn de_mutant_avx2(t: &mut [f64], a: &[f64], b: &[f64], c: &[f64], f: f64, lo: &[f64], hi: &[f64]) {
+    de_mutant_generic(t, a, b, c, f, lo, hi)
 }
 
-/// The DE/rand/1/bin trial: gene j is the clamped mutant a + f (b - c) where `from_mutant[j]` is
-/// non-zero, the target's x[j] elsewhere (one pass, a blend per vector of genes).
-#[allow(clippy::too_many_arguments)]
-pub fn de_trial(t: &mut [f64], x: &[f64], a: &[f64], b: &[f64], c: &[f64], from_mutant: &[u8], f: f64, lo: &[f64], hi: &[f64]) {
+/// t = clamp(a + f (b - c)) per coordinate (DE/rand/1 mutant).
+pub fn de_mutant(t: &mut [f64], a: &[f64], b: &[f64], c: &[f64], f: f64, lo: &[f64], hi: &[f64]) {
     #[cfg(target_arch = "x86_64")]
     {
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU reports AVX2.
-            return unsafe { de_trial_avx2(t, x, a, b, c, from_mutant, f, lo, hi) };
+            return unsafe { de_mutant_avx2(t, a, b, c, f, lo, hi) };
         }
     }
-    de_trial_generic(t, x, a, b, c, from_mutant, f, lo, hi)
+    de_mutant_generic(t, a, b, c, f, lo, hi)
 }
 
 /// PSO constants of one move.
@@ -138,18 +127,15 @@ mod tests {
         let mut rng = ChaCha8Rng::seed_from_u64(1);
         let n = 1001;
         let mut r = || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64 * 4.0 - 2.0;
-        let (a, b, c, x): (Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>) =
-            ((0..n).map(|_| r()).collect(), (0..n).map(|_| r()).collect(), (0..n).map(|_| r()).collect(), (0..n).map(|_| r()).collect());
+        let (a, b, c): (Vec<f64>, Vec<f64>, Vec<f64>) = ((0..n).map(|_| r()).collect(), (0..n).map(|_| r()).collect(), (0..n).map(|_| r()).collect());
         let (lo, hi) = (vec![-1.0; n], vec![1.5; n]);
-        let mask: Vec<u8> = (0..n).map(|j| (j % 3 != 1) as u8).collect();
         let mut t1 = vec![0.0; n];
         let mut t2 = vec![0.0; n];
-        de_trial_generic(&mut t1, &x, &a, &b, &c, &mask, 0.3, &lo, &hi);
-        de_trial(&mut t2, &x, &a, &b, &c, &mask, 0.3, &lo, &hi);
+        de_mutant_generic(&mut t1, &a, &b, &c, 0.3, &lo, &hi);
+        de_mutant(&mut t2, &a, &b, &c, 0.3, &lo, &hi);
         assert_eq!(t1, t2);
         for j in 0..n {
-            let want = if mask[j] == 1 { (a[j] + 0.3 * (b[j] - c[j])).clamp(-1.0, 1.5) } else { x[j] };
-            assert_eq!(t1[j], want);
+            assert_eq!(t1[j], (a[j] + 0.3 * (b[j] - c[j])).clamp(-1.0, 1.5));
         }
         let co = PsoCoefficients { k: 0.729, c1: 2.05, c2: 2.05, vmax_fraction: 0.2 };
         let gen = BulkLanes::from_rng(&mut ChaCha8Rng::seed_from_u64(2));
