@@ -1,12 +1,13 @@
 //! The optimisers' per-coordinate loops, compiled twice (baseline and AVX2) and picked at run
 //! time. Results are bit-identical between the two: every operation is an IEEE multiply, add or
-//! compare in the same order (no fused multiply-add), only the vector width differs.
+//! compare in the same order (no fused multiply-add), or exact integer arithmetic, only the vector
+//! width differs.
 //!
 //! Clamping is written as `if v < lo { lo } else { v }` then `if v > hi { hi } else { v }`: the
 //! same value as `max(lo).min(hi)` for every number (and NaN passes through), but it compiles to
 //! one vector max and one vector min instead of NaN-aware blends.
 
-use super::sampling::two_units;
+use super::sampling::{two_units, xoshiro_step, BulkLanes, LANES};
 
 #[inline(always)]
 fn clamp(v: f64, lo: f64, hi: f64) -> f64 {
@@ -51,40 +52,60 @@ pub struct PsoCoefficients {
     pub k: f64,
     pub c1: f64,
     pub c2: f64,
+    /// Velocity clamp as a fraction of the range: |v_j| <= vmax_fraction (hi_j - lo_j).
+    pub vmax_fraction: f64,
 }
 
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn pso_move_generic(x: &mut [f64], v: &mut [f64], p: &[f64], g: &[f64], words: &[u64], co: PsoCoefficients, vmax: &[f64], lo: &[f64], hi: &[f64]) {
+fn pso_move_block(x: &mut [f64], v: &mut [f64], p: &[f64], g: &[f64], lo: &[f64], hi: &[f64], s: [&mut [u64]; 4], co: PsoCoefficients) {
     let n = x.len();
-    let (v, p, g, words, vmax, lo, hi) = (&mut v[..n], &p[..n], &g[..n], &words[..n], &vmax[..n], &lo[..n], &hi[..n]);
+    let (v, p, g, lo, hi) = (&mut v[..n], &p[..n], &g[..n], &lo[..n], &hi[..n]);
+    let [s0, s1, s2, s3] = s;
+    let (s0, s1, s2, s3) = (&mut s0[..n], &mut s1[..n], &mut s2[..n], &mut s3[..n]);
     for j in 0..n {
-        let (r1, r2) = two_units(words[j]);
+        let (r1, r2) = two_units(xoshiro_step(&mut s0[j], &mut s1[j], &mut s2[j], &mut s3[j]));
+        let vmax = co.vmax_fraction * (hi[j] - lo[j]);
         let vj = co.k * (v[j] + co.c1 * r1 * (p[j] - x[j]) + co.c2 * r2 * (g[j] - x[j]));
-        let vj = clamp(vj, -vmax[j], vmax[j]);
+        let vj = clamp(vj, -vmax, vmax);
         v[j] = vj;
         x[j] = clamp(x[j] + vj, lo[j], hi[j]);
+    }
+}
+
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn pso_move_generic(x: &mut [f64], v: &mut [f64], p: &[f64], g: &[f64], rng: &mut BulkLanes, co: PsoCoefficients, lo: &[f64], hi: &[f64]) {
+    let n = x.len();
+    for start in (0..n).step_by(LANES) {
+        let r = start..(start + LANES).min(n);
+        let m = r.len();
+        let [s0, s1, s2, s3] = rng.state_mut();
+        let s = [&mut s0[..m], &mut s1[..m], &mut s2[..m], &mut s3[..m]];
+        pso_move_block(&mut x[r.clone()], &mut v[r.clone()], &p[r.clone()], &g[r.clone()], &lo[r.clone()], &hi[r], s, co);
     }
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[allow(clippy::too_many_arguments)]
-fn pso_move_avx2(x: &mut [f64], v: &mut [f64], p: &[f64], g: &[f64], words: &[u64], co: PsoCoefficients, vmax: &[f64], lo: &[f64], hi: &[f64]) {
-    pso_move_generic(x, v, p, g, words, co, vmax, lo, hi)
+fn pso_move_avx2(x: &mut [f64], v: &mut [f64], p: &[f64], g: &[f64], rng: &mut BulkLanes, co: PsoCoefficients, lo: &[f64], hi: &[f64]) {
+    pso_move_generic(x, v, p, g, rng, co, lo, hi)
 }
 
-/// One constricted PSO move of one particle; r1, r2 are the 32-bit halves of `words[j]`.
+/// One constricted PSO move of one particle. Coordinate j takes r1, r2 from the two 32-bit
+/// halves of the next word of lane j % LANES of `rng` (the generation and the move are one
+/// vectorised loop).
 #[allow(clippy::too_many_arguments)]
-pub fn pso_move(x: &mut [f64], v: &mut [f64], p: &[f64], g: &[f64], words: &[u64], co: PsoCoefficients, vmax: &[f64], lo: &[f64], hi: &[f64]) {
+pub fn pso_move(x: &mut [f64], v: &mut [f64], p: &[f64], g: &[f64], rng: &mut BulkLanes, co: PsoCoefficients, lo: &[f64], hi: &[f64]) {
     #[cfg(target_arch = "x86_64")]
     {
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU reports AVX2.
-            return unsafe { pso_move_avx2(x, v, p, g, words, co, vmax, lo, hi) };
+            return unsafe { pso_move_avx2(x, v, p, g, rng, co, lo, hi) };
         }
     }
-    pso_move_generic(x, v, p, g, words, co, vmax, lo, hi)
+    pso_move_generic(x, v, p, g, rng, co, lo, hi)
 }
 
 #[cfg(test)]
@@ -102,7 +123,7 @@ mod tests {
     }
 
     #[test]
-    fn dispatched_copies_are_bit_identical() {
+    fn dispatched_copies_are_bit_identical_and_follow_the_formulas() {
         let mut rng = ChaCha8Rng::seed_from_u64(1);
         let n = 1001;
         let mut r = || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64 * 4.0 - 2.0;
@@ -116,13 +137,30 @@ mod tests {
         for j in 0..n {
             assert_eq!(t1[j], (a[j] + 0.3 * (b[j] - c[j])).clamp(-1.0, 1.5));
         }
-        let words: Vec<u64> = (0..n as u64).map(|k| k.wrapping_mul(0x9e37_79b9_7f4a_7c15)).collect();
-        let co = PsoCoefficients { k: 0.729, c1: 2.05, c2: 2.05 };
-        let vmax = vec![0.4; n];
-        let (mut x1, mut v1) = (a.clone(), b.clone());
-        let (mut x2, mut v2) = (a.clone(), b.clone());
-        pso_move_generic(&mut x1, &mut v1, &c, &hi, &words, co, &vmax, &lo, &hi);
-        pso_move(&mut x2, &mut v2, &c, &hi, &words, co, &vmax, &lo, &hi);
-        assert_eq!((x1, v1), (x2, v2));
+        let co = PsoCoefficients { k: 0.729, c1: 2.05, c2: 2.05, vmax_fraction: 0.2 };
+        let gen = BulkLanes::from_rng(&mut ChaCha8Rng::seed_from_u64(2));
+        let (mut x1, mut v1, mut g1) = (a.clone(), b.clone(), gen.clone());
+        let (mut x2, mut v2, mut g2) = (a.clone(), b.clone(), gen.clone());
+        for _ in 0..2 {
+            pso_move_generic(&mut x1, &mut v1, &c, &hi, &mut g1, co, &lo, &hi);
+            pso_move(&mut x2, &mut v2, &c, &hi, &mut g2, co, &lo, &hi);
+        }
+        assert_eq!((&x1, &v1), (&x2, &v2));
+        // The scalar formula, coordinate j drawing the next word of lane j % LANES.
+        let mut g3 = gen.clone();
+        let (mut x3, mut v3) = (a.clone(), b.clone());
+        for _ in 0..2 {
+            for j in 0..n {
+                let [s0, s1, s2, s3] = g3.state_mut();
+                let l = j % LANES;
+                let (r1, r2) = two_units(xoshiro_step(&mut s0[l], &mut s1[l], &mut s2[l], &mut s3[l]));
+                let vmax = 0.2 * (1.5 - -1.0);
+                let vj = (0.729 * (v3[j] + 2.05 * r1 * (c[j] - x3[j]) + 2.05 * r2 * (hi[j] - x3[j]))).clamp(-vmax, vmax);
+                v3[j] = vj;
+                x3[j] = (x3[j] + vj).clamp(-1.0, 1.5);
+            }
+        }
+        assert_eq!((x1, v1), (x3, v3));
+        assert_eq!(g1.state_mut(), g3.state_mut());
     }
 }

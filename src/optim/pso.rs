@@ -9,14 +9,14 @@
 //! and global bests are updated (a personal best moves only on strict improvement).
 //! `population * (1 + generations)` evaluations.
 //!
-//! Random numbers: r1 and r2 are the two 32-bit halves of one 64-bit draw (resolution 2^-32),
-//! drawn in bulk for a whole particle from the run's bulk generator ([`super::sampling::Bulk`]).
+//! Random numbers: r1 and r2 are the two 32-bit halves of one 64-bit word (resolution 2^-32),
+//! one word per coordinate from interleaved xoshiro256++ generators seeded from the run's
+//! stream ([`super::sampling::BulkLanes`]), generated and consumed in the vectorised move loop.
 
 use super::problem::{check_problem, Budget, Evaluator, Optimiser, Population, Problem, RunResult};
 use super::kernels::{pso_move, PsoCoefficients};
-use super::sampling::bulk_from;
+use super::sampling::BulkLanes;
 use super::{check_range, OptimError};
-use rand::RngCore;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
@@ -60,7 +60,6 @@ impl Optimiser for Pso {
         check_problem(problem)?;
         let d = problem.dim();
         let (lo, hi) = problem.bounds();
-        let vmax: Vec<f64> = lo.iter().zip(hi).map(|(l, h)| self.vmax_fraction * (h - l)).collect();
         let mut eval = Evaluator::new(problem, budget);
         let Population { x: mut pos, f: mut fit } = Population::initial(problem, budget, &mut eval, rng);
         let n = pos.len();
@@ -70,15 +69,11 @@ impl Optimiser for Pso {
         let mut g = argmin(&pbest_f);
         let initial_best = pbest_f[g];
         let mut gbest = pbest[g].clone();
-        let mut words = vec![0u64; d];
-        let mut bulk = bulk_from(rng);
-        let co = PsoCoefficients { k: self.k, c1: self.c1, c2: self.c2 };
+        let mut bulk = BulkLanes::from_rng(rng);
+        let co = PsoCoefficients { k: self.k, c1: self.c1, c2: self.c2, vmax_fraction: self.vmax_fraction };
         for _ in 0..budget.generations {
             for i in 0..n {
-                for w in words.iter_mut() {
-                    *w = bulk.next_u64();
-                }
-                pso_move(&mut pos[i], &mut vel[i], &pbest[i], &gbest, &words, co, &vmax, lo, hi);
+                pso_move(&mut pos[i], &mut vel[i], &pbest[i], &gbest, &mut bulk, co, lo, hi);
             }
             for i in 0..n {
                 fit[i] = eval.eval(&pos[i]);

@@ -26,7 +26,6 @@ pub fn bulk_from(rng: &mut ChaCha8Rng) -> Bulk {
 }
 
 const TWO_POW_M53: f64 = 1.0 / (1u64 << 53) as f64;
-const TWO_POW_M32: f64 = 1.0 / (1u64 << 32) as f64;
 
 /// A uniform in [0, 1) with 53 random bits.
 #[inline]
@@ -40,10 +39,70 @@ pub fn symmetric(rng: &mut ChaCha8Rng, r: f64) -> f64 {
     r * (2.0 * unit(rng) - 1.0)
 }
 
-/// Two independent uniforms in [0, 1), 32 random bits each, from one 64-bit draw.
-#[inline]
+/// Two independent uniforms in [0, 1), 32 random bits each, from one 64-bit draw: h 2^-32 and
+/// l 2^-32 for the high and low halves h, l. Built from the bits, (1 + h 2^-32) - 1 with the 32
+/// bits placed at the top of the mantissa, which is exact (the same value as `h as f64 * 2^-32`)
+/// and vectorises (x86 has no vector conversion from 64-bit integers before AVX-512).
+#[inline(always)]
 pub fn two_units(word: u64) -> (f64, f64) {
-    ((word >> 32) as f64 * TWO_POW_M32, (word & 0xffff_ffff) as f64 * TWO_POW_M32)
+    const ONE: u64 = 0x3ff0_0000_0000_0000;
+    const MANTISSA_TOP32: u64 = 0x000f_ffff_fff0_0000;
+    let hi = f64::from_bits(((word >> 12) & MANTISSA_TOP32) | ONE) - 1.0;
+    let lo = f64::from_bits(((word << 20) & MANTISSA_TOP32) | ONE) - 1.0;
+    (hi, lo)
+}
+
+/// Lanes of [`BulkLanes`].
+pub const LANES: usize = 256;
+
+/// `LANES` independent xoshiro256++ generators, each seeded from 256 bits of the run's ChaCha8
+/// stream: the per-coordinate words of PSO, coordinate j drawing from lane j % LANES. One
+/// xoshiro256++ is a serial chain (each state depends on the previous one, about 3 cycles per
+/// word, as much as a third of a PSO run); independent lanes step in parallel, so a loop over
+/// lanes vectorises (shifts, xors, adds: several words per cycle). The states are kept as four
+/// arrays over the lanes (structure of arrays) for that loop. Each lane is exactly
+/// `Xoshiro256PlusPlus` from its seed.
+#[derive(Debug, Clone)]
+pub struct BulkLanes {
+    s: [Box<[u64; LANES]>; 4],
+}
+
+impl BulkLanes {
+    /// Lane l takes the l-th 4 words of the stream as its state (an all-zero state, probability
+    /// 2^-256, would stay zero forever, so it is replaced by one word 1).
+    pub fn from_rng(rng: &mut ChaCha8Rng) -> BulkLanes {
+        let mut s: [Box<[u64; LANES]>; 4] = std::array::from_fn(|_| Box::new([0u64; LANES]));
+        for l in 0..LANES {
+            for row in s.iter_mut() {
+                row[l] = rng.next_u64();
+            }
+            if s.iter().all(|row| row[l] == 0) {
+                s[0][l] = 1;
+            }
+        }
+        BulkLanes { s }
+    }
+
+    /// The four state words of every lane.
+    #[inline(always)]
+    pub fn state_mut(&mut self) -> [&mut [u64; LANES]; 4] {
+        let [s0, s1, s2, s3] = &mut self.s;
+        [s0, s1, s2, s3]
+    }
+}
+
+/// One xoshiro256++ output and state step of one lane (Blackman & Vigna's reference `next`).
+#[inline(always)]
+pub fn xoshiro_step(s0: &mut u64, s1: &mut u64, s2: &mut u64, s3: &mut u64) -> u64 {
+    let out = s0.wrapping_add(*s3).rotate_left(23).wrapping_add(*s0);
+    let t = *s1 << 17;
+    *s2 ^= *s0;
+    *s3 ^= *s1;
+    *s1 ^= *s2;
+    *s0 ^= *s3;
+    *s2 ^= t;
+    *s3 = s3.rotate_left(45);
+    out
 }
 
 /// A uniform index in 0..n (n >= 1), unbiased (Lemire's multiply-and-reject).
@@ -329,6 +388,37 @@ mod tests {
         }
         assert_eq!(inv_abs_pow_two_thirds(0.0), f64::INFINITY);
         assert_eq!(inv_abs_pow_two_thirds(f64::INFINITY), 0.0);
+    }
+
+    #[test]
+    fn two_units_are_the_halves_times_two_to_the_minus_32() {
+        let mut rng = ChaCha8Rng::seed_from_u64(6);
+        let scale = 1.0 / (1u64 << 32) as f64;
+        for w in (0..10_000).map(|_| rng.next_u64()).chain([0, u64::MAX, 1 << 32, 0xffff_ffff]) {
+            let (h, l) = two_units(w);
+            assert_eq!((h.to_bits(), l.to_bits()), (((w >> 32) as f64 * scale).to_bits(), ((w & 0xffff_ffff) as f64 * scale).to_bits()), "{w:x}");
+        }
+    }
+
+    #[test]
+    fn every_lane_is_xoshiro256_plus_plus() {
+        let mut rng = ChaCha8Rng::seed_from_u64(8);
+        let mut lanes = BulkLanes::from_rng(&mut rng.clone());
+        let mut single: Vec<Xoshiro256PlusPlus> = (0..LANES)
+            .map(|_| {
+                let mut seed = [0u8; 32];
+                for k in 0..4 {
+                    seed[8 * k..8 * k + 8].copy_from_slice(&rng.next_u64().to_le_bytes());
+                }
+                Xoshiro256PlusPlus::from_seed(seed)
+            })
+            .collect();
+        for _ in 0..100 {
+            let [s0, s1, s2, s3] = lanes.state_mut();
+            for l in 0..LANES {
+                assert_eq!(xoshiro_step(&mut s0[l], &mut s1[l], &mut s2[l], &mut s3[l]), single[l].next_u64(), "lane {l}");
+            }
+        }
     }
 
     #[test]
