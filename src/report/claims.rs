@@ -61,7 +61,7 @@ pub fn read(path: &std::path::Path) -> anyhow::Result<Vec<Claim>> {
 
 /// Markdown table of claims.
 pub fn markdown(claims: &[Claim]) -> String {
-    let mut s = String::from("| chapter | claim | verdict here | here | thesis' own figures | note |\n|---|---|---|---|---|---|\n");
+    let mut s = String::from("| chapter | claim | verdict here | here | source's own figures (thesis or paper) | note |\n|---|---|---|---|---|---|\n");
     for c in claims {
         let thesis = c.thesis.map(|(a, b)| format!("{a}/{b}")).unwrap_or_else(|| "-".into());
         let _ = writeln!(s, "| {} | {} | **{}** | {}/{} | {} | {} |", c.chapter, c.statement, c.verdict(), c.ours.0, c.ours.1, thesis, c.note);
