@@ -317,7 +317,7 @@ impl super::family::Family for Seed003 {
         cells(spec).iter().map(|c| c.key()).collect()
     }
     fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<super::family::Outcome> {
-        let s3 = spec.file.seed003.as_ref().context("spec has no [seed003] section")?;
+        let s3 = section(spec)?;
         let runs = run(spec, ctx)?;
         let section = if tables { Some(crate::report::seed003::write(s3, &runs, &ctx.out)?) } else { None };
         Ok(super::family::Outcome { section, cpu_s: runs.iter().map(|r| r.row.cpu_s).sum(), cells: runs.len() })

@@ -140,13 +140,12 @@ fn run_cell_on(spec: &Spec, problem: &RingNetProblem, cell: &Cell) -> Result<Run
     Ok(Run { cell: cell.clone(), row, population_best: r.population_best, best_so_far: r.best_so_far, best_x: r.result.best_x })
 }
 
-/// Run every cell of the spec (the analytical fit of each number of control points once, on
-/// the worker threads).
-pub fn run(spec: &Spec, ctx: &RunContext) -> Result<Vec<Run>> {
+/// Run every cell of the spec on `data` (the analytical fit of each number of control points
+/// once, on the worker threads).
+pub fn run(spec: &Spec, ctx: &RunContext, data: &RingData) -> Result<Vec<Run>> {
     let s = section(spec)?;
-    let data = data(s);
     let cps: Vec<usize> = crate::report::ordered(s.control_points.iter().copied());
-    let problems = runner::run_cells(&cps, ctx.jobs, "seed004 analytical fits", |&cp| problem(s, &data, cp), |_, _| Ok(()))?;
+    let problems = runner::run_cells(&cps, ctx.jobs, "seed004 analytical fits", |&cp| problem(s, data, cp), |_, _| Ok(()))?;
     let by_cp: std::collections::BTreeMap<usize, &RingNetProblem> = cps.iter().copied().zip(problems.iter()).collect();
     let cells = cells(spec);
     runner::run_logged(
@@ -160,20 +159,18 @@ pub fn run(spec: &Spec, ctx: &RunContext) -> Result<Vec<Run>> {
 
 /// The analytical method alone at every number of control points from the smallest to the
 /// largest of the spec's list (deterministic and cheap: not logged): (control points, RMS).
-pub fn analytical_sweep(spec: &Spec) -> Result<Vec<(usize, f64)>> {
+pub fn analytical_sweep(spec: &Spec, data: &RingData) -> Result<Vec<(usize, f64)>> {
     let s = section(spec)?;
-    let data = data(s);
     let (lo, hi) = (s.control_points.iter().min().copied().unwrap_or(0), s.control_points.iter().max().copied().unwrap_or(0));
-    (lo..=hi).map(|n| Ok((n, fit_closed(&data, shape(s, n)).map_err(|e| anyhow::anyhow!("seed004, {n} control points: {e}"))?.rms))).collect()
+    (lo..=hi).map(|n| Ok((n, fit_closed(data, shape(s, n)).map_err(|e| anyhow::anyhow!("seed004, {n} control points: {e}"))?.rms))).collect()
 }
 
 /// RMS distance of the data to the exact cylinder (sqrt(x^2 + y^2) - radius): a floor under
 /// every fit's RMS error at the data's own radial scatter.
-pub fn data_floor(spec: &Spec) -> Result<f64> {
+pub fn data_floor(spec: &Spec, data: &RingData) -> Result<f64> {
     let s = section(spec)?;
-    let d = data(s);
-    let sse: f64 = d.points().map(|p| ((p[0] * p[0] + p[1] * p[1]).sqrt() - s.radius).powi(2)).sum();
-    Ok((sse / d.n_points().max(1) as f64).sqrt())
+    let sse: f64 = data.points().map(|p| ((p[0] * p[0] + p[1] * p[1]).sqrt() - s.radius).powi(2)).sum();
+    Ok((sse / data.n_points().max(1) as f64).sqrt())
 }
 
 /// What the Fig. 2(a) analogue draws: the bottom ring of the data, the GA's best curve and its
@@ -191,11 +188,10 @@ pub struct TopView {
 }
 
 /// The top view of the lowest-RMS run at `control_points` (None if there is no such run).
-pub fn top_view(spec: &Spec, runs: &[Run], control_points: usize) -> Result<Option<TopView>> {
+pub fn top_view(spec: &Spec, data: &RingData, runs: &[Run], control_points: usize) -> Result<Option<TopView>> {
     let s = section(spec)?;
     let Some(best) = runs.iter().filter(|r| r.cell.control_points == control_points && !r.best_x.is_empty()).min_by(|a, b| a.row.best_rms.total_cmp(&b.row.best_rms)) else { return Ok(None) };
-    let data = data(s);
-    let problem = problem(s, &data, control_points)?;
+    let problem = problem(s, data, control_points)?;
     let ga = problem.surface(&best.best_x);
     let an = &problem.analytical().surface;
     let curve = |surf: &crate::spline::closed::ClosedSurface| -> Vec<(f64, f64)> {
@@ -229,12 +225,14 @@ impl super::family::Family for Seed004 {
         cells(spec).iter().map(|c| c.key()).collect()
     }
     fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<super::family::Outcome> {
-        let s4 = spec.file.seed004.as_ref().context("spec has no [seed004] section")?;
-        let runs = run(spec, ctx)?;
+        let s4 = section(spec)?;
+        // The lattice and its rings once, for the runs and the report.
+        let data = data(s4);
+        let runs = run(spec, ctx, &data)?;
         let section = if tables {
-            let sweep = analytical_sweep(spec)?;
-            let top = top_view(spec, &runs, 7)?;
-            Some(crate::report::seed004::write(s4, &runs, &sweep, data_floor(spec)?, top.as_ref(), &ctx.out)?)
+            let sweep = analytical_sweep(spec, &data)?;
+            let top = top_view(spec, &data, &runs, 7)?;
+            Some(crate::report::seed004::write(s4, &runs, &sweep, data_floor(spec, &data)?, top.as_ref(), &ctx.out)?)
         } else {
             None
         };
