@@ -48,6 +48,8 @@ pub fn table(name: &str) -> Option<RefTable> {
         "seed003_table3" => include_str!("../../experiments/reference/seed003_table3.csv"),
         "seed003_table4" => include_str!("../../experiments/reference/seed003_table4.csv"),
         "seed003_table5" => include_str!("../../experiments/reference/seed003_table5.csv"),
+        "seed004_table2" => include_str!("../../experiments/reference/seed004_table2.csv"),
+        "seed004_table3" => include_str!("../../experiments/reference/seed004_table3.csv"),
         _ => return None,
     };
     Some(RefTable::parse(text))

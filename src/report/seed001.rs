@@ -16,12 +16,7 @@ use std::collections::BTreeMap;
 use std::fmt::Write;
 use std::path::Path;
 
-fn mean_std(v: &[f64]) -> (f64, f64) {
-    let n = v.len() as f64;
-    let m = v.iter().sum::<f64>() / n;
-    let s = if v.len() > 1 { (v.iter().map(|x| (x - m) * (x - m)).sum::<f64>() / (n - 1.0)).sqrt() } else { 0.0 };
-    (m, s)
-}
+use crate::stats::describe::mean_std;
 
 fn write_csv(out: &Path, name: &str, header: &[&str], rows: &[Vec<String>]) -> Result<()> {
     let h: Vec<String> = header.iter().map(|s| s.to_string()).collect();

@@ -29,8 +29,7 @@ impl Stats {
     fn of(runs: &[&Run]) -> Stats {
         let y: Vec<f64> = runs.iter().map(|r| r.row.y).collect();
         let n = y.len() as f64;
-        let y_mean = y.iter().sum::<f64>() / n;
-        let y_var = if y.len() > 1 { y.iter().map(|v| (v - y_mean).powi(2)).sum::<f64>() / (n - 1.0) } else { 0.0 };
+        let (y_mean, y_var) = crate::stats::describe::mean_var(&y);
         let rmse_mean = runs.iter().map(|r| r.row.rmse).sum::<f64>() / n;
         let min = |v: &mut dyn Iterator<Item = f64>| v.fold(f64::INFINITY, f64::min);
         Stats { y_mean, y_best: min(&mut y.iter().copied()), y_var, y_std: y_var.sqrt(), rmse_mean, rmse_best: min(&mut runs.iter().map(|r| r.row.rmse)) }

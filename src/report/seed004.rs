@@ -14,12 +14,9 @@ use plotters::style::RGBColor;
 use std::fmt::Write;
 use std::path::Path;
 
-/// The paper's Table II and III as transcribed.
-fn paper_table2() -> RefTable {
-    RefTable::parse(include_str!("../../experiments/reference/seed004_table2.csv"))
-}
-fn paper_table3() -> RefTable {
-    RefTable::parse(include_str!("../../experiments/reference/seed004_table3.csv"))
+/// The paper's Table II or III as transcribed (compiled in, so always there).
+fn paper_table(name: &str) -> RefTable {
+    super::reference::table(name).expect("the seed 004 reference tables are compiled in")
 }
 
 /// Summary of values over repeats: (min, mean, median, lower quartile, upper quartile, max, std).
@@ -36,9 +33,7 @@ struct Summary {
 fn summary(v: &[f64]) -> Summary {
     let mut s = v.to_vec();
     s.sort_by(|a, b| a.total_cmp(b));
-    let n = s.len() as f64;
-    let mean = s.iter().sum::<f64>() / n;
-    let var = if s.len() > 1 { s.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0) } else { 0.0 };
+    let (mean, var) = crate::stats::describe::mean_var(&s);
     Summary { min: s[0], mean, q1: quantile_type7(&s, 0.25), median: quantile_type7(&s, 0.5), q3: quantile_type7(&s, 0.75), max: s[s.len() - 1], std: var.sqrt() }
 }
 
@@ -59,7 +54,8 @@ pub fn write(s4: &Seed004Spec, runs: &[Run], sweep: &[(usize, f64)], floor: f64,
     let mut s = String::new();
     let _ = writeln!(s, "## Seed 004: closed B-spline surface of a cylinder by a binary-coded GA\n");
     let n_points = runs.first().map(|r| r.row.n_points).unwrap_or(0);
-    let paper_min_ratio = paper_table3().rows.iter().filter_map(|r| r.get("best_fitness")?.parse::<f64>().ok()).fold(f64::INFINITY, f64::min) / floor;
+    let p3 = paper_table("seed004_table3");
+    let paper_min_ratio = p3.rows.iter().filter_map(|r| r.get("best_fitness")?.parse::<f64>().ok()).fold(f64::INFINITY, f64::min) / floor;
     let _ = writeln!(
         s,
         "Data: the lattice points (step {}) with |x^2 + y^2 - {}^2| <= {} and 0 <= z <= {}: {n_points} points (the paper: 3876), sorted into rings by height and by angle. Surface: closed uniform B-spline of order {} around (Eq. 5), clamped order {} up, net {} x N; analytical method: chord-length parameters (Eq. 8) and least squares by SVD. GA: {} bits per variable, x and y of each control column (shared by its rows; z fixed at the analytical net's), box = analytical +- {}, population {}, {} generations, linear ranking beta = {}, uniform crossover with probability {} (bit swap {}), bit flip {}, elitism {}. Fitness = RMS distance of the data to the surface at their parameters. {} repeats per number of control points. The data scatter about the exact cylinder by {floor:.5} RMS (radial distance of the lattice points); a surface with N control points around can follow that scatter only in part, and the paper's least Table III error is {paper_min_ratio:.2} times this scatter.\n",
@@ -67,7 +63,7 @@ pub fn write(s4: &Seed004Spec, runs: &[Run], sweep: &[(usize, f64)], floor: f64,
     );
 
     // Table II.
-    let p2 = paper_table2();
+    let p2 = paper_table("seed004_table2");
     let mut t2 = Vec::new();
     let mut md2 = Vec::new();
     for &cp in s4.table2_control_points.iter().filter(|cp| cps.contains(cp)) {
@@ -94,7 +90,6 @@ pub fn write(s4: &Seed004Spec, runs: &[Run], sweep: &[(usize, f64)], floor: f64,
     s.push_str(&table(&header(&["control points", "generation", "GA best", "GA mean", "population mean", "analytical", "paper best RMS"]), &md2));
 
     // Table III.
-    let p3 = paper_table3();
     let mut t3 = Vec::new();
     let mut md3 = Vec::new();
     for &cp in &cps {
