@@ -10,11 +10,14 @@
 //! the first pass runs along control rows (contiguous in x), its result is transposed once, and
 //! the second pass and the distances run with grid rows i as vector lanes (structure of arrays:
 //! x, y, z apart; chunks of 4 lanes, padded with zeros), accumulating per lane in registers. No
-//! allocation per call; the summation order is fixed and no fused multiply-add is used, so the
-//! baseline and the AVX2 copy of the kernel (picked at run time) give bit-identical results.
+//! allocation per call; the summation order is fixed, and every multiply-add is fused
+//! (`f64::mul_add`: one rounding, a hardware instruction in the AVX2 + FMA copy and the C
+//! library's `fma` in the baseline copy), so the two copies (picked at run time) give
+//! bit-identical results.
 //!
 //! A border grid class is scored once, on the bottom view (Eq. 5.13): the top view is evaluated
-//! at its interior grid points only.
+//! at its interior grid points only. The top view's control points are read in place: its
+//! border classes are the bottom's, so the border columns of its first pass are the bottom's.
 
 use super::exact::{solve_exact, ExactOptions, ExactResult, SumOfNorms, Term};
 use super::problem::Problem;
@@ -46,10 +49,12 @@ pub enum BoxSpec {
 }
 
 /// Which compiled copy of the fitness kernel runs. (An AVX-512 copy was measured slower than
-/// AVX2 on the development machine, an AMD Zen 5: LLVM turns the transpose into scatters.)
+/// AVX2 on the development machine, an AMD Zen 4 (family 25) whose 512-bit operations take two
+/// passes: LLVM also turns the transpose into scatters.)
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Isa {
     Baseline,
+    /// AVX2 with FMA.
     Avx2,
 }
 
@@ -67,7 +72,7 @@ impl Isa {
         match self {
             Isa::Baseline => true,
             #[cfg(target_arch = "x86_64")]
-            Isa::Avx2 => std::arch::is_x86_feature_detected!("avx2"),
+            Isa::Avx2 => std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma"),
             #[cfg(not(target_arch = "x86_64"))]
             Isa::Avx2 => false,
         }
@@ -82,8 +87,6 @@ pub struct ControlNetProblem {
     lower: Vec<f64>,
     upper: Vec<f64>,
     box_axes: (Point3, Point3),
-    /// Copy runs (destination, source, length) building the top view's P from x.
-    top_runs: Vec<(usize, usize, usize)>,
     /// Grid data, per grid column j, per coordinate, over the lanes i: bottom all (i, j), top
     /// the interior only.
     data_b: Vec<f64>,
@@ -100,7 +103,6 @@ pub struct ControlNetProblem {
 pub struct Scratch {
     /// (nx, ny, cn_x, cn_y) the buffers are laid out for.
     key: (usize, usize, usize, usize),
-    pt: Vec<f64>,
     r_b: Vec<f64>,
     r_t: Vec<f64>,
     rt_b: Vec<f64>,
@@ -168,13 +170,14 @@ fn validate_parts(p: &ControlNetParts) -> Result<(), OptimError> {
     Ok(())
 }
 
-/// out[k] = w0 a[k] + w1 b[k] + w2 c[k] + w3 d[k] over equal-length rows (vectorises).
+/// Pass 1 of one grid row: R = sum_t Nu[i][t] P[first_i + t] over whole control rows,
+/// vectorised along the row (four source rows, weights `w`).
 #[inline(always)]
 fn lin4(out: &mut [f64], a: &[f64], b: &[f64], c: &[f64], d: &[f64], w: &[f64; 4]) {
     let n = out.len();
     let (a, b, c, d) = (&a[..n], &b[..n], &c[..n], &d[..n]);
     for k in 0..n {
-        out[k] = w[0] * a[k] + w[1] * b[k] + w[2] * c[k] + w[3] * d[k];
+        out[k] = w[3].mul_add(d[k], w[2].mul_add(c[k], w[1].mul_add(b[k], w[0] * a[k])));
     }
 }
 
@@ -186,39 +189,19 @@ fn padded(n: usize) -> usize {
     n.div_ceil(CHUNK) * CHUNK
 }
 
-/// Sum of distances |D - D^G| of one view over `lanes` grid rows (starting at `row0`) and the
-/// grid columns `cols`. `p`: control points of the view, row-major ([a][b*3 + c], rows of
-/// k3 = 3 cn_y); `data`: chunk-major [chunk][column][c][lane]; `r` (rows padded to k3p) and `rt`
-/// are this view's buffers, with zeros in every padded place.
+/// Sum of distances |D - D^G| of one view over `lanes` grid rows and the grid columns `cols`,
+/// from its pass-1 rows `r` (row li at li * k3p, k3 = 3 cn_y values, zero padded). `data`:
+/// chunk-major [chunk][column][c][lane]; `rt`: this view's transposed buffer, with zeros in
+/// every padded place.
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
-fn view_error(
-    p: &[f64],
-    nu: &SparseBasis,
-    nv: &SparseBasis,
-    row0: usize,
-    lanes: usize,
-    cols: Range<usize>,
-    k3: usize,
-    data: &[f64],
-    r: &mut [f64],
-    rt: &mut [f64],
-) -> f64 {
+fn view_error(lanes: usize, cols: Range<usize>, k3: usize, nv: &SparseBasis, data: &[f64], r: &[f64], rt: &mut [f64]) -> f64 {
     let nc = cols.len();
     if lanes == 0 || nc == 0 {
         return 0.0;
     }
     let chunks = lanes.div_ceil(CHUNK);
     let k3p = padded(k3);
-    // Pass 1: R[i] = sum_t Nu[i][t] P[first_i + t], whole control rows at a time (R's rows
-    // are padded to k3p; the padding is never written and stays zero).
-    for li in 0..lanes {
-        let i = row0 + li;
-        let f = nu.first[i] * k3;
-        let row = &mut r[li * k3p..li * k3p + k3];
-        lin4(row, &p[f..f + k3], &p[f + k3..f + 2 * k3], &p[f + 2 * k3..f + 3 * k3], &p[f + 3 * k3..f + 4 * k3], &nu.w[i]);
-    }
-    // Transpose into chunk-major RT[chunk][b*3 + c][lane], eight lanes per store (rows past
+    // Transpose into chunk-major RT[chunk][b*3 + c][lane], four lanes per store (rows past
     // `lanes` are zero rows of R).
     for ch in 0..chunks {
         let src: [&[f64]; CHUNK] = std::array::from_fn(|l| &r[(ch * CHUNK + l) * k3p..(ch * CHUNK + l + 1) * k3p]);
@@ -229,7 +212,8 @@ fn view_error(
             }
         }
     }
-    // Pass 2 and distances: per chunk of lanes, over all grid columns, in registers.
+    // Pass 2 and distances: per chunk of lanes, over all grid columns, in registers:
+    // D^G = sum_t Nv[j][t] RT[first_j + t] (Eq. 5.3), fused multiply-adds in a fixed order.
     let mut total = 0.0;
     for ch in 0..chunks {
         let block = &rt[ch * k3p * CHUNK..(ch + 1) * k3p * CHUNK];
@@ -242,10 +226,10 @@ fn view_error(
             let w = &nv.w[j];
             // Row (t, c) of the 4 x 3 block starts at (3 t + c) * CHUNK.
             for l in 0..CHUNK {
-                let ex = w[0] * q[l] + w[1] * q[3 * CHUNK + l] + w[2] * q[6 * CHUNK + l] + w[3] * q[9 * CHUNK + l] - d[l];
-                let ey = w[0] * q[CHUNK + l] + w[1] * q[4 * CHUNK + l] + w[2] * q[7 * CHUNK + l] + w[3] * q[10 * CHUNK + l] - d[CHUNK + l];
-                let ez = w[0] * q[2 * CHUNK + l] + w[1] * q[5 * CHUNK + l] + w[2] * q[8 * CHUNK + l] + w[3] * q[11 * CHUNK + l] - d[2 * CHUNK + l];
-                acc[l] += (ex * ex + ey * ey + ez * ez).sqrt();
+                let ex = w[3].mul_add(q[9 * CHUNK + l], w[2].mul_add(q[6 * CHUNK + l], w[1].mul_add(q[3 * CHUNK + l], w[0].mul_add(q[l], -d[l]))));
+                let ey = w[3].mul_add(q[10 * CHUNK + l], w[2].mul_add(q[7 * CHUNK + l], w[1].mul_add(q[4 * CHUNK + l], w[0].mul_add(q[CHUNK + l], -d[CHUNK + l]))));
+                let ez = w[3].mul_add(q[11 * CHUNK + l], w[2].mul_add(q[8 * CHUNK + l], w[1].mul_add(q[5 * CHUNK + l], w[0].mul_add(q[2 * CHUNK + l], -d[2 * CHUNK + l]))));
+                acc[l] += ez.mul_add(ez, ey.mul_add(ey, ex * ex)).sqrt();
             }
         }
         for a in acc {
@@ -258,25 +242,39 @@ fn view_error(
 #[inline(always)]
 fn kernel(pb: &ControlNetProblem, x: &[f64], s: &mut Scratch) -> f64 {
     let parts = &pb.parts;
-    let (nx, ny, k3) = (parts.nx, parts.ny, 3 * parts.cn_y);
-    // Bottom view: its classes are 0..cn_x*cn_y in row-major order, so P is a prefix of x.
-    let bottom = view_error(&x[..parts.cn_x * k3], &parts.nu, &parts.nv, 0, nx, 0..ny, k3, &pb.data_b, &mut s.r_b, &mut s.rt_b);
-    // Top view: gather its P (border classes are shared with the bottom view).
-    for &(dst, src, len) in &pb.top_runs {
-        if len == 3 {
-            s.pt[dst] = x[src];
-            s.pt[dst + 1] = x[src + 1];
-            s.pt[dst + 2] = x[src + 2];
-        } else {
-            s.pt[dst..dst + len].copy_from_slice(&x[src..src + len]);
-        }
+    let (nx, ny, cx, k3) = (parts.nx, parts.ny, parts.cn_x, 3 * parts.cn_y);
+    let k3p = padded(k3);
+    let nu = &parts.nu;
+    // Bottom view: its classes are 0..cn_x*cn_y in row-major order, so its P is a prefix of x.
+    for i in 0..nx {
+        let f = nu.first[i] * k3;
+        lin4(&mut s.r_b[i * k3p..i * k3p + k3], &x[f..f + k3], &x[f + k3..f + 2 * k3], &x[f + 2 * k3..f + 3 * k3], &x[f + 3 * k3..f + 4 * k3], &nu.w[i]);
     }
-    let top = view_error(&s.pt, &parts.nu, &parts.nv, 1, nx - 2, 1..ny - 1, k3, &pb.data_t, &mut s.r_t, &mut s.rt_t);
+    let bottom = view_error(nx, 0..ny, k3, &parts.nv, &pb.data_b, &s.r_b, &mut s.rt_b);
+    // Top view, read in place: its P rows 0 and cn_x - 1 are the bottom's, and every other row
+    // is a bottom border class, the row's own interior classes (contiguous in x after the
+    // bottom's), then a bottom border class. Pass 1 is column-wise, so the border columns of
+    // its R are the bottom's R at the same grid row; only the interior columns are computed.
+    let ki = k3 - 6;
+    let top_interior = 3 * cx * parts.cn_y;
+    let row = |a: usize| -> &[f64] {
+        let o = if a == 0 || a == cx - 1 { a * k3 + 3 } else { top_interior + (a - 1) * ki };
+        &x[o..o + ki]
+    };
+    for li in 0..nx - 2 {
+        let i = li + 1;
+        let f = nu.first[i];
+        let (rb, out) = (&s.r_b[i * k3p..i * k3p + k3], &mut s.r_t[li * k3p..li * k3p + k3]);
+        lin4(&mut out[3..3 + ki], row(f), row(f + 1), row(f + 2), row(f + 3), &nu.w[i]);
+        out[..3].copy_from_slice(&rb[..3]);
+        out[3 + ki..].copy_from_slice(&rb[3 + ki..]);
+    }
+    let top = view_error(nx - 2, 1..ny - 1, k3, &parts.nv, &pb.data_t, &s.r_t, &mut s.rt_t);
     bottom + top
 }
 
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx2,fma")]
 fn kernel_avx2(pb: &ControlNetProblem, x: &[f64], s: &mut Scratch) -> f64 {
     kernel(pb, x, s)
 }
@@ -286,7 +284,7 @@ impl ControlNetProblem {
     pub fn new(parts: ControlNetParts, bounds: BoxSpec) -> Result<ControlNetProblem, OptimError> {
         validate_parts(&parts)?;
         let net = DoubleNet::new(parts.cn_x, parts.cn_y).expect("control net checked to be at least 4x4");
-        let (nx, ny, cn_x, cn_y) = (parts.nx, parts.ny, parts.cn_x, parts.cn_y);
+        let (nx, ny) = (parts.nx, parts.ny);
         let all: Vec<Point3> = parts.data_bottom.iter().chain(&parts.data_top).copied().collect();
         let (dlo, dhi) = crate::geom::bounding_box(&all).expect("grid has points");
         let box_axes = match bounds {
@@ -332,18 +330,6 @@ impl ControlNetProblem {
             BoxSpec::AroundStart { half_width } => parts.x0.iter().map(|&v| (v - half_width, v + half_width)).unzip(),
             _ => ((0..3 * nov).map(|k| box_axes.0[k % 3]).collect(), (0..3 * nov).map(|k| box_axes.1[k % 3]).collect()),
         };
-        // The top view's P from x: contiguous runs of classes.
-        let mut top_runs: Vec<(usize, usize, usize)> = Vec::new();
-        for a in 0..cn_x {
-            for b in 0..cn_y {
-                let dst = 3 * (a * cn_y + b);
-                let src = 3 * net.class(View::Top, a, b);
-                match top_runs.last_mut() {
-                    Some(last) if last.0 + last.2 == dst && last.1 + last.2 == src => last.2 += 3,
-                    _ => top_runs.push((dst, src, 3)),
-                }
-            }
-        }
         // Grid data chunk-major: [chunk of 8 grid rows][grid column][xyz][lane], zero padded.
         let layout = |d: &[Point3], rows: Range<usize>, cols: Range<usize>| {
             let (lanes, nc) = (rows.len(), cols.len());
@@ -392,7 +378,6 @@ impl ControlNetProblem {
             lower,
             upper,
             box_axes,
-            top_runs,
             data_b,
             data_t,
             isa: Isa::detect(),
@@ -450,7 +435,6 @@ impl ControlNetProblem {
             let (lb, lt) = (padded(p.nx), padded(p.nx - 2));
             *scratch = Scratch {
                 key,
-                pt: vec![0.0; p.cn_x * 3 * p.cn_y],
                 r_b: vec![0.0; lb * k3p],
                 r_t: vec![0.0; lt * k3p],
                 rt_b: vec![0.0; lb * k3p],

@@ -221,12 +221,7 @@ fn cuckoo_search(
             let (x, c) = (&pop.x[i][..d], &mut cand[i][..d]);
             let (a, b) = (&pop.x[p1[i]][..d], &pop.x[p2[i]][..d]);
             c.copy_from_slice(x);
-            let mut j = walk.skip(&mut pool, rng);
-            while j < d {
-                let nj = x[j] + r * (a[j] - b[j]);
-                c[j] = nj.max(lo[j]).min(hi[j]);
-                j = walk.next_after(j, &mut pool, rng);
-            }
+            walk.for_each(d, &mut pool, rng, |j| c[j] = (x[j] + r * (a[j] - b[j])).max(lo[j]).min(hi[j]));
         }
         for i in 0..n {
             cand_f[i] = eval.eval(&cand[i]);

@@ -1,11 +1,11 @@
 //! Differential evolution DE/rand/1/bin (Storn & Price 1997; thesis 6.2.4.2).
 //!
 //! For each target i in order: three distinct indices r1, r2, r3, all different from i, give the
-//! mutant v = x_r1 + F (x_r2 - x_r3), clamped to the bounds; binomial crossover builds the trial,
-//! each gene from the mutant with probability CR and at one uniformly drawn position j_rand
-//! always; the trial replaces the target if f(trial) <= f(target). Generations are synchronous
-//! (mutants are built from the population of the previous generation). `population` evaluations
-//! per generation, `population * (1 + generations)` in all.
+//! mutant v = x_r1 + F (x_r2 - x_r3) (one fused multiply-add), clamped to the bounds; binomial
+//! crossover builds the trial, each gene from the mutant with probability CR and at one uniformly
+//! drawn position j_rand always; the trial replaces the target if f(trial) <= f(target).
+//! Generations are synchronous (mutants are built from the population of the previous
+//! generation). `population` evaluations per generation, `population * (1 + generations)` in all.
 //!
 //! Table 6.1 gives CR = 0.8, F = 0.3 (the default); the prose of 6.2.2 reads CR = 0.01,
 //! F = 0.8 (`De::thesis_prose()`).
@@ -17,7 +17,7 @@
 //! it replaces; the forced position j_rand is then set from the mutant. With CR = 0.8 this draws
 //! about 0.2 d skips (12 random bits each, mostly) instead of d uniforms.
 
-use super::kernels::de_mutant;
+use super::kernels::{de_mutant, de_mutant_gene};
 use super::problem::{check_problem, Budget, Evaluator, Optimiser, Population, Problem, RunResult};
 use super::sampling::{index, BitPool, Geometric};
 use super::{check_range, OptimError};
@@ -102,22 +102,16 @@ impl Optimiser for De {
                 if from_target {
                     // Start from the (clamped) mutant, put back the target's genes.
                     de_mutant(t, a, b, c, fw, lo, hi);
-                    let mut j = rare.skip(&mut pool, rng);
-                    while j < d {
+                    rare.for_each(d, &mut pool, rng, |j| {
                         if j != j_rand {
                             t[j] = x[j];
                         }
-                        j = rare.next_after(j, &mut pool, rng);
-                    }
+                    });
                 } else {
                     // Start from the target, take the mutant's genes.
                     t.copy_from_slice(x);
-                    let mut j = rare.skip(&mut pool, rng);
-                    while j < d {
-                        t[j] = (a[j] + fw * (b[j] - c[j])).max(lo[j]).min(hi[j]);
-                        j = rare.next_after(j, &mut pool, rng);
-                    }
-                    t[j_rand] = (a[j_rand] + fw * (b[j_rand] - c[j_rand])).max(lo[j_rand]).min(hi[j_rand]);
+                    rare.for_each(d, &mut pool, rng, |j| t[j] = de_mutant_gene(a[j], b[j], c[j], fw, lo[j], hi[j]));
+                    t[j_rand] = de_mutant_gene(a[j_rand], b[j_rand], c[j_rand], fw, lo[j_rand], hi[j_rand]);
                 }
                 let ft = eval.eval(t);
                 if ft <= pop.f[i] {

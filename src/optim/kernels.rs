@@ -1,13 +1,14 @@
-//! The optimisers' per-coordinate loops, compiled twice (baseline and AVX2) and picked at run
-//! time. Results are bit-identical between the two: every operation is an IEEE multiply, add or
-//! compare in the same order (no fused multiply-add), or exact integer arithmetic, only the vector
-//! width differs.
+//! The optimisers' per-coordinate loops, compiled twice (baseline and AVX2 with FMA) and picked at
+//! run time. Results are bit-identical between the two: every operation is an IEEE multiply, add,
+//! fused multiply-add (`f64::mul_add`, one rounding in both copies: a hardware instruction in the
+//! AVX2 copy, the C library's `fma` in the baseline one) or compare in the same order, or exact
+//! integer arithmetic; only the vector width differs.
 //!
 //! Clamping is written as `if v < lo { lo } else { v }` then `if v > hi { hi } else { v }`: the
 //! same value as `max(lo).min(hi)` for every number (and NaN passes through), but it compiles to
 //! one vector max and one vector min instead of NaN-aware blends.
 
-use super::sampling::{two_units, xoshiro_step, BulkLanes, LANES};
+use super::sampling::{two_units_plus_one, xoshiro_next, BulkLanes, LANES};
 
 #[inline(always)]
 fn clamp(v: f64, lo: f64, hi: f64) -> f64 {
@@ -19,27 +20,40 @@ fn clamp(v: f64, lo: f64, hi: f64) -> f64 {
     }
 }
 
+/// One gene of the DE/rand/1 mutant, clamp(a + f (b - c)), the same number as [`de_mutant`] gives.
+#[inline(always)]
+pub fn de_mutant_gene(a: f64, b: f64, c: f64, f: f64, lo: f64, hi: f64) -> f64 {
+    clamp(f.mul_add(b - c, a), lo, hi)
+}
+
 #[inline(always)]
 fn de_mutant_generic(t: &mut [f64], a: &[f64], b: &[f64], c: &[f64], f: f64, lo: &[f64], hi: &[f64]) {
     let n = t.len();
     let (a, b, c, lo, hi) = (&a[..n], &b[..n], &c[..n], &lo[..n], &hi[..n]);
     for j in 0..n {
-        t[j] = clamp(a[j] + f * (b[j] - c[j]), lo[j], hi[j]);
+        t[j] = de_mutant_gene(a[j], b[j], c[j], f, lo[j], hi[j]);
     }
 }
 
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
+#[target_feature(enable = "avx2,fma")]
 fn de_mutant_avx2(t: &mut [f64], a: &[f64], b: &[f64], c: &[f64], f: f64, lo: &[f64], hi: &[f64]) {
     de_mutant_generic(t, a, b, c, f, lo, hi)
 }
 
-/// t = clamp(a + f (b - c)) per coordinate (DE/rand/1 mutant).
+/// Whether this CPU runs the AVX2 + FMA copies.
+#[cfg(target_arch = "x86_64")]
+#[inline]
+pub fn avx2_fma() -> bool {
+    std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
+}
+
+/// t = clamp(a + f (b - c)) per coordinate (DE/rand/1 mutant), a + f (b - c) fused.
 pub fn de_mutant(t: &mut [f64], a: &[f64], b: &[f64], c: &[f64], f: f64, lo: &[f64], hi: &[f64]) {
     #[cfg(target_arch = "x86_64")]
     {
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU reports AVX2.
+        if avx2_fma() {
+            // SAFETY: the CPU reports AVX2 and FMA.
             return unsafe { de_mutant_avx2(t, a, b, c, f, lo, hi) };
         }
     }
@@ -52,65 +66,74 @@ pub struct PsoCoefficients {
     pub k: f64,
     pub c1: f64,
     pub c2: f64,
-    /// Velocity clamp as a fraction of the range: |v_j| <= vmax_fraction (hi_j - lo_j).
-    pub vmax_fraction: f64,
+}
+
+/// The box of a PSO run per coordinate: positions in [lo, hi], velocities in [-vmax, vmax].
+#[derive(Debug, Clone, Copy)]
+pub struct PsoBounds<'a> {
+    pub lo: &'a [f64],
+    pub hi: &'a [f64],
+    pub vmax: &'a [f64],
 }
 
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
-fn pso_move_block(x: &mut [f64], v: &mut [f64], p: &[f64], g: &[f64], lo: &[f64], hi: &[f64], s: [&mut [u64]; 4], co: PsoCoefficients) {
+fn pso_move_block(x: &mut [f64], v: &mut [f64], p: &[f64], g: &[f64], b: PsoBounds, s: [&mut [u64]; 4], co: PsoCoefficients) {
     let n = x.len();
-    let (v, p, g, lo, hi) = (&mut v[..n], &p[..n], &g[..n], &lo[..n], &hi[..n]);
+    let (v, p, g, lo, hi, vmax) = (&mut v[..n], &p[..n], &g[..n], &b.lo[..n], &b.hi[..n], &b.vmax[..n]);
     let [s0, s1, s2, s3] = s;
     let (s0, s1, s2, s3) = (&mut s0[..n], &mut s1[..n], &mut s2[..n], &mut s3[..n]);
     for j in 0..n {
-        let (r1, r2) = two_units(xoshiro_step(&mut s0[j], &mut s1[j], &mut s2[j], &mut s3[j]));
-        let vmax = co.vmax_fraction * (hi[j] - lo[j]);
-        let vj = co.k * (v[j] + co.c1 * r1 * (p[j] - x[j]) + co.c2 * r2 * (g[j] - x[j]));
-        let vj = clamp(vj, -vmax, vmax);
+        // The state goes through values, not `&mut`: the compiler then keeps it in registers
+        // instead of reloading each word after every store.
+        let (word, [n0, n1, n2, n3]) = xoshiro_next([s0[j], s1[j], s2[j], s3[j]]);
+        (s0[j], s1[j], s2[j], s3[j]) = (n0, n1, n2, n3);
+        let (u1, u2) = two_units_plus_one(word);
+        // c r = c (u - 1) with r = u - 1 exact, so c u - c in one rounding is the same number.
+        let (a1, a2) = (co.c1.mul_add(u1, -co.c1), co.c2.mul_add(u2, -co.c2));
+        let vj = co.k * a2.mul_add(g[j] - x[j], a1.mul_add(p[j] - x[j], v[j]));
+        let vj = clamp(vj, -vmax[j], vmax[j]);
         v[j] = vj;
         x[j] = clamp(x[j] + vj, lo[j], hi[j]);
     }
 }
 
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
-fn pso_move_generic(x: &mut [f64], v: &mut [f64], p: &[f64], g: &[f64], rng: &mut BulkLanes, co: PsoCoefficients, lo: &[f64], hi: &[f64]) {
+fn pso_move_generic(x: &mut [f64], v: &mut [f64], p: &[f64], g: &[f64], rng: &mut BulkLanes, co: PsoCoefficients, b: PsoBounds) {
     let n = x.len();
     for start in (0..n).step_by(LANES) {
         let r = start..(start + LANES).min(n);
         let m = r.len();
         let [s0, s1, s2, s3] = rng.state_mut();
         let s = [&mut s0[..m], &mut s1[..m], &mut s2[..m], &mut s3[..m]];
-        pso_move_block(&mut x[r.clone()], &mut v[r.clone()], &p[r.clone()], &g[r.clone()], &lo[r.clone()], &hi[r], s, co);
+        let rb = PsoBounds { lo: &b.lo[r.clone()], hi: &b.hi[r.clone()], vmax: &b.vmax[r.clone()] };
+        pso_move_block(&mut x[r.clone()], &mut v[r.clone()], &p[r.clone()], &g[r], rb, s, co);
     }
 }
 
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-#[allow(clippy::too_many_arguments)]
-fn pso_move_avx2(x: &mut [f64], v: &mut [f64], p: &[f64], g: &[f64], rng: &mut BulkLanes, co: PsoCoefficients, lo: &[f64], hi: &[f64]) {
-    pso_move_generic(x, v, p, g, rng, co, lo, hi)
+#[target_feature(enable = "avx2,fma")]
+fn pso_move_avx2(x: &mut [f64], v: &mut [f64], p: &[f64], g: &[f64], rng: &mut BulkLanes, co: PsoCoefficients, b: PsoBounds) {
+    pso_move_generic(x, v, p, g, rng, co, b)
 }
 
 /// One constricted PSO move of one particle. Coordinate j takes r1, r2 from the two 32-bit
 /// halves of the next word of lane j % LANES of `rng` (the generation and the move are one
 /// vectorised loop).
-#[allow(clippy::too_many_arguments)]
-pub fn pso_move(x: &mut [f64], v: &mut [f64], p: &[f64], g: &[f64], rng: &mut BulkLanes, co: PsoCoefficients, lo: &[f64], hi: &[f64]) {
+pub fn pso_move(x: &mut [f64], v: &mut [f64], p: &[f64], g: &[f64], rng: &mut BulkLanes, co: PsoCoefficients, bounds: PsoBounds) {
     #[cfg(target_arch = "x86_64")]
     {
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU reports AVX2.
-            return unsafe { pso_move_avx2(x, v, p, g, rng, co, lo, hi) };
+        if avx2_fma() {
+            // SAFETY: the CPU reports AVX2 and FMA.
+            return unsafe { pso_move_avx2(x, v, p, g, rng, co, bounds) };
         }
     }
-    pso_move_generic(x, v, p, g, rng, co, lo, hi)
+    pso_move_generic(x, v, p, g, rng, co, bounds)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::optim::sampling::{two_units, xoshiro_step};
     use rand::{RngCore, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
@@ -124,8 +147,13 @@ mod tests {
 
     #[test]
     fn dispatched_copies_are_bit_identical_and_follow_the_formulas() {
+        for n in [1001, 7] {
+            copies_agree(n);
+        }
+    }
+
+    fn copies_agree(n: usize) {
         let mut rng = ChaCha8Rng::seed_from_u64(1);
-        let n = 1001;
         let mut r = || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64 * 4.0 - 2.0;
         let (a, b, c): (Vec<f64>, Vec<f64>, Vec<f64>) = ((0..n).map(|_| r()).collect(), (0..n).map(|_| r()).collect(), (0..n).map(|_| r()).collect());
         let (lo, hi) = (vec![-1.0; n], vec![1.5; n]);
@@ -135,15 +163,17 @@ mod tests {
         de_mutant(&mut t2, &a, &b, &c, 0.3, &lo, &hi);
         assert_eq!(t1, t2);
         for j in 0..n {
-            assert_eq!(t1[j], (a[j] + 0.3 * (b[j] - c[j])).clamp(-1.0, 1.5));
+            assert_eq!(t1[j], 0.3f64.mul_add(b[j] - c[j], a[j]).clamp(-1.0, 1.5));
         }
-        let co = PsoCoefficients { k: 0.729, c1: 2.05, c2: 2.05, vmax_fraction: 0.2 };
+        let co = PsoCoefficients { k: 0.729, c1: 2.05, c2: 2.05 };
+        let vmax: Vec<f64> = lo.iter().zip(&hi).map(|(l, h)| 0.2 * (h - l)).collect();
+        let bounds = PsoBounds { lo: &lo, hi: &hi, vmax: &vmax };
         let gen = BulkLanes::from_rng(&mut ChaCha8Rng::seed_from_u64(2));
         let (mut x1, mut v1, mut g1) = (a.clone(), b.clone(), gen.clone());
         let (mut x2, mut v2, mut g2) = (a.clone(), b.clone(), gen.clone());
         for _ in 0..2 {
-            pso_move_generic(&mut x1, &mut v1, &c, &hi, &mut g1, co, &lo, &hi);
-            pso_move(&mut x2, &mut v2, &c, &hi, &mut g2, co, &lo, &hi);
+            pso_move_generic(&mut x1, &mut v1, &c, &hi, &mut g1, co, bounds);
+            pso_move(&mut x2, &mut v2, &c, &hi, &mut g2, co, bounds);
         }
         assert_eq!((&x1, &v1), (&x2, &v2));
         // The scalar formula, coordinate j drawing the next word of lane j % LANES.
@@ -155,7 +185,10 @@ mod tests {
                 let l = j % LANES;
                 let (r1, r2) = two_units(xoshiro_step(&mut s0[l], &mut s1[l], &mut s2[l], &mut s3[l]));
                 let vmax = 0.2 * (1.5 - -1.0);
-                let vj = (0.729 * (v3[j] + 2.05 * r1 * (c[j] - x3[j]) + 2.05 * r2 * (hi[j] - x3[j]))).clamp(-vmax, vmax);
+                let (u1, u2) = (r1 + 1.0, r2 + 1.0);
+                // The folded c u - c is exactly c r.
+                assert_eq!((2.05f64.mul_add(u1, -2.05), 2.05f64.mul_add(u2, -2.05)), (2.05 * r1, 2.05 * r2));
+                let vj: f64 = (0.729 * (2.05 * r2).mul_add(hi[j] - x3[j], (2.05 * r1).mul_add(c[j] - x3[j], v3[j]))).clamp(-vmax, vmax);
                 v3[j] = vj;
                 x3[j] = (x3[j] + vj).clamp(-1.0, 1.5);
             }

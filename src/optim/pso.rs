@@ -3,10 +3,11 @@
 //! range, positions kept in the range), global-best topology.
 //!
 //! Per coordinate: v <- K (v + c1 r1 (pbest - x) + c2 r2 (gbest - x)), r1, r2 ~ U[0, 1) drawn
-//! anew for every coordinate; v is clamped to +-(upper - lower)/2 and x + v to [lower, upper]
-//! (the velocity is kept when the position is clamped). Updates are synchronous: all particles
-//! move with the global best of the previous iteration, then all are evaluated, then personal
-//! and global bests are updated (a personal best moves only on strict improvement).
+//! anew for every coordinate (the two products added by fused multiply-adds); v is clamped to
+//! +-(upper - lower)/2 and x + v to [lower, upper] (the velocity is kept when the position is
+//! clamped). Updates are synchronous: every particle moves with the global best of the previous
+//! iteration, and the global best is updated after all have moved and been evaluated (a
+//! personal best moves only on strict improvement).
 //! `population * (1 + generations)` evaluations.
 //!
 //! Random numbers: r1 and r2 are the two 32-bit halves of one 64-bit word (resolution 2^-32),
@@ -14,7 +15,7 @@
 //! stream ([`super::sampling::BulkLanes`]), generated and consumed in the vectorised move loop.
 
 use super::problem::{check_problem, Budget, Evaluator, Optimiser, Population, Problem, RunResult};
-use super::kernels::{pso_move, PsoCoefficients};
+use super::kernels::{pso_move, PsoBounds, PsoCoefficients};
 use super::sampling::BulkLanes;
 use super::{check_range, OptimError};
 use rand_chacha::ChaCha8Rng;
@@ -70,12 +71,14 @@ impl Optimiser for Pso {
         let initial_best = pbest_f[g];
         let mut gbest = pbest[g].clone();
         let mut bulk = BulkLanes::from_rng(rng);
-        let co = PsoCoefficients { k: self.k, c1: self.c1, c2: self.c2, vmax_fraction: self.vmax_fraction };
+        let co = PsoCoefficients { k: self.k, c1: self.c1, c2: self.c2 };
+        let vmax: Vec<f64> = lo.iter().zip(hi).map(|(l, h)| self.vmax_fraction * (h - l)).collect();
+        let bounds = PsoBounds { lo, hi, vmax: &vmax };
         for _ in 0..budget.generations {
+            // Each particle is evaluated right after its move, while its coordinates are in
+            // cache; the global best it moved towards is the previous iteration's (a copy).
             for i in 0..n {
-                pso_move(&mut pos[i], &mut vel[i], &pbest[i], &gbest, &mut bulk, co, lo, hi);
-            }
-            for i in 0..n {
+                pso_move(&mut pos[i], &mut vel[i], &pbest[i], &gbest, &mut bulk, co, bounds);
                 fit[i] = eval.eval(&pos[i]);
                 if fit[i] < pbest_f[i] {
                     pbest_f[i] = fit[i];

@@ -45,11 +45,17 @@ pub fn symmetric(rng: &mut ChaCha8Rng, r: f64) -> f64 {
 /// and vectorises (x86 has no vector conversion from 64-bit integers before AVX-512).
 #[inline(always)]
 pub fn two_units(word: u64) -> (f64, f64) {
+    let (hi, lo) = two_units_plus_one(word);
+    (hi - 1.0, lo - 1.0)
+}
+
+/// [`two_units`] plus one, in [1, 2) (the subtraction of 1 is exact, so a caller may fold it
+/// into a fused multiply-add: c u - c = c (u - 1) in one rounding).
+#[inline(always)]
+pub fn two_units_plus_one(word: u64) -> (f64, f64) {
     const ONE: u64 = 0x3ff0_0000_0000_0000;
     const MANTISSA_TOP32: u64 = 0x000f_ffff_fff0_0000;
-    let hi = f64::from_bits(((word >> 12) & MANTISSA_TOP32) | ONE) - 1.0;
-    let lo = f64::from_bits(((word << 20) & MANTISSA_TOP32) | ONE) - 1.0;
-    (hi, lo)
+    (f64::from_bits(((word >> 12) & MANTISSA_TOP32) | ONE), f64::from_bits(((word << 20) & MANTISSA_TOP32) | ONE))
 }
 
 /// Lanes of [`BulkLanes`].
@@ -94,15 +100,23 @@ impl BulkLanes {
 /// One xoshiro256++ output and state step of one lane (Blackman & Vigna's reference `next`).
 #[inline(always)]
 pub fn xoshiro_step(s0: &mut u64, s1: &mut u64, s2: &mut u64, s3: &mut u64) -> u64 {
-    let out = s0.wrapping_add(*s3).rotate_left(23).wrapping_add(*s0);
-    let t = *s1 << 17;
-    *s2 ^= *s0;
-    *s3 ^= *s1;
-    *s1 ^= *s2;
-    *s0 ^= *s3;
-    *s2 ^= t;
-    *s3 = s3.rotate_left(45);
+    let (out, [a, b, c, d]) = xoshiro_next([*s0, *s1, *s2, *s3]);
+    (*s0, *s1, *s2, *s3) = (a, b, c, d);
     out
+}
+
+/// The same step on values: (output, next state). A loop over lanes that loads the four words,
+/// calls this and stores the four results keeps the state in registers (through `&mut` the
+/// compiler reloads each word after every store).
+#[inline(always)]
+pub fn xoshiro_next(s: [u64; 4]) -> (u64, [u64; 4]) {
+    let out = s[0].wrapping_add(s[3]).rotate_left(23).wrapping_add(s[0]);
+    let t = s[1] << 17;
+    let s2 = s[2] ^ s[0];
+    let s3 = s[3] ^ s[1];
+    let s1 = s[1] ^ s2;
+    let s0 = s[0] ^ s3;
+    (out, [s0, s1, s2 ^ t, s3.rotate_left(45)])
 }
 
 /// A uniform index in 0..n (n >= 1), unbiased (Lemire's multiply-and-reject).
@@ -247,13 +261,41 @@ impl Geometric {
         pos.saturating_add(1).saturating_add(self.skip(pool, rng))
     }
 
-    /// Call `visit(j)` for each j in 0..n chosen independently with probability p, in order.
+    /// Call `visit(j)` for each j in 0..n chosen independently with probability p, in order: the
+    /// positions and the random bits drawn are exactly those of the walk with `skip` and
+    /// `next_after`, with the table's checks hoisted out of the loop.
     #[inline]
     pub fn for_each<F: FnMut(usize)>(&self, n: usize, pool: &mut BitPool, rng: &mut ChaCha8Rng, mut visit: F) {
-        let mut pos = self.skip(pool, rng);
-        while pos < n {
-            visit(pos);
-            pos = pos.saturating_add(1).saturating_add(self.skip(pool, rng));
+        let table: Option<&[u16; 1 << BUCKET_BITS]> = self.table.as_deref().map(|t| t.try_into().expect("4096 buckets"));
+        match table {
+            Some(table) if self.p > 0.0 && self.p < 1.0 => {
+                // A skip is at most MIXED - 1 from the table, or the formula's value (which may
+                // be huge, hence the saturating add).
+                let mut pos = 0usize;
+                loop {
+                    let b = pool.take(BUCKET_BITS, rng);
+                    let g = table[b as usize];
+                    let g = if g != MIXED {
+                        g as usize
+                    } else {
+                        let low = rng.next_u64() >> (64 - LOW_BITS);
+                        self.formula((b << LOW_BITS) | low)
+                    };
+                    pos = pos.saturating_add(g);
+                    if pos >= n {
+                        return;
+                    }
+                    visit(pos);
+                    pos += 1;
+                }
+            }
+            _ => {
+                let mut pos = self.skip(pool, rng);
+                while pos < n {
+                    visit(pos);
+                    pos = pos.saturating_add(1).saturating_add(self.skip(pool, rng));
+                }
+            }
         }
     }
 }
@@ -321,6 +363,28 @@ mod tests {
         let t = Geometric::new(0.2).table.unwrap();
         let mixed = t.iter().filter(|&&v| v == MIXED).count();
         assert!(mixed < 80, "{mixed} mixed buckets of 4096");
+    }
+
+    /// The hoisted walk visits the same positions and draws the same bits as skip/next_after.
+    #[test]
+    fn for_each_is_the_skip_walk() {
+        for p in [0.0, 0.01, 0.2, 0.5, 0.9, 1.0] {
+            let g = Geometric::new(p);
+            for n in [0, 1, 7, 1740, 20_000] {
+                let (mut r1, mut r2) = (ChaCha8Rng::seed_from_u64(11), ChaCha8Rng::seed_from_u64(11));
+                let (mut b1, mut b2) = (BitPool::new(), BitPool::new());
+                let mut walked = Vec::new();
+                let mut j = g.skip(&mut b1, &mut r1);
+                while j < n {
+                    walked.push(j);
+                    j = g.next_after(j, &mut b1, &mut r1);
+                }
+                let mut visited = Vec::new();
+                g.for_each(n, &mut b2, &mut r2, |j| visited.push(j));
+                assert_eq!(visited, walked, "p {p}, n {n}");
+                assert_eq!((b1.take(32, &mut r1), r1.next_u64()), (b2.take(32, &mut r2), r2.next_u64()), "p {p}, n {n}");
+            }
+        }
     }
 
     #[test]
