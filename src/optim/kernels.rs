@@ -1,8 +1,9 @@
-//! The optimisers' per-coordinate loops, compiled twice (baseline and AVX2 with FMA) and picked at
-//! run time. Results are bit-identical between the two: every operation is an IEEE multiply, add,
-//! fused multiply-add (`f64::mul_add`, one rounding in both copies: a hardware instruction in the
-//! AVX2 copy, the C library's `fma` in the baseline one) or compare in the same order, or exact
-//! integer arithmetic; only the vector width differs.
+//! The optimisers' per-coordinate loops, compiled twice (baseline and AVX2 with FMA; the PSO move
+//! also hand-written for AVX-512VL) and picked at run time. Results are bit-identical between the
+//! copies: every operation is an IEEE multiply, add, fused multiply-add (`f64::mul_add`, one
+//! rounding in every copy: a hardware instruction in the AVX2 copy, the C library's `fma` in the
+//! baseline one) or compare in the same order, or exact integer arithmetic; only the vector width
+//! differs.
 //!
 //! Clamping is written as `if v < lo { lo } else { v }` then `if v > hi { hi } else { v }`: the
 //! same value as `max(lo).min(hi)` for every number (and NaN passes through), but it compiles to
@@ -116,12 +117,87 @@ fn pso_move_avx2(x: &mut [f64], v: &mut [f64], p: &[f64], g: &[f64], rng: &mut B
     pso_move_generic(x, v, p, g, rng, co, b)
 }
 
+/// The PSO move in 256-bit AVX-512VL instructions: native 64-bit rotates and three-input logic
+/// cut the random-number part of the loop; the same integer operations and the same IEEE
+/// operations in the same order as [`pso_move_block`], so the same bits. (Left to the compiler,
+/// AVX-512 code uses 512-bit vectors, which this Zen 4 runs in two halves, slower.)
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma,avx512f,avx512vl")]
+fn pso_move_avx512vl(x: &mut [f64], v: &mut [f64], p: &[f64], g: &[f64], rng: &mut BulkLanes, co: PsoCoefficients, b: PsoBounds) {
+    use std::arch::x86_64::*;
+    const XOR3: i32 = 0x96; // a ^ b ^ c
+    const AND_OR: i32 = 0xEA; // (a & b) | c
+    let n = x.len();
+    let (v, p, g, lo, hi, vmax) = (&mut v[..n], &p[..n], &g[..n], &b.lo[..n], &b.hi[..n], &b.vmax[..n]);
+    let mantissa_top32 = _mm256_set1_epi64x(0x000f_ffff_fff0_0000);
+    let one = _mm256_set1_epi64x(0x3ff0_0000_0000_0000);
+    let (c1, c2, k) = (_mm256_set1_pd(co.c1), _mm256_set1_pd(co.c2), _mm256_set1_pd(co.k));
+    let (nc1, nc2) = (_mm256_set1_pd(-co.c1), _mm256_set1_pd(-co.c2));
+    let sign = _mm256_set1_pd(-0.0);
+    for start in (0..n).step_by(LANES) {
+        let m = (n - start).min(LANES);
+        let [s0, s1, s2, s3] = rng.state_mut();
+        let vec_end = m - m % 4;
+        for l in (0..vec_end).step_by(4) {
+            let j = start + l;
+            // SAFETY: l + 4 <= m <= LANES bounds the lane reads and writes; j + 4 <= n bounds
+            // every coordinate slice (all re-sliced to n above).
+            unsafe {
+                let a0 = _mm256_loadu_si256(s0.as_ptr().add(l).cast());
+                let a1 = _mm256_loadu_si256(s1.as_ptr().add(l).cast());
+                let a2 = _mm256_loadu_si256(s2.as_ptr().add(l).cast());
+                let a3 = _mm256_loadu_si256(s3.as_ptr().add(l).cast());
+                let word = _mm256_add_epi64(_mm256_rol_epi64::<23>(_mm256_add_epi64(a0, a3)), a0);
+                let t = _mm256_slli_epi64::<17>(a1);
+                let n0 = _mm256_ternarylogic_epi64::<XOR3>(a0, a3, a1);
+                let n1 = _mm256_ternarylogic_epi64::<XOR3>(a1, a2, a0);
+                let n2 = _mm256_ternarylogic_epi64::<XOR3>(a2, a0, t);
+                let n3 = _mm256_rol_epi64::<45>(_mm256_xor_si256(a3, a1));
+                _mm256_storeu_si256(s0.as_mut_ptr().add(l).cast(), n0);
+                _mm256_storeu_si256(s1.as_mut_ptr().add(l).cast(), n1);
+                _mm256_storeu_si256(s2.as_mut_ptr().add(l).cast(), n2);
+                _mm256_storeu_si256(s3.as_mut_ptr().add(l).cast(), n3);
+                let u1 = _mm256_castsi256_pd(_mm256_ternarylogic_epi64::<AND_OR>(_mm256_srli_epi64::<12>(word), mantissa_top32, one));
+                let u2 = _mm256_castsi256_pd(_mm256_ternarylogic_epi64::<AND_OR>(_mm256_slli_epi64::<20>(word), mantissa_top32, one));
+                let (w1, w2) = (_mm256_fmadd_pd(c1, u1, nc1), _mm256_fmadd_pd(c2, u2, nc2));
+                let xj = _mm256_loadu_pd(x.as_ptr().add(j));
+                let dp = _mm256_sub_pd(_mm256_loadu_pd(p.as_ptr().add(j)), xj);
+                let dg = _mm256_sub_pd(_mm256_loadu_pd(g.as_ptr().add(j)), xj);
+                let vel = _mm256_fmadd_pd(w2, dg, _mm256_fmadd_pd(w1, dp, _mm256_loadu_pd(v.as_ptr().add(j))));
+                let vel = _mm256_mul_pd(k, vel);
+                // max(a, b) is a > b ? a : b, so max(lo, v) = v < lo ? lo : v, as `clamp`.
+                let vm = _mm256_loadu_pd(vmax.as_ptr().add(j));
+                let vel = _mm256_min_pd(vm, _mm256_max_pd(_mm256_xor_pd(vm, sign), vel));
+                _mm256_storeu_pd(v.as_mut_ptr().add(j), vel);
+                let xn = _mm256_add_pd(xj, vel);
+                let xn = _mm256_min_pd(_mm256_loadu_pd(hi.as_ptr().add(j)), _mm256_max_pd(_mm256_loadu_pd(lo.as_ptr().add(j)), xn));
+                _mm256_storeu_pd(x.as_mut_ptr().add(j), xn);
+            }
+        }
+        if vec_end < m {
+            let r = start + vec_end..start + m;
+            let s = [&mut s0[vec_end..m], &mut s1[vec_end..m], &mut s2[vec_end..m], &mut s3[vec_end..m]];
+            let rb = PsoBounds { lo: &lo[r.clone()], hi: &hi[r.clone()], vmax: &vmax[r.clone()] };
+            pso_move_block(&mut x[r.clone()], &mut v[r.clone()], &p[r.clone()], &g[r], rb, s, co);
+        }
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+fn avx512vl() -> bool {
+    std::arch::is_x86_feature_detected!("avx512f") && std::arch::is_x86_feature_detected!("avx512vl")
+}
+
 /// One constricted PSO move of one particle. Coordinate j takes r1, r2 from the two 32-bit
 /// halves of the next word of lane j % LANES of `rng` (the generation and the move are one
 /// vectorised loop).
 pub fn pso_move(x: &mut [f64], v: &mut [f64], p: &[f64], g: &[f64], rng: &mut BulkLanes, co: PsoCoefficients, bounds: PsoBounds) {
     #[cfg(target_arch = "x86_64")]
     {
+        if avx2_fma() && avx512vl() {
+            // SAFETY: the CPU reports AVX2, FMA, AVX-512F and AVX-512VL.
+            return unsafe { pso_move_avx512vl(x, v, p, g, rng, co, bounds) };
+        }
         if avx2_fma() {
             // SAFETY: the CPU reports AVX2 and FMA.
             return unsafe { pso_move_avx2(x, v, p, g, rng, co, bounds) };
@@ -176,6 +252,21 @@ mod tests {
             pso_move(&mut x2, &mut v2, &c, &hi, &mut g2, co, bounds);
         }
         assert_eq!((&x1, &v1), (&x2, &v2));
+        // Each compiled copy this CPU can run, not only the one `pso_move` picks.
+        #[cfg(target_arch = "x86_64")]
+        {
+            type Move = unsafe fn(&mut [f64], &mut [f64], &[f64], &[f64], &mut BulkLanes, PsoCoefficients, PsoBounds);
+            let copies: [(bool, Move); 2] = [(avx2_fma(), pso_move_avx2), (avx2_fma() && avx512vl(), pso_move_avx512vl)];
+            for (_, copy) in copies.into_iter().filter(|c| c.0) {
+                let (mut x3, mut v3, mut g3) = (a.clone(), b.clone(), gen.clone());
+                for _ in 0..2 {
+                    // SAFETY: the CPU reports the copy's features.
+                    unsafe { copy(&mut x3, &mut v3, &c, &hi, &mut g3, co, bounds) };
+                }
+                assert_eq!((&x1, &v1), (&x3, &v3));
+                assert_eq!(g1.state_mut(), g3.state_mut());
+            }
+        }
         // The scalar formula, coordinate j drawing the next word of lane j % LANES.
         let mut g3 = gen.clone();
         let (mut x3, mut v3) = (a.clone(), b.clone());
