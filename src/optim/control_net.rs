@@ -72,7 +72,7 @@ impl Isa {
         match self {
             Isa::Baseline => true,
             #[cfg(target_arch = "x86_64")]
-            Isa::Avx2 => std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma"),
+            Isa::Avx2 => super::kernels::avx2_fma(),
             #[cfg(not(target_arch = "x86_64"))]
             Isa::Avx2 => false,
         }

@@ -10,6 +10,7 @@
 //! one vector max and one vector min instead of NaN-aware blends.
 
 use super::sampling::{two_units_plus_one, xoshiro_next, BulkLanes, LANES};
+use std::ops::Range;
 
 #[inline(always)]
 fn clamp(v: f64, lo: f64, hi: f64) -> f64 {
@@ -77,6 +78,13 @@ pub struct PsoBounds<'a> {
     pub vmax: &'a [f64],
 }
 
+impl<'a> PsoBounds<'a> {
+    /// The box of coordinates `r` only.
+    fn range(&self, r: Range<usize>) -> PsoBounds<'a> {
+        PsoBounds { lo: &self.lo[r.clone()], hi: &self.hi[r.clone()], vmax: &self.vmax[r] }
+    }
+}
+
 #[inline(always)]
 fn pso_move_block(x: &mut [f64], v: &mut [f64], p: &[f64], g: &[f64], b: PsoBounds, s: [&mut [u64]; 4], co: PsoCoefficients) {
     let n = x.len();
@@ -106,8 +114,7 @@ fn pso_move_generic(x: &mut [f64], v: &mut [f64], p: &[f64], g: &[f64], rng: &mu
         let m = r.len();
         let [s0, s1, s2, s3] = rng.state_mut();
         let s = [&mut s0[..m], &mut s1[..m], &mut s2[..m], &mut s3[..m]];
-        let rb = PsoBounds { lo: &b.lo[r.clone()], hi: &b.hi[r.clone()], vmax: &b.vmax[r.clone()] };
-        pso_move_block(&mut x[r.clone()], &mut v[r.clone()], &p[r.clone()], &g[r], rb, s, co);
+        pso_move_block(&mut x[r.clone()], &mut v[r.clone()], &p[r.clone()], &g[r.clone()], b.range(r), s, co);
     }
 }
 
@@ -177,8 +184,7 @@ fn pso_move_avx512vl(x: &mut [f64], v: &mut [f64], p: &[f64], g: &[f64], rng: &m
         if vec_end < m {
             let r = start + vec_end..start + m;
             let s = [&mut s0[vec_end..m], &mut s1[vec_end..m], &mut s2[vec_end..m], &mut s3[vec_end..m]];
-            let rb = PsoBounds { lo: &lo[r.clone()], hi: &hi[r.clone()], vmax: &vmax[r.clone()] };
-            pso_move_block(&mut x[r.clone()], &mut v[r.clone()], &p[r.clone()], &g[r], rb, s, co);
+            pso_move_block(&mut x[r.clone()], &mut v[r.clone()], &p[r.clone()], &g[r.clone()], b.range(r), s, co);
         }
     }
 }

@@ -39,23 +39,24 @@ pub fn symmetric(rng: &mut ChaCha8Rng, r: f64) -> f64 {
     r * (2.0 * unit(rng) - 1.0)
 }
 
-/// Two independent uniforms in [0, 1), 32 random bits each, from one 64-bit draw: h 2^-32 and
-/// l 2^-32 for the high and low halves h, l. Built from the bits, (1 + h 2^-32) - 1 with the 32
-/// bits placed at the top of the mantissa, which is exact (the same value as `h as f64 * 2^-32`)
-/// and vectorises (x86 has no vector conversion from 64-bit integers before AVX-512).
-#[inline(always)]
-pub fn two_units(word: u64) -> (f64, f64) {
-    let (hi, lo) = two_units_plus_one(word);
-    (hi - 1.0, lo - 1.0)
-}
-
-/// [`two_units`] plus one, in [1, 2) (the subtraction of 1 is exact, so a caller may fold it
-/// into a fused multiply-add: c u - c = c (u - 1) in one rounding).
+/// Two independent uniforms in [1, 2), 32 random bits each, from one 64-bit draw: 1 + h 2^-32 and
+/// 1 + l 2^-32 for the high and low halves h, l, built from the bits (the 32 bits placed at the
+/// top of the mantissa), which vectorises (x86 has no vector conversion from 64-bit integers
+/// before AVX-512). Subtracting 1 is exact and gives the uniforms h 2^-32, l 2^-32 in [0, 1)
+/// (`h as f64 * 2^-32`, tested), so a caller may fold it into a fused multiply-add:
+/// c u - c = c (u - 1) in one rounding.
 #[inline(always)]
 pub fn two_units_plus_one(word: u64) -> (f64, f64) {
     const ONE: u64 = 0x3ff0_0000_0000_0000;
     const MANTISSA_TOP32: u64 = 0x000f_ffff_fff0_0000;
     (f64::from_bits(((word >> 12) & MANTISSA_TOP32) | ONE), f64::from_bits(((word << 20) & MANTISSA_TOP32) | ONE))
+}
+
+/// The uniforms in [0, 1) themselves (the tests' reference for the folded form).
+#[cfg(test)]
+pub fn two_units(word: u64) -> (f64, f64) {
+    let (hi, lo) = two_units_plus_one(word);
+    (hi - 1.0, lo - 1.0)
 }
 
 /// Lanes of [`BulkLanes`].
@@ -97,15 +98,16 @@ impl BulkLanes {
     }
 }
 
-/// One xoshiro256++ output and state step of one lane (Blackman & Vigna's reference `next`).
-#[inline(always)]
+/// One xoshiro256++ output and state step of one lane, in the shape of Blackman & Vigna's
+/// reference `next` (the tests' reference for [`xoshiro_next`]).
+#[cfg(test)]
 pub fn xoshiro_step(s0: &mut u64, s1: &mut u64, s2: &mut u64, s3: &mut u64) -> u64 {
     let (out, [a, b, c, d]) = xoshiro_next([*s0, *s1, *s2, *s3]);
     (*s0, *s1, *s2, *s3) = (a, b, c, d);
     out
 }
 
-/// The same step on values: (output, next state). A loop over lanes that loads the four words,
+/// One xoshiro256++ step on values (Blackman & Vigna's reference `next`): (output, next state). A loop over lanes that loads the four words,
 /// calls this and stores the four results keeps the state in registers (through `&mut` the
 /// compiler reloads each word after every store).
 #[inline(always)]
