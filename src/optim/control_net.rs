@@ -48,24 +48,26 @@ pub enum BoxSpec {
     AroundStart { half_width: f64 },
 }
 
-/// Which compiled copy of the fitness kernel runs. (An AVX-512 copy was measured slower than
-/// AVX2 on the development machine, an AMD Zen 4 (family 25) whose 512-bit operations take two
-/// passes: LLVM also turns the transpose into scatters.)
+/// Which compiled copy of the fitness kernel runs. (The AVX-512VL copy is hand-written with
+/// 256-bit vectors: compiler-vectorised AVX-512 code picks 512-bit vectors, which the development
+/// machine, an AMD Zen 4 (family 25), runs in two halves, and turns the transpose into scatters.)
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Isa {
     Baseline,
     /// AVX2 with FMA.
     Avx2,
+    /// AVX-512VL (256-bit vectors, 32 registers): the first pass fused with the transpose.
+    Avx512Vl,
 }
 
 impl Isa {
     /// The fastest copy this CPU supports.
+    /// Every copy, slowest first.
+    pub const ALL: [Isa; 3] = [Isa::Baseline, Isa::Avx2, Isa::Avx512Vl];
+
+    /// The fastest copy this CPU supports.
     pub fn detect() -> Isa {
-        if Isa::Avx2.supported() {
-            Isa::Avx2
-        } else {
-            Isa::Baseline
-        }
+        Isa::ALL.into_iter().rev().find(|isa| isa.supported()).unwrap_or(Isa::Baseline)
     }
 
     fn supported(self) -> bool {
@@ -73,8 +75,10 @@ impl Isa {
             Isa::Baseline => true,
             #[cfg(target_arch = "x86_64")]
             Isa::Avx2 => super::kernels::avx2_fma(),
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx512Vl => super::kernels::avx2_fma() && super::kernels::avx512vl(),
             #[cfg(not(target_arch = "x86_64"))]
-            Isa::Avx2 => false,
+            Isa::Avx2 | Isa::Avx512Vl => false,
         }
     }
 }
@@ -107,6 +111,9 @@ pub struct Scratch {
     r_t: Vec<f64>,
     rt_b: Vec<f64>,
     rt_t: Vec<f64>,
+    /// The top view's first and last four interior-run rows (stride 3 cn_y - 6), for the
+    /// fused AVX-512VL copy.
+    edge: Vec<f64>,
 }
 
 thread_local! {
@@ -189,21 +196,11 @@ fn padded(n: usize) -> usize {
     n.div_ceil(CHUNK) * CHUNK
 }
 
-/// Sum of distances |D - D^G| of one view over `lanes` grid rows and the grid columns `cols`,
-/// from its pass-1 rows `r` (row li at li * k3p, k3 = 3 cn_y values, zero padded). `data`:
-/// chunk-major [chunk][column][c][lane]; `rt`: this view's transposed buffer, with zeros in
-/// every padded place.
+/// Transpose a view's pass-1 rows `r` (row li at li * k3p) into chunk-major RT[chunk][k][lane],
+/// four lanes per store (rows past `lanes` are zero rows of R).
 #[inline(always)]
-fn view_error(lanes: usize, cols: Range<usize>, k3: usize, nv: &SparseBasis, data: &[f64], r: &[f64], rt: &mut [f64]) -> f64 {
-    let nc = cols.len();
-    if lanes == 0 || nc == 0 {
-        return 0.0;
-    }
-    let chunks = lanes.div_ceil(CHUNK);
-    let k3p = padded(k3);
-    // Transpose into chunk-major RT[chunk][b*3 + c][lane], four lanes per store (rows past
-    // `lanes` are zero rows of R).
-    for ch in 0..chunks {
+fn transpose_rows(lanes: usize, k3p: usize, r: &[f64], rt: &mut [f64]) {
+    for ch in 0..lanes.div_ceil(CHUNK) {
         let src: [&[f64]; CHUNK] = std::array::from_fn(|l| &r[(ch * CHUNK + l) * k3p..(ch * CHUNK + l + 1) * k3p]);
         let dst = &mut rt[ch * k3p * CHUNK..(ch + 1) * k3p * CHUNK];
         for (k, out) in dst.chunks_exact_mut(CHUNK).enumerate() {
@@ -212,10 +209,21 @@ fn view_error(lanes: usize, cols: Range<usize>, k3: usize, nv: &SparseBasis, dat
             }
         }
     }
-    // Pass 2 and distances: per chunk of lanes, over all grid columns, in registers:
-    // D^G = sum_t Nv[j][t] RT[first_j + t] (Eq. 5.3), fused multiply-adds in a fixed order.
+}
+
+/// Sum of distances |D - D^G| of one view over `lanes` grid rows and the grid columns `cols`,
+/// from its transposed pass-1 result `rt` (chunk-major RT[chunk][k][lane], k < k3p, zeros in
+/// every padded lane). `data`: chunk-major [chunk][column][c][lane].
+/// Pass 2 and distances: per chunk of lanes, over all grid columns, in registers:
+/// D^G = sum_t Nv[j][t] RT[first_j + t] (Eq. 5.3), fused multiply-adds in a fixed order.
+#[inline(always)]
+fn pass2_error(lanes: usize, cols: Range<usize>, k3p: usize, nv: &SparseBasis, data: &[f64], rt: &[f64]) -> f64 {
+    let nc = cols.len();
+    if lanes == 0 || nc == 0 {
+        return 0.0;
+    }
     let mut total = 0.0;
-    for ch in 0..chunks {
+    for ch in 0..lanes.div_ceil(CHUNK) {
         let block = &rt[ch * k3p * CHUNK..(ch + 1) * k3p * CHUNK];
         let dchunk = &data[ch * nc * 3 * CHUNK..(ch + 1) * nc * 3 * CHUNK];
         let mut acc = [0.0; CHUNK];
@@ -237,6 +245,18 @@ fn view_error(lanes: usize, cols: Range<usize>, k3: usize, nv: &SparseBasis, dat
         }
     }
     total
+}
+
+/// Sum of distances of one view from its pass-1 rows `r` (row li at li * k3p, zero padded):
+/// transpose into `rt`, then [`pass2_error`].
+#[inline(always)]
+fn view_error(lanes: usize, cols: Range<usize>, k3: usize, nv: &SparseBasis, data: &[f64], r: &[f64], rt: &mut [f64]) -> f64 {
+    if lanes == 0 || cols.is_empty() {
+        return 0.0;
+    }
+    let k3p = padded(k3);
+    transpose_rows(lanes, k3p, r, rt);
+    pass2_error(lanes, cols, k3p, nv, data, rt)
 }
 
 #[inline(always)]
@@ -277,6 +297,264 @@ fn kernel(pb: &ControlNetProblem, x: &[f64], s: &mut Scratch) -> f64 {
 #[target_feature(enable = "avx2,fma")]
 fn kernel_avx2(pb: &ControlNetProblem, x: &[f64], s: &mut Scratch) -> f64 {
     kernel(pb, x, s)
+}
+
+/// The kernel in 256-bit AVX-512VL instructions (32 vector registers).
+///
+/// - First pass fused with the transpose: four grid rows (one chunk of lanes) at a time, each
+///   row's four-control-row sum over four consecutive k is one vector, and the four vectors are
+///   transposed in registers and stored straight into RT (no R buffer, no second pass over it).
+///   Its sixteen broadcast weights take half of the 32 registers.
+/// - Second pass over up to five chunks at once, grid columns outside: the column's weights are
+///   broadcast once for all of them.
+///
+/// The arithmetic is that of [`lin4`] and [`pass2_error`] (the same multiplies, fused
+/// multiply-adds, square roots and additions in the same order per lane), so the result is
+/// bit-identical to the other copies (tested).
+///
+/// Safety: every pointer read here is a control row of `x` (checked by `fitness_with` to have
+/// 3 NOV values) or of the scratch's `edge` copy, read at k < the row's length; the first basis
+/// indices satisfy first + 4 <= control-net size (checked by `ControlNetProblem::new`), so four
+/// rows from the first are inside the net; RT and the data hold `chunks` chunks (sized by
+/// `fitness_with` and `new`).
+#[cfg(target_arch = "x86_64")]
+mod fused {
+    use super::{padded, ControlNetProblem, Scratch, CHUNK};
+    use std::arch::x86_64::*;
+
+    /// R for one grid row over four consecutive k: sum_t w[t] P[row t][k..k + 4], rows `s`
+    /// apart from `p`.
+    #[inline(always)]
+    unsafe fn row4(p: *const f64, s: usize, w: &[__m256d; 4]) -> __m256d {
+        let r = _mm256_mul_pd(w[0], _mm256_loadu_pd(p));
+        let r = _mm256_fmadd_pd(w[1], _mm256_loadu_pd(p.add(s)), r);
+        let r = _mm256_fmadd_pd(w[2], _mm256_loadu_pd(p.add(2 * s)), r);
+        _mm256_fmadd_pd(w[3], _mm256_loadu_pd(p.add(3 * s)), r)
+    }
+
+    /// One block: the rows of the first `VALID` lanes over k..k + 4 (from `src[l] + off`; the
+    /// other lanes are zeros), transposed, and its four k rows stored at `out + 4 k`.
+    #[inline(always)]
+    unsafe fn block<const VALID: usize>(src: &[*const f64; CHUNK], s: usize, w: &[[__m256d; 4]; CHUNK], off: usize, out: *mut f64) {
+        let mut r = [_mm256_setzero_pd(); CHUNK];
+        for l in 0..VALID {
+            r[l] = row4(src[l].add(off), s, &w[l]);
+        }
+        let t0 = _mm256_unpacklo_pd(r[0], r[1]);
+        let t1 = _mm256_unpackhi_pd(r[0], r[1]);
+        let t2 = _mm256_unpacklo_pd(r[2], r[3]);
+        let t3 = _mm256_unpackhi_pd(r[2], r[3]);
+        let o = [
+            _mm256_permute2f128_pd::<0x20>(t0, t2),
+            _mm256_permute2f128_pd::<0x20>(t1, t3),
+            _mm256_permute2f128_pd::<0x31>(t0, t2),
+            _mm256_permute2f128_pd::<0x31>(t1, t3),
+        ];
+        for (q, v) in o.iter().enumerate() {
+            _mm256_storeu_pd(out.add(q * CHUNK), *v);
+        }
+    }
+
+    /// A run of `len` (>= 4) consecutive k, read at `src[l]` (stride `s` between control rows)
+    /// and written to RT rows from `out` on: whole blocks, then one last block ending at `len`
+    /// that recomputes up to three k (and rewrites them with the same bits).
+    #[inline(always)]
+    #[allow(clippy::pointers_in_nomem_asm_block)]
+    unsafe fn segment<const VALID: usize>(src: &[*const f64; CHUNK], s: usize, w: &[[__m256d; 4]; CHUNK], len: usize, out: *mut f64) {
+        // The lanes' pointers move with the block and each load is one pointer plus a multiple
+        // of the stride. The empty `asm!` hides the pointers' progression from the compiler,
+        // which would otherwise keep all sixteen row pointers apart (more than the general
+        // registers hold, so reloaded from the stack in every block).
+        let mut k = 0;
+        let mut at = *src;
+        while k + 4 <= len {
+            for p in at.iter_mut().take(VALID) {
+                // The asm is empty: it reads and writes no memory, it only passes the pointer on.
+                std::arch::asm!("/* {0} */", inout(reg) *p, options(pure, nomem, nostack, preserves_flags));
+            }
+            block::<VALID>(&at, s, w, 0, out.add(k * CHUNK));
+            for p in at.iter_mut() {
+                *p = p.add(4);
+            }
+            k += 4;
+        }
+        if k < len {
+            block::<VALID>(src, s, w, len - 4, out.add((len - 4) * CHUNK));
+        }
+    }
+
+    /// `f::<VALID>(args)` for `valid` (1..=4) real lanes: the loops compiled once per count.
+    macro_rules! by_lanes {
+        ($valid:expr, $f:ident($($arg:expr),*)) => {
+            match $valid {
+                4 => $f::<4>($($arg),*),
+                3 => $f::<3>($($arg),*),
+                2 => $f::<2>($($arg),*),
+                _ => $f::<1>($($arg),*),
+            }
+        };
+    }
+
+    /// The broadcast weights Nu[i0 + l][t] of the chunk's first `valid` lanes (zeros after).
+    #[inline(always)]
+    unsafe fn weights(nu: &crate::spline::SparseBasis, i0: usize, valid: usize) -> [[__m256d; 4]; CHUNK] {
+        let mut w = [[_mm256_setzero_pd(); 4]; CHUNK];
+        for (l, wl) in w.iter_mut().enumerate().take(valid) {
+            for (t, wt) in wl.iter_mut().enumerate() {
+                *wt = _mm256_set1_pd(nu.w[i0 + l][t]);
+            }
+        }
+        w
+    }
+
+    /// [`pass2_error`] over `G` chunks at once, grid columns outside and chunks inside: the
+    /// column's four broadcast weights serve all `G` chunks and each chunk keeps its running sum
+    /// in a register. Per lane the same operations in the same order, so the same bits.
+    #[inline(always)]
+    unsafe fn pass2_group<const G: usize>(ch0: usize, cols: std::ops::Range<usize>, k3p: usize, nv: &crate::spline::SparseBasis, data: *const f64, rt: *const f64) -> [__m256d; G] {
+        let nc = cols.len();
+        let mut acc = [_mm256_setzero_pd(); G];
+        for (lj, j) in cols.enumerate() {
+            let w = &nv.w[j];
+            let (w0, w1, w2, w3) = (_mm256_set1_pd(w[0]), _mm256_set1_pd(w[1]), _mm256_set1_pd(w[2]), _mm256_set1_pd(w[3]));
+            let base = nv.first[j] * 3 * CHUNK;
+            for (g, a) in acc.iter_mut().enumerate() {
+                let ch = ch0 + g;
+                let q = rt.add(ch * k3p * CHUNK + base);
+                let d = data.add((ch * nc + lj) * 3 * CHUNK);
+                let mut e = [_mm256_setzero_pd(); 3];
+                for (c, ec) in e.iter_mut().enumerate() {
+                    let v = _mm256_fmsub_pd(w0, _mm256_loadu_pd(q.add(c * CHUNK)), _mm256_loadu_pd(d.add(c * CHUNK)));
+                    let v = _mm256_fmadd_pd(w1, _mm256_loadu_pd(q.add((3 + c) * CHUNK)), v);
+                    let v = _mm256_fmadd_pd(w2, _mm256_loadu_pd(q.add((6 + c) * CHUNK)), v);
+                    *ec = _mm256_fmadd_pd(w3, _mm256_loadu_pd(q.add((9 + c) * CHUNK)), v);
+                }
+                let sq = _mm256_mul_pd(e[0], e[0]);
+                let sq = _mm256_fmadd_pd(e[1], e[1], sq);
+                let sq = _mm256_fmadd_pd(e[2], e[2], sq);
+                *a = _mm256_add_pd(*a, _mm256_sqrt_pd(sq));
+            }
+        }
+        acc
+    }
+
+    /// [`pass2_error`] in groups of up to five chunks ([`pass2_group`]).
+    #[inline(always)]
+    unsafe fn pass2_grouped(lanes: usize, cols: std::ops::Range<usize>, k3p: usize, nv: &crate::spline::SparseBasis, data: &[f64], rt: &[f64]) -> f64 {
+        let nc = cols.len();
+        if lanes == 0 || nc == 0 {
+            return 0.0;
+        }
+        let chunks = lanes.div_ceil(CHUNK);
+        debug_assert!(rt.len() >= chunks * k3p * CHUNK && data.len() >= chunks * nc * 3 * CHUNK);
+        debug_assert!(cols.clone().all(|j| (nv.first[j] + 4) * 3 <= k3p));
+        let (dp, rp) = (data.as_ptr(), rt.as_ptr());
+        let mut total = 0.0;
+        let mut ch = 0;
+        while ch < chunks {
+            let g = (chunks - ch).min(5);
+            let mut sums = [[0.0; CHUNK]; 5];
+            match g {
+                5 => store(&pass2_group::<5>(ch, cols.clone(), k3p, nv, dp, rp), &mut sums),
+                4 => store(&pass2_group::<4>(ch, cols.clone(), k3p, nv, dp, rp), &mut sums),
+                3 => store(&pass2_group::<3>(ch, cols.clone(), k3p, nv, dp, rp), &mut sums),
+                2 => store(&pass2_group::<2>(ch, cols.clone(), k3p, nv, dp, rp), &mut sums),
+                _ => store(&pass2_group::<1>(ch, cols.clone(), k3p, nv, dp, rp), &mut sums),
+            }
+            for lane_sums in &sums[..g] {
+                for v in lane_sums {
+                    total += v;
+                }
+            }
+            ch += g;
+        }
+        total
+    }
+
+    /// The `G` chunks' per-lane sums, for adding in chunk and lane order.
+    #[inline(always)]
+    unsafe fn store<const G: usize>(acc: &[__m256d; G], out: &mut [[f64; CHUNK]; 5]) {
+        for (a, o) in acc.iter().zip(out.iter_mut()) {
+            _mm256_storeu_pd(o.as_mut_ptr(), *a);
+        }
+    }
+
+    #[target_feature(enable = "avx2,fma,avx512f,avx512vl")]
+    pub(super) unsafe fn kernel(pb: &ControlNetProblem, x: &[f64], s: &mut Scratch) -> f64 {
+        let parts = &pb.parts;
+        let (nx, ny, cx, k3) = (parts.nx, parts.ny, parts.cn_x, 3 * parts.cn_y);
+        let k3p = padded(k3);
+        let nu = &parts.nu;
+        let xp = x.as_ptr();
+        // Bottom view: control row a starts at a * k3 in x.
+        for ch in 0..nx.div_ceil(CHUNK) {
+            let i0 = ch * CHUNK;
+            let valid = (nx - i0).min(CHUNK);
+            let mut src = [xp; CHUNK];
+            for l in 0..valid {
+                src[l] = xp.add(nu.first[i0 + l] * k3);
+            }
+            let w = weights(nu, i0, valid);
+            by_lanes!(valid, segment(&src, k3, &w, k3, s.rt_b.as_mut_ptr().add(ch * k3p * CHUNK)));
+        }
+        let bottom = pass2_grouped(nx, 0..ny, k3p, &parts.nv, &pb.data_b, &s.rt_b);
+        // Top view, lanes li = grid rows li + 1. Its k < 3 and k >= k3 - 3 are bottom border
+        // classes (the bottom's rows, read as such); its k in 3..k3 - 3 come from rows of ki
+        // values: rows 1..cx - 1 are the top's interior classes, contiguous in x after the
+        // bottom's, and rows 0 and cx - 1 are the bottom's border rows at offset 3. Rows 0..4 and
+        // cx - 4..cx are copied into `edge` (stride ki), so every lane reads 4 rows at stride ki.
+        let ki = k3 - 6;
+        let top_interior = 3 * cx * parts.cn_y;
+        let lanes = nx - 2;
+        if lanes == 0 || ny < 3 {
+            return bottom;
+        }
+        let row = |a: usize| -> usize {
+            if a == 0 || a == cx - 1 {
+                a * k3 + 3
+            } else {
+                top_interior + (a - 1) * ki
+            }
+        };
+        assert!(s.edge.len() >= 8 * ki);
+        for (e, first_row) in [0, cx - 4].into_iter().enumerate() {
+            for t in 0..4 {
+                // Inline vector copies (ki >= 6): shorter than calls to memcpy.
+                let (from, to) = (xp.add(row(first_row + t)), s.edge.as_mut_ptr().add((4 * e + t) * ki));
+                let mut k = 0;
+                while k + 4 <= ki {
+                    _mm256_storeu_pd(to.add(k), _mm256_loadu_pd(from.add(k)));
+                    k += 4;
+                }
+                _mm256_storeu_pd(to.add(ki - 4), _mm256_loadu_pd(from.add(ki - 4)));
+            }
+        }
+        let edge = s.edge.as_ptr();
+        for ch in 0..lanes.div_ceil(CHUNK) {
+            let li0 = ch * CHUNK;
+            let valid = (lanes - li0).min(CHUNK);
+            let w = weights(nu, li0 + 1, valid);
+            let out = s.rt_t.as_mut_ptr().add(ch * k3p * CHUNK);
+            let (mut border, mut inner) = ([xp; CHUNK], [xp; CHUNK]);
+            for l in 0..valid {
+                let a = nu.first[li0 + l + 1];
+                border[l] = xp.add(a * k3);
+                inner[l] = if a == 0 {
+                    edge
+                } else if a + 4 == cx {
+                    edge.add(4 * ki)
+                } else {
+                    xp.add(row(a))
+                };
+            }
+            // k 0..4 and k3 - 4..k3 from the bottom's rows; k = 3 and k3 - 4 are interior and
+            // are rewritten by the interior run below.
+            by_lanes!(valid, block(&border, k3, &w, 0, out));
+            by_lanes!(valid, block(&border, k3, &w, k3 - 4, out.add((k3 - 4) * CHUNK)));
+            by_lanes!(valid, segment(&inner, ki, &w, ki, out.add(3 * CHUNK)));
+        }
+        bottom + pass2_grouped(lanes, 1..ny - 1, k3p, &parts.nv, &pb.data_t, &s.rt_t)
+    }
 }
 
 impl ControlNetProblem {
@@ -439,12 +717,16 @@ impl ControlNetProblem {
                 r_t: vec![0.0; lt * k3p],
                 rt_b: vec![0.0; lb * k3p],
                 rt_t: vec![0.0; lt * k3p],
+                edge: vec![0.0; 8 * (3 * p.cn_y - 6)],
             };
         }
         match self.isa {
             // SAFETY: `with_isa` and `Isa::detect` only select AVX2 when this CPU reports it.
             #[cfg(target_arch = "x86_64")]
             Isa::Avx2 => unsafe { kernel_avx2(self, x, scratch) },
+            // SAFETY: as above, for AVX-512F and AVX-512VL.
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx512Vl => unsafe { fused::kernel(self, x, scratch) },
             _ => kernel(self, x, scratch),
         }
     }
@@ -623,7 +905,7 @@ mod tests {
             }
             for xs in [pb.initial_point().to_vec(), x] {
                 let want = dense_reference(&pb, &xs);
-                for isa in [Isa::Baseline, Isa::Avx2] {
+                for isa in Isa::ALL {
                     let q = pb.clone().with_isa(isa);
                     let got = q.fitness(&xs);
                     // 1e-12 relative; near interpolation (least-squares x0 of a large net) the
@@ -637,10 +919,15 @@ mod tests {
 
     #[test]
     fn all_kernel_copies_are_bit_identical() {
-        let pb = sphere_problem(20, 20, 18, 18, BoxSpec::DataRange);
-        let x: Vec<f64> = pb.initial_point().iter().enumerate().map(|(k, v)| v + 1e-4 * (k % 5) as f64).collect();
-        let base = pb.clone().with_isa(Isa::Baseline).fitness(&x);
-        assert_eq!(pb.clone().with_isa(Isa::Avx2).fitness(&x).to_bits(), base.to_bits());
+        // Square and oblong grids and nets, lane counts with and without padding, the smallest net.
+        for (nx, ny, cx, cy) in [(20, 20, 18, 18), (18, 30, 16, 28), (20, 20, 6, 6), (9, 7, 4, 5), (7, 9, 5, 4), (5, 5, 4, 4), (4, 4, 4, 4), (6, 9, 4, 6)] {
+            let pb = sphere_problem(nx, ny, cx, cy, BoxSpec::DataRange);
+            let x: Vec<f64> = pb.initial_point().iter().enumerate().map(|(k, v)| v + 1e-4 * (k % 5) as f64).collect();
+            let base = pb.clone().with_isa(Isa::Baseline).fitness(&x);
+            for isa in Isa::ALL {
+                assert_eq!(pb.clone().with_isa(isa).fitness(&x).to_bits(), base.to_bits(), "{nx}x{ny} cn {cx}x{cy} {isa:?}");
+            }
+        }
     }
 
     #[test]
@@ -741,7 +1028,7 @@ mod timing {
         for (nx, ny, cx, cy) in [(20, 20, 18, 18), (18, 30, 16, 28), (20, 20, 6, 6)] {
             let pb = sphere_problem(nx, ny, cx, cy, BoxSpec::DataRange);
             let x = pb.initial_point().to_vec();
-            for isa in [Isa::Baseline, Isa::Avx2] {
+            for isa in Isa::ALL {
                 let q = pb.clone().with_isa(isa);
                 if q.isa() != isa {
                     continue;

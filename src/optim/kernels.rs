@@ -189,8 +189,9 @@ fn pso_move_avx512vl(x: &mut [f64], v: &mut [f64], p: &[f64], g: &[f64], rng: &m
     }
 }
 
+/// Whether this CPU runs the AVX-512VL copies (256-bit vectors, 32 registers).
 #[cfg(target_arch = "x86_64")]
-fn avx512vl() -> bool {
+pub fn avx512vl() -> bool {
     std::arch::is_x86_feature_detected!("avx512f") && std::arch::is_x86_feature_detected!("avx512vl")
 }
 
