@@ -61,7 +61,6 @@ pub enum Isa {
 }
 
 impl Isa {
-    /// The fastest copy this CPU supports.
     /// Every copy, slowest first.
     pub const ALL: [Isa; 3] = [Isa::Baseline, Isa::Avx2, Isa::Avx512Vl];
 
@@ -76,7 +75,7 @@ impl Isa {
             #[cfg(target_arch = "x86_64")]
             Isa::Avx2 => super::kernels::avx2_fma(),
             #[cfg(target_arch = "x86_64")]
-            Isa::Avx512Vl => super::kernels::avx2_fma() && super::kernels::avx512vl(),
+            Isa::Avx512Vl => super::kernels::avx512vl(),
             #[cfg(not(target_arch = "x86_64"))]
             Isa::Avx2 | Isa::Avx512Vl => false,
         }
@@ -251,9 +250,6 @@ fn pass2_error(lanes: usize, cols: Range<usize>, k3p: usize, nv: &SparseBasis, d
 /// transpose into `rt`, then [`pass2_error`].
 #[inline(always)]
 fn view_error(lanes: usize, cols: Range<usize>, k3: usize, nv: &SparseBasis, data: &[f64], r: &[f64], rt: &mut [f64]) -> f64 {
-    if lanes == 0 || cols.is_empty() {
-        return 0.0;
-    }
     let k3p = padded(k3);
     transpose_rows(lanes, k3p, r, rt);
     pass2_error(lanes, cols, k3p, nv, data, rt)

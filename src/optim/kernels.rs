@@ -189,10 +189,11 @@ fn pso_move_avx512vl(x: &mut [f64], v: &mut [f64], p: &[f64], g: &[f64], rng: &m
     }
 }
 
-/// Whether this CPU runs the AVX-512VL copies (256-bit vectors, 32 registers).
+/// Whether this CPU runs the AVX-512VL copies (256-bit vectors, 32 registers; compiled with
+/// AVX2, FMA, AVX-512F and AVX-512VL).
 #[cfg(target_arch = "x86_64")]
 pub fn avx512vl() -> bool {
-    std::arch::is_x86_feature_detected!("avx512f") && std::arch::is_x86_feature_detected!("avx512vl")
+    avx2_fma() && std::arch::is_x86_feature_detected!("avx512f") && std::arch::is_x86_feature_detected!("avx512vl")
 }
 
 /// One constricted PSO move of one particle. Coordinate j takes r1, r2 from the two 32-bit
@@ -201,7 +202,7 @@ pub fn avx512vl() -> bool {
 pub fn pso_move(x: &mut [f64], v: &mut [f64], p: &[f64], g: &[f64], rng: &mut BulkLanes, co: PsoCoefficients, bounds: PsoBounds) {
     #[cfg(target_arch = "x86_64")]
     {
-        if avx2_fma() && avx512vl() {
+        if avx512vl() {
             // SAFETY: the CPU reports AVX2, FMA, AVX-512F and AVX-512VL.
             return unsafe { pso_move_avx512vl(x, v, p, g, rng, co, bounds) };
         }
@@ -263,7 +264,7 @@ mod tests {
         #[cfg(target_arch = "x86_64")]
         {
             type Move = unsafe fn(&mut [f64], &mut [f64], &[f64], &[f64], &mut BulkLanes, PsoCoefficients, PsoBounds);
-            let copies: [(bool, Move); 2] = [(avx2_fma(), pso_move_avx2), (avx2_fma() && avx512vl(), pso_move_avx512vl)];
+            let copies: [(bool, Move); 2] = [(avx2_fma(), pso_move_avx2), (avx512vl(), pso_move_avx512vl)];
             for (_, copy) in copies.into_iter().filter(|c| c.0) {
                 let (mut x3, mut v3, mut g3) = (a.clone(), b.clone(), gen.clone());
                 for _ in 0..2 {
