@@ -19,6 +19,7 @@
 //! at its interior grid points only. The top view's control points are read in place: its
 //! border classes are the bottom's, so the border columns of its first pass are the bottom's.
 
+use super::aligned::Aligned;
 use super::exact::{solve_exact, ExactOptions, ExactResult, SumOfNorms, Term};
 use super::problem::Problem;
 use super::OptimError;
@@ -87,13 +88,13 @@ impl Isa {
 pub struct ControlNetProblem {
     parts: ControlNetParts,
     net: DoubleNet,
-    lower: Vec<f64>,
-    upper: Vec<f64>,
+    lower: Aligned,
+    upper: Aligned,
     box_axes: (Point3, Point3),
     /// Grid data, per grid column j, per coordinate, over the lanes i: bottom all (i, j), top
     /// the interior only.
-    data_b: Vec<f64>,
-    data_t: Vec<f64>,
+    data_b: Aligned,
+    data_t: Aligned,
     isa: Isa,
     /// Sparse rows of the sum-of-norms form (16 control points per grid class).
     term_points: Vec<[usize; 16]>,
@@ -108,8 +109,8 @@ pub struct Scratch {
     key: (usize, usize, usize, usize),
     r_b: Vec<f64>,
     r_t: Vec<f64>,
-    rt_b: Vec<f64>,
-    rt_t: Vec<f64>,
+    rt_b: Aligned,
+    rt_t: Aligned,
     /// The top view's first and last four interior-run rows (stride 3 cn_y - 6), for the
     /// fused AVX-512VL copy.
     edge: Vec<f64>,
@@ -604,10 +605,10 @@ impl ControlNetProblem {
             BoxSpec::AroundStart { half_width } => parts.x0.iter().map(|&v| (v - half_width, v + half_width)).unzip(),
             _ => ((0..3 * nov).map(|k| box_axes.0[k % 3]).collect(), (0..3 * nov).map(|k| box_axes.1[k % 3]).collect()),
         };
-        // Grid data chunk-major: [chunk of 8 grid rows][grid column][xyz][lane], zero padded.
+        // Grid data chunk-major: [chunk of CHUNK grid rows][grid column][xyz][lane], zero padded.
         let layout = |d: &[Point3], rows: Range<usize>, cols: Range<usize>| {
             let (lanes, nc) = (rows.len(), cols.len());
-            let mut out = vec![0.0; padded(lanes) * nc * 3];
+            let mut out = Aligned::zeros(padded(lanes) * nc * 3);
             for (lj, j) in cols.enumerate() {
                 for c in 0..3 {
                     for (li, i) in rows.clone().enumerate() {
@@ -649,8 +650,8 @@ impl ControlNetProblem {
         Ok(ControlNetProblem {
             parts,
             net,
-            lower,
-            upper,
+            lower: Aligned::from_slice(&lower),
+            upper: Aligned::from_slice(&upper),
             box_axes,
             data_b,
             data_t,
@@ -711,8 +712,8 @@ impl ControlNetProblem {
                 key,
                 r_b: vec![0.0; lb * k3p],
                 r_t: vec![0.0; lt * k3p],
-                rt_b: vec![0.0; lb * k3p],
-                rt_t: vec![0.0; lt * k3p],
+                rt_b: Aligned::zeros(lb * k3p),
+                rt_t: Aligned::zeros(lt * k3p),
                 edge: vec![0.0; 8 * (3 * p.cn_y - 6)],
             };
         }
@@ -1031,10 +1032,10 @@ mod timing {
                 }
                 let mut s = Scratch::default();
                 let mut acc = 0.0;
-                let n = 40_000;
-                // Best of 7 batches (the machine is shared).
+                let n = 4_000;
+                // Best of 60 short batches (the machine is shared, and its speed drifts).
                 let mut per = f64::INFINITY;
-                for _ in 0..7 {
+                for _ in 0..60 {
                     let t = Instant::now();
                     for k in 0..n {
                         acc += q.fitness_with(&x, &mut s) * (k & 1) as f64;

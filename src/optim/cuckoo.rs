@@ -27,6 +27,7 @@
 // Index loops over several parallel arrays read more plainly than zipped iterators here.
 #![allow(clippy::needless_range_loop)]
 
+use super::aligned::Aligned;
 use super::problem::{check_problem, Budget, Evaluator, Optimiser, Population, Problem, RunResult};
 use super::sampling::{bulk_from, index, inv_abs_pow_two_thirds, mantegna_sigma_u, unit, BitPool, Bulk, Geometric};
 use super::{check_range, OptimError};
@@ -188,7 +189,7 @@ fn cuckoo_search(
     let mut step = vec![0.0; d];
     let mut v_buf = vec![0.0; d];
     let mut psi = vec![0.0; d];
-    let mut cand: Vec<Vec<f64>> = vec![vec![0.0; d]; n];
+    let mut cand = vec![Aligned::zeros(d); n];
     let mut cand_f = vec![0.0; n];
     let mut pool = BitPool::new();
     let mut bulk = bulk_from(rng);

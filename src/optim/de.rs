@@ -17,6 +17,7 @@
 //! it replaces; the forced position j_rand is then set from the mutant. With CR = 0.8 this draws
 //! about 0.2 d skips (12 random bits each, mostly) instead of d uniforms.
 
+use super::aligned::Aligned;
 use super::kernels::{de_mutant, de_mutant_gene};
 use super::problem::{check_problem, Budget, Evaluator, Optimiser, Population, Problem, RunResult};
 use super::sampling::{index, BitPool, Geometric};
@@ -89,9 +90,9 @@ impl Optimiser for De {
         // waits until the end of the generation (the population is still needed as donors) and
         // then swaps with its target. Only accepted trials occupy memory, which keeps the
         // working set near the population's size (cache).
-        let mut spare: Vec<Vec<f64>> = Vec::with_capacity(n + 1);
-        let mut accepted: Vec<(usize, Vec<f64>, f64)> = Vec::with_capacity(n);
-        let mut t_buf = vec![0.0; d];
+        let mut spare: Vec<Aligned> = Vec::with_capacity(n + 1);
+        let mut accepted: Vec<(usize, Aligned, f64)> = Vec::with_capacity(n);
+        let mut t_buf = Aligned::zeros(d);
         let fw = self.f;
         for _ in 0..budget.generations {
             for i in 0..n {
@@ -115,7 +116,7 @@ impl Optimiser for De {
                 }
                 let ft = eval.eval(t);
                 if ft <= pop.f[i] {
-                    let next = spare.pop().unwrap_or_else(|| vec![0.0; d]);
+                    let next = spare.pop().unwrap_or_else(|| Aligned::zeros(d));
                     accepted.push((i, std::mem::replace(&mut t_buf, next), ft));
                 }
             }

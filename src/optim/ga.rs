@@ -14,6 +14,7 @@
 //! Random bits: one fair bit per gene for the crossover (64 genes per draw) and geometric skips
 //! for the mutation (one draw per mutated gene, not per gene; see `sampling::Geometric`).
 
+use super::aligned::Aligned;
 use super::problem::{check_problem, Budget, Evaluator, Optimiser, Population, Problem, RunResult};
 use super::sampling::{index, symmetric, unit, BitPool, Geometric};
 use super::{check_range, OptimError};
@@ -94,8 +95,8 @@ impl Optimiser for Ga {
         let initial_best = pop.best_fitness();
         let mutation = Geometric::new(self.pm);
         let mut pool = BitPool::new();
-        let mut c1 = vec![0.0; d];
-        let mut c2 = vec![0.0; d];
+        let mut c1 = Aligned::zeros(d);
+        let mut c2 = Aligned::zeros(d);
         for _ in 0..budget.generations {
             let a = self.tournament(&pop.f, rng);
             let b = self.tournament(&pop.f, rng);

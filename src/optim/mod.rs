@@ -4,6 +4,7 @@
 //! is convex, so how far each metaheuristic stops from the true optimum can be stated, not
 //! guessed. Pure code: no file or terminal I/O (the IOHprofiler export returns text).
 
+pub mod aligned;
 pub mod control_net;
 pub mod cuckoo;
 pub mod de;
@@ -17,6 +18,7 @@ pub mod problem;
 pub mod pso;
 pub mod sampling;
 
+pub use aligned::Aligned;
 pub use control_net::{BoxSpec, ControlNetParts, ControlNetProblem, SparseBasis};
 pub use cuckoo::{Csa, Icsa};
 pub use de::De;

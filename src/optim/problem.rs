@@ -3,6 +3,7 @@
 //! records the convergence trace at fixed evaluation counts, so that budgets are measured outside
 //! the algorithms and the traces of repeats line up checkpoint by checkpoint.
 
+use super::aligned::Aligned;
 use super::sampling::symmetric;
 use super::OptimError;
 use rand_chacha::ChaCha8Rng;
@@ -147,7 +148,8 @@ impl<'a> Evaluator<'a> {
 
     /// Close the run: `best_x` is the optimiser's best individual (whose fitness is the best
     /// value seen, since every optimiser here keeps its best).
-    pub fn finish(mut self, best_x: Vec<f64>, initial_best_fitness: f64) -> RunResult {
+    pub fn finish(mut self, best_x: impl Into<Vec<f64>>, initial_best_fitness: f64) -> RunResult {
+        let best_x = best_x.into();
         if self.trace.last().map(|t| t.0) != Some(self.evaluations) {
             self.trace.push((self.evaluations, self.best));
         }
@@ -167,7 +169,7 @@ pub fn clamp_into(x: &mut [f64], lo: &[f64], hi: &[f64]) {
 
 /// A population: one vector per individual and its fitness.
 pub struct Population {
-    pub x: Vec<Vec<f64>>,
+    pub x: Vec<Aligned>,
     pub f: Vec<f64>,
 }
 
@@ -180,7 +182,10 @@ impl Population {
         let mut x = Vec::with_capacity(budget.population);
         let mut f = Vec::with_capacity(budget.population);
         for _ in 0..budget.population {
-            let mut v: Vec<f64> = x0.iter().map(|&c| c + symmetric(rng, budget.init_range)).collect();
+            let mut v = Aligned::zeros(x0.len());
+            for (v, &c) in v.iter_mut().zip(x0) {
+                *v = c + symmetric(rng, budget.init_range);
+            }
             clamp_into(&mut v, lo, hi);
             f.push(eval.eval(&v));
             x.push(v);

@@ -16,6 +16,7 @@
 
 use super::problem::{check_problem, Budget, Evaluator, Optimiser, Population, Problem, RunResult};
 use super::kernels::{pso_move, PsoBounds, PsoCoefficients};
+use super::aligned::Aligned;
 use super::sampling::BulkLanes;
 use super::{check_range, OptimError};
 use rand_chacha::ChaCha8Rng;
@@ -64,7 +65,7 @@ impl Optimiser for Pso {
         let mut eval = Evaluator::new(problem, budget);
         let Population { x: mut pos, f: mut fit } = Population::initial(problem, budget, &mut eval, rng);
         let n = pos.len();
-        let mut vel = vec![vec![0.0; d]; n];
+        let mut vel = vec![Aligned::zeros(d); n];
         let mut pbest = pos.clone();
         let mut pbest_f = fit.clone();
         let mut g = argmin(&pbest_f);
@@ -72,7 +73,10 @@ impl Optimiser for Pso {
         let mut gbest = pbest[g].clone();
         let mut bulk = BulkLanes::from_rng(rng);
         let co = PsoCoefficients { k: self.k, c1: self.c1, c2: self.c2 };
-        let vmax: Vec<f64> = lo.iter().zip(hi).map(|(l, h)| self.vmax_fraction * (h - l)).collect();
+        let mut vmax = Aligned::zeros(d);
+        for (v, (l, h)) in vmax.iter_mut().zip(lo.iter().zip(hi)) {
+            *v = self.vmax_fraction * (h - l);
+        }
         let bounds = PsoBounds { lo, hi, vmax: &vmax };
         for _ in 0..budget.generations {
             // Each particle is evaluated right after its move, while its coordinates are in
