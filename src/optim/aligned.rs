@@ -53,9 +53,9 @@ impl<'a> IntoIterator for &'a Aligned {
     }
 }
 
-impl From<&[f64]> for Aligned {
-    fn from(v: &[f64]) -> Aligned {
-        Aligned::from_slice(v)
+impl FromIterator<f64> for Aligned {
+    fn from_iter<I: IntoIterator<Item = f64>>(iter: I) -> Aligned {
+        Aligned::from_slice(&iter.into_iter().collect::<Vec<f64>>())
     }
 }
 
@@ -80,6 +80,8 @@ mod tests {
                 assert_eq!(&s[..], &v[..]);
             }
             assert_eq!(Vec::from(b), v);
+            let c: Aligned = v.iter().copied().collect();
+            assert!(c.as_ptr() as usize % 64 == 0 && c[..] == v[..]);
             let z = Aligned::zeros(len);
             assert!(z.len() == len && z.iter().all(|&x| x == 0.0));
         }

@@ -182,10 +182,7 @@ impl Population {
         let mut x = Vec::with_capacity(budget.population);
         let mut f = Vec::with_capacity(budget.population);
         for _ in 0..budget.population {
-            let mut v = Aligned::zeros(x0.len());
-            for (v, &c) in v.iter_mut().zip(x0) {
-                *v = c + symmetric(rng, budget.init_range);
-            }
+            let mut v: Aligned = x0.iter().map(|&c| c + symmetric(rng, budget.init_range)).collect();
             clamp_into(&mut v, lo, hi);
             f.push(eval.eval(&v));
             x.push(v);

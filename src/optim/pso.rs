@@ -73,10 +73,7 @@ impl Optimiser for Pso {
         let mut gbest = pbest[g].clone();
         let mut bulk = BulkLanes::from_rng(rng);
         let co = PsoCoefficients { k: self.k, c1: self.c1, c2: self.c2 };
-        let mut vmax = Aligned::zeros(d);
-        for (v, (l, h)) in vmax.iter_mut().zip(lo.iter().zip(hi)) {
-            *v = self.vmax_fraction * (h - l);
-        }
+        let vmax: Aligned = lo.iter().zip(hi).map(|(l, h)| self.vmax_fraction * (h - l)).collect();
         let bounds = PsoBounds { lo, hi, vmax: &vmax };
         for _ in 0..budget.generations {
             // Each particle is evaluated right after its move, while its coordinates are in
