@@ -10,17 +10,16 @@
 //! Table 6.1 gives CR = 0.8, F = 0.3 (the default); the prose of 6.2.2 reads CR = 0.01,
 //! F = 0.8 (`De::thesis_prose()`).
 //!
-//! Crossover cost: the genes are not decided by one uniform draw each. Whichever of the two
-//! sources is rarer (the target when CR >= 0.5, the mutant otherwise) has its positions drawn by
-//! geometric skips: walking the genes with `j += 1 + skip`, skip ~ Geometric(p), visits each gene
-//! independently with probability p, which is exactly the law of the per-gene Bernoulli(p) draws
-//! it replaces; the forced position j_rand is then set from the mutant. With CR = 0.8 this draws
-//! about 0.2 d skips (12 random bits each, mostly) instead of d uniforms.
+//! Crossover: gene j of the trial is the mutant's when a 32-bit uniform h_j is below
+//! floor(CR 2^32) (probability within 2^-32 of CR), drawn from four xoshiro256++ lanes seeded
+//! from the run's stream ([`super::sampling::DeLanes`]; one step of the four gives the halves
+//! for eight genes), so the mutant, the choices and the trial are one vectorised pass over the
+//! genes ([`super::kernels::de_trial`]); j_rand is drawn from the run's stream.
 
 use super::aligned::Aligned;
-use super::kernels::{de_mutant, de_mutant_gene};
+use super::kernels::{de_mutant_gene, de_trial, DeSources};
 use super::problem::{check_problem, Budget, Evaluator, Optimiser, Population, Problem, RunResult};
-use super::sampling::{index, BitPool, Geometric};
+use super::sampling::{bernoulli_threshold_32, index, DeLanes};
 use super::{check_range, OptimError};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
@@ -83,9 +82,8 @@ impl Optimiser for De {
         let mut eval = Evaluator::new(problem, budget);
         let mut pop = Population::initial(problem, budget, &mut eval, rng);
         let initial_best = pop.best_fitness();
-        let from_target = self.cr >= 0.5;
-        let rare = Geometric::new(if from_target { 1.0 - self.cr } else { self.cr });
-        let mut pool = BitPool::new();
+        let threshold = bernoulli_threshold_32(self.cr);
+        let mut lanes = DeLanes::from_rng(rng);
         // Trial buffers: a rejected trial's buffer is reused by the next target, an accepted one
         // waits until the end of the generation (the population is still needed as donors) and
         // then swaps with its target. Only accepted trials occupy memory, which keeps the
@@ -100,20 +98,8 @@ impl Optimiser for De {
                 let j_rand = index(rng, d);
                 let (a, b, c, x) = (&pop.x[r1][..d], &pop.x[r2][..d], &pop.x[r3][..d], &pop.x[i][..d]);
                 let t = &mut t_buf[..d];
-                if from_target {
-                    // Start from the (clamped) mutant, put back the target's genes.
-                    de_mutant(t, a, b, c, fw, lo, hi);
-                    rare.for_each(d, &mut pool, rng, |j| {
-                        if j != j_rand {
-                            t[j] = x[j];
-                        }
-                    });
-                } else {
-                    // Start from the target, take the mutant's genes.
-                    t.copy_from_slice(x);
-                    rare.for_each(d, &mut pool, rng, |j| t[j] = de_mutant_gene(a[j], b[j], c[j], fw, lo[j], hi[j]));
-                    t[j_rand] = de_mutant_gene(a[j_rand], b[j_rand], c[j_rand], fw, lo[j_rand], hi[j_rand]);
-                }
+                de_trial(t, DeSources { a, b, c, x, lo, hi }, fw, &mut lanes, threshold);
+                t[j_rand] = de_mutant_gene(a[j_rand], b[j_rand], c[j_rand], fw, lo[j_rand], hi[j_rand]);
                 let ft = eval.eval(t);
                 if ft <= pop.f[i] {
                     let next = spare.pop().unwrap_or_else(|| Aligned::zeros(d));

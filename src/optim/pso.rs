@@ -11,13 +11,14 @@
 //! `population * (1 + generations)` evaluations.
 //!
 //! Random numbers: r1 and r2 are the two 32-bit halves of one 64-bit word (resolution 2^-32),
-//! one word per coordinate from interleaved xoshiro256++ generators seeded from the run's
-//! stream ([`super::sampling::BulkLanes`]), generated and consumed in the vectorised move loop.
+//! one word per coordinate from eight interleaved xoshiro256++ generators seeded from the run's
+//! stream ([`super::sampling::PsoLanes`]; coordinate j from lane j % 8), generated and consumed
+//! in the vectorised move loop.
 
 use super::problem::{check_problem, Budget, Evaluator, Optimiser, Population, Problem, RunResult};
 use super::kernels::{pso_move, PsoBounds, PsoCoefficients};
 use super::aligned::Aligned;
-use super::sampling::BulkLanes;
+use super::sampling::PsoLanes;
 use super::{check_range, OptimError};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
@@ -71,7 +72,7 @@ impl Optimiser for Pso {
         let mut g = argmin(&pbest_f);
         let initial_best = pbest_f[g];
         let mut gbest = pbest[g].clone();
-        let mut bulk = BulkLanes::from_rng(rng);
+        let mut bulk = PsoLanes::from_rng(rng);
         let co = PsoCoefficients { k: self.k, c1: self.c1, c2: self.c2 };
         let vmax: Aligned = lo.iter().zip(hi).map(|(l, h)| self.vmax_fraction * (h - l)).collect();
         let bounds = PsoBounds { lo, hi, vmax: &vmax };

@@ -59,27 +59,35 @@ pub fn two_units(word: u64) -> (f64, f64) {
     (hi - 1.0, lo - 1.0)
 }
 
-/// Lanes of [`BulkLanes`].
-pub const LANES: usize = 256;
+/// Lanes of PSO's generators ([`PsoLanes`]): coordinate j of a move draws from lane j % 8.
+pub const PSO_LANES: usize = 8;
+/// Lanes of DE's crossover generators ([`DeLanes`]): one step of the four lanes decides eight
+/// genes.
+pub const DE_LANES: usize = 4;
 
-/// `LANES` independent xoshiro256++ generators, each seeded from 256 bits of the run's ChaCha8
-/// stream: the per-coordinate words of PSO, coordinate j drawing from lane j % LANES. One
-/// xoshiro256++ is a serial chain (each state depends on the previous one, about 3 cycles per
-/// word, as much as a third of a PSO run); independent lanes step in parallel, so a loop over
-/// lanes vectorises (shifts, xors, adds: several words per cycle). The states are kept as four
-/// arrays over the lanes (structure of arrays) for that loop. Each lane is exactly
-/// `Xoshiro256PlusPlus` from its seed.
-#[derive(Debug, Clone)]
-pub struct BulkLanes {
-    s: [Box<[u64; LANES]>; 4],
+/// `L` independent xoshiro256++ generators, each seeded from 256 bits of the run's ChaCha8
+/// stream, for the per-coordinate words of the vectorised loops (PSO's r1 and r2, DE's crossover
+/// choices). One xoshiro256++ is a serial chain (each state depends on the previous one, about 3
+/// cycles per word); independent lanes step in parallel, one vector instruction for all of them.
+/// The state is kept as four rows over the lanes (structure of arrays), so that a vector loop
+/// holds each row in one or two registers for a whole pass over a vector and stores it once at
+/// the end. Each lane is exactly `Xoshiro256PlusPlus` from its seed.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BulkLanes<const L: usize> {
+    s: [[u64; L]; 4],
 }
 
-impl BulkLanes {
+/// PSO's generators: eight lanes, two 256-bit registers per state row.
+pub type PsoLanes = BulkLanes<PSO_LANES>;
+/// DE's crossover generators: four lanes, one 256-bit register per state row.
+pub type DeLanes = BulkLanes<DE_LANES>;
+
+impl<const L: usize> BulkLanes<L> {
     /// Lane l takes the l-th 4 words of the stream as its state (an all-zero state, probability
     /// 2^-256, would stay zero forever, so it is replaced by one word 1).
-    pub fn from_rng(rng: &mut ChaCha8Rng) -> BulkLanes {
-        let mut s: [Box<[u64; LANES]>; 4] = std::array::from_fn(|_| Box::new([0u64; LANES]));
-        for l in 0..LANES {
+    pub fn from_rng(rng: &mut ChaCha8Rng) -> BulkLanes<L> {
+        let mut s = [[0u64; L]; 4];
+        for l in 0..L {
             for row in s.iter_mut() {
                 row[l] = rng.next_u64();
             }
@@ -90,12 +98,30 @@ impl BulkLanes {
         BulkLanes { s }
     }
 
-    /// The four state words of every lane.
+    /// The four state rows over the lanes.
     #[inline(always)]
-    pub fn state_mut(&mut self) -> [&mut [u64; LANES]; 4] {
-        let [s0, s1, s2, s3] = &mut self.s;
-        [s0, s1, s2, s3]
+    pub fn state_mut(&mut self) -> &mut [[u64; L]; 4] {
+        &mut self.s
     }
+
+    /// The next word of every lane (lane l's word at index l).
+    #[inline(always)]
+    pub fn next_words(&mut self) -> [u64; L] {
+        let mut out = [0u64; L];
+        for (l, o) in out.iter_mut().enumerate() {
+            let (word, [a, b, c, d]) = xoshiro_next([self.s[0][l], self.s[1][l], self.s[2][l], self.s[3][l]]);
+            (self.s[0][l], self.s[1][l], self.s[2][l], self.s[3][l]) = (a, b, c, d);
+            *o = word;
+        }
+        out
+    }
+}
+
+/// The 32-bit threshold of a Bernoulli(p) choice made by one 32-bit uniform h: h < threshold
+/// with probability floor(p 2^32) / 2^32, within 2^-32 of p (exactly 0 and 1 at p = 0 and 1).
+pub fn bernoulli_threshold_32(p: f64) -> u64 {
+    let p = if p.is_nan() { 0.0 } else { p.clamp(0.0, 1.0) };
+    (p * 4_294_967_296.0).floor() as u64
 }
 
 /// One xoshiro256++ output and state step of one lane, in the shape of Blackman & Vigna's
@@ -478,22 +504,45 @@ mod tests {
 
     #[test]
     fn every_lane_is_xoshiro256_plus_plus() {
-        let mut rng = ChaCha8Rng::seed_from_u64(8);
-        let mut lanes = BulkLanes::from_rng(&mut rng.clone());
-        let mut single: Vec<Xoshiro256PlusPlus> = (0..LANES)
-            .map(|_| {
-                let mut seed = [0u8; 32];
-                for k in 0..4 {
-                    seed[8 * k..8 * k + 8].copy_from_slice(&rng.next_u64().to_le_bytes());
+        fn lanes_agree<const L: usize>() {
+            let mut rng = ChaCha8Rng::seed_from_u64(8);
+            let mut lanes = BulkLanes::<L>::from_rng(&mut rng.clone());
+            let mut single: Vec<Xoshiro256PlusPlus> = (0..L)
+                .map(|_| {
+                    let mut seed = [0u8; 32];
+                    for k in 0..4 {
+                        seed[8 * k..8 * k + 8].copy_from_slice(&rng.next_u64().to_le_bytes());
+                    }
+                    Xoshiro256PlusPlus::from_seed(seed)
+                })
+                .collect();
+            let mut stepped = lanes.clone();
+            for _ in 0..100 {
+                let [s0, s1, s2, s3] = lanes.state_mut();
+                let words = stepped.next_words();
+                for l in 0..L {
+                    let want = single[l].next_u64();
+                    assert_eq!(xoshiro_step(&mut s0[l], &mut s1[l], &mut s2[l], &mut s3[l]), want, "lane {l}");
+                    assert_eq!(words[l], want, "lane {l}");
                 }
-                Xoshiro256PlusPlus::from_seed(seed)
-            })
-            .collect();
-        for _ in 0..100 {
-            let [s0, s1, s2, s3] = lanes.state_mut();
-            for l in 0..LANES {
-                assert_eq!(xoshiro_step(&mut s0[l], &mut s1[l], &mut s2[l], &mut s3[l]), single[l].next_u64(), "lane {l}");
             }
+            assert_eq!(lanes, stepped);
+        }
+        lanes_agree::<PSO_LANES>();
+        lanes_agree::<DE_LANES>();
+        lanes_agree::<1>();
+    }
+
+    #[test]
+    fn bernoulli_thresholds() {
+        assert_eq!(bernoulli_threshold_32(0.0), 0);
+        assert_eq!(bernoulli_threshold_32(1.0), 1 << 32);
+        assert_eq!(bernoulli_threshold_32(0.5), 1 << 31);
+        assert_eq!(bernoulli_threshold_32(f64::NAN), 0);
+        assert_eq!(bernoulli_threshold_32(2.0), 1 << 32);
+        for p in [0.8, 0.01, 0.3, 1e-12] {
+            let t = bernoulli_threshold_32(p) as f64 / 4_294_967_296.0;
+            assert!(t <= p && p - t < 2.4e-10, "{p}: {t}");
         }
     }
 
