@@ -189,7 +189,7 @@ fn de_trial_avx512vl(t: &mut [f64], src: DeSources, f: f64, rng: &mut DeLanes, t
 
 /// The DE/rand/1/bin trial before its forced gene: t_j = clamp(a_j + F (b_j - c_j)) (fused)
 /// where gene j's 32-bit uniform h_j < `threshold` ([`super::sampling::bernoulli_threshold_32`]
-/// of CR), else x_j; one pass, the uniforms drawn from `rng` as in [`de_trial_scalar`].
+/// of CR), else x_j; one pass, the uniforms drawn from `rng` as in `de_trial_scalar`.
 pub fn de_trial(t: &mut [f64], src: DeSources, f: f64, rng: &mut DeLanes, threshold: u64) {
     #[cfg(target_arch = "x86_64")]
     {

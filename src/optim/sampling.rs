@@ -1,7 +1,9 @@
 //! Cheap random draws for the optimisers' inner loops.
 //!
 //! A ChaCha8 64-bit draw costs about 2 ns here, as much as a quarter of a fitness evaluation per
-//! few hundred genes, so the per-gene loops must not draw one uniform per gene. Per-gene
+//! few hundred genes, so the per-gene loops must not draw one ChaCha8 uniform per gene. The
+//! vectorised loops (PSO's move, DE's trial) draw from interleaved xoshiro256++ lanes held in
+//! registers ([`BulkLanes`]). Elsewhere (GA's mutation, cuckoo search's discovery), per-gene
 //! Bernoulli(p) choices are made by geometric skips (one draw per *event*, not per gene), and the
 //! skip itself mostly costs 12 random bits and a table look-up instead of a 53-bit uniform and a
 //! logarithm, with exactly the distribution of the logarithm formula (see [`Geometric`]).
@@ -10,12 +12,11 @@ use rand::{RngCore, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_xoshiro::Xoshiro256PlusPlus;
 
-/// The generator of an optimiser's bulk per-gene draws (PSO's r1, r2; cuckoo search's normals):
-/// xoshiro256++ seeded from 256 bits of the run's ChaCha8 stream, so a run stays a pure function
-/// of its (cell, repeat) stream. ChaCha8 is the stream the runner hands out because its streams
-/// are independent by construction; xoshiro256++ (Blackman & Vigna 2021; passes BigCrush) makes
-/// the hundreds of millions of coefficient draws of one PSO run about four times cheaper, which
-/// is most of a PSO run's time otherwise.
+/// The generator of an optimiser's scalar bulk draws (cuckoo search's normals; the vectorised
+/// loops use [`BulkLanes`]): xoshiro256++ seeded from 256 bits of the run's ChaCha8 stream, so a
+/// run stays a pure function of its (cell, repeat) stream. ChaCha8 is the stream the runner hands
+/// out because its streams are independent by construction; xoshiro256++ (Blackman & Vigna 2021;
+/// passes BigCrush) makes the millions of draws of one run about four times cheaper.
 pub type Bulk = Xoshiro256PlusPlus;
 
 /// A bulk generator seeded from the run's stream.
