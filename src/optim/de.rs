@@ -173,7 +173,7 @@ mod tests {
                 0.0
             }
         }
-        for cr in [0.8, 0.01, 0.3] {
+        for cr in [0.8, 0.01, 0.3, 0.0, 1.0] {
             let d = 2000;
             let p = Flat(vec![0.0; d], vec![-1.0; d], vec![1.0; d]);
             let de = De { cr, f: 0.5 };
@@ -189,6 +189,10 @@ mod tests {
             let out = de.run(&p, &budget, &mut rng).unwrap();
             // best_x is individual 0 (all fitness 0, first on ties), trial of target 0.
             let same = out.best_x.iter().zip(&init.x[0]).filter(|(a, b)| a == b).count();
+            // CR = 0: the forced gene j_rand alone; CR = 1: every gene from the mutant.
+            if cr == 0.0 || cr == 1.0 {
+                assert_eq!(same, if cr == 0.0 { d - 1 } else { 0 }, "cr {cr}");
+            }
             let frac_mutant = 1.0 - same as f64 / d as f64;
             let want = cr + (1.0 - cr) / d as f64;
             let sd = (want * (1.0 - want) / d as f64).sqrt();
