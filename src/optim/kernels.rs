@@ -9,7 +9,7 @@
 //! same value as `max(lo).min(hi)` for every number (and NaN passes through), but it compiles to
 //! one vector max and one vector min instead of NaN-aware blends.
 
-use super::sampling::{two_units_plus_one, xoshiro_next, DeLanes, PsoLanes, DE_LANES, PSO_LANES};
+use super::sampling::{two_units_plus_one, DeLanes, PsoLanes, DE_LANES, PSO_LANES};
 
 #[inline(always)]
 fn clamp(v: f64, lo: f64, hi: f64) -> f64 {
@@ -33,14 +33,6 @@ pub fn avx2_fma() -> bool {
 #[cfg(target_arch = "x86_64")]
 pub fn avx512vl() -> bool {
     avx2_fma() && std::arch::is_x86_feature_detected!("avx512f") && std::arch::is_x86_feature_detected!("avx512vl")
-}
-
-/// One xoshiro256++ step of lane `l` of a state held as four rows over the lanes.
-#[inline(always)]
-fn step_lane<const L: usize>(s: &mut [[u64; L]; 4], l: usize) -> u64 {
-    let (word, [a, b, c, d]) = xoshiro_next([s[0][l], s[1][l], s[2][l], s[3][l]]);
-    (s[0][l], s[1][l], s[2][l], s[3][l]) = (a, b, c, d);
-    word
 }
 
 /// The few operations whose AVX2 and AVX-512VL forms differ, so that each hand-written kernel
@@ -92,13 +84,10 @@ const DE_BLOCK: usize = 2 * DE_LANES;
 /// each block of eight genes steps the four lanes once (also a partial last block); gene j is
 /// the mutant's when its 32-bit uniform h is below `threshold`, else the target's.
 #[inline(always)]
-fn de_trial_scalar(t: &mut [f64], src: DeSources, f: f64, s: &mut [[u64; DE_LANES]; 4], threshold: u64, from: usize) {
+fn de_trial_scalar(t: &mut [f64], src: DeSources, f: f64, rng: &mut DeLanes, threshold: u64, from: usize) {
     let n = t.len();
     for start in (from..n).step_by(DE_BLOCK) {
-        let mut words = [0u64; DE_LANES];
-        for (l, w) in words.iter_mut().enumerate() {
-            *w = step_lane(s, l);
-        }
+        let words = rng.next_words();
         let end = (start + DE_BLOCK).min(n);
         for (i, tj) in t[start..end].iter_mut().enumerate() {
             let j = start + i;
@@ -128,10 +117,7 @@ impl<'a> DeSources<'a> {
 
 #[inline(always)]
 fn de_trial_generic(t: &mut [f64], src: DeSources, f: f64, rng: &mut DeLanes, threshold: u64) {
-    let src = src.cut(t.len());
-    let mut s = *rng.state_mut();
-    de_trial_scalar(t, src, f, &mut s, threshold, 0);
-    *rng.state_mut() = s;
+    de_trial_scalar(t, src.cut(t.len()), f, rng, threshold, 0);
 }
 
 /// [`de_trial_scalar`] in 256-bit instructions: the four lanes' state in four registers for the
@@ -171,7 +157,7 @@ macro_rules! de_trial_simd {
         for (r, row) in s.iter().enumerate() {
             unsafe { _mm256_storeu_si256(state[r].as_mut_ptr().cast(), *row) };
         }
-        de_trial_scalar($t, src, $f, state, $threshold, full);
+        de_trial_scalar($t, src, $f, $rng, $threshold, full);
     }};
 }
 
@@ -232,35 +218,21 @@ fn pso_coordinate(x: f64, v: f64, p: f64, g: f64, lo: f64, hi: f64, vmax: f64, w
     (clamp(x + vj, lo, hi), vj)
 }
 
-/// The move of coordinates `from..n`, coordinate j taking the next word of lane j % 8.
+/// The move of coordinates `from..n`, coordinate j taking the next word of lane j % 8 (the
+/// baseline copy from 0; the vector copies for the coordinates after their last whole vector).
 #[allow(clippy::too_many_arguments)] // the vector copies' arguments and where they stopped
 #[inline(always)]
-fn pso_move_scalar(x: &mut [f64], v: &mut [f64], p: &[f64], g: &[f64], b: PsoBounds, s: &mut [[u64; PSO_LANES]; 4], co: PsoCoefficients, from: usize) {
+fn pso_move_scalar(x: &mut [f64], v: &mut [f64], p: &[f64], g: &[f64], b: PsoBounds, rng: &mut PsoLanes, co: PsoCoefficients, from: usize) {
     let n = x.len();
     let (v, p, g, lo, hi, vmax) = (&mut v[..n], &p[..n], &g[..n], &b.lo[..n], &b.hi[..n], &b.vmax[..n]);
     for j in from..n {
-        let word = step_lane(s, j % PSO_LANES);
+        let word = rng.next_word(j % PSO_LANES);
         (x[j], v[j]) = pso_coordinate(x[j], v[j], p[j], g[j], lo[j], hi[j], vmax[j], word, co);
     }
 }
 
-#[inline(always)]
 fn pso_move_generic(x: &mut [f64], v: &mut [f64], p: &[f64], g: &[f64], rng: &mut PsoLanes, co: PsoCoefficients, b: PsoBounds) {
-    let n = x.len();
-    let (v, p, g, lo, hi, vmax) = (&mut v[..n], &p[..n], &g[..n], &b.lo[..n], &b.hi[..n], &b.vmax[..n]);
-    // The state in locals for the whole move; whole blocks of eight coordinates as a loop of
-    // fixed length over the lanes (which the compiler vectorises), then the rest.
-    let mut s = *rng.state_mut();
-    let full = n - n % PSO_LANES;
-    for start in (0..full).step_by(PSO_LANES) {
-        for l in 0..PSO_LANES {
-            let j = start + l;
-            let word = step_lane(&mut s, l);
-            (x[j], v[j]) = pso_coordinate(x[j], v[j], p[j], g[j], lo[j], hi[j], vmax[j], word, co);
-        }
-    }
-    pso_move_scalar(x, v, p, g, PsoBounds { lo, hi, vmax }, &mut s, co, full);
-    *rng.state_mut() = s;
+    pso_move_scalar(x, v, p, g, b, rng, co, 0)
 }
 
 /// The PSO move in 256-bit instructions: the eight lanes' state in eight registers for the whole
@@ -324,7 +296,7 @@ macro_rules! pso_move_simd {
                 _mm256_storeu_si256(state[r].as_mut_ptr().add(4).cast(), *hg);
             }
         }
-        pso_move_scalar(x, v, p, g, PsoBounds { lo, hi, vmax }, state, co, done);
+        pso_move_scalar(x, v, p, g, PsoBounds { lo, hi, vmax }, $rng, co, done);
     }};
 }
 

@@ -105,16 +105,18 @@ impl<const L: usize> BulkLanes<L> {
         &mut self.s
     }
 
+    /// The next word of lane `l`.
+    #[inline(always)]
+    pub fn next_word(&mut self, l: usize) -> u64 {
+        let (word, [a, b, c, d]) = xoshiro_next([self.s[0][l], self.s[1][l], self.s[2][l], self.s[3][l]]);
+        (self.s[0][l], self.s[1][l], self.s[2][l], self.s[3][l]) = (a, b, c, d);
+        word
+    }
+
     /// The next word of every lane (lane l's word at index l).
     #[inline(always)]
     pub fn next_words(&mut self) -> [u64; L] {
-        let mut out = [0u64; L];
-        for (l, o) in out.iter_mut().enumerate() {
-            let (word, [a, b, c, d]) = xoshiro_next([self.s[0][l], self.s[1][l], self.s[2][l], self.s[3][l]]);
-            (self.s[0][l], self.s[1][l], self.s[2][l], self.s[3][l]) = (a, b, c, d);
-            *o = word;
-        }
-        out
+        std::array::from_fn(|l| self.next_word(l))
     }
 }
 
