@@ -15,7 +15,7 @@ fn main() {
     let cell = SomCell { dataset: "spindle".into(), model: Model::Dnsom, grid: GridSize { nx: 20, ny: 20 }, repeat: 0 };
     let run = ch4::run_cell(&cell, &data["spindle"].points, &SomParams::default(), 2023).unwrap();
     let grid = ch5::grid_from_weights(20, 20, &run.weights);
-    let fit = fit_two_view(&grid, 18, 18, Parameterisation::ChordLength, Approach::Improved).unwrap();
+    let fit = fit_two_view(&grid, 18, 18, Parameterisation::ChordLength, Approach::Improved, &Default::default()).unwrap();
     let problem = ControlNetProblem::new(fit.control_net_parts(&grid).unwrap(), BoxSpec::Cover { fraction: 0.0 }).unwrap();
     let x0 = problem.initial_point().to_vec();
     println!("control-net problem 18x18 on 20x20: {} variables, B = {:.6}", problem.dim(), problem.fitness(&x0));

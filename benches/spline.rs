@@ -38,7 +38,7 @@ fn main() {
                 for &(cx, cy) in nets.iter() {
                     for p in Parameterisation::ALL {
                         for a in [Approach::Conventional, Approach::Improved] {
-                            std::hint::black_box(fit_two_view(g, cx, cy, p, a).unwrap());
+                            std::hint::black_box(fit_two_view(g, cx, cy, p, a, &Default::default()).unwrap());
                             n += 1;
                         }
                     }
@@ -52,7 +52,7 @@ fn main() {
     let t0 = Instant::now();
     let reps = 200;
     for _ in 0..reps {
-        std::hint::black_box(fit_two_view(&same[2], 18, 18, Parameterisation::ChordLength, Approach::Improved).unwrap());
+        std::hint::black_box(fit_two_view(&same[2], 18, 18, Parameterisation::ChordLength, Approach::Improved, &Default::default()).unwrap());
     }
     let per = t0.elapsed().as_secs_f64() / reps as f64;
     println!("one 18x18-net fit (both surfaces, approach B) on the 20x20 grid: {:.3} ms (numpy 1.2 ms: {:.1}x; geomdl 27 ms: {:.0}x)", per * 1e3, 1.2e-3 / per, 27e-3 / per);

@@ -31,7 +31,7 @@ pub enum Command {
     Datasets(DatasetsArgs),
     /// Fit cubic B-spline surfaces to a structured two-view grid (the CSV Chapter 4 saves in
     /// maps/) and write the control nets (CSV), an IGES file and an OBJ mesh.
-    #[command(after_help = "Example:\n  somnurbs fit --grid results/ch4_models/maps/dnsom_spindle_20x20.csv --cn 18x18 --param chord_length --approach improved --out fit_spindle")]
+    #[command(after_help = "Examples (after `somnurbs reproduce`):\n  somnurbs fit --grid results/thesis/ch4_models/maps/dnsom_spindle_20x20.csv --cn 18x18 --out fit_spindle\n  somnurbs fit --grid results/thesis/ch4_models/maps/dnsom_cube_20x20.csv --cn 18x18 --knots nurbs_book --fairness 1e-4 --out fit_cube\n\nThe surfaces are also evaluated between the data points; a warning is printed when they leave\nthe data's bounding box by more than 10% of its diagonal.")]
     Fit(FitArgs),
     /// Compare the optimisers of a Chapter 6 results folder: per cell Wilcoxon signed-rank
     /// (repeats paired by index) and rank-sum tests with A12, and overall Friedman with
@@ -81,6 +81,17 @@ pub struct FitArgs {
     /// Evaluation samples per direction in the OBJ mesh.
     #[arg(long, default_value_t = 40)]
     pub samples: usize,
+    /// Knot reading for nets smaller than the grid: eq2_10 (the thesis' Eq. 2.10 literally) or
+    /// nurbs_book (The NURBS Book eq. 9.68-9.69). See the README's "Readings" table.
+    #[arg(long, default_value = "eq2_10")]
+    pub knots: String,
+    /// Reading of approach A's surface error: per_surface or nov_bottom.
+    #[arg(long, default_value = "per_surface")]
+    pub error_a: String,
+    /// Penalised least squares weight (0: plain least squares, as the thesis); a small value such
+    /// as 1e-4 keeps near-square nets bounded between the data points.
+    #[arg(long, default_value_t = 0.0)]
+    pub fairness: f64,
 }
 
 #[derive(Debug, Args)]

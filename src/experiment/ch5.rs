@@ -6,7 +6,7 @@ use crate::double_net::{DoubleNet, View};
 use crate::experiment::spec::{FitSom, GridSize, SomCell};
 use crate::report::fsio::write_atomic;
 use crate::som::{Model, SomParams};
-use crate::spline::{fit_two_view, TwoSurfaceFit, TwoViewGrid};
+use crate::spline::{fit_two_view, FitOptions, TwoSurfaceFit, TwoViewGrid};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -27,6 +27,14 @@ pub struct FitRow {
     pub surface_error: f64,
     /// Largest distance between the two fitted surfaces along the shared border.
     pub gap: f64,
+    /// The readings the fit used (README "Readings").
+    pub knots: String,
+    pub error_a: String,
+    /// Between the data points (dense evaluation): largest distance of a surface point from the
+    /// data's bounding box, largest absolute control-point coordinate, largest border gap.
+    pub excursion: f64,
+    pub max_control: f64,
+    pub dense_gap: f64,
     pub cpu_s: f64,
 }
 
@@ -116,10 +124,14 @@ fn recompute_map(spec: &Spec, ctx: &RunContext, data: &str, grid: GridSize, som:
 }
 
 /// Fit one cell.
-pub fn run_cell(cell: &FitCell, grid: &TwoViewGrid) -> Result<FitRun> {
+pub fn run_cell(cell: &FitCell, grid: &TwoViewGrid, opts: &FitOptions) -> Result<FitRun> {
     let t0 = runner::thread_cpu_seconds();
-    let fit = fit_two_view(grid, cell.cn.nx, cell.cn.ny, cell.param, cell.approach).map_err(|e| anyhow::anyhow!("{}: {e}", cell.key()))?;
+    let fit = fit_two_view(grid, cell.cn.nx, cell.cn.ny, cell.param, cell.approach, opts).with_context(|| cell.key())?;
     let cpu_s = runner::thread_cpu_seconds() - t0;
+    let dense = fit.dense_geometry(grid);
+    if !(fit.surface_error.is_finite() && dense.excursion.is_finite()) {
+        anyhow::bail!("{}: the fit is not finite (surface error {}, excursion {})", cell.key(), fit.surface_error, dense.excursion);
+    }
     let row = FitRow {
         cell: cell.key(),
         dataset: cell.dataset.clone(),
@@ -131,6 +143,11 @@ pub fn run_cell(cell: &FitCell, grid: &TwoViewGrid) -> Result<FitRun> {
         approach: cell.approach.letter().into(),
         surface_error: fit.surface_error,
         gap: fit.gap,
+        knots: opts.knots.name().into(),
+        error_a: opts.error_a.name().into(),
+        excursion: dense.excursion,
+        max_control: dense.max_control,
+        dense_gap: dense.border_gap,
         cpu_s,
     };
     Ok(FitRun { cell: cell.clone(), row, fit })
@@ -139,9 +156,10 @@ pub fn run_cell(cell: &FitCell, grid: &TwoViewGrid) -> Result<FitRun> {
 /// Run every fit cell of a spec.
 pub fn run(spec: &Spec, ctx: &RunContext, maps: &BTreeMap<String, MapSource>) -> Result<Vec<FitRun>> {
     let cells = spec.fit_cells();
+    let opts = spec.file.fit.as_ref().context("spec has no [fit] section")?.fit_options();
     // A logged cell's fit is rebuilt from its map (deterministic, a fraction of a millisecond);
     // the logged row, with its CPU time, is kept.
-    runner::run_logged(&cells, ctx, &spec.file.name, |cell| run_cell(cell, &maps[&cell.dataset].grid), |cell, row| Ok(FitRun { row, ..run_cell(cell, &maps[&cell.dataset].grid)? }))
+    runner::run_logged(&cells, ctx, &spec.file.name, |cell| run_cell(cell, &maps[&cell.dataset].grid, &opts), |cell, row| Ok(FitRun { row, ..run_cell(cell, &maps[&cell.dataset].grid, &opts)? }))
 }
 
 /// Chapter 5's family: the `[fit]` section.

@@ -33,6 +33,9 @@ pub struct OptimRow {
     /// Best fitness found (Eq. 6.2).
     pub best: f64,
     pub evaluations: u64,
+    /// The best surfaces between the data points (dense evaluation, see `spline::geometry`).
+    pub excursion: f64,
+    pub max_control: f64,
     pub cpu_s: f64,
 }
 
@@ -79,7 +82,7 @@ pub fn problems(spec: &Spec, ctx: &RunContext) -> Result<BTreeMap<ProblemKey, Co
             for p in &o.parameterisations {
                 let param: Parameterisation = p.parse().map_err(anyhow::Error::msg)?;
                 let grid = &maps[d].grid;
-                let fit = fit_two_view(grid, cn.nx, cn.ny, param, Approach::Improved).map_err(|e| anyhow::anyhow!("{d} {cn} {p}: {e}"))?;
+                let fit = fit_two_view(grid, cn.nx, cn.ny, param, Approach::Improved, &o.fit_options()).map_err(|e| anyhow::anyhow!("{d} {cn} {p}: {e}"))?;
                 let parts = fit.control_net_parts(grid).map_err(|e| anyhow::anyhow!("{e}"))?;
                 let bounds = match o.search_range {
                     Some(half_width) => BoxSpec::AroundStart { half_width },
@@ -103,6 +106,10 @@ pub fn run_cell(spec: &Spec, cell: &OptimCell, problem: &ControlNetProblem) -> R
     let t0 = runner::thread_cpu_seconds();
     let r: RunResult = opt.run(problem, &budget, &mut rng).map_err(|e| anyhow::anyhow!("{key}: {e}"))?;
     let cpu_s = runner::thread_cpu_seconds() - t0;
+    if !r.best_fitness.is_finite() {
+        anyhow::bail!("{key}: the best fitness is not finite ({})", r.best_fitness);
+    }
+    let dense = problem.parts().dense_geometry(&r.best_x);
     let row = OptimRow {
         cell: key.clone(),
         dataset: cell.dataset.clone(),
@@ -119,6 +126,8 @@ pub fn run_cell(spec: &Spec, cell: &OptimCell, problem: &ControlNetProblem) -> R
         initial_best: r.initial_best_fitness,
         best: r.best_fitness,
         evaluations: r.evaluations,
+        excursion: dense.excursion,
+        max_control: dense.max_control,
         cpu_s,
     };
     Ok(OptimRun { cell: cell.clone(), row, trace: r.trace, best_x: r.best_x })

@@ -3,17 +3,23 @@
 use crate::cli::FitArgs;
 use crate::experiment::spec::GridSize;
 use crate::report::fsio::{csv_records, read_text, write_atomic};
-use crate::spline::{export, fit_two_view, Approach, Parameterisation};
+use crate::spline::{export, fit_two_view, Approach, ErrorA, FitOptions, KnotRule, Parameterisation};
 use anyhow::{Context, Result};
 
 pub fn fit(args: &FitArgs) -> Result<()> {
     let cn: GridSize = args.cn.parse().map_err(|e| anyhow::anyhow!("--cn: {e}"))?;
     let param: Parameterisation = args.param.parse().map_err(|e| anyhow::anyhow!("--param: {e}"))?;
     let approach: Approach = args.approach.parse().map_err(|e| anyhow::anyhow!("--approach: {e}"))?;
+    let knots: KnotRule = args.knots.parse().map_err(|e| anyhow::anyhow!("--knots: {e}"))?;
+    let error_a = ErrorA::ALL.into_iter().find(|e| e.name() == args.error_a).with_context(|| format!("--error-a: unknown reading `{}` (expected per_surface or nov_bottom)", args.error_a))?;
+    if !(0.0..=1e6).contains(&args.fairness) {
+        anyhow::bail!("--fairness: must be in [0, 1e6], got {}", args.fairness);
+    }
+    let opts = FitOptions { knots, error_a, fairness: args.fairness };
     let shown = args.grid.display().to_string();
     let text = read_text(&args.grid)?;
     let grid = crate::data::grid_csv::parse_two_view_grid(&text).with_context(|| shown.clone())?;
-    let fit = fit_two_view(&grid, cn.nx, cn.ny, param, approach).with_context(|| format!("{shown}: {}x{} grid", grid.nx, grid.ny))?;
+    let fit = fit_two_view(&grid, cn.nx, cn.ny, param, approach, &opts).with_context(|| format!("{shown}: {}x{} grid", grid.nx, grid.ny))?;
 
     let header: Vec<String> = ["view", "a", "b", "x", "y", "z"].iter().map(|s| s.to_string()).collect();
     let mut rows = Vec::new();
@@ -30,9 +36,33 @@ pub fn fit(args: &FitArgs) -> Result<()> {
     let surfaces = [("bottom", &fit.bottom), ("top", &fit.top)];
     write_atomic(&out.join("surfaces.igs"), export::write_iges(&surfaces, true).as_bytes())?;
     write_atomic(&out.join("surfaces.obj"), export::write_obj(&surfaces, args.samples, args.samples).as_bytes())?;
-    let summary: Vec<String> = ["grid", "cn", "parameterisation", "approach", "surface_error", "gap"].iter().map(|s| s.to_string()).collect();
-    let row = vec![format!("{}x{}", grid.nx, grid.ny), cn.to_string(), param.name().into(), approach.letter().into(), format!("{:?}", fit.surface_error), format!("{:?}", fit.gap)];
+    let dense = fit.dense_geometry(&grid);
+    let summary: Vec<String> = ["grid", "cn", "parameterisation", "approach", "knots", "error_a", "fairness", "surface_error", "gap", "excursion", "max_control", "dense_gap"].iter().map(|s| s.to_string()).collect();
+    let row = vec![
+        format!("{}x{}", grid.nx, grid.ny),
+        cn.to_string(),
+        param.name().into(),
+        approach.letter().into(),
+        knots.name().into(),
+        error_a.name().into(),
+        format!("{:?}", args.fairness),
+        format!("{:?}", fit.surface_error),
+        format!("{:?}", fit.gap),
+        format!("{:?}", dense.excursion),
+        format!("{:?}", dense.max_control),
+        format!("{:?}", dense.border_gap),
+    ];
     write_atomic(&out.join("fit.csv"), csv_records(&summary, &[row])?.as_bytes())?;
-    println!("surface error {:.6}, gap {:.3e}; wrote control_nets.csv, surfaces.igs, surfaces.obj, fit.csv in {}", fit.surface_error, fit.gap, out.display());
+    println!("surface error {:.6}, gap {:.3e}, excursion {:.3e}; wrote control_nets.csv, surfaces.igs, surfaces.obj, fit.csv in {}", fit.surface_error, fit.gap, dense.excursion, out.display());
+    let (lo, hi) = crate::spline::geometry::bounding_box(grid.bottom.iter().chain(&grid.top));
+    let diagonal = crate::geom::dist(lo, hi);
+    if dense.excursion > 0.1 * diagonal {
+        eprintln!(
+            "warning: between the data points the surfaces leave the data's bounding box by {:.3e} ({:.0}% of its diagonal; largest control-point coordinate {:.3e}): the exported IGES/OBJ are not usable as they are. Try --knots eq2_10, a smaller --cn, or --fairness 1e-4.",
+            dense.excursion,
+            100.0 * dense.excursion / diagonal,
+            dense.max_control
+        );
+    }
     Ok(())
 }

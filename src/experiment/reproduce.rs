@@ -4,7 +4,7 @@
 //! and one table of the thesis' claims with their verdicts. The list of specs is data
 //! (`experiments/thesis.toml`).
 
-use super::spec::Spec;
+use super::spec::{Override, Spec};
 use super::{run_spec, RunContext};
 use crate::report::claims::{self, Claim};
 use crate::report::fsio::{csv_records, write_atomic};
@@ -26,6 +26,41 @@ pub struct Plan {
     /// The spec whose `maps/` folder the later specs read (plans with Chapters 5 or 6).
     #[serde(default)]
     pub maps_from: Option<String>,
+    /// The name of the readings the specs make as written (a row label of the readings matrix).
+    #[serde(default = "default_reading")]
+    pub reading: String,
+    /// Other reading sets: each runs the specs it names again with its overrides, into
+    /// `readings/<name>/`, and the report sets every claim under every reading side by side.
+    #[serde(default)]
+    pub readings: Vec<ReadingSet>,
+}
+
+/// A named set of readings (README "Readings"): dotted spec keys and the values to use.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReadingSet {
+    pub name: String,
+    #[serde(default)]
+    pub description: String,
+    /// E.g. `"fit.knots" = "nurbs_book"`; a key is applied to the specs that have its section.
+    pub set: std::collections::BTreeMap<String, toml::Value>,
+    /// Which of the plan's specs run under this set.
+    pub specs: Vec<String>,
+}
+
+impl ReadingSet {
+    fn overrides(&self) -> Vec<Override> {
+        self.set.iter().map(|(k, v)| Override { key: k.clone(), value: v.clone() }).collect()
+    }
+}
+
+fn default_reading() -> String {
+    "as_written".into()
+}
+
+/// A reading-set name is a folder name: lower-case letters, digits and `_`.
+fn valid_name(name: &str) -> bool {
+    !name.is_empty() && name.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_')
 }
 
 fn default_title() -> String {
@@ -42,19 +77,38 @@ impl Plan {
         if let Some(m) = plan.maps_from.as_ref().filter(|m| !plan.specs.contains(m)) {
             anyhow::bail!("{}: maps_from: `{m}` is not one of the specs", path.display());
         }
+        let mut names = vec![plan.reading.as_str()];
+        for r in &plan.readings {
+            if !valid_name(&r.name) {
+                anyhow::bail!("{}: readings: name `{}` must be lower-case letters, digits and _", path.display(), r.name);
+            }
+            if names.contains(&r.name.as_str()) {
+                anyhow::bail!("{}: readings: the name `{}` is used twice", path.display(), r.name);
+            }
+            names.push(&r.name);
+            if let Some(s) = r.specs.iter().find(|s| !plan.specs.contains(s)) {
+                anyhow::bail!("{}: readings.{}.specs: `{s}` is not one of the plan's specs", path.display(), r.name);
+            }
+            if r.set.is_empty() {
+                anyhow::bail!("{}: readings.{}.set: is empty", path.display(), r.name);
+            }
+        }
         Ok(plan)
     }
 }
 
 /// Load every spec of the plan (all before any runs, so a bad one stops nothing half-way), with
-/// the maps of the later ones pointed at `<out>/<maps_from>/maps`.
-fn load_specs(dir: &Path, plan: &Plan, profile: Option<&str>, out: &Path) -> Result<Vec<Spec>> {
+/// the maps of the later ones pointed at `<out>/<maps_from>/maps`; `names` and `overrides` select
+/// a reading set's specs and apply its keys.
+fn load_specs(dir: &Path, plan: &Plan, names: &[String], overrides: &[Override], profile: Option<&str>, out: &Path) -> Result<Vec<Spec>> {
     let maps = plan.maps_from.as_ref().map(|m| out.join(m).join("maps").to_string_lossy().into_owned());
-    plan.specs
+    names
         .iter()
         .map(|name| {
             let path = dir.join(format!("{name}.toml"));
-            let mut spec = Spec::load(&path, profile.filter(|p| has_profile(&path, p)))?;
+            let shown = path.display().to_string();
+            let text = std::fs::read_to_string(&path).with_context(|| format!("{shown}: cannot read spec"))?;
+            let mut spec = Spec::parse_with(&shown, &text, profile.filter(|p| has_profile(&path, p)), overrides)?;
             if let Some(maps) = &maps {
                 if let Some(f) = spec.file.fit.as_mut() {
                     f.maps = Some(maps.clone());
@@ -82,7 +136,9 @@ pub fn reproduce(specs_dir: &Path, plan_name: &str, profile: &str, ctx: &RunCont
     }
     let plan = Plan::load(&plan_path)?;
     let profile = if profile == "full" { None } else { Some(profile) };
-    let specs = load_specs(specs_dir, &plan, profile, &ctx.out)?;
+    let specs = load_specs(specs_dir, &plan, &plan.specs, &[], profile, &ctx.out)?;
+    let reading_specs: Vec<(&ReadingSet, Vec<Spec>)> =
+        plan.readings.iter().map(|r| Ok((r, load_specs(specs_dir, &plan, &r.specs, &r.overrides(), profile, &ctx.out)?))).collect::<Result<_>>()?;
     crate::report::fsio::ensure_dir(&ctx.out)?;
     let started = Instant::now();
     let mut done = Vec::new();
@@ -93,10 +149,157 @@ pub fn reproduce(specs_dir: &Path, plan_name: &str, profile: &str, ctx: &RunCont
         run_spec(spec, &sub)?;
         done.push((spec.file.name.clone(), t.elapsed().as_secs_f64()));
     }
-    let report = combined_report(&ctx.out, &plan, plan_name, &specs, &done, profile.unwrap_or("full"), started.elapsed().as_secs_f64())?;
+    for (reading, rspecs) in &reading_specs {
+        for spec in rspecs {
+            let folder = Path::new(READINGS_DIR).join(&reading.name).join(&spec.file.name);
+            let sub = RunContext { out: ctx.out.join(&folder), ..ctx.clone() };
+            eprintln!("somnurbs: reproduce: {} under the readings `{}` -> {}", spec.file.name, reading.name, sub.out.display());
+            let t = Instant::now();
+            run_spec(spec, &sub)?;
+            done.push((folder.to_string_lossy().into_owned(), t.elapsed().as_secs_f64()));
+        }
+    }
+    let mut report = combined_report(&ctx.out, &plan, plan_name, &specs, &done, profile.unwrap_or("full"), started.elapsed().as_secs_f64())?;
+    if !plan.readings.is_empty() {
+        let matrix = readings_matrix(&ctx.out, &plan)?;
+        report.push_str(&render_readings(&ctx.out, &plan, &matrix)?);
+    }
     let path = ctx.out.join("REPORT.md");
     write_atomic(&path, report.as_bytes())?;
     Ok(path)
+}
+
+/// Where the reading sets' runs go, inside the plan's output folder.
+pub const READINGS_DIR: &str = "readings";
+
+/// One claim under one reading.
+struct ReadingClaim {
+    reading: String,
+    folder: String,
+    claim: Claim,
+}
+
+/// Every claim of the specs that some reading set runs, under the plan's own reading and under
+/// each set (read back from each run's `claims.csv`).
+fn readings_matrix(out: &Path, plan: &Plan) -> Result<Vec<ReadingClaim>> {
+    let mut compared: Vec<&String> = Vec::new();
+    for r in &plan.readings {
+        for s in &r.specs {
+            if !compared.contains(&s) {
+                compared.push(s);
+            }
+        }
+    }
+    let mut rows = Vec::new();
+    let mut collect = |reading: &str, folder: PathBuf, name: &str| -> Result<()> {
+        let path = folder.join("claims.csv");
+        if path.exists() {
+            for claim in claims::read(&path)? {
+                rows.push(ReadingClaim { reading: reading.to_string(), folder: name.to_string(), claim });
+            }
+        }
+        Ok(())
+    };
+    for s in &compared {
+        collect(&plan.reading, out.join(s), s)?;
+    }
+    for r in &plan.readings {
+        for s in &r.specs {
+            collect(&r.name, out.join(READINGS_DIR).join(&r.name).join(s), s)?;
+        }
+    }
+    Ok(rows)
+}
+
+/// `readings.csv` and the REPORT.md section: one row per (spec, claim), one column per reading,
+/// and whether the verdict changes with the reading.
+fn render_readings(out: &Path, plan: &Plan, rows: &[ReadingClaim]) -> Result<String> {
+    let header: Vec<String> = ["spec", "chapter", "claim", "reading", "verdict", "holds", "checked", "note"].iter().map(|s| s.to_string()).collect();
+    let csv_rows: Vec<Vec<String>> = rows
+        .iter()
+        .map(|r| vec![r.folder.clone(), r.claim.chapter.clone(), r.claim.statement.clone(), r.reading.clone(), r.claim.verdict().to_string(), r.claim.ours.0.to_string(), r.claim.ours.1.to_string(), r.claim.note.clone()])
+        .collect();
+    write_atomic(&out.join("readings.csv"), csv_records(&header, &csv_rows)?.as_bytes())?;
+    let mut readings = vec![plan.reading.clone()];
+    readings.extend(plan.readings.iter().map(|r| r.name.clone()));
+    let mut s = String::from("\n---\n\n# Readings matrix\n\nThe thesis leaves some steps ambiguous; each is a named spec option (README, \"Readings\"). The plan's specs ran as written");
+    let _ = write!(s, " (reading `{}`) and again under each reading set below, from the same maps and seeds; every claim is shown under every reading, so a reader sees which conclusions rest on which reading (`readings.csv`).\n\n", plan.reading);
+    for r in &plan.readings {
+        let keys: Vec<String> = r.set.iter().map(|(k, v)| format!("`{k} = {v}`")).collect();
+        let _ = writeln!(s, "- `{}`: {} ({}; specs {}; folders `readings/{}/`)", r.name, r.description, keys.join(", "), r.specs.join(", "), r.name);
+    }
+    let mut keys: Vec<(String, String)> = Vec::new();
+    for r in rows {
+        let k = (r.folder.clone(), r.claim.statement.clone());
+        if !keys.contains(&k) {
+            keys.push(k);
+        }
+    }
+    let mut h = vec!["spec".to_string(), "claim".into()];
+    h.extend(readings.iter().map(|r| format!("`{r}`")));
+    h.push("changes with the reading".into());
+    let mut md_rows = Vec::new();
+    let mut changing = 0;
+    for (folder, statement) in &keys {
+        let cells: Vec<Option<&Claim>> = readings.iter().map(|rd| rows.iter().find(|r| &r.reading == rd && &r.folder == folder && &r.claim.statement == statement).map(|r| &r.claim)).collect();
+        let verdicts: Vec<&str> = cells.iter().flatten().map(|c| c.verdict()).collect();
+        let changes = verdicts.windows(2).any(|w| w[0] != w[1]);
+        changing += changes as usize;
+        let mut row = vec![folder.clone(), statement.clone()];
+        row.extend(cells.iter().map(|c| c.map(|c| format!("{} {}/{}", c.verdict(), c.ours.0, c.ours.1)).unwrap_or_else(|| "-".into())));
+        row.push(if changes { "**yes**".into() } else { "no".into() });
+        md_rows.push(row);
+    }
+    let _ = writeln!(s, "\n{changing} of {} claims change their verdict with the reading.\n", keys.len());
+    s.push_str(&markdown_table(&h, &md_rows));
+    if let Some(chart) = error_vs_excursion(out, plan)? {
+        let _ = writeln!(s, "\n![{chart}]({chart})\n\nSurface error against the largest distance of the fitted surfaces from the data's bounding box (log scale), one point per control net, for one data set under each reading: a reading can lower the error at the data points while its surfaces leave the data between them.");
+    }
+    Ok(s)
+}
+
+/// One fitted cell as a readings chart needs it (from a Chapter 5 `runs.csv`).
+#[derive(Debug, Deserialize)]
+struct FitPoint {
+    dataset: String,
+    cn_x: usize,
+    parameterisation: String,
+    approach: String,
+    surface_error: f64,
+    excursion: f64,
+}
+
+/// The chart of surface error against excursion across readings: the first Chapter 5 spec every
+/// reading ran, its first data set, chord length, approach B. Returns its path in `out`.
+fn error_vs_excursion(out: &Path, plan: &Plan) -> Result<Option<String>> {
+    let Some(spec) = plan.specs.iter().find(|s| plan.readings.iter().all(|r| r.specs.contains(s)) && out.join(s).join("runs.csv").exists() && is_fit_runs(&out.join(s).join("runs.csv"))) else {
+        return Ok(None);
+    };
+    let mut folders = vec![(plan.reading.clone(), out.join(spec))];
+    folders.extend(plan.readings.iter().map(|r| (r.name.clone(), out.join(READINGS_DIR).join(&r.name).join(spec))));
+    let mut series = Vec::new();
+    let mut data_set = None;
+    for (k, (name, folder)) in folders.iter().enumerate() {
+        let path = folder.join("runs.csv");
+        let points: Vec<FitPoint> = crate::report::fsio::read_rows(&path)?;
+        let d = data_set.get_or_insert_with(|| points.first().map(|p| p.dataset.clone()).unwrap_or_default()).clone();
+        let mut pts: Vec<(usize, f64, f64)> = points.iter().filter(|p| p.dataset == d && p.parameterisation == "chord_length" && p.approach == "B" && p.excursion > 0.0).map(|p| (p.cn_x, p.excursion.log10(), p.surface_error)).collect();
+        pts.sort_by_key(|p| p.0);
+        series.push(crate::report::plots::Series { label: name.clone(), colour: crate::report::plots::style::cycle_colour(k), points: pts.iter().map(|p| (p.1, p.2)).collect(), band: None });
+    }
+    let name = format!("readings_error_vs_excursion_{spec}.png");
+    let title = format!("{spec}, {}, chord length, B: one point per control net", data_set.unwrap_or_default());
+    match crate::report::plots::line_chart_png(&out.join(&name), &title, "log10 excursion from the data's box", "surface error (Eq. 5.13)", &series, false) {
+        Ok(()) => Ok(Some(name)),
+        Err(e) => {
+            eprintln!("somnurbs: warning: picture skipped: {e}");
+            Ok(None)
+        }
+    }
+}
+
+fn is_fit_runs(path: &Path) -> bool {
+    std::fs::read_to_string(path).ok().and_then(|t| t.lines().next().map(|h| h.split(',').any(|c| c == "excursion") && h.split(',').any(|c| c == "approach"))).unwrap_or(false)
 }
 
 /// A win-count table (Tables 6.4-6.7: data, parameterisation, one column per optimiser, cells).

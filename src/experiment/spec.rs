@@ -350,6 +350,22 @@ pub struct FitSpec {
     /// Pictures like Appendices G/H and the error-vs-control-net chart.
     #[serde(default = "default_true")]
     pub pictures: bool,
+    /// Reading of the knot rule for nets smaller than the grid (README "Readings").
+    #[serde(default)]
+    pub knots: crate::spline::KnotRule,
+    /// Reading of approach A's surface error (README "Readings").
+    #[serde(default)]
+    pub error_a: crate::spline::ErrorA,
+    /// Beyond the thesis: penalised least squares weight (0 = the thesis' plain least squares).
+    #[serde(default)]
+    pub fairness: f64,
+}
+
+impl FitSpec {
+    /// The readings and options every fit of this section uses.
+    pub fn fit_options(&self) -> crate::spline::FitOptions {
+        crate::spline::FitOptions { knots: self.knots, error_a: self.error_a, fairness: self.fairness }
+    }
 }
 
 /// Chapter 6 section: data sets x control nets x parameterisations x optimisers x repeats, every
@@ -406,6 +422,19 @@ pub struct OptimSpec {
     pub csa: crate::optim::cuckoo::Csa,
     #[serde(default)]
     pub icsa: crate::optim::cuckoo::Icsa,
+    /// Reading of the knot rule of approach B's start (README "Readings").
+    #[serde(default)]
+    pub knots: crate::spline::KnotRule,
+    /// Beyond the thesis: penalised least squares weight of B's start (0 = plain least squares).
+    #[serde(default)]
+    pub fairness: f64,
+}
+
+impl OptimSpec {
+    /// The readings and options of approach B's fit that every cell starts from.
+    pub fn fit_options(&self) -> crate::spline::FitOptions {
+        crate::spline::FitOptions { knots: self.knots, fairness: self.fairness, ..Default::default() }
+    }
 }
 
 /// Seed 001 section: a Growing Grid (Fritzke 1995) per open-surface data set, one cubic B-spline
@@ -555,7 +584,63 @@ fn merge(base: &mut toml::Table, over: &toml::Table) {
     }
 }
 
+/// One change to a spec by a dotted key (`fit.knots`, `optim.de.f`), as a reading set of a plan
+/// makes it: applied after the profile and validated exactly as the file's own value.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Override {
+    pub key: String,
+    pub value: toml::Value,
+}
+
+impl fmt::Display for Override {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{} = {}", self.key, self.value)
+    }
+}
+
+/// Apply `over` to a spec table. A key whose section (first part) the spec does not have is
+/// skipped (a reading set names keys of several families) and reported as `false`.
+fn apply_override(table: &mut toml::Table, over: &Override) -> Result<bool, String> {
+    let parts: Vec<&str> = over.key.split('.').collect();
+    if parts.iter().any(|p| p.is_empty()) {
+        return Err(format!("`{}` is not a dotted key", over.key));
+    }
+    if parts.len() > 1 && !matches!(table.get(parts[0]), Some(toml::Value::Table(_))) {
+        return Ok(false);
+    }
+    let mut t = table;
+    for p in &parts[..parts.len() - 1] {
+        let entry = t.entry(p.to_string()).or_insert_with(|| toml::Value::Table(toml::Table::new()));
+        t = match entry {
+            toml::Value::Table(inner) => inner,
+            _ => return Err(format!("`{}`: `{p}` is not a table", over.key)),
+        };
+    }
+    t.insert(parts[parts.len() - 1].to_string(), over.value.clone());
+    Ok(true)
+}
+
 impl Spec {
+    /// Parse spec text with a reading set's overrides applied after the profile (each validated
+    /// as if written in the file); `path` is used in messages only.
+    pub fn parse_with(path: &str, text: &str, profile: Option<&str>, overrides: &[Override]) -> Result<Spec, SpecError> {
+        let mut spec = Spec::parse(path, text, profile)?;
+        if overrides.is_empty() {
+            return Ok(spec);
+        }
+        let mut table: toml::Table = toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
+        if let Some(over) = profile.and_then(|p| spec.file.profiles.get(p)) {
+            merge(&mut table, &over.clone());
+        }
+        for o in overrides {
+            apply_override(&mut table, o).map_err(|e| SpecError(format!("{path}: {e}")))?;
+        }
+        let merged = toml::to_string(&table).map_err(|e| SpecError(format!("{path}: {e}")))?;
+        spec.file = toml::from_str(&merged).map_err(|e| SpecError(format!("{path}: with {}: {}", overrides.iter().map(|o| o.to_string()).collect::<Vec<_>>().join(", "), e.message().replace('\n', " "))))?;
+        spec.validate()?;
+        Ok(spec)
+    }
+
     /// Parse spec text; `path` is used in messages only.
     pub fn parse(path: &str, text: &str, profile: Option<&str>) -> Result<Spec, SpecError> {
         let file: SpecFile = toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
@@ -707,6 +792,9 @@ impl Spec {
         }
         for a in &fit.approaches {
             a.parse::<crate::spline::Approach>().map_err(|e| self.err("fit.approaches", e))?;
+        }
+        if !(0.0..=1e6).contains(&fit.fairness) {
+            return Err(self.err("fit.fairness", format!("must be in [0, 1e6], got {}", fit.fairness)));
         }
         if let Some(som) = &fit.som {
             if som.iterations == 0 {
@@ -893,6 +981,9 @@ impl Spec {
             maps: o.maps.clone(),
             som: o.som.clone(),
             pictures: false,
+            knots: o.knots,
+            error_a: Default::default(),
+            fairness: o.fairness,
         };
         self.validate_fit(&as_fit).map_err(|e| SpecError(e.0.replace(": fit.", ": optim.")))?;
         self.validate_runs("optim", &o.optimisers, &["ga", "de", "pso", "csa", "icsa"], o.repeats, o.generations as u64, o.population)?;

@@ -839,7 +839,7 @@ pub(crate) mod test_support {
     /// Approach B's parts for a `cn_x` x `cn_y` net on an `nx` x `ny` test grid.
     pub fn test_parts(nx: usize, ny: usize, cn_x: usize, cn_y: usize) -> ControlNetParts {
         let grid = crate::spline::approach::tests::test_grid(nx, ny, 0.02);
-        let fit = fit_two_view(&grid, cn_x, cn_y, Parameterisation::ChordLength, Approach::Improved).expect("test fit");
+        let fit = fit_two_view(&grid, cn_x, cn_y, Parameterisation::ChordLength, Approach::Improved, &Default::default()).expect("test fit");
         fit.control_net_parts(&grid).expect("approach B")
     }
 

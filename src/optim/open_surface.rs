@@ -11,7 +11,7 @@ use super::problem::Problem;
 use crate::geom::{self, Point3};
 use crate::spline::basis::basis_matrix;
 use crate::spline::fit::least_squares_net;
-use crate::spline::knots::knot_vector;
+use crate::spline::knots::{knot_vector, KnotRule};
 use crate::spline::param::grid_params;
 use crate::spline::{BSplineSurface, Parameterisation, SparseBasis};
 
@@ -43,8 +43,8 @@ impl OpenSurfaceProblem {
             return Err(format!("box margin must be >= 0, got {margin}"));
         }
         let (us, vs) = grid_params(grid, nx, ny, param);
-        let knots_u = knot_vector(&us, cn_x, 3).map_err(|e| format!("u: {e}"))?;
-        let knots_v = knot_vector(&vs, cn_y, 3).map_err(|e| format!("v: {e}"))?;
+        let knots_u = knot_vector(&us, cn_x, 3, KnotRule::NurbsBook).map_err(|e| format!("u: {e}"))?;
+        let knots_v = knot_vector(&vs, cn_y, 3, KnotRule::NurbsBook).map_err(|e| format!("v: {e}"))?;
         let net = least_squares_net(grid, &basis_matrix(&us, &knots_u, 3, cn_x), &basis_matrix(&vs, &knots_v, 3, cn_y))?;
         let x0: Vec<f64> = net.iter().flat_map(|p| p.iter().copied()).collect();
         let all: Vec<Point3> = grid.iter().chain(&net).copied().collect();
@@ -176,7 +176,7 @@ mod tests {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
         // A genuinely open patch: control points on a perturbed plane.
         let control: Vec<Point3> = (0..cx * cy).map(|k| [(k / cy) as f64 + rng.gen_range(-0.2..0.2), (k % cy) as f64 + rng.gen_range(-0.2..0.2), rng.gen_range(-1.0..1.0)]).collect();
-        let truth = BSplineSurface { p: 3, q: 3, knots_u: knot_vector(&us, cx, 3).unwrap(), knots_v: knot_vector(&vs, cy, 3).unwrap(), cn_x: cx, cn_y: cy, control: control.clone() };
+        let truth = BSplineSurface { p: 3, q: 3, knots_u: knot_vector(&us, cx, 3, KnotRule::NurbsBook).unwrap(), knots_v: knot_vector(&vs, cy, 3, KnotRule::NurbsBook).unwrap(), cn_x: cx, cn_y: cy, control: control.clone() };
         let grid = truth.eval_grid(&us, &vs);
         let pr = OpenSurfaceProblem::new(&grid, nx, ny, cx, cy, Parameterisation::Uniform, 0.0).unwrap();
         // The same knots up to rounding (the uniform parameters are averaged over the columns).

@@ -1,20 +1,21 @@
 //! Chapter 5 pictures: per data set a page laid out like Appendices G/H (rows: control nets;
-//! columns: each parameterisation's A beside B; the fitted surfaces as two-colour wireframes at the
-//! data parameters), and a chart of surface error against control-net size.
+//! columns: each parameterisation's A beside B; the fitted surfaces as two-colour wireframes
+//! evaluated densely between the data parameters), and a chart of surface error against control-net size.
 
-use super::plots::{self, style, grid_edges, LineMesh, Panel, Series};
+use super::plots::{self, style, LineMesh, Panel, Series};
 use crate::experiment::ch5::FitRun;
 use crate::experiment::spec::GridSize;
 use crate::spline::Approach;
 use anyhow::Result;
 use std::path::Path;
 
+/// The two fitted surfaces, drawn from their dense evaluation (iso-lines through the data
+/// parameters, each sampled between the data points), so a surface that swings out shows.
 fn surface_meshes(run: &FitRun) -> Vec<LineMesh> {
-    let (nx, ny) = (run.cell.grid.nx, run.cell.grid.ny);
-    let edges = grid_edges(nx, ny);
+    let [(bottom, be), (top, te)] = run.fit.dense_wireframes();
     vec![
-        LineMesh { points: run.fit.fitted_bottom.clone(), edges: edges.clone(), colour: style::DNSOM_BOTTOM, label: "bottom surface".into() },
-        LineMesh { points: run.fit.fitted_top.clone(), edges, colour: style::DNSOM_TOP, label: "top surface".into() },
+        LineMesh { points: bottom, edges: be, colour: style::DNSOM_BOTTOM, label: "bottom surface".into() },
+        LineMesh { points: top, edges: te, colour: style::DNSOM_TOP, label: "top surface".into() },
     ]
 }
 

@@ -29,6 +29,61 @@ fn stats(v: &[f64]) -> Option<(f64, f64, f64)> {
 
 type CellKey = (String, Parameterisation, GridSize);
 
+/// One value of ours beside the thesis' (Appendices K-N): the row key (data, parameterisation,
+/// cn_x, cn_y), the column, ours, the thesis'.
+struct Beside {
+    key: Vec<String>,
+    measure: String,
+    ours: f64,
+    thesis: f64,
+}
+
+/// Every cell of our appendix table that the published one also has.
+fn side_by_side(header: &[String], rows: &[Vec<String>], thesis: &reference::RefTable) -> Vec<Beside> {
+    let keys = ["data", "parameterisation", "cn_x", "cn_y"];
+    let mut out = Vec::new();
+    for row in rows {
+        let key = row[..keys.len()].to_vec();
+        for (col, v) in header.iter().zip(row).skip(keys.len()) {
+            if let (Ok(ours), Some(t)) = (v.parse::<f64>(), thesis.value(&keys, &key, col)) {
+                out.push(Beside { key: key.clone(), measure: col.clone(), ours, thesis: t });
+            }
+        }
+    }
+    out
+}
+
+/// `<name>_vs_thesis.csv` (long: one row per cell and column, ours, the thesis', the ratio) and
+/// the Markdown table of the median ratio per control net and column.
+fn render_side_by_side(pairs: &[Beside], name: &str, out: &Path) -> Result<String> {
+    let h: Vec<String> = ["data", "parameterisation", "cn_x", "cn_y", "measure", "ours", "thesis", "ratio"].iter().map(|s| s.to_string()).collect();
+    let rows: Vec<Vec<String>> = pairs
+        .iter()
+        .map(|b| {
+            let mut r = b.key.clone();
+            r.extend([b.measure.clone(), format!("{:.6}", b.ours), format!("{:.6}", b.thesis), if b.thesis != 0.0 { format!("{:.6}", b.ours / b.thesis) } else { String::new() }]);
+            r
+        })
+        .collect();
+    write_atomic(&out.join(format!("{name}_vs_thesis.csv")), csv_records(&h, &rows)?.as_bytes())?;
+    let measures = ordered(pairs.iter().map(|b| b.measure.clone()));
+    let shown: Vec<&String> = measures.iter().filter(|m| m.as_str() == "b" || m.ends_with("_avg") || m.ends_with("_avg_s")).collect();
+    let nets = ordered(pairs.iter().map(|b| (b.key[2].parse::<usize>().unwrap_or(0), b.key[3].parse::<usize>().unwrap_or(0))));
+    let mut mh = vec!["CN".to_string()];
+    mh.extend(shown.iter().map(|m| m.to_string()));
+    let mut mrows = Vec::new();
+    for (cx, cy) in nets {
+        let mut r = vec![format!("{cx}x{cy}")];
+        for m in &shown {
+            let v: Vec<f64> = pairs.iter().filter(|b| &&b.measure == m && b.key[2] == cx.to_string() && b.key[3] == cy.to_string() && b.thesis != 0.0).map(|b| b.ours / b.thesis).collect();
+            r.push(super::markdown::num(super::markdown::median(&v), 3));
+        }
+        mrows.push(r);
+    }
+    let what = if name.ends_with("_m") || name.ends_with("_n") { "CPU seconds per run" } else { "surface error" };
+    Ok(format!("\n**`{name}_vs_thesis.csv`**: ours beside the thesis' {what}, cell by cell; below, the median ratio ours/thesis per control net\n\n{}", table(&mh, &mrows)))
+}
+
 /// Write every Chapter 6 file; returns the REPORT.md section.
 pub fn write(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProblem>, exact: &BTreeMap<ProblemKey, ExactResult>, setting: &str, out: &Path) -> Result<String> {
     let rows: Vec<_> = runs.iter().map(|r| r.row.clone()).collect();
@@ -102,6 +157,13 @@ pub fn write(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProble
         }
         write_atomic(&out.join(format!("{err_name}.csv")), csv_records(&eh, &erows)?.as_bytes())?;
         write_atomic(&out.join(format!("{time_name}.csv")), csv_records(&th, &trows)?.as_bytes())?;
+        let mut beside_md = String::new();
+        for (name, h, rows) in [(err_name, &eh, &erows), (time_name, &th, &trows)] {
+            if let Some(t) = reference::table(name) {
+                let pairs = side_by_side(h, rows, &t);
+                beside_md.push_str(&render_side_by_side(&pairs, name, out)?);
+            }
+        }
         let mut wh = vec!["data".to_string(), "parameterisation".into()];
         wh.extend(opts.iter().cloned());
         wh.push("cells".into());
@@ -149,6 +211,7 @@ pub fn write(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProble
             Some((w, t.rows.len()))
         };
         if let Some(k) = opts.iter().position(|o| o == "de") {
+            s.push_str(&beside_md);
             claims.push(Claim { chapter: "6".into(), statement: format!("DE gives the least average error in most cells (grid {grid})"), ours: (err_wins[k], cells.len()), thesis: thesis_wins(thesis.as_ref(), "", "de"), note: "thesis: 126/140 and 117/140 (Tables 6.4, 6.5); verdict 'mostly holds' when more than half".into() });
         }
         if let Some(k) = opts.iter().position(|o| o == "ga") {
@@ -193,12 +256,13 @@ pub fn write(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProble
                 let mut panels = Vec::new();
                 for &p in &params {
                     let Some(problem) = problems.get(&(d.clone(), cn, p)) else { continue };
+                    // Drawn from the dense evaluation, so a surface that swings out between the
+                    // data points shows.
                     let meshes = |x: &[f64]| {
-                        let g = problem.surface(x);
-                        let edges = plots::grid_edges(g.nx, g.ny);
+                        let [(bottom, be), (top, te)] = problem.parts().dense_wireframes(x);
                         vec![
-                            plots::LineMesh { points: g.bottom, edges: edges.clone(), colour: style::DNSOM_BOTTOM, label: "bottom surface".into() },
-                            plots::LineMesh { points: g.top, edges, colour: style::DNSOM_TOP, label: "top surface".into() },
+                            plots::LineMesh { points: bottom, edges: be, colour: style::DNSOM_BOTTOM, label: "bottom surface".into() },
+                            plots::LineMesh { points: top, edges: te, colour: style::DNSOM_TOP, label: "top surface".into() },
                         ]
                     };
                     panels.push(plots::Panel { title: format!("{} {cn} B ({:.4})", p.name(), problem.fitness(problem.initial_point())), meshes: meshes(problem.initial_point()) });
@@ -276,6 +340,15 @@ pub fn write(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProble
     }
     let n_ioh = super::ioh::write(runs, out)?;
     let _ = writeln!(s, "\nConvergence traces of every run in the IOHprofiler format (`ioh/<optimiser>/`, {n_ioh} problem files), loadable by IOHanalyzer.");
+    let near = runs.iter().filter(|r| r.row.excursion <= super::ch5::NEAR).count();
+    let worst = runs.iter().max_by(|a, b| a.row.excursion.total_cmp(&b.row.excursion));
+    claims.push(Claim {
+        chapter: "6".into(),
+        statement: "The optimised surfaces stay near the data".into(),
+        ours: (near, runs.len()),
+        thesis: None,
+        note: format!("runs whose best surfaces' dense excursion from the data's bounding box is at most {}{}", super::ch5::NEAR, worst.map(|w| format!("; largest {:.3e} at {}", w.row.excursion, w.row.cell)).unwrap_or_default()),
+    });
     let kept = runs.iter().filter(|r| r.row.best <= r.row.initial_best).count();
     claims.push(Claim { chapter: "6".into(), statement: "Every run's best is no worse than its initial population's best".into(), ours: (kept, runs.len()), thesis: None, note: "elitism check over all runs".into() });
     s.push_str("\n### Claims\n\n");

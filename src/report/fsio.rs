@@ -42,6 +42,13 @@ pub fn read_text(path: &Path) -> Result<String> {
 
 
 /// Serialise rows to CSV text (header from the struct's field names).
+/// Typed rows of a CSV file (extra columns ignored); errors name the file and line.
+pub fn read_rows<T: serde::de::DeserializeOwned>(path: &Path) -> Result<Vec<T>> {
+    let text = read_text(path)?;
+    let mut rd = csv::Reader::from_reader(text.as_bytes());
+    rd.deserialize().enumerate().map(|(k, r)| r.with_context(|| format!("{}: line {}", path.display(), k + 2))).collect()
+}
+
 pub fn csv_text<T: serde::Serialize>(rows: &[T]) -> Result<String> {
     let mut w = csv::Writer::from_writer(Vec::new());
     for r in rows {

@@ -14,14 +14,8 @@ use std::path::Path;
 
 use crate::stats::describe::mean_std;
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(|a, b| a.total_cmp(b));
-    let n = v.len();
-    if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
+fn median(v: Vec<f64>) -> f64 {
+    super::markdown::median(&v).unwrap_or(f64::NAN)
 }
 
 /// Write runs.csv-derived tables and charts; return the REPORT.md section.

@@ -5,29 +5,73 @@
 //! - Grids are row-major (i * ny + j); u runs along i (nx values), v along j (ny values).
 //! - Parameters: per column j the polyline over i, per row i the polyline over j (Eq. 2.7/2.8),
 //!   averaged (Eq. 5.1, 5.2). B averages the two views' averaged parameters (Eq. 5.3, 5.4).
-//! - Knots: clamped cubic; averaging when the net is as large as the grid, else The NURBS Book
-//!   9.68-9.69 (see `knots`). A and B differ only through the parameters they are built from.
+//! - Knots: clamped cubic by the named rule of [`FitOptions::knots`] (see `knots`: Eq. 2.10
+//!   literally, or The NURBS Book 9.68-9.69). A and B differ only through their parameters.
 //! - Control nets: least squares per coordinate (`fit`), then for B every border control point
 //!   (a = 0, cn_x - 1, b = 0, cn_y - 1: one class number in the double net) becomes the mean of
 //!   the two nets' (Eq. 5.7); then the corner rule on each net (corner control point := corner data
 //!   point; corners are border data, the same in both views, so the order of the two steps does not
 //!   change them).
-//! - Surface error (Eq. 5.13): sum over the NOV grid class numbers of |D - D^G|, a border class
-//!   taken at its first allocation (the bottom view). Gap: the largest |D^G_bottom - D^G_top| over
+//! - Surface error (Eq. 5.13): for B, the sum over the NOV grid class numbers of |D - D^G|, a
+//!   border class taken at its first allocation (the bottom view). For A by the named reading
+//!   [`ErrorA`]: over all 2 nx ny map neurons, each view against its own fit (`per_surface`), or
+//!   Eq. 5.13 as for B (`nov_bottom`). Gap: the largest |D^G_bottom - D^G_top| over
 //!   the border positions; B has gap 0 exactly, since its border rows and columns of D^G are
 //!   copies of the same shared control points.
 
 use super::basis::{basis_matrix, SparseBasis};
-use super::fit::{fitted_grid, least_squares_net, pin_corners};
-use super::knots::knot_vector;
+use super::fit::{faired_net, fitted_grid, least_squares_net, pin_corners};
+use super::knots::{knot_vector, KnotRule};
 use super::param::{grid_params, Parameterisation};
 use super::surface::BSplineSurface;
 use super::SplineError;
 pub use crate::double_net::TwoViewGrid;
 use crate::double_net::{DoubleNet, View};
 use crate::geom::{self, Point3};
+use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::str::FromStr;
+
+/// How approach A's surface error is scored (thesis Section 5.2.4 defines Eq. 5.13 "for the
+/// improved approach" only; a named reading, README "Readings").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ErrorA {
+    /// Sum of |D - D^G| over all 2 nx ny map neurons, each surface against its own fitted points
+    /// (shared border neurons once per surface), as the conventional approach of the thesis' [23]
+    /// treats each surface separately.
+    #[default]
+    PerSurface,
+    /// Eq. 5.13 over the NOV class numbers, a shared border class scored on the bottom surface.
+    NovBottom,
+}
+
+impl ErrorA {
+    pub const ALL: [ErrorA; 2] = [ErrorA::PerSurface, ErrorA::NovBottom];
+
+    /// The spec value.
+    pub fn name(self) -> &'static str {
+        match self {
+            ErrorA::PerSurface => "per_surface",
+            ErrorA::NovBottom => "nov_bottom",
+        }
+    }
+}
+
+impl fmt::Display for ErrorA {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// The named readings and options of a two-surface fit. `Default` is the thesis plan's reading.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct FitOptions {
+    pub knots: KnotRule,
+    pub error_a: ErrorA,
+    /// Penalised least squares weight (0: the thesis' plain least squares; see `fit::faired_net`).
+    pub fairness: f64,
+}
 
 /// Conventional (A) or improved (B).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -122,8 +166,8 @@ struct ViewFit {
     net: Vec<Point3>,
 }
 
-/// Fit both views of `grid` with a `cn_x x cn_y` cubic control net each.
-pub fn fit_two_view(grid: &TwoViewGrid, cn_x: usize, cn_y: usize, param: Parameterisation, approach: Approach) -> Result<TwoSurfaceFit, SplineError> {
+/// Fit both views of `grid` with a `cn_x x cn_y` cubic control net each (Eq. 5.1-5.7, 5.12, 5.13).
+pub fn fit_two_view(grid: &TwoViewGrid, cn_x: usize, cn_y: usize, param: Parameterisation, approach: Approach, opts: &FitOptions) -> Result<TwoSurfaceFit, SplineError> {
     grid.validate()?;
     if cn_x < 4 || cn_y < 4 {
         return Err(SplineError::ControlNet(format!("control net {cn_x}x{cn_y} is smaller than 4 (cubic needs p + 1 = 4 a side)")));
@@ -145,11 +189,12 @@ pub fn fit_two_view(grid: &TwoViewGrid, cn_x: usize, cn_y: usize, param: Paramet
     let mut fits = Vec::with_capacity(2);
     for (k, view) in View::BOTH.iter().enumerate() {
         let (u, v) = params[k].clone();
-        let knots_u = knot_vector(&u, cn_x, 3).map_err(SplineError::ControlNet)?;
-        let knots_v = knot_vector(&v, cn_y, 3).map_err(SplineError::ControlNet)?;
+        let knots_u = knot_vector(&u, cn_x, 3, opts.knots).map_err(SplineError::ControlNet)?;
+        let knots_v = knot_vector(&v, cn_y, 3, opts.knots).map_err(SplineError::ControlNet)?;
         let nu = basis_matrix(&u, &knots_u, 3, cn_x);
         let nv = basis_matrix(&v, &knots_v, 3, cn_y);
-        let net = least_squares_net(grid.view(*view), &nu, &nv).map_err(SplineError::Singular)?;
+        let net = if opts.fairness > 0.0 { faired_net(grid.view(*view), &nu, &nv, opts.fairness) } else { least_squares_net(grid.view(*view), &nu, &nv) };
+        let net = net.map_err(SplineError::Singular)?;
         fits.push(ViewFit { u, v, knots_u, knots_v, net });
     }
     if approach == Approach::Improved {
@@ -172,7 +217,10 @@ pub fn fit_two_view(grid: &TwoViewGrid, cn_x: usize, cn_y: usize, param: Paramet
         .map(|f| fitted_grid(&f.net, &basis_matrix(&f.u, &f.knots_u, 3, cn_x), &basis_matrix(&f.v, &f.knots_v, 3, cn_y)))
         .collect();
     let net = DoubleNet::new(nx, ny).expect("validated sides");
-    let surface_error = surface_error(grid, &net, &fitted[0], &fitted[1]);
+    let surface_error = match (approach, opts.error_a) {
+        (Approach::Conventional, ErrorA::PerSurface) => per_surface_error(grid, &fitted[0], &fitted[1]),
+        _ => surface_error(grid, &net, &fitted[0], &fitted[1]),
+    };
     let gap = border_gap(&net, &fitted[0], &fitted[1]);
     let surface = |f: &ViewFit| BSplineSurface { p: 3, q: 3, knots_u: f.knots_u.clone(), knots_v: f.knots_v.clone(), cn_x, cn_y, control: f.net.clone() };
     let (bottom, top) = (surface(&fits[0]), surface(&fits[1]));
@@ -205,6 +253,12 @@ pub fn surface_error(grid: &TwoViewGrid, net: &DoubleNet, fitted_bottom: &[Point
         .sum()
 }
 
+/// Approach A's error under `per_surface`: sum of |D - D^G| over every position of both views.
+pub fn per_surface_error(grid: &TwoViewGrid, fitted_bottom: &[Point3], fitted_top: &[Point3]) -> f64 {
+    let one = |data: &[Point3], fitted: &[Point3]| data.iter().zip(fitted).map(|(d, g)| geom::dist(*d, *g)).sum::<f64>();
+    one(&grid.bottom, fitted_bottom) + one(&grid.top, fitted_top)
+}
+
 /// Largest distance between the fitted surfaces over the shared border positions.
 pub fn border_gap(net: &DoubleNet, fitted_bottom: &[Point3], fitted_top: &[Point3]) -> f64 {
     let mut gap = 0.0f64;
@@ -231,9 +285,26 @@ pub struct ControlNetParts {
     pub data_bottom: Vec<Point3>,
     pub data_top: Vec<Point3>,
     pub x0: Vec<f64>,
+    /// B's shared data parameters and knot vectors (for evaluating a net between the data).
+    pub params_u: Vec<f64>,
+    pub params_v: Vec<f64>,
+    pub knots_u: Vec<f64>,
+    pub knots_v: Vec<f64>,
 }
 
 impl TwoSurfaceFit {
+    /// The surfaces between the data points (see `geometry`), sampled `DENSE_FACTOR` times finer.
+    pub fn dense_geometry(&self, grid: &TwoViewGrid) -> super::DenseGeometry {
+        let data: Vec<Point3> = grid.bottom.iter().chain(&grid.top).copied().collect();
+        let params = [(&self.params_u[0][..], &self.params_v[0][..]), (&self.params_u[1][..], &self.params_v[1][..])];
+        super::geometry::dense_geometry([&self.bottom, &self.top], params, &data, super::DENSE_FACTOR)
+    }
+
+    /// Dense wireframes (bottom, top) of the fitted surfaces, for pictures.
+    pub fn dense_wireframes(&self) -> [(Vec<Point3>, Vec<(u32, u32)>); 2] {
+        [(&self.bottom, 0), (&self.top, 1)].map(|(s, k)| super::geometry::dense_wireframe(s, &self.params_u[k], &self.params_v[k], super::DENSE_FACTOR))
+    }
+
     /// The control-net problem of Chapter 6 (approach B only: one set of knots and parameters).
     pub fn control_net_parts(&self, grid: &TwoViewGrid) -> Result<ControlNetParts, SplineError> {
         if self.approach != Approach::Improved {
@@ -260,28 +331,57 @@ impl TwoSurfaceFit {
             data_bottom: grid.bottom.clone(),
             data_top: grid.top.clone(),
             x0,
+            params_u: self.params_u[0].clone(),
+            params_v: self.params_v[0].clone(),
+            knots_u: self.bottom.knots_u.clone(),
+            knots_v: self.bottom.knots_v.clone(),
         })
     }
 }
 
 impl ControlNetParts {
-    /// Eq. 6.2 (= Eq. 5.13) for a decision vector x, the plain dense way (the reference the fast
-    /// fitness of Chapter 6 is tested against).
-    pub fn surface_error(&self, x: &[f64]) -> f64 {
+    /// Dense wireframes (bottom, top) of a decision vector's surfaces, for pictures.
+    pub fn dense_wireframes(&self, x: &[f64]) -> [(Vec<Point3>, Vec<(u32, u32)>); 2] {
+        self.surfaces(x).map(|s| super::geometry::dense_wireframe(&s, &self.params_u, &self.params_v, super::DENSE_FACTOR))
+    }
+
+    /// The dense geometry of a decision vector's surfaces (B's shared parameters and knots).
+    pub fn dense_geometry(&self, x: &[f64]) -> super::DenseGeometry {
+        let [bottom, top] = self.surfaces(x);
+        let u = &self.params_u[..];
+        let v = &self.params_v[..];
+        let data: Vec<Point3> = self.data_bottom.iter().chain(&self.data_top).copied().collect();
+        super::geometry::dense_geometry([&bottom, &top], [(u, v), (u, v)], &data, super::DENSE_FACTOR)
+    }
+
+    /// The two surfaces (bottom, top) of a decision vector x (one point per control-net class).
+    pub fn surfaces(&self, x: &[f64]) -> [BSplineSurface; 2] {
         let cn = DoubleNet::new(self.cn_x, self.cn_y).expect("sides at least 4");
-        let grid_net = DoubleNet::new(self.nx, self.ny).expect("sides at least 2");
-        let nu = self.nu.dense(self.cn_x);
-        let nv = self.nv.dense(self.cn_y);
-        let net_of = |view: View| -> Vec<Point3> {
-            (0..self.cn_x * self.cn_y)
+        View::BOTH.map(|view| BSplineSurface {
+            p: 3,
+            q: 3,
+            knots_u: self.knots_u.clone(),
+            knots_v: self.knots_v.clone(),
+            cn_x: self.cn_x,
+            cn_y: self.cn_y,
+            control: (0..self.cn_x * self.cn_y)
                 .map(|k| {
                     let c = cn.class(view, k / self.cn_y, k % self.cn_y);
                     [x[3 * c], x[3 * c + 1], x[3 * c + 2]]
                 })
-                .collect()
-        };
-        let fb = fitted_grid(&net_of(View::Bottom), &nu, &nv);
-        let ft = fitted_grid(&net_of(View::Top), &nu, &nv);
+                .collect(),
+        })
+    }
+
+    /// Eq. 6.2 (= Eq. 5.13) for a decision vector x, the plain dense way (the reference the fast
+    /// fitness of Chapter 6 is tested against).
+    pub fn surface_error(&self, x: &[f64]) -> f64 {
+        let grid_net = DoubleNet::new(self.nx, self.ny).expect("sides at least 2");
+        let nu = self.nu.dense(self.cn_x);
+        let nv = self.nv.dense(self.cn_y);
+        let [bottom, top] = self.surfaces(x);
+        let fb = fitted_grid(&bottom.control, &nu, &nv);
+        let ft = fitted_grid(&top.control, &nu, &nv);
         let grid = TwoViewGrid { nx: self.nx, ny: self.ny, bottom: self.data_bottom.clone(), top: self.data_top.clone() };
         surface_error(&grid, &grid_net, &fb, &ft)
     }
@@ -314,45 +414,97 @@ pub mod tests {
         let g = test_grid(20, 20, 0.02);
         for p in Parameterisation::ALL {
             for cn in [6, 10, 18] {
-                let b = fit_two_view(&g, cn, cn, p, Approach::Improved).unwrap();
+                let b = fit_two_view(&g, cn, cn, p, Approach::Improved, &FitOptions::default()).unwrap();
                 assert_eq!(b.gap, 0.0, "{p} {cn}");
-                let a = fit_two_view(&g, cn, cn, p, Approach::Conventional).unwrap();
+                let a = fit_two_view(&g, cn, cn, p, Approach::Conventional, &FitOptions::default()).unwrap();
                 assert!(a.gap > 0.0, "{p} {cn}");
                 assert!(a.surface_error > 0.0 && b.surface_error > 0.0);
             }
         }
         let g = test_grid(18, 30, 0.02);
-        assert_eq!(fit_two_view(&g, 16, 28, Parameterisation::ChordLength, Approach::Improved).unwrap().gap, 0.0);
+        assert_eq!(fit_two_view(&g, 16, 28, Parameterisation::ChordLength, Approach::Improved, &FitOptions::default()).unwrap().gap, 0.0);
+    }
+
+    /// Hand-computed: a 4x5 map, bottom fitted 0.1 off everywhere, top fitted exactly but for a
+    /// border position 5 off (3-4-5) and an interior one 1 off. per_surface counts all 40
+    /// positions: 20 * 0.1 + 5 + 1 = 8; Eq. 5.13 counts the NOV = 26 classes, the border on the
+    /// bottom view: 20 * 0.1 + 1 = 3.
+    #[test]
+    fn per_surface_and_nov_bottom_errors_by_hand() {
+        let g = test_grid(4, 5, 0.0);
+        let net = DoubleNet::new(4, 5).unwrap();
+        assert_eq!(net.nov(), 26);
+        let fb: Vec<Point3> = g.bottom.iter().map(|p| [p[0], p[1], p[2] + 0.1]).collect();
+        let mut ft = g.top.clone();
+        ft[net.at(0, 2)] = geom::add(ft[net.at(0, 2)], [3.0, 4.0, 0.0]);
+        ft[net.at(1, 1)] = geom::add(ft[net.at(1, 1)], [0.0, 0.0, 1.0]);
+        assert!((per_surface_error(&g, &fb, &ft) - 8.0).abs() < 1e-12);
+        assert!((surface_error(&g, &net, &fb, &ft) - 3.0).abs() < 1e-12);
+    }
+
+    /// Under per_surface, A's error is the sum of both views' own residuals, so it is never below
+    /// Eq. 5.13 of the same fit; the two readings differ only for A.
+    #[test]
+    fn error_readings_change_a_only() {
+        let g = test_grid(20, 20, 0.02);
+        for cn in [6, 12] {
+            let per = FitOptions::default();
+            let nov = FitOptions { error_a: ErrorA::NovBottom, ..per };
+            let (a1, a2) = (fit_two_view(&g, cn, cn, Parameterisation::ChordLength, Approach::Conventional, &per).unwrap(), fit_two_view(&g, cn, cn, Parameterisation::ChordLength, Approach::Conventional, &nov).unwrap());
+            assert!(a1.surface_error > a2.surface_error);
+            let (b1, b2) = (fit_two_view(&g, cn, cn, Parameterisation::ChordLength, Approach::Improved, &per).unwrap(), fit_two_view(&g, cn, cn, Parameterisation::ChordLength, Approach::Improved, &nov).unwrap());
+            assert_eq!(b1.surface_error.to_bits(), b2.surface_error.to_bits());
+        }
+    }
+
+    /// B's border curves are built from the same averaged control points on the same knots: the
+    /// dense border gap is exactly 0; A's is at least its gap at the data parameters.
+    #[test]
+    fn dense_gap_and_excursion() {
+        let g = test_grid(20, 20, 0.02);
+        for knots in KnotRule::ALL {
+            let o = FitOptions { knots, ..FitOptions::default() };
+            let b = fit_two_view(&g, 10, 10, Parameterisation::ChordLength, Approach::Improved, &o).unwrap();
+            let gb = b.dense_geometry(&g);
+            assert_eq!(gb.border_gap, 0.0);
+            let a = fit_two_view(&g, 10, 10, Parameterisation::ChordLength, Approach::Conventional, &o).unwrap();
+            let ga = a.dense_geometry(&g);
+            assert!(ga.border_gap >= a.gap && a.gap > 0.0, "{ga:?} {}", a.gap);
+            assert!(gb.excursion.is_finite() && gb.max_control > 0.0);
+            // The optimiser's view of B gives the same surfaces, so the same measures.
+            let parts = b.control_net_parts(&g).unwrap();
+            assert_eq!(parts.dense_geometry(&parts.x0), gb);
+        }
     }
 
     #[test]
     fn error_is_zero_when_the_net_is_as_large_as_the_grid() {
         // n_ctrl = n_params: the least squares interpolates every data point.
         let g = test_grid(9, 11, 0.03);
-        let a = fit_two_view(&g, 9, 11, Parameterisation::ChordLength, Approach::Conventional).unwrap();
+        let a = fit_two_view(&g, 9, 11, Parameterisation::ChordLength, Approach::Conventional, &FitOptions::default()).unwrap();
         assert!(a.surface_error < 1e-9, "{}", a.surface_error);
     }
 
     #[test]
     fn bad_sizes_are_refused() {
         let g = test_grid(10, 10, 0.0);
-        assert!(fit_two_view(&g, 3, 8, Parameterisation::Uniform, Approach::Improved).unwrap_err().to_string().contains("smaller than 4"));
-        assert!(fit_two_view(&g, 11, 8, Parameterisation::Uniform, Approach::Improved).unwrap_err().to_string().contains("larger than the grid"));
+        assert!(fit_two_view(&g, 3, 8, Parameterisation::Uniform, Approach::Improved, &FitOptions::default()).unwrap_err().to_string().contains("smaller than 4"));
+        assert!(fit_two_view(&g, 11, 8, Parameterisation::Uniform, Approach::Improved, &FitOptions::default()).unwrap_err().to_string().contains("larger than the grid"));
         let mut bad = g.clone();
         bad.top[17][1] = f64::NAN;
-        assert!(fit_two_view(&bad, 6, 6, Parameterisation::Uniform, Approach::Improved).unwrap_err().to_string().contains("non-finite"));
+        assert!(fit_two_view(&bad, 6, 6, Parameterisation::Uniform, Approach::Improved, &FitOptions::default()).unwrap_err().to_string().contains("non-finite"));
         let mut bad = g.clone();
         bad.top[0][0] += 1.0;
-        assert!(fit_two_view(&bad, 6, 6, Parameterisation::Uniform, Approach::Improved).unwrap_err().to_string().contains("border position (0, 0)"));
+        assert!(fit_two_view(&bad, 6, 6, Parameterisation::Uniform, Approach::Improved, &FitOptions::default()).unwrap_err().to_string().contains("border position (0, 0)"));
         bad.top.pop();
-        assert!(fit_two_view(&bad, 6, 6, Parameterisation::Uniform, Approach::Improved).is_err());
+        assert!(fit_two_view(&bad, 6, 6, Parameterisation::Uniform, Approach::Improved, &FitOptions::default()).is_err());
     }
 
     #[test]
     fn control_net_parts_reproduce_the_surface_error() {
         let g = test_grid(20, 20, 0.02);
         for cn in [(6, 6), (12, 9), (18, 18)] {
-            let b = fit_two_view(&g, cn.0, cn.1, Parameterisation::Centripetal, Approach::Improved).unwrap();
+            let b = fit_two_view(&g, cn.0, cn.1, Parameterisation::Centripetal, Approach::Improved, &FitOptions::default()).unwrap();
             let parts = b.control_net_parts(&g).unwrap();
             assert_eq!(parts.x0.len(), 3 * DoubleNet::new(cn.0, cn.1).unwrap().nov());
             let e = parts.surface_error(&parts.x0);

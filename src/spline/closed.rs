@@ -17,7 +17,7 @@
 //! the surface at their parameters (Eq. 9 as an RMS, the unit of the paper's Tables II and III).
 
 use super::basis::{basis_funs, find_span};
-use super::knots::knot_vector;
+use super::knots::{knot_vector, KnotRule};
 use super::SplineError;
 use crate::geom::Point3;
 use crate::optim::Problem;
@@ -158,7 +158,7 @@ pub struct ClosedFit {
 pub fn fit_closed(data: &RingData, shape: ClosedNetShape) -> Result<ClosedFit, SplineError> {
     shape.check(data)?;
     let vs = data.row_parameters();
-    let knots_v = knot_vector(&vs, shape.rows, shape.order_up - 1).map_err(SplineError::ControlNet)?;
+    let knots_v = knot_vector(&vs, shape.rows, shape.order_up - 1, KnotRule::NurbsBook).map_err(SplineError::ControlNet)?;
     let mut uv = Vec::with_capacity(data.n_points());
     for (ring, &v) in data.rings.iter().zip(&vs) {
         uv.extend(RingData::ring_parameters(ring, shape.n_around).into_iter().map(|u| (u, v)));
@@ -330,7 +330,7 @@ mod tests {
         // its net and reproduces its samples.
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
         for (n, k, rows, q) in [(7, 3, 2, 2), (9, 4, 4, 3), (5, 2, 3, 2)] {
-            let knots_v = knot_vector(&(0..20).map(|s| s as f64 / 19.0).collect::<Vec<_>>(), rows, q - 1).unwrap();
+            let knots_v = knot_vector(&(0..20).map(|s| s as f64 / 19.0).collect::<Vec<_>>(), rows, q - 1, KnotRule::NurbsBook).unwrap();
             let control: Vec<Point3> = (0..n * rows).map(|_| [rng.gen(), rng.gen(), rng.gen()]).collect();
             let surf = ClosedSurface { order_around: k, order_up: q, n_around: n, rows, knots_v: knots_v.clone(), control: control.clone() };
             let uv: Vec<(f64, f64)> = (0..600).map(|_| (rng.gen::<f64>() * n as f64, rng.gen::<f64>())).collect();

@@ -187,7 +187,7 @@ pub fn write_obj(surfaces: &[(&str, &BSplineSurface)], samples_u: usize, samples
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::spline::knots::knot_vector;
+    use crate::spline::knots::{knot_vector, KnotRule};
     use rand::{Rng, SeedableRng};
 
     fn surface(cn_x: usize, cn_y: usize, seed: u64) -> BSplineSurface {
@@ -196,8 +196,8 @@ mod tests {
         BSplineSurface {
             p: 3,
             q: 3,
-            knots_u: knot_vector(&t(20), cn_x, 3).unwrap(),
-            knots_v: knot_vector(&t(30), cn_y, 3).unwrap(),
+            knots_u: knot_vector(&t(20), cn_x, 3, KnotRule::NurbsBook).unwrap(),
+            knots_v: knot_vector(&t(30), cn_y, 3, KnotRule::NurbsBook).unwrap(),
             cn_x,
             cn_y,
             control: (0..cn_x * cn_y).map(|_| [rng.gen::<f64>() * 100.0 - 50.0, rng.gen::<f64>() * 1e-6, rng.gen()]).collect(),

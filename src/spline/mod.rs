@@ -9,12 +9,15 @@ pub mod bezier;
 pub mod closed;
 pub mod export;
 pub mod fit;
+pub mod geometry;
 pub mod knots;
 pub mod param;
 pub mod rational_bezier;
 pub mod surface;
 
-pub use approach::{fit_two_view, Approach, ControlNetParts, TwoSurfaceFit, TwoViewGrid};
+pub use approach::{fit_two_view, Approach, ControlNetParts, ErrorA, FitOptions, TwoSurfaceFit, TwoViewGrid};
+pub use geometry::{DenseGeometry, DENSE_FACTOR};
+pub use knots::KnotRule;
 pub use basis::SparseBasis;
 pub use param::Parameterisation;
 pub use surface::BSplineSurface;
