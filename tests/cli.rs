@@ -214,8 +214,20 @@ fn fit_writes_nets_iges_and_obj_and_refuses_bad_grids() {
     let igs = std::fs::read_to_string(c.path("f/surfaces.igs")).unwrap();
     let surfaces = somnurbs::spline::export::parse_iges_128(&igs).unwrap();
     assert_eq!((surfaces.len(), surfaces[0].cn_x, surfaces[0].cn_y), (2, 8, 6));
-    let (_, fit) = read_csv(&c.path("f/fit.csv"));
-    assert_eq!(fit[0][5].parse::<f64>().unwrap(), 0.0, "approach B has no gap");
+    let (fh, fit) = read_csv(&c.path("f/fit.csv"));
+    let at = |name: &str| fit[0][fh.iter().position(|h| h == name).unwrap()].clone();
+    assert_eq!(at("gap").parse::<f64>().unwrap(), 0.0, "approach B has no gap");
+    assert_eq!(at("dense_gap").parse::<f64>().unwrap(), 0.0, "nor between the data points");
+    assert_eq!((at("knots").as_str(), at("error_a").as_str()), ("eq2_10", "per_surface"));
+    // Between the data points: an 18x18 net on the 20x20 map stays near the data under Eq. 2.10's
+    // knots and blows up under the NURBS Book's, which `fit` warns about; fairness tames it.
+    let out = c.ok(&["fit", "--grid", grid, "--cn", "18x18", "--out", "f18"]);
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("warning"));
+    let out = c.ok(&["fit", "--grid", grid, "--cn", "18x18", "--knots", "nurbs_book", "--out", "f18b"]);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("leave the data's bounding box"), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = c.ok(&["fit", "--grid", grid, "--cn", "18x18", "--knots", "nurbs_book", "--fairness", "1e-3", "--out", "f18f"]);
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("warning"), "{}", String::from_utf8_lossy(&out.stderr));
+    c.fails(&["fit", "--grid", grid, "--cn", "8x8", "--knots", "9.69"], &["--knots", "9.69"]);
     assert!(std::fs::read_to_string(c.path("f/surfaces.obj")).unwrap().contains("o bottom"));
 
     let text = std::fs::read_to_string(c.path(grid)).unwrap();
@@ -338,4 +350,56 @@ fn exact_optimum_bounds_every_run_from_below() {
             assert!(run[best].parse::<f64>().unwrap() >= lb, "{run:?} beats the certified bound {lb}");
         }
     }
+}
+
+/// The readings matrix: a plan's reading set runs a spec again with its keys changed, from the
+/// same maps; readings.csv holds every claim under both readings, runs.csv records the readings
+/// and the dense excursion, which shows the NURBS Book knots blowing up an 18x18 net on a 20x20
+/// map while Eq. 2.10's stay near the data.
+#[test]
+fn readings_matrix_runs_each_reading_set_and_sets_claims_side_by_side() {
+    let c = Case::new();
+    c.write("specs/maps.toml", CH4_FOR_FIT);
+    c.write("specs/fits.toml", &CH5_TINY.replace("MAPS", "unused").replace(r#"["6x6", "12x12"]"#, r#"["6x6", "12x12", "18x18"]"#));
+    c.write(
+        "specs/p.toml",
+        r#"specs = ["maps", "fits"]
+maps_from = "maps"
+reading = "eq2_10"
+[[readings]]
+name = "nurbs_book"
+description = "the old reading"
+set = { "fit.knots" = "nurbs_book", "fit.error_a" = "nov_bottom" }
+specs = ["fits"]
+"#,
+    );
+    c.ok(&["reproduce", "--specs", "specs", "--plan", "p", "--out", "out"]);
+    let (h, rows) = read_csv(&c.path("out/readings.csv"));
+    let col = |name: &str| h.iter().position(|x| x == name).unwrap();
+    let claims_of = |reading: &str| -> Vec<String> { rows.iter().filter(|r| r[col("reading")] == reading).map(|r| r[col("claim")].clone()).collect() };
+    assert!(!claims_of("eq2_10").is_empty());
+    assert_eq!(claims_of("eq2_10"), claims_of("nurbs_book"), "every claim under both readings");
+    let max_excursion = |path: &str, knots: &str| -> f64 {
+        let (h, rows) = read_csv(&c.path(path));
+        let (k, e, cn) = (h.iter().position(|x| x == "knots").unwrap(), h.iter().position(|x| x == "excursion").unwrap(), h.iter().position(|x| x == "cn_x").unwrap());
+        assert!(rows.iter().all(|r| r[k] == knots), "{path} records its knot reading");
+        rows.iter().filter(|r| r[cn] == "18").map(|r| r[e].parse::<f64>().unwrap()).fold(0.0, f64::max)
+    };
+    let faithful = max_excursion("out/fits/runs.csv", "eq2_10");
+    let old = max_excursion("out/readings/nurbs_book/fits/runs.csv", "nurbs_book");
+    assert!(faithful < 0.1 && old > 10.0 * faithful.max(0.01), "eq2_10 {faithful}, nurbs_book {old}");
+    let report = std::fs::read_to_string(c.path("out/REPORT.md")).unwrap();
+    assert!(report.contains("# Readings matrix") && report.contains("`nurbs_book`"));
+    // A reading set naming a spec the plan does not have is refused before anything runs.
+    c.write("specs/bad.toml", "specs = [\"fits\"]\n[[readings]]\nname = \"x\"\nset = { \"fit.knots\" = \"nurbs_book\" }\nspecs = [\"nope\"]\n");
+    let out = c.run(&["reproduce", "--specs", "specs", "--plan", "bad", "--out", "bad_out"]);
+    assert_eq!(out.status.code(), Some(2), "{}", c.explain(&["reproduce"], &out));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("readings.x.specs: `nope`"));
+    assert!(!c.path("bad_out").exists());
+    // A bad value under a reading set names the key.
+    c.write("specs/badv.toml", "specs = [\"fits\"]\n[[readings]]\nname = \"x\"\nset = { \"fit.knots\" = \"9.69\" }\nspecs = [\"fits\"]\n");
+    let out = c.run(&["reproduce", "--specs", "specs", "--plan", "badv", "--out", "bad_out"]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("fit.knots") && err.contains("9.69"), "{err}");
 }

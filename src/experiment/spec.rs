@@ -1174,6 +1174,28 @@ iterations = 7
         assert_eq!(q.som_cells()[3].key(), "som/cube/dnsom/18x30/r0");
     }
 
+    /// A reading set's keys go through the same parsing and validation as the file's own values;
+    /// a key of a section the spec does not have is skipped.
+    #[test]
+    fn overrides_apply_after_the_profile_and_are_validated() {
+        let text = "name = \"f\"\nmaster_seed = 1\n[fit]\ndatasets = [\"cube\"]\ngrid = \"20x20\"\ncontrol_nets = [\"6x6\"]\nparameterisations = [\"uniform\"]\napproaches = [\"A\"]\n[profiles.quick.fit]\nfairness = 0.5\n";
+        let ov = |k: &str, v: toml::Value| Override { key: k.into(), value: v };
+        let plain = Spec::parse("f.toml", text, Some("quick")).unwrap();
+        let fit = plain.file.fit.as_ref().unwrap();
+        assert_eq!((fit.knots, fit.error_a, fit.fairness), (crate::spline::KnotRule::Eq2_10, crate::spline::ErrorA::PerSurface, 0.5));
+        let set = [ov("fit.knots", "nurbs_book".into()), ov("fit.error_a", "nov_bottom".into()), ov("optim.knots", "nurbs_book".into())];
+        let s = Spec::parse_with("f.toml", text, Some("quick"), &set).unwrap();
+        let fit = s.file.fit.as_ref().unwrap();
+        assert_eq!((fit.knots, fit.error_a, fit.fairness), (crate::spline::KnotRule::NurbsBook, crate::spline::ErrorA::NovBottom, 0.5));
+        assert!(s.file.optim.is_none(), "a key of an absent section is skipped");
+        let e = Spec::parse_with("f.toml", text, None, &[ov("fit.knots", "9.69".into())]).unwrap_err().to_string();
+        assert!(e.contains("fit.knots") && e.contains("9.69"), "{e}");
+        let e = Spec::parse_with("f.toml", text, None, &[ov("fit.fairness", toml::Value::Float(-1.0))]).unwrap_err().to_string();
+        assert!(e.contains("fit.fairness"), "{e}");
+        let e = Spec::parse_with("f.toml", text, None, &[ov("fit.colour", "red".into())]).unwrap_err().to_string();
+        assert!(e.contains("colour"), "{e}");
+    }
+
     #[test]
     fn exactly_one_experiment_section() {
         let none = "name = \"t\"\nmaster_seed = 1\n";
