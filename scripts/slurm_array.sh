@@ -90,7 +90,10 @@ else
   bin="$PWD/target/release/somnurbs"
 fi
 data=""
-[ -n "${SOMNURBS_DATA:-}" ] && data="$(cd "$SOMNURBS_DATA" && pwd)"
+if [ -n "${SOMNURBS_DATA:-}" ]; then
+  [ -d "$SOMNURBS_DATA" ] || die "SOMNURBS_DATA=$SOMNURBS_DATA is not a folder"
+  data="$(cd "$SOMNURBS_DATA" && pwd)"
+fi
 
 # A spec, profile or argument error shows here, once, not in every task.
 cells="$(SOMNURBS_DATA="$data" "$bin" run "$spec" "${run_args[@]}" --dry-run | wc -l)" || die "somnurbs run $spec ${run_args[*]} --dry-run failed (see above)"
