@@ -129,8 +129,8 @@ start() {
   rm -rf "$dir/state" "$dir/spool" "$dir/munged.pid"
   write_conf
   start_munge
-  as_root slurmctld -f "$conf"
-  as_root slurmd -f "$conf"
+  as_root slurmctld -f "$conf" || { stop; die "slurmctld did not start; see $dir/slurmctld.log"; }
+  as_root slurmd -f "$conf" || { stop; die "slurmd did not start; see $dir/slurmd.log"; }
   local t0=$SECONDS state=""
   while [ $((SECONDS - t0)) -lt "$timeout" ]; do
     state="$(node_state)"
