@@ -161,7 +161,7 @@ stop_daemon() {
     [ -d "/proc/$pid" ] || break
     sleep 0.1
   done
-  [ -d "/proc/$pid" ] && as_root kill -KILL "$pid" 2>/dev/null || true
+  if [ -d "/proc/$pid" ]; then as_root kill -KILL "$pid" 2>/dev/null || true; fi
   say "stopped $prog (PID $pid)"
   rm -f "$file"
 }

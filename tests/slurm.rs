@@ -73,7 +73,12 @@ fn array(c: &Case, args: &[&str], env: &[(&str, &str)]) -> Output {
     let path = format!("{}:{}", stand_ins(c).display(), std::env::var("PATH").unwrap_or_default());
     let mut cmd = Command::new(script);
     cmd.args(args).current_dir(c.dir.path()).env("PATH", path).env("STANDIN_LOG", c.path("sbatch.log"));
-    cmd.env("SOMNURBS_BIN", env!("CARGO_BIN_EXE_somnurbs")).env("SOMNURBS_DATA", shared_data()).env_remove("CPUS");
+    cmd.env("SOMNURBS_BIN", env!("CARGO_BIN_EXE_somnurbs")).env_remove("CPUS");
+    // The tiny spec needs no data files; pass the data folder only when there is one.
+    match shared_data() {
+        d if d.is_dir() => cmd.env("SOMNURBS_DATA", d),
+        _ => cmd.env_remove("SOMNURBS_DATA"),
+    };
     for (k, v) in env {
         cmd.env(k, v);
     }
