@@ -85,9 +85,13 @@ pub fn maps_for(spec: &Spec, ctx: &RunContext, datasets: &[String], grid: GridSi
             Some(path) => read_map(&path, grid)?,
             None => recompute_map(spec, ctx, data, grid, som)?,
         };
-        let text = crate::report::ch4::two_view_grid_csv(&source.grid)?;
-        write_atomic(&ctx.out.join("maps").join(&name), text.as_bytes())?;
         out.insert(data.clone(), source);
+    }
+    // Every map has loaded: only now may the folder change.
+    ctx.begin()?;
+    for (data, source) in &out {
+        let text = crate::report::ch4::two_view_grid_csv(&source.grid)?;
+        write_atomic(&ctx.out.join("maps").join(map_file_name(data, grid)), text.as_bytes())?;
     }
     Ok(out)
 }

@@ -83,7 +83,10 @@ pub fn reproduce(specs_dir: &Path, plan_name: &str, profile: &str, ctx: &RunCont
     let plan = Plan::load(&plan_path)?;
     let profile = if profile == "full" { None } else { Some(profile) };
     let specs = load_specs(specs_dir, &plan, profile, &ctx.out)?;
-    crate::report::fsio::ensure_dir(&ctx.out)?;
+    let _lock = crate::outdir::lock(&ctx.out, &format!("reproduce --plan {plan_name}"))?;
+    // Every spec has loaded: the folder is unfinished until the combined REPORT.md is written.
+    let incomplete = ctx.out.join(crate::outdir::INCOMPLETE);
+    write_atomic(&incomplete, format!("reproduce --plan {plan_name} --profile {} started here\n", profile.unwrap_or("full")).as_bytes())?;
     let started = Instant::now();
     let mut done = Vec::new();
     for spec in &specs {
@@ -96,6 +99,8 @@ pub fn reproduce(specs_dir: &Path, plan_name: &str, profile: &str, ctx: &RunCont
     let report = combined_report(&ctx.out, &plan, plan_name, &specs, &done, profile.unwrap_or("full"), started.elapsed().as_secs_f64())?;
     let path = ctx.out.join("REPORT.md");
     write_atomic(&path, report.as_bytes())?;
+    std::fs::remove_file(&incomplete).with_context(|| format!("cannot remove {}", incomplete.display()))?;
+    crate::outdir::sync_dir(&ctx.out)?;
     Ok(path)
 }
 
