@@ -171,27 +171,22 @@ impl ser::SerializeMap for Seq<'_> {
     }
 }
 
-impl ser::SerializeStruct for Seq<'_> {
-    type Ok = ();
-    type Error = Stop;
-    fn serialize_field<T: Serialize + ?Sized>(&mut self, key: &'static str, v: &T) -> Result<(), Stop> {
-        self.f.at(format!(".{key}"), v)
-    }
-    fn end(self) -> Result<(), Stop> {
-        Ok(())
-    }
+macro_rules! named_fields {
+    ($($tr:ident),*) => {
+        $(impl ser::$tr for Seq<'_> {
+            type Ok = ();
+            type Error = Stop;
+            fn serialize_field<T: Serialize + ?Sized>(&mut self, key: &'static str, v: &T) -> Result<(), Stop> {
+                self.f.at(format!(".{key}"), v)
+            }
+            fn end(self) -> Result<(), Stop> {
+                Ok(())
+            }
+        })*
+    };
 }
 
-impl ser::SerializeStructVariant for Seq<'_> {
-    type Ok = ();
-    type Error = Stop;
-    fn serialize_field<T: Serialize + ?Sized>(&mut self, key: &'static str, v: &T) -> Result<(), Stop> {
-        self.f.at(format!(".{key}"), v)
-    }
-    fn end(self) -> Result<(), Stop> {
-        Ok(())
-    }
-}
+named_fields!(SerializeStruct, SerializeStructVariant);
 
 #[cfg(test)]
 mod tests {

@@ -8,6 +8,7 @@ pub mod datasets;
 pub mod family;
 pub mod finite;
 pub mod fit_cmd;
+pub mod limits;
 pub mod log;
 pub mod reproduce;
 pub mod runner;

@@ -83,6 +83,12 @@ pub fn reproduce(specs_dir: &Path, plan_name: &str, profile: &str, ctx: &RunCont
     let plan = Plan::load(&plan_path)?;
     let profile = if profile == "full" { None } else { Some(profile) };
     let specs = load_specs(specs_dir, &plan, profile, &ctx.out)?;
+    // Every data set of every spec loads before the folder changes (a bad --data-dir changes nothing).
+    for spec in &specs {
+        for d in super::limits::dataset_entries(spec) {
+            crate::data::registry::load_dataset(d, &ctx.data_dir).with_context(|| format!("{}: data set `{d}`", spec.path))?;
+        }
+    }
     let _lock = crate::outdir::lock(&ctx.out, &format!("reproduce --plan {plan_name}"))?;
     // Every spec has loaded: the folder is unfinished until the combined REPORT.md is written.
     let incomplete = ctx.out.join(crate::outdir::INCOMPLETE);
