@@ -432,8 +432,9 @@ pub fn accept(baseline: &Path, current: &Path) -> Result<Vec<String>> {
     files.extend(identities(current)?.keys().map(|d| d.join(crate::outdir::MANIFEST)));
     let mut said = Vec::new();
     crate::outdir::replace_dir(baseline, |staged| {
-        // The old baseline's files first (not its lock, nor the tables the current run lacks) ...
-        for f in old_files.iter().filter(|f| !tc.contains(f) && !tb.contains(f) && !files.contains(f) && f.as_os_str() != crate::outdir::LOCK_FILE) {
+        // The old baseline's files first (not lock files, nor the tables the current run lacks) ...
+        let lock = |f: &Path| f.file_name().is_some_and(|n| n == crate::outdir::LOCK_FILE);
+        for f in old_files.iter().filter(|f| !tc.contains(f) && !tb.contains(f) && !files.contains(f) && !lock(f)) {
             let text = std::fs::read(baseline.join(f)).with_context(|| format!("cannot read {}", baseline.join(f).display()))?;
             write_atomic(&staged.join(f), &text)?;
         }
