@@ -8,6 +8,7 @@ pub mod double_net;
 pub mod experiment;
 pub mod geom;
 pub mod optim;
+pub mod outdir;
 pub mod report;
 pub mod som;
 pub mod spline;

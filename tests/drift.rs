@@ -4,23 +4,6 @@
 mod common;
 use common::*;
 
-const SPEC: &str = r#"
-name = "d"
-master_seed = 3
-[optim]
-datasets = ["sphere"]
-grid = "20x20"
-control_nets = ["6x6"]
-parameterisations = ["chord_length"]
-optimisers = ["ga", "de"]
-repeats = 2
-generations = 20
-population = 8
-maps = "nowhere"
-[optim.som]
-iterations = 300
-"#;
-
 fn status(out: &std::process::Output) -> i32 {
     out.status.code().unwrap_or(-1)
 }

@@ -5,24 +5,6 @@ use common::*;
 use std::collections::BTreeSet;
 use std::time::{Duration, Instant};
 
-/// Long enough (a few seconds on one thread) to be killed part-way.
-const SLOW: &str = r#"
-name = "slow"
-master_seed = 11
-[optim]
-datasets = ["sphere"]
-grid = "20x20"
-control_nets = ["10x10", "12x12"]
-parameterisations = ["chord_length"]
-optimisers = ["ga", "de", "pso"]
-repeats = 12
-generations = 600
-population = 20
-maps = "nowhere"
-[optim.som]
-iterations = 500
-"#;
-
 fn log_keys(path: &std::path::Path) -> Vec<String> {
     std::fs::read_to_string(path)
         .unwrap_or_default()

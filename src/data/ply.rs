@@ -1,6 +1,8 @@
-//! PLY reader: `format ascii 1.0` and `format binary_little_endian 1.0`; returns the x, y, z of
-//! the `vertex` element. Other vertex properties and other elements (faces with list properties)
-//! are skipped.
+//! PLY reader: `format ascii 1.0`, `binary_little_endian 1.0` and `binary_big_endian 1.0`;
+//! returns the x, y, z of the `vertex` element. Other vertex properties and other elements (faces
+//! with list properties) are skipped. Every count in the header is checked against the bytes the
+//! file has left before anything is allocated or looped over, and list counts must be of an
+//! integer type (a count stored as a float would shift every later offset).
 
 use super::DataError;
 use crate::geom::Point3;
@@ -41,18 +43,34 @@ impl Scalar {
         }
     }
 
-    fn read_le(self, b: &[u8]) -> f64 {
+    fn is_integer(self) -> bool {
+        !matches!(self, Scalar::F32 | Scalar::F64)
+    }
+
+    /// The value of `b` (exactly `size()` bytes), little or big endian.
+    fn read(self, b: &[u8], big: bool) -> f64 {
+        let mut x = [0u8; 8];
+        x[..b.len()].copy_from_slice(b);
+        if big {
+            x[..b.len()].reverse();
+        }
         match self {
-            Scalar::I8 => b[0] as i8 as f64,
-            Scalar::U8 => b[0] as f64,
-            Scalar::I16 => i16::from_le_bytes([b[0], b[1]]) as f64,
-            Scalar::U16 => u16::from_le_bytes([b[0], b[1]]) as f64,
-            Scalar::I32 => i32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
-            Scalar::U32 => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
-            Scalar::F32 => f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
-            Scalar::F64 => f64::from_le_bytes([b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7]]),
+            Scalar::I8 => x[0] as i8 as f64,
+            Scalar::U8 => x[0] as f64,
+            Scalar::I16 => i16::from_le_bytes([x[0], x[1]]) as f64,
+            Scalar::U16 => u16::from_le_bytes([x[0], x[1]]) as f64,
+            Scalar::I32 => i32::from_le_bytes([x[0], x[1], x[2], x[3]]) as f64,
+            Scalar::U32 => u32::from_le_bytes([x[0], x[1], x[2], x[3]]) as f64,
+            Scalar::F32 => f32::from_le_bytes([x[0], x[1], x[2], x[3]]) as f64,
+            Scalar::F64 => f64::from_le_bytes(x),
         }
     }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Format {
+    Ascii,
+    Binary { big: bool },
 }
 
 #[derive(Debug, Clone)]
@@ -95,20 +113,26 @@ pub fn parse_ply(bytes: &[u8]) -> Result<Vec<Point3>, DataError> {
         match w.first().copied() {
             Some("format") => {
                 binary = Some(match w.get(1).copied() {
-                    Some("ascii") => false,
-                    Some("binary_little_endian") => true,
-                    Some("binary_big_endian") => return Err(err(ctx, "binary_big_endian PLY is not supported (convert to ascii or little endian)")),
+                    Some("ascii") => Format::Ascii,
+                    Some("binary_little_endian") => Format::Binary { big: false },
+                    Some("binary_big_endian") => Format::Binary { big: true },
                     _ => return Err(err(ctx, "unknown format")),
                 })
             }
             Some("element") => {
-                let count = w.get(2).and_then(|c| c.parse().ok()).ok_or_else(|| err(ctx.clone(), "element needs a name and a count"))?;
+                let count: usize = w.get(2).and_then(|c| c.parse().ok()).ok_or_else(|| err(ctx.clone(), "element needs a name and a count"))?;
+                if w.len() > 3 {
+                    return Err(err(ctx, "element takes a name and a count only"));
+                }
                 elements.push(Element { name: w.get(1).unwrap_or(&"").to_string(), count, props: Vec::new() });
             }
             Some("property") => {
                 let el = elements.last_mut().ok_or_else(|| err(ctx.clone(), "property before any element"))?;
                 let prop = if w.get(1) == Some(&"list") {
                     let count = w.get(2).and_then(|t| Scalar::parse(t)).ok_or_else(|| err(ctx.clone(), "bad list count type"))?;
+                    if !count.is_integer() {
+                        return Err(err(ctx, "a list's count type must be an integer type (uchar, ushort, uint, ...)"));
+                    }
                     let item = w.get(3).and_then(|t| Scalar::parse(t)).ok_or_else(|| err(ctx.clone(), "bad list item type"))?;
                     Property::List { count, item }
                 } else {
@@ -121,14 +145,34 @@ pub fn parse_ply(bytes: &[u8]) -> Result<Vec<Point3>, DataError> {
             Some(other) => return Err(err(ctx, &format!("unknown header keyword `{other}`"))),
         }
     }
-    let binary = binary.ok_or_else(|| err("header".into(), "no format line"))?;
+    let format = binary.ok_or_else(|| err("header".into(), "no format line"))?;
     let vi = elements.iter().position(|e| e.name == "vertex").ok_or_else(|| err("header".into(), "no vertex element"))?;
     let axis = |name: &str| {
         elements[vi].props.iter().position(|p| matches!(p, Property::Scalar { name: n, .. } if n == name)).ok_or_else(|| err("header".into(), &format!("vertex element has no `{name}` property")))
     };
     let (ix, iy, iz) = (axis("x")?, axis("y")?, axis("z")?);
+    // Every element up to the vertices must fit in what the file has left: at least its scalar
+    // bytes plus its list counts' bytes (binary), or one value and a separator per property
+    // (ascii), per item. Nothing is allocated or looped over before this holds.
+    let left = bytes.len() - pos;
+    let mut need: usize = 0;
+    for el in &elements[..=vi] {
+        if el.props.is_empty() && el.count > 0 {
+            return Err(err(format!("element {}", el.name), "has items but no properties"));
+        }
+        let per = match format {
+            Format::Binary { .. } => el.props.iter().map(|p| match p {
+                Property::Scalar { ty, .. } => ty.size(),
+                Property::List { count, .. } => count.size(),
+            }).sum(),
+            Format::Ascii => 2 * el.props.len().max(1),
+        };
+        need = per.checked_mul(el.count).and_then(|n| n.checked_add(need)).filter(|&n| n <= left).ok_or_else(|| {
+            err(format!("element {}", el.name), &format!("the header says {} items, more than the {left} bytes after the header can hold", el.count))
+        })?;
+    }
     let mut points = Vec::with_capacity(elements[vi].count);
-    if binary {
+    if let Format::Binary { big } = format {
         let mut at = pos;
         for (e, el) in elements.iter().enumerate() {
             for k in 0..el.count {
@@ -139,7 +183,7 @@ pub fn parse_ply(bytes: &[u8]) -> Result<Vec<Point3>, DataError> {
                         Property::Scalar { ty, .. } => {
                             let b = bytes.get(at..at + ty.size()).ok_or_else(short)?;
                             if e == vi {
-                                let v = ty.read_le(b);
+                                let v = ty.read(b, big);
                                 if p == ix {
                                     vals[0] = v;
                                 } else if p == iy {
@@ -152,8 +196,11 @@ pub fn parse_ply(bytes: &[u8]) -> Result<Vec<Point3>, DataError> {
                         }
                         Property::List { count, item } => {
                             let b = bytes.get(at..at + count.size()).ok_or_else(short)?;
-                            let n = count.read_le(b) as usize;
-                            at += count.size() + n * item.size();
+                            let n = count.read(b, big);
+                            if n < 0.0 {
+                                return Err(err(format!("{} {}", el.name, k + 1), &format!("negative list count {n}")));
+                            }
+                            at += count.size() + n as usize * item.size();
                             if at > bytes.len() {
                                 return Err(short());
                             }
@@ -247,6 +294,37 @@ mod tests {
         let e = parse_ply(&cut).unwrap_err().to_string();
         assert!(e.contains("vertex"), "{e}");
         let e = parse_ply(b"ply\nformat binary_big_endian 1.0\nend_header\n").unwrap_err().to_string();
-        assert!(e.contains("big_endian"), "{e}");
+        assert!(e.contains("no vertex element"), "{e}");
+    }
+
+    #[test]
+    fn big_endian_reads_the_same_points() {
+        let mut b = b"ply\nformat binary_big_endian 1.0\nelement vertex 4\nproperty float x\nproperty double y\nproperty float z\nproperty uchar red\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n".to_vec();
+        for v in VERTS {
+            b.extend((v[0] as f32).to_be_bytes());
+            b.extend(v[1].to_be_bytes());
+            b.extend((v[2] as f32).to_be_bytes());
+            b.push(200);
+        }
+        b.push(3);
+        for i in [0i32, 1, 2] {
+            b.extend(i.to_be_bytes());
+        }
+        assert_eq!(parse_ply(&b).unwrap(), parse_ply(&binary_ply()).unwrap());
+    }
+
+    #[test]
+    fn counts_beyond_the_file_and_float_list_counts_are_refused_at_once() {
+        let head = |fmt: &str, count: &str| format!("ply\nformat {fmt} 1.0\nelement vertex {count}\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n");
+        for fmt in ["ascii", "binary_little_endian", "binary_big_endian"] {
+            let e = parse_ply(head(fmt, "1000000000000").as_bytes()).unwrap_err().to_string();
+            assert!(e.contains("1000000000000 items"), "{e}");
+        }
+        // An element of no properties and 10^18 items before the vertices: refused, not looped.
+        let t = std::time::Instant::now();
+        let e = parse_ply(b"ply\nformat binary_little_endian 1.0\nelement junk 1000000000000000000\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n123456789012").unwrap_err().to_string();
+        assert!(t.elapsed().as_secs() < 1 && e.contains("junk"), "{e}");
+        let e = parse_ply(b"ply\nformat binary_little_endian 1.0\nelement face 1\nproperty list double int vertex_indices\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n").unwrap_err().to_string();
+        assert!(e.contains("integer type"), "{e}");
     }
 }

@@ -14,6 +14,49 @@ pub const TALUS_POINTS: usize = 5253;
 pub const TALUS_SAMPLE_SEED: u64 = 5253;
 /// Points sampled from a user's STL file unless `path.stl:N` says otherwise.
 pub const DEFAULT_STL_POINTS: usize = 5000;
+/// The most points `path.stl:N` may ask for.
+pub const MAX_STL_POINTS: usize = 10_000_000;
+/// File types a data-set path may have.
+pub const EXTENSIONS: [&str; 5] = [".ply", ".stl", ".xyz", ".csv", ".txt"];
+
+/// [`dataset_name`] of an entry validation has passed (the entry itself if it would not).
+pub fn name_of(entry: &str) -> String {
+    dataset_name(entry).unwrap_or_else(|_| entry.to_string())
+}
+
+/// A data-set entry of a spec split into its file and the `:N` point count of an STL path.
+fn split_count(entry: &str) -> Result<(&str, Option<usize>), DataError> {
+    match entry.rsplit_once(':') {
+        Some((f, n)) if f.to_ascii_lowercase().ends_with(".stl") => {
+            let n: usize = n.parse().map_err(|_| DataError::Invalid(format!("{entry}: `{n}` is not a point count")))?;
+            if !(4..=MAX_STL_POINTS).contains(&n) {
+                return Err(DataError::Invalid(format!("{entry}: {n} points is outside [4, {MAX_STL_POINTS}]")));
+            }
+            Ok((f, Some(n)))
+        }
+        _ => Ok((entry, None)),
+    }
+}
+
+/// The name a data set goes by in cell keys, seeds, tables and file names: a built-in's own name,
+/// a file's stem (`scans/part.xyz` and `/abs/part.xyz` are both `part`, so a result does not
+/// depend on where its file lives). Refuses an entry that is neither a built-in nor a point file,
+/// and a name that could not be a file name (empty, `.`, `..`).
+pub fn dataset_name(entry: &str) -> Result<String, DataError> {
+    if BUILTIN.contains(&entry) {
+        return Ok(entry.to_string());
+    }
+    let (file, _) = split_count(entry)?;
+    let lower = file.to_ascii_lowercase();
+    if !EXTENSIONS.iter().any(|e| lower.ends_with(e)) {
+        return Err(DataError::Invalid(format!("unknown data set `{entry}` (built-in: {}; or a .ply/.stl/.xyz/.csv/.txt file)", BUILTIN.join(", "))));
+    }
+    let stem = Path::new(file).file_stem().and_then(|s| s.to_str()).unwrap_or("");
+    if stem.is_empty() || stem == "." || stem == ".." || stem.starts_with('.') {
+        return Err(DataError::Invalid(format!("data set `{entry}`: its file name gives no usable name (`{stem}`)")));
+    }
+    Ok(stem.to_string())
+}
 
 pub const BUNNY_FILE: &str = "bun_zipper.ply";
 pub const TALUS_FILE: &str = "talus_r.stl";
@@ -81,20 +124,9 @@ pub fn load_dataset(name: &str, data_dir: &Path) -> Result<PointCloud, DataError
             sample_stl(&read(&path, &where_to_get(TALUS_FILE))?, TALUS_POINTS, TALUS_SAMPLE_SEED, &shown)?
         }
         other => {
-            let (file, count) = match other.rsplit_once(':') {
-                Some((f, n)) if f.to_ascii_lowercase().ends_with(".stl") => {
-                    (f, Some(n.parse::<usize>().map_err(|_| DataError::Invalid(format!("{other}: `{n}` is not a point count")))?))
-                }
-                _ => (other, None),
-            };
+            dataset_name(other)?;
+            let (file, count) = split_count(other)?;
             let lower = file.to_ascii_lowercase();
-            let known = [".ply", ".stl", ".xyz", ".csv", ".txt"];
-            if !known.iter().any(|e| lower.ends_with(e)) {
-                return Err(DataError::Invalid(format!(
-                    "unknown data set `{other}` (built-in: {}; or a .ply/.stl/.xyz/.csv/.txt file)",
-                    BUILTIN.join(", ")
-                )));
-            }
             let path = Path::new(file);
             let bytes = read(path, "Check the path in the spec.")?;
             if lower.ends_with(".ply") {
@@ -109,7 +141,12 @@ pub fn load_dataset(name: &str, data_dir: &Path) -> Result<PointCloud, DataError
     };
     validate(&points, 4).map_err(|e| e.in_file(name))?;
     normalise_min_max(&mut points);
-    Ok(PointCloud { name: name.to_string(), points })
+    // Coordinates near the f64 limit overflow the ranges into inf and the points into NaN.
+    validate(&points, 4).map_err(|e| DataError::Invalid(format!("{name}: after normalisation to [0, 1]: {e} (coordinates too large to normalise)")))?;
+    if points.iter().all(|p| *p == points[0]) {
+        return Err(DataError::Invalid(format!("{name}: all {} points are the same point", points.len())));
+    }
+    Ok(PointCloud { name: dataset_name(name)?, points })
 }
 
 /// The data folder the tests use: `SOMNURBS_DATA`, else `../shared/data` beside the crate.
@@ -150,5 +187,27 @@ mod tests {
         assert!(e.contains("/nonexistent/bun_zipper.ply") && e.contains("Stanford") && e.contains("SOMNURBS_DATA"), "{e}");
         let e = load_dataset("teapot", Path::new(".")).unwrap_err().to_string();
         assert!(e.contains("teapot") && e.contains("cube"), "{e}");
+    }
+
+    #[test]
+    fn names_are_stems_and_bad_files_are_refused_by_name() {
+        assert_eq!(dataset_name("cube").unwrap(), "cube");
+        assert_eq!(dataset_name("/abs/path/part.xyz").unwrap(), "part");
+        assert_eq!(dataset_name("../up/part.stl:500").unwrap(), "part");
+        for bad in ["../.xyz", "x.stl:0", "x.stl:99999999999", "x.obj", "..", "."] {
+            assert!(dataset_name(bad).is_err(), "{bad}");
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let huge = dir.path().join("huge.xyz");
+        std::fs::write(&huge, "1e308 0 0\n-1e308 1 1\n0 0 2\n5 5 5\n").unwrap();
+        let e = load_dataset(huge.to_str().unwrap(), dir.path()).unwrap_err().to_string();
+        assert!(e.contains("huge.xyz") && e.contains("non-finite"), "{e}");
+        let same = dir.path().join("same.csv");
+        std::fs::write(&same, "1,2,3\n1,2,3\n1,2,3\n1,2,3\n1,2,3\n").unwrap();
+        let e = load_dataset(same.to_str().unwrap(), dir.path()).unwrap_err().to_string();
+        assert!(e.contains("same.csv") && e.contains("same point"), "{e}");
+        let ok = dir.path().join("ok.xyz");
+        std::fs::write(&ok, "0 0 0\n1 0 0\n0 1 0\n0 0 1\n").unwrap();
+        assert_eq!(load_dataset(ok.to_str().unwrap(), dir.path()).unwrap().name, "ok");
     }
 }

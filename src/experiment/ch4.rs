@@ -78,13 +78,13 @@ impl SomRow {
     }
 }
 
-/// Load every data set a spec names, once.
+/// Load every data set a spec names, once, by its name ([`crate::data::registry::dataset_name`]).
 pub fn load_datasets(names: &[String], ctx: &RunContext) -> Result<BTreeMap<String, Arc<PointCloud>>> {
     let mut out = BTreeMap::new();
     for name in names {
-        if !out.contains_key(name) {
+        if !out.contains_key(&crate::data::registry::name_of(name)) {
             let cloud = crate::data::registry::load_dataset(name, &ctx.data_dir)?;
-            out.insert(name.clone(), Arc::new(cloud));
+            out.insert(cloud.name.clone(), Arc::new(cloud));
         }
     }
     Ok(out)

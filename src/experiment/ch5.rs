@@ -83,7 +83,8 @@ pub fn maps(spec: &Spec, ctx: &RunContext) -> Result<BTreeMap<String, MapSource>
 pub fn maps_for(spec: &Spec, ctx: &RunContext, datasets: &[String], grid: GridSize, maps_dir: Option<&str>, som: Option<&FitSom>) -> Result<BTreeMap<String, MapSource>> {
     let dir: Option<PathBuf> = maps_dir.map(PathBuf::from);
     let mut out = BTreeMap::new();
-    for data in datasets {
+    for entry in datasets {
+        let data = &crate::data::registry::name_of(entry);
         if out.contains_key(data) {
             continue;
         }
@@ -91,11 +92,15 @@ pub fn maps_for(spec: &Spec, ctx: &RunContext, datasets: &[String], grid: GridSi
         let from_file = dir.as_ref().map(|d| d.join(&name)).filter(|p| p.exists());
         let source = match from_file {
             Some(path) => read_map(&path, grid)?,
-            None => recompute_map(spec, ctx, data, grid, som)?,
+            None => recompute_map(spec, ctx, entry, grid, som)?,
         };
-        let text = crate::report::ch4::two_view_grid_csv(&source.grid)?;
-        write_atomic(&ctx.out.join("maps").join(&name), text.as_bytes())?;
         out.insert(data.clone(), source);
+    }
+    // Every map has loaded: only now may the folder change.
+    ctx.begin()?;
+    for (data, source) in &out {
+        let text = crate::report::ch4::two_view_grid_csv(&source.grid)?;
+        write_atomic(&ctx.out.join("maps").join(map_file_name(data, grid)), text.as_bytes())?;
     }
     Ok(out)
 }
@@ -115,8 +120,9 @@ fn recompute_map(spec: &Spec, ctx: &RunContext, data: &str, grid: GridSize, som:
         None => (spec.file.master_seed, SomParams::default()),
     };
     let clouds = ch4::load_datasets(&[data.to_string()], ctx)?;
-    let cell = SomCell { dataset: data.to_string(), model: Model::Dnsom, grid, repeat: 0 };
-    let run = ch4::run_cell(&cell, &clouds[data].points, &params, seed)?;
+    let name = crate::data::registry::name_of(data);
+    let cell = SomCell { dataset: name.clone(), model: Model::Dnsom, grid, repeat: 0 };
+    let run = ch4::run_cell(&cell, &clouds[&name].points, &params, seed)?;
     Ok(MapSource {
         grid: grid_from_weights(grid.nx, grid.ny, &run.weights),
         origin: format!("recomputed: {} with master seed {seed}, T = {}", cell.key(), params.iterations),

@@ -77,7 +77,8 @@ pub fn problems(spec: &Spec, ctx: &RunContext) -> Result<BTreeMap<ProblemKey, Co
     let o = spec.file.optim.as_ref().context("spec has no [optim] section")?;
     let maps = ch5::maps_for(spec, ctx, &o.datasets, o.grid, o.maps.as_deref(), o.som.as_ref())?;
     let mut out = BTreeMap::new();
-    for d in &o.datasets {
+    for entry in &o.datasets {
+        let d = &crate::data::registry::name_of(entry);
         for &cn in &o.control_nets {
             for p in &o.parameterisations {
                 let param: Parameterisation = p.parse().map_err(anyhow::Error::msg)?;

@@ -1,6 +1,7 @@
 //! The durable cell log of an output folder, and the fingerprint that says which run it belongs to.
 //!
-//! `cells.jsonl` holds one JSON line per finished cell, `{"key": …, "record": …}`, appended and
+//! `cells.jsonl` holds one JSON line per finished cell, `{"key": …, "seed": …, "record": …}`
+//! (`seed`: the cell's seed, checked against the spec's when the log is read back), appended and
 //! flushed the moment the cell finishes. A run killed at any instant leaves every finished cell on
 //! disk and at most one torn last line (a write cut short has no trailing newline), which a resumed
 //! run drops. `fingerprint.toml` is written before the first cell: a resumed run (`--resume`) or a
@@ -98,13 +99,16 @@ impl Fingerprint {
 #[derive(Serialize, Deserialize)]
 struct Line<T> {
     key: String,
+    #[serde(default)]
+    seed: Option<String>,
     record: T,
 }
 
 /// The finished cells a folder's log holds, by key (the last line wins if a key repeats). A torn
 /// last line (no newline: the write was cut short) is dropped and cut off the file; any other
-/// malformed line is an error naming the file and line.
-pub fn read_records<T: DeserializeOwned>(dir: &Path) -> Result<BTreeMap<String, T>> {
+/// malformed line is an error naming the file and line, and so is a line whose seed is not the
+/// cell's seed under `master_seed` (a log that mixes runs).
+pub fn read_records<T: DeserializeOwned>(dir: &Path, master_seed: u64) -> Result<BTreeMap<String, T>> {
     let path = dir.join(LOG_FILE);
     let mut out = BTreeMap::new();
     if !path.exists() {
@@ -120,6 +124,10 @@ pub fn read_records<T: DeserializeOwned>(dir: &Path) -> Result<BTreeMap<String, 
             continue;
         }
         let l: Line<T> = serde_json::from_str(line).map_err(|e| anyhow::anyhow!("{}:{}: malformed cell record: {e}", path.display(), n + 1))?;
+        let want = super::seeds::seed_hex(master_seed, &l.key);
+        if l.seed.as_deref() != Some(want.as_str()) {
+            bail!("{}:{}: cell {} was logged with seed {}, but its seed in this run is {want} (the folder mixes runs: start afresh without --resume)", path.display(), n + 1, l.key, l.seed.as_deref().unwrap_or("none"));
+        }
         out.insert(l.key, l.record);
     }
     if complete < text.len() {
@@ -133,12 +141,13 @@ pub fn read_records<T: DeserializeOwned>(dir: &Path) -> Result<BTreeMap<String, 
 pub struct CellLog {
     file: File,
     path: PathBuf,
+    master_seed: u64,
 }
 
 impl CellLog {
     /// Open the folder's log: appending to it when resuming, else starting it empty. A run
     /// opens it once, empty or not, and every cell family of the spec appends (`append`).
-    pub fn open(dir: &Path, resume: bool) -> Result<CellLog> {
+    pub fn open(dir: &Path, resume: bool, master_seed: u64) -> Result<CellLog> {
         let path = dir.join(LOG_FILE);
         let file = if resume {
             OpenOptions::new().create(true).append(true).open(&path)
@@ -146,16 +155,17 @@ impl CellLog {
             File::create(&path)
         }
         .with_context(|| format!("cannot open {}", path.display()))?;
-        Ok(CellLog { file, path })
+        Ok(CellLog { file, path, master_seed })
     }
 
     /// Append to the folder's log (created if missing).
-    pub fn append(dir: &Path) -> Result<CellLog> {
-        CellLog::open(dir, true)
+    pub fn append(dir: &Path, master_seed: u64) -> Result<CellLog> {
+        CellLog::open(dir, true, master_seed)
     }
 
     pub fn push<T: Serialize>(&mut self, key: &str, record: &T) -> Result<()> {
-        let mut line = serde_json::to_string(&Line { key: key.to_string(), record }).context("cannot serialise a cell record")?;
+        let seed = Some(super::seeds::seed_hex(self.master_seed, key));
+        let mut line = serde_json::to_string(&Line { key: key.to_string(), seed, record }).context("cannot serialise a cell record")?;
         line.push('\n');
         self.file.write_all(line.as_bytes()).with_context(|| format!("cannot append to {}", self.path.display()))?;
         self.file.flush().with_context(|| format!("cannot flush {}", self.path.display()))
@@ -183,7 +193,7 @@ mod tests {
     fn log_survives_a_torn_last_line_and_names_a_bad_one() {
         let dir = tempfile::tempdir().unwrap();
         {
-            let mut log = CellLog::open(dir.path(), false).unwrap();
+            let mut log = CellLog::open(dir.path(), false, 5).unwrap();
             log.push("a", &vec![1.0, 2.0]).unwrap();
             log.push("b", &vec![3.0]).unwrap();
         }
@@ -192,16 +202,21 @@ mod tests {
         let mut f = OpenOptions::new().append(true).open(&path).unwrap();
         f.write_all(b"{\"key\":\"c\",\"rec").unwrap();
         drop(f);
-        let got: BTreeMap<String, Vec<f64>> = read_records(dir.path()).unwrap();
+        let got: BTreeMap<String, Vec<f64>> = read_records(dir.path(), 5).unwrap();
         assert_eq!(got.len(), 2);
         assert_eq!(got["b"], vec![3.0]);
         // The torn line is gone, so appending continues on a clean line.
-        let mut log = CellLog::open(dir.path(), true).unwrap();
+        let mut log = CellLog::open(dir.path(), true, 5).unwrap();
         log.push("c", &vec![4.0]).unwrap();
-        let got: BTreeMap<String, Vec<f64>> = read_records(dir.path()).unwrap();
+        let got: BTreeMap<String, Vec<f64>> = read_records(dir.path(), 5).unwrap();
         assert_eq!(got.keys().cloned().collect::<Vec<_>>(), vec!["a", "b", "c"]);
-        std::fs::write(&path, "{\"key\":\"a\",\"record\":[1]}\nnot json\n").unwrap();
-        let e = read_records::<Vec<f64>>(dir.path()).unwrap_err().to_string();
+        // Lines of another run (another master seed) mixed in are named.
+        CellLog::open(dir.path(), true, 6).unwrap().push("d", &vec![5.0]).unwrap();
+        let e = read_records::<Vec<f64>>(dir.path(), 5).unwrap_err().to_string();
+        assert!(e.contains("cells.jsonl:4") && e.contains("cell d") && e.contains("mixes runs"), "{e}");
+        let a = format!("{{\"key\":\"a\",\"seed\":\"{}\",\"record\":[1]}}", crate::experiment::seeds::seed_hex(5, "a"));
+        std::fs::write(&path, format!("{a}\nnot json\n")).unwrap();
+        let e = read_records::<Vec<f64>>(dir.path(), 5).unwrap_err().to_string();
         assert!(e.contains("cells.jsonl:2"), "{e}");
     }
 
@@ -209,8 +224,8 @@ mod tests {
     fn records_keep_every_bit_of_a_float() {
         let dir = tempfile::tempdir().unwrap();
         let xs: Vec<f64> = vec![10.552161934452197, 0.1 + 0.2, 1e-300, f64::MIN_POSITIVE, 2.0f64.sqrt(), -1.0 / 3.0];
-        CellLog::open(dir.path(), false).unwrap().push("k", &xs).unwrap();
-        let back: BTreeMap<String, Vec<f64>> = read_records(dir.path()).unwrap();
+        CellLog::open(dir.path(), false, 1).unwrap().push("k", &xs).unwrap();
+        let back: BTreeMap<String, Vec<f64>> = read_records(dir.path(), 1).unwrap();
         assert_eq!(back["k"].iter().map(|v| v.to_bits()).collect::<Vec<_>>(), xs.iter().map(|v| v.to_bits()).collect::<Vec<_>>());
     }
 

@@ -6,7 +6,9 @@ pub mod ch6;
 pub mod compare;
 pub mod datasets;
 pub mod family;
+pub mod finite;
 pub mod fit_cmd;
+pub mod limits;
 pub mod log;
 pub mod reproduce;
 pub mod runner;
@@ -22,6 +24,7 @@ use serde::Serialize;
 use spec::Spec;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use std::time::Instant;
 
 /// Where and how a run happens (everything that is not the spec).
@@ -34,13 +37,46 @@ pub struct RunContext {
     pub resume: bool,
     /// Run only this slice of the cells (no tables: `somnurbs merge` makes them).
     pub shard: Option<log::Shard>,
+    /// Set by `run_spec`: the folder's reset, done once the inputs have loaded.
+    pub session: Option<Arc<Session>>,
 }
 
 impl RunContext {
     /// A plain run: fresh folder, all cells.
     pub fn new(out: PathBuf, jobs: usize, data_dir: PathBuf) -> RunContext {
-        RunContext { out, jobs, data_dir, resume: false, shard: None }
+        RunContext { out, jobs, data_dir, resume: false, shard: None, session: None }
     }
+
+    /// Make the folder this run's: called by the runner when the first cell is about to run,
+    /// i.e. after every input (spec, data, maps) has loaded, and before anything is written. The
+    /// first call removes the old manifest (the folder is unfinished from here on), writes the
+    /// fingerprint and starts the cell log (kept when resuming); later calls do nothing.
+    pub fn begin(&self) -> Result<()> {
+        let Some(session) = &self.session else { return Ok(()) };
+        let mut pending = session.pending.lock().map_err(|_| anyhow::anyhow!("run state lock poisoned"))?;
+        if let Some(fp) = pending.take() {
+            let manifest = self.out.join(crate::outdir::MANIFEST);
+            if manifest.exists() {
+                std::fs::remove_file(&manifest).with_context(|| format!("cannot remove {}", manifest.display()))?;
+                crate::outdir::sync_dir(&self.out)?;
+            }
+            fp.write(&self.out)?;
+            drop(log::CellLog::open(&self.out, self.resume, session.master_seed)?);
+        }
+        Ok(())
+    }
+
+    /// The master seed the cell log tags records with (0 outside `run_spec`).
+    pub fn master_seed(&self) -> u64 {
+        self.session.as_ref().map_or(0, |s| s.master_seed)
+    }
+}
+
+/// What `run_spec` hands the runner: the spec's master seed and the folder reset still to do.
+#[derive(Debug)]
+pub struct Session {
+    pub master_seed: u64,
+    pending: std::sync::Mutex<Option<log::Fingerprint>>,
 }
 
 /// One line per cell for `--dry-run`: key and seed.
@@ -109,13 +145,6 @@ impl Default for Definitions {
     }
 }
 
-fn host_name() -> String {
-    std::fs::read_to_string("/proc/sys/kernel/hostname")
-        .map(|s| s.trim().to_string())
-        .or_else(|_| std::env::var("HOSTNAME"))
-        .unwrap_or_else(|_| "unknown".into())
-}
-
 /// The fingerprint of a spec run in a folder (what `--resume` and `merge` compare).
 pub fn fingerprint(spec: &Spec, shard: Option<log::Shard>) -> log::Fingerprint {
     log::Fingerprint {
@@ -131,14 +160,19 @@ pub fn fingerprint(spec: &Spec, shard: Option<log::Shard>) -> log::Fingerprint {
 }
 
 /// Run a whole spec: cells, tables, pictures, REPORT.md, and last the manifest (its presence marks
-/// a complete run; an old one is removed first). With a shard, only its cells run and no tables
-/// are written (`merge` writes them). With `resume`, the cells in the folder's log are kept if
-/// the folder's fingerprint matches, else the run is refused before anything is touched.
+/// a complete run). The folder is locked for the whole run (one writer), and nothing in it is
+/// removed or rewritten until every input (data, maps) has loaded: the old manifest goes, and the
+/// fingerprint and a fresh cell log come, only when the first cell is about to run
+/// ([`RunContext::begin`]). With a shard, only its cells run and no tables are written (`merge`
+/// writes them). With `resume`, the cells in the folder's log are kept if the folder's
+/// fingerprint and every logged seed match, else the run is refused before anything is touched.
 pub fn run_spec(spec: &Spec, ctx: &RunContext) -> Result<PathBuf> {
-    crate::report::fsio::ensure_dir(&ctx.out)?;
-    let probe = ctx.out.join(".somnurbs-write-test");
-    std::fs::write(&probe, b"").with_context(|| format!("output folder {} is not writable", ctx.out.display()))?;
-    let _ = std::fs::remove_file(&probe);
+    let _lock = crate::outdir::lock(&ctx.out, &format!("run {}", spec.path))?;
+    run_spec_locked(spec, ctx)
+}
+
+/// [`run_spec`] in a folder the caller has locked.
+fn run_spec_locked(spec: &Spec, ctx: &RunContext) -> Result<PathBuf> {
     let fp = fingerprint(spec, ctx.shard);
     if ctx.resume {
         match log::Fingerprint::read(&ctx.out)? {
@@ -151,19 +185,16 @@ pub fn run_spec(spec: &Spec, ctx: &RunContext) -> Result<PathBuf> {
             None => {}
         }
     }
-    let manifest_path = ctx.out.join("manifest.toml");
-    if manifest_path.exists() {
-        std::fs::remove_file(&manifest_path).with_context(|| format!("cannot remove {}", manifest_path.display()))?;
-    }
-    fp.write(&ctx.out)?;
-    // Start the cell log (kept when resuming); the cell families of the spec append to it.
-    drop(log::CellLog::open(&ctx.out, ctx.resume)?);
+    let manifest_path = ctx.out.join(crate::outdir::MANIFEST);
+    let session = Arc::new(Session { master_seed: spec.file.master_seed, pending: std::sync::Mutex::new(Some(fp.clone())) });
+    let ctx = &RunContext { session: Some(session), ..ctx.clone() };
     let started = Instant::now();
     let started_unix = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map(|d| d.as_secs()).unwrap_or(0);
     let tables = ctx.shard.is_none();
 
     let family = family::present(spec).into_iter().next().context("the spec has no experiment section")?;
     let family::Outcome { section, cpu_s: cpu, cells } = family.run(spec, ctx, tables)?;
+    ctx.begin()?;
 
     let manifest = Manifest {
         spec_name: spec.file.name.clone(),
@@ -176,7 +207,7 @@ pub fn run_spec(spec: &Spec, ctx: &RunContext) -> Result<PathBuf> {
         git_commit: env!("SOMNURBS_GIT_COMMIT").into(),
         git_dirty: env!("SOMNURBS_GIT_DIRTY") == "true",
         rustc: env!("SOMNURBS_RUSTC").into(),
-        host: host_name(),
+        host: crate::outdir::host_name(),
         jobs: ctx.jobs,
         cells,
         started_unix,
@@ -195,21 +226,25 @@ pub fn run_spec(spec: &Spec, ctx: &RunContext) -> Result<PathBuf> {
 }
 
 /// Combine shard folders of one spec into `out` and write its tables: the shards' fingerprints
-/// must agree (apart from the shard) and cover 1..N once; their cell logs are joined and the spec
-/// is run in `out` with every cell restored from the log, so the tables equal a one-machine run's.
+/// must agree (apart from the shard) and cover 1..N once, each shard finished, its logged seeds
+/// the spec's, and their cell logs together hold exactly the spec's cells; the logs are joined and
+/// the spec is run in `out` (locked, and empty of any run) with every cell restored from the log,
+/// so the tables equal a one-machine run's.
 pub fn merge(shards: &[PathBuf], ctx: &RunContext) -> Result<PathBuf> {
     if shards.is_empty() {
         anyhow::bail!("merge: no shard folders given");
     }
+    let _lock = crate::outdir::lock(&ctx.out, "merge")?;
     let mut first: Option<log::Fingerprint> = None;
     let mut seen: BTreeMap<usize, PathBuf> = BTreeMap::new();
     let mut count = 0;
     let mut records: BTreeMap<String, serde_json::Value> = BTreeMap::new();
     for dir in shards {
+        crate::outdir::require_not_being_written(dir).context("merge")?;
         let fp = log::Fingerprint::read(dir)?.with_context(|| format!("merge: {} has no {} (not a somnurbs output folder?)", dir.display(), log::FINGERPRINT_FILE))?;
         let shard = fp.shard.as_deref().with_context(|| format!("merge: {} is not a shard (it was run without --shard)", dir.display()))?;
         let shard = log::Shard::parse(shard).with_context(|| format!("merge: {}", dir.display()))?;
-        if !dir.join("manifest.toml").exists() {
+        if !dir.join(crate::outdir::MANIFEST).exists() {
             anyhow::bail!("merge: shard {shard} in {} did not finish (no manifest.toml); resume it with --resume first", dir.display());
         }
         let plain = log::Fingerprint { shard: None, ..fp.clone() };
@@ -230,28 +265,31 @@ pub fn merge(shards: &[PathBuf], ctx: &RunContext) -> Result<PathBuf> {
         if let Some(other) = seen.insert(shard.index, dir.clone()) {
             anyhow::bail!("merge: shard {shard} given twice ({} and {})", other.display(), dir.display());
         }
-        records.extend(log::read_records::<serde_json::Value>(dir)?);
+        records.extend(log::read_records::<serde_json::Value>(dir, fp.master_seed).context("merge")?);
     }
     if let Some(missing) = (1..=count).find(|i| !seen.contains_key(i)) {
         anyhow::bail!("merge: shard {missing}/{count} is missing");
     }
     let fp = first.expect("at least one shard");
-    if records.len() != fp.cells {
-        anyhow::bail!("merge: the shards hold {} cells, the spec has {}", records.len(), fp.cells);
-    }
     let spec = Spec::parse(&fp.spec_path, &fp.spec_text, if fp.profile == "default" { None } else { Some(fp.profile.as_str()) }).map_err(|e| anyhow::anyhow!("{e}"))?;
-    crate::report::fsio::ensure_dir(&ctx.out)?;
-    if ctx.out.join(log::LOG_FILE).exists() || ctx.out.join("manifest.toml").exists() {
+    let expected: std::collections::BTreeSet<String> = logged_cell_keys(&spec).into_iter().collect();
+    if let Some(k) = expected.iter().find(|k| !records.contains_key(*k)) {
+        anyhow::bail!("merge: no shard logged cell {k} (the shards hold {} of the spec's {} cells)", expected.iter().filter(|k| records.contains_key(*k)).count(), expected.len());
+    }
+    if let Some(k) = records.keys().find(|k| !expected.contains(*k)) {
+        anyhow::bail!("merge: the shards log cell {k}, which the spec does not have");
+    }
+    if ctx.out.join(log::LOG_FILE).exists() || ctx.out.join(crate::outdir::MANIFEST).exists() || ctx.out.join(log::FINGERPRINT_FILE).exists() {
         anyhow::bail!("merge: {} already holds a run; choose an empty folder", ctx.out.display());
     }
     {
-        let mut out_log = log::CellLog::open(&ctx.out, false)?;
+        let mut out_log = log::CellLog::open(&ctx.out, false, fp.master_seed)?;
         for (key, rec) in &records {
             out_log.push(key, rec)?;
         }
     }
     fingerprint(&spec, None).write(&ctx.out)?;
-    run_spec(&spec, &RunContext { resume: true, shard: None, ..ctx.clone() })
+    run_spec_locked(&spec, &RunContext { resume: true, shard: None, ..ctx.clone() })
 }
 
 /// Resolve the data directory: flag, else `SOMNURBS_DATA`, else `./data`.

@@ -139,7 +139,16 @@ pub fn reproduce(specs_dir: &Path, plan_name: &str, profile: &str, ctx: &RunCont
     let specs = load_specs(specs_dir, &plan, &plan.specs, &[], profile, &ctx.out)?;
     let reading_specs: Vec<(&ReadingSet, Vec<Spec>)> =
         plan.readings.iter().map(|r| Ok((r, load_specs(specs_dir, &plan, &r.specs, &r.overrides(), profile, &ctx.out)?))).collect::<Result<_>>()?;
-    crate::report::fsio::ensure_dir(&ctx.out)?;
+    // Every data set of every spec loads before the folder changes (a bad --data-dir changes nothing).
+    for spec in &specs {
+        for d in super::limits::dataset_entries(spec) {
+            crate::data::registry::load_dataset(d, &ctx.data_dir).with_context(|| format!("{}: data set `{d}`", spec.path))?;
+        }
+    }
+    let _lock = crate::outdir::lock(&ctx.out, &format!("reproduce --plan {plan_name}"))?;
+    // Every spec has loaded: the folder is unfinished until the combined REPORT.md is written.
+    let incomplete = ctx.out.join(crate::outdir::INCOMPLETE);
+    write_atomic(&incomplete, format!("reproduce --plan {plan_name} --profile {} started here\n", profile.unwrap_or("full")).as_bytes())?;
     let started = Instant::now();
     let mut done = Vec::new();
     for spec in &specs {
@@ -166,6 +175,8 @@ pub fn reproduce(specs_dir: &Path, plan_name: &str, profile: &str, ctx: &RunCont
     }
     let path = ctx.out.join("REPORT.md");
     write_atomic(&path, report.as_bytes())?;
+    std::fs::remove_file(&incomplete).with_context(|| format!("cannot remove {}", incomplete.display()))?;
+    crate::outdir::sync_dir(&ctx.out)?;
     Ok(path)
 }
 

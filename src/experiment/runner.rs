@@ -78,15 +78,23 @@ where
     R: Logged,
 {
     // The log may hold other cell families of the same spec: only this family's keys are read.
-    let mut logged: BTreeMap<String, serde_json::Value> = if ctx.resume { super::log::read_records(&ctx.out)? } else { BTreeMap::new() };
+    let mut logged: BTreeMap<String, serde_json::Value> = if ctx.resume { super::log::read_records(&ctx.out, ctx.master_seed())? } else { BTreeMap::new() };
     let slice: Vec<&C> = cells.iter().enumerate().filter(|(k, _)| ctx.shard.is_none_or(|s| s.contains(*k))).map(|(_, c)| c).collect();
     let todo: Vec<&C> = slice.iter().copied().filter(|c| !logged.contains_key(&c.key())).collect();
     if ctx.resume && todo.len() < slice.len() {
         eprintln!("somnurbs: resuming {}: {} of {} cells already done", ctx.out.display(), slice.len() - todo.len(), slice.len());
     }
-    // `run_spec` started the log (empty unless resuming); every family appends.
-    let log = std::sync::Mutex::new(super::log::CellLog::append(&ctx.out)?);
-    let computed = run_cells(&todo, ctx.jobs, label, |c| work(c), |c, r: &R| log.lock().map_err(|_| anyhow::anyhow!("cell log lock poisoned"))?.push(&c.key(), &r.record()))?;
+    // Every input has loaded: the folder becomes this run's (once per run), then the log
+    // (empty unless resuming) gets one line per finished cell; every family appends.
+    ctx.begin()?;
+    let log = std::sync::Mutex::new(super::log::CellLog::append(&ctx.out, ctx.master_seed())?);
+    let computed = run_cells(&todo, ctx.jobs, label, |c| work(c), |c, r: &R| {
+        let record = r.record();
+        if let Some(at) = super::finite::first_non_finite(&record) {
+            anyhow::bail!("cell {}: its result is not finite ({at})", c.key());
+        }
+        log.lock().map_err(|_| anyhow::anyhow!("cell log lock poisoned"))?.push(&c.key(), &record)
+    })?;
     let mut computed: BTreeMap<String, R> = todo.iter().map(|c| c.key()).zip(computed).collect();
     slice
         .into_iter()

@@ -97,7 +97,7 @@ fn section(spec: &Spec) -> Result<&GrowingGridSpec> {
 pub fn cells(spec: &Spec) -> Vec<Cell> {
     let Some(g) = &spec.file.growing_grid else { return Vec::new() };
     let mut out = Vec::new();
-    for d in &g.datasets {
+    for d in g.datasets.iter().map(|d| registry::name_of(d)) {
         for &cn in &g.control_nets {
             for p in &g.parameterisations {
                 let Ok(param) = p.parse::<Parameterisation>() else { continue };
@@ -119,7 +119,7 @@ pub fn maps(spec: &Spec, ctx: &RunContext) -> Result<Vec<MapRun>> {
     let data: Vec<(String, Vec<Point3>)> = g
         .datasets
         .iter()
-        .map(|d| registry::load_dataset(d, &ctx.data_dir).map(|c| (d.clone(), c.points)).with_context(|| format!("growing_grid.datasets: `{d}`")))
+        .map(|d| registry::load_dataset(d, &ctx.data_dir).map(|c| (c.name, c.points)).with_context(|| format!("growing_grid.datasets: `{d}`")))
         .collect::<Result<_>>()?;
     runner::run_cells(&data, ctx.jobs, "growing grids", |(d, points)| {
         let mut rng = seeds::cell_rng(spec.file.master_seed, &format!("seed001/map/{d}"));

@@ -684,6 +684,8 @@ impl Spec {
         if f.name.trim().is_empty() || f.name.contains(['/', '\\']) {
             return Err(self.err("name", "must be a non-empty name without slashes"));
         }
+        // Bounds, duplicates and names first: later checks allocate from sizes.
+        super::limits::check(self)?;
         let families = super::family::present(self);
         match families.len() {
             0 => return Err(SpecError(format!("{}: the spec has no experiment section (add one of {})", self.path, super::family::section_list()))),
@@ -792,9 +794,6 @@ impl Spec {
         }
         for a in &fit.approaches {
             a.parse::<crate::spline::Approach>().map_err(|e| self.err("fit.approaches", e))?;
-        }
-        if !(0.0..=1e6).contains(&fit.fairness) {
-            return Err(self.err("fit.fairness", format!("must be in [0, 1e6], got {}", fit.fairness)));
         }
         if let Some(som) = &fit.som {
             if som.iterations == 0 {
@@ -1021,7 +1020,7 @@ impl Spec {
                     let Ok(param) = p.parse() else { continue };
                     for opt in &o.optimisers {
                         for repeat in 0..o.repeats {
-                            cells.push(OptimCell { dataset: dataset.clone(), grid: o.grid, cn: *cn, param, optimiser: opt.clone(), repeat });
+                            cells.push(OptimCell { dataset: crate::data::registry::name_of(dataset), grid: o.grid, cn: *cn, param, optimiser: opt.clone(), repeat });
                         }
                     }
                 }
@@ -1040,7 +1039,7 @@ impl Spec {
                     let Ok(param) = p.parse() else { continue };
                     for a in &fit.approaches {
                         let Ok(approach) = a.parse() else { continue };
-                        cells.push(FitCell { dataset: dataset.clone(), grid: fit.grid, cn: *cn, param, approach });
+                        cells.push(FitCell { dataset: crate::data::registry::name_of(dataset), grid: fit.grid, cn: *cn, param, approach });
                     }
                 }
             }
@@ -1052,14 +1051,16 @@ impl Spec {
     pub fn som_cells(&self) -> Vec<SomCell> {
         let Some(som) = &self.file.som else { return Vec::new() };
         let mut cells = Vec::new();
+        // Groups may share a (model, grid): each cell once, in first-seen order.
+        let mut seen = std::collections::HashSet::new();
         for dataset in &som.datasets {
             for group in &som.groups {
                 for grid in &group.grids {
                     for m in &group.models {
                         let Ok(model) = m.parse() else { continue };
                         for repeat in 0..som.repeats {
-                            let cell = SomCell { dataset: dataset.clone(), model, grid: *grid, repeat };
-                            if !cells.contains(&cell) {
+                            let cell = SomCell { dataset: crate::data::registry::name_of(dataset), model, grid: *grid, repeat };
+                            if seen.insert(cell.key()) {
                                 cells.push(cell);
                             }
                         }

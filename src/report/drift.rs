@@ -6,7 +6,9 @@
 //! Numbers are equal within `abs + rel * max(|a|, |b|)`; timing columns (CPU or wall seconds) and
 //! the tables and rows the baseline's `drift.toml` declares timing-dependent are compared and
 //! reported but never judged. Bad input (a folder or CSV that cannot be read, a malformed CSV, a
-//! run of another spec, seed or profile) is an error, not drift.
+//! run of another spec, seed or profile) is an error, not drift, and so is a folder that does not
+//! hold a finished, whole run ([`crate::outdir::require_finished`]). Non-finite numbers compare by
+//! identity (`inf` equals only `inf` of the same sign, `NaN` only `NaN`) and are always reported.
 
 use super::fsio::{csv_records, write_atomic};
 use anyhow::{bail, Context, Result};
@@ -36,6 +38,10 @@ impl Tolerance {
         }
         if a == b {
             return true;
+        }
+        // |inf - x| <= abs + rel * inf would call inf equal to anything.
+        if a.is_infinite() || b.is_infinite() {
+            return false;
         }
         (a - b).abs() <= self.abs + self.rel * a.abs().max(b.abs())
     }
@@ -136,13 +142,15 @@ pub enum Finding {
     RowCount { table: String, baseline: usize, current: usize },
     RowKey { table: String, row: usize, baseline: String, current: String },
     Cell { table: String, row: String, column: String, baseline: String, current: String, abs: f64, rel: f64, judged: bool },
+    /// A non-finite number equal on both sides (not drift, but never silent).
+    NonFinite { table: String, row: String, column: String, value: String },
 }
 
 impl Finding {
     /// Whether it counts as drift (an extra table or a timing cell does not).
     pub fn drifted(&self) -> bool {
         match self {
-            Finding::ExtraTable { .. } | Finding::ExtraColumn { .. } => false,
+            Finding::ExtraTable { .. } | Finding::ExtraColumn { .. } | Finding::NonFinite { .. } => false,
             Finding::Cell { judged, .. } => *judged,
             _ => true,
         }
@@ -154,6 +162,7 @@ impl Finding {
             Finding::ExtraTable { table } => format!("{table}: new table (not in the baseline)"),
             Finding::MissingColumn { table, column } => format!("{table}: column {column} is missing"),
             Finding::ExtraColumn { table, column } => format!("{table}: new column {column}"),
+            Finding::NonFinite { table, row, column, value } => format!("{table}:{row}:{column} is {value} in both folders"),
             Finding::RowCount { table, baseline, current } => format!("{table}: {baseline} rows in the baseline, {current} now"),
             Finding::RowKey { table, row, baseline, current } => format!("{table}: row {row} is {current}, the baseline has {baseline}"),
             Finding::Cell { table, row, column, baseline, current, rel, judged, .. } => {
@@ -188,7 +197,7 @@ impl DriftReport {
                 let (t, rel) = match f {
                     Finding::MissingTable { table } | Finding::MissingColumn { table, .. } | Finding::RowCount { table, .. } | Finding::RowKey { table, .. } => (table.as_str(), f64::INFINITY),
                     Finding::Cell { table, rel, .. } => (table.as_str(), *rel),
-                    Finding::ExtraTable { table } | Finding::ExtraColumn { table, .. } => (table.as_str(), 0.0),
+                    Finding::ExtraTable { table } | Finding::ExtraColumn { table, .. } | Finding::NonFinite { table, .. } => (table.as_str(), 0.0),
                 };
                 let e = per_table.entry(t).or_insert((0, 0.0));
                 e.0 += 1;
@@ -207,7 +216,7 @@ impl DriftReport {
         if timing > 0 {
             let _ = write!(s, "\n{timing} timing cells differ (reported in the diff CSV, not judged)");
         }
-        for f in self.findings.iter().filter(|f| matches!(f, Finding::ExtraTable { .. } | Finding::ExtraColumn { .. })) {
+        for f in self.findings.iter().filter(|f| matches!(f, Finding::ExtraTable { .. } | Finding::ExtraColumn { .. } | Finding::NonFinite { .. })) {
             let _ = write!(s, "\nnote: {}", f.describe());
         }
         s
@@ -225,7 +234,7 @@ impl DriftReport {
                 }
                 other => {
                     let table = match other {
-                        Finding::MissingTable { table } | Finding::ExtraTable { table } | Finding::MissingColumn { table, .. } | Finding::ExtraColumn { table, .. } | Finding::RowCount { table, .. } | Finding::RowKey { table, .. } => table.clone(),
+                        Finding::MissingTable { table } | Finding::ExtraTable { table } | Finding::MissingColumn { table, .. } | Finding::ExtraColumn { table, .. } | Finding::RowCount { table, .. } | Finding::RowKey { table, .. } | Finding::NonFinite { table, .. } => table.clone(),
                         Finding::Cell { .. } => unreachable!(),
                     };
                     vec![table, String::new(), String::new(), String::new(), String::new(), String::new(), String::new(), "yes".into(), yes(other.drifted()), other.describe()]
@@ -298,6 +307,9 @@ pub fn compare_table(name: &str, base: &Table, cur: &Table, opts: &DriftOptions,
             let (vb, vc) = (b.get(i).map(String::as_str).unwrap_or(""), c.get(j).map(String::as_str).unwrap_or(""));
             report.cells += 1;
             if vb == vc {
+                if vb.parse::<f64>().is_ok_and(|x| !x.is_finite()) {
+                    report.findings.push(Finding::NonFinite { table: name.into(), row: key.clone(), column: col.clone(), value: vb.into() });
+                }
                 continue;
             }
             let judged = !(timing_table || timing_row || is_timing_column(col));
@@ -307,7 +319,7 @@ pub fn compare_table(name: &str, base: &Table, cur: &Table, opts: &DriftOptions,
                         continue;
                     }
                     let abs = (x - y).abs();
-                    let rel = abs / x.abs().max(y.abs()).max(f64::MIN_POSITIVE);
+                    let rel = if x.is_finite() && y.is_finite() { abs / x.abs().max(y.abs()).max(f64::MIN_POSITIVE) } else { f64::INFINITY };
                     report.findings.push(Finding::Cell { table: name.into(), row: key.clone(), column: col.clone(), baseline: vb.into(), current: vc.into(), abs, rel, judged });
                 }
                 _ => report.findings.push(Finding::Cell { table: name.into(), row: key.clone(), column: col.clone(), baseline: vb.into(), current: vc.into(), abs: f64::NAN, rel: f64::INFINITY, judged }),
@@ -316,29 +328,15 @@ pub fn compare_table(name: &str, base: &Table, cur: &Table, opts: &DriftOptions,
     }
 }
 
-/// The tables of a folder: relative paths of its CSVs outside `png/`, `ioh/` and `maps/`.
+/// The tables of a folder: relative paths of its CSVs outside `png/`, `ioh/` and `maps/` (links
+/// to folders are not followed).
 pub fn tables(dir: &Path) -> Result<Vec<PathBuf>> {
-    fn walk(root: &Path, dir: &Path, out: &mut Vec<PathBuf>) -> Result<()> {
-        for e in std::fs::read_dir(dir).with_context(|| format!("cannot read folder {}", dir.display()))? {
-            let p = e.with_context(|| format!("cannot read folder {}", dir.display()))?.path();
-            let name = p.file_name().and_then(|n| n.to_str()).unwrap_or("");
-            if p.is_dir() {
-                if !["png", "ioh", "maps"].contains(&name) {
-                    walk(root, &p, out)?;
-                }
-            } else if name.ends_with(".csv") && name != "drift.csv" {
-                out.push(p.strip_prefix(root).expect("under root").to_path_buf());
-            }
-        }
-        Ok(())
-    }
     if !dir.is_dir() {
         bail!("{} is not a folder", dir.display());
     }
-    let mut out = Vec::new();
-    walk(dir, dir, &mut out)?;
-    out.sort();
-    Ok(out)
+    let skipped = |p: &Path| p.components().any(|c| ["png", "ioh", "maps"].iter().any(|s| c.as_os_str() == *s));
+    let (files, _) = crate::outdir::walk(dir)?;
+    Ok(files.into_iter().filter(|f| f.extension().is_some_and(|e| e == "csv") && f.file_name().is_some_and(|n| n != "drift.csv") && !skipped(f.parent().unwrap_or(Path::new("")))).collect())
 }
 
 /// The run identity of every `manifest.toml` under a folder, by relative folder.
@@ -350,19 +348,11 @@ fn identities(dir: &Path) -> Result<BTreeMap<PathBuf, (String, String, String)>>
         master_seed: u64,
     }
     let mut out = BTreeMap::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(d) = stack.pop() {
-        let m = d.join("manifest.toml");
-        if m.exists() {
-            let text = std::fs::read_to_string(&m).with_context(|| format!("cannot read {}", m.display()))?;
-            let id: Id = toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {}", m.display(), e.message()))?;
-            out.insert(d.strip_prefix(dir).expect("under root").to_path_buf(), (id.spec_sha256, id.profile, id.master_seed.to_string()));
-        }
-        for e in std::fs::read_dir(&d).with_context(|| format!("cannot read folder {}", d.display()))?.flatten() {
-            if e.path().is_dir() {
-                stack.push(e.path());
-            }
-        }
+    for f in crate::outdir::walk(dir)?.0.into_iter().filter(|f| f.file_name().is_some_and(|n| n == crate::outdir::MANIFEST)) {
+        let m = dir.join(&f);
+        let text = std::fs::read_to_string(&m).with_context(|| format!("cannot read {}", m.display()))?;
+        let id: Id = toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {}", m.display(), e.message()))?;
+        out.insert(f.parent().unwrap_or(Path::new("")).to_path_buf(), (id.spec_sha256, id.profile, id.master_seed.to_string()));
     }
     Ok(out)
 }
@@ -379,6 +369,8 @@ pub fn read_config(baseline: &Path) -> Result<DriftConfig> {
 
 /// Compare two folders. `allow_spec_change`: runs of other specs are compared anyway.
 pub fn compare_dirs(baseline: &Path, current: &Path, opts: &DriftOptions, allow_spec_change: bool) -> Result<DriftReport> {
+    crate::outdir::require_finished(baseline, "the baseline")?;
+    crate::outdir::require_finished(current, "the current folder")?;
     let (tb, tc) = (tables(baseline)?, tables(current)?);
     if tb.is_empty() {
         bail!("{} holds no tables (*.csv): not a baseline", baseline.display());
@@ -422,30 +414,42 @@ pub fn compare_dirs(baseline: &Path, current: &Path, opts: &DriftOptions, allow_
     Ok(report)
 }
 
-/// Make `baseline` hold the current tables (and manifests): each file written atomically; tables
-/// the current folder lacks are removed. Returns one line per file changed.
+/// Make `baseline` hold the current tables (and manifests); tables the current folder lacks are
+/// removed, other files of the baseline (its drift.toml) kept. The current folder must hold a
+/// finished, whole run. The new baseline is built beside the old one and swapped in whole
+/// ([`crate::outdir::replace_dir`]) under the baseline's lock: a failure leaves the old baseline
+/// as it was. Returns one line per file changed.
 pub fn accept(baseline: &Path, current: &Path) -> Result<Vec<String>> {
+    crate::outdir::require_finished(current, "the current folder")?;
     let tc = tables(current)?;
     if tc.is_empty() {
         bail!("{} holds no tables (*.csv)", current.display());
     }
-    let tb = if baseline.is_dir() { tables(baseline)? } else { Vec::new() };
-    let mut said = Vec::new();
+    let _lock = crate::outdir::lock(baseline, "drift --accept")?;
+    let (old_files, _) = crate::outdir::walk(baseline)?;
+    let tb = tables(baseline)?;
     let mut files: Vec<PathBuf> = tc.clone();
-    files.extend(identities(current)?.keys().map(|d| d.join("manifest.toml")));
-    for f in &files {
-        let text = std::fs::read(current.join(f)).with_context(|| format!("cannot read {}", current.join(f).display()))?;
-        let target = baseline.join(f);
-        let old = std::fs::read(&target).ok();
-        if old.as_deref() != Some(&text[..]) {
-            write_atomic(&target, &text)?;
-            said.push(format!("{} {}", if old.is_some() { "replaced" } else { "added" }, f.display()));
+    files.extend(identities(current)?.keys().map(|d| d.join(crate::outdir::MANIFEST)));
+    let mut said = Vec::new();
+    crate::outdir::replace_dir(baseline, |staged| {
+        // The old baseline's files first (not lock files, nor the tables the current run lacks) ...
+        let lock = |f: &Path| f.file_name().is_some_and(|n| n == crate::outdir::LOCK_FILE);
+        for f in old_files.iter().filter(|f| !tc.contains(f) && !tb.contains(f) && !files.contains(f) && !lock(f)) {
+            let text = std::fs::read(baseline.join(f)).with_context(|| format!("cannot read {}", baseline.join(f).display()))?;
+            write_atomic(&staged.join(f), &text)?;
         }
-    }
-    for f in tb.iter().filter(|f| !tc.contains(f)) {
-        std::fs::remove_file(baseline.join(f)).with_context(|| format!("cannot remove {}", baseline.join(f).display()))?;
-        said.push(format!("removed {}", f.display()));
-    }
+        // ... then the current run's tables and manifests.
+        for f in &files {
+            let text = std::fs::read(current.join(f)).with_context(|| format!("cannot read {}", current.join(f).display()))?;
+            let old = std::fs::read(baseline.join(f)).ok();
+            write_atomic(&staged.join(f), &text)?;
+            if old.as_deref() != Some(&text[..]) {
+                said.push(format!("{} {}", if old.is_some() { "replaced" } else { "added" }, f.display()));
+            }
+        }
+        said.extend(tb.iter().filter(|f| !tc.contains(f)).map(|f| format!("removed {}", f.display())));
+        Ok(())
+    })?;
     Ok(said)
 }
 
@@ -532,5 +536,22 @@ mod tests {
         assert!(parse_tol("err").is_err() && parse_tol("err=-1").is_err() && parse_tol("err=x").is_err());
         assert!(glob("*_avg", "de_avg") && glob("ch6*/table_6_6.csv", "ch6_same/table_6_6.csv") && !glob("a*b", "ac") && glob("x", "x"));
         assert!(Tolerance::default().equal(f64::NAN, f64::NAN) && !Tolerance::default().equal(1.0, f64::NAN));
+    }
+
+    #[test]
+    fn non_finite_numbers_compare_by_identity_and_are_reported() {
+        let t = Tolerance { abs: 1e-9, rel: 1e-9 };
+        let (inf, nan) = (f64::INFINITY, f64::NAN);
+        assert!(!t.equal(1.5, inf) && !t.equal(inf, 1.5) && !t.equal(-inf, inf) && !t.equal(inf, nan));
+        assert!(t.equal(inf, inf) && t.equal(-inf, -inf) && t.equal(nan, nan));
+        let loose = Tolerance { abs: 1e300, rel: 1.0 };
+        assert!(!loose.equal(f64::MAX, inf));
+        let base = "k,v\na,1.5\nb,inf\n";
+        let r = cmp(base, "k,v\na,inf\nb,inf\n", &DriftOptions::default());
+        assert!(r.drifted(), "{:?}", r.findings);
+        assert!(r.summary(5).contains("t.csv:a:v 1.5 -> inf") && r.summary(5).contains("b:v is inf in both"), "{}", r.summary(5));
+        assert!(cmp(base, "k,v\na,1.5\nb,-inf\n", &DriftOptions::default()).drifted());
+        let r = cmp(base, base, &DriftOptions::default());
+        assert!(!r.drifted() && r.summary(5).contains("note: t.csv:b:v is inf in both folders"), "{}", r.summary(5));
     }
 }

@@ -1,20 +1,16 @@
 //! All file output goes through here: every error carries its path, and every finished file is
-//! written to a temporary name in the same folder and renamed, so a reader never sees half a file.
+//! written to a unique temporary name in the same folder, synced, renamed, and the folder synced,
+//! so a reader never sees half a file and two writers never share a temporary file (the rest of
+//! the output-folder contract is in [`crate::outdir`]).
 
 use anyhow::{Context, Result};
 use std::fs::{self, File};
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// Create a folder (and parents), naming it on failure.
 pub fn ensure_dir(dir: &Path) -> Result<()> {
     fs::create_dir_all(dir).with_context(|| format!("cannot create folder {}", dir.display()))
-}
-
-/// The temporary sibling a file is written to before it is renamed into place.
-pub fn temp_sibling(path: &Path) -> PathBuf {
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    path.with_file_name(format!(".{name}.tmp"))
 }
 
 /// Write `bytes` to `path` atomically (temporary file + rename).
@@ -22,9 +18,9 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
         ensure_dir(parent)?;
     }
-    let tmp = temp_sibling(path);
+    let tmp = crate::outdir::temp_name(path, "tmp");
     let result = (|| -> std::io::Result<()> {
-        let mut f = File::create(&tmp)?;
+        let mut f = File::options().write(true).create_new(true).open(&tmp)?;
         f.write_all(bytes)?;
         f.sync_all()?;
         fs::rename(&tmp, path)
@@ -32,7 +28,8 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     if result.is_err() {
         let _ = fs::remove_file(&tmp);
     }
-    result.with_context(|| format!("cannot write {}", path.display()))
+    result.with_context(|| format!("cannot write {}", path.display()))?;
+    crate::outdir::sync_dir(path.parent().unwrap_or(Path::new(".")))
 }
 
 /// Read a whole file as text, naming it on failure.
@@ -77,7 +74,7 @@ mod tests {
         let p = dir.path().join("a/b.csv");
         write_atomic(&p, b"x,y\n").unwrap();
         assert_eq!(fs::read_to_string(&p).unwrap(), "x,y\n");
-        assert!(!temp_sibling(&p).exists());
+        assert_eq!(fs::read_dir(dir.path().join("a")).unwrap().count(), 1, "no temporary file left");
         let blocked = dir.path().join("a/b.csv/c.csv");
         let e = format!("{:#}", write_atomic(&blocked, b"1").unwrap_err());
         assert!(e.contains("b.csv"), "{e}");

@@ -120,3 +120,39 @@ pub fn same_tables(a: &Path, b: &Path) -> usize {
     }
     ta.len()
 }
+
+/// A small Chapter 6 spec (a second or two).
+pub const SPEC: &str = r#"
+name = "d"
+master_seed = 3
+[optim]
+datasets = ["sphere"]
+grid = "20x20"
+control_nets = ["6x6"]
+parameterisations = ["chord_length"]
+optimisers = ["ga", "de"]
+repeats = 2
+generations = 20
+population = 8
+maps = "nowhere"
+[optim.som]
+iterations = 300
+"#;
+
+/// A Chapter 6 spec of several seconds on one thread: long enough to be killed or raced part-way.
+pub const SLOW: &str = r#"
+name = "slow"
+master_seed = 11
+[optim]
+datasets = ["sphere"]
+grid = "20x20"
+control_nets = ["10x10", "12x12"]
+parameterisations = ["chord_length"]
+optimisers = ["ga", "de", "pso"]
+repeats = 12
+generations = 600
+population = 20
+maps = "nowhere"
+[optim.som]
+iterations = 500
+"#;

@@ -1,0 +1,313 @@
+//! Bounds checked on every spec before anything else in validation (so `--dry-run` too): each
+//! size, count and radius has a documented finite range (README, "Spec limits"), lists hold no
+//! entry twice, and the experiment's name and data-set names can only name files inside the output
+//! folder. The checks only read numbers and list lengths: nothing is allocated from a spec value
+//! before it has passed, so a bad value is a one-line error naming its key at once.
+
+use super::spec::{GridSize, Spec, SpecError};
+use std::collections::HashSet;
+use std::fmt::Display;
+
+/// Largest side of any SOM grid or control net.
+pub const MAX_GRID_SIDE: usize = 256;
+/// SOM iterations T (Chapter 4 and the map recomputation of Chapters 5 and 6).
+pub const MAX_ITERATIONS: u64 = 10_000_000;
+/// Largest initial SOM radius sigma0 (the neighbourhood is tabulated per iteration).
+pub const MAX_SIGMA0: f64 = 256.0;
+/// Repeats (runs) per cell.
+pub const MAX_REPEATS: u64 = 10_000;
+/// Generations (iterations) of one optimiser run.
+pub const MAX_GENERATIONS: u64 = 1_000_000;
+/// Individuals (nests, particles) of one optimiser run.
+pub const MAX_POPULATION: u64 = 10_000;
+/// Cells of one spec.
+pub const MAX_CELLS: u64 = 100_000;
+/// Entries of one list.
+pub const MAX_LIST: usize = 1_000;
+/// Initial range, search range and box margin, in units of the (normalised) data's extent.
+pub const MAX_RANGE: f64 = 10.0;
+/// Trace checkpoint spacing in evaluations.
+pub const MAX_TRACE_EVERY: u64 = 1_000_000_000_000;
+/// Newton steps of the exact solver.
+pub const MAX_NEWTON_STEPS: u64 = 100_000;
+/// Data-unit lengths of the seed 004 cylinder (radius, height, step, accuracy, search range).
+pub const MAX_LENGTH: f64 = 1e6;
+/// Points or samples per side of a generated data set (seed 002 grid, seed 003 examples).
+pub const MAX_SAMPLES: u64 = 100_000;
+
+struct Check<'a> {
+    spec: &'a Spec,
+}
+
+impl Check<'_> {
+    fn err(&self, key: &str, msg: impl Display) -> SpecError {
+        SpecError(format!("{}: {key}: {msg}", self.spec.path))
+    }
+
+    fn int(&self, key: &str, v: impl TryInto<u64>, hi: u64) -> Result<(), SpecError> {
+        match v.try_into() {
+            Ok(v) if v <= hi => Ok(()),
+            Ok(v) => Err(self.err(key, format!("{v} is above the limit {hi}"))),
+            Err(_) => Err(self.err(key, format!("is above the limit {hi}"))),
+        }
+    }
+
+    /// A finite number in [lo, hi] (lo itself allowed or not).
+    fn real(&self, key: &str, v: f64, lo: f64, lo_allowed: bool, hi: f64) -> Result<(), SpecError> {
+        let above_lo = if lo_allowed { v >= lo } else { v > lo };
+        if v.is_finite() && above_lo && v <= hi {
+            return Ok(());
+        }
+        Err(self.err(key, format!("must be a finite number in {}{lo}, {hi}], got {v}", if lo_allowed { "[" } else { "(" })))
+    }
+
+    fn grids<'g>(&self, key: &str, grids: impl IntoIterator<Item = &'g GridSize>) -> Result<(), SpecError> {
+        for g in grids {
+            if g.nx > MAX_GRID_SIDE || g.ny > MAX_GRID_SIDE {
+                return Err(self.err(key, format!("{g} has a side above the limit {MAX_GRID_SIDE}")));
+            }
+        }
+        Ok(())
+    }
+
+    /// No entry twice, and not too many entries.
+    fn list<T: Display + Eq + std::hash::Hash>(&self, key: &str, list: &[T]) -> Result<(), SpecError> {
+        if list.len() > MAX_LIST {
+            return Err(self.err(key, format!("{} entries, above the limit {MAX_LIST}", list.len())));
+        }
+        let mut seen = HashSet::new();
+        match list.iter().find(|v| !seen.insert(*v)) {
+            Some(v) => Err(self.err(key, format!("`{v}` is listed twice"))),
+            None => Ok(()),
+        }
+    }
+
+    /// Data-set entries: each a built-in or a point file whose name (stem) is usable, no name twice.
+    fn datasets(&self, key: &str, list: &[String]) -> Result<(), SpecError> {
+        self.list(key, list)?;
+        let mut seen: Vec<(String, &String)> = Vec::new();
+        for d in list {
+            let name = crate::data::registry::dataset_name(d).map_err(|e| self.err(key, e))?;
+            if let Some((_, other)) = seen.iter().find(|(n, _)| *n == name) {
+                return Err(self.err(key, format!("`{other}` and `{d}` both go by the name `{name}` (a file's name is its stem)")));
+            }
+            seen.push((name, d));
+        }
+        Ok(())
+    }
+
+    fn cells(&self, key: &str, factors: &[usize]) -> Result<(), SpecError> {
+        let n = factors.iter().fold(1u64, |a, &f| a.saturating_mul(f as u64));
+        if n > MAX_CELLS {
+            return Err(self.err(key, format!("the spec has {n} cells, above the limit {MAX_CELLS}")));
+        }
+        Ok(())
+    }
+
+    fn optimiser_run(&self, section: &str, repeats: usize, generations: usize, population: usize) -> Result<(), SpecError> {
+        self.int(&format!("{section}.repeats"), repeats, MAX_REPEATS)?;
+        self.int(&format!("{section}.generations"), generations, MAX_GENERATIONS)?;
+        self.int(&format!("{section}.population"), population, MAX_POPULATION)
+    }
+}
+
+/// The data-set entries of a spec's section (as written: names or paths).
+pub fn dataset_entries(spec: &Spec) -> Vec<&String> {
+    let f = &spec.file;
+    let lists = [f.som.as_ref().map(|s| &s.datasets), f.fit.as_ref().map(|s| &s.datasets), f.optim.as_ref().map(|s| &s.datasets), f.growing_grid.as_ref().map(|s| &s.datasets)];
+    lists.into_iter().flatten().flatten().collect()
+}
+
+/// A usable experiment or file name: not empty, no path separator or NUL, not `.` or `..`.
+/// The penalised least squares weight (`fairness`): at most 10^6.
+pub const MAX_FAIRNESS: f64 = 1e6;
+
+pub fn check_name(name: &str) -> Result<(), String> {
+    if name.trim().is_empty() || name.contains(['/', '\\', '\0']) || name == "." || name == ".." {
+        return Err(format!("`{name}` must be a non-empty name without slashes, not `.` or `..`"));
+    }
+    Ok(())
+}
+
+/// Every bound of a spec (see the module doc), before any other check.
+pub fn check(spec: &Spec) -> Result<(), SpecError> {
+    let c = Check { spec };
+    let f = &spec.file;
+    check_name(&f.name).map_err(|e| c.err("name", e))?;
+    if let Some(s) = &f.som {
+        c.datasets("som.datasets", &s.datasets)?;
+        c.int("som.iterations", s.iterations, MAX_ITERATIONS)?;
+        if let Some(sigma0) = s.sigma0 {
+            c.real("som.sigma0", sigma0, 1.0, false, MAX_SIGMA0)?;
+        }
+        c.int("som.repeats", s.repeats, MAX_REPEATS)?;
+        c.list("som.group", &(0..s.groups.len()).collect::<Vec<_>>())?;
+        let mut per_data = 0usize;
+        for (g, group) in s.groups.iter().enumerate() {
+            c.list(&format!("som.group[{g}].models"), &group.models)?;
+            c.list(&format!("som.group[{g}].grids"), &group.grids)?;
+            c.grids(&format!("som.group[{g}].grids"), &group.grids)?;
+            per_data = per_data.saturating_add(group.models.len().saturating_mul(group.grids.len()));
+        }
+        c.list("som.save_maps", &s.save_maps)?;
+        c.grids("som.save_maps", &s.save_maps)?;
+        c.cells("som", &[s.datasets.len(), per_data, s.repeats])?;
+    }
+    if let Some(s) = &f.fit {
+        c.datasets("fit.datasets", &s.datasets)?;
+        c.grids("fit.grid", [&s.grid])?;
+        c.list("fit.control_nets", &s.control_nets)?;
+        c.grids("fit.control_nets", &s.control_nets)?;
+        c.list("fit.parameterisations", &s.parameterisations)?;
+        c.list("fit.approaches", &s.approaches)?;
+        if let Some(som) = &s.som {
+            c.int("fit.som.iterations", som.iterations, MAX_ITERATIONS)?;
+        }
+        c.real("fit.fairness", s.fairness, 0.0, true, MAX_FAIRNESS)?;
+        c.cells("fit", &[s.datasets.len(), s.control_nets.len(), s.parameterisations.len(), s.approaches.len()])?;
+    }
+    if let Some(o) = &f.optim {
+        c.datasets("optim.datasets", &o.datasets)?;
+        c.grids("optim.grid", [&o.grid])?;
+        c.list("optim.control_nets", &o.control_nets)?;
+        c.grids("optim.control_nets", &o.control_nets)?;
+        c.list("optim.parameterisations", &o.parameterisations)?;
+        c.list("optim.optimisers", &o.optimisers)?;
+        c.optimiser_run("optim", o.repeats, o.generations, o.population)?;
+        c.real("optim.fairness", o.fairness, 0.0, true, MAX_FAIRNESS)?;
+        c.real("optim.init_range", o.init_range, 0.0, true, MAX_RANGE)?;
+        c.real("optim.bounds_margin", o.bounds_margin, 0.0, true, MAX_RANGE)?;
+        if let Some(r) = o.search_range {
+            c.real("optim.search_range", r, 0.0, false, MAX_RANGE)?;
+        }
+        c.int("optim.trace_every_evals", o.trace_every_evals, MAX_TRACE_EVERY)?;
+        c.int("optim.exact_newton_steps", o.exact_newton_steps, MAX_NEWTON_STEPS)?;
+        if let Some(som) = &o.som {
+            c.int("optim.som.iterations", som.iterations, MAX_ITERATIONS)?;
+        }
+        c.cells("optim", &[o.datasets.len(), o.control_nets.len(), o.parameterisations.len(), o.optimisers.len(), o.repeats])?;
+    }
+    if let Some(g) = &f.growing_grid {
+        c.datasets("growing_grid.datasets", &g.datasets)?;
+        c.grids("growing_grid.grid", [&g.grid])?;
+        c.list("growing_grid.control_nets", &g.control_nets)?;
+        c.grids("growing_grid.control_nets", &g.control_nets)?;
+        c.list("growing_grid.parameterisations", &g.parameterisations)?;
+        c.list("growing_grid.optimisers", &g.optimisers)?;
+        c.optimiser_run("growing_grid", g.repeats, g.generations, g.population)?;
+        c.real("growing_grid.init_range", g.init_range, 0.0, true, MAX_RANGE)?;
+        c.real("growing_grid.bounds_margin", g.bounds_margin, 0.0, true, MAX_RANGE)?;
+        c.int("growing_grid.trace_every_evals", g.trace_every_evals, MAX_TRACE_EVERY)?;
+        c.int("growing_grid.growth.lambda_g", g.growth.lambda_g, MAX_ITERATIONS)?;
+        c.int("growing_grid.growth.lambda_f", g.growth.lambda_f, MAX_ITERATIONS)?;
+        c.cells("growing_grid", &[g.datasets.len(), g.control_nets.len(), g.parameterisations.len(), g.optimisers.len(), g.repeats])?;
+    }
+    if let Some(s) = &f.seed002 {
+        c.list("seed002.surfaces", &s.surfaces)?;
+        c.list("seed002.optimisers", &s.optimisers)?;
+        c.list("seed002.outlines", &s.outlines)?;
+        c.optimiser_run("seed002", s.repeats, s.generations, s.population)?;
+        c.int("seed002.curve_generations", s.curve_generations, MAX_GENERATIONS)?;
+        c.int("seed002.grid", s.grid, 1001)?;
+        c.real("seed002.init_range", s.init_range, 0.0, true, MAX_RANGE)?;
+        c.real("seed002.bounds_margin", s.bounds_margin, 0.0, true, MAX_RANGE)?;
+        c.int("seed002.trace_every_evals", s.trace_every_evals, MAX_TRACE_EVERY)?;
+        c.int("seed002.sam06_l", s.sam06_l, 1000)?;
+        if let Some(r) = s.sam06_r {
+            c.int("seed002.sam06_r", r, 1000)?;
+        }
+        c.real("seed002.sam06_d", s.sam06_d, 0.0, false, MAX_LENGTH)?;
+        c.cells("seed002", &[s.surfaces.len().max(s.outlines.len()), s.optimisers.len(), s.repeats])?;
+    }
+    if let Some(s) = &f.seed003 {
+        c.list("seed003.examples", &s.examples)?;
+        c.list("seed003.methods", &s.methods)?;
+        c.int("seed003.runs", s.runs, MAX_REPEATS)?;
+        c.int("seed003.nests", s.nests, MAX_POPULATION)?;
+        c.int("seed003.trace_every", s.trace_every, MAX_TRACE_EVERY)?;
+        for name in super::seed003::EXAMPLES {
+            if let Some(e) = s.example(name) {
+                c.int(&format!("seed003.{name}.size"), e.size, MAX_SAMPLES)?;
+                c.int(&format!("seed003.{name}.degree"), e.degree, 30)?;
+                c.int(&format!("seed003.{name}.generations"), e.generations, MAX_GENERATIONS)?;
+            }
+        }
+        c.cells("seed003", &[s.examples.len(), s.methods.len(), s.runs])?;
+    }
+    if let Some(s) = &f.seed004 {
+        c.list("seed004.control_points", &s.control_points)?;
+        c.list("seed004.table2_control_points", &s.table2_control_points)?;
+        c.list("seed004.table2_generations", &s.table2_generations)?;
+        c.optimiser_run("seed004", s.repeats, s.generations, s.population)?;
+        c.int("seed004.rows", s.rows, MAX_GRID_SIDE as u64)?;
+        for (key, v) in [("radius", s.radius), ("height", s.height), ("grid_step", s.grid_step), ("accuracy", s.accuracy), ("search_range", s.search_range)] {
+            c.real(&format!("seed004.{key}"), v, 0.0, false, MAX_LENGTH)?;
+        }
+        c.cells("seed004", &[s.control_points.len(), s.repeats])?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SPEC: &str = "name = \"t\"\nmaster_seed = 1\n[optim]\ndatasets = [\"sphere\"]\ngrid = \"20x20\"\ncontrol_nets = [\"6x6\"]\nparameterisations = [\"uniform\"]\noptimisers = [\"ga\", \"de\"]\nrepeats = 2\ngenerations = 10\npopulation = 8\n";
+
+    fn refused(from: &str, to: &str, key: &str) {
+        let t = std::time::Instant::now();
+        let text = SPEC.replace(from, to);
+        assert_ne!(text, SPEC, "{from} not in the spec");
+        let e = Spec::parse("t.toml", &text, None).unwrap_err().0;
+        assert!(e.contains(key) && !e.contains('\n'), "{to}: {e}");
+        assert!(t.elapsed().as_secs_f64() < 1.0, "{to}: slow refusal");
+    }
+
+    #[test]
+    fn every_size_has_a_bound_named_by_its_key() {
+        Spec::parse("t.toml", SPEC, None).unwrap();
+        refused("grid = \"20x20\"", "grid = \"100000x100000\"", "optim.grid");
+        refused("control_nets = [\"6x6\"]", "control_nets = [\"6x6\", \"6x100000\"]", "optim.control_nets");
+        refused("generations = 10", "generations = 1000000000000", "optim.generations");
+        refused("population = 8", "population = 1000000000000", "optim.population");
+        refused("repeats = 2", "repeats = 100000000", "optim.repeats");
+        refused("population = 8", "population = 8\nsearch_range = 1e308", "optim.search_range");
+        refused("population = 8", "population = 8\nsearch_range = inf", "optim.search_range");
+        refused("population = 8", "population = 8\ninit_range = nan", "optim.init_range");
+        refused("optimisers = [\"ga\", \"de\"]", "optimisers = [\"ga\", \"de\", \"ga\"]", "optim.optimisers: `ga` is listed twice");
+        refused("control_nets = [\"6x6\"]", "control_nets = [\"6x6\", \"6\"]", "optim.control_nets: `6x6` is listed twice");
+        refused("datasets = [\"sphere\"]", "datasets = [\"a/x.xyz\", \"b/x.xyz\"]", "both go by the name `x`");
+        refused("datasets = [\"sphere\"]", "datasets = [\"..\"]", "optim.datasets");
+        refused("name = \"t\"", "name = \"..\"", "name");
+        refused("name = \"t\"", "name = \".\"", "name");
+        let som = "name = \"s\"\nmaster_seed = 1\n[som]\ndatasets = [\"cube\"]\niterations = 10\n[[som.group]]\nmodels = [\"som2d\"]\ngrids = [\"10x10\"]\n";
+        for (to, key) in [
+            ("grids = [\"100000x100000\"]", "som.group[0].grids"),
+            ("grids = [\"10x10\"]\n[som.x]", "unknown field"),
+            ("grids = [\"10x10\", \"10x10\"]", "`10x10` is listed twice"),
+        ] {
+            let e = Spec::parse("s.toml", &som.replace("grids = [\"10x10\"]", to), None).unwrap_err().0;
+            assert!(e.contains(key), "{e}");
+        }
+        for (to, key) in [("iterations = 100000000000", "som.iterations"), ("iterations = 10\nsigma0 = 1e5", "som.sigma0"), ("iterations = 10\nsigma0 = inf", "som.sigma0"), ("iterations = 10\nrepeats = 1000000000", "som.repeats")] {
+            let e = Spec::parse("s.toml", &som.replace("iterations = 10", to), None).unwrap_err().0;
+            assert!(e.contains(key), "{e}");
+        }
+    }
+
+    #[test]
+    fn many_repeats_expand_in_linear_time() {
+        let som = "name = \"s\"\nmaster_seed = 1\n[som]\ndatasets = [\"cube\"]\niterations = 10\nrepeats = 10000\n[[som.group]]\nmodels = [\"som2d\", \"dnsom\"]\ngrids = [\"10x10\", \"12x12\"]\n[[som.group]]\nmodels = [\"som2d\"]\ngrids = [\"10x10\"]\n";
+        let t = std::time::Instant::now();
+        let spec = Spec::parse("s.toml", som, None).unwrap();
+        assert_eq!(spec.som_cells().len(), 40_000);
+        assert!(t.elapsed().as_secs_f64() < 2.0, "{:?}", t.elapsed());
+    }
+
+    #[test]
+    fn file_names_become_stems_in_keys() {
+        let text = SPEC.replace("datasets = [\"sphere\"]", "datasets = [\"/some/where/part.xyz\"]");
+        let spec = Spec::parse("t.toml", &text, None).unwrap();
+        assert!(spec.optim_cells().iter().all(|c| c.key().starts_with("optim/part/")), "{:?}", spec.optim_cells()[0].key());
+    }
+}
