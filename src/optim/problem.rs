@@ -81,6 +81,9 @@ pub struct RunResult {
     /// (evaluations, best fitness so far) at every multiple of `Budget::trace_every_evals` and at
     /// the end.
     pub trace: Vec<(u64, f64)>,
+    /// (evaluation, its fitness) at every strict improvement of the best so far, from the first
+    /// evaluation (1-based, as IOHprofiler's improvement-based `.dat` files record a run).
+    pub improvements: Vec<(u64, f64)>,
 }
 
 /// Check a problem's shapes and box before a run.
@@ -116,11 +119,12 @@ pub struct Evaluator<'a> {
     best: f64,
     every: u64,
     trace: Vec<(u64, f64)>,
+    improvements: Vec<(u64, f64)>,
 }
 
 impl<'a> Evaluator<'a> {
     pub fn new(problem: &'a dyn Problem, budget: &Budget) -> Evaluator<'a> {
-        Evaluator { problem, evaluations: 0, best: f64::INFINITY, every: budget.trace_every_evals.max(1), trace: Vec::new() }
+        Evaluator { problem, evaluations: 0, best: f64::INFINITY, every: budget.trace_every_evals.max(1), trace: Vec::new(), improvements: Vec::new() }
     }
 
     /// Evaluate `x`, counting it and updating the best and the trace.
@@ -131,6 +135,7 @@ impl<'a> Evaluator<'a> {
         self.evaluations += 1;
         if f < self.best {
             self.best = f;
+            self.improvements.push((self.evaluations, f));
         }
         if self.evaluations.is_multiple_of(self.every) {
             self.trace.push((self.evaluations, self.best));
@@ -153,7 +158,7 @@ impl<'a> Evaluator<'a> {
         if self.trace.last().map(|t| t.0) != Some(self.evaluations) {
             self.trace.push((self.evaluations, self.best));
         }
-        RunResult { best_x, best_fitness: self.best, initial_best_fitness, evaluations: self.evaluations, trace: self.trace }
+        RunResult { best_x, best_fitness: self.best, initial_best_fitness, evaluations: self.evaluations, trace: self.trace, improvements: self.improvements }
     }
 }
 
@@ -257,6 +262,22 @@ pub(crate) mod tests {
         assert_eq!(r.trace.iter().map(|t| t.0).collect::<Vec<_>>(), vec![4, 8, 10]);
         // Best so far is monotone.
         assert!(r.trace.windows(2).all(|w| w[1].1 <= w[0].1));
+    }
+
+    /// Improvements: every strict decrease of the best, at its 1-based evaluation; equal values
+    /// and NaN (recorded as +inf) are not improvements.
+    #[test]
+    fn improvements_from_the_first_evaluation() {
+        let mut p = Sphere::new(1);
+        p.centre = vec![0.0];
+        let budget = Budget { trace_every_evals: 100, ..Budget::default() };
+        let mut e = Evaluator::new(&p, &budget);
+        for x in [2.0, 1.0, 1.5, -1.0, 0.5, f64::NAN, 0.25] {
+            e.eval(&[x]);
+        }
+        let r = e.finish(vec![0.25], 4.0);
+        assert_eq!(r.improvements, vec![(1, 4.0), (2, 1.0), (5, 0.25), (7, 0.0625)]);
+        assert_eq!(r.trace, vec![(7, 0.0625)]);
     }
 
     #[test]

@@ -275,7 +275,7 @@ pub fn write(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProble
         }
     }
     let n_ioh = super::ioh::write(runs, out)?;
-    let _ = writeln!(s, "\nConvergence traces of every run in the IOHprofiler format (`ioh/<optimiser>/`, {n_ioh} problem files), loadable by IOHanalyzer.");
+    let _ = writeln!(s, "\nEvery run's improvements of the best so far in the IOHprofiler format (`ioh/<optimiser>/`: {n_ioh} JSON meta-data files, format version 0.3.3 or later, each with its improvement-based `.dat`), loadable by IOHanalyzer and iohinspector.");
     let kept = runs.iter().filter(|r| r.row.best <= r.row.initial_best).count();
     claims.push(Claim { chapter: "6".into(), statement: "Every run's best is no worse than its initial population's best".into(), ours: (kept, runs.len()), thesis: None, note: "elitism check over all runs".into() });
     s.push_str("\n### Claims\n\n");
