@@ -3,6 +3,7 @@
 //! Nemenyi's critical difference, and the Vargha-Delaney A12 effect size. Pure functions over
 //! slices; distributions from statrs.
 
+pub mod bayes;
 pub mod describe;
 pub mod effect;
 pub mod friedman;
