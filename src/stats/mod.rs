@@ -10,6 +10,7 @@ pub mod friedman;
 pub mod holm;
 pub mod ranks;
 pub mod rank_sum;
+pub mod runtime;
 pub mod wilcoxon;
 
 use thiserror::Error;
