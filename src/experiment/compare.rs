@@ -176,6 +176,11 @@ const TARGET_DECADES: f64 = 3.0;
 /// Budgets at which the ECDF and the fixed-budget values are tabulated (log-spaced).
 const BUDGETS: usize = 40;
 
+/// A run's (evaluations, improvement rows).
+type RunTrace = (u64, Vec<(u64, f64)>);
+/// Per cell: approach B's error and per optimiser (sum of best errors, runs).
+type CellSums = (f64, BTreeMap<String, (f64, usize)>);
+
 /// One problem (data set, grid, net, parameterisation) as the runtime distributions see it.
 struct Problem {
     name: String,
@@ -184,7 +189,7 @@ struct Problem {
     certified: bool,
     targets: Vec<f64>,
     /// Per optimiser, its runs' (evaluations, improvements).
-    runs: BTreeMap<String, Vec<(u64, Vec<(u64, f64)>)>>,
+    runs: BTreeMap<String, Vec<RunTrace>>,
 }
 
 /// What the runtime-distribution tables and charts show, computed before anything is written.
@@ -353,7 +358,7 @@ fn render_fixed_budget(rt: &Runtime, group: &str, opts: &[String], path: &std::p
 /// The Bayesian signed-rank test of every pair over the cells every optimiser ran: each cell's
 /// mean best error divided by the cell's approach-B error.
 fn bayes_table(rows: &[OptimRow], opts: &[String], args: &CompareArgs) -> Result<Vec<Vec<String>>> {
-    let mut cells: BTreeMap<CellKey, (f64, BTreeMap<String, (f64, usize)>)> = BTreeMap::new();
+    let mut cells: BTreeMap<CellKey, CellSums> = BTreeMap::new();
     for r in rows {
         let e = cells.entry((r.dataset.clone(), r.grid_x, r.grid_y, r.cn_x, r.cn_y, r.parameterisation.clone())).or_insert((r.b, BTreeMap::new()));
         let s = e.1.entry(r.optimiser.clone()).or_default();

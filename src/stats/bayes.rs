@@ -46,7 +46,8 @@ pub fn signed_rank(a: &[f64], b: &[f64], rope: f64, prior: f64, samples: usize, 
     if a.is_empty() {
         return Err(StatsError::TooFew("no pairs".into()));
     }
-    if !(rope >= 0.0 && rope.is_finite()) || !(prior > 0.0 && prior.is_finite()) || samples == 0 {
+    let valid = rope >= 0.0 && rope.is_finite() && prior > 0.0 && prior.is_finite() && samples > 0;
+    if !valid {
         return Err(StatsError::TooFew(format!("rope must be finite and >= 0 (got {rope}), the prior > 0 (got {prior}), samples >= 1 (got {samples})")));
     }
     let mut d = vec![0.0];

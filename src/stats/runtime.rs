@@ -30,7 +30,7 @@ impl Trace<'_> {
 /// and `best` itself last. A zero or negative gap gives the single target `best`.
 pub fn log_targets(start: f64, best: f64, count: usize, decades: f64) -> Vec<f64> {
     let gap = start - best;
-    if !(gap > 0.0) || count < 2 {
+    if gap.is_nan() || gap <= 0.0 || count < 2 {
         return vec![best];
     }
     let mut t: Vec<f64> = (0..count - 1).map(|k| best + gap * 10f64.powf(-decades * k as f64 / (count - 2).max(1) as f64)).collect();
