@@ -59,6 +59,13 @@ pub struct CompareArgs {
     /// Significance level for the h columns.
     #[arg(long, default_value_t = 0.05)]
     pub alpha: f64,
+    /// Region of practical equivalence of the Bayesian signed-rank test: half-width on the
+    /// difference of the mean errors per cell, each divided by the cell's approach-B error.
+    #[arg(long, default_value_t = 1e-6)]
+    pub rope: f64,
+    /// Monte Carlo samples of the Bayesian signed-rank test.
+    #[arg(long, default_value_t = 50_000)]
+    pub bayes_samples: usize,
 }
 
 #[derive(Debug, Args)]

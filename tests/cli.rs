@@ -331,6 +331,61 @@ fn compare_writes_statistics_and_refuses_bad_folders() {
     c.fails(&["compare", "bad"], &["bad/runs.csv", "line 4"]);
 }
 
+/// Issue 18: the IOHprofiler export (JSON keys the readers require, .dat from evaluation 1), and
+/// compare's Bayesian table and runtime distributions (ECDF non-decreasing in [0, 1], AOCC in
+/// [0, 1], ERT hits within runs), no negative zero, and refusals (bad rope, stale traces).
+#[test]
+fn compare_writes_runtime_distributions_and_bayesian_table() {
+    let c = Case::new();
+    c.write("opt.toml", &CH6_TINY.replace("repeats = 2", "repeats = 3"));
+    c.ok(&["run", "opt.toml", "--out", "o"]);
+    let ioh = c.path("o/ioh/de");
+    let json = std::fs::read_dir(&ioh).unwrap().flatten().map(|e| e.path()).find(|p| p.extension().is_some_and(|x| x == "json")).unwrap();
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    for k in ["version", "suite", "function_id", "function_name", "maximization", "algorithm", "attributes", "scenarios"] {
+        assert!(v.get(k).is_some(), "{k}");
+    }
+    assert!(!std::fs::read_dir(&ioh).unwrap().flatten().any(|e| e.path().extension().is_some_and(|x| x == "info")));
+    let dat = ioh.join(v["scenarios"][0]["path"].as_str().unwrap());
+    let text = std::fs::read_to_string(&dat).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    let starts: Vec<&str> = lines.windows(2).filter(|w| w[0] == "evaluations raw_y").map(|w| w[1]).collect();
+    assert_eq!(starts.len(), 3);
+    assert!(starts.iter().all(|l| l.starts_with("1 ")), "{starts:?}");
+    let out = c.ok(&["compare", "o", "--bayes-samples", "2000"]);
+    assert!(String::from_utf8_lossy(&out.stdout).contains("Bayesian signed-rank"));
+    let (h, rows) = read_csv(&c.path("o/compare_bayes.csv"));
+    assert_eq!(rows.len(), 3);
+    let col = |n: &str| h.iter().position(|x| x == n).unwrap();
+    for r in &rows {
+        let s: f64 = ["p_x_better", "p_rope", "p_y_better"].iter().map(|k| r[col(k)].parse::<f64>().unwrap()).sum();
+        assert!((s - 1.0).abs() < 1e-3, "{r:?}");
+    }
+    let (h, rows) = read_csv(&c.path("o/compare_ecdf.csv"));
+    let (g, o, e) = (h.iter().position(|x| x == "group").unwrap(), h.iter().position(|x| x == "optimiser").unwrap(), h.iter().position(|x| x == "ecdf").unwrap());
+    assert!(rows.iter().any(|r| r[g] == "all"));
+    assert!(rows.iter().filter(|r| r[g] != "all").count() > 0);
+    for w in rows.windows(2).filter(|w| w[0][g] == w[1][g] && w[0][o] == w[1][o]) {
+        let (a, b): (f64, f64) = (w[0][e].parse().unwrap(), w[1][e].parse().unwrap());
+        assert!((0.0..=1.0).contains(&a) && a <= b, "{w:?}");
+    }
+    let (h, rows) = read_csv(&c.path("o/compare_aocc.csv"));
+    let a = h.iter().position(|x| x == "aocc").unwrap();
+    assert!(rows.iter().all(|r| (0.0..=1.0).contains(&r[a].parse::<f64>().unwrap())));
+    let (h, rows) = read_csv(&c.path("o/compare_ert.csv"));
+    let (hi, ru) = (h.iter().position(|x| x == "hits").unwrap(), h.iter().position(|x| x == "runs").unwrap());
+    assert!(rows.iter().all(|r| r[hi].parse::<usize>().unwrap() <= r[ru].parse::<usize>().unwrap()));
+    assert!(c.path("o/compare_ecdf_all.png").exists() && c.path("o/compare_fixed_budget_all.png").exists());
+    for f in ["compare_cells", "compare_overall", "compare_bayes", "compare_ecdf", "compare_aocc", "compare_fixed_budget", "compare_ert"] {
+        let (_, rows) = read_csv(&c.path(&format!("o/{f}.csv")));
+        assert!(!rows.iter().flatten().any(|x| x.starts_with('-') && x[1..].parse::<f64>() == Ok(0.0)), "{f}: negative zero");
+    }
+    c.fails(&["compare", "o", "--rope=-1"], &["--rope"]);
+    // Traces that do not match runs.csv are refused, naming the folder.
+    std::fs::write(&dat, text.replacen("evaluations raw_y\n", "", 1)).unwrap();
+    c.fails(&["compare", "o"], &["ioh/de"]);
+}
+
 #[test]
 fn exact_optimum_bounds_every_run_from_below() {
     let c = Case::new();

@@ -45,8 +45,20 @@ pub struct OptimRun {
     pub cell: OptimCell,
     pub row: OptimRow,
     pub trace: Vec<(u64, f64)>,
+    /// (evaluation, fitness) at every improvement of the best so far, from evaluation 1 (the
+    /// IOHprofiler `.dat` rows and the runtime distributions of `compare`).
+    pub improvements: Vec<(u64, f64)>,
     /// The best control points found (for the pictures of Appendices I/J).
     pub best_x: Vec<f64>,
+}
+
+/// What the cell log keeps of a run (a log written before `improvements` existed does not fit:
+/// `--resume` then names the cell and stops, as for any change of the record).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct OptimRecord {
+    pub row: OptimRow,
+    pub trace: Vec<(u64, f64)>,
+    pub improvements: Vec<(u64, f64)>,
 }
 
 pub type ProblemKey = (String, GridSize, Parameterisation);
@@ -131,15 +143,15 @@ pub fn run_cell(spec: &Spec, cell: &OptimCell, problem: &ControlNetProblem) -> R
         max_control: dense.max_control,
         cpu_s,
     };
-    Ok(OptimRun { cell: cell.clone(), row, trace: r.trace, best_x: r.best_x })
+    Ok(OptimRun { cell: cell.clone(), row, trace: r.trace, improvements: r.improvements, best_x: r.best_x })
 }
 
 impl runner::Logged for OptimRun {
     /// The row and the convergence trace; the best control points are not logged (a run is
     /// deterministic, so the few the pictures need are recomputed: see [`picture_points`]).
-    type Record = (OptimRow, Vec<(u64, f64)>);
+    type Record = OptimRecord;
     fn record(&self) -> Self::Record {
-        (self.row.clone(), self.trace.clone())
+        OptimRecord { row: self.row.clone(), trace: self.trace.clone(), improvements: self.improvements.clone() }
     }
 }
 
@@ -165,7 +177,7 @@ pub fn run(spec: &Spec, ctx: &RunContext, problems: &BTreeMap<ProblemKey, Contro
             }
             Ok(r)
         },
-        |cell, (row, trace)| Ok(OptimRun { cell: cell.clone(), row, trace, best_x: Vec::new() }),
+        |cell, rec: OptimRecord| Ok(OptimRun { cell: cell.clone(), row: rec.row, trace: rec.trace, improvements: rec.improvements, best_x: Vec::new() }),
     )?;
     picture_points(spec, &mut runs, largest, problem)?;
     Ok(runs)

@@ -81,6 +81,14 @@ pub struct RunResult {
     /// (evaluations, best fitness so far) at every multiple of `Budget::trace_every_evals` and at
     /// the end.
     pub trace: Vec<(u64, f64)>,
+    /// (evaluation, its fitness) at strict improvements of the best so far, from the first
+    /// evaluation (1-based, as IOHprofiler's improvement-based `.dat` files record a run): the
+    /// first improvement at or after each of 20 log-spaced marks per decade of evaluations, and
+    /// always the last one, so a run of 80,000 evaluations that improves at nearly every one
+    /// (DE, PSO in a tiny box) keeps about 100 rows, not tens of thousands. Every row is a true
+    /// (evaluation, best) pair; a skipped improvement is seen at the next kept one (at most a
+    /// factor 10^(1/20) = 1.12 later in evaluations) and the final best at its own evaluation.
+    pub improvements: Vec<(u64, f64)>,
 }
 
 /// Check a problem's shapes and box before a run.
@@ -116,11 +124,31 @@ pub struct Evaluator<'a> {
     best: f64,
     every: u64,
     trace: Vec<(u64, f64)>,
+    improvements: Vec<(u64, f64)>,
+    /// The next log-spaced mark at or after which an improvement is kept, and the last
+    /// improvement not kept (kept at the end if no later one is).
+    next_mark: u64,
+    pending: Option<(u64, f64)>,
+}
+
+/// Marks per decade of evaluations for the kept improvements.
+const MARKS_PER_DECADE: f64 = 20.0;
+
+/// The least mark ceil(10^(k/20)) greater than `e`.
+fn mark_after(e: u64) -> u64 {
+    let mut k = (MARKS_PER_DECADE * (e.max(1) as f64).log10()).floor();
+    loop {
+        let m = 10f64.powf(k / MARKS_PER_DECADE).ceil() as u64;
+        if m > e {
+            return m;
+        }
+        k += 1.0;
+    }
 }
 
 impl<'a> Evaluator<'a> {
     pub fn new(problem: &'a dyn Problem, budget: &Budget) -> Evaluator<'a> {
-        Evaluator { problem, evaluations: 0, best: f64::INFINITY, every: budget.trace_every_evals.max(1), trace: Vec::new() }
+        Evaluator { problem, evaluations: 0, best: f64::INFINITY, every: budget.trace_every_evals.max(1), trace: Vec::new(), improvements: Vec::new(), next_mark: 1, pending: None }
     }
 
     /// Evaluate `x`, counting it and updating the best and the trace.
@@ -131,6 +159,13 @@ impl<'a> Evaluator<'a> {
         self.evaluations += 1;
         if f < self.best {
             self.best = f;
+            if self.evaluations >= self.next_mark {
+                self.improvements.push((self.evaluations, f));
+                self.next_mark = mark_after(self.evaluations);
+                self.pending = None;
+            } else {
+                self.pending = Some((self.evaluations, f));
+            }
         }
         if self.evaluations.is_multiple_of(self.every) {
             self.trace.push((self.evaluations, self.best));
@@ -153,7 +188,8 @@ impl<'a> Evaluator<'a> {
         if self.trace.last().map(|t| t.0) != Some(self.evaluations) {
             self.trace.push((self.evaluations, self.best));
         }
-        RunResult { best_x, best_fitness: self.best, initial_best_fitness, evaluations: self.evaluations, trace: self.trace }
+        self.improvements.extend(self.pending.take());
+        RunResult { best_x, best_fitness: self.best, initial_best_fitness, evaluations: self.evaluations, trace: self.trace, improvements: self.improvements }
     }
 }
 
@@ -257,6 +293,48 @@ pub(crate) mod tests {
         assert_eq!(r.trace.iter().map(|t| t.0).collect::<Vec<_>>(), vec![4, 8, 10]);
         // Best so far is monotone.
         assert!(r.trace.windows(2).all(|w| w[1].1 <= w[0].1));
+    }
+
+    /// Improvements: every strict decrease of the best, at its 1-based evaluation; equal values
+    /// and NaN (recorded as +inf) are not improvements.
+    #[test]
+    fn improvements_from_the_first_evaluation() {
+        let mut p = Sphere::new(1);
+        p.centre = vec![0.0];
+        let budget = Budget { trace_every_evals: 100, ..Budget::default() };
+        let mut e = Evaluator::new(&p, &budget);
+        for x in [2.0, 1.0, 1.5, -1.0, 0.5, f64::NAN, 0.25] {
+            e.eval(&[x]);
+        }
+        let r = e.finish(vec![0.25], 4.0);
+        assert_eq!(r.improvements, vec![(1, 4.0), (2, 1.0), (5, 0.25), (7, 0.0625)]);
+        assert_eq!(r.trace, vec![(7, 0.0625)]);
+    }
+
+    /// A run that improves at every evaluation keeps one improvement per log-spaced mark and the
+    /// last one: about 20 per decade, each a true (evaluation, best) pair.
+    #[test]
+    fn improvements_are_thinned_on_log_marks_and_keep_the_last() {
+        let mut p = Sphere::new(1);
+        p.centre = vec![0.0];
+        let mut e = Evaluator::new(&p, &Budget::default());
+        let n = 100_000u64;
+        for k in 0..n {
+            e.eval(&[1.0 / (1.0 + k as f64)]);
+        }
+        let r = e.finish(vec![0.0], 1.0);
+        assert!(r.improvements.len() <= 20 * 5 + 2 && r.improvements.len() >= 80, "{}", r.improvements.len());
+        assert_eq!(r.improvements[0], (1, 1.0));
+        assert_eq!(*r.improvements.last().unwrap(), (n, r.best_fitness));
+        for &(ev, f) in &r.improvements {
+            assert_eq!(f, 1.0 / (ev as f64 * ev as f64), "evaluation {ev}");
+        }
+        assert!(r.improvements.windows(2).all(|w| w[1].0 > w[0].0 && w[1].1 < w[0].1));
+        // Consecutive kept rows are at most one mark apart (a factor 10^(1/20), rounded up).
+        for w in r.improvements.windows(2) {
+            assert!(w[1].0 <= mark_after(w[0].0).max(w[0].0 + 1), "{w:?}");
+        }
+        assert_eq!((mark_after(1), mark_after(2), mark_after(9), mark_after(10)), (2, 3, 10, 12));
     }
 
     #[test]

@@ -343,7 +343,7 @@ pub fn write(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProble
         }
     }
     let n_ioh = super::ioh::write(runs, out)?;
-    let _ = writeln!(s, "\nConvergence traces of every run in the IOHprofiler format (`ioh/<optimiser>/`, {n_ioh} problem files), loadable by IOHanalyzer.");
+    let _ = writeln!(s, "\nEvery run's improvements of the best so far in the IOHprofiler format (`ioh/<optimiser>/`: {n_ioh} JSON meta-data files, format version 0.3.3 or later, each with its improvement-based `.dat`), loadable by IOHanalyzer and iohinspector.");
     let near = runs.iter().filter(|r| r.row.excursion <= super::ch5::NEAR).count();
     let worst = runs.iter().max_by(|a, b| a.row.excursion.total_cmp(&b.row.excursion));
     claims.push(Claim {

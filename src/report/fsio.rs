@@ -38,7 +38,6 @@ pub fn read_text(path: &Path) -> Result<String> {
 }
 
 
-/// Serialise rows to CSV text (header from the struct's field names).
 /// Typed rows of a CSV file (extra columns ignored); errors name the file and line.
 pub fn read_rows<T: serde::de::DeserializeOwned>(path: &Path) -> Result<Vec<T>> {
     let text = read_text(path)?;
@@ -46,20 +45,36 @@ pub fn read_rows<T: serde::de::DeserializeOwned>(path: &Path) -> Result<Vec<T>> 
     rd.deserialize().enumerate().map(|(k, r)| r.with_context(|| format!("{}: line {}", path.display(), k + 2))).collect()
 }
 
+/// A CSV field with a negative zero ("-0", "-0.0000", "-0e0": an empty f64 sum, or a small negative
+/// value rounded for print) written as zero; every other field unchanged.
+fn no_negative_zero(field: &str) -> &str {
+    match field.strip_prefix('-') {
+        Some(rest) if rest.starts_with(|c: char| c.is_ascii_digit()) && rest.parse::<f64>() == Ok(0.0) => rest,
+        _ => field,
+    }
+}
+
+/// Serialise rows to CSV text (header from the struct's field names), with no negative zero.
 pub fn csv_text<T: serde::Serialize>(rows: &[T]) -> Result<String> {
     let mut w = csv::Writer::from_writer(Vec::new());
     for r in rows {
         w.serialize(r)?;
     }
-    Ok(String::from_utf8(w.into_inner().map_err(|e| anyhow::anyhow!("{e}"))?)?)
+    let raw = w.into_inner().map_err(|e| anyhow::anyhow!("{e}"))?;
+    let mut reader = csv::ReaderBuilder::new().has_headers(false).from_reader(raw.as_slice());
+    let mut out = csv::Writer::from_writer(Vec::new());
+    for record in reader.records() {
+        out.write_record(record?.iter().map(no_negative_zero))?;
+    }
+    Ok(String::from_utf8(out.into_inner().map_err(|e| anyhow::anyhow!("{e}"))?)?)
 }
 
-/// CSV text from a header and string records.
+/// CSV text from a header and string records, with no negative zero.
 pub fn csv_records(header: &[String], rows: &[Vec<String>]) -> Result<String> {
     let mut w = csv::Writer::from_writer(Vec::new());
     w.write_record(header)?;
     for r in rows {
-        w.write_record(r)?;
+        w.write_record(r.iter().map(|f| no_negative_zero(f)))?;
     }
     Ok(String::from_utf8(w.into_inner().map_err(|e| anyhow::anyhow!("{e}"))?)?)
 }
@@ -67,6 +82,21 @@ pub fn csv_records(header: &[String], rows: &[Vec<String>]) -> Result<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[derive(serde::Serialize)]
+    struct Row {
+        name: &'static str,
+        v: f64,
+    }
+
+    #[test]
+    fn no_negative_zero_in_csv() {
+        let h = vec!["a".to_string(), "b".to_string(), "c".to_string(), "d".to_string()];
+        let rows = vec![vec!["-0".to_string(), "-0.0000".to_string(), "-1e-300".to_string(), "-x".to_string()], vec![format!("{}", -0.0f64), format!("{:e}", -0.0f64), "-0.5".to_string(), "-".to_string()]];
+        assert_eq!(csv_records(&h, &rows).unwrap(), "a,b,c,d\n0,0.0000,-1e-300,-x\n0,0e0,-0.5,-\n");
+        let t = csv_text(&[Row { name: "-0", v: -0.0 }, Row { name: "a,b", v: -2.5 }]).unwrap();
+        assert_eq!(t, "name,v\n0,0.0\n\"a,b\",-2.5\n");
+    }
 
     #[test]
     fn atomic_write_leaves_no_temp_and_names_path_on_error() {

@@ -3,12 +3,14 @@
 //! Nemenyi's critical difference, and the Vargha-Delaney A12 effect size. Pure functions over
 //! slices; distributions from statrs.
 
+pub mod bayes;
 pub mod describe;
 pub mod effect;
 pub mod friedman;
 pub mod holm;
 pub mod ranks;
 pub mod rank_sum;
+pub mod runtime;
 pub mod wilcoxon;
 
 use thiserror::Error;
@@ -63,11 +65,23 @@ fn normal_cdf(z: f64) -> f64 {
     Normal::new(0.0, 1.0).expect("standard normal").cdf(z)
 }
 
+/// The sign of `v` as R's and scipy's `sign`: -1, 0 or 1 (f64::signum is 1 for 0.0).
+fn sign(v: f64) -> f64 {
+    if v > 0.0 {
+        1.0
+    } else if v < 0.0 {
+        -1.0
+    } else {
+        0.0
+    }
+}
+
 /// Normal approximation with continuity correction: (z, p) for a statistic `diff` = S - E[S] with
-/// variance `var`, as R's wilcox.test computes it.
+/// variance `var`, as R's wilcox.test computes it (no correction when S equals its mean, so p = 1
+/// two-sided there).
 fn normal_approximation(diff: f64, var: f64, alt: Alternative) -> (f64, f64) {
     let correction = match alt {
-        Alternative::TwoSided => 0.5 * diff.signum(),
+        Alternative::TwoSided => 0.5 * sign(diff),
         Alternative::Greater => 0.5,
         Alternative::Less => -0.5,
     };

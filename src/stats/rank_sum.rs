@@ -93,6 +93,16 @@ mod tests {
         }
     }
 
+    /// sign(0) = 0: x = (1, 2, 2, 3), y = (3, 2, 1, 2): ranks 1.5, 4.5, 4.5, 7.5 | 7.5, 4.5, 1.5,
+    /// 4.5 (ties, so the normal path), W = 18 - 10 = 8 = n1 n2 / 2: p = 1 as in scipy.stats.mannwhitneyu and
+    /// R (0.876 with signum's 1 for 0).
+    #[test]
+    fn statistic_at_its_mean_gives_p_one() {
+        let r = rank_sum(&[1.0, 2.0, 2.0, 3.0], &[3.0, 2.0, 1.0, 2.0], Alternative::TwoSided).unwrap();
+        assert_eq!((r.w, r.method), (8.0, Method::Normal));
+        assert_eq!((r.z, r.p_value), (Some(0.0), 1.0));
+    }
+
     /// Tied case by hand: x = (1, 2, 2), y = (2, 3, 4, 5): ranks 1, 3, 3 | 3, 5, 6, 7; W = 7 - 6 = 1;
     /// mean 6, var = 12/12 (8 - 24/42) = 7.428571; two-sided z = (1 - 6 + 0.5)/sqrt(var).
     #[test]

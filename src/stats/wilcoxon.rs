@@ -44,7 +44,8 @@ pub fn signed_rank(x: &[f64], y: &[f64], alt: Alternative) -> Result<SignedRank,
         return Err(StatsError::AllZero);
     }
     let (ranks, ties) = midranks(&d.iter().map(|v| v.abs()).collect::<Vec<f64>>());
-    let w_plus: f64 = d.iter().zip(&ranks).filter(|(v, _)| **v > 0.0).map(|(_, r)| r).sum();
+    // + 0.0: an empty f64 sum is -0.0, which would print as "-0".
+    let w_plus: f64 = d.iter().zip(&ranks).filter(|(v, _)| **v > 0.0).map(|(_, r)| r).sum::<f64>() + 0.0;
     let total = (n * (n + 1)) as f64 / 2.0;
     let w_minus = total - w_plus;
     let rank_biserial = (w_plus - w_minus) / total;
@@ -100,6 +101,19 @@ mod tests {
         assert!((r.z.unwrap() - z).abs() < 1e-12);
         assert!((r.p_value - 2.0 * normal_cdf(-z)).abs() < 1e-15);
         assert!(r.p_value > 0.008 && r.p_value < 0.009, "{}", r.p_value);
+    }
+
+    /// sign(0) = 0 (R, scipy): d = (-2, 0, 1, 1) keeps (-2, 1, 1), ranks 3, 1.5, 1.5 (a tie, so the
+    /// normal path), W+ = 3 = n(n+1)/4: z = 0 and p = 1, as scipy.stats.wilcoxon(x, y,
+    /// correction=True, method="approx") and R's wilcox.test give (0.785 with signum's 1 for 0).
+    #[test]
+    fn statistic_at_its_mean_gives_p_one() {
+        let r = signed_rank(&[1.0, 2.0, 2.0, 3.0], &[3.0, 2.0, 1.0, 2.0], Alternative::TwoSided).unwrap();
+        assert_eq!((r.n, r.w_plus, r.method), (3, 3.0, Method::Normal));
+        assert_eq!((r.z, r.p_value), (Some(0.0), 1.0));
+        // No positive difference: W+ is +0, not -0.
+        let r = signed_rank(&[1.0, 1.0, 1.0], &[2.0, 2.0, 3.0], Alternative::TwoSided).unwrap();
+        assert!(r.w_plus == 0.0 && r.w_plus.is_sign_positive(), "{}", r.w_plus);
     }
 
     #[test]
