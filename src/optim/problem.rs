@@ -327,7 +327,8 @@ pub(crate) mod tests {
         assert_eq!(r.improvements[0], (1, 1.0));
         assert_eq!(*r.improvements.last().unwrap(), (n, r.best_fitness));
         for &(ev, f) in &r.improvements {
-            assert_eq!(f, 1.0 / (ev as f64 * ev as f64), "evaluation {ev}");
+            let x = 1.0 / ev as f64;
+            assert_eq!(f, x * x, "evaluation {ev}");
         }
         assert!(r.improvements.windows(2).all(|w| w[1].0 > w[0].0 && w[1].1 < w[0].1));
         // Consecutive kept rows are at most one mark apart (a factor 10^(1/20), rounded up).
