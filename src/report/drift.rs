@@ -207,8 +207,13 @@ impl DriftReport {
             for (t, (n, rel)) in &per_table {
                 let _ = write!(s, "\n  {t}: {n} moved (largest relative change {rel:.2e})");
             }
+            // Structural findings (a missing table, column or row) always show, before the cells.
+            let structural: Vec<&&Finding> = drifted.iter().filter(|f| !matches!(f, Finding::Cell { .. })).collect();
+            for f in &structural {
+                let _ = write!(s, "\n  {}", f.describe());
+            }
             s.push_str("\nfirst moves:");
-            for f in drifted.iter().take(most) {
+            for f in drifted.iter().filter(|f| matches!(f, Finding::Cell { .. })).take(most) {
                 let _ = write!(s, "\n  {}", f.describe());
             }
         }
