@@ -67,24 +67,20 @@ pub fn distance_to_box(p: Point3, lo: Point3, hi: Point3) -> f64 {
     s.sqrt()
 }
 
-/// `surf` at every dense (u, v), row-major over u; returns (points, dense u count, dense v count).
-pub fn dense_grid(surf: &BSplineSurface, params_u: &[f64], params_v: &[f64], factor: usize) -> (Vec<Point3>, usize, usize) {
+/// `surf` at every dense (u, v), row-major over u; returns the points and the dense u and v.
+pub fn dense_grid(surf: &BSplineSurface, params_u: &[f64], params_v: &[f64], factor: usize) -> (Vec<Point3>, Vec<f64>, Vec<f64>) {
     let du = dense_params(params_u, &surf.knots_u, factor);
     let dv = dense_params(params_v, &surf.knots_v, factor);
     let nu = basis_matrix(&du, &surf.knots_u, surf.p, surf.cn_x);
     let nv = basis_matrix(&dv, &surf.knots_v, surf.q, surf.cn_y);
-    (fitted_grid(&surf.control, &nu, &nv), du.len(), dv.len())
+    (fitted_grid(&surf.control, &nu, &nv), du, dv)
 }
 
 /// A wireframe of `surf` for pictures: the iso-parameter lines through the data parameters, each
 /// drawn through the dense parameters of the other direction, so whatever the surface does between
 /// the data points shows. Returns the points and the edges (index pairs) between them.
 pub fn dense_wireframe(surf: &BSplineSurface, params_u: &[f64], params_v: &[f64], factor: usize) -> (Vec<Point3>, Vec<(u32, u32)>) {
-    let du = dense_params(params_u, &surf.knots_u, factor);
-    let dv = dense_params(params_v, &surf.knots_v, factor);
-    let nu = basis_matrix(&du, &surf.knots_u, surf.p, surf.cn_x);
-    let nv = basis_matrix(&dv, &surf.knots_v, surf.q, surf.cn_y);
-    let points = fitted_grid(&surf.control, &nu, &nv);
+    let (points, du, dv) = dense_grid(surf, params_u, params_v, factor);
     let (mu, mv) = (du.len(), dv.len());
     let id = |i: usize, j: usize| (i * mv + j) as u32;
     let is_data = |d: &[f64], x: f64| d.iter().any(|&t| t == x);
