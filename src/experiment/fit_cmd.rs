@@ -11,7 +11,7 @@ pub fn fit(args: &FitArgs) -> Result<()> {
     let param: Parameterisation = args.param.parse().map_err(|e| anyhow::anyhow!("--param: {e}"))?;
     let approach: Approach = args.approach.parse().map_err(|e| anyhow::anyhow!("--approach: {e}"))?;
     let knots: KnotRule = args.knots.parse().map_err(|e| anyhow::anyhow!("--knots: {e}"))?;
-    let error_a = ErrorA::ALL.into_iter().find(|e| e.name() == args.error_a).with_context(|| format!("--error-a: unknown reading `{}` (expected per_surface or nov_bottom)", args.error_a))?;
+    let error_a: ErrorA = args.error_a.parse().map_err(|e| anyhow::anyhow!("--error-a: {e}"))?;
     if !(0.0..=1e6).contains(&args.fairness) {
         anyhow::bail!("--fairness: must be in [0, 1e6], got {}", args.fairness);
     }

@@ -64,6 +64,13 @@ impl fmt::Display for ErrorA {
     }
 }
 
+impl FromStr for ErrorA {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        ErrorA::ALL.into_iter().find(|e| e.name() == s).ok_or_else(|| format!("unknown reading `{s}` (expected per_surface or nov_bottom)"))
+    }
+}
+
 /// The named readings and options of a two-surface fit. `Default` is the thesis plan's reading.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct FitOptions {
