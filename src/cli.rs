@@ -7,7 +7,7 @@ const EXAMPLES: &str = "\
 Examples:
   somnurbs run experiments/ch4_models.toml                 # Appendix B/C, Tables 4.9/4.13/4.14
   somnurbs run experiments/ch4_models.toml --profile quick # the same, T = 3000 (seconds)
-  somnurbs run experiments/ch4_bunny.toml --data-dir ../shared/data
+  somnurbs run experiments/ch4_bunny.toml --data-dir ~/scans   # bun_zipper.ply lives in ~/scans
   somnurbs run experiments/ch4_grids.toml --dry-run        # list cells and their seeds
   somnurbs datasets list
   somnurbs datasets export sphere sphere.xyz
@@ -35,12 +35,14 @@ pub enum Command {
     Fit(FitArgs),
     /// Compare the optimisers of a Chapter 6 results folder: per cell Wilcoxon signed-rank
     /// (repeats paired by index) and rank-sum tests with A12, and overall Friedman with
-    /// Holm-corrected pairwise tests and a critical-difference diagram.
+    /// Holm-corrected pairwise tests and a critical-difference diagram; the Bayesian signed-rank
+    /// test; runtime ECDFs, ERT, fixed-budget curves and AOCC from the IOHprofiler traces.
+    #[command(after_help = "Examples (after `somnurbs reproduce`):\n  somnurbs compare results/thesis/ch6_same\n  somnurbs compare results/thesis/ch6_diff --alpha 0.01 --rope 1e-5")]
     Compare(CompareArgs),
     /// Regenerate the thesis: Chapters 4, 5 and 6 in order (each chapter's maps feed the next),
     /// then one REPORT.md with every table and picture, the thesis' figures beside ours, Tables
     /// 6.8/6.9 and the table of the thesis' claims with verdicts.
-    #[command(after_help = "Examples:\n  somnurbs reproduce --profile quick   # minutes\n  somnurbs reproduce                   # the full protocol\n  somnurbs reproduce --plan seeds      # the other seeds' experiments (001-004)")]
+    #[command(after_help = "Examples:\n  somnurbs reproduce --profile quick   # under a minute\n  somnurbs reproduce                   # the full protocol\n  somnurbs reproduce --plan seeds      # the other seeds' experiments (001-004)")]
     Reproduce(ReproduceArgs),
     /// Compare every table of a results folder with a baseline folder: numbers to per-column
     /// tolerances, timing columns reported but not judged. Exit 0: no drift; 1: drift (the moved
@@ -49,6 +51,7 @@ pub enum Command {
     Drift(DriftArgs),
     /// Combine the shard folders of one spec (`run --shard I/N`) into one folder with its tables,
     /// identical to a one-machine run apart from timing.
+    #[command(after_help = "Example:\n  somnurbs run experiments/ch6_same.toml --shard 1/2 --out s1   # on one machine\n  somnurbs run experiments/ch6_same.toml --shard 2/2 --out s2   # on another\n  somnurbs merge s1 s2 --out results/ch6_same")]
     Merge(MergeArgs),
 }
 
@@ -161,15 +164,18 @@ pub struct MergeArgs {
     /// The folder to write the combined run to (must not hold a run yet).
     #[arg(long)]
     pub out: PathBuf,
+    /// Worker threads (default: all cores). Results do not depend on it.
     #[arg(long, short = 'j')]
     pub jobs: Option<usize>,
+    /// Folder holding bun_zipper.ply and talus_r.stl (default: $SOMNURBS_DATA, else ./data).
     #[arg(long)]
     pub data_dir: Option<PathBuf>,
 }
 
 #[derive(Debug, Args)]
 pub struct ReproduceArgs {
-    /// quick (minutes; CI) or full (the thesis' protocol).
+    /// quick (every spec's quick profile: under a minute on 2 cores; what CI runs) or full (the
+    /// thesis' protocol: about half an hour on 2 cores, nearly all of it Chapter 6).
     #[arg(long, default_value = "full", value_parser = ["quick", "full"])]
     pub profile: String,
     /// Which plan: `<specs>/<PLAN>.toml` lists the specs to run in order (thesis: Chapters 4-6;
@@ -182,8 +188,10 @@ pub struct ReproduceArgs {
     /// Folder of the experiment specs.
     #[arg(long, default_value = "experiments")]
     pub specs: PathBuf,
+    /// Worker threads (default: all cores). Results do not depend on it.
     #[arg(long, short = 'j')]
     pub jobs: Option<usize>,
+    /// Folder holding bun_zipper.ply and talus_r.stl (default: $SOMNURBS_DATA, else ./data).
     #[arg(long)]
     pub data_dir: Option<PathBuf>,
     /// Keep what an interrupted reproduction finished (per chapter, as `run --resume`).
@@ -205,7 +213,15 @@ pub enum DatasetsAction {
     /// List the built-in data sets (default).
     List,
     /// Load one data set and print its size and bounds.
-    Show { name: String },
+    Show {
+        /// A name from `somnurbs datasets list`, e.g. sphere or bunny.
+        name: String,
+    },
     /// Write a data set's normalised points to FILE (.csv: comma-separated with header; else XYZ).
-    Export { name: String, file: PathBuf },
+    Export {
+        /// A name from `somnurbs datasets list`, e.g. sphere or bunny.
+        name: String,
+        /// The file to write (.csv, or .xyz: one "x y z" line per point).
+        file: PathBuf,
+    },
 }
