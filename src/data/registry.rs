@@ -89,10 +89,14 @@ fn read(path: &Path, hint: &str) -> Result<Vec<u8>, DataError> {
 
 fn where_to_get(file: &str) -> String {
     let source = match file {
-        BUNNY_FILE => "the Stanford 3D Scanning Repository, bunny/reconstruction/bun_zipper.ply",
-        _ => "the TLEM 2.0 data set as redistributed in the STAPLE toolbox, bone_datasets/TLEM2/talus_r.stl",
+        BUNNY_FILE => {
+            "http://graphics.stanford.edu/pub/3Dscanrep/bunny.tar.gz (the file bunny/reconstruction/bun_zipper.ply inside it)"
+        }
+        _ => "https://github.com/modenaxe/msk-STAPLE/raw/master/bone_datasets/TLEM2/stl/talus_r.stl",
     };
-    format!("Download {file} from {source} and name its folder with --data-dir or SOMNURBS_DATA.")
+    format!(
+        "Download {file} from {source} into ./data (the default), or name its folder with --data-dir or SOMNURBS_DATA (README, \"Set up\")."
+    )
 }
 
 fn sample_stl(bytes: &[u8], n: usize, seed: u64, shown: &str) -> Result<Vec<Point3>, DataError> {
