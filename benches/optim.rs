@@ -4,7 +4,8 @@
 //! (target under 0.2 s; scipy's differential_evolution 2.75 s; the thesis 48 s), and GA and PSO runs.
 
 use somnurbs::experiment::{ch4, ch5, runner, spec::{GridSize, SomCell}, RunContext};
-use somnurbs::optim::{control_net::ControlNetProblem, default_optimiser, BoxSpec, Budget, ExactOptions, Problem};
+use somnurbs::geom::Point3;
+use somnurbs::optim::{control_net::{ControlNetProblem, Isa}, default_optimiser, BoxSpec, Budget, ExactOptions, Problem};
 use somnurbs::som::{Model, SomParams};
 use somnurbs::spline::{fit_two_view, Approach, Parameterisation};
 use std::time::Instant;
@@ -41,6 +42,24 @@ fn main() {
     };
     let per = (0..rounds).map(|_| round(true) - round(false)).fold(f64::INFINITY, f64::min) / reps as f64;
     println!("fitness: {:.3} us per evaluation ({:.2} M evaluations/s; target 1.5 us, numpy 8.3 us: {:.1}x, thesis DE ~600 us: {:.0}x)", per * 1e6, 1e-6 / per, 8.3e-6 / per, 600e-6 / per);
+    let (model, mhz) = cpu_model();
+    println!("CPU: {model}, {mhz:.0} MHz (nominal, from /proc/cpuinfo); load {}", load());
+    // Every compiled copy of the fitness on this problem, in cycles (ns x the nominal clock)
+    // beside the floating-point lower bound (multiply(-add)s on two 4-wide FMA pipes).
+    let bound = fma_lower_bound_cycles(20, 20, 18);
+    for isa in Isa::ALL {
+        let q = problem.clone().with_isa(isa);
+        if q.isa() != isa {
+            println!("fitness, {isa:?} copy: not run (this CPU lacks it)");
+            continue;
+        }
+        let ns = best_fitness_ns(&q, &x0, rounds);
+        let cycles = ns * mhz / 1e3;
+        println!("fitness, {isa:?} copy: {ns:.0} ns = {cycles:.0} cycles per evaluation; FMA lower bound {bound:.0} cycles (2 pipes x 4 lanes): {:.2}x the bound", cycles / bound);
+    }
+    if std::env::var("BENCH_SCALING").is_ok_and(|v| v != "0") {
+        scaling(&data["spindle"].points, mhz);
+    }
     let generations: usize = std::env::var("BENCH_GENERATIONS").ok().and_then(|v| v.parse().ok()).unwrap_or(2000);
     // BENCH_ONLY=de,pso runs only those optimisers and skips the exact optimum (for profiling).
     let only: Option<Vec<String>> = std::env::var("BENCH_ONLY").ok().map(|v| v.split(',').map(str::to_string).collect());
@@ -79,6 +98,82 @@ fn main() {
             (per_eval - per) * 1e6,
             per_eval / per,
             r.best_fitness
+        );
+    }
+}
+
+/// The CPU model and nominal clock (MHz) from /proc/cpuinfo ("unknown", 0 elsewhere).
+fn cpu_model() -> (String, f64) {
+    let info = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
+    let field = |name: &str| info.lines().find(|l| l.starts_with(name)).and_then(|l| l.split(':').nth(1)).map(|v| v.trim().to_string());
+    (field("model name").unwrap_or_else(|| "unknown".into()), field("cpu MHz").and_then(|v| v.parse().ok()).unwrap_or(0.0))
+}
+
+/// The 1-minute load average (the machine may be shared).
+fn load() -> String {
+    std::fs::read_to_string("/proc/loadavg").ok().and_then(|l| l.split_whitespace().next().map(str::to_string)).unwrap_or_else(|| "unknown".into())
+}
+
+/// Floating-point lower bound of one fitness evaluation in cycles: pass 1 is 4 multiply(-add)s
+/// per grid row and control coordinate (bottom view: nx rows x 3 cn_y; top: nx - 2 rows x its
+/// 3 cn_y - 6 interior coordinates), pass 2 is 12 multiply-adds and 3 for the squared norm per
+/// grid point (lanes padded to 4), all on two 4-wide FMA pipes.
+fn fma_lower_bound_cycles(nx: usize, ny: usize, cn_y: usize) -> f64 {
+    let pad = |n: usize| n.div_ceil(4) * 4;
+    let k3 = 3 * cn_y;
+    let pass1 = 4 * (nx * k3 + (nx - 2) * (k3 - 6));
+    let pass2 = 15 * (pad(nx) * ny + pad(nx - 2) * (ny - 2));
+    (pass1 + pass2) as f64 / 8.0
+}
+
+/// Best of `rounds` batches of fitness evaluations at x0 (ns per evaluation, thread CPU time).
+fn best_fitness_ns(problem: &ControlNetProblem, x0: &[f64], rounds: usize) -> f64 {
+    let n = 20_000;
+    (0..rounds.max(1))
+        .map(|_| {
+            let t = runner::thread_cpu_seconds();
+            let mut acc = 0.0;
+            for _ in 0..n {
+                acc += problem.fitness(std::hint::black_box(x0));
+            }
+            std::hint::black_box(acc);
+            (runner::thread_cpu_seconds() - t) / n as f64 * 1e9
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// How cost grows: the fitness and one DE run (BENCH_SCALING_GENERATIONS, default 200, x 40)
+/// against net size on the 20x20 map, and against map size for an 18x18 net (BENCH_SCALING=1).
+fn scaling(points: &[Point3], mhz: f64) {
+    let generations: u64 = std::env::var("BENCH_SCALING_GENERATIONS").ok().and_then(|v| v.parse().ok()).unwrap_or(200);
+    println!("\nscaling (spindle, DNSOM map, chord length, approach B; one DE run of {generations} x 40):");
+    println!("| map | net | variables | fitness ns | cycles | FMA bound | ratio | DE run s | DE us per evaluation |");
+    println!("|---|---|---|---|---|---|---|---|---|");
+    let cases = [(20, 6), (20, 12), (20, 18), (20, 24), (20, 28), (30, 18), (40, 18), (40, 28)];
+    let mut maps: Vec<(usize, somnurbs::spline::TwoViewGrid)> = Vec::new();
+    for (m, cn) in cases {
+        if !maps.iter().any(|(k, _)| *k == m) {
+            let cell = SomCell { dataset: "spindle".into(), model: Model::Dnsom, grid: GridSize { nx: m, ny: m }, repeat: 0 };
+            let run = ch4::run_cell(&cell, points, &SomParams::default(), 2023).unwrap();
+            maps.push((m, ch5::grid_from_weights(m, m, &run.weights)));
+        }
+        let grid = &maps.iter().find(|(k, _)| *k == m).unwrap().1;
+        let fit = fit_two_view(grid, cn, cn, Parameterisation::ChordLength, Approach::Improved, &Default::default()).unwrap();
+        let pb = ControlNetProblem::new(fit.control_net_parts(grid).unwrap(), BoxSpec::Cover { fraction: 0.0 }).unwrap();
+        let x0 = pb.initial_point().to_vec();
+        let ns = best_fitness_ns(&pb, &x0, 3);
+        let bound = fma_lower_bound_cycles(m, m, cn);
+        let budget = Budget { generations, population: 40, init_range: 5e-6, trace_every_evals: 400 };
+        let mut rng = somnurbs::experiment::seeds::cell_rng(1, "bench");
+        let t = runner::thread_cpu_seconds();
+        let r = default_optimiser("de").unwrap().run(&pb, &budget, &mut rng).unwrap();
+        let s = runner::thread_cpu_seconds() - t;
+        println!(
+            "| {m}x{m} | {cn}x{cn} | {} | {ns:.0} | {:.0} | {bound:.0} | {:.2} | {s:.3} | {:.3} |",
+            pb.dim(),
+            ns * mhz / 1e3,
+            ns * mhz / 1e3 / bound,
+            s / r.evaluations as f64 * 1e6
         );
     }
 }

@@ -6,6 +6,11 @@
 #
 #   scripts/bench_ch6_protocol.sh [OUT_DIR] [JOBS]      (defaults: a temporary folder, nproc)
 #
+# With PREV_BIN=/path/to/an/older/somnurbs, each spec is also run by that build right before this
+# one (back to back, so both see the same machine) and the ratio of the wall times is printed.
+# The CPU model, the copy of the kernels that runs (SOMNURBS_SIMD, default auto) and the load
+# before each run are printed, since a shared machine's speed varies from hour to hour.
+#
 # Needs the Chapter 4 maps (results/ch4_models/maps, from the README's main job); missing maps are
 # recomputed. SOMNURBS_DATA must name the folder with the talus mesh (e.g. ../shared/data).
 set -euo pipefail
@@ -14,15 +19,28 @@ out="${1:-$(mktemp -d)}"
 jobs="${2:-$(nproc)}"
 mkdir -p "$out"
 cargo build --release --quiet
-total_start=$(date +%s.%N)
+echo "CPU: $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2- | sed 's/^ *//'), $(nproc) cores; flags: $(grep -m1 -o -w -E 'avx512vl|avx2' /proc/cpuinfo | sort -u | tr '\n' ' ')SOMNURBS_SIMD=${SOMNURBS_SIMD:-auto}"
+wall=0
 for s in ch6_same ch6_diff; do
+  if [ -n "${PREV_BIN:-}" ]; then
+    echo "load before the previous build's $s: $(cut -d' ' -f1-3 /proc/loadavg)"
+    p0=$(date +%s.%N)
+    "$PREV_BIN" run "experiments/$s.toml" --out "$out/prev_$s" --jobs "$jobs" > "$out/prev_$s.log" 2>&1
+    p1=$(date +%s.%N)
+    prev=$(echo "$p1 - $p0" | bc)
+    echo "$s, previous build ($PREV_BIN): $prev s wall"
+  fi
+  echo "load before $s: $(cut -d' ' -f1-3 /proc/loadavg)"
   t0=$(date +%s.%N)
   ./target/release/somnurbs run "experiments/$s.toml" --out "$out/$s" --jobs "$jobs" > "$out/$s.log" 2>&1
   t1=$(date +%s.%N)
-  echo "$s: $(echo "$t1 - $t0" | bc) s wall ($(($(wc -l < "$out/$s/runs.csv") - 1)) runs, $jobs threads)"
+  this=$(echo "$t1 - $t0" | bc)
+  wall=$(echo "$wall + $this" | bc)
+  echo "$s: $this s wall ($(($(wc -l < "$out/$s/runs.csv") - 1)) runs, $jobs threads)"
+  if [ -n "${PREV_BIN:-}" ]; then
+    echo "$s: this build / previous build = $(echo "scale=3; $this / $prev" | bc)"
+  fi
 done
-total_end=$(date +%s.%N)
-wall=$(echo "$total_end - $total_start" | bc)
 # Our CPU: the cpu_s column of every run.
 ours=$(awk -F, 'FNR == 1 { for (i = 1; i <= NF; i++) if ($i == "cpu_s") c = i; next } { s += $c } END { printf "%.1f", s }' "$out/ch6_same/runs.csv" "$out/ch6_diff/runs.csv")
 # The thesis' CPU: 10 repeats x the AVG columns of Appendices M and N.

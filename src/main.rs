@@ -27,6 +27,7 @@ fn jobs(flag: Option<usize>) -> anyhow::Result<usize> {
 }
 
 fn run(cli: Cli) -> anyhow::Result<ExitCode> {
+    somnurbs::optim::kernels::simd()?;
     match cli.command {
         Command::Run(args) => {
             let spec = Spec::load(&args.spec, args.profile.as_deref())?;

@@ -66,11 +66,12 @@ impl Isa {
     pub const ALL: [Isa; 3] = [Isa::Baseline, Isa::Avx2, Isa::Avx512Vl];
 
     /// The fastest copy this CPU supports.
-    pub fn detect() -> Isa {
+    pub fn fastest() -> Isa {
         Isa::ALL.into_iter().rev().find(|isa| isa.supported()).unwrap_or(Isa::Baseline)
     }
 
-    fn supported(self) -> bool {
+    /// Whether this CPU runs this copy.
+    pub fn supported(self) -> bool {
         match self {
             Isa::Baseline => true,
             #[cfg(target_arch = "x86_64")]
@@ -655,7 +656,7 @@ impl ControlNetProblem {
             box_axes,
             data_b,
             data_t,
-            isa: Isa::detect(),
+            isa: super::kernels::simd()?,
             term_points,
             term_coef,
             term_data,
@@ -718,7 +719,7 @@ impl ControlNetProblem {
             };
         }
         match self.isa {
-            // SAFETY: `with_isa` and `Isa::detect` only select AVX2 when this CPU reports it.
+            // SAFETY: `with_isa` and `kernels::simd` only select AVX2 when this CPU reports it.
             #[cfg(target_arch = "x86_64")]
             Isa::Avx2 => unsafe { kernel_avx2(self, x, scratch) },
             // SAFETY: as above, for AVX-512F and AVX-512VL.

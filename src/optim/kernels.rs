@@ -9,10 +9,12 @@
 //! same value as `max(lo).min(hi)` for every number (and NaN passes through), but it compiles to
 //! one vector max and one vector min instead of NaN-aware blends.
 
+use super::control_net::Isa;
 use super::sampling::{two_units_plus_one, DeLanes, PsoLanes, DE_LANES, PSO_LANES};
+use super::OptimError;
 
 #[inline(always)]
-fn clamp(v: f64, lo: f64, hi: f64) -> f64 {
+pub(crate) fn clamp(v: f64, lo: f64, hi: f64) -> f64 {
     let v = if v < lo { lo } else { v };
     if v > hi {
         hi
@@ -33,6 +35,57 @@ pub fn avx2_fma() -> bool {
 #[cfg(target_arch = "x86_64")]
 pub fn avx512vl() -> bool {
     avx2_fma() && std::arch::is_x86_feature_detected!("avx512f") && std::arch::is_x86_feature_detected!("avx512vl")
+}
+
+/// The environment variable that forces one compiled copy of every SIMD kernel (the fitness,
+/// DE's trial, PSO's move, cuckoo search's Levy steps): `scalar`, `avx2` or `avx512` (the
+/// AVX-512VL copies); unset, empty or `auto` runs the fastest copy this CPU has. All copies give
+/// the same bits, so this only changes the speed; a copy the CPU lacks is refused with an error.
+pub const SIMD_ENV: &str = "SOMNURBS_SIMD";
+
+/// The copy `value` (the variable's value, if set) asks for, checked against this CPU.
+pub fn parse_simd(value: Option<&str>) -> Result<Isa, OptimError> {
+    let isa = match value.map(str::trim) {
+        None | Some("") | Some("auto") => return Ok(Isa::fastest()),
+        Some("scalar") => Isa::Baseline,
+        Some("avx2") => Isa::Avx2,
+        Some("avx512") => Isa::Avx512Vl,
+        Some(other) => return Err(OptimError::param(SIMD_ENV, format!("must be scalar, avx2, avx512 or auto, got '{other}'"))),
+    };
+    if !isa.supported() {
+        let needs = if isa == Isa::Avx2 { "AVX2 and FMA" } else { "AVX2, FMA, AVX-512F and AVX-512VL" };
+        return Err(OptimError::param(
+            SIMD_ENV,
+            format!("asks for the {} copy, which needs {needs}, but this CPU lacks them (the fastest copy here is {:?})", value.unwrap_or_default().trim(), Isa::fastest()),
+        ));
+    }
+    Ok(isa)
+}
+
+/// The copy this process runs: [`SIMD_ENV`] if set (read once), else the fastest this CPU has.
+/// Every optimiser run and every control-net problem checks it first, so a bad value is an
+/// error before any work.
+pub fn simd() -> Result<Isa, OptimError> {
+    static CHOICE: std::sync::OnceLock<Result<Isa, OptimError>> = std::sync::OnceLock::new();
+    CHOICE.get_or_init(|| parse_simd(std::env::var(SIMD_ENV).ok().as_deref())).clone()
+}
+
+/// The copy the dispatchers run ([`simd`]; the fastest copy if the variable is malformed, which
+/// the runs have already refused).
+fn chosen() -> Isa {
+    simd().unwrap_or_else(|_| Isa::fastest())
+}
+
+/// Whether the AVX2 (or AVX-512VL) copies run.
+#[inline]
+pub fn use_avx2() -> bool {
+    matches!(chosen(), Isa::Avx2 | Isa::Avx512Vl)
+}
+
+/// Whether the AVX-512VL copies run.
+#[inline]
+pub fn use_avx512() -> bool {
+    chosen() == Isa::Avx512Vl
 }
 
 /// The few operations whose AVX2 and AVX-512VL forms differ, so that each hand-written kernel
@@ -179,16 +232,51 @@ fn de_trial_avx512vl(t: &mut [f64], src: DeSources, f: f64, rng: &mut DeLanes, t
 pub fn de_trial(t: &mut [f64], src: DeSources, f: f64, rng: &mut DeLanes, threshold: u64) {
     #[cfg(target_arch = "x86_64")]
     {
-        if avx512vl() {
+        if use_avx512() {
             // SAFETY: the CPU reports AVX2, FMA, AVX-512F and AVX-512VL.
             return unsafe { de_trial_avx512vl(t, src, f, rng, threshold) };
         }
-        if avx2_fma() {
+        if use_avx2() {
             // SAFETY: the CPU reports AVX2 and FMA.
             return unsafe { de_trial_avx2(t, src, f, rng, threshold) };
         }
     }
     de_trial_generic(t, src, f, rng, threshold)
+}
+
+/// Fill `words` (a multiple of 4 long) with the next words of DE's four lanes: word m from lane
+/// m % 4 at step m / 4 (cuckoo search's bulk Levy draws). The AVX2 copy keeps the state in four
+/// registers (the same integer operations, so the same words).
+pub fn lanes_fill(words: &mut [u64], rng: &mut DeLanes) {
+    assert_eq!(words.len() % DE_LANES, 0, "whole steps of the four lanes");
+    #[cfg(target_arch = "x86_64")]
+    {
+        if use_avx2() {
+            // SAFETY: the CPU reports AVX2 and FMA.
+            return unsafe { lanes_fill_avx2(words, rng) };
+        }
+    }
+    for w in words.chunks_exact_mut(DE_LANES) {
+        w.copy_from_slice(&rng.next_words());
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+fn lanes_fill_avx2(words: &mut [u64], rng: &mut DeLanes) {
+    use std::arch::x86_64::*;
+    let state = rng.state_mut();
+    // SAFETY: every state row holds 4 words; every store writes words[4 q..4 q + 4], q < len / 4.
+    unsafe {
+        let mut s: [__m256i; 4] = [0, 1, 2, 3].map(|r| _mm256_loadu_si256(state[r].as_ptr().cast()));
+        for w in words.chunks_exact_mut(DE_LANES) {
+            let word = xoshiro4!(avx2, s);
+            _mm256_storeu_si256(w.as_mut_ptr().cast(), word);
+        }
+        for (r, row) in s.iter().enumerate() {
+            _mm256_storeu_si256(state[r].as_mut_ptr().cast(), *row);
+        }
+    }
 }
 
 /// PSO constants of one move.
@@ -318,11 +406,11 @@ fn pso_move_avx512vl(x: &mut [f64], v: &mut [f64], p: &[f64], g: &[f64], rng: &m
 pub fn pso_move(x: &mut [f64], v: &mut [f64], p: &[f64], g: &[f64], rng: &mut PsoLanes, co: PsoCoefficients, bounds: PsoBounds) {
     #[cfg(target_arch = "x86_64")]
     {
-        if avx512vl() {
+        if use_avx512() {
             // SAFETY: the CPU reports AVX2, FMA, AVX-512F and AVX-512VL.
             return unsafe { pso_move_avx512vl(x, v, p, g, rng, co, bounds) };
         }
-        if avx2_fma() {
+        if use_avx2() {
             // SAFETY: the CPU reports AVX2 and FMA.
             return unsafe { pso_move_avx2(x, v, p, g, rng, co, bounds) };
         }

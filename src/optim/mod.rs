@@ -13,6 +13,7 @@ pub mod binary_ga;
 pub mod ga;
 pub mod ioh;
 pub mod kernels;
+pub mod levy;
 pub mod open_surface;
 pub mod problem;
 pub mod pso;
