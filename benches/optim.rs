@@ -4,7 +4,8 @@
 //! (target under 0.2 s; scipy's differential_evolution 2.75 s; the thesis 48 s), and GA and PSO runs.
 
 use somnurbs::experiment::{ch4, ch5, runner, spec::{GridSize, SomCell}, RunContext};
-use somnurbs::optim::{control_net::ControlNetProblem, default_optimiser, BoxSpec, Budget, ExactOptions, Problem};
+use somnurbs::optim::{default_optimiser, Budget, ExactOptions, Problem};
+use somnurbs::spline::{BoxSpec, ControlNetProblem};
 use somnurbs::som::{Model, SomParams};
 use somnurbs::spline::{fit_two_view, Approach, Parameterisation};
 use std::time::Instant;
@@ -60,7 +61,9 @@ fn main() {
             problem.fitness(&x0) - ex.f
         );
     }
-    let budget = Budget { generations: generations as u64, population: 40, init_range: 5e-6, trace_every_evals: 400 };
+    // BENCH_INIT_RANGE sets the initial population's spread around x0 (the thesis' 5e-6 by default).
+    let init_range: f64 = std::env::var("BENCH_INIT_RANGE").ok().and_then(|v| v.parse().ok()).unwrap_or(5e-6);
+    let budget = Budget { generations: generations as u64, population: 40, init_range, trace_every_evals: 400 };
     // Per run: CPU seconds of this thread (the machine may be shared), per evaluation, and what
     // the optimiser itself costs per evaluation on top of the fitness (its per-coordinate work).
     for name in ["de", "ga", "pso", "csa", "icsa"].into_iter().filter(|n| only.as_ref().is_none_or(|o| o.iter().any(|x| x == n))) {

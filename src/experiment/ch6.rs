@@ -5,8 +5,9 @@
 use super::spec::{OptimCell, Spec};
 use super::{ch5, runner, seeds, RunContext};
 use crate::experiment::spec::GridSize;
-use crate::optim::control_net::ControlNetProblem;
-use crate::optim::{BoxSpec, Budget, ExactOptions, Optimiser, Problem, RunResult};
+use crate::spline::ControlNetProblem;
+use crate::optim::{Budget, ExactOptions, Optimiser, Problem, RunResult};
+use crate::spline::BoxSpec;
 use crate::spline::{fit_two_view, Approach, Parameterisation};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};

@@ -6,7 +6,7 @@ use super::spec::{GridSize, GrowingGridSpec, Spec};
 use super::{runner, seeds, RunContext};
 use crate::data::registry;
 use crate::geom::Point3;
-use crate::optim::open_surface::OpenSurfaceProblem;
+use crate::spline::open_surface::OpenSurfaceProblem;
 use crate::optim::{Budget, Optimiser, Problem};
 use crate::som::growing_grid::{grow, GrowingGrid};
 use crate::spline::Parameterisation;

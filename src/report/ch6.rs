@@ -9,7 +9,7 @@ use super::markdown::table;
 use super::plots::{self, style, Series};
 use super::reference;
 use crate::experiment::ch6::{OptimRun, ProblemKey};
-use crate::optim::control_net::ControlNetProblem;
+use crate::spline::ControlNetProblem;
 use crate::optim::exact::ExactResult;
 use crate::optim::Problem;
 use std::collections::BTreeMap;

@@ -9,7 +9,7 @@ use super::fsio::{csv_records, ensure_dir, write_atomic};
 use super::markdown::{num, table};
 use super::plots::{self, grid_edges, style, LineMesh, Panel};
 use crate::experiment::seed001::{MapRun, ProblemKey, Run};
-use crate::optim::open_surface::OpenSurfaceProblem;
+use crate::spline::open_surface::OpenSurfaceProblem;
 use crate::optim::Problem;
 use anyhow::Result;
 use std::collections::BTreeMap;

@@ -19,13 +19,13 @@
 //! at its interior grid points only. The top view's control points are read in place: its
 //! border classes are the bottom's, so the border columns of its first pass are the bottom's.
 
-use super::aligned::Aligned;
-use super::exact::{solve_exact, ExactOptions, ExactResult, SumOfNorms, Term};
-use super::problem::Problem;
-use super::OptimError;
+use super::{ControlNetParts, SparseBasis};
 use crate::double_net::{DoubleNet, TwoViewGrid, View};
 use crate::geom::Point3;
-pub use crate::spline::{ControlNetParts, SparseBasis};
+use crate::optim::aligned::Aligned;
+use crate::optim::exact::{solve_exact, ExactOptions, ExactResult, SumOfNorms, Term};
+use crate::optim::problem::Problem;
+use crate::optim::OptimError;
 use std::cell::RefCell;
 use std::ops::Range;
 
@@ -74,9 +74,9 @@ impl Isa {
         match self {
             Isa::Baseline => true,
             #[cfg(target_arch = "x86_64")]
-            Isa::Avx2 => super::kernels::avx2_fma(),
+            Isa::Avx2 => crate::optim::kernels::avx2_fma(),
             #[cfg(target_arch = "x86_64")]
-            Isa::Avx512Vl => super::kernels::avx512vl(),
+            Isa::Avx512Vl => crate::optim::kernels::avx512vl(),
             #[cfg(not(target_arch = "x86_64"))]
             Isa::Avx2 | Isa::Avx512Vl => false,
         }
