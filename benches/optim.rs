@@ -3,7 +3,9 @@
 //! with BLAS 8.3 us; the thesis' DE about 600 us), one full DE run (2000 generations x 40) on it
 //! (target under 0.2 s; scipy's differential_evolution 2.75 s; the thesis 48 s), and GA and PSO runs.
 
-use somnurbs::experiment::{ch4, ch5, runner, spec::{GridSize, SomCell}, RunContext};
+use somnurbs::experiment::{runner, spec::GridSize, RunContext};
+use somnurbs::families::som::spec::SomCell;
+use somnurbs::families;
 use somnurbs::optim::{default_optimiser, Budget, ExactOptions, Problem};
 use somnurbs::spline::{BoxSpec, ControlNetProblem};
 use somnurbs::som::{Model, SomParams};
@@ -12,10 +14,10 @@ use std::time::Instant;
 
 fn main() {
     let ctx = RunContext::new(std::env::temp_dir(), 1, somnurbs::experiment::data_dir(None));
-    let data = ch4::load_datasets(&["spindle".to_string()], &ctx).unwrap();
+    let data = families::som::load_datasets(&["spindle".to_string()], &ctx).unwrap();
     let cell = SomCell { dataset: "spindle".into(), model: Model::Dnsom, grid: GridSize { nx: 20, ny: 20 }, repeat: 0 };
-    let run = ch4::run_cell(&cell, &data["spindle"].points, &SomParams::default(), 2023).unwrap();
-    let grid = ch5::grid_from_weights(20, 20, &run.weights);
+    let run = families::som::run_cell(&cell, &data["spindle"].points, &SomParams::default(), 2023).unwrap();
+    let grid = families::fit::grid_from_weights(20, 20, &run.weights);
     let fit = fit_two_view(&grid, 18, 18, Parameterisation::ChordLength, Approach::Improved, &Default::default()).unwrap();
     let problem = ControlNetProblem::new(fit.control_net_parts(&grid).unwrap(), BoxSpec::Cover { fraction: 0.0 }).unwrap();
     let x0 = problem.initial_point().to_vec();
