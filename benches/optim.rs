@@ -3,19 +3,23 @@
 //! with BLAS 8.3 us; the thesis' DE about 600 us), one full DE run (2000 generations x 40) on it
 //! (target under 0.2 s; scipy's differential_evolution 2.75 s; the thesis 48 s), and GA and PSO runs.
 
-use somnurbs::experiment::{ch4, ch5, runner, spec::{GridSize, SomCell}, RunContext};
+use somnurbs::experiment::{runner, spec::GridSize, RunContext};
+use somnurbs::families::som::spec::SomCell;
+use somnurbs::families;
+use somnurbs::optim::{default_optimiser, Budget, ExactOptions, Problem};
 use somnurbs::geom::Point3;
-use somnurbs::optim::{control_net::{ControlNetProblem, Isa}, default_optimiser, BoxSpec, Budget, ExactOptions, Problem};
+use somnurbs::spline::control_net::Isa;
+use somnurbs::spline::{BoxSpec, ControlNetProblem};
 use somnurbs::som::{Model, SomParams};
 use somnurbs::spline::{fit_two_view, Approach, Parameterisation};
 use std::time::Instant;
 
 fn main() {
     let ctx = RunContext::new(std::env::temp_dir(), 1, somnurbs::experiment::data_dir(None));
-    let data = ch4::load_datasets(&["spindle".to_string()], &ctx).unwrap();
+    let data = families::som::load_datasets(&["spindle".to_string()], &ctx).unwrap();
     let cell = SomCell { dataset: "spindle".into(), model: Model::Dnsom, grid: GridSize { nx: 20, ny: 20 }, repeat: 0 };
-    let run = ch4::run_cell(&cell, &data["spindle"].points, &SomParams::default(), 2023).unwrap();
-    let grid = ch5::grid_from_weights(20, 20, &run.weights);
+    let run = families::som::run_cell(&cell, &data["spindle"].points, &SomParams::default(), 2023).unwrap();
+    let grid = families::fit::grid_from_weights(20, 20, &run.weights);
     let fit = fit_two_view(&grid, 18, 18, Parameterisation::ChordLength, Approach::Improved, &Default::default()).unwrap();
     let problem = ControlNetProblem::new(fit.control_net_parts(&grid).unwrap(), BoxSpec::Cover { fraction: 0.0 }).unwrap();
     let x0 = problem.initial_point().to_vec();
@@ -79,7 +83,9 @@ fn main() {
             problem.fitness(&x0) - ex.f
         );
     }
-    let budget = Budget { generations: generations as u64, population: 40, init_range: 5e-6, trace_every_evals: 400 };
+    // BENCH_INIT_RANGE sets the initial population's spread around x0 (the thesis' 5e-6 by default).
+    let init_range: f64 = std::env::var("BENCH_INIT_RANGE").ok().and_then(|v| v.parse().ok()).unwrap_or(5e-6);
+    let budget = Budget { generations: generations as u64, population: 40, init_range, trace_every_evals: 400 };
     // Per run: CPU seconds of this thread (the machine may be shared), per evaluation, and what
     // the optimiser itself costs per evaluation on top of the fitness (its per-coordinate work).
     for name in ["de", "ga", "pso", "csa", "icsa"].into_iter().filter(|n| only.as_ref().is_none_or(|o| o.iter().any(|x| x == n))) {
@@ -154,8 +160,8 @@ fn scaling(points: &[Point3], mhz: f64) {
     for (m, cn) in cases {
         if !maps.iter().any(|(k, _)| *k == m) {
             let cell = SomCell { dataset: "spindle".into(), model: Model::Dnsom, grid: GridSize { nx: m, ny: m }, repeat: 0 };
-            let run = ch4::run_cell(&cell, points, &SomParams::default(), 2023).unwrap();
-            maps.push((m, ch5::grid_from_weights(m, m, &run.weights)));
+            let run = families::som::run_cell(&cell, points, &SomParams::default(), 2023).unwrap();
+            maps.push((m, families::fit::grid_from_weights(m, m, &run.weights)));
         }
         let grid = &maps.iter().find(|(k, _)| *k == m).unwrap().1;
         let fit = fit_two_view(grid, cn, cn, Parameterisation::ChordLength, Approach::Improved, &Default::default()).unwrap();

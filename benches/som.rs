@@ -3,14 +3,15 @@
 //! - the whole Appendix B grid (5 data x n in {10,20,30} x 4 models) wall time on all cores, and
 //!   its ratio to the thesis' summed CPU times.
 
-use somnurbs::experiment::{ch4, runner, spec::Spec, RunContext};
+use somnurbs::experiment::{runner, spec::Spec, RunContext};
+use somnurbs::families;
 use somnurbs::som::{self, Model, SomParams};
 use std::time::Instant;
 
 fn main() {
     let data_dir = somnurbs::experiment::data_dir(None);
     let ctx = RunContext::new(std::env::temp_dir(), 1, data_dir.clone());
-    let spindle = ch4::load_datasets(&["spindle".to_string()], &ctx).expect("spindle")["spindle"].clone();
+    let spindle = families::som::load_datasets(&["spindle".to_string()], &ctx).expect("spindle")["spindle"].clone();
 
     // 1. DNSOM 30x30, T = 30000, one core: median of 5 seeds.
     let topo = Model::Dnsom.topology(30, 30).unwrap();
@@ -30,12 +31,12 @@ fn main() {
     // 2. The whole Appendix B grid on all cores.
     let spec_path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/ch4_models.toml");
     let spec = Spec::load(&spec_path, None).expect("spec");
-    let cells: Vec<_> = spec.som_cells().into_iter().filter(|c| c.grid.nx == c.grid.ny).collect();
+    let cells: Vec<_> = families::som::spec::cells(&spec).into_iter().filter(|c| c.grid.nx == c.grid.ny).collect();
     let jobs = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
     let ctx = RunContext { jobs, ..ctx };
-    let data = ch4::load_datasets(&spec.file.som.as_ref().unwrap().datasets, &ctx).expect("data sets");
+    let data = families::som::load_datasets(&spec.file.som.as_ref().unwrap().datasets, &ctx).expect("data sets");
     let t0 = Instant::now();
-    let runs = runner::run_cells(&cells, jobs, "appendix B", |c| ch4::run_cell(c, &data[&c.dataset].points, &params, spec.file.master_seed), |_, _| Ok(())).unwrap();
+    let runs = runner::run_cells(&cells, jobs, "appendix B", |c| families::som::run_cell(c, &data[&c.dataset].points, &params, spec.file.master_seed), |_, _| Ok(())).unwrap();
     let wall = t0.elapsed().as_secs_f64();
     let cpu: f64 = runs.iter().map(|r| r.row.cpu_s).sum();
     let thesis = somnurbs::report::reference::table("appendix_b").unwrap();

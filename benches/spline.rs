@@ -3,7 +3,9 @@
 //! fit on the 20x20 grid. Target: the 280 fits in under 0.5 s (a numpy implementation: 1.2 ms per
 //! 18x18 fit; geomdl's approximate_surface: 27 ms).
 
-use somnurbs::experiment::{ch4, ch5, runner, seeds, spec::SomCell, RunContext};
+use somnurbs::experiment::{runner, seeds, RunContext};
+use somnurbs::families::som::spec::SomCell;
+use somnurbs::families;
 use somnurbs::som::{Model, SomParams};
 use somnurbs::spline::{fit_two_view, Approach, Parameterisation, TwoViewGrid};
 use std::time::Instant;
@@ -11,14 +13,14 @@ use std::time::Instant;
 fn maps(grid: (usize, usize)) -> Vec<TwoViewGrid> {
     let ctx = RunContext::new(std::env::temp_dir(), 1, somnurbs::experiment::data_dir(None));
     let names: Vec<String> = ["cube", "sphere", "spindle", "oiltank", "talus"].iter().map(|s| s.to_string()).collect();
-    let data = ch4::load_datasets(&names, &ctx).expect("data sets (talus needs SOMNURBS_DATA)");
+    let data = families::som::load_datasets(&names, &ctx).expect("data sets (talus needs SOMNURBS_DATA)");
     names
         .iter()
         .map(|d| {
             let g = somnurbs::experiment::spec::GridSize { nx: grid.0, ny: grid.1 };
             let cell = SomCell { dataset: d.clone(), model: Model::Dnsom, grid: g, repeat: 0 };
-            let run = ch4::run_cell(&cell, &data[d].points, &SomParams::default(), 2023).unwrap();
-            ch5::grid_from_weights(grid.0, grid.1, &run.weights)
+            let run = families::som::run_cell(&cell, &data[d].points, &SomParams::default(), 2023).unwrap();
+            families::fit::grid_from_weights(grid.0, grid.1, &run.weights)
         })
         .collect()
 }

@@ -1,14 +1,16 @@
 //! somnurbs: reproduce, from seeds, SOM + cubic B-spline surface reconstruction experiments.
 //!
 //! Pure algorithms (`data`, `som`, `spline`, `optim`, `stats`) know nothing of files or the CLI;
-//! `experiment` (spec, runner, seeds) and `report` (CSV, PNG, Markdown) wire them together.
+//! `experiment` (the engine: spec, runner, seeds), `report` (the toolkit: tables, PNG, Markdown)
+//! and `io` serve the experiment `families`, one folder each, listed once in `families/mod.rs`.
 pub mod cli;
 pub mod data;
 pub mod double_net;
 pub mod experiment;
+pub mod families;
 pub mod geom;
+pub mod io;
 pub mod optim;
-pub mod outdir;
 pub mod report;
 pub mod som;
 pub mod spline;

@@ -62,7 +62,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             let opts = drift::DriftOptions { columns, config, ..Default::default() };
             let report = drift::compare_dirs(&args.baseline, &args.current, &opts, args.allow_spec_change)?;
             let out = args.out.clone().unwrap_or_else(|| args.current.join("drift.csv"));
-            somnurbs::report::fsio::write_atomic(&out, report.csv()?.as_bytes())?;
+            somnurbs::io::write_atomic(&out, report.csv()?.as_bytes())?;
             println!("{}
 per-cell differences: {}", report.summary(10), out.display());
             Ok(if report.drifted() { ExitCode::from(1) } else { ExitCode::SUCCESS })
@@ -81,7 +81,7 @@ per-cell differences: {}", report.summary(10), out.display());
             Ok(ExitCode::SUCCESS)
         }
         Command::Compare(args) => {
-            experiment::compare::compare(&args)?;
+            somnurbs::families::optimise::compare::compare(&args)?;
             Ok(ExitCode::SUCCESS)
         }
         Command::Fit(args) => {

@@ -5,7 +5,7 @@
 
 mod common;
 use common::*;
-use somnurbs::optim::control_net::Isa;
+use somnurbs::spline::control_net::Isa;
 
 /// Every optimiser (so every kernel) on two nets, one of them with padded lanes.
 const ALL_KERNELS: &str = r#"

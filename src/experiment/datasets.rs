@@ -37,7 +37,7 @@ pub fn datasets(action: DatasetsAction, data_dir: &Path) -> Result<()> {
                     let _ = writeln!(text, "{:?} {:?} {:?}", p[0], p[1], p[2]);
                 }
             }
-            crate::report::fsio::write_atomic(&file, text.as_bytes())?;
+            crate::io::write_atomic(&file, text.as_bytes())?;
             eprintln!("somnurbs: wrote {} points to {}", cloud.points.len(), file.display());
         }
     }

@@ -1,10 +1,10 @@
-//! Experiment families: one per kind of spec section (Chapter 4's `[som]`, Chapter 5's `[fit]`,
-//! Chapter 6's `[optim]`, and one per other seed). `run_spec`, `--dry-run`, the fingerprint and
-//! `merge` see a family only through [`Family`], so a new experiment (another seed's problem)
-//! plugs in as one file implementing it plus one line in [`FAMILIES`]; nothing in the runner
-//! changes for it.
+//! The family contract: one family per kind of spec section (Chapter 4's `[som]`, Chapter 5's
+//! `[fit]`, Chapter 6's `[optim]`, and one per other seed). `run_spec`, `--dry-run`, the
+//! fingerprint and `merge` see a family only through [`Family`], so a new experiment (another
+//! seed's problem) plugs in as one folder under `src/families/` implementing it plus one line in
+//! the registry, [`crate::families::FAMILIES`]; nothing in the engine changes for it.
 
-use super::spec::Spec;
+use super::spec::{Spec, SpecError};
 use super::RunContext;
 use anyhow::Result;
 
@@ -24,6 +24,18 @@ pub trait Family: Sync {
     fn section(&self) -> &'static str;
     /// Whether the spec has this family's section.
     fn present(&self, spec: &Spec) -> bool;
+    /// Check the bounds of the section's sizes and counts (before anything is allocated from them).
+    fn check_limits(&self, c: &super::limits::Check) -> Result<(), SpecError>;
+    /// The data-set entries of the section, as written (names or paths).
+    fn datasets<'a>(&self, _spec: &'a Spec) -> Vec<&'a String> {
+        Vec::new()
+    }
+    /// Read the SOM maps from the folder `maps` (a plan whose earlier spec saved them); families
+    /// that read no maps ignore it.
+    fn use_maps(&self, _spec: &mut Spec, _maps: &str) {}
+    /// Check every value of the family's section (called once the limits have passed and the
+    /// spec has been found to hold this family's section only).
+    fn validate(&self, spec: &Spec) -> Result<(), SpecError>;
     /// The keys of every cell that goes through the cell log, in cell order (what `--resume`
     /// and `merge` must find; cell k goes to shard k mod N + 1).
     fn logged_keys(&self, spec: &Spec) -> Vec<String>;
@@ -37,15 +49,13 @@ pub trait Family: Sync {
     fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<Outcome>;
 }
 
-/// Every family the harness knows, in the order their sections are named in messages.
-pub static FAMILIES: &[&dyn Family] = &[&super::ch4::Som, &super::ch5::Fit, &super::ch6::Optim, &super::seed001::Seed001, &super::seed002::Seed002, &super::seed003::Seed003, &super::seed004::Seed004];
-
-/// The families whose sections the spec has (validation requires exactly one).
+/// The families whose sections the spec has (validation requires exactly one). The engine reaches
+/// the families only through the registry, [`crate::families::FAMILIES`].
 pub fn present(spec: &Spec) -> Vec<&'static dyn Family> {
-    FAMILIES.iter().copied().filter(|f| f.present(spec)).collect()
+    crate::families::FAMILIES.iter().copied().filter(|f| f.present(spec)).collect()
 }
 
 /// The section names, as `[som], [fit], ...`, for messages.
 pub fn section_list() -> String {
-    FAMILIES.iter().map(|f| format!("[{}]", f.section())).collect::<Vec<_>>().join(", ")
+    crate::families::FAMILIES.iter().map(|f| format!("[{}]", f.section())).collect::<Vec<_>>().join(", ")
 }

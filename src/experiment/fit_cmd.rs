@@ -2,7 +2,7 @@
 
 use crate::cli::FitArgs;
 use crate::experiment::spec::GridSize;
-use crate::report::fsio::{csv_records, read_text, write_atomic};
+use crate::io::{csv_records, read_text, write_atomic};
 use crate::spline::{export, fit_two_view, Approach, ErrorA, FitOptions, KnotRule, Parameterisation};
 use anyhow::{Context, Result};
 

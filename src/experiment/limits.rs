@@ -35,16 +35,17 @@ pub const MAX_LENGTH: f64 = 1e6;
 /// Points or samples per side of a generated data set (seed 002 grid, seed 003 examples).
 pub const MAX_SAMPLES: u64 = 100_000;
 
-struct Check<'a> {
-    spec: &'a Spec,
+/// The bound checks a family applies to its section, each error naming the spec and key.
+pub struct Check<'a> {
+    pub spec: &'a Spec,
 }
 
 impl Check<'_> {
-    fn err(&self, key: &str, msg: impl Display) -> SpecError {
+    pub fn err(&self, key: &str, msg: impl Display) -> SpecError {
         SpecError(format!("{}: {key}: {msg}", self.spec.path))
     }
 
-    fn int(&self, key: &str, v: impl TryInto<u64>, hi: u64) -> Result<(), SpecError> {
+    pub fn int(&self, key: &str, v: impl TryInto<u64>, hi: u64) -> Result<(), SpecError> {
         match v.try_into() {
             Ok(v) if v <= hi => Ok(()),
             Ok(v) => Err(self.err(key, format!("{v} is above the limit {hi}"))),
@@ -53,7 +54,7 @@ impl Check<'_> {
     }
 
     /// A finite number in [lo, hi] (lo itself allowed or not).
-    fn real(&self, key: &str, v: f64, lo: f64, lo_allowed: bool, hi: f64) -> Result<(), SpecError> {
+    pub fn real(&self, key: &str, v: f64, lo: f64, lo_allowed: bool, hi: f64) -> Result<(), SpecError> {
         let above_lo = if lo_allowed { v >= lo } else { v > lo };
         if v.is_finite() && above_lo && v <= hi {
             return Ok(());
@@ -61,7 +62,7 @@ impl Check<'_> {
         Err(self.err(key, format!("must be a finite number in {}{lo}, {hi}], got {v}", if lo_allowed { "[" } else { "(" })))
     }
 
-    fn grids<'g>(&self, key: &str, grids: impl IntoIterator<Item = &'g GridSize>) -> Result<(), SpecError> {
+    pub fn grids<'g>(&self, key: &str, grids: impl IntoIterator<Item = &'g GridSize>) -> Result<(), SpecError> {
         for g in grids {
             if g.nx > MAX_GRID_SIDE || g.ny > MAX_GRID_SIDE {
                 return Err(self.err(key, format!("{g} has a side above the limit {MAX_GRID_SIDE}")));
@@ -71,7 +72,7 @@ impl Check<'_> {
     }
 
     /// No entry twice, and not too many entries.
-    fn list<T: Display + Eq + std::hash::Hash>(&self, key: &str, list: &[T]) -> Result<(), SpecError> {
+    pub fn list<T: Display + Eq + std::hash::Hash>(&self, key: &str, list: &[T]) -> Result<(), SpecError> {
         if list.len() > MAX_LIST {
             return Err(self.err(key, format!("{} entries, above the limit {MAX_LIST}", list.len())));
         }
@@ -83,7 +84,7 @@ impl Check<'_> {
     }
 
     /// Data-set entries: each a built-in or a point file whose name (stem) is usable, no name twice.
-    fn datasets(&self, key: &str, list: &[String]) -> Result<(), SpecError> {
+    pub fn datasets(&self, key: &str, list: &[String]) -> Result<(), SpecError> {
         self.list(key, list)?;
         let mut seen: Vec<(String, &String)> = Vec::new();
         for d in list {
@@ -96,7 +97,7 @@ impl Check<'_> {
         Ok(())
     }
 
-    fn cells(&self, key: &str, factors: &[usize]) -> Result<(), SpecError> {
+    pub fn cells(&self, key: &str, factors: &[usize]) -> Result<(), SpecError> {
         let n = factors.iter().fold(1u64, |a, &f| a.saturating_mul(f as u64));
         if n > MAX_CELLS {
             return Err(self.err(key, format!("the spec has {n} cells, above the limit {MAX_CELLS}")));
@@ -104,7 +105,7 @@ impl Check<'_> {
         Ok(())
     }
 
-    fn optimiser_run(&self, section: &str, repeats: usize, generations: usize, population: usize) -> Result<(), SpecError> {
+    pub fn optimiser_run(&self, section: &str, repeats: usize, generations: usize, population: usize) -> Result<(), SpecError> {
         self.int(&format!("{section}.repeats"), repeats, MAX_REPEATS)?;
         self.int(&format!("{section}.generations"), generations, MAX_GENERATIONS)?;
         self.int(&format!("{section}.population"), population, MAX_POPULATION)
@@ -113,9 +114,7 @@ impl Check<'_> {
 
 /// The data-set entries of a spec's section (as written: names or paths).
 pub fn dataset_entries(spec: &Spec) -> Vec<&String> {
-    let f = &spec.file;
-    let lists = [f.som.as_ref().map(|s| &s.datasets), f.fit.as_ref().map(|s| &s.datasets), f.optim.as_ref().map(|s| &s.datasets), f.growing_grid.as_ref().map(|s| &s.datasets)];
-    lists.into_iter().flatten().flatten().collect()
+    super::family::present(spec).into_iter().flat_map(|f| f.datasets(spec)).collect()
 }
 
 /// A usable experiment or file name: not empty, no path separator or NUL, not `.` or `..`.
@@ -134,116 +133,8 @@ pub fn check(spec: &Spec) -> Result<(), SpecError> {
     let c = Check { spec };
     let f = &spec.file;
     check_name(&f.name).map_err(|e| c.err("name", e))?;
-    if let Some(s) = &f.som {
-        c.datasets("som.datasets", &s.datasets)?;
-        c.int("som.iterations", s.iterations, MAX_ITERATIONS)?;
-        if let Some(sigma0) = s.sigma0 {
-            c.real("som.sigma0", sigma0, 1.0, false, MAX_SIGMA0)?;
-        }
-        c.int("som.repeats", s.repeats, MAX_REPEATS)?;
-        c.list("som.group", &(0..s.groups.len()).collect::<Vec<_>>())?;
-        let mut per_data = 0usize;
-        for (g, group) in s.groups.iter().enumerate() {
-            c.list(&format!("som.group[{g}].models"), &group.models)?;
-            c.list(&format!("som.group[{g}].grids"), &group.grids)?;
-            c.grids(&format!("som.group[{g}].grids"), &group.grids)?;
-            per_data = per_data.saturating_add(group.models.len().saturating_mul(group.grids.len()));
-        }
-        c.list("som.save_maps", &s.save_maps)?;
-        c.grids("som.save_maps", &s.save_maps)?;
-        c.cells("som", &[s.datasets.len(), per_data, s.repeats])?;
-    }
-    if let Some(s) = &f.fit {
-        c.datasets("fit.datasets", &s.datasets)?;
-        c.grids("fit.grid", [&s.grid])?;
-        c.list("fit.control_nets", &s.control_nets)?;
-        c.grids("fit.control_nets", &s.control_nets)?;
-        c.list("fit.parameterisations", &s.parameterisations)?;
-        c.list("fit.approaches", &s.approaches)?;
-        if let Some(som) = &s.som {
-            c.int("fit.som.iterations", som.iterations, MAX_ITERATIONS)?;
-        }
-        c.real("fit.fairness", s.fairness, 0.0, true, MAX_FAIRNESS)?;
-        c.cells("fit", &[s.datasets.len(), s.control_nets.len(), s.parameterisations.len(), s.approaches.len()])?;
-    }
-    if let Some(o) = &f.optim {
-        c.datasets("optim.datasets", &o.datasets)?;
-        c.grids("optim.grid", [&o.grid])?;
-        c.list("optim.control_nets", &o.control_nets)?;
-        c.grids("optim.control_nets", &o.control_nets)?;
-        c.list("optim.parameterisations", &o.parameterisations)?;
-        c.list("optim.optimisers", &o.optimisers)?;
-        c.optimiser_run("optim", o.repeats, o.generations, o.population)?;
-        c.real("optim.fairness", o.fairness, 0.0, true, MAX_FAIRNESS)?;
-        c.real("optim.init_range", o.init_range, 0.0, true, MAX_RANGE)?;
-        c.real("optim.bounds_margin", o.bounds_margin, 0.0, true, MAX_RANGE)?;
-        if let Some(r) = o.search_range {
-            c.real("optim.search_range", r, 0.0, false, MAX_RANGE)?;
-        }
-        c.int("optim.trace_every_evals", o.trace_every_evals, MAX_TRACE_EVERY)?;
-        c.int("optim.exact_newton_steps", o.exact_newton_steps, MAX_NEWTON_STEPS)?;
-        if let Some(som) = &o.som {
-            c.int("optim.som.iterations", som.iterations, MAX_ITERATIONS)?;
-        }
-        c.cells("optim", &[o.datasets.len(), o.control_nets.len(), o.parameterisations.len(), o.optimisers.len(), o.repeats])?;
-    }
-    if let Some(g) = &f.growing_grid {
-        c.datasets("growing_grid.datasets", &g.datasets)?;
-        c.grids("growing_grid.grid", [&g.grid])?;
-        c.list("growing_grid.control_nets", &g.control_nets)?;
-        c.grids("growing_grid.control_nets", &g.control_nets)?;
-        c.list("growing_grid.parameterisations", &g.parameterisations)?;
-        c.list("growing_grid.optimisers", &g.optimisers)?;
-        c.optimiser_run("growing_grid", g.repeats, g.generations, g.population)?;
-        c.real("growing_grid.init_range", g.init_range, 0.0, true, MAX_RANGE)?;
-        c.real("growing_grid.bounds_margin", g.bounds_margin, 0.0, true, MAX_RANGE)?;
-        c.int("growing_grid.trace_every_evals", g.trace_every_evals, MAX_TRACE_EVERY)?;
-        c.int("growing_grid.growth.lambda_g", g.growth.lambda_g, MAX_ITERATIONS)?;
-        c.int("growing_grid.growth.lambda_f", g.growth.lambda_f, MAX_ITERATIONS)?;
-        c.cells("growing_grid", &[g.datasets.len(), g.control_nets.len(), g.parameterisations.len(), g.optimisers.len(), g.repeats])?;
-    }
-    if let Some(s) = &f.seed002 {
-        c.list("seed002.surfaces", &s.surfaces)?;
-        c.list("seed002.optimisers", &s.optimisers)?;
-        c.list("seed002.outlines", &s.outlines)?;
-        c.optimiser_run("seed002", s.repeats, s.generations, s.population)?;
-        c.int("seed002.curve_generations", s.curve_generations, MAX_GENERATIONS)?;
-        c.int("seed002.grid", s.grid, 1001)?;
-        c.real("seed002.init_range", s.init_range, 0.0, true, MAX_RANGE)?;
-        c.real("seed002.bounds_margin", s.bounds_margin, 0.0, true, MAX_RANGE)?;
-        c.int("seed002.trace_every_evals", s.trace_every_evals, MAX_TRACE_EVERY)?;
-        c.int("seed002.sam06_l", s.sam06_l, 1000)?;
-        if let Some(r) = s.sam06_r {
-            c.int("seed002.sam06_r", r, 1000)?;
-        }
-        c.real("seed002.sam06_d", s.sam06_d, 0.0, false, MAX_LENGTH)?;
-        c.cells("seed002", &[s.surfaces.len().max(s.outlines.len()), s.optimisers.len(), s.repeats])?;
-    }
-    if let Some(s) = &f.seed003 {
-        c.list("seed003.examples", &s.examples)?;
-        c.list("seed003.methods", &s.methods)?;
-        c.int("seed003.runs", s.runs, MAX_REPEATS)?;
-        c.int("seed003.nests", s.nests, MAX_POPULATION)?;
-        c.int("seed003.trace_every", s.trace_every, MAX_TRACE_EVERY)?;
-        for name in super::seed003::EXAMPLES {
-            if let Some(e) = s.example(name) {
-                c.int(&format!("seed003.{name}.size"), e.size, MAX_SAMPLES)?;
-                c.int(&format!("seed003.{name}.degree"), e.degree, 30)?;
-                c.int(&format!("seed003.{name}.generations"), e.generations, MAX_GENERATIONS)?;
-            }
-        }
-        c.cells("seed003", &[s.examples.len(), s.methods.len(), s.runs])?;
-    }
-    if let Some(s) = &f.seed004 {
-        c.list("seed004.control_points", &s.control_points)?;
-        c.list("seed004.table2_control_points", &s.table2_control_points)?;
-        c.list("seed004.table2_generations", &s.table2_generations)?;
-        c.optimiser_run("seed004", s.repeats, s.generations, s.population)?;
-        c.int("seed004.rows", s.rows, MAX_GRID_SIDE as u64)?;
-        for (key, v) in [("radius", s.radius), ("height", s.height), ("grid_step", s.grid_step), ("accuracy", s.accuracy), ("search_range", s.search_range)] {
-            c.real(&format!("seed004.{key}"), v, 0.0, false, MAX_LENGTH)?;
-        }
-        c.cells("seed004", &[s.control_points.len(), s.repeats])?;
+    for family in super::family::present(spec) {
+        family.check_limits(&c)?;
     }
     Ok(())
 }
@@ -300,7 +191,7 @@ mod tests {
         let som = "name = \"s\"\nmaster_seed = 1\n[som]\ndatasets = [\"cube\"]\niterations = 10\nrepeats = 10000\n[[som.group]]\nmodels = [\"som2d\", \"dnsom\"]\ngrids = [\"10x10\", \"12x12\"]\n[[som.group]]\nmodels = [\"som2d\"]\ngrids = [\"10x10\"]\n";
         let t = std::time::Instant::now();
         let spec = Spec::parse("s.toml", som, None).unwrap();
-        assert_eq!(spec.som_cells().len(), 40_000);
+        assert_eq!(crate::families::som::spec::cells(&spec).len(), 40_000);
         assert!(t.elapsed().as_secs_f64() < 2.0, "{:?}", t.elapsed());
     }
 
@@ -308,6 +199,6 @@ mod tests {
     fn file_names_become_stems_in_keys() {
         let text = SPEC.replace("datasets = [\"sphere\"]", "datasets = [\"/some/where/part.xyz\"]");
         let spec = Spec::parse("t.toml", &text, None).unwrap();
-        assert!(spec.optim_cells().iter().all(|c| c.key().starts_with("optim/part/")), "{:?}", spec.optim_cells()[0].key());
+        assert!(crate::families::optimise::spec::cells(&spec).iter().all(|c| c.key().starts_with("optim/part/")), "{:?}", crate::families::optimise::spec::cells(&spec)[0].key());
     }
 }

@@ -14,8 +14,7 @@ use std::fs::{File, OpenOptions};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-pub const LOG_FILE: &str = "cells.jsonl";
-pub const FINGERPRINT_FILE: &str = "fingerprint.toml";
+pub use crate::io::outdir::{FINGERPRINT_FILE, LOG_FILE};
 
 /// The `I`-th of `N` deterministic slices of a spec's cells (1-based): cell number k belongs to
 /// shard (k mod N) + 1, so every shard gets a mix of small and large cells.
@@ -92,7 +91,7 @@ impl Fingerprint {
 
     pub fn write(&self, dir: &Path) -> Result<()> {
         let text = toml::to_string(self).context("cannot serialise the fingerprint")?;
-        crate::report::fsio::write_atomic(&dir.join(FINGERPRINT_FILE), text.as_bytes())
+        crate::io::write_atomic(&dir.join(FINGERPRINT_FILE), text.as_bytes())
     }
 }
 

@@ -1,21 +1,14 @@
 //! Experiments: spec -> cells -> runs (on per-cell random streams) -> report files and manifest.
 
-pub mod ch4;
-pub mod ch5;
-pub mod ch6;
-pub mod compare;
 pub mod datasets;
 pub mod family;
 pub mod finite;
 pub mod fit_cmd;
+pub mod grid_size;
 pub mod limits;
 pub mod log;
 pub mod reproduce;
 pub mod runner;
-pub mod seed002;
-pub mod seed003;
-pub mod seed001;
-pub mod seed004;
 pub mod seeds;
 pub mod spec;
 
@@ -23,6 +16,7 @@ use anyhow::{Context, Result};
 use serde::Serialize;
 use spec::Spec;
 use std::collections::BTreeMap;
+use std::fmt::Write;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
@@ -55,10 +49,10 @@ impl RunContext {
         let Some(session) = &self.session else { return Ok(()) };
         let mut pending = session.pending.lock().map_err(|_| anyhow::anyhow!("run state lock poisoned"))?;
         if let Some(fp) = pending.take() {
-            let manifest = self.out.join(crate::outdir::MANIFEST);
+            let manifest = self.out.join(crate::io::outdir::MANIFEST);
             if manifest.exists() {
                 std::fs::remove_file(&manifest).with_context(|| format!("cannot remove {}", manifest.display()))?;
-                crate::outdir::sync_dir(&self.out)?;
+                crate::io::outdir::sync_dir(&self.out)?;
             }
             fp.write(&self.out)?;
             drop(log::CellLog::open(&self.out, self.resume, session.master_seed)?);
@@ -167,7 +161,7 @@ pub fn fingerprint(spec: &Spec, shard: Option<log::Shard>) -> log::Fingerprint {
 /// writes them). With `resume`, the cells in the folder's log are kept if the folder's
 /// fingerprint and every logged seed match, else the run is refused before anything is touched.
 pub fn run_spec(spec: &Spec, ctx: &RunContext) -> Result<PathBuf> {
-    let _lock = crate::outdir::lock(&ctx.out, &format!("run {}", spec.path))?;
+    let _lock = crate::io::outdir::lock(&ctx.out, &format!("run {}", spec.path))?;
     run_spec_locked(spec, ctx)
 }
 
@@ -185,7 +179,7 @@ fn run_spec_locked(spec: &Spec, ctx: &RunContext) -> Result<PathBuf> {
             None => {}
         }
     }
-    let manifest_path = ctx.out.join(crate::outdir::MANIFEST);
+    let manifest_path = ctx.out.join(crate::io::outdir::MANIFEST);
     let session = Arc::new(Session { master_seed: spec.file.master_seed, pending: std::sync::Mutex::new(Some(fp.clone())) });
     let ctx = &RunContext { session: Some(session), ..ctx.clone() };
     let started = Instant::now();
@@ -207,7 +201,7 @@ fn run_spec_locked(spec: &Spec, ctx: &RunContext) -> Result<PathBuf> {
         git_commit: env!("SOMNURBS_GIT_COMMIT").into(),
         git_dirty: env!("SOMNURBS_GIT_DIRTY") == "true",
         rustc: env!("SOMNURBS_RUSTC").into(),
-        host: crate::outdir::host_name(),
+        host: crate::io::outdir::host_name(),
         jobs: ctx.jobs,
         cells,
         started_unix,
@@ -217,12 +211,45 @@ fn run_spec_locked(spec: &Spec, ctx: &RunContext) -> Result<PathBuf> {
         spec_text: spec.text.clone(),
     };
     if let Some(section) = section {
-        let report = crate::report::report_md(spec, &manifest, &[section]);
-        crate::report::fsio::write_atomic(&ctx.out.join("REPORT.md"), report.as_bytes())?;
+        let report = report_md(spec, &manifest, &[section]);
+        crate::io::write_atomic(&ctx.out.join("REPORT.md"), report.as_bytes())?;
     }
     let text = toml::to_string_pretty(&manifest).context("cannot serialise the manifest")?;
-    crate::report::fsio::write_atomic(&manifest_path, text.as_bytes())?;
+    crate::io::write_atomic(&manifest_path, text.as_bytes())?;
     Ok(ctx.out.clone())
+}
+
+/// REPORT.md: a header naming the run, then the chapters' sections.
+pub fn report_md(spec: &Spec, m: &Manifest, sections: &[String]) -> String {
+    let mut s = String::new();
+    let _ = writeln!(s, "# somnurbs report: {}\n", spec.file.name);
+    if !spec.file.description.is_empty() {
+        let _ = writeln!(s, "{}\n", spec.file.description.trim());
+    }
+    let commit = if m.git_commit.is_empty() { "unknown".to_string() } else { format!("{}{}", &m.git_commit[..m.git_commit.len().min(12)], if m.git_dirty { " (dirty)" } else { "" }) };
+    let _ = writeln!(
+        s,
+        "Spec `{}` (sha256 {}), profile `{}`, master seed {}, somnurbs {} at commit {}, {} on {} with {} thread(s): {} cells in {:.1} s wall, {:.1} s CPU in cells. Re-run: `somnurbs run {}{}`.\n",
+        m.spec_path,
+        &m.spec_sha256[..12],
+        m.profile,
+        m.master_seed,
+        m.crate_version,
+        commit,
+        m.rustc,
+        m.host,
+        m.jobs,
+        m.cells,
+        m.wall_seconds,
+        m.cpu_seconds_cells,
+        m.spec_path,
+        if m.profile == "default" { String::new() } else { format!(" --profile {}", m.profile) }
+    );
+    for sec in sections {
+        s.push_str(sec);
+        s.push('\n');
+    }
+    s
 }
 
 /// Combine shard folders of one spec into `out` and write its tables: the shards' fingerprints
@@ -234,17 +261,17 @@ pub fn merge(shards: &[PathBuf], ctx: &RunContext) -> Result<PathBuf> {
     if shards.is_empty() {
         anyhow::bail!("merge: no shard folders given");
     }
-    let _lock = crate::outdir::lock(&ctx.out, "merge")?;
+    let _lock = crate::io::outdir::lock(&ctx.out, "merge")?;
     let mut first: Option<log::Fingerprint> = None;
     let mut seen: BTreeMap<usize, PathBuf> = BTreeMap::new();
     let mut count = 0;
     let mut records: BTreeMap<String, serde_json::Value> = BTreeMap::new();
     for dir in shards {
-        crate::outdir::require_not_being_written(dir).context("merge")?;
+        crate::io::outdir::require_not_being_written(dir).context("merge")?;
         let fp = log::Fingerprint::read(dir)?.with_context(|| format!("merge: {} has no {} (not a somnurbs output folder?)", dir.display(), log::FINGERPRINT_FILE))?;
         let shard = fp.shard.as_deref().with_context(|| format!("merge: {} is not a shard (it was run without --shard)", dir.display()))?;
         let shard = log::Shard::parse(shard).with_context(|| format!("merge: {}", dir.display()))?;
-        if !dir.join(crate::outdir::MANIFEST).exists() {
+        if !dir.join(crate::io::outdir::MANIFEST).exists() {
             anyhow::bail!("merge: shard {shard} in {} did not finish (no manifest.toml); resume it with --resume first", dir.display());
         }
         let plain = log::Fingerprint { shard: None, ..fp.clone() };
@@ -279,7 +306,7 @@ pub fn merge(shards: &[PathBuf], ctx: &RunContext) -> Result<PathBuf> {
     if let Some(k) = records.keys().find(|k| !expected.contains(*k)) {
         anyhow::bail!("merge: the shards log cell {k}, which the spec does not have");
     }
-    if ctx.out.join(log::LOG_FILE).exists() || ctx.out.join(crate::outdir::MANIFEST).exists() || ctx.out.join(log::FINGERPRINT_FILE).exists() {
+    if ctx.out.join(log::LOG_FILE).exists() || ctx.out.join(crate::io::outdir::MANIFEST).exists() || ctx.out.join(log::FINGERPRINT_FILE).exists() {
         anyhow::bail!("merge: {} already holds a run; choose an empty folder", ctx.out.display());
     }
     {

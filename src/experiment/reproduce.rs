@@ -7,7 +7,7 @@
 use super::spec::{Override, Spec};
 use super::{run_spec, RunContext};
 use crate::report::claims::{self, Claim};
-use crate::report::fsio::{csv_records, write_atomic};
+use crate::io::{csv_records, write_atomic};
 use anyhow::{Context, Result};
 use serde::Deserialize;
 use std::fmt::Write;
@@ -110,11 +110,8 @@ fn load_specs(dir: &Path, plan: &Plan, names: &[String], overrides: &[Override],
             let text = std::fs::read_to_string(&path).with_context(|| format!("{shown}: cannot read spec"))?;
             let mut spec = Spec::parse_with(&shown, &text, profile.filter(|p| has_profile(&path, p)), overrides)?;
             if let Some(maps) = &maps {
-                if let Some(f) = spec.file.fit.as_mut() {
-                    f.maps = Some(maps.clone());
-                }
-                if let Some(o) = spec.file.optim.as_mut() {
-                    o.maps = Some(maps.clone());
+                for family in super::family::present(&spec) {
+                    family.use_maps(&mut spec, maps);
                 }
             }
             Ok(spec)
@@ -145,9 +142,9 @@ pub fn reproduce(specs_dir: &Path, plan_name: &str, profile: &str, ctx: &RunCont
             crate::data::registry::load_dataset(d, &ctx.data_dir).with_context(|| format!("{}: data set `{d}`", spec.path))?;
         }
     }
-    let _lock = crate::outdir::lock(&ctx.out, &format!("reproduce --plan {plan_name}"))?;
+    let _lock = crate::io::outdir::lock(&ctx.out, &format!("reproduce --plan {plan_name}"))?;
     // Every spec has loaded: the folder is unfinished until the combined REPORT.md is written.
-    let incomplete = ctx.out.join(crate::outdir::INCOMPLETE);
+    let incomplete = ctx.out.join(crate::io::outdir::INCOMPLETE);
     write_atomic(&incomplete, format!("reproduce --plan {plan_name} --profile {} started here\n", profile.unwrap_or("full")).as_bytes())?;
     let started = Instant::now();
     let mut done = Vec::new();
@@ -176,7 +173,7 @@ pub fn reproduce(specs_dir: &Path, plan_name: &str, profile: &str, ctx: &RunCont
     let path = ctx.out.join("REPORT.md");
     write_atomic(&path, report.as_bytes())?;
     std::fs::remove_file(&incomplete).with_context(|| format!("cannot remove {}", incomplete.display()))?;
-    crate::outdir::sync_dir(&ctx.out)?;
+    crate::io::outdir::sync_dir(&ctx.out)?;
     Ok(path)
 }
 
@@ -292,7 +289,7 @@ fn error_vs_excursion(out: &Path, plan: &Plan) -> Result<Option<String>> {
     let mut data_set = None;
     for (k, (name, folder)) in folders.iter().enumerate() {
         let path = folder.join("runs.csv");
-        let points: Vec<FitPoint> = crate::report::fsio::read_rows(&path)?;
+        let points: Vec<FitPoint> = crate::io::read_rows(&path)?;
         let d = data_set.get_or_insert_with(|| points.first().map(|p| p.dataset.clone()).unwrap_or_default()).clone();
         let mut pts: Vec<(usize, f64, f64)> = points.iter().filter(|p| p.dataset == d && p.parameterisation == "chord_length" && p.approach == "B" && p.excursion > 0.0).map(|p| (p.cn_x, p.excursion.log10(), p.surface_error)).collect();
         pts.sort_by_key(|p| p.0);

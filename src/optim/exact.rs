@@ -741,8 +741,8 @@ pub fn solve_exact(pb: &dyn SumOfNorms, lower: &[f64], upper: &[f64], x_start: &
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::optim::control_net::test_support::sphere_problem;
-    use crate::optim::control_net::BoxSpec;
+    use crate::spline::control_net::test_support::sphere_problem;
+    use crate::spline::control_net::BoxSpec;
     use crate::optim::problem::Problem;
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
@@ -912,8 +912,8 @@ mod tests {
 #[cfg(test)]
 mod timing {
     use super::*;
-    use crate::optim::control_net::test_support::sphere_problem;
-    use crate::optim::control_net::BoxSpec;
+    use crate::spline::control_net::test_support::sphere_problem;
+    use crate::spline::control_net::BoxSpec;
     use crate::optim::problem::Problem;
 
     #[test]

@@ -9,9 +9,43 @@
 //! same value as `max(lo).min(hi)` for every number (and NaN passes through), but it compiles to
 //! one vector max and one vector min instead of NaN-aware blends.
 
-use super::control_net::Isa;
 use super::sampling::{two_units_plus_one, DeLanes, PsoLanes, DE_LANES, PSO_LANES};
 use super::OptimError;
+
+/// Which compiled copy of the fitness kernel runs. (The AVX-512VL copy is hand-written with
+/// 256-bit vectors: compiler-vectorised AVX-512 code picks 512-bit vectors, which the development
+/// machine, an AMD Zen 4 (family 25), runs in two halves, and turns the transpose into scatters.)
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Isa {
+    Baseline,
+    /// AVX2 with FMA.
+    Avx2,
+    /// AVX-512VL (256-bit vectors, 32 registers): the first pass fused with the transpose.
+    Avx512Vl,
+}
+
+impl Isa {
+    /// Every copy, slowest first.
+    pub const ALL: [Isa; 3] = [Isa::Baseline, Isa::Avx2, Isa::Avx512Vl];
+
+    /// The fastest copy this CPU supports.
+    pub fn fastest() -> Isa {
+        Isa::ALL.into_iter().rev().find(|isa| isa.supported()).unwrap_or(Isa::Baseline)
+    }
+
+    /// Whether this CPU runs this copy.
+    pub fn supported(self) -> bool {
+        match self {
+            Isa::Baseline => true,
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx2 => avx2_fma(),
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx512Vl => avx512vl(),
+            #[cfg(not(target_arch = "x86_64"))]
+            Isa::Avx2 | Isa::Avx512Vl => false,
+        }
+    }
+}
 
 #[inline(always)]
 pub(crate) fn clamp(v: f64, lo: f64, hi: f64) -> f64 {

@@ -5,7 +5,6 @@
 //! guessed. Pure code: no file or terminal I/O (the IOHprofiler export returns text).
 
 pub mod aligned;
-pub mod control_net;
 pub mod cuckoo;
 pub mod de;
 pub mod exact;
@@ -14,13 +13,11 @@ pub mod ga;
 pub mod ioh;
 pub mod kernels;
 pub mod levy;
-pub mod open_surface;
 pub mod problem;
 pub mod pso;
 pub mod sampling;
 
 pub use aligned::Aligned;
-pub use control_net::{BoxSpec, ControlNetParts, ControlNetProblem, SparseBasis};
 pub use cuckoo::{Csa, Icsa};
 pub use de::De;
 pub use exact::{certify, solve_exact, ExactOptions, ExactResult, SumOfNorms};
@@ -134,59 +131,5 @@ pub(crate) mod optimiser_tests {
             assert_eq!(default_optimiser(name).unwrap().name(), name);
         }
         assert!(default_optimiser("sa").is_none());
-    }
-}
-
-/// Measurements (run with `cargo test --release -- --ignored --nocapture optimiser_timing`):
-/// full thesis budgets (2000 generations of 40) on an 18x18 control net over a 20x20 grid.
-#[cfg(test)]
-mod timing {
-    use super::control_net::test_support::sphere_problem;
-    use super::*;
-    use rand::SeedableRng;
-    use rand_chacha::ChaCha8Rng;
-    use std::time::Instant;
-
-    #[test]
-    #[ignore]
-    fn optimiser_timing() {
-        let pb = sphere_problem(20, 20, 18, 18, BoxSpec::Cover { fraction: 0.0 });
-        let f0 = pb.fitness(pb.initial_point());
-        for range in [5e-6, 1e-3] {
-            let budget = Budget { init_range: range, ..Budget::default() };
-            for name in ["ga", "de", "pso", "csa", "icsa"] {
-                let opt = default_optimiser(name).unwrap();
-                let t = Instant::now();
-                let r = opt.run(&pb, &budget, &mut ChaCha8Rng::seed_from_u64(1)).unwrap();
-                let secs = t.elapsed().as_secs_f64();
-                println!(
-                    "range {range:e} {name:>4}: {:.3} s, {} evaluations, {:.0} evaluations/s; f(x0) {f0:.6e} initial best {:.6e} best {:.6e}",
-                    secs,
-                    r.evaluations,
-                    r.evaluations as f64 / secs,
-                    r.initial_best_fitness,
-                    r.best_fitness
-                );
-            }
-        }
-    }
-}
-#[cfg(test)]
-mod timing_one {
-    use super::control_net::test_support::sphere_problem;
-    use super::*;
-    use rand::SeedableRng;
-    use rand_chacha::ChaCha8Rng;
-    #[test]
-    #[ignore]
-    fn one_run_timing() {
-        let pb = sphere_problem(20, 20, 18, 18, BoxSpec::Cover { fraction: 0.0 });
-        let name = std::env::var("OPT").unwrap_or("de".into());
-        let opt = default_optimiser(&name).unwrap();
-        for _ in 0..3 {
-            let t = std::time::Instant::now();
-            let r = opt.run(&pb, &Budget::default(), &mut ChaCha8Rng::seed_from_u64(1)).unwrap();
-            println!("{name} {:.3} s {}", t.elapsed().as_secs_f64(), r.best_fitness);
-        }
     }
 }

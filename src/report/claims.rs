@@ -42,7 +42,7 @@ pub fn write(out: &std::path::Path, claims: &[Claim]) -> anyhow::Result<String> 
         })
         .collect();
     let header: Vec<String> = CSV_HEADER.iter().map(|h| h.to_string()).collect();
-    super::fsio::write_atomic(&out.join("claims.csv"), super::fsio::csv_records(&header, &rows)?.as_bytes())?;
+    crate::io::write_atomic(&out.join("claims.csv"), crate::io::csv_records(&header, &rows)?.as_bytes())?;
     Ok(markdown(claims))
 }
 

@@ -7,10 +7,10 @@
 //! the tables and rows the baseline's `drift.toml` declares timing-dependent are compared and
 //! reported but never judged. Bad input (a folder or CSV that cannot be read, a malformed CSV, a
 //! run of another spec, seed or profile) is an error, not drift, and so is a folder that does not
-//! hold a finished, whole run ([`crate::outdir::require_finished`]). Non-finite numbers compare by
+//! hold a finished, whole run ([`crate::io::outdir::require_finished`]). Non-finite numbers compare by
 //! identity (`inf` equals only `inf` of the same sign, `NaN` only `NaN`) and are always reported.
 
-use super::fsio::{csv_records, write_atomic};
+use crate::io::{csv_records, write_atomic};
 use anyhow::{bail, Context, Result};
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -340,7 +340,7 @@ pub fn tables(dir: &Path) -> Result<Vec<PathBuf>> {
         bail!("{} is not a folder", dir.display());
     }
     let skipped = |p: &Path| p.components().any(|c| ["png", "ioh", "maps"].iter().any(|s| c.as_os_str() == *s));
-    let (files, _) = crate::outdir::walk(dir)?;
+    let (files, _) = crate::io::outdir::walk(dir)?;
     Ok(files.into_iter().filter(|f| f.extension().is_some_and(|e| e == "csv") && f.file_name().is_some_and(|n| n != "drift.csv") && !skipped(f.parent().unwrap_or(Path::new("")))).collect())
 }
 
@@ -353,7 +353,7 @@ fn identities(dir: &Path) -> Result<BTreeMap<PathBuf, (String, String, String)>>
         master_seed: u64,
     }
     let mut out = BTreeMap::new();
-    for f in crate::outdir::walk(dir)?.0.into_iter().filter(|f| f.file_name().is_some_and(|n| n == crate::outdir::MANIFEST)) {
+    for f in crate::io::outdir::walk(dir)?.0.into_iter().filter(|f| f.file_name().is_some_and(|n| n == crate::io::outdir::MANIFEST)) {
         let m = dir.join(&f);
         let text = std::fs::read_to_string(&m).with_context(|| format!("cannot read {}", m.display()))?;
         let id: Id = toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {}", m.display(), e.message()))?;
@@ -374,8 +374,8 @@ pub fn read_config(baseline: &Path) -> Result<DriftConfig> {
 
 /// Compare two folders. `allow_spec_change`: runs of other specs are compared anyway.
 pub fn compare_dirs(baseline: &Path, current: &Path, opts: &DriftOptions, allow_spec_change: bool) -> Result<DriftReport> {
-    crate::outdir::require_finished(baseline, "the baseline")?;
-    crate::outdir::require_finished(current, "the current folder")?;
+    crate::io::outdir::require_finished(baseline, "the baseline")?;
+    crate::io::outdir::require_finished(current, "the current folder")?;
     let (tb, tc) = (tables(baseline)?, tables(current)?);
     if tb.is_empty() {
         bail!("{} holds no tables (*.csv): not a baseline", baseline.display());
@@ -422,23 +422,23 @@ pub fn compare_dirs(baseline: &Path, current: &Path, opts: &DriftOptions, allow_
 /// Make `baseline` hold the current tables (and manifests); tables the current folder lacks are
 /// removed, other files of the baseline (its drift.toml) kept. The current folder must hold a
 /// finished, whole run. The new baseline is built beside the old one and swapped in whole
-/// ([`crate::outdir::replace_dir`]) under the baseline's lock: a failure leaves the old baseline
+/// ([`crate::io::outdir::replace_dir`]) under the baseline's lock: a failure leaves the old baseline
 /// as it was. Returns one line per file changed.
 pub fn accept(baseline: &Path, current: &Path) -> Result<Vec<String>> {
-    crate::outdir::require_finished(current, "the current folder")?;
+    crate::io::outdir::require_finished(current, "the current folder")?;
     let tc = tables(current)?;
     if tc.is_empty() {
         bail!("{} holds no tables (*.csv)", current.display());
     }
-    let _lock = crate::outdir::lock(baseline, "drift --accept")?;
-    let (old_files, _) = crate::outdir::walk(baseline)?;
+    let _lock = crate::io::outdir::lock(baseline, "drift --accept")?;
+    let (old_files, _) = crate::io::outdir::walk(baseline)?;
     let tb = tables(baseline)?;
     let mut files: Vec<PathBuf> = tc.clone();
-    files.extend(identities(current)?.keys().map(|d| d.join(crate::outdir::MANIFEST)));
+    files.extend(identities(current)?.keys().map(|d| d.join(crate::io::outdir::MANIFEST)));
     let mut said = Vec::new();
-    crate::outdir::replace_dir(baseline, |staged| {
+    crate::io::outdir::replace_dir(baseline, |staged| {
         // The old baseline's files first (not lock files, nor the tables the current run lacks) ...
-        let lock = |f: &Path| f.file_name().is_some_and(|n| n == crate::outdir::LOCK_FILE);
+        let lock = |f: &Path| f.file_name().is_some_and(|n| n == crate::io::outdir::LOCK_FILE);
         for f in old_files.iter().filter(|f| !tc.contains(f) && !tb.contains(f) && !files.contains(f) && !lock(f)) {
             let text = std::fs::read(baseline.join(f)).with_context(|| format!("cannot read {}", baseline.join(f).display()))?;
             write_atomic(&staged.join(f), &text)?;

@@ -4,13 +4,15 @@
 
 pub mod approach;
 pub mod basis;
-pub mod conic;
 pub mod bezier;
 pub mod closed;
+pub mod conic;
+pub mod control_net;
 pub mod export;
 pub mod fit;
 pub mod geometry;
 pub mod knots;
+pub mod open_surface;
 pub mod param;
 pub mod rational_bezier;
 pub mod surface;
@@ -19,6 +21,7 @@ pub use approach::{fit_two_view, Approach, ControlNetParts, ErrorA, FitOptions, 
 pub use geometry::{DenseGeometry, DENSE_FACTOR};
 pub use knots::KnotRule;
 pub use basis::SparseBasis;
+pub use control_net::{BoxSpec, ControlNetProblem};
 pub use param::Parameterisation;
 pub use surface::BSplineSurface;
 

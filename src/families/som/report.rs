@@ -1,12 +1,12 @@
 //! Chapter 4 outputs: runs.csv, the Appendix B/C tables, the neuron-count tables 4.9/4.13/4.14, the
 //! saved DNSOM maps, the pictures and the Chapter 4 section of REPORT.md. Reads only the runs.
 
-use super::claims::Claim;
-use super::fsio::{csv_records, csv_text, write_atomic};
-use super::markdown::{beside, geometric_mean, num, table};
-use super::reference::{self, RefTable};
+use crate::report::claims::Claim;
+use crate::io::{csv_records, csv_text, write_atomic};
+use crate::report::markdown::{beside, geometric_mean, num, table};
+use crate::report::reference::{self, RefTable};
 use crate::double_net::View;
-use crate::experiment::ch4::SomRun;
+use crate::families::som::SomRun;
 use crate::experiment::spec::{GridSize, Spec};
 use crate::som::Model;
 use anyhow::Result;
@@ -169,7 +169,7 @@ pub fn two_view_grid_csv(grid: &crate::spline::TwoViewGrid) -> Result<String> {
 /// The saved DNSOM map of a run.
 pub fn dnsom_map_csv(run: &SomRun) -> Result<String> {
     let g = run.cell.grid;
-    two_view_grid_csv(&crate::experiment::ch5::grid_from_weights(g.nx, g.ny, &run.weights))
+    two_view_grid_csv(&crate::families::fit::grid_from_weights(g.nx, g.ny, &run.weights))
 }
 
 /// Write every Chapter 4 file; returns the REPORT.md section.
@@ -208,11 +208,11 @@ pub fn write(spec: &Spec, runs: &[SomRun], out: &Path) -> Result<String> {
         maps.push(name);
     }
     let pictures = if spec.file.som.as_ref().map(|s| s.pictures).unwrap_or(false) {
-        super::ch4_pictures::write(runs, out)?
+        super::pictures::write(runs, out)?
     } else {
         Vec::new()
     };
-    let claims_md = super::claims::write(out, &claims(runs))?;
+    let claims_md = crate::report::claims::write(out, &claims(runs))?;
     Ok(section(runs, &written, &maps, &pictures, &claims_md))
 }
 

@@ -5,9 +5,9 @@
 //! both tables), and the convergence diagrams (best Y against iterations, median and quartiles
 //! over the runs).
 
-use super::plots::{self, boxplot::quantile_type7, style, Series};
-use super::reference::{table, RefTable};
-use crate::experiment::seed003::{Run, Seed003Spec, EXAMPLES, METHODS};
+use crate::report::plots::{self, boxplot::quantile_type7, style, Series};
+use crate::report::reference::{table, RefTable};
+use crate::families::cuckoo_bezier::{Run, Seed003Spec, EXAMPLES, METHODS};
 use crate::stats::{rank_sum::rank_sum, wilcoxon::signed_rank, Alternative};
 use anyhow::Result;
 use std::fmt::Write;
@@ -90,13 +90,13 @@ fn cell(v: Option<f64>) -> String {
 
 fn write_csv(out: &Path, name: &str, header: &[&str], rows: &[Vec<String>]) -> Result<()> {
     let header: Vec<String> = header.iter().map(|h| h.to_string()).collect();
-    super::fsio::write_atomic(&out.join(name), super::fsio::csv_records(&header, rows)?.as_bytes())
+    crate::io::write_atomic(&out.join(name), crate::io::csv_records(&header, rows)?.as_bytes())
 }
 
 /// Write runs.csv, the tables and the pictures; return the REPORT.md section.
 pub fn write(s: &Seed003Spec, runs: &[Run], out: &Path) -> Result<String> {
     let rows: Vec<_> = runs.iter().map(|r| r.row.clone()).collect();
-    super::fsio::write_atomic(&out.join("runs.csv"), super::fsio::csv_text(&rows)?.as_bytes())?;
+    crate::io::write_atomic(&out.join("runs.csv"), crate::io::csv_text(&rows)?.as_bytes())?;
     let examples: Vec<&str> = EXAMPLES.iter().copied().filter(|e| s.examples.iter().any(|x| x == e)).collect();
     let methods: Vec<&str> = METHODS.iter().copied().filter(|m| s.methods.iter().any(|x| x == m)).collect();
     let stats = |e: &str, m: &str| -> Option<Stats> {
@@ -278,12 +278,12 @@ fn write_tests(s: &Seed003Spec, runs: &[Run], examples: &[&str], others: &[&str]
     write_csv(out, "seed003_agreement.csv", &["comparison", "example", "better_ours", "better_paper", "h_sign_ours", "h_sign_paper", "h_sum_ours", "h_sum_paper", "direction_agrees", "significance_agrees", "agrees"], &agree)?;
     // One claim per comparison for the combined report: the paper's verdict (direction and
     // significance) checked on each example.
-    let claims: Vec<super::claims::Claim> = results
+    let claims: Vec<crate::report::claims::Claim> = results
         .iter()
         .map(|(o, comp, _)| {
             let rows: Vec<&Vec<String>> = agree.iter().filter(|r| &r[0] == comp).collect();
             let paper: Vec<String> = rows.iter().map(|r| format!("{}: {} better", r[1], if r[3].is_empty() { "?" } else { &r[3] })).collect();
-            super::claims::Claim {
+            crate::report::claims::Claim {
                 chapter: "seed003".into(),
                 statement: format!("CSA vs {o}: the better method and the significance of both Wilcoxon tests are as in the paper's Tables 4-5"),
                 ours: (rows.iter().filter(|r| r[10] == "yes").count(), rows.len()),
@@ -292,7 +292,7 @@ fn write_tests(s: &Seed003Spec, runs: &[Run], examples: &[&str], others: &[&str]
             }
         })
         .collect();
-    super::claims::write(out, &claims).map(|_| ())
+    crate::report::claims::write(out, &claims).map(|_| ())
 }
 
 /// Convergence diagrams: per example, the median and quartiles over the runs of CSA's and ICSA's
@@ -308,7 +308,7 @@ fn convergence(s: &Seed003Spec, runs: &[Run], examples: &[&str], methods: &[&str
         }
     }
     write_csv(out, "seed003_traces.csv", &["cell", "example", "method", "run", "evaluations", "iteration", "best_y"], &trace_rows)?;
-    super::fsio::ensure_dir(&out.join("png"))?;
+    crate::io::ensure_dir(&out.join("png"))?;
     let _ = writeln!(md, "\n### Convergence diagrams (the paper's Figures 2, 4, 6 show the mean for CSA)\n");
     for e in examples {
         let mut series = Vec::new();

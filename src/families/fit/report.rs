@@ -1,12 +1,12 @@
 //! Chapter 5 outputs: runs.csv, Appendix E/F (surface error of A and B per parameterisation), the
 //! win-count tables 5.4-5.9, the gap table, the charts and pictures and the REPORT.md section.
 
-use super::claims::Claim;
-use super::ordered;
-use super::fsio::{csv_records, csv_text, write_atomic};
-use super::markdown::{beside, num, table};
-use super::reference::{self, RefTable};
-use crate::experiment::ch5::FitRun;
+use crate::report::claims::Claim;
+use crate::report::ordered;
+use crate::io::{csv_records, csv_text, write_atomic};
+use crate::report::markdown::{beside, num, table};
+use crate::report::reference::{self, RefTable};
+use crate::families::fit::FitRun;
 use crate::experiment::spec::GridSize;
 use crate::spline::{Approach, Parameterisation};
 use anyhow::Result;
@@ -240,14 +240,14 @@ pub fn write(runs: &[FitRun], out: &Path, maps_origin: &[(String, String)], pict
         s.push_str(&table(&mh, &md_rows));
         s.push_str(&wins_md);
         if pictures {
-            for name in super::ch5_pictures::write(&g_runs, grid, out)? {
+            for name in super::pictures::write(&g_runs, grid, out)? {
                 let _ = writeln!(s, "\n![{name}]({name})");
             }
         }
     }
     let mut out_s = String::from(&s[..]);
     out_s.push_str("\n### Claims\n\n");
-    out_s.push_str(&super::claims::write(out, &claims)?);
+    out_s.push_str(&crate::report::claims::write(out, &claims)?);
     if claims.iter().any(|c| c.statement.starts_with("B beats A") && 2 * c.ours.0 <= c.ours.1) {
         out_s.push_str(DISAGREEMENT);
     }
@@ -279,7 +279,7 @@ fn thesis_ratios(ours: &ErrorOf, thesis: &ErrorOf, data: &[String], cns: &[GridS
                 }
             }
         }
-        if let Some(median) = super::markdown::median(&r) {
+        if let Some(median) = crate::report::markdown::median(&r) {
             let min = r.iter().copied().fold(f64::INFINITY, f64::min);
             let max = r.iter().copied().fold(f64::NEG_INFINITY, f64::max);
             out.push(Ratio { cn, median, min, max, cells: r.len() });

@@ -8,8 +8,11 @@
 //! test; Example III's clean surface and its 628 sampling parameters come from the stream
 //! `seed003/example3/surface`, the same in every run.
 
-use super::spec::Spec;
-use super::{runner, seeds, RunContext};
+pub mod report;
+pub mod spec;
+
+use crate::experiment::spec::Spec;
+use crate::experiment::{runner, seeds, RunContext};
 use crate::geom::Point3;
 use crate::optim::{Budget, Csa, Icsa, Optimiser, Problem};
 use crate::spline::bezier::{self, BezierParamProblem, Layout};
@@ -306,20 +309,31 @@ pub fn run(spec: &Spec, ctx: &RunContext) -> Result<Vec<Run>> {
 /// Seed 003's family: the `[seed003]` section.
 pub struct Seed003;
 
-impl super::family::Family for Seed003 {
+impl crate::experiment::family::Family for Seed003 {
     fn section(&self) -> &'static str {
         "seed003"
     }
     fn present(&self, spec: &Spec) -> bool {
         spec.file.seed003.is_some()
     }
+    fn check_limits(&self, c: &crate::experiment::limits::Check) -> Result<(), crate::experiment::spec::SpecError> {
+        match &c.spec.file.seed003 {
+            Some(s) => self::spec::limits(c, s),
+            None => Ok(()),
+        }
+    }
+    fn validate(&self, spec: &Spec) -> Result<(), crate::experiment::spec::SpecError> {
+        let Some(s) = &spec.file.seed003 else { return Ok(()) };
+        s.validate().map_err(|(key, msg)| spec.err(&key, msg))?;
+        spec.validate_optimiser_params("seed003", [s.csa.validate(), s.icsa.validate()])
+    }
     fn logged_keys(&self, spec: &Spec) -> Vec<String> {
         cells(spec).iter().map(|c| c.key()).collect()
     }
-    fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<super::family::Outcome> {
+    fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<crate::experiment::family::Outcome> {
         let s3 = section(spec)?;
         let runs = run(spec, ctx)?;
-        let section = if tables { Some(crate::report::seed003::write(s3, &runs, &ctx.out)?) } else { None };
-        Ok(super::family::Outcome { section, cpu_s: runs.iter().map(|r| r.row.cpu_s).sum(), cells: runs.len() })
+        let section = if tables { Some(crate::families::cuckoo_bezier::report::write(s3, &runs, &ctx.out)?) } else { None };
+        Ok(crate::experiment::family::Outcome { section, cpu_s: runs.iter().map(|r| r.row.cpu_s).sum(), cells: runs.len() })
     }
 }

@@ -1,8 +1,13 @@
 //! Chapter 4 wiring: load the data sets, train every SOM cell on its own stream, log each finished
 //! cell at once, and hand the runs to the report.
 
-use super::spec::{SomCell, Spec};
-use super::{runner, seeds, RunContext};
+pub mod pictures;
+pub mod report;
+pub mod spec;
+
+use crate::experiment::spec::Spec;
+use spec::SomCell;
+use crate::experiment::{runner, seeds, RunContext};
 use crate::data::PointCloud;
 use crate::geom::Point3;
 use crate::som::{self, FinalMetrics, NeuronCounts, OnlineMetrics, SomParams};
@@ -108,7 +113,7 @@ pub fn run(spec: &Spec, ctx: &RunContext) -> Result<Vec<SomRun>> {
     let som_spec = spec.file.som.as_ref().context("spec has no [som] section")?;
     let data = load_datasets(&som_spec.datasets, ctx)?;
     let params = SomParams { iterations: som_spec.iterations, alpha0: som_spec.alpha0, sigma0: som_spec.sigma0 };
-    let cells = spec.som_cells();
+    let cells = spec::cells(spec);
     runner::run_logged(&cells, ctx, &spec.file.name, |cell| run_cell(cell, &data[&cell.dataset].points, &params, spec.file.master_seed), |cell, (row, weights)| Ok(SomRun { cell: cell.clone(), row, weights }))
 }
 
@@ -116,19 +121,34 @@ pub fn run(spec: &Spec, ctx: &RunContext) -> Result<Vec<SomRun>> {
 /// Chapter 4's family: the `[som]` section.
 pub struct Som;
 
-impl super::family::Family for Som {
+impl crate::experiment::family::Family for Som {
     fn section(&self) -> &'static str {
         "som"
     }
     fn present(&self, spec: &Spec) -> bool {
         spec.file.som.is_some()
     }
-    fn logged_keys(&self, spec: &Spec) -> Vec<String> {
-        spec.som_cells().iter().map(|c| c.key()).collect()
+    fn check_limits(&self, c: &crate::experiment::limits::Check) -> Result<(), crate::experiment::spec::SpecError> {
+        match &c.spec.file.som {
+            Some(s) => self::spec::limits(c, s),
+            None => Ok(()),
+        }
     }
-    fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<super::family::Outcome> {
+    fn datasets<'a>(&self, spec: &'a Spec) -> Vec<&'a String> {
+        spec.file.som.iter().flat_map(|s| &s.datasets).collect()
+    }
+    fn validate(&self, spec: &Spec) -> Result<(), crate::experiment::spec::SpecError> {
+        match &spec.file.som {
+            Some(s) => self::spec::validate(spec, s),
+            None => Ok(()),
+        }
+    }
+    fn logged_keys(&self, spec: &Spec) -> Vec<String> {
+        spec::cells(spec).iter().map(|c| c.key()).collect()
+    }
+    fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<crate::experiment::family::Outcome> {
         let runs = run(spec, ctx)?;
-        let section = if tables { Some(crate::report::ch4::write(spec, &runs, &ctx.out)?) } else { None };
-        Ok(super::family::Outcome { section, cpu_s: runs.iter().map(|r| r.row.cpu_s).sum(), cells: runs.len() })
+        let section = if tables { Some(crate::families::som::report::write(spec, &runs, &ctx.out)?) } else { None };
+        Ok(crate::experiment::family::Outcome { section, cpu_s: runs.iter().map(|r| r.row.cpu_s).sum(), cells: runs.len() })
     }
 }

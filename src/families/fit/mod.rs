@@ -1,10 +1,16 @@
 //! Chapter 5 wiring: read (or recompute) the DNSOM maps, fit every cell, log each at once.
 
-use super::spec::{FitCell, Spec};
-use super::{ch4, runner, RunContext};
+pub mod pictures;
+pub mod report;
+pub mod spec;
+
+use crate::experiment::spec::{GridSize, Spec};
+use spec::{FitCell, FitSom};
+use crate::experiment::{runner, RunContext};
+use crate::families::som;
 use crate::double_net::{DoubleNet, View};
-use crate::experiment::spec::{FitSom, GridSize, SomCell};
-use crate::report::fsio::write_atomic;
+use crate::families::som::spec::SomCell;
+use crate::io::write_atomic;
 use crate::som::{Model, SomParams};
 use crate::spline::{fit_two_view, FitOptions, TwoSurfaceFit, TwoViewGrid};
 use anyhow::{Context, Result};
@@ -99,14 +105,14 @@ pub fn maps_for(spec: &Spec, ctx: &RunContext, datasets: &[String], grid: GridSi
     // Every map has loaded: only now may the folder change.
     ctx.begin()?;
     for (data, source) in &out {
-        let text = crate::report::ch4::two_view_grid_csv(&source.grid)?;
+        let text = crate::families::som::report::two_view_grid_csv(&source.grid)?;
         write_atomic(&ctx.out.join("maps").join(map_file_name(data, grid)), text.as_bytes())?;
     }
     Ok(out)
 }
 
 fn read_map(path: &Path, grid: GridSize) -> Result<MapSource> {
-    let text = crate::report::fsio::read_text(path)?;
+    let text = crate::io::read_text(path)?;
     let g = crate::data::grid_csv::parse_two_view_grid(&text).with_context(|| path.display().to_string())?;
     if (g.nx, g.ny) != (grid.nx, grid.ny) {
         anyhow::bail!("{}: map is {}x{}, the spec's grid is {grid}", path.display(), g.nx, g.ny);
@@ -119,10 +125,10 @@ fn recompute_map(spec: &Spec, ctx: &RunContext, data: &str, grid: GridSize, som:
         Some(s) => (s.master_seed.unwrap_or(spec.file.master_seed), SomParams { iterations: s.iterations, alpha0: s.alpha0, sigma0: None }),
         None => (spec.file.master_seed, SomParams::default()),
     };
-    let clouds = ch4::load_datasets(&[data.to_string()], ctx)?;
+    let clouds = som::load_datasets(&[data.to_string()], ctx)?;
     let name = crate::data::registry::name_of(data);
     let cell = SomCell { dataset: name.clone(), model: Model::Dnsom, grid, repeat: 0 };
-    let run = ch4::run_cell(&cell, &clouds[&name].points, &params, seed)?;
+    let run = som::run_cell(&cell, &clouds[&name].points, &params, seed)?;
     Ok(MapSource {
         grid: grid_from_weights(grid.nx, grid.ny, &run.weights),
         origin: format!("recomputed: {} with master seed {seed}, T = {}", cell.key(), params.iterations),
@@ -161,7 +167,7 @@ pub fn run_cell(cell: &FitCell, grid: &TwoViewGrid, opts: &FitOptions) -> Result
 
 /// Run every fit cell of a spec.
 pub fn run(spec: &Spec, ctx: &RunContext, maps: &BTreeMap<String, MapSource>) -> Result<Vec<FitRun>> {
-    let cells = spec.fit_cells();
+    let cells = spec::cells(spec);
     let opts = spec.file.fit.as_ref().context("spec has no [fit] section")?.fit_options();
     // A logged cell's fit is rebuilt from its map (deterministic, a fraction of a millisecond);
     // the logged row, with its CPU time, is kept.
@@ -171,22 +177,42 @@ pub fn run(spec: &Spec, ctx: &RunContext, maps: &BTreeMap<String, MapSource>) ->
 /// Chapter 5's family: the `[fit]` section.
 pub struct Fit;
 
-impl super::family::Family for Fit {
+impl crate::experiment::family::Family for Fit {
     fn section(&self) -> &'static str {
         "fit"
     }
     fn present(&self, spec: &Spec) -> bool {
         spec.file.fit.is_some()
     }
-    fn logged_keys(&self, spec: &Spec) -> Vec<String> {
-        spec.fit_cells().iter().map(|c| c.key()).collect()
+    fn check_limits(&self, c: &crate::experiment::limits::Check) -> Result<(), crate::experiment::spec::SpecError> {
+        match &c.spec.file.fit {
+            Some(s) => self::spec::limits(c, s),
+            None => Ok(()),
+        }
     }
-    fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<super::family::Outcome> {
+    fn datasets<'a>(&self, spec: &'a Spec) -> Vec<&'a String> {
+        spec.file.fit.iter().flat_map(|s| &s.datasets).collect()
+    }
+    fn use_maps(&self, spec: &mut Spec, maps: &str) {
+        if let Some(s) = spec.file.fit.as_mut() {
+            s.maps = Some(maps.to_string());
+        }
+    }
+    fn validate(&self, spec: &Spec) -> Result<(), crate::experiment::spec::SpecError> {
+        match &spec.file.fit {
+            Some(s) => self::spec::validate(spec, s),
+            None => Ok(()),
+        }
+    }
+    fn logged_keys(&self, spec: &Spec) -> Vec<String> {
+        spec::cells(spec).iter().map(|c| c.key()).collect()
+    }
+    fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<crate::experiment::family::Outcome> {
         let maps = maps(spec, ctx)?;
         let runs = run(spec, ctx, &maps)?;
         let origins: Vec<(String, String)> = maps.iter().map(|(d, m)| (d.clone(), m.origin.clone())).collect();
         let pictures = spec.file.fit.as_ref().map(|f| f.pictures).unwrap_or(false);
-        let section = if tables { Some(crate::report::ch5::write(&runs, &ctx.out, &origins, pictures)?) } else { None };
-        Ok(super::family::Outcome { section, cpu_s: runs.iter().map(|r| r.row.cpu_s).sum(), cells: runs.len() })
+        let section = if tables { Some(crate::families::fit::report::write(&runs, &ctx.out, &origins, pictures)?) } else { None };
+        Ok(crate::experiment::family::Outcome { section, cpu_s: runs.iter().map(|r| r.row.cpu_s).sum(), cells: runs.len() })
     }
 }

@@ -2,11 +2,15 @@
 //! cubic B-spline problem per (data, net, parameterisation) from the least-squares fit of that map,
 //! then every (problem, optimiser, repeat) cell on its own stream, logged at once.
 
-use super::spec::{GridSize, GrowingGridSpec, Spec};
-use super::{runner, seeds, RunContext};
+pub mod report;
+pub mod spec;
+
+use crate::experiment::spec::{GridSize, Spec};
+use spec::GrowingGridSpec;
+use crate::experiment::{runner, seeds, RunContext};
 use crate::data::registry;
 use crate::geom::Point3;
-use crate::optim::open_surface::OpenSurfaceProblem;
+use crate::spline::open_surface::OpenSurfaceProblem;
 use crate::optim::{Budget, Optimiser, Problem};
 use crate::som::growing_grid::{grow, GrowingGrid};
 use crate::spline::Parameterisation;
@@ -195,22 +199,37 @@ pub fn run(spec: &Spec, ctx: &RunContext, problems: &BTreeMap<ProblemKey, OpenSu
 /// Seed 001's family: the `[growing_grid]` section.
 pub struct Seed001;
 
-impl super::family::Family for Seed001 {
+impl crate::experiment::family::Family for Seed001 {
     fn section(&self) -> &'static str {
         "growing_grid"
     }
     fn present(&self, spec: &Spec) -> bool {
         spec.file.growing_grid.is_some()
     }
+    fn check_limits(&self, c: &crate::experiment::limits::Check) -> Result<(), crate::experiment::spec::SpecError> {
+        match &c.spec.file.growing_grid {
+            Some(s) => self::spec::limits(c, s),
+            None => Ok(()),
+        }
+    }
+    fn datasets<'a>(&self, spec: &'a Spec) -> Vec<&'a String> {
+        spec.file.growing_grid.iter().flat_map(|s| &s.datasets).collect()
+    }
+    fn validate(&self, spec: &Spec) -> Result<(), crate::experiment::spec::SpecError> {
+        match &spec.file.growing_grid {
+            Some(s) => self::spec::validate(spec, s),
+            None => Ok(()),
+        }
+    }
     fn logged_keys(&self, spec: &Spec) -> Vec<String> {
         cells(spec).iter().map(|c| c.key()).collect()
     }
-    fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<super::family::Outcome> {
+    fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<crate::experiment::family::Outcome> {
         let maps = maps(spec, ctx)?;
         let problems = problems(spec, &maps)?;
         let runs = run(spec, ctx, &problems)?;
-        let section = if tables { Some(crate::report::seed001::write(&maps, &problems, &runs, &ctx.out)?) } else { None };
+        let section = if tables { Some(crate::families::growing_grid::report::write(&maps, &problems, &runs, &ctx.out)?) } else { None };
         let cpu_s = maps.iter().map(|m| m.cpu_s).sum::<f64>() + runs.iter().map(|r| r.row.cpu_s).sum::<f64>();
-        Ok(super::family::Outcome { section, cpu_s, cells: runs.len() })
+        Ok(crate::experiment::family::Outcome { section, cpu_s, cells: runs.len() })
     }
 }

@@ -3,12 +3,12 @@
 //! paper's transcribed numbers (`experiments/reference/seed004_table{2,3}.csv`), the paper's
 //! claims checked on the runs (verdicts computed), and the Fig. 2(a), 3 and 5 analogues.
 
-use super::markdown::{num, table};
-use super::plots::boxplot::quantile_type7;
-use super::plots::{self, style, Series};
-use super::reference::RefTable;
-use crate::experiment::seed004::{Run, TopView};
-use crate::experiment::spec::Seed004Spec;
+use crate::report::markdown::{num, table};
+use crate::report::plots::boxplot::quantile_type7;
+use crate::report::plots::{self, style, Series};
+use crate::report::reference::RefTable;
+use crate::families::closed_cylinder::{Run, TopView};
+use super::spec::Seed004Spec;
 use anyhow::Result;
 use plotters::style::RGBColor;
 use std::fmt::Write;
@@ -16,7 +16,7 @@ use std::path::Path;
 
 /// The paper's Table II or III as transcribed (compiled in, so always there).
 fn paper_table(name: &str) -> RefTable {
-    super::reference::table(name).expect("the seed 004 reference tables are compiled in")
+    crate::report::reference::table(name).expect("the seed 004 reference tables are compiled in")
 }
 
 /// Summary of values over repeats: (min, mean, median, lower quartile, upper quartile, max, std).
@@ -48,8 +48,8 @@ fn header(cols: &[&str]) -> Vec<String> {
 /// Write the tables and charts; return the REPORT.md section.
 pub fn write(s4: &Seed004Spec, runs: &[Run], sweep: &[(usize, f64)], floor: f64, top: Option<&TopView>, out: &Path) -> Result<String> {
     let rows: Vec<_> = runs.iter().map(|r| r.row.clone()).collect();
-    super::fsio::write_atomic(&out.join("runs.csv"), super::fsio::csv_text(&rows)?.as_bytes())?;
-    let cps = super::ordered(runs.iter().map(|r| r.cell.control_points));
+    crate::io::write_atomic(&out.join("runs.csv"), crate::io::csv_text(&rows)?.as_bytes())?;
+    let cps = crate::report::ordered(runs.iter().map(|r| r.cell.control_points));
     let of = |cp: usize| -> Vec<&Run> { runs.iter().filter(|r| r.cell.control_points == cp).collect() };
     let mut s = String::new();
     let _ = writeln!(s, "## Seed 004: closed B-spline surface of a cylinder by a binary-coded GA\n");
@@ -81,9 +81,9 @@ pub fn write(s4: &Seed004Spec, runs: &[Run], sweep: &[(usize, f64)], floor: f64,
             md2.push(vec![cp.to_string(), if g == 0 { "initial".into() } else { g.to_string() }, num(Some(a.min), 4), num(Some(a.mean), 4), num(Some(b.mean), 4), num(Some(analytical), 4), num(paper, 4)]);
         }
     }
-    super::fsio::write_atomic(
+    crate::io::write_atomic(
         &out.join("seed004_table2.csv"),
-        super::fsio::csv_records(&header(&["control_points", "generation", "analytical_rms", "ga_best_rms", "ga_mean_rms", "ga_median_rms", "ga_population_best_rms", "ga_population_mean_rms", "runs"]), &t2)?.as_bytes(),
+        crate::io::csv_records(&header(&["control_points", "generation", "analytical_rms", "ga_best_rms", "ga_mean_rms", "ga_median_rms", "ga_population_best_rms", "ga_population_mean_rms", "runs"]), &t2)?.as_bytes(),
     )?;
     let _ = writeln!(s, "### Table II: best RMS against generation (ours beside the paper)\n");
     let _ = writeln!(s, "GA best / mean = best-so-far RMS at that generation, lowest and mean over the repeats; population mean = the mean over repeats of the best RMS in that generation's population (without elitism it can rise, as the paper's does from 200 to 300).\n");
@@ -104,12 +104,12 @@ pub fn write(s4: &Seed004Spec, runs: &[Run], sweep: &[(usize, f64)], floor: f64,
         let key = [cp.to_string()];
         md3.push(vec![cp.to_string(), num(Some(an), 5), num(Some(sm.min), 5), num(Some(sm.mean), 5), winner.row.best_generation.to_string(), format!("{impr:.2}%"), num(p3.value(&["control_points"], &key, "best_fitness"), 5), p3.find(&["control_points"], &key).and_then(|r| r.get("generation").cloned()).unwrap_or_else(|| "-".into())]);
     }
-    super::fsio::write_atomic(
+    crate::io::write_atomic(
         &out.join("seed004_table3.csv"),
-        super::fsio::csv_records(&header(&["control_points", "analytical_rms", "ga_best_rms", "ga_mean_rms", "ga_worst_rms", "ga_std_rms", "best_generation", "mean_best_generation", "improvement_pct", "runs"]), &t3)?.as_bytes(),
+        crate::io::csv_records(&header(&["control_points", "analytical_rms", "ga_best_rms", "ga_mean_rms", "ga_worst_rms", "ga_std_rms", "best_generation", "mean_best_generation", "improvement_pct", "runs"]), &t3)?.as_bytes(),
     )?;
     let sweep_rows: Vec<Vec<String>> = sweep.iter().map(|(n, r)| vec![n.to_string(), e(*r)]).collect();
-    super::fsio::write_atomic(&out.join("seed004_analytical.csv"), super::fsio::csv_records(&header(&["control_points", "analytical_rms"]), &sweep_rows)?.as_bytes())?;
+    crate::io::write_atomic(&out.join("seed004_analytical.csv"), crate::io::csv_records(&header(&["control_points", "analytical_rms"]), &sweep_rows)?.as_bytes())?;
     let _ = writeln!(s, "\n### Table III: best fitness (RMS) against the number of control points (ours beside the paper)\n");
     s.push_str(&table(&header(&["control points", "analytical", "GA best", "GA mean", "generation of GA best", "GA vs analytical", "paper best fitness", "paper generation"]), &md3));
 
@@ -117,7 +117,7 @@ pub fn write(s4: &Seed004Spec, runs: &[Run], sweep: &[(usize, f64)], floor: f64,
     let mut claims = Vec::new();
     let row3 = |cp: usize| t3.iter().find(|r| r[0] == cp.to_string()).map(|r| (r[1].parse::<f64>().unwrap_or(f64::NAN), r[2].parse::<f64>().unwrap_or(f64::NAN)));
     if let Some((an, ga)) = row3(7) {
-        claims.push(super::claims::Claim {
+        claims.push(crate::report::claims::Claim {
             chapter: "seed004".into(),
             statement: "GA's least error beats the analytical method's at 7 control points (paper: 0.0164 vs 0.0174, 5.7471%)".into(),
             ours: ((ga < an) as usize, 1),
@@ -129,7 +129,7 @@ pub fn write(s4: &Seed004Spec, runs: &[Run], sweep: &[(usize, f64)], floor: f64,
     let ga_by_cp: Vec<(usize, f64)> = t3.iter().map(|r| (r[0].parse().unwrap_or(0), r[2].parse().unwrap_or(f64::NAN))).collect();
     let paper_by_cp: Vec<(usize, f64)> = p3.rows.iter().filter_map(|r| Some((r.get("control_points")?.parse().ok()?, r.get("best_fitness")?.parse().ok()?))).collect();
     if let (Some((cp, v)), Some((pcp, _))) = (argmin(&ga_by_cp), argmin(&paper_by_cp)) {
-        claims.push(super::claims::Claim {
+        claims.push(crate::report::claims::Claim {
             chapter: "seed004".into(),
             statement: "The GA's fitness is best (least error) between 25 and 30 control points (Table III)".into(),
             ours: ((25..=30).contains(&cp) as usize, 1),
@@ -138,7 +138,7 @@ pub fn write(s4: &Seed004Spec, runs: &[Run], sweep: &[(usize, f64)], floor: f64,
         });
     }
     if let Some((cp, v)) = argmin(sweep) {
-        claims.push(super::claims::Claim {
+        claims.push(crate::report::claims::Claim {
             chapter: "seed004".into(),
             statement: "The analytical method's least error is at 28 control points (0.001132)".into(),
             ours: ((cp == 28) as usize, 1),
@@ -147,7 +147,7 @@ pub fn write(s4: &Seed004Spec, runs: &[Run], sweep: &[(usize, f64)], floor: f64,
         });
     }
     let better = ga_by_cp.iter().filter(|(cp, ga)| row3(*cp).is_some_and(|(an, _)| *ga < an)).count();
-    claims.push(super::claims::Claim {
+    claims.push(crate::report::claims::Claim {
         chapter: "seed004".into(),
         statement: "The GA improves on the analytical control points for the other numbers of control points too".into(),
         ours: (better, ga_by_cp.len()),
@@ -155,7 +155,7 @@ pub fn write(s4: &Seed004Spec, runs: &[Run], sweep: &[(usize, f64)], floor: f64,
         note: "numbers of control points where the GA's best RMS is below the analytical RMS (the paper states it but gives analytical numbers only at 7 and 28)".into(),
     });
     let falls = runs.iter().filter(|r| r.population_best.last().is_some_and(|l| *l < r.population_best[0])).count();
-    claims.push(super::claims::Claim {
+    claims.push(crate::report::claims::Claim {
         chapter: "seed004".into(),
         statement: "The fitness improves (the error decreases) as the generations increase (Table II)".into(),
         ours: (falls, runs.len()),
@@ -163,7 +163,7 @@ pub fn write(s4: &Seed004Spec, runs: &[Run], sweep: &[(usize, f64)], floor: f64,
         note: "runs whose last population's best RMS is below their initial population's best".into(),
     });
     let _ = writeln!(s, "\n### The paper's claims, checked here\n");
-    s.push_str(&super::claims::write(out, &claims)?);
+    s.push_str(&crate::report::claims::write(out, &claims)?);
     let _ = writeln!(
         s,
         "\nThe GA's error against the number of control points has a minimum that moves with the search box (`search_range`; the spec's `narrow` profile uses 0.02 instead of 0.25). The box is centred on the least-squares minimiser, so a decoded point x0 + r d has SSE = SSE(x0) + r^2 q(d) with q independent of r: the GA's ranking, and so its whole run in bit space, is the same in every box (up to rounding), and its excess error over the analytical one scales with r^2. With 10 individuals and 500 generations that excess grows with the 2N dimensions while the analytical error falls, so a middle optimum such as the paper's 25-30 is a property of the GA's budget and box, not of the surface.");
@@ -174,7 +174,7 @@ pub fn write(s4: &Seed004Spec, runs: &[Run], sweep: &[(usize, f64)], floor: f64,
     );
 
     // Pictures.
-    super::fsio::ensure_dir(&out.join("png"))?;
+    crate::io::ensure_dir(&out.join("png"))?;
     let mut pictures = Vec::new();
     let mut conv = Vec::new();
     for (k, &cp) in s4.table2_control_points.iter().filter(|cp| cps.contains(cp)).enumerate() {

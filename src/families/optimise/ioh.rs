@@ -4,8 +4,8 @@
 //! improvement-based raw data `data_f<id>_<name>/IOHprofiler_f<id>_DIM<d>.dat` (layout:
 //! [`crate::optim::ioh`]). Runs are listed in repeat order.
 
-use super::fsio::{read_text, write_atomic};
-use crate::experiment::ch6::OptimRun;
+use crate::io::{read_text, write_atomic};
+use crate::families::optimise::OptimRun;
 use crate::optim::ioh::{dat_text, json_text, parse_dat, IohMeta, IohRun};
 use anyhow::{Context, Result};
 use std::path::Path;

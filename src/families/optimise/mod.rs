@@ -2,11 +2,19 @@
 //! optimiser of a cell starts from the same control net (paired comparisons); each (cell, repeat)
 //! runs on its own stream and is logged at once.
 
-use super::spec::{OptimCell, Spec};
-use super::{ch5, runner, seeds, RunContext};
+pub mod compare;
+pub mod ioh;
+pub mod report;
+pub mod spec;
+
+use crate::experiment::spec::Spec;
+use spec::OptimCell;
+use crate::experiment::{runner, seeds, RunContext};
+use crate::families::fit;
 use crate::experiment::spec::GridSize;
-use crate::optim::control_net::ControlNetProblem;
-use crate::optim::{BoxSpec, Budget, ExactOptions, Optimiser, Problem, RunResult};
+use crate::spline::ControlNetProblem;
+use crate::optim::{Budget, ExactOptions, Optimiser, Problem, RunResult};
+use crate::spline::BoxSpec;
 use crate::spline::{fit_two_view, Approach, Parameterisation};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
@@ -87,7 +95,7 @@ pub fn optimiser(spec: &Spec, name: &str) -> Result<Box<dyn Optimiser>> {
 /// The control-net problems of every (data, net, parameterisation), from approach B's fit.
 pub fn problems(spec: &Spec, ctx: &RunContext) -> Result<BTreeMap<ProblemKey, ControlNetProblem>> {
     let o = spec.file.optim.as_ref().context("spec has no [optim] section")?;
-    let maps = ch5::maps_for(spec, ctx, &o.datasets, o.grid, o.maps.as_deref(), o.som.as_ref())?;
+    let maps = fit::maps_for(spec, ctx, &o.datasets, o.grid, o.maps.as_deref(), o.som.as_ref())?;
     let mut out = BTreeMap::new();
     for entry in &o.datasets {
         let d = &crate::data::registry::name_of(entry);
@@ -163,7 +171,7 @@ fn pictured(cell: &OptimCell, largest: GridSize) -> bool {
 
 /// Run every optimisation cell of a spec (its shard's, with `--shard`).
 pub fn run(spec: &Spec, ctx: &RunContext, problems: &BTreeMap<ProblemKey, ControlNetProblem>) -> Result<Vec<OptimRun>> {
-    let cells = spec.optim_cells();
+    let cells = spec::cells(spec);
     let largest = cells.iter().map(|c| c.cn).max().unwrap_or(GridSize { nx: 0, ny: 0 });
     let problem = |cell: &OptimCell| &problems[&(cell.dataset.clone(), cell.cn, cell.param)];
     let mut runs = runner::run_logged(
@@ -223,21 +231,41 @@ pub fn setting(spec: &Spec) -> String {
 /// Chapter 6's family: the `[optim]` section.
 pub struct Optim;
 
-impl super::family::Family for Optim {
+impl crate::experiment::family::Family for Optim {
     fn section(&self) -> &'static str {
         "optim"
     }
     fn present(&self, spec: &Spec) -> bool {
         spec.file.optim.is_some()
     }
-    fn logged_keys(&self, spec: &Spec) -> Vec<String> {
-        spec.optim_cells().iter().map(|c| c.key()).collect()
+    fn check_limits(&self, c: &crate::experiment::limits::Check) -> Result<(), crate::experiment::spec::SpecError> {
+        match &c.spec.file.optim {
+            Some(s) => self::spec::limits(c, s),
+            None => Ok(()),
+        }
     }
-    fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<super::family::Outcome> {
+    fn datasets<'a>(&self, spec: &'a Spec) -> Vec<&'a String> {
+        spec.file.optim.iter().flat_map(|s| &s.datasets).collect()
+    }
+    fn use_maps(&self, spec: &mut Spec, maps: &str) {
+        if let Some(s) = spec.file.optim.as_mut() {
+            s.maps = Some(maps.to_string());
+        }
+    }
+    fn validate(&self, spec: &Spec) -> Result<(), crate::experiment::spec::SpecError> {
+        match &spec.file.optim {
+            Some(s) => self::spec::validate(spec, s),
+            None => Ok(()),
+        }
+    }
+    fn logged_keys(&self, spec: &Spec) -> Vec<String> {
+        spec::cells(spec).iter().map(|c| c.key()).collect()
+    }
+    fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<crate::experiment::family::Outcome> {
         let problems = problems(spec, ctx)?;
         let exact = if tables { exact_optima(spec, ctx, &problems)? } else { BTreeMap::new() };
         let runs = run(spec, ctx, &problems)?;
-        let section = if tables { Some(crate::report::ch6::write(&runs, &problems, &exact, &setting(spec), &ctx.out)?) } else { None };
-        Ok(super::family::Outcome { section, cpu_s: runs.iter().map(|r| r.row.cpu_s).sum(), cells: runs.len() })
+        let section = if tables { Some(crate::families::optimise::report::write(&runs, &problems, &exact, &setting(spec), &ctx.out)?) } else { None };
+        Ok(crate::experiment::family::Outcome { section, cpu_s: runs.iter().map(|r| r.row.cpu_s).sum(), cells: runs.len() })
     }
 }

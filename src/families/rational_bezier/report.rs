@@ -4,8 +4,8 @@
 //! The paper's published numbers are not in the surviving seed text (it stops in section 3.1),
 //! so no reference column can be typed in; the section says so.
 
-use super::plots::{self, style, Series};
-use crate::experiment::seed002::{CurveRun, Run};
+use crate::report::plots::{self, style, Series};
+use crate::families::rational_bezier::{CurveRun, Run};
 use crate::spline::rational_bezier::conic_point;
 use crate::spline::rational_bezier::TestSurface;
 use anyhow::Result;
@@ -15,13 +15,13 @@ use std::path::Path;
 use crate::stats::describe::mean_std;
 
 fn median(v: Vec<f64>) -> f64 {
-    super::markdown::median(&v).unwrap_or(f64::NAN)
+    crate::report::markdown::median(&v).unwrap_or(f64::NAN)
 }
 
 /// Write runs.csv-derived tables and charts; return the REPORT.md section.
 pub fn write(runs: &[Run], curves: &[CurveRun], population: usize, out: &Path) -> Result<String> {
     let rows: Vec<_> = runs.iter().map(|r| r.row.clone()).collect();
-    super::fsio::write_atomic(&out.join("runs.csv"), super::fsio::csv_text(&rows)?.as_bytes())?;
+    crate::io::write_atomic(&out.join("runs.csv"), crate::io::csv_text(&rows)?.as_bytes())?;
     // Error versus iteration, every trace point of every run.
     let trace_header: Vec<String> = ["cell", "surface", "optimiser", "repeat", "evaluations", "best_sse"].iter().map(|h| h.to_string()).collect();
     let mut trace_rows = Vec::new();
@@ -30,9 +30,9 @@ pub fn write(runs: &[Run], curves: &[CurveRun], population: usize, out: &Path) -
             trace_rows.push(vec![r.row.cell.clone(), r.row.surface.clone(), r.row.optimiser.clone(), r.row.repeat.to_string(), e.to_string(), format!("{f:e}")]);
         }
     }
-    super::fsio::write_atomic(&out.join("seed002_traces.csv"), super::fsio::csv_records(&trace_header, &trace_rows)?.as_bytes())?;
-    let surfaces = super::ordered(runs.iter().map(|r| r.row.surface.clone()));
-    let optimisers = super::ordered(runs.iter().map(|r| r.row.optimiser.clone()));
+    crate::io::write_atomic(&out.join("seed002_traces.csv"), crate::io::csv_records(&trace_header, &trace_rows)?.as_bytes())?;
+    let surfaces = crate::report::ordered(runs.iter().map(|r| r.row.surface.clone()));
+    let optimisers = crate::report::ordered(runs.iter().map(|r| r.row.optimiser.clone()));
     let mut s = String::new();
     let _ = writeln!(s, "## Seed 002: four-patch G1 rational bi-quadratic Bezier surface by GA, DE and PSO\n");
     let _ = writeln!(s, "Objective: sum of squared 3-D errors (SSE) between the n x n grid of the function and the surface at the same uniform parameters; variables p01, p10, p11, p12, p14, p21, p41 (x, y, z each) and w11 (22 numbers); the other net entries are the data (p00, p02, p04, p20, p22, p24, p40, p42, p44) or follow from the G1 joins (homogeneous reflection across row 2 and column 2). No noise. Domains are our choice (the paper gives none):\n");
@@ -64,7 +64,7 @@ pub fn write(runs: &[Run], curves: &[CurveRun], population: usize, out: &Path) -
             let _ = writeln!(s, "| {sf} | {o} | {} | {:.6e} | {m:.6e} | {worst:.6e} | {sd:.3e} | {:.4e} | {:.4e} | {:.4} | {cpu:.3} |", sel.len(), best.row.best_sse, best.row.rmse, best.row.start_sse, best.row.w11);
         }
     }
-    super::fsio::write_atomic(&out.join("seed002_errors.csv"), super::fsio::csv_records(&header, &rows)?.as_bytes())?;
+    crate::io::write_atomic(&out.join("seed002_errors.csv"), crate::io::csv_records(&header, &rows)?.as_bytes())?;
     // Which optimiser wins each surface (lowest mean SSE), computed from the runs.
     let _ = writeln!(s);
     for sf in &surfaces {
@@ -80,7 +80,7 @@ pub fn write(runs: &[Run], curves: &[CurveRun], population: usize, out: &Path) -
         let _ = writeln!(s, "- {sf}: mean SSE order, best first: {}", order.join(" < "));
     }
     // Error versus iteration.
-    super::fsio::ensure_dir(&out.join("png"))?;
+    crate::io::ensure_dir(&out.join("png"))?;
     for sf in &surfaces {
         let mut series = Vec::new();
         for (k, o) in optimisers.iter().enumerate() {
@@ -110,9 +110,9 @@ fn write_curves(curves: &[CurveRun], out: &Path, s: &mut String) -> Result<()> {
         return Ok(());
     }
     let rows: Vec<_> = curves.iter().map(|c| c.row.clone()).collect();
-    super::fsio::write_atomic(&out.join("seed002_curve_runs.csv"), super::fsio::csv_text(&rows)?.as_bytes())?;
-    let outlines = super::ordered(curves.iter().map(|c| c.row.outline.clone()));
-    let optimisers = super::ordered(curves.iter().map(|c| c.row.optimiser.clone()));
+    crate::io::write_atomic(&out.join("seed002_curve_runs.csv"), crate::io::csv_text(&rows)?.as_bytes())?;
+    let outlines = crate::report::ordered(curves.iter().map(|c| c.row.outline.clone()));
+    let optimisers = crate::report::ordered(curves.iter().map(|c| c.row.optimiser.clone()));
     let _ = writeln!(s, "\n### Conic curve fitting on generated outlines\n");
     let _ = writeln!(s, "The paper's outlines are scanned images (R, beta, S, Kanji, face); here they are generated from lines and circular arcs (square 60x60; letter D: stem 80, bars 20, half circle r = 40; letter P: stem 100, foot 20, bowl half circle r = 25 on bars of 15), sampled at one point per unit of arc length. Corners: SAM06 (L, D, R from the spec); between consecutive corners the outline is split at its middle data point and each half is one rational quadratic (conic) with its ends on the data, b1 and w optimised, SSE at chord-length parameters.\n");
     let _ = writeln!(s, "| outline | optimiser | runs | points | true corners | found | matched | conics | start SSE | best SSE | mean SSE | mean CPU s |");
@@ -134,7 +134,7 @@ fn write_curves(curves: &[CurveRun], out: &Path, s: &mut String) -> Result<()> {
             let _ = writeln!(s, "| {ol} | {o} | {} | {} | {} | {} | {} | {} | {:.4e} | {best:.4e} | {m:.4e} | {cpu:.4} |", sel.len(), r0.n_points, r0.true_corners, r0.corners_found, r0.corners_matched, r0.conics, r0.start_sse);
         }
     }
-    super::fsio::write_atomic(&out.join("seed002_curves.csv"), super::fsio::csv_records(&header, &table)?.as_bytes())?;
+    crate::io::write_atomic(&out.join("seed002_curves.csv"), crate::io::csv_records(&header, &table)?.as_bytes())?;
     for ol in &outlines {
         let Some(best) = curves.iter().filter(|c| &c.row.outline == ol).min_by(|a, b| a.row.sse.total_cmp(&b.row.sse)) else { continue };
         let mut series = vec![Series { label: "outline (data)".into(), colour: plotters::style::RGBColor(170, 170, 170), points: best.points.iter().chain(best.points.first()).map(|p| (p[0], p[1])).collect(), band: None }];

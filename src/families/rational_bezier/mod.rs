@@ -2,8 +2,12 @@
 //! bi-quadratic Bezier surface to the surface's grid by minimising the sum of squared errors over
 //! the seven free control points and w11, on its own stream, logged at once.
 
-use super::spec::{Seed002Spec, Spec};
-use super::{runner, seeds, RunContext};
+pub mod report;
+pub mod spec;
+
+use crate::experiment::spec::Spec;
+use spec::Seed002Spec;
+use crate::experiment::{runner, seeds, RunContext};
 use crate::optim::{Budget, Optimiser, Problem, RunResult};
 use crate::spline::conic::{self, ConicProblem, P2};
 use crate::spline::rational_bezier::{SurfaceSse, TestSurface};
@@ -238,12 +242,24 @@ pub fn run_curves(spec: &Spec, ctx: &RunContext) -> Result<Vec<CurveRun>> {
 /// Seed 002's family: the `[seed002]` section (surface cells logged, curve cells not).
 pub struct Seed002;
 
-impl super::family::Family for Seed002 {
+impl crate::experiment::family::Family for Seed002 {
     fn section(&self) -> &'static str {
         "seed002"
     }
     fn present(&self, spec: &Spec) -> bool {
         spec.file.seed002.is_some()
+    }
+    fn check_limits(&self, c: &crate::experiment::limits::Check) -> Result<(), crate::experiment::spec::SpecError> {
+        match &c.spec.file.seed002 {
+            Some(s) => self::spec::limits(c, s),
+            None => Ok(()),
+        }
+    }
+    fn validate(&self, spec: &Spec) -> Result<(), crate::experiment::spec::SpecError> {
+        match &spec.file.seed002 {
+            Some(s) => self::spec::validate(spec, s),
+            None => Ok(()),
+        }
     }
     fn logged_keys(&self, spec: &Spec) -> Vec<String> {
         cells(spec).iter().map(|c| c.key()).collect()
@@ -251,12 +267,12 @@ impl super::family::Family for Seed002 {
     fn unlogged_keys(&self, spec: &Spec) -> Vec<String> {
         curve_cells(spec).iter().map(|c| c.key()).collect()
     }
-    fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<super::family::Outcome> {
+    fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<crate::experiment::family::Outcome> {
         let s = section(spec)?;
         let runs = run(spec, ctx)?;
         let curves = run_curves(spec, ctx)?;
-        let section = if tables { Some(crate::report::seed002::write(&runs, &curves, s.population, &ctx.out)?) } else { None };
+        let section = if tables { Some(crate::families::rational_bezier::report::write(&runs, &curves, s.population, &ctx.out)?) } else { None };
         let cpu_s = runs.iter().map(|r| r.row.cpu_s).chain(curves.iter().map(|c| c.row.cpu_s)).sum();
-        Ok(super::family::Outcome { section, cpu_s, cells: runs.len() + curves.len() })
+        Ok(crate::experiment::family::Outcome { section, cpu_s, cells: runs.len() + curves.len() })
     }
 }

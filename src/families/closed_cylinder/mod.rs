@@ -3,8 +3,12 @@
 //! (control points, repeat) cell then runs the binary-coded GA on the columns' (x, y) in a box
 //! around the analytical net, on its own stream, logged at once.
 
-use super::spec::{Seed004Spec, Spec};
-use super::{runner, seeds, RunContext};
+pub mod report;
+pub mod spec;
+
+use crate::experiment::spec::Spec;
+use spec::Seed004Spec;
+use crate::experiment::{runner, seeds, RunContext};
 use crate::data::cylinder::{lattice_cylinder, sort_into_rings};
 use crate::optim::{Budget, Problem};
 use crate::spline::closed::{fit_closed, ClosedNetShape, RingData, RingNetProblem};
@@ -214,17 +218,29 @@ pub fn top_view(spec: &Spec, data: &RingData, runs: &[Run], control_points: usiz
 /// Seed 004's family: the `[seed004]` section.
 pub struct Seed004;
 
-impl super::family::Family for Seed004 {
+impl crate::experiment::family::Family for Seed004 {
     fn section(&self) -> &'static str {
         "seed004"
     }
     fn present(&self, spec: &Spec) -> bool {
         spec.file.seed004.is_some()
     }
+    fn check_limits(&self, c: &crate::experiment::limits::Check) -> Result<(), crate::experiment::spec::SpecError> {
+        match &c.spec.file.seed004 {
+            Some(s) => self::spec::limits(c, s),
+            None => Ok(()),
+        }
+    }
+    fn validate(&self, spec: &Spec) -> Result<(), crate::experiment::spec::SpecError> {
+        match &spec.file.seed004 {
+            Some(s) => self::spec::validate(spec, s),
+            None => Ok(()),
+        }
+    }
     fn logged_keys(&self, spec: &Spec) -> Vec<String> {
         cells(spec).iter().map(|c| c.key()).collect()
     }
-    fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<super::family::Outcome> {
+    fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<crate::experiment::family::Outcome> {
         let s4 = section(spec)?;
         // The lattice and its rings once, for the runs and the report.
         let data = data(s4);
@@ -232,10 +248,10 @@ impl super::family::Family for Seed004 {
         let section = if tables {
             let sweep = analytical_sweep(spec, &data)?;
             let top = top_view(spec, &data, &runs, 7)?;
-            Some(crate::report::seed004::write(s4, &runs, &sweep, data_floor(spec, &data)?, top.as_ref(), &ctx.out)?)
+            Some(crate::families::closed_cylinder::report::write(s4, &runs, &sweep, data_floor(spec, &data)?, top.as_ref(), &ctx.out)?)
         } else {
             None
         };
-        Ok(super::family::Outcome { section, cpu_s: runs.iter().map(|r| r.row.cpu_s).sum(), cells: runs.len() })
+        Ok(crate::experiment::family::Outcome { section, cpu_s: runs.iter().map(|r| r.row.cpu_s).sum(), cells: runs.len() })
     }
 }

@@ -2,8 +2,8 @@
 //! two colours) and overview pages laid out like the thesis' Appendix A (rows data x n, columns the
 //! four models) and Appendix D (rows data x grid, columns CKSOM and DNSOM).
 
-use super::plots::{self, style, LineMesh, Panel};
-use crate::experiment::ch4::SomRun;
+use crate::report::plots::{self, style, LineMesh, Panel};
+use crate::families::som::SomRun;
 use crate::som::Model;
 use anyhow::Result;
 use rayon::prelude::*;
@@ -40,7 +40,7 @@ fn cell_picture_name(run: &SomRun) -> String {
 /// Write every Chapter 4 picture; returns the written paths relative to `out`. A picture that
 /// fails is reported on stderr and the others are still written.
 pub fn write(runs: &[SomRun], out: &Path) -> Result<Vec<String>> {
-    super::fsio::ensure_dir(&out.join("png"))?;
+    crate::io::ensure_dir(&out.join("png"))?;
     let first: Vec<&SomRun> = runs.iter().filter(|r| r.cell.repeat == 0).collect();
     let mut written: Vec<String> = first
         .par_iter()

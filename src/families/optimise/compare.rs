@@ -2,8 +2,8 @@
 //! from its runs.csv only (so a folder from another machine or an older run compares the same).
 
 use crate::cli::CompareArgs;
-use crate::experiment::ch6::OptimRow;
-use crate::report::fsio::{csv_records, write_atomic};
+use crate::families::optimise::OptimRow;
+use crate::io::{csv_records, write_atomic};
 use crate::report::plots;
 use crate::stats;
 use crate::stats::{effect, friedman::friedman, rank_sum::rank_sum, wilcoxon::signed_rank, Alternative};
@@ -148,7 +148,7 @@ pub fn compare(args: &CompareArgs) -> Result<()> {
         written.push_str(", compare_ecdf.csv, compare_aocc.csv, compare_fixed_budget.csv, compare_ert.csv, compare_targets.csv");
         let groups: Vec<String> = std::iter::once("all".to_string()).chain(probs.iter().map(|p| p.name.clone())).collect();
         let mut pngs = 0;
-        crate::report::fsio::ensure_dir(&args.results.join("png").join("compare"))?;
+        crate::io::ensure_dir(&args.results.join("png").join("compare"))?;
         for g in &groups {
             let dir = if g == "all" { args.results.clone() } else { args.results.join("png").join("compare") };
             for (kind, res) in [("ecdf", render_ecdf(&rt, g, &opts, &dir.join(format!("compare_ecdf_{g}.png")))), ("fixed_budget", render_fixed_budget(&rt, g, &opts, &dir.join(format!("compare_fixed_budget_{g}.png"))))] {
@@ -217,7 +217,7 @@ fn certified_optima(folder: &std::path::Path) -> Result<BTreeMap<String, f64>> {
             let rec = rec.with_context(|| format!("{}: line {}", p.display(), n + 2))?;
             let get = |k: &str| rec.get(k).with_context(|| format!("{}: line {}: no column {k}", p.display(), n + 2));
             let f: f64 = get("exact_f")?.parse().with_context(|| format!("{}: line {}: exact_f is not a number", p.display(), n + 2))?;
-            let key = crate::report::ioh::problem_name(get("data")?, grid, &format!("{}x{}", get("cn_x")?, get("cn_y")?), get("parameterisation")?);
+            let key = crate::families::optimise::ioh::problem_name(get("data")?, grid, &format!("{}x{}", get("cn_x")?, get("cn_y")?), get("parameterisation")?);
             out.insert(key, f);
         }
     }
@@ -228,13 +228,13 @@ fn certified_optima(folder: &std::path::Path) -> Result<BTreeMap<String, f64>> {
 /// with the same evaluation counts and final values).
 fn problems(rows: &[OptimRow], folder: &std::path::Path) -> Result<Vec<Problem>> {
     let certified = certified_optima(folder)?;
-    let name = |r: &OptimRow| crate::report::ioh::problem_name(&r.dataset, &format!("{}x{}", r.grid_x, r.grid_y), &format!("{}x{}", r.cn_x, r.cn_y), &r.parameterisation);
+    let name = |r: &OptimRow| crate::families::optimise::ioh::problem_name(&r.dataset, &format!("{}x{}", r.grid_x, r.grid_y), &format!("{}x{}", r.cn_x, r.cn_y), &r.parameterisation);
     let mut expected: BTreeMap<(String, String), Vec<&OptimRow>> = BTreeMap::new();
     for r in rows {
         expected.entry((name(r), r.optimiser.clone())).or_default().push(r);
     }
     let mut out: BTreeMap<String, Problem> = BTreeMap::new();
-    for lp in crate::report::ioh::read(folder)? {
+    for lp in crate::families::optimise::ioh::read(folder)? {
         let mut exp = expected.remove(&(lp.function_name.clone(), lp.optimiser.clone())).with_context(|| format!("{}: ioh/{} has problem {} that runs.csv does not", folder.display(), lp.optimiser, lp.function_name))?;
         exp.sort_by_key(|r| r.repeat);
         let agree = exp.len() == lp.runs.len() && exp.iter().zip(&lp.runs).all(|(r, (e, imp))| *e == r.evaluations && imp.iter().map(|x| x.1).fold(f64::INFINITY, f64::min) == r.best);

@@ -18,7 +18,7 @@
 //! - **Whole-folder swaps.** [`replace_dir`] builds a new folder beside the old one and swaps
 //!   them with one `renameat2(RENAME_EXCHANGE)`, so a reader sees the old folder or the new one,
 //!   never a mix, and a failure leaves the old one as it was.
-//! - Files are written through [`crate::report::fsio::write_atomic`]: a unique temporary name
+//! - Files are written through [`crate::io::write_atomic`]: a unique temporary name
 //!   (pid + counter) in the same folder, `fsync`, rename, `fsync` of the folder.
 
 use anyhow::{bail, Context, Result};
@@ -32,6 +32,10 @@ use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
 pub const LOCK_FILE: &str = ".somnurbs.lock";
 pub const MANIFEST: &str = "manifest.toml";
+/// The cell log of a run (one JSON record per finished cell; see `experiment::log`).
+pub const LOG_FILE: &str = "cells.jsonl";
+/// The fingerprint of the run a folder holds (what `--resume` and `merge` compare).
+pub const FINGERPRINT_FILE: &str = "fingerprint.toml";
 /// Present in a `reproduce` folder from the moment its inputs have loaded until its REPORT.md.
 pub const INCOMPLETE: &str = ".somnurbs-incomplete";
 /// How often a lock holder refreshes its record.
@@ -164,7 +168,7 @@ impl std::fmt::Debug for Lock {
 /// Take the one-writer lock of `dir` (created if missing) for `command` (shown to a refused
 /// writer, e.g. `run spec.toml`).
 pub fn lock(dir: &Path, command: &str) -> Result<Lock> {
-    crate::report::fsio::ensure_dir(dir)?;
+    crate::io::ensure_dir(dir)?;
     let path = dir.join(LOCK_FILE);
     let mut file = OpenOptions::new().read(true).write(true).create(true).truncate(false).open(&path).with_context(|| format!("output folder {} is not writable (cannot open {LOCK_FILE})", dir.display()))?;
     let refused = |who: String| anyhow::anyhow!("output folder {} is in use by another writer: {who}; wait for it to finish or choose another folder", dir.display());
@@ -289,7 +293,7 @@ pub fn require_finished(dir: &Path, role: &str) -> Result<()> {
         if has(INCOMPLETE) {
             bail!("{role} {} is unfinished: its reproduction did not complete ({INCOMPLETE} is still there); finish it with `somnurbs reproduce --resume`", shown.display());
         }
-        let marker = [crate::experiment::log::FINGERPRINT_FILE, crate::experiment::log::LOG_FILE].into_iter().find(|f| has(f));
+        let marker = [FINGERPRINT_FILE, LOG_FILE].into_iter().find(|f| has(f));
         if !has(MANIFEST) {
             if let Some(m) = marker {
                 bail!("{role} {} is unfinished: it has {m} but no {MANIFEST} (the run did not complete; finish it with `somnurbs run SPEC --out {} --resume`)", shown.display(), shown.display());

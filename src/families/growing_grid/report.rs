@@ -5,11 +5,11 @@
 //! The seed's tables did not survive (only its front matter), so there are no published numbers
 //! to print beside ours; the verdicts compare each optimiser with its least-squares start.
 
-use super::fsio::{csv_records, ensure_dir, write_atomic};
-use super::markdown::{num, table};
-use super::plots::{self, grid_edges, style, LineMesh, Panel};
-use crate::experiment::seed001::{MapRun, ProblemKey, Run};
-use crate::optim::open_surface::OpenSurfaceProblem;
+use crate::io::{csv_records, ensure_dir, write_atomic};
+use crate::report::markdown::{num, table};
+use crate::report::plots::{self, grid_edges, style, LineMesh, Panel};
+use crate::families::growing_grid::{MapRun, ProblemKey, Run};
+use crate::spline::open_surface::OpenSurfaceProblem;
 use crate::optim::Problem;
 use anyhow::Result;
 use std::collections::BTreeMap;
@@ -30,7 +30,7 @@ pub fn write(maps: &[MapRun], problems: &BTreeMap<ProblemKey, OpenSurfaceProblem
     let _ = writeln!(md, "The seed's own tables did not survive (only its front matter), so no published figures are printed beside ours.\n");
 
     let rows: Vec<_> = runs.iter().map(|r| r.row.clone()).collect();
-    write_atomic(&out.join("runs.csv"), super::fsio::csv_text(&rows)?.as_bytes())?;
+    write_atomic(&out.join("runs.csv"), crate::io::csv_text(&rows)?.as_bytes())?;
 
     // Map quality.
     let map_rows: Vec<Vec<String>> = maps

@@ -19,13 +19,13 @@
 //! at its interior grid points only. The top view's control points are read in place: its
 //! border classes are the bottom's, so the border columns of its first pass are the bottom's.
 
-use super::aligned::Aligned;
-use super::exact::{solve_exact, ExactOptions, ExactResult, SumOfNorms, Term};
-use super::problem::Problem;
-use super::OptimError;
+use super::{ControlNetParts, SparseBasis};
 use crate::double_net::{DoubleNet, TwoViewGrid, View};
 use crate::geom::Point3;
-pub use crate::spline::{ControlNetParts, SparseBasis};
+use crate::optim::aligned::Aligned;
+use crate::optim::exact::{solve_exact, ExactOptions, ExactResult, SumOfNorms, Term};
+use crate::optim::problem::Problem;
+use crate::optim::OptimError;
 use std::cell::RefCell;
 use std::ops::Range;
 
@@ -49,40 +49,7 @@ pub enum BoxSpec {
     AroundStart { half_width: f64 },
 }
 
-/// Which compiled copy of the fitness kernel runs. (The AVX-512VL copy is hand-written with
-/// 256-bit vectors: compiler-vectorised AVX-512 code picks 512-bit vectors, which the development
-/// machine, an AMD Zen 4 (family 25), runs in two halves, and turns the transpose into scatters.)
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Isa {
-    Baseline,
-    /// AVX2 with FMA.
-    Avx2,
-    /// AVX-512VL (256-bit vectors, 32 registers): the first pass fused with the transpose.
-    Avx512Vl,
-}
-
-impl Isa {
-    /// Every copy, slowest first.
-    pub const ALL: [Isa; 3] = [Isa::Baseline, Isa::Avx2, Isa::Avx512Vl];
-
-    /// The fastest copy this CPU supports.
-    pub fn fastest() -> Isa {
-        Isa::ALL.into_iter().rev().find(|isa| isa.supported()).unwrap_or(Isa::Baseline)
-    }
-
-    /// Whether this CPU runs this copy.
-    pub fn supported(self) -> bool {
-        match self {
-            Isa::Baseline => true,
-            #[cfg(target_arch = "x86_64")]
-            Isa::Avx2 => super::kernels::avx2_fma(),
-            #[cfg(target_arch = "x86_64")]
-            Isa::Avx512Vl => super::kernels::avx512vl(),
-            #[cfg(not(target_arch = "x86_64"))]
-            Isa::Avx2 | Isa::Avx512Vl => false,
-        }
-    }
-}
+pub use crate::optim::kernels::Isa;
 
 /// The control-net problem: minimise Eq. 6.2 over the distinct control points inside a box.
 #[derive(Debug, Clone)]
@@ -656,7 +623,7 @@ impl ControlNetProblem {
             box_axes,
             data_b,
             data_t,
-            isa: super::kernels::simd()?,
+            isa: crate::optim::kernels::simd()?,
             term_points,
             term_coef,
             term_data,

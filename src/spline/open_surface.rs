@@ -7,13 +7,13 @@
 //! is no border shared with a second surface). The box is the smallest one holding the data and
 //! x0, grown by `margin` of its width per side.
 
-use super::problem::Problem;
+use super::basis::basis_matrix;
+use super::fit::least_squares_net;
+use super::knots::{knot_vector, KnotRule};
+use super::param::grid_params;
+use super::{BSplineSurface, Parameterisation, SparseBasis};
 use crate::geom::{self, Point3};
-use crate::spline::basis::basis_matrix;
-use crate::spline::fit::least_squares_net;
-use crate::spline::knots::{knot_vector, KnotRule};
-use crate::spline::param::grid_params;
-use crate::spline::{BSplineSurface, Parameterisation, SparseBasis};
+use crate::optim::problem::Problem;
 
 #[derive(Debug, Clone)]
 pub struct OpenSurfaceProblem {

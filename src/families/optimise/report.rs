@@ -2,14 +2,14 @@
 //! beside B) and M/N (CPU seconds), the win-count tables 6.4-6.9, each optimiser's count of cells
 //! where it beats B, convergence curves and box plots, and the REPORT.md section.
 
-use super::claims::Claim;
-use super::ordered;
-use super::fsio::{csv_records, csv_text, write_atomic};
-use super::markdown::table;
-use super::plots::{self, style, Series};
-use super::reference;
-use crate::experiment::ch6::{OptimRun, ProblemKey};
-use crate::optim::control_net::ControlNetProblem;
+use crate::report::claims::Claim;
+use crate::report::ordered;
+use crate::io::{csv_records, csv_text, write_atomic};
+use crate::report::markdown::table;
+use crate::report::plots::{self, style, Series};
+use crate::report::reference;
+use crate::families::optimise::{OptimRun, ProblemKey};
+use crate::spline::ControlNetProblem;
 use crate::optim::exact::ExactResult;
 use crate::optim::Problem;
 use std::collections::BTreeMap;
@@ -80,7 +80,7 @@ fn render_side_by_side(pairs: &[Beside], name: &str, out: &Path) -> Result<Strin
         let mut r = vec![format!("{cx}x{cy}")];
         for m in &shown {
             let v: Vec<f64> = pairs.iter().filter(|b| &&b.measure == m && b.key[2] == cx.to_string() && b.key[3] == cy.to_string() && b.thesis != 0.0).map(|b| b.ours / b.thesis).collect();
-            r.push(super::markdown::num(super::markdown::median(&v), 3));
+            r.push(crate::report::markdown::num(crate::report::markdown::median(&v), 3));
         }
         mrows.push(r);
     }
@@ -280,7 +280,7 @@ pub fn write(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProble
                 if panels.is_empty() {
                     continue;
                 }
-                super::fsio::ensure_dir(&out.join("png"))?;
+                crate::io::ensure_dir(&out.join("png"))?;
                 let name = format!("png/{appendix}_{d}.png");
                 match plots::overview_png(&out.join(&name), &format!("{d}, {cn} on {grid}: approach B and the MIN-error surface of each optimiser"), &panels, opts.len() + 1) {
                     Ok(()) => {
@@ -316,7 +316,7 @@ pub fn write(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProble
                     series.push(Series { label: o.clone(), colour: style::optimiser_colour(o).unwrap_or_else(|| style::cycle_colour(k)), points: pts, band: Some(band) });
                 }
                 let conv = format!("png/convergence_{grid}_{d}_{}_{cn}.png", p0.name());
-                super::fsio::ensure_dir(&out.join("png"))?;
+                crate::io::ensure_dir(&out.join("png"))?;
                 if let Err(e) = plots::line_chart_png(&out.join(&conv), &format!("{d}, {} {cn} on {grid}: best fitness (median, quartiles)", p0.name()), "evaluations", "surface error", &series, false) {
                     eprintln!("somnurbs: warning: picture skipped: {e}");
                 } else {
@@ -331,8 +331,8 @@ pub fn write(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProble
             }
         }
     }
-    let all_rows: Vec<crate::experiment::ch6::OptimRow> = runs.iter().map(|r| r.row.clone()).collect();
-    let (fopts, ftable) = crate::experiment::compare::friedman_table(&all_rows);
+    let all_rows: Vec<crate::families::optimise::OptimRow> = runs.iter().map(|r| r.row.clone()).collect();
+    let (fopts, ftable) = crate::families::optimise::compare::friedman_table(&all_rows);
     if fopts.len() > 1 {
         if let Ok(f) = crate::stats::friedman::friedman(&ftable) {
             let _ = writeln!(s, "\n### Statistics over all cells\n\nFriedman test over {} cells (mean best per optimiser): chi-squared {:.3}, df {}, p = {:.3e}. Mean ranks (1 = least error): {}.{}\n", f.blocks, f.chi_squared, f.df, f.p_value, fopts.iter().zip(&f.mean_ranks).map(|(o, r)| format!("{o} {r:.2}")).collect::<Vec<_>>().join(", "), f.critical_difference.map(|cd| format!(" Nemenyi critical difference (alpha 0.05): {cd:.3}.")).unwrap_or_default());
@@ -344,18 +344,18 @@ pub fn write(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProble
     }
     let n_ioh = super::ioh::write(runs, out)?;
     let _ = writeln!(s, "\nEvery run's improvements of the best so far in the IOHprofiler format (`ioh/<optimiser>/`: {n_ioh} JSON meta-data files, format version 0.3.3 or later, each with its improvement-based `.dat`), loadable by IOHanalyzer and iohinspector.");
-    let near = runs.iter().filter(|r| r.row.excursion <= super::ch5::NEAR).count();
+    let near = runs.iter().filter(|r| r.row.excursion <= crate::families::fit::report::NEAR).count();
     let worst = runs.iter().max_by(|a, b| a.row.excursion.total_cmp(&b.row.excursion));
     claims.push(Claim {
         chapter: "6".into(),
         statement: "The optimised surfaces stay near the data".into(),
         ours: (near, runs.len()),
         thesis: None,
-        note: format!("runs whose best surfaces' dense excursion from the data's bounding box is at most {}{}", super::ch5::NEAR, worst.map(|w| format!("; largest {:.3e} at {}", w.row.excursion, w.row.cell)).unwrap_or_default()),
+        note: format!("runs whose best surfaces' dense excursion from the data's bounding box is at most {}{}", crate::families::fit::report::NEAR, worst.map(|w| format!("; largest {:.3e} at {}", w.row.excursion, w.row.cell)).unwrap_or_default()),
     });
     let kept = runs.iter().filter(|r| r.row.best <= r.row.initial_best).count();
     claims.push(Claim { chapter: "6".into(), statement: "Every run's best is no worse than its initial population's best".into(), ours: (kept, runs.len()), thesis: None, note: "elitism check over all runs".into() });
     s.push_str("\n### Claims\n\n");
-    s.push_str(&super::claims::write(out, &claims)?);
+    s.push_str(&crate::report::claims::write(out, &claims)?);
     Ok(s)
 }

@@ -2,8 +2,8 @@
 //! columns: each parameterisation's A beside B; the fitted surfaces as two-colour wireframes
 //! evaluated densely between the data parameters), and a chart of surface error against control-net size.
 
-use super::plots::{self, style, LineMesh, Panel, Series};
-use crate::experiment::ch5::FitRun;
+use crate::report::plots::{self, style, LineMesh, Panel, Series};
+use crate::families::fit::FitRun;
 use crate::experiment::spec::GridSize;
 use crate::spline::Approach;
 use anyhow::Result;
@@ -50,7 +50,7 @@ pub fn write(runs: &[FitRun], grid: GridSize, out: &Path) -> Result<Vec<String>>
             }
         }
         let name = format!("png/{appendix}_{d}.png");
-        super::fsio::ensure_dir(&out.join("png"))?;
+        crate::io::ensure_dir(&out.join("png"))?;
         let title = format!("{d}, grid {grid}: conventional (A) and improved (B) surfaces by control net and parameterisation");
         match plots::overview_png(&out.join(&name), &title, &panels, columns.len()) {
             Ok(()) => written.push(name),

@@ -1,7 +1,9 @@
 //! All file output goes through here: every error carries its path, and every finished file is
 //! written to a unique temporary name in the same folder, synced, renamed, and the folder synced,
 //! so a reader never sees half a file and two writers never share a temporary file (the rest of
-//! the output-folder contract is in [`crate::outdir`]).
+//! the output-folder contract is in [`crate::io::outdir`]).
+
+pub mod outdir;
 
 use anyhow::{Context, Result};
 use std::fs::{self, File};
@@ -18,7 +20,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
         ensure_dir(parent)?;
     }
-    let tmp = crate::outdir::temp_name(path, "tmp");
+    let tmp = crate::io::outdir::temp_name(path, "tmp");
     let result = (|| -> std::io::Result<()> {
         let mut f = File::options().write(true).create_new(true).open(&tmp)?;
         f.write_all(bytes)?;
@@ -29,7 +31,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
         let _ = fs::remove_file(&tmp);
     }
     result.with_context(|| format!("cannot write {}", path.display()))?;
-    crate::outdir::sync_dir(path.parent().unwrap_or(Path::new(".")))
+    crate::io::outdir::sync_dir(path.parent().unwrap_or(Path::new(".")))
 }
 
 /// Read a whole file as text, naming it on failure.

@@ -1,0 +1,136 @@
+//! The `[seed004]` section (Chaurasiya & Agarwal: closed cylinder surface): its defaults and
+//! checks.
+
+use crate::experiment::limits::{self, Check};
+use crate::experiment::spec::{Spec, SpecError};
+use serde::Deserialize;
+
+fn default_s4_control_points() -> Vec<usize> {
+    vec![5, 6, 7, 8, 9, 10, 15, 20, 25, 30, 35, 40]
+}
+fn default_s4_table2_control_points() -> Vec<usize> {
+    vec![5, 7]
+}
+fn default_s4_table2_generations() -> Vec<usize> {
+    vec![0, 10, 25, 50, 100, 200, 300, 400, 500]
+}
+fn default_s4_generations() -> usize {
+    500
+}
+fn default_s4_two() -> usize {
+    2
+}
+fn default_s4_three() -> usize {
+    3
+}
+fn default_five() -> f64 {
+    5.0
+}
+fn default_s4_step() -> f64 {
+    0.1
+}
+fn default_s4_search_range() -> f64 {
+    0.25
+}
+
+/// Seed 004 section (Chaurasiya & Agarwal: closed B-spline surface of a cylinder by a binary GA):
+/// numbers of control points around x repeats; defaults are the paper's (Tables I-III) and the
+/// stated readings of experiments/seed004_cylinder.toml.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Seed004Spec {
+    /// Control points around (Table III's list); each is one family of `repeats` GA runs.
+    #[serde(default = "default_s4_control_points")]
+    pub control_points: Vec<usize>,
+    /// The ones Table II follows generation by generation (must be in `control_points`).
+    #[serde(default = "default_s4_table2_control_points")]
+    pub table2_control_points: Vec<usize>,
+    /// Table II's checkpoints (0 = the initial population; each at most `generations`).
+    #[serde(default = "default_s4_table2_generations")]
+    pub table2_generations: Vec<usize>,
+    #[serde(default = "crate::families::optimise::spec::default_ten")]
+    pub repeats: usize,
+    #[serde(default = "default_s4_generations")]
+    pub generations: usize,
+    #[serde(default = "crate::families::optimise::spec::default_ten")]
+    pub population: usize,
+    /// Order around (closed; 3 = quadratic pieces) and up (clamped; 2 = linear), rows of the net.
+    #[serde(default = "default_s4_three")]
+    pub order_around: usize,
+    #[serde(default = "default_s4_two")]
+    pub order_vertical: usize,
+    #[serde(default = "default_s4_two")]
+    pub rows: usize,
+    /// Cylinder and lattice: radius, height, lattice step, accuracy of |x^2 + y^2 - r^2|.
+    #[serde(default = "default_five")]
+    pub radius: f64,
+    #[serde(default = "default_five")]
+    pub height: f64,
+    #[serde(default = "default_s4_step")]
+    pub grid_step: f64,
+    #[serde(default = "default_s4_step")]
+    pub accuracy: f64,
+    /// GA box: the analytical (x, y) of each control column +- this (data units).
+    #[serde(default = "default_s4_search_range")]
+    pub search_range: f64,
+    #[serde(default)]
+    pub ga: crate::optim::binary_ga::BinaryGa,
+}
+
+/// Every value of the `[seed004]` section (after the limits).
+pub(crate) fn validate(spec: &Spec, s: &Seed004Spec) -> Result<(), SpecError> {
+    if s.control_points.is_empty() {
+        return Err(spec.err("seed004.control_points", "is empty"));
+    }
+    if s.order_around < 2 || s.order_around > 8 {
+        return Err(spec.err("seed004.order_around", format!("must be in [2, 8], got {}", s.order_around)));
+    }
+    if let Some(n) = s.control_points.iter().find(|&&n| n < s.order_around || n > 200) {
+        return Err(spec.err("seed004.control_points", format!("{n} is outside [order_around = {}, 200]", s.order_around)));
+    }
+    if let Some(n) = s.table2_control_points.iter().find(|n| !s.control_points.contains(n)) {
+        return Err(spec.err("seed004.table2_control_points", format!("{n} is not in seed004.control_points")));
+    }
+    if let Some(g) = s.table2_generations.iter().find(|&&g| g > s.generations) {
+        return Err(spec.err("seed004.table2_generations", format!("{g} exceeds seed004.generations = {}", s.generations)));
+    }
+    if s.order_vertical < 2 || s.rows < s.order_vertical {
+        return Err(spec.err("seed004.order_vertical", format!("must be at least 2 and at most rows = {}, got {}", s.rows, s.order_vertical)));
+    }
+    if s.repeats == 0 {
+        return Err(spec.err("seed004.repeats", "must be at least 1"));
+    }
+    if s.generations == 0 {
+        return Err(spec.err("seed004.generations", "must be at least 1"));
+    }
+    if s.population < 2 || s.population <= s.ga.elitism {
+        return Err(spec.err("seed004.population", format!("must be at least 2 and above seed004.ga.elitism, got {}", s.population)));
+    }
+    for (key, v) in [("radius", s.radius), ("height", s.height), ("grid_step", s.grid_step), ("accuracy", s.accuracy), ("search_range", s.search_range)] {
+        if !(v > 0.0 && v.is_finite()) {
+            return Err(spec.err(&format!("seed004.{key}"), format!("must be a positive number, got {v}")));
+        }
+    }
+    if s.radius / s.grid_step > 2000.0 || s.height / s.grid_step > 2000.0 {
+        return Err(spec.err("seed004.grid_step", format!("{} makes more than 2000 lattice steps across the cylinder", s.grid_step)));
+    }
+    s.ga.validate().map_err(|e| match e {
+        crate::optim::OptimError::InvalidParameter { key, message } => spec.err(&format!("seed004.{}", key.replace("binary_ga", "ga")), message),
+        other => spec.err("seed004.ga", other),
+    })?;
+    Ok(())
+}
+
+/// The bounds of the `[seed004]` section's sizes and counts (README, "Spec limits").
+pub(crate) fn limits(c: &Check, s: &Seed004Spec) -> Result<(), SpecError> {
+    c.list("seed004.control_points", &s.control_points)?;
+    c.list("seed004.table2_control_points", &s.table2_control_points)?;
+    c.list("seed004.table2_generations", &s.table2_generations)?;
+    c.optimiser_run("seed004", s.repeats, s.generations, s.population)?;
+    c.int("seed004.rows", s.rows, limits::MAX_GRID_SIDE as u64)?;
+    for (key, v) in [("radius", s.radius), ("height", s.height), ("grid_step", s.grid_step), ("accuracy", s.accuracy), ("search_range", s.search_range)] {
+        c.real(&format!("seed004.{key}"), v, 0.0, false, limits::MAX_LENGTH)?;
+    }
+    c.cells("seed004", &[s.control_points.len(), s.repeats])?;
+    Ok(())
+}

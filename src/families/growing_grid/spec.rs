@@ -1,0 +1,124 @@
+//! The `[growing_grid]` section (seed 001): its settings and checks.
+
+use crate::experiment::limits::{self, Check};
+use crate::experiment::spec::{GridSize, Spec, SpecError};
+use serde::Deserialize;
+
+/// Seed 001 section: a Growing Grid (Fritzke 1995) per open-surface data set, one cubic B-spline
+/// surface per (net, parameterisation) from its least-squares fit, then GA/DE/PSO on the control
+/// points (Table 6.1 settings by default).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GrowingGridSpec {
+    pub datasets: Vec<String>,
+    /// Target size of the grown map.
+    pub grid: GridSize,
+    pub control_nets: Vec<GridSize>,
+    pub parameterisations: Vec<String>,
+    /// ga, de, pso.
+    pub optimisers: Vec<String>,
+    #[serde(default = "crate::families::optimise::spec::default_ten")]
+    pub repeats: usize,
+    #[serde(default = "crate::families::optimise::spec::default_generations")]
+    pub generations: usize,
+    #[serde(default = "crate::families::optimise::spec::default_population")]
+    pub population: usize,
+    #[serde(default = "crate::families::optimise::spec::default_init_range")]
+    pub init_range: f64,
+    /// The search box: the data and the least-squares control points, widened by this share.
+    #[serde(default)]
+    pub bounds_margin: f64,
+    #[serde(default = "crate::families::optimise::spec::default_trace_every")]
+    pub trace_every_evals: u64,
+    /// Constants of the growing grid (defaults: `som::growing_grid::GrowingGridParams`).
+    #[serde(default)]
+    pub growth: GrowthSpec,
+    #[serde(default)]
+    pub ga: crate::optim::ga::Ga,
+    #[serde(default)]
+    pub de: crate::optim::de::De,
+    #[serde(default)]
+    pub pso: crate::optim::pso::Pso,
+}
+
+/// The growing grid's constants in a spec.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct GrowthSpec {
+    pub lambda_g: usize,
+    pub eps_g: f64,
+    pub lambda_f: usize,
+    pub eps_f0: f64,
+    pub eps_f1: f64,
+    pub sigma: f64,
+    pub reach2: i32,
+}
+
+impl Default for GrowthSpec {
+    fn default() -> Self {
+        let p = crate::som::growing_grid::GrowingGridParams::default();
+        GrowthSpec { lambda_g: p.lambda_g, eps_g: p.eps_g, lambda_f: p.lambda_f, eps_f0: p.eps_f0, eps_f1: p.eps_f1, sigma: p.sigma, reach2: p.reach2 }
+    }
+}
+
+impl GrowingGridSpec {
+    /// The growing grid's parameters for the target grid.
+    pub fn params(&self) -> crate::som::growing_grid::GrowingGridParams {
+        let g = &self.growth;
+        crate::som::growing_grid::GrowingGridParams { nx: self.grid.nx, ny: self.grid.ny, lambda_g: g.lambda_g, eps_g: g.eps_g, lambda_f: g.lambda_f, eps_f0: g.eps_f0, eps_f1: g.eps_f1, sigma: g.sigma, reach2: g.reach2 }
+    }
+}
+
+/// Every value of the `[growing_grid]` section (after the limits).
+pub(crate) fn validate(spec: &Spec, g: &GrowingGridSpec) -> Result<(), SpecError> {
+    if g.datasets.is_empty() {
+        return Err(spec.err("growing_grid.datasets", "is empty"));
+    }
+    if let Some(d) = g.datasets.iter().find(|d| d.trim().is_empty()) {
+        return Err(spec.err("growing_grid.datasets", format!("empty data set name `{d}`")));
+    }
+    g.params().validate().map_err(|e| spec.err("growing_grid.growth", e))?;
+    if g.control_nets.is_empty() {
+        return Err(spec.err("growing_grid.control_nets", "is empty"));
+    }
+    for cn in &g.control_nets {
+        if cn.nx < 4 || cn.ny < 4 || cn.nx > g.grid.nx || cn.ny > g.grid.ny {
+            return Err(spec.err("growing_grid.control_nets", format!("net {cn} must be at least 4x4 (cubic) and at most the grid {}", g.grid)));
+        }
+    }
+    if g.parameterisations.is_empty() {
+        return Err(spec.err("growing_grid.parameterisations", "is empty"));
+    }
+    for p in &g.parameterisations {
+        p.parse::<crate::spline::Parameterisation>().map_err(|e| spec.err("growing_grid.parameterisations", e))?;
+    }
+    spec.validate_runs("growing_grid", &g.optimisers, &["ga", "de", "pso"], g.repeats, g.generations as u64, g.population)?;
+    if !(g.init_range >= 0.0 && g.init_range.is_finite()) {
+        return Err(spec.err("growing_grid.init_range", format!("must be a non-negative number, got {}", g.init_range)));
+    }
+    if !(g.bounds_margin >= 0.0 && g.bounds_margin.is_finite()) {
+        return Err(spec.err("growing_grid.bounds_margin", format!("must be a non-negative number, got {}", g.bounds_margin)));
+    }
+    if g.trace_every_evals == 0 {
+        return Err(spec.err("growing_grid.trace_every_evals", "must be at least 1"));
+    }
+    Ok(())
+}
+
+/// The bounds of the `[growing_grid]` section's sizes and counts (README, "Spec limits").
+pub(crate) fn limits(c: &Check, g: &GrowingGridSpec) -> Result<(), SpecError> {
+    c.datasets("growing_grid.datasets", &g.datasets)?;
+    c.grids("growing_grid.grid", [&g.grid])?;
+    c.list("growing_grid.control_nets", &g.control_nets)?;
+    c.grids("growing_grid.control_nets", &g.control_nets)?;
+    c.list("growing_grid.parameterisations", &g.parameterisations)?;
+    c.list("growing_grid.optimisers", &g.optimisers)?;
+    c.optimiser_run("growing_grid", g.repeats, g.generations, g.population)?;
+    c.real("growing_grid.init_range", g.init_range, 0.0, true, limits::MAX_RANGE)?;
+    c.real("growing_grid.bounds_margin", g.bounds_margin, 0.0, true, limits::MAX_RANGE)?;
+    c.int("growing_grid.trace_every_evals", g.trace_every_evals, limits::MAX_TRACE_EVERY)?;
+    c.int("growing_grid.growth.lambda_g", g.growth.lambda_g, limits::MAX_ITERATIONS)?;
+    c.int("growing_grid.growth.lambda_f", g.growth.lambda_f, limits::MAX_ITERATIONS)?;
+    c.cells("growing_grid", &[g.datasets.len(), g.control_nets.len(), g.parameterisations.len(), g.optimisers.len(), g.repeats])?;
+    Ok(())
+}

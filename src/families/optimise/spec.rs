@@ -1,0 +1,194 @@
+//! The `[optim]` section (thesis Chapter 6): data sets x control nets x parameterisations x
+//! optimisers x repeats, its defaults (Table 6.1), its checks and its cells.
+
+use crate::experiment::limits::{self, Check};
+use crate::experiment::spec::{GridSize, Spec, SpecError};
+use crate::families::fit::spec::{validate_grid_keys, validate_map_som, FitSom};
+use serde::Deserialize;
+
+/// Chapter 6 section: data sets x control nets x parameterisations x optimisers x repeats, every
+/// optimiser started from approach B's control net of its cell.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OptimSpec {
+    pub datasets: Vec<String>,
+    pub grid: GridSize,
+    pub control_nets: Vec<GridSize>,
+    pub parameterisations: Vec<String>,
+    /// ga, de, pso, csa, icsa.
+    pub optimisers: Vec<String>,
+    #[serde(default = "default_ten")]
+    pub repeats: usize,
+    #[serde(default = "default_generations")]
+    pub generations: usize,
+    #[serde(default = "default_population")]
+    pub population: usize,
+    /// Half-width of the initial range around B (Table 6.1: 5e-6).
+    #[serde(default = "default_init_range")]
+    pub init_range: f64,
+    /// The search box: the data and B's control points, widened by this share of its size.
+    #[serde(default)]
+    pub bounds_margin: f64,
+    /// If set, the search box is instead B's control points +- this per coordinate (Table 6.1's
+    /// "control point coordinate range", 5e-6).
+    #[serde(default)]
+    pub search_range: Option<f64>,
+    #[serde(default)]
+    pub maps: Option<String>,
+    #[serde(default)]
+    pub som: Option<FitSom>,
+    /// Also solve each cell's convex problem exactly in the box (certified) and report every
+    /// optimiser's gap to it.
+    #[serde(default)]
+    pub exact: bool,
+    /// Newton-step cap of the exact solver.
+    #[serde(default = "default_exact_newton_steps")]
+    pub exact_newton_steps: usize,
+    /// The exact solver stops when its certified gap is at most this share of the optimum.
+    #[serde(default = "default_exact_tol")]
+    pub exact_tol: f64,
+    /// Trace checkpoint: the best fitness so far is recorded every this many evaluations.
+    #[serde(default = "default_trace_every")]
+    pub trace_every_evals: u64,
+    #[serde(default)]
+    pub ga: crate::optim::ga::Ga,
+    #[serde(default)]
+    pub de: crate::optim::de::De,
+    #[serde(default)]
+    pub pso: crate::optim::pso::Pso,
+    #[serde(default)]
+    pub csa: crate::optim::cuckoo::Csa,
+    #[serde(default)]
+    pub icsa: crate::optim::cuckoo::Icsa,
+    /// Reading of the knot rule of approach B's start (README "Readings").
+    #[serde(default)]
+    pub knots: crate::spline::KnotRule,
+    /// Beyond the thesis: penalised least squares weight of B's start (0 = plain least squares).
+    #[serde(default)]
+    pub fairness: f64,
+}
+
+impl OptimSpec {
+    /// The readings and options of approach B's fit that every cell starts from.
+    pub fn fit_options(&self) -> crate::spline::FitOptions {
+        crate::spline::FitOptions { knots: self.knots, fairness: self.fairness, ..Default::default() }
+    }
+}
+
+pub(crate) fn default_ten() -> usize {
+    10
+}
+pub(crate) fn default_generations() -> usize {
+    2000
+}
+pub(crate) fn default_population() -> usize {
+    40
+}
+fn default_exact_newton_steps() -> usize {
+    300
+}
+fn default_exact_tol() -> f64 {
+    1e-7
+}
+pub(crate) fn default_trace_every() -> u64 {
+    400
+}
+pub(crate) fn default_init_range() -> f64 {
+    5e-6
+}
+
+
+/// Every value of the `[optim]` section (after the limits).
+pub(crate) fn validate(spec: &Spec, o: &OptimSpec) -> Result<(), SpecError> {
+    validate_grid_keys(spec, "optim", &o.datasets, o.grid, &o.control_nets, &o.parameterisations)?;
+    validate_map_som(spec, "optim", o.som.as_ref())?;
+    spec.validate_runs("optim", &o.optimisers, &["ga", "de", "pso", "csa", "icsa"], o.repeats, o.generations as u64, o.population)?;
+    if !(o.init_range >= 0.0 && o.init_range.is_finite()) {
+        return Err(spec.err("optim.init_range", format!("must be a non-negative number, got {}", o.init_range)));
+    }
+    if let Some(r) = o.search_range {
+        if !(r > 0.0 && r.is_finite()) {
+            return Err(spec.err("optim.search_range", format!("must be a positive number, got {r}")));
+        }
+        if o.init_range > r {
+            return Err(spec.err("optim.init_range", format!("{} is wider than optim.search_range {r}", o.init_range)));
+        }
+    }
+    if !(o.bounds_margin >= 0.0 && o.bounds_margin.is_finite()) {
+        return Err(spec.err("optim.bounds_margin", format!("must be a non-negative number, got {}", o.bounds_margin)));
+    }
+    if o.trace_every_evals == 0 {
+        return Err(spec.err("optim.trace_every_evals", "must be at least 1"));
+    }
+    if !(o.exact_tol > 0.0 && o.exact_tol < 1.0) {
+        return Err(spec.err("optim.exact_tol", format!("must be in (0,1), got {}", o.exact_tol)));
+    }
+    spec.validate_optimiser_params("optim", [o.ga.validate(), o.de.validate(), o.pso.validate(), o.csa.validate(), o.icsa.validate()])?;
+    Ok(())
+}
+
+/// The flat list of optimisation cells (data x net x parameterisation x optimiser x repeat).
+pub fn cells(spec: &Spec) -> Vec<OptimCell> {
+    let Some(o) = &spec.file.optim else { return Vec::new() };
+    let mut cells = Vec::new();
+    for dataset in &o.datasets {
+        for cn in &o.control_nets {
+            for p in &o.parameterisations {
+                let Ok(param) = p.parse() else { continue };
+                for opt in &o.optimisers {
+                    for repeat in 0..o.repeats {
+                        cells.push(OptimCell { dataset: crate::data::registry::name_of(dataset), grid: o.grid, cn: *cn, param, optimiser: opt.clone(), repeat });
+                    }
+                }
+            }
+        }
+    }
+    cells
+}
+
+/// One Chapter 6 cell: one optimiser run from approach B's control net.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OptimCell {
+    pub dataset: String,
+    pub grid: GridSize,
+    pub cn: GridSize,
+    pub param: crate::spline::Parameterisation,
+    pub optimiser: String,
+    pub repeat: usize,
+}
+
+impl crate::experiment::runner::Cell for OptimCell {
+    fn key(&self) -> String {
+        OptimCell::key(self)
+    }
+}
+
+impl OptimCell {
+    pub fn key(&self) -> String {
+        format!("optim/{}/{}/{}/{}/{}/r{}", self.dataset, self.grid, self.cn, self.param.name(), self.optimiser, self.repeat)
+    }
+}
+
+/// The bounds of the `[optim]` section's sizes and counts (README, "Spec limits").
+pub(crate) fn limits(c: &Check, o: &OptimSpec) -> Result<(), SpecError> {
+    c.datasets("optim.datasets", &o.datasets)?;
+    c.grids("optim.grid", [&o.grid])?;
+    c.list("optim.control_nets", &o.control_nets)?;
+    c.grids("optim.control_nets", &o.control_nets)?;
+    c.list("optim.parameterisations", &o.parameterisations)?;
+    c.list("optim.optimisers", &o.optimisers)?;
+    c.optimiser_run("optim", o.repeats, o.generations, o.population)?;
+    c.real("optim.fairness", o.fairness, 0.0, true, limits::MAX_FAIRNESS)?;
+    c.real("optim.init_range", o.init_range, 0.0, true, limits::MAX_RANGE)?;
+    c.real("optim.bounds_margin", o.bounds_margin, 0.0, true, limits::MAX_RANGE)?;
+    if let Some(r) = o.search_range {
+        c.real("optim.search_range", r, 0.0, false, limits::MAX_RANGE)?;
+    }
+    c.int("optim.trace_every_evals", o.trace_every_evals, limits::MAX_TRACE_EVERY)?;
+    c.int("optim.exact_newton_steps", o.exact_newton_steps, limits::MAX_NEWTON_STEPS)?;
+    if let Some(som) = &o.som {
+        c.int("optim.som.iterations", som.iterations, limits::MAX_ITERATIONS)?;
+    }
+    c.cells("optim", &[o.datasets.len(), o.control_nets.len(), o.parameterisations.len(), o.optimisers.len(), o.repeats])?;
+    Ok(())
+}

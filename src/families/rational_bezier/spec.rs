@@ -1,0 +1,174 @@
+//! The `[seed002]` section (Yahya: rational Bezier surfaces): its defaults and checks.
+
+use crate::experiment::limits::{self, Check};
+use crate::experiment::spec::{Spec, SpecError};
+use serde::Deserialize;
+
+fn default_s2_surfaces() -> Vec<String> {
+    ["surface1", "surface2", "surface3", "surface4"].iter().map(|s| s.to_string()).collect()
+}
+fn default_s2_optimisers() -> Vec<String> {
+    ["ga", "de", "pso"].iter().map(|s| s.to_string()).collect()
+}
+fn default_s2_generations() -> usize {
+    1000
+}
+fn default_s2_grid() -> usize {
+    21
+}
+fn default_s2_population() -> usize {
+    40
+}
+fn default_s2_init_range() -> f64 {
+    0.05
+}
+fn default_s2_margin() -> f64 {
+    0.25
+}
+fn default_s2_w_min() -> f64 {
+    0.01
+}
+fn default_s2_trace() -> u64 {
+    400
+}
+fn default_s2_outlines() -> Vec<String> {
+    crate::spline::conic::OUTLINES.iter().map(|s| s.to_string()).collect()
+}
+fn default_one() -> f64 {
+    1.0
+}
+fn default_s2_l() -> usize {
+    14
+}
+fn default_s2_d() -> f64 {
+    2.6
+}
+fn default_s2_curve_generations() -> usize {
+    200
+}
+
+/// Seed 002 section: surfaces x optimisers x repeats. The paper's settings tables did not survive
+/// in the seed text, so the defaults are stated choices (see experiments/seed002_rational.toml).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Seed002Spec {
+    /// surface1..surface4 (SPEC 7; domains fixed in `rational_bezier::TestSurface`).
+    #[serde(default = "default_s2_surfaces")]
+    pub surfaces: Vec<String>,
+    /// ga, de, pso.
+    #[serde(default = "default_s2_optimisers")]
+    pub optimisers: Vec<String>,
+    #[serde(default = "crate::families::optimise::spec::default_ten")]
+    pub repeats: usize,
+    /// Iterations (the paper's charts run to 1000).
+    #[serde(default = "default_s2_generations")]
+    pub generations: usize,
+    #[serde(default = "default_s2_population")]
+    pub population: usize,
+    /// Samples per side of the data grid (odd).
+    #[serde(default = "default_s2_grid")]
+    pub grid: usize,
+    /// Half-width of the initial range around the start, as a share of the data's largest
+    /// bounding-box extent (the data are not normalised; the domains differ in scale).
+    #[serde(default = "default_s2_init_range")]
+    pub init_range: f64,
+    /// Search box: the data's bounding box widened by this share of its extent per axis.
+    #[serde(default = "default_s2_margin")]
+    pub bounds_margin: f64,
+    /// w11 is searched in [w_min, 2 - w_min] (the G1 joins need 0 < w11 < 2).
+    #[serde(default = "default_s2_w_min")]
+    pub w_min: f64,
+    #[serde(default = "default_s2_trace")]
+    pub trace_every_evals: u64,
+    /// Generated 2-D outlines for the conic curve fits (square, letter_d, letter_p); empty: none.
+    #[serde(default = "default_s2_outlines")]
+    pub outlines: Vec<String>,
+    /// Arc-length spacing of the outline samples (one point per unit, pixel-like).
+    #[serde(default = "default_one")]
+    pub outline_spacing: f64,
+    /// SAM06 length parameter L (default 14).
+    #[serde(default = "default_s2_l")]
+    pub sam06_l: usize,
+    /// SAM06 distance threshold D (default 2.6).
+    #[serde(default = "default_s2_d")]
+    pub sam06_d: f64,
+    /// SAM06 domination range R (default L).
+    #[serde(default)]
+    pub sam06_r: Option<usize>,
+    /// Iterations of each conic fit (the paper's curve charts show 100 and 200).
+    #[serde(default = "default_s2_curve_generations")]
+    pub curve_generations: usize,
+    #[serde(default)]
+    pub ga: crate::optim::ga::Ga,
+    #[serde(default)]
+    pub de: crate::optim::de::De,
+    #[serde(default)]
+    pub pso: crate::optim::pso::Pso,
+}
+
+/// Every value of the `[seed002]` section (after the limits).
+pub(crate) fn validate(spec: &Spec, s: &Seed002Spec) -> Result<(), SpecError> {
+    if s.surfaces.is_empty() {
+        return Err(spec.err("seed002.surfaces", "is empty"));
+    }
+    for name in &s.surfaces {
+        if crate::spline::rational_bezier::TestSurface::by_name(name).is_none() {
+            return Err(spec.err("seed002.surfaces", format!("unknown surface `{name}` (expected surface1, surface2, surface3 or surface4)")));
+        }
+    }
+    spec.validate_runs("seed002", &s.optimisers, &["ga", "de", "pso"], s.repeats, s.generations as u64, s.population)?;
+    if s.grid < 5 || s.grid.is_multiple_of(2) {
+        return Err(spec.err("seed002.grid", format!("must be odd and at least 5, got {}", s.grid)));
+    }
+    if !(s.init_range >= 0.0 && s.init_range.is_finite()) {
+        return Err(spec.err("seed002.init_range", format!("must be a non-negative number, got {}", s.init_range)));
+    }
+    if !(s.bounds_margin >= 0.0 && s.bounds_margin.is_finite()) {
+        return Err(spec.err("seed002.bounds_margin", format!("must be a non-negative number, got {}", s.bounds_margin)));
+    }
+    if !(s.w_min > 0.0 && s.w_min < 1.0) {
+        return Err(spec.err("seed002.w_min", format!("must be in (0, 1), got {}", s.w_min)));
+    }
+    if s.trace_every_evals == 0 {
+        return Err(spec.err("seed002.trace_every_evals", "must be at least 1"));
+    }
+    for name in &s.outlines {
+        if crate::spline::conic::outline(name).is_none() {
+            return Err(spec.err("seed002.outlines", format!("unknown outline `{name}` (expected square, letter_d or letter_p)")));
+        }
+    }
+    if !(s.outline_spacing > 0.0 && s.outline_spacing <= 10.0) {
+        return Err(spec.err("seed002.outline_spacing", format!("must be in (0, 10], got {}", s.outline_spacing)));
+    }
+    if s.sam06_l < 2 {
+        return Err(spec.err("seed002.sam06_l", format!("must be at least 2, got {}", s.sam06_l)));
+    }
+    if !(s.sam06_d > 0.0 && s.sam06_d.is_finite()) {
+        return Err(spec.err("seed002.sam06_d", format!("must be a positive number, got {}", s.sam06_d)));
+    }
+    if s.curve_generations == 0 {
+        return Err(spec.err("seed002.curve_generations", "must be at least 1"));
+    }
+    spec.validate_optimiser_params("seed002", [s.ga.validate(), s.de.validate(), s.pso.validate()])?;
+    Ok(())
+}
+
+/// The bounds of the `[seed002]` section's sizes and counts (README, "Spec limits").
+pub(crate) fn limits(c: &Check, s: &Seed002Spec) -> Result<(), SpecError> {
+    c.list("seed002.surfaces", &s.surfaces)?;
+    c.list("seed002.optimisers", &s.optimisers)?;
+    c.list("seed002.outlines", &s.outlines)?;
+    c.optimiser_run("seed002", s.repeats, s.generations, s.population)?;
+    c.int("seed002.curve_generations", s.curve_generations, limits::MAX_GENERATIONS)?;
+    c.int("seed002.grid", s.grid, 1001)?;
+    c.real("seed002.init_range", s.init_range, 0.0, true, limits::MAX_RANGE)?;
+    c.real("seed002.bounds_margin", s.bounds_margin, 0.0, true, limits::MAX_RANGE)?;
+    c.int("seed002.trace_every_evals", s.trace_every_evals, limits::MAX_TRACE_EVERY)?;
+    c.int("seed002.sam06_l", s.sam06_l, 1000)?;
+    if let Some(r) = s.sam06_r {
+        c.int("seed002.sam06_r", r, 1000)?;
+    }
+    c.real("seed002.sam06_d", s.sam06_d, 0.0, false, limits::MAX_LENGTH)?;
+    c.cells("seed002", &[s.surfaces.len().max(s.outlines.len()), s.optimisers.len(), s.repeats])?;
+    Ok(())
+}
