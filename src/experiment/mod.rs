@@ -96,6 +96,11 @@ pub fn logged_cell_keys(spec: &Spec) -> Vec<String> {
     family::present(spec).iter().flat_map(|f| f.logged_keys(spec)).collect()
 }
 
+/// [`logged_cell_keys`] of every variant of a run, in order.
+fn logged_variant_keys(variants: &[Spec]) -> Vec<String> {
+    variants.iter().flat_map(logged_cell_keys).collect()
+}
+
 /// The manifest: enough to re-run exactly.
 #[derive(Debug, Serialize)]
 pub struct Manifest {
@@ -107,6 +112,11 @@ pub struct Manifest {
     /// `I/N` when this folder holds one shard of the cells (no tables).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub shard: Option<String>,
+    /// The command line's `--set KEY=VALUE` and `--sweep KEY=V1,V2` (absent for a plain run).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub set: Vec<String>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub sweep: Vec<String>,
     pub crate_version: String,
     pub git_commit: String,
     pub git_dirty: bool,
@@ -145,17 +155,21 @@ impl Default for Definitions {
     }
 }
 
-/// The fingerprint of a spec run in a folder (what `--resume` and `merge` compare).
-pub fn fingerprint(spec: &Spec, shard: Option<log::Shard>) -> log::Fingerprint {
+/// The fingerprint of a run of a spec's variants (one for a plain run) in a folder (what
+/// `--resume` and `merge` compare).
+pub fn fingerprint(variants: &[Spec], shard: Option<log::Shard>) -> log::Fingerprint {
+    let spec = &variants[0];
     log::Fingerprint {
         spec_name: spec.file.name.clone(),
         spec_path: spec.path.clone(),
         spec_sha256: hex::encode(<sha2::Sha256 as sha2::Digest>::digest(spec.text.as_bytes())),
         profile: spec.profile.clone().unwrap_or_else(|| "default".into()),
         master_seed: spec.file.master_seed,
-        cells: logged_cell_keys(spec).len(),
+        cells: logged_variant_keys(variants).len(),
         shard: shard.map(|s| s.to_string()),
         spec_text: spec.text.clone(),
+        set: spec.cli.set.clone(),
+        sweep: spec.cli.sweep.clone(),
     }
 }
 
@@ -167,13 +181,21 @@ pub fn fingerprint(spec: &Spec, shard: Option<log::Shard>) -> log::Fingerprint {
 /// writes them). With `resume`, the cells in the folder's log are kept if the folder's
 /// fingerprint and every logged seed match, else the run is refused before anything is touched.
 pub fn run_spec(spec: &Spec, ctx: &RunContext) -> Result<PathBuf> {
-    let _lock = crate::outdir::lock(&ctx.out, &format!("run {}", spec.path))?;
-    run_spec_locked(spec, ctx)
+    run_variants(std::slice::from_ref(spec), ctx)
 }
 
-/// [`run_spec`] in a folder the caller has locked.
-fn run_spec_locked(spec: &Spec, ctx: &RunContext) -> Result<PathBuf> {
-    let fp = fingerprint(spec, ctx.shard);
+/// [`run_spec`] of the variants of one spec (`--set`/`--sweep`: [`spec::CliOverrides`]) into one
+/// folder: one cell log, one fingerprint and manifest, the family's tables over every variant.
+pub fn run_variants(variants: &[Spec], ctx: &RunContext) -> Result<PathBuf> {
+    let spec = variants.first().context("no spec to run")?;
+    let _lock = crate::outdir::lock(&ctx.out, &format!("run {}", spec.path))?;
+    run_spec_locked(variants, ctx)
+}
+
+/// [`run_variants`] in a folder the caller has locked.
+fn run_spec_locked(variants: &[Spec], ctx: &RunContext) -> Result<PathBuf> {
+    let spec = variants.first().context("no spec to run")?;
+    let fp = fingerprint(variants, ctx.shard);
     if ctx.resume {
         match log::Fingerprint::read(&ctx.out)? {
             Some(old) => {
@@ -193,7 +215,7 @@ fn run_spec_locked(spec: &Spec, ctx: &RunContext) -> Result<PathBuf> {
     let tables = ctx.shard.is_none();
 
     let family = family::present(spec).into_iter().next().context("the spec has no experiment section")?;
-    let family::Outcome { section, cpu_s: cpu, cells } = family.run(spec, ctx, tables)?;
+    let family::Outcome { section, cpu_s: cpu, cells } = family.run_variants(variants, ctx, tables)?;
     ctx.begin()?;
 
     let manifest = Manifest {
@@ -203,6 +225,8 @@ fn run_spec_locked(spec: &Spec, ctx: &RunContext) -> Result<PathBuf> {
         profile: fp.profile.clone(),
         master_seed: spec.file.master_seed,
         shard: fp.shard.clone(),
+        set: fp.set.clone(),
+        sweep: fp.sweep.clone(),
         crate_version: env!("CARGO_PKG_VERSION").into(),
         git_commit: env!("SOMNURBS_GIT_COMMIT").into(),
         git_dirty: env!("SOMNURBS_GIT_DIRTY") == "true",
@@ -271,8 +295,8 @@ pub fn merge(shards: &[PathBuf], ctx: &RunContext) -> Result<PathBuf> {
         anyhow::bail!("merge: shard {missing}/{count} is missing");
     }
     let fp = first.expect("at least one shard");
-    let spec = Spec::parse(&fp.spec_path, &fp.spec_text, if fp.profile == "default" { None } else { Some(fp.profile.as_str()) }).map_err(|e| anyhow::anyhow!("{e}"))?;
-    let expected: std::collections::BTreeSet<String> = logged_cell_keys(&spec).into_iter().collect();
+    let variants = fp.overrides().variants(&fp.spec_path, &fp.spec_text, if fp.profile == "default" { None } else { Some(fp.profile.as_str()) }).context("merge: the shards' spec")?;
+    let expected: std::collections::BTreeSet<String> = logged_variant_keys(&variants).into_iter().collect();
     if let Some(k) = expected.iter().find(|k| !records.contains_key(*k)) {
         anyhow::bail!("merge: no shard logged cell {k} (the shards hold {} of the spec's {} cells)", expected.iter().filter(|k| records.contains_key(*k)).count(), expected.len());
     }
@@ -288,8 +312,8 @@ pub fn merge(shards: &[PathBuf], ctx: &RunContext) -> Result<PathBuf> {
             out_log.push(key, rec)?;
         }
     }
-    fingerprint(&spec, None).write(&ctx.out)?;
-    run_spec_locked(&spec, &RunContext { resume: true, shard: None, ..ctx.clone() })
+    fingerprint(&variants, None).write(&ctx.out)?;
+    run_spec_locked(&variants, &RunContext { resume: true, shard: None, ..ctx.clone() })
 }
 
 /// Resolve the data directory: flag, else `SOMNURBS_DATA`, else `./data`.

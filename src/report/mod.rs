@@ -31,7 +31,7 @@ pub fn report_md(spec: &Spec, m: &Manifest, sections: &[String]) -> String {
     let commit = if m.git_commit.is_empty() { "unknown".to_string() } else { format!("{}{}", &m.git_commit[..m.git_commit.len().min(12)], if m.git_dirty { " (dirty)" } else { "" }) };
     let _ = writeln!(
         s,
-        "Spec `{}` (sha256 {}), profile `{}`, master seed {}, somnurbs {} at commit {}, {} on {} with {} thread(s): {} cells in {:.1} s wall, {:.1} s CPU in cells. Re-run: `somnurbs run {}{}`.\n",
+        "Spec `{}` (sha256 {}), profile `{}`, master seed {}, somnurbs {} at commit {}, {} on {} with {} thread(s): {} cells in {:.1} s wall, {:.1} s CPU in cells. Re-run: `somnurbs run {}{}{}`.\n",
         m.spec_path,
         &m.spec_sha256[..12],
         m.profile,
@@ -45,7 +45,8 @@ pub fn report_md(spec: &Spec, m: &Manifest, sections: &[String]) -> String {
         m.wall_seconds,
         m.cpu_seconds_cells,
         m.spec_path,
-        if m.profile == "default" { String::new() } else { format!(" --profile {}", m.profile) }
+        if m.profile == "default" { String::new() } else { format!(" --profile {}", m.profile) },
+        m.set.iter().map(|a| format!(" --set {a}")).chain(m.sweep.iter().map(|a| format!(" --sweep {a}"))).collect::<String>()
     );
     for sec in sections {
         s.push_str(sec);
