@@ -74,6 +74,16 @@ pub fn validate(points: &[Point3], min_points: usize) -> Result<(), DataError> {
     Ok(())
 }
 
+/// Refuse a cloud of fewer points than the map trained on it has neurons: units would be left
+/// with no data of their own, so the map could not organise over the surface. `entry` names the
+/// data set as the spec wrote it (its file).
+pub fn require_points(entry: &str, points: usize, neurons: usize, map: &str) -> Result<(), DataError> {
+    if points < neurons {
+        return Err(DataError::Invalid(format!("data set `{entry}`: {points} points, fewer than the {neurons} neurons of the {map} map trained on it (use a smaller grid or more points)")));
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -90,6 +90,12 @@ pub fn load_datasets(names: &[String], ctx: &RunContext) -> Result<BTreeMap<Stri
     Ok(out)
 }
 
+/// Refuse training `cell` on a data set (`entry`) of fewer points than its map has neurons.
+pub fn require_points(entry: &str, points: usize, cell: &SomCell) -> Result<()> {
+    let neurons = cell.model.topology(cell.grid.nx, cell.grid.ny).map_err(anyhow::Error::msg)?.counts().non;
+    Ok(crate::data::require_points(entry, points, neurons, &format!("{} {}", cell.model.key(), cell.grid))?)
+}
+
 /// Train one cell (pure apart from the CPU clock).
 pub fn run_cell(cell: &SomCell, data: &[Point3], params: &SomParams, master_seed: u64) -> Result<SomRun> {
     let key = cell.key();
@@ -109,6 +115,12 @@ pub fn run(spec: &Spec, ctx: &RunContext) -> Result<Vec<SomRun>> {
     let data = load_datasets(&som_spec.datasets, ctx)?;
     let params = SomParams { iterations: som_spec.iterations, alpha0: som_spec.alpha0, sigma0: som_spec.sigma0 };
     let cells = spec.som_cells();
+    for entry in &som_spec.datasets {
+        let name = crate::data::registry::name_of(entry);
+        for c in cells.iter().filter(|c| c.dataset == name) {
+            require_points(entry, data[&name].points.len(), c)?;
+        }
+    }
     runner::run_logged(&cells, ctx, &spec.file.name, |cell| run_cell(cell, &data[&cell.dataset].points, &params, spec.file.master_seed), |cell, (row, weights)| Ok(SomRun { cell: cell.clone(), row, weights }))
 }
 

@@ -122,6 +122,7 @@ fn recompute_map(spec: &Spec, ctx: &RunContext, data: &str, grid: GridSize, som:
     let clouds = ch4::load_datasets(&[data.to_string()], ctx)?;
     let name = crate::data::registry::name_of(data);
     let cell = SomCell { dataset: name.clone(), model: Model::Dnsom, grid, repeat: 0 };
+    ch4::require_points(data, clouds[&name].points.len(), &cell)?;
     let run = ch4::run_cell(&cell, &clouds[&name].points, &params, seed)?;
     Ok(MapSource {
         grid: grid_from_weights(grid.nx, grid.ny, &run.weights),

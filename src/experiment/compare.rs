@@ -34,6 +34,12 @@ pub fn compare(args: &CompareArgs) -> Result<()> {
     if !(args.rope >= 0.0 && args.rope.is_finite()) || args.bayes_samples == 0 {
         anyhow::bail!("--rope must be finite and >= 0 (got {}) and --bayes-samples at least 1 (got {})", args.rope, args.bayes_samples);
     }
+    if !args.results.is_dir() {
+        anyhow::bail!("{}: no such results folder", args.results.display());
+    }
+    // compare writes its tables into the folder: one writer at a time (a run still writing it
+    // refuses this, naming itself).
+    let _lock = crate::outdir::lock(&args.results, "compare")?;
     let path = args.results.join("runs.csv");
     let mut reader = csv::Reader::from_path(&path).with_context(|| format!("cannot read {}", path.display()))?;
     let mut rows: Vec<OptimRow> = Vec::new();
