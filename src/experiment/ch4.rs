@@ -79,11 +79,11 @@ impl SomRow {
 }
 
 /// Load every data set a spec names, once, by its name ([`crate::data::registry::dataset_name`]).
-pub fn load_datasets(names: &[String], ctx: &RunContext) -> Result<BTreeMap<String, Arc<PointCloud>>> {
+pub fn load_datasets(spec: &Spec, names: &[String], ctx: &RunContext) -> Result<BTreeMap<String, Arc<PointCloud>>> {
     let mut out = BTreeMap::new();
     for name in names {
         if !out.contains_key(&crate::data::registry::name_of(name)) {
-            let cloud = crate::data::registry::load_dataset(name, &ctx.data_dir)?;
+            let cloud = ctx.loader(spec).load(name)?;
             out.insert(cloud.name.clone(), Arc::new(cloud));
         }
     }
@@ -112,7 +112,7 @@ pub fn run_cell(cell: &SomCell, data: &[Point3], params: &SomParams, master_seed
 /// Run every SOM cell of a spec, logging each finished cell to the folder's cell log.
 pub fn run(spec: &Spec, ctx: &RunContext) -> Result<Vec<SomRun>> {
     let som_spec = spec.file.som.as_ref().context("spec has no [som] section")?;
-    let data = load_datasets(&som_spec.datasets, ctx)?;
+    let data = load_datasets(spec, &som_spec.datasets, ctx)?;
     let params = SomParams { iterations: som_spec.iterations, alpha0: som_spec.alpha0, sigma0: som_spec.sigma0 };
     let cells = spec.som_cells();
     for entry in &som_spec.datasets {

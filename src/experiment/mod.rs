@@ -66,6 +66,13 @@ impl RunContext {
         Ok(())
     }
 
+    /// How `spec`'s data sets load: from this run's data folder, relative paths from the spec's
+    /// own folder, scaled by the spec's `normalise`.
+    pub fn loader(&self, spec: &Spec) -> crate::data::registry::Loader {
+        let base = Path::new(&spec.path).parent().map(Path::to_path_buf).unwrap_or_default();
+        crate::data::registry::Loader { data_dir: self.data_dir.clone(), base, normalise: spec.file.normalise }
+    }
+
     /// The master seed the cell log tags records with (0 outside `run_spec`).
     pub fn master_seed(&self) -> u64 {
         self.session.as_ref().map_or(0, |s| s.master_seed)
@@ -188,6 +195,10 @@ pub fn run_spec(spec: &Spec, ctx: &RunContext) -> Result<PathBuf> {
 /// folder: one cell log, one fingerprint and manifest, the family's tables over every variant.
 pub fn run_variants(variants: &[Spec], ctx: &RunContext) -> Result<PathBuf> {
     let spec = variants.first().context("no spec to run")?;
+    // A data file the spec names but that is not there: refused before the folder is touched.
+    for d in limits::dataset_entries(spec) {
+        ctx.loader(spec).require_file(d).with_context(|| format!("{}: data set `{d}`", spec.path))?;
+    }
     let _lock = crate::outdir::lock(&ctx.out, &format!("run {}", spec.path))?;
     run_spec_locked(variants, ctx)
 }

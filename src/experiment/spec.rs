@@ -260,6 +260,9 @@ pub struct SpecFile {
     /// Output folder (overridden by `--out`).
     #[serde(default)]
     pub output: Option<String>,
+    /// How the data sets are scaled: per_axis (the thesis), uniform (aspect ratios kept) or none.
+    #[serde(default)]
+    pub normalise: crate::data::Normalise,
     /// Chapter 4: SOM models.
     #[serde(default)]
     pub som: Option<SomSpec>,

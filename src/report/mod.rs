@@ -48,6 +48,9 @@ pub fn report_md(spec: &Spec, m: &Manifest, sections: &[String]) -> String {
         if m.profile == "default" { String::new() } else { format!(" --profile {}", m.profile) },
         m.set.iter().map(|a| format!(" --set {a}")).chain(m.sweep.iter().map(|a| format!(" --sweep {a}"))).collect::<String>()
     );
+    if !crate::experiment::limits::dataset_entries(spec).is_empty() {
+        let _ = writeln!(s, "Data sets are {} (`normalise`); a data set given as a relative path is read from the spec's folder.\n", spec.file.normalise.describe());
+    }
     for sec in sections {
         s.push_str(sec);
         s.push('\n');
