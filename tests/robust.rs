@@ -341,11 +341,14 @@ fn data_with_fewer_points_than_the_maps_neurons_is_refused_naming_the_file() {
     let c = Case::new();
     let pts: String = (0..60).map(|k| { let t = k as f64 * 0.7; format!("{} {} {}\n", t.cos(), t.sin(), (k as f64 * 0.37).sin()) }).collect();
     c.write("few.xyz", &pts);
-    let som = "name = \"s\"\nmaster_seed = 1\n[som]\ndatasets = [\"few.xyz\"]\niterations = 50\n[[som.group]]\nmodels = [\"som2d\"]\ngrids = [\"GRID\"]\n";
+    let som = "name = \"s\"\nmaster_seed = 1\n[som]\ndatasets = [\"few.xyz\"]\niterations = 50\n[[som.group]]\nmodels = [\"som2d\", \"dnsom\"]\ngrids = [\"GRID\"]\n";
     c.write("big.toml", &som.replace("GRID", "10x10"));
-    c.fails(&["run", "big.toml", "--out", "big"], &["few.xyz", "60 points", "fewer than the 100 neurons", "som2d 10x10"]);
+    c.fails(&["run", "big.toml", "--out", "big"], &["few.xyz", "60 points", "fewer than the", "neurons of the dnsom 10x10"]);
     assert!(!c.path("big/cells.jsonl").exists() && !c.path("big/manifest.toml").exists());
-    c.write("small.toml", &som.replace("GRID", "6x6"));
+    // A SOM2D may have more neurons than points (as the thesis' SOM3D does); a small DNSOM runs.
+    c.write("s2d.toml", &som.replace("GRID", "10x10").replace("\"som2d\", \"dnsom\"", "\"som2d\""));
+    c.ok(&["run", "s2d.toml", "--out", "s2d"]);
+    c.write("small.toml", &som.replace("GRID", "4x4"));
     c.ok(&["run", "small.toml", "--out", "small"]);
     // Chapter 6 recomputing a 20x20 DNSOM map from it.
     c.write("o.toml", &SPEC.replace("\"sphere\"", "\"few.xyz\""));
