@@ -3,7 +3,7 @@
 //! with BLAS 8.3 us; the thesis' DE about 600 us), one full DE run (2000 generations x 40) on it
 //! (target under 0.2 s; scipy's differential_evolution 2.75 s; the thesis 48 s), and GA and PSO runs.
 
-use somnurbs::experiment::{runner, spec::GridSize, RunContext};
+use somnurbs::experiment::{runner, spec::GridSize};
 use somnurbs::families::som::spec::SomCell;
 use somnurbs::families;
 use somnurbs::optim::{default_optimiser, Budget, ExactOptions, Problem};
@@ -15,10 +15,9 @@ use somnurbs::spline::{fit_two_view, Approach, Parameterisation};
 use std::time::Instant;
 
 fn main() {
-    let ctx = RunContext::new(std::env::temp_dir(), 1, somnurbs::experiment::data_dir(None));
-    let data = families::som::load_datasets(&["spindle".to_string()], &ctx).unwrap();
+    let spindle = somnurbs::data::registry::load_dataset("spindle", &somnurbs::experiment::data_dir(None)).unwrap();
     let cell = SomCell { dataset: "spindle".into(), model: Model::Dnsom, grid: GridSize { nx: 20, ny: 20 }, repeat: 0 };
-    let run = families::som::run_cell(&cell, &data["spindle"].points, &SomParams::default(), 2023).unwrap();
+    let run = families::som::run_cell(&cell, &spindle.points, &SomParams::default(), 2023).unwrap();
     let grid = families::fit::grid_from_weights(20, 20, &run.weights);
     let fit = fit_two_view(&grid, 18, 18, Parameterisation::ChordLength, Approach::Improved, &Default::default()).unwrap();
     let problem = ControlNetProblem::new(fit.control_net_parts(&grid).unwrap(), BoxSpec::Cover { fraction: 0.0 }).unwrap();
@@ -62,7 +61,7 @@ fn main() {
         println!("fitness, {isa:?} copy: {ns:.0} ns = {cycles:.0} cycles per evaluation; FMA lower bound {bound:.0} cycles (2 pipes x 4 lanes): {:.2}x the bound", cycles / bound);
     }
     if std::env::var("BENCH_SCALING").is_ok_and(|v| v != "0") {
-        scaling(&data["spindle"].points, mhz);
+        scaling(&spindle.points, mhz);
     }
     let generations: usize = std::env::var("BENCH_GENERATIONS").ok().and_then(|v| v.parse().ok()).unwrap_or(2000);
     // BENCH_ONLY=de,pso runs only those optimisers and skips the exact optimum (for profiling).

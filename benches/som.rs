@@ -11,7 +11,7 @@ use std::time::Instant;
 fn main() {
     let data_dir = somnurbs::experiment::data_dir(None);
     let ctx = RunContext::new(std::env::temp_dir(), 1, data_dir.clone());
-    let spindle = families::som::load_datasets(&["spindle".to_string()], &ctx).expect("spindle")["spindle"].clone();
+    let spindle = somnurbs::data::registry::load_dataset("spindle", &data_dir).expect("spindle");
 
     // 1. DNSOM 30x30, T = 30000, one core: median of 5 seeds.
     let topo = Model::Dnsom.topology(30, 30).unwrap();
@@ -34,7 +34,7 @@ fn main() {
     let cells: Vec<_> = families::som::spec::cells(&spec).into_iter().filter(|c| c.grid.nx == c.grid.ny).collect();
     let jobs = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
     let ctx = RunContext { jobs, ..ctx };
-    let data = families::som::load_datasets(&spec.file.som.as_ref().unwrap().datasets, &ctx).expect("data sets");
+    let data = families::som::load_datasets(&spec, &spec.file.som.as_ref().unwrap().datasets, &ctx).expect("data sets");
     let t0 = Instant::now();
     let runs = runner::run_cells(&cells, jobs, "appendix B", |c| families::som::run_cell(c, &data[&c.dataset].points, &params, spec.file.master_seed), |_, _| Ok(())).unwrap();
     let wall = t0.elapsed().as_secs_f64();

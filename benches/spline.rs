@@ -3,7 +3,7 @@
 //! fit on the 20x20 grid. Target: the 280 fits in under 0.5 s (a numpy implementation: 1.2 ms per
 //! 18x18 fit; geomdl's approximate_surface: 27 ms).
 
-use somnurbs::experiment::{runner, seeds, RunContext};
+use somnurbs::experiment::{runner, seeds};
 use somnurbs::families::som::spec::SomCell;
 use somnurbs::families;
 use somnurbs::som::{Model, SomParams};
@@ -11,9 +11,10 @@ use somnurbs::spline::{fit_two_view, Approach, Parameterisation, TwoViewGrid};
 use std::time::Instant;
 
 fn maps(grid: (usize, usize)) -> Vec<TwoViewGrid> {
-    let ctx = RunContext::new(std::env::temp_dir(), 1, somnurbs::experiment::data_dir(None));
+    let dir = somnurbs::experiment::data_dir(None);
     let names: Vec<String> = ["cube", "sphere", "spindle", "oiltank", "talus"].iter().map(|s| s.to_string()).collect();
-    let data = families::som::load_datasets(&names, &ctx).expect("data sets (talus needs SOMNURBS_DATA)");
+    let data: std::collections::BTreeMap<String, _> =
+        names.iter().map(|n| (n.clone(), somnurbs::data::registry::load_dataset(n, &dir).expect("data sets (talus needs SOMNURBS_DATA)"))).collect();
     names
         .iter()
         .map(|d| {

@@ -9,6 +9,7 @@ Examples:
   somnurbs run experiments/ch4_models.toml --profile quick # the same, T = 3000 (seconds)
   somnurbs run experiments/ch4_bunny.toml --data-dir ~/scans   # bun_zipper.ply lives in ~/scans
   somnurbs run experiments/ch4_grids.toml --dry-run        # list cells and their seeds
+  somnurbs run experiments/ch6_same.toml --profile quick --sweep optim.de.f=0.3,0.5,0.8 --out f_sweep
   somnurbs datasets list
   somnurbs datasets export sphere sphere.xyz
 
@@ -132,6 +133,16 @@ pub struct RunArgs {
     /// tables; `somnurbs merge` combines the N shard folders into one.
     #[arg(long, value_name = "I/N")]
     pub shard: Option<String>,
+    /// Change one key of the spec's [optim] section, validated as if written in the file, e.g.
+    /// `--set optim.de.f=0.5` (repeatable). The change is recorded in the manifest and enters
+    /// every cell key, so the run's seeds differ from the unchanged spec's.
+    #[arg(long, value_name = "KEY=VALUE")]
+    pub set: Vec<String>,
+    /// Run the spec once per value of an optimiser setting into one folder, e.g.
+    /// `--sweep optim.de.f=0.3,0.5,0.8` (repeatable: every combination). runs.csv gets a
+    /// `variant` column and `somnurbs compare` ranks each optimiser@variant like an optimiser.
+    #[arg(long, value_name = "KEY=V1,V2,...")]
+    pub sweep: Vec<String>,
 }
 
 #[derive(Debug, Args)]

@@ -2,7 +2,7 @@
 
 use clap::Parser;
 use somnurbs::cli::{Cli, Command, DatasetsAction};
-use somnurbs::experiment::{self, log::Shard, spec::Spec, RunContext};
+use somnurbs::experiment::{self, log::Shard, spec::{CliOverrides, Spec}, RunContext};
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
@@ -30,16 +30,18 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     somnurbs::optim::kernels::simd()?;
     match cli.command {
         Command::Run(args) => {
-            let spec = Spec::load(&args.spec, args.profile.as_deref())?;
+            let cli = CliOverrides { set: args.set.clone(), sweep: args.sweep.clone() };
+            let variants = Spec::load_variants(&args.spec, args.profile.as_deref(), &cli)?;
+            let spec = &variants[0];
             if args.dry_run {
-                for (key, seed) in experiment::dry_run_listing(&spec) {
+                for (key, seed) in variants.iter().flat_map(experiment::dry_run_listing) {
                     println!("{key}\tseed {seed}");
                 }
                 return Ok(ExitCode::SUCCESS);
             }
             let shard = args.shard.as_deref().map(Shard::parse).transpose()?;
             let ctx = RunContext { resume: args.resume, shard, ..RunContext::new(spec.output_dir(args.out.as_deref()), jobs(args.jobs)?, experiment::data_dir(args.data_dir.as_deref())) };
-            let out = experiment::run_spec(&spec, &ctx)?;
+            let out = experiment::run_variants(&variants, &ctx)?;
             match shard {
                 Some(s) => eprintln!("somnurbs: wrote shard {s} to {} (combine the shards with `somnurbs merge`)", out.display()),
                 None => eprintln!("somnurbs: wrote {}", out.join("REPORT.md").display()),

@@ -107,3 +107,21 @@ fn reproduce_plan_seeds_runs_the_other_seeds_and_a_missing_plan_is_named() {
     }
     c.fails(&["reproduce", "--plan", "nosuch", "--profile", "quick", "--out", "x", "--specs", specs], &["--plan nosuch", "nosuch.toml"]);
 }
+
+/// With stderr in a file (a log), progress comes as plain lines: at the start, every
+/// SOMNURBS_PROGRESS_SECS (here 0.2 s instead of 15) and at the end.
+#[test]
+fn progress_lines_appear_in_a_log() {
+    let c = Case::new();
+    c.write("slow.toml", SLOW);
+    let log = std::fs::File::create(c.path("stderr.log")).unwrap();
+    let status = bin().args(["run", "slow.toml", "--out", "o", "--jobs", "1"]).current_dir(c.dir.path()).env("SOMNURBS_DATA", shared_data()).env("SOMNURBS_PROGRESS_SECS", "0.2").stderr(log).status().unwrap();
+    assert!(status.success());
+    let text = std::fs::read_to_string(c.path("stderr.log")).unwrap();
+    let lines: Vec<&str> = text.lines().filter(|l| l.starts_with("somnurbs: progress slow: ")).collect();
+    assert!(lines.first().is_some_and(|l| l.contains(" 0/72 cells, elapsed 0s, eta unknown")), "{text}");
+    assert!(lines.last().is_some_and(|l| l.contains(" 72/72 cells") && l.ends_with("eta 0s")), "{text}");
+    let between = lines.iter().filter(|l| !l.contains(" 0/72 ") && !l.contains(" 72/72 ")).count();
+    assert!(between >= 1 && lines.iter().all(|l| l.contains(", elapsed ") && l.contains(", eta ")), "no progress during the run:\n{text}");
+    assert!(!text.contains('\r'), "a terminal bar was drawn into the log");
+}

@@ -296,3 +296,61 @@ fn big_endian_ply_reads_like_ascii() {
     let show = |f: &str| String::from_utf8_lossy(&c.ok(&["datasets", "show", f]).stdout).replace(&format!("{}:", &f[..1]), ":");
     assert_eq!(show("a.ply"), show("b.ply"));
 }
+
+/// A two-view grid CSV of `n` x `n` positions (a lens), for `fit`.
+fn small_grid(n: usize) -> String {
+    let mut s = String::from("i,j,view,class,x,y,z\n");
+    for (view, sign) in [("bottom", -1.0), ("top", 1.0)] {
+        for i in 0..n {
+            for j in 0..n {
+                let (x, y) = (i as f64 / (n - 1) as f64, j as f64 / (n - 1) as f64);
+                // The views meet on the border (z = 0 there), as a two-view grid must.
+                s.push_str(&format!("{i},{j},{view},0,{x},{y},{}\n", sign * x * (1.0 - x) * y * (1.0 - y)));
+            }
+        }
+    }
+    s
+}
+
+#[test]
+fn fit_export_and_compare_refuse_a_folder_another_writer_holds() {
+    let c = Case::new();
+    c.write("slow.toml", SLOW);
+    c.write("g.csv", &small_grid(6));
+    c.write("r.toml", &SPEC.replace("control_nets = [\"6x6\"]", "control_nets = [\"6x6\", \"8x8\"]"));
+    c.ok(&["run", "r.toml", "--out", "done", "--jobs", "1"]);
+    let mut child = start_slow(&c, "slow.toml", "busy");
+    let pid = format!("pid {}", child.id());
+    c.fails(&["fit", "--grid", "g.csv", "--cn", "4x4", "--out", "busy"], &["in use", &pid, "run slow.toml"]);
+    c.fails(&["datasets", "export", "sphere", "busy/sphere.xyz"], &["in use", &pid]);
+    c.fails(&["compare", "busy"], &["in use", &pid]);
+    assert!(!c.path("busy/control_nets.csv").exists() && !c.path("busy/sphere.xyz").exists() && !c.path("busy/compare_cells.csv").exists());
+    child.kill().unwrap();
+    child.wait().unwrap();
+    // Free folders: each command writes, and leaves the lock released for the next writer.
+    c.ok(&["fit", "--grid", "g.csv", "--cn", "4x4", "--out", "busy"]);
+    c.ok(&["datasets", "export", "sphere", "busy/sphere.xyz"]);
+    c.ok(&["compare", "done", "--bayes-samples", "500"]);
+    c.ok(&["run", "r.toml", "--out", "busy", "--jobs", "1"]);
+    c.fails(&["compare", "nothere"], &["nothere", "no such results folder"]);
+    assert!(!c.path("nothere").exists());
+}
+
+#[test]
+fn data_with_fewer_points_than_the_maps_neurons_is_refused_naming_the_file() {
+    let c = Case::new();
+    let pts: String = (0..60).map(|k| { let t = k as f64 * 0.7; format!("{} {} {}\n", t.cos(), t.sin(), (k as f64 * 0.37).sin()) }).collect();
+    c.write("few.xyz", &pts);
+    let som = "name = \"s\"\nmaster_seed = 1\n[som]\ndatasets = [\"few.xyz\"]\niterations = 50\n[[som.group]]\nmodels = [\"som2d\", \"dnsom\"]\ngrids = [\"GRID\"]\n";
+    c.write("big.toml", &som.replace("GRID", "10x10"));
+    c.fails(&["run", "big.toml", "--out", "big"], &["few.xyz", "60 points", "fewer than the", "neurons of the dnsom 10x10"]);
+    assert!(!c.path("big/cells.jsonl").exists() && !c.path("big/manifest.toml").exists());
+    // A SOM2D may have more neurons than points (as the thesis' SOM3D does); a small DNSOM runs.
+    c.write("s2d.toml", &som.replace("GRID", "10x10").replace("\"som2d\", \"dnsom\"", "\"som2d\""));
+    c.ok(&["run", "s2d.toml", "--out", "s2d"]);
+    c.write("small.toml", &som.replace("GRID", "4x4"));
+    c.ok(&["run", "small.toml", "--out", "small"]);
+    // Chapter 6 recomputing a 20x20 DNSOM map from it.
+    c.write("o.toml", &SPEC.replace("\"sphere\"", "\"few.xyz\""));
+    c.fails(&["run", "o.toml", "--out", "o"], &["few.xyz", "fewer than", "neurons"]);
+}

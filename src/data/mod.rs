@@ -48,6 +48,51 @@ impl DataError {
     }
 }
 
+/// How a data set's points are scaled before use (a spec's `normalise`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Normalise {
+    /// Each axis min-max to [0, 1] (the thesis: a 40:25:15 ellipsoid becomes a unit cube's sphere).
+    #[default]
+    PerAxis,
+    /// One scale for all axes: the longest axis to [0, 1], the others in proportion (aspect ratios kept).
+    Uniform,
+    /// The file's coordinates as they are.
+    None,
+}
+
+impl Normalise {
+    /// A sentence for the report.
+    pub fn describe(self) -> &'static str {
+        match self {
+            Normalise::PerAxis => "normalised per axis to [0, 1] (the thesis' reading)",
+            Normalise::Uniform => "normalised uniformly (the longest axis to [0, 1], one scale for all axes, so aspect ratios are kept)",
+            Normalise::None => "not normalised (the files' own coordinates)",
+        }
+    }
+
+    /// Scale `points` in place.
+    pub fn apply(self, points: &mut [Point3]) {
+        match self {
+            Normalise::PerAxis => normalise_min_max(points),
+            Normalise::Uniform => normalise_uniform(points),
+            Normalise::None => {}
+        }
+    }
+}
+
+/// Uniform min-max normalisation: every axis shifted to start at 0 and divided by the largest
+/// axis range, so the longest axis spans [0, 1] and the shape's proportions are kept.
+pub fn normalise_uniform(points: &mut [Point3]) {
+    let Some((lo, hi)) = crate::geom::bounding_box(points) else { return };
+    let range = (0..3).map(|a| hi[a] - lo[a]).fold(0.0, f64::max);
+    for p in points.iter_mut() {
+        for a in 0..3 {
+            p[a] = if range > 0.0 { (p[a] - lo[a]) / range } else { 0.0 };
+        }
+    }
+}
+
 /// Per-axis min-max normalisation to [0, 1], as the thesis did; an axis with zero range maps to 0.
 pub fn normalise_min_max(points: &mut [Point3]) {
     let Some((lo, hi)) = crate::geom::bounding_box(points) else { return };
@@ -74,6 +119,16 @@ pub fn validate(points: &[Point3], min_points: usize) -> Result<(), DataError> {
     Ok(())
 }
 
+/// Refuse a cloud of fewer points than the map trained on it has neurons: units would be left
+/// with no data of their own, so the map could not organise over the surface. `entry` names the
+/// data set as the spec wrote it (its file).
+pub fn require_points(entry: &str, points: usize, neurons: usize, map: &str) -> Result<(), DataError> {
+    if points < neurons {
+        return Err(DataError::Invalid(format!("data set `{entry}`: {points} points, fewer than the {neurons} neurons of the {map} map trained on it (use a smaller grid or more points)")));
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -83,6 +138,20 @@ mod tests {
         let mut p = vec![[1.0, -2.0, 5.0], [3.0, 2.0, 5.0], [2.0, 0.0, 5.0]];
         normalise_min_max(&mut p);
         assert_eq!(p, vec![[0.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.5, 0.5, 0.0]]);
+    }
+
+    #[test]
+    fn uniform_normalisation_keeps_aspect_ratios() {
+        let mut p = vec![[0.0, 0.0, 0.0], [40.0, 25.0, 15.0], [-40.0, -25.0, -15.0]];
+        Normalise::Uniform.apply(&mut p);
+        let (lo, hi) = crate::geom::bounding_box(&p).unwrap();
+        let ext: Vec<f64> = (0..3).map(|a| hi[a] - lo[a]).collect();
+        assert_eq!(ext, vec![1.0, 0.625, 0.375]);
+        let mut q = p.clone();
+        Normalise::None.apply(&mut q);
+        assert_eq!(p, q);
+        Normalise::PerAxis.apply(&mut q);
+        assert_eq!(q[1], [1.0, 1.0, 1.0]);
     }
 
     #[test]

@@ -1,9 +1,9 @@
 //! Named data sets and user files: the one place in `data` that reads files.
 
-use super::{generators, normalise_min_max, ply, stl, validate, xyz, DataError, PointCloud};
+use super::{generators, ply, stl, validate, xyz, DataError, Normalise, PointCloud};
 use crate::geom::Point3;
 use rand::SeedableRng;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Built-in data-set names.
 pub const BUILTIN: &[&str] = &["cube", "sphere", "spindle", "oiltank", "talus", "bunny", "cylinder", "semi_sphere", "saddle"];
@@ -105,52 +105,91 @@ fn sample_stl(bytes: &[u8], n: usize, seed: u64, shown: &str) -> Result<Vec<Poin
     stl::sample_surface(&tris, n, &mut rng).map_err(|e| e.in_file(shown))
 }
 
-/// Load a data set by name (`somnurbs datasets list`) or a point file path (.ply, .xyz, .csv, .txt,
-/// or .stl, sampled with `path.stl:N` points, default 5000). Points are validated (finite, at
-/// least 4) and normalised per axis to [0, 1].
+/// Load a data set by name or path ([`Loader::load`]): paths relative to the working folder,
+/// normalised per axis (the thesis).
 pub fn load_dataset(name: &str, data_dir: &Path) -> Result<PointCloud, DataError> {
-    let mut points = match name {
-        "cube" => generators::cube(),
-        "sphere" => generators::sphere(),
-        "spindle" => generators::spindle(),
-        "oiltank" => generators::oiltank(),
-        "cylinder" => generators::cylinder(),
-        "semi_sphere" => generators::semi_sphere(),
-        "saddle" => generators::saddle(),
-        "bunny" => {
-            let path = data_dir.join(BUNNY_FILE);
-            let shown = path.display().to_string();
-            ply::parse_ply(&read(&path, &where_to_get(BUNNY_FILE))?).map_err(|e| e.in_file(&shown))?
-        }
-        "talus" => {
-            let path = data_dir.join(TALUS_FILE);
-            let shown = path.display().to_string();
-            sample_stl(&read(&path, &where_to_get(TALUS_FILE))?, TALUS_POINTS, TALUS_SAMPLE_SEED, &shown)?
-        }
-        other => {
-            dataset_name(other)?;
-            let (file, count) = split_count(other)?;
-            let lower = file.to_ascii_lowercase();
-            let path = Path::new(file);
-            let bytes = read(path, "Check the path in the spec.")?;
-            if lower.ends_with(".ply") {
-                ply::parse_ply(&bytes).map_err(|e| e.in_file(file))?
-            } else if lower.ends_with(".stl") {
-                sample_stl(&bytes, count.unwrap_or(DEFAULT_STL_POINTS), TALUS_SAMPLE_SEED, file)?
-            } else {
-                let text = String::from_utf8_lossy(&bytes);
-                xyz::parse_xyz(&text).map_err(|e| e.in_file(file))?
-            }
-        }
-    };
-    validate(&points, 4).map_err(|e| e.in_file(name))?;
-    normalise_min_max(&mut points);
-    // Coordinates near the f64 limit overflow the ranges into inf and the points into NaN.
-    validate(&points, 4).map_err(|e| DataError::Invalid(format!("{name}: after normalisation to [0, 1]: {e} (coordinates too large to normalise)")))?;
-    if points.iter().all(|p| *p == points[0]) {
-        return Err(DataError::Invalid(format!("{name}: all {} points are the same point", points.len())));
+    Loader { data_dir: data_dir.to_path_buf(), ..Loader::default() }.load(name)
+}
+
+/// How a spec's data sets load: the folder of the data files (bunny, talus), the folder a
+/// relative data-set path resolves against (the spec's own), and the normalisation.
+#[derive(Debug, Clone, Default)]
+pub struct Loader {
+    pub data_dir: PathBuf,
+    pub base: PathBuf,
+    pub normalise: Normalise,
+}
+
+impl Loader {
+    /// The file of a path entry (not a built-in): absolute as it is, relative under `base`.
+    pub fn resolve(&self, entry: &str) -> Result<PathBuf, DataError> {
+        let (file, _) = split_count(entry)?;
+        Ok(if Path::new(file).is_absolute() { PathBuf::from(file) } else { self.base.join(file) })
     }
-    Ok(PointCloud { name: dataset_name(name)?, points })
+
+    /// Refuse a path entry whose file is not there (cheap: nothing is read), so that a run can
+    /// fail before it writes anything.
+    pub fn require_file(&self, entry: &str) -> Result<(), DataError> {
+        if BUILTIN.contains(&entry) {
+            return Ok(());
+        }
+        dataset_name(entry)?;
+        let path = self.resolve(entry)?;
+        if !path.is_file() {
+            return Err(DataError::Missing { path: path.display().to_string(), hint: format!("The spec names `{entry}`; a relative data-set path is read from the spec's folder ({}).", if self.base.as_os_str().is_empty() { ".".into() } else { self.base.display().to_string() }) });
+        }
+        Ok(())
+    }
+
+    /// Load a data set by name (`somnurbs datasets list`) or a point file path (.ply, .xyz, .csv,
+    /// .txt, or .stl, sampled with `path.stl:N` points, default 5000). Points are validated
+    /// (finite, at least 4, not all equal) and scaled by `normalise`.
+    pub fn load(&self, name: &str) -> Result<PointCloud, DataError> {
+        let data_dir = &self.data_dir;
+        let mut points = match name {
+            "cube" => generators::cube(),
+            "sphere" => generators::sphere(),
+            "spindle" => generators::spindle(),
+            "oiltank" => generators::oiltank(),
+            "cylinder" => generators::cylinder(),
+            "semi_sphere" => generators::semi_sphere(),
+            "saddle" => generators::saddle(),
+            "bunny" => {
+                let path = data_dir.join(BUNNY_FILE);
+                let shown = path.display().to_string();
+                ply::parse_ply(&read(&path, &where_to_get(BUNNY_FILE))?).map_err(|e| e.in_file(&shown))?
+            }
+            "talus" => {
+                let path = data_dir.join(TALUS_FILE);
+                let shown = path.display().to_string();
+                sample_stl(&read(&path, &where_to_get(TALUS_FILE))?, TALUS_POINTS, TALUS_SAMPLE_SEED, &shown)?
+            }
+            other => {
+                self.require_file(other)?;
+                let (_, count) = split_count(other)?;
+                let path = self.resolve(other)?;
+                let shown = path.display().to_string();
+                let lower = shown.to_ascii_lowercase();
+                let bytes = read(&path, "Check the path in the spec.")?;
+                if lower.ends_with(".ply") {
+                    ply::parse_ply(&bytes).map_err(|e| e.in_file(&shown))?
+                } else if lower.ends_with(".stl") {
+                    sample_stl(&bytes, count.unwrap_or(DEFAULT_STL_POINTS), TALUS_SAMPLE_SEED, &shown)?
+                } else {
+                    let text = String::from_utf8_lossy(&bytes);
+                    xyz::parse_xyz(&text).map_err(|e| e.in_file(&shown))?
+                }
+            }
+        };
+        validate(&points, 4).map_err(|e| e.in_file(name))?;
+        self.normalise.apply(&mut points);
+        // Coordinates near the f64 limit overflow the ranges into inf and the points into NaN.
+        validate(&points, 4).map_err(|e| DataError::Invalid(format!("{name}: after normalisation: {e} (coordinates too large to normalise)")))?;
+        if points.iter().all(|p| *p == points[0]) {
+            return Err(DataError::Invalid(format!("{name}: all {} points are the same point", points.len())));
+        }
+        Ok(PointCloud { name: dataset_name(name)?, points })
+    }
 }
 
 /// The data folder the tests use: `SOMNURBS_DATA`, else `../shared/data` beside the crate.
@@ -210,6 +249,11 @@ mod tests {
         std::fs::write(&same, "1,2,3\n1,2,3\n1,2,3\n1,2,3\n1,2,3\n").unwrap();
         let e = load_dataset(same.to_str().unwrap(), dir.path()).unwrap_err().to_string();
         assert!(e.contains("same.csv") && e.contains("same point"), "{e}");
+        // A relative path resolves against the loader's base (a spec's folder), not the working folder.
+        let own = Loader { base: dir.path().to_path_buf(), ..Loader::default() };
+        assert!(own.load("same.csv").unwrap_err().to_string().contains("same point"));
+        let e = own.load("sub/none.xyz").unwrap_err().to_string();
+        assert!(e.contains(&dir.path().join("sub/none.xyz").display().to_string()) && e.contains("spec's folder"), "{e}");
         let ok = dir.path().join("ok.xyz");
         std::fs::write(&ok, "0 0 0\n1 0 0\n0 1 0\n0 0 1\n").unwrap();
         assert_eq!(load_dataset(ok.to_str().unwrap(), dir.path()).unwrap().name, "ok");

@@ -37,6 +37,9 @@ pub fn datasets(action: DatasetsAction, data_dir: &Path) -> Result<()> {
                     let _ = writeln!(text, "{:?} {:?} {:?}", p[0], p[1], p[2]);
                 }
             }
+            // The file's folder has one writer at a time (a run writing there refuses this).
+            let folder = file.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+            let _lock = crate::io::outdir::lock(folder, "datasets export")?;
             crate::io::write_atomic(&file, text.as_bytes())?;
             eprintln!("somnurbs: wrote {} points to {}", cloud.points.len(), file.display());
         }

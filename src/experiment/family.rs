@@ -47,6 +47,14 @@ pub trait Family: Sync {
     /// Run the cells of `ctx`'s slice; with `tables`, write the tables and pictures into
     /// `ctx.out` and return the REPORT.md section.
     fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<Outcome>;
+    /// Run the variants of a spec (`--sweep`) into one folder, their tables together. A family
+    /// whose tables cannot tell variants apart runs one variant only.
+    fn run_variants(&self, variants: &[Spec], ctx: &RunContext, tables: bool) -> Result<Outcome> {
+        match variants {
+            [one] => self.run(one, ctx, tables),
+            _ => anyhow::bail!("--sweep: [{}] specs run one variant at a time (sweeps work on [optim] specs)", self.section()),
+        }
+    }
 }
 
 /// The families whose sections the spec has (validation requires exactly one). The engine reaches

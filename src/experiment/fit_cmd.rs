@@ -32,6 +32,8 @@ pub fn fit(args: &FitArgs) -> Result<()> {
         }
     }
     let out = &args.out;
+    // Every input has loaded: the folder is this command's (one writer at a time).
+    let _lock = crate::io::outdir::lock(out, "fit")?;
     write_atomic(&out.join("control_nets.csv"), csv_records(&header, &rows)?.as_bytes())?;
     let surfaces = [("bottom", &fit.bottom), ("top", &fit.top)];
     write_atomic(&out.join("surfaces.igs"), export::write_iges(&surfaces, true).as_bytes())?;

@@ -63,6 +63,11 @@ pub struct Fingerprint {
     pub shard: Option<String>,
     /// The spec's text, so that a merge can re-read it.
     pub spec_text: String,
+    /// The command line's `--set KEY=VALUE` and `--sweep KEY=V1,V2` (absent for a plain run).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub set: Vec<String>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub sweep: Vec<String>,
 }
 
 impl Fingerprint {
@@ -75,8 +80,15 @@ impl Fingerprint {
             ("spec text (sha256)", self.spec_sha256.clone(), other.spec_sha256.clone()),
             ("cell count", self.cells.to_string(), other.cells.to_string()),
             ("shard", self.shard.clone().unwrap_or_else(|| "none".into()), other.shard.clone().unwrap_or_else(|| "none".into())),
+            ("--set", shown(&self.set), shown(&other.set)),
+            ("--sweep", shown(&self.sweep), shown(&other.sweep)),
         ];
         pairs.into_iter().find(|(_, a, b)| a != b).map(|(name, a, b)| format!("{name}: {a} vs {b}"))
+    }
+
+    /// The command line's changes, as a spec reads them back (merge).
+    pub fn overrides(&self) -> super::spec::CliOverrides {
+        super::spec::CliOverrides { set: self.set.clone(), sweep: self.sweep.clone() }
     }
 
     pub fn read(dir: &Path) -> Result<Option<Fingerprint>> {
@@ -92,6 +104,15 @@ impl Fingerprint {
     pub fn write(&self, dir: &Path) -> Result<()> {
         let text = toml::to_string(self).context("cannot serialise the fingerprint")?;
         crate::io::write_atomic(&dir.join(FINGERPRINT_FILE), text.as_bytes())
+    }
+}
+
+/// A list of command-line changes for messages ("none" when empty).
+fn shown(list: &[String]) -> String {
+    if list.is_empty() {
+        "none".into()
+    } else {
+        list.join(" ")
     }
 }
 
@@ -230,11 +251,13 @@ mod tests {
 
     #[test]
     fn fingerprint_names_the_first_difference() {
-        let a = Fingerprint { spec_name: "s".into(), spec_path: "s.toml".into(), spec_sha256: "ab".into(), profile: "quick".into(), master_seed: 1, cells: 4, shard: None, spec_text: String::new() };
+        let a = Fingerprint { spec_name: "s".into(), spec_path: "s.toml".into(), spec_sha256: "ab".into(), profile: "quick".into(), master_seed: 1, cells: 4, shard: None, spec_text: String::new(), set: Vec::new(), sweep: Vec::new() };
         assert_eq!(a.difference(&a.clone()), None);
         let b = Fingerprint { master_seed: 2, ..a.clone() };
         assert_eq!(a.difference(&b).unwrap(), "master seed: 1 vs 2");
         let c = Fingerprint { profile: "default".into(), ..a.clone() };
         assert!(a.difference(&c).unwrap().starts_with("profile"));
+        let d = Fingerprint { set: vec!["optim.de.f=0.5".into()], ..a.clone() };
+        assert_eq!(a.difference(&d).unwrap(), "--set: none vs optim.de.f=0.5");
     }
 }

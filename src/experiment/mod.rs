@@ -60,6 +60,13 @@ impl RunContext {
         Ok(())
     }
 
+    /// How `spec`'s data sets load: from this run's data folder, relative paths from the spec's
+    /// own folder, scaled by the spec's `normalise`.
+    pub fn loader(&self, spec: &Spec) -> crate::data::registry::Loader {
+        let base = Path::new(&spec.path).parent().map(Path::to_path_buf).unwrap_or_default();
+        crate::data::registry::Loader { data_dir: self.data_dir.clone(), base, normalise: spec.file.normalise }
+    }
+
     /// The master seed the cell log tags records with (0 outside `run_spec`).
     pub fn master_seed(&self) -> u64 {
         self.session.as_ref().map_or(0, |s| s.master_seed)
@@ -90,6 +97,11 @@ pub fn logged_cell_keys(spec: &Spec) -> Vec<String> {
     family::present(spec).iter().flat_map(|f| f.logged_keys(spec)).collect()
 }
 
+/// [`logged_cell_keys`] of every variant of a run, in order.
+fn logged_variant_keys(variants: &[Spec]) -> Vec<String> {
+    variants.iter().flat_map(logged_cell_keys).collect()
+}
+
 /// The manifest: enough to re-run exactly.
 #[derive(Debug, Serialize)]
 pub struct Manifest {
@@ -101,6 +113,11 @@ pub struct Manifest {
     /// `I/N` when this folder holds one shard of the cells (no tables).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub shard: Option<String>,
+    /// The command line's `--set KEY=VALUE` and `--sweep KEY=V1,V2` (absent for a plain run).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub set: Vec<String>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub sweep: Vec<String>,
     pub crate_version: String,
     pub git_commit: String,
     pub git_dirty: bool,
@@ -139,17 +156,21 @@ impl Default for Definitions {
     }
 }
 
-/// The fingerprint of a spec run in a folder (what `--resume` and `merge` compare).
-pub fn fingerprint(spec: &Spec, shard: Option<log::Shard>) -> log::Fingerprint {
+/// The fingerprint of a run of a spec's variants (one for a plain run) in a folder (what
+/// `--resume` and `merge` compare).
+pub fn fingerprint(variants: &[Spec], shard: Option<log::Shard>) -> log::Fingerprint {
+    let spec = &variants[0];
     log::Fingerprint {
         spec_name: spec.file.name.clone(),
         spec_path: spec.path.clone(),
         spec_sha256: hex::encode(<sha2::Sha256 as sha2::Digest>::digest(spec.text.as_bytes())),
         profile: spec.profile.clone().unwrap_or_else(|| "default".into()),
         master_seed: spec.file.master_seed,
-        cells: logged_cell_keys(spec).len(),
+        cells: logged_variant_keys(variants).len(),
         shard: shard.map(|s| s.to_string()),
         spec_text: spec.text.clone(),
+        set: spec.cli.set.clone(),
+        sweep: spec.cli.sweep.clone(),
     }
 }
 
@@ -161,13 +182,25 @@ pub fn fingerprint(spec: &Spec, shard: Option<log::Shard>) -> log::Fingerprint {
 /// writes them). With `resume`, the cells in the folder's log are kept if the folder's
 /// fingerprint and every logged seed match, else the run is refused before anything is touched.
 pub fn run_spec(spec: &Spec, ctx: &RunContext) -> Result<PathBuf> {
-    let _lock = crate::io::outdir::lock(&ctx.out, &format!("run {}", spec.path))?;
-    run_spec_locked(spec, ctx)
+    run_variants(std::slice::from_ref(spec), ctx)
 }
 
-/// [`run_spec`] in a folder the caller has locked.
-fn run_spec_locked(spec: &Spec, ctx: &RunContext) -> Result<PathBuf> {
-    let fp = fingerprint(spec, ctx.shard);
+/// [`run_spec`] of the variants of one spec (`--set`/`--sweep`: [`spec::CliOverrides`]) into one
+/// folder: one cell log, one fingerprint and manifest, the family's tables over every variant.
+pub fn run_variants(variants: &[Spec], ctx: &RunContext) -> Result<PathBuf> {
+    let spec = variants.first().context("no spec to run")?;
+    // A data file the spec names but that is not there: refused before the folder is touched.
+    for d in limits::dataset_entries(spec) {
+        ctx.loader(spec).require_file(d).with_context(|| format!("{}: data set `{d}`", spec.path))?;
+    }
+    let _lock = crate::io::outdir::lock(&ctx.out, &format!("run {}", spec.path))?;
+    run_spec_locked(variants, ctx)
+}
+
+/// [`run_variants`] in a folder the caller has locked.
+fn run_spec_locked(variants: &[Spec], ctx: &RunContext) -> Result<PathBuf> {
+    let spec = variants.first().context("no spec to run")?;
+    let fp = fingerprint(variants, ctx.shard);
     if ctx.resume {
         match log::Fingerprint::read(&ctx.out)? {
             Some(old) => {
@@ -187,7 +220,7 @@ fn run_spec_locked(spec: &Spec, ctx: &RunContext) -> Result<PathBuf> {
     let tables = ctx.shard.is_none();
 
     let family = family::present(spec).into_iter().next().context("the spec has no experiment section")?;
-    let family::Outcome { section, cpu_s: cpu, cells } = family.run(spec, ctx, tables)?;
+    let family::Outcome { section, cpu_s: cpu, cells } = family.run_variants(variants, ctx, tables)?;
     ctx.begin()?;
 
     let manifest = Manifest {
@@ -197,6 +230,8 @@ fn run_spec_locked(spec: &Spec, ctx: &RunContext) -> Result<PathBuf> {
         profile: fp.profile.clone(),
         master_seed: spec.file.master_seed,
         shard: fp.shard.clone(),
+        set: fp.set.clone(),
+        sweep: fp.sweep.clone(),
         crate_version: env!("CARGO_PKG_VERSION").into(),
         git_commit: env!("SOMNURBS_GIT_COMMIT").into(),
         git_dirty: env!("SOMNURBS_GIT_DIRTY") == "true",
@@ -229,7 +264,7 @@ pub fn report_md(spec: &Spec, m: &Manifest, sections: &[String]) -> String {
     let commit = if m.git_commit.is_empty() { "unknown".to_string() } else { format!("{}{}", &m.git_commit[..m.git_commit.len().min(12)], if m.git_dirty { " (dirty)" } else { "" }) };
     let _ = writeln!(
         s,
-        "Spec `{}` (sha256 {}), profile `{}`, master seed {}, somnurbs {} at commit {}, {} on {} with {} thread(s): {} cells in {:.1} s wall, {:.1} s CPU in cells. Re-run: `somnurbs run {}{}`.\n",
+        "Spec `{}` (sha256 {}), profile `{}`, master seed {}, somnurbs {} at commit {}, {} on {} with {} thread(s): {} cells in {:.1} s wall, {:.1} s CPU in cells. Re-run: `somnurbs run {}{}{}`.\n",
         m.spec_path,
         &m.spec_sha256[..12],
         m.profile,
@@ -243,8 +278,12 @@ pub fn report_md(spec: &Spec, m: &Manifest, sections: &[String]) -> String {
         m.wall_seconds,
         m.cpu_seconds_cells,
         m.spec_path,
-        if m.profile == "default" { String::new() } else { format!(" --profile {}", m.profile) }
+        if m.profile == "default" { String::new() } else { format!(" --profile {}", m.profile) },
+        m.set.iter().map(|a| format!(" --set {a}")).chain(m.sweep.iter().map(|a| format!(" --sweep {a}"))).collect::<String>()
     );
+    if !limits::dataset_entries(spec).is_empty() {
+        let _ = writeln!(s, "Data sets are {} (`normalise`); a data set given as a relative path is read from the spec's folder.\n", spec.file.normalise.describe());
+    }
     for sec in sections {
         s.push_str(sec);
         s.push('\n');
@@ -298,8 +337,8 @@ pub fn merge(shards: &[PathBuf], ctx: &RunContext) -> Result<PathBuf> {
         anyhow::bail!("merge: shard {missing}/{count} is missing");
     }
     let fp = first.expect("at least one shard");
-    let spec = Spec::parse(&fp.spec_path, &fp.spec_text, if fp.profile == "default" { None } else { Some(fp.profile.as_str()) }).map_err(|e| anyhow::anyhow!("{e}"))?;
-    let expected: std::collections::BTreeSet<String> = logged_cell_keys(&spec).into_iter().collect();
+    let variants = fp.overrides().variants(&fp.spec_path, &fp.spec_text, if fp.profile == "default" { None } else { Some(fp.profile.as_str()) }).context("merge: the shards' spec")?;
+    let expected: std::collections::BTreeSet<String> = logged_variant_keys(&variants).into_iter().collect();
     if let Some(k) = expected.iter().find(|k| !records.contains_key(*k)) {
         anyhow::bail!("merge: no shard logged cell {k} (the shards hold {} of the spec's {} cells)", expected.iter().filter(|k| records.contains_key(*k)).count(), expected.len());
     }
@@ -315,8 +354,8 @@ pub fn merge(shards: &[PathBuf], ctx: &RunContext) -> Result<PathBuf> {
             out_log.push(key, rec)?;
         }
     }
-    fingerprint(&spec, None).write(&ctx.out)?;
-    run_spec_locked(&spec, &RunContext { resume: true, shard: None, ..ctx.clone() })
+    fingerprint(&variants, None).write(&ctx.out)?;
+    run_spec_locked(&variants, &RunContext { resume: true, shard: None, ..ctx.clone() })
 }
 
 /// Resolve the data directory: flag, else `SOMNURBS_DATA`, else `./data`.

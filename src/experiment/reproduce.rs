@@ -139,7 +139,7 @@ pub fn reproduce(specs_dir: &Path, plan_name: &str, profile: &str, ctx: &RunCont
     // Every data set of every spec loads before the folder changes (a bad --data-dir changes nothing).
     for spec in &specs {
         for d in super::limits::dataset_entries(spec) {
-            crate::data::registry::load_dataset(d, &ctx.data_dir).with_context(|| format!("{}: data set `{d}`", spec.path))?;
+            ctx.loader(spec).load(d).with_context(|| format!("{}: data set `{d}`", spec.path))?;
         }
     }
     let _lock = crate::io::outdir::lock(&ctx.out, &format!("reproduce --plan {plan_name}"))?;

@@ -7,7 +7,43 @@ use rayon::prelude::*;
 use serde::{de::DeserializeOwned, Serialize};
 use std::collections::BTreeMap;
 
-/// Run `work` over `cells` on `jobs` threads.
+/// Seconds between the plain progress lines of a run whose stderr is not a terminal (a log),
+/// unless the environment variable [`PROGRESS_ENV`] gives another (e.g. `0.2` in tests).
+pub const PROGRESS_SECS: f64 = 15.0;
+pub const PROGRESS_ENV: &str = "SOMNURBS_PROGRESS_SECS";
+
+/// The interval of the plain progress lines: [`PROGRESS_ENV`] if it holds a positive number of
+/// seconds, else [`PROGRESS_SECS`].
+fn progress_interval() -> std::time::Duration {
+    let secs = std::env::var(PROGRESS_ENV).ok().and_then(|v| v.trim().parse::<f64>().ok()).filter(|s| *s > 0.0 && s.is_finite()).unwrap_or(PROGRESS_SECS);
+    std::time::Duration::from_secs_f64(secs.min(86_400.0))
+}
+
+/// `1h02m03s`, `4m05s` or `6s`.
+fn clock(d: std::time::Duration) -> String {
+    let s = d.as_secs();
+    match (s / 3600, s / 60 % 60, s % 60) {
+        (0, 0, sec) => format!("{sec}s"),
+        (0, m, sec) => format!("{m}m{sec:02}s"),
+        (h, m, sec) => format!("{h}h{m:02}m{sec:02}s"),
+    }
+}
+
+/// One plain progress line: `somnurbs: progress LABEL: DONE/TOTAL cells, elapsed E, eta T`.
+pub fn progress_line(label: &str, done: usize, total: usize, elapsed: std::time::Duration) -> String {
+    let eta = if done == 0 {
+        "unknown".to_string()
+    } else if done >= total {
+        "0s".to_string()
+    } else {
+        clock(elapsed.mul_f64((total - done) as f64 / done as f64))
+    };
+    format!("somnurbs: progress {label}: {done}/{total} cells, elapsed {}, eta {eta}", clock(elapsed))
+}
+
+/// Run `work` over `cells` on `jobs` threads. On a terminal a progress bar shows; otherwise (a
+/// log: SLURM, nohup, CI) a plain [`progress_line`] is printed to stderr when the cells start, every
+/// [`progress_interval`] and when they end.
 pub fn run_cells<C, R>(
     cells: &[C],
     jobs: usize,
@@ -19,26 +55,56 @@ where
     C: Sync,
     R: Send,
 {
+    use std::io::IsTerminal;
+    use std::sync::atomic::{AtomicUsize, Ordering};
     let pool = rayon::ThreadPoolBuilder::new().num_threads(jobs.max(1)).build().context("cannot start worker threads")?;
-    let bar = ProgressBar::new(cells.len() as u64);
+    let plain = !std::io::stderr().is_terminal() && !cells.is_empty();
+    let bar = if plain { ProgressBar::hidden() } else { ProgressBar::new(cells.len() as u64) };
     bar.set_style(
         ProgressStyle::with_template("{prefix} [{elapsed_precise}] {wide_bar} {pos}/{len} cells, eta {eta}")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     bar.set_prefix(label.to_string());
-    let results = pool.install(|| {
-        cells
-            .par_iter()
-            .with_max_len(1)
-            .map(|c| {
-                let r = work(c)?;
-                done(c, &r)?;
-                bar.inc(1);
-                Ok(r)
-            })
-            .collect::<Result<Vec<R>>>()
+    let finished = AtomicUsize::new(0);
+    let stop = (std::sync::Mutex::new(false), std::sync::Condvar::new());
+    let started = std::time::Instant::now();
+    let results = std::thread::scope(|scope| {
+        if plain {
+            eprintln!("{}", progress_line(label, 0, cells.len(), started.elapsed()));
+            let (finished, stop) = (&finished, &stop);
+            scope.spawn(move || {
+                let interval = progress_interval();
+                let mut stopped = stop.0.lock().unwrap_or_else(|e| e.into_inner());
+                loop {
+                    stopped = stop.1.wait_timeout(stopped, interval).unwrap_or_else(|e| e.into_inner()).0;
+                    if *stopped {
+                        break;
+                    }
+                    eprintln!("{}", progress_line(label, finished.load(Ordering::Relaxed), cells.len(), started.elapsed()));
+                }
+            });
+        }
+        let results = pool.install(|| {
+            cells
+                .par_iter()
+                .with_max_len(1)
+                .map(|c| {
+                    let r = work(c)?;
+                    done(c, &r)?;
+                    bar.inc(1);
+                    finished.fetch_add(1, Ordering::Relaxed);
+                    Ok(r)
+                })
+                .collect::<Result<Vec<R>>>()
+        });
+        *stop.0.lock().unwrap_or_else(|e| e.into_inner()) = true;
+        stop.1.notify_all();
+        results
     });
     bar.finish_and_clear();
+    if plain && results.is_ok() {
+        eprintln!("{}", progress_line(label, cells.len(), cells.len(), started.elapsed()));
+    }
     results
 }
 
@@ -142,6 +208,14 @@ mod tests {
         }
         let err = run_cells(&cells, 2, "t", |c| if *c == 7 { anyhow::bail!("cell 7 failed") } else { Ok(*c) }, |_, _| Ok(()));
         assert!(format!("{:#}", err.unwrap_err()).contains("cell 7"));
+    }
+
+    #[test]
+    fn progress_lines_say_done_total_elapsed_and_eta() {
+        let d = std::time::Duration::from_secs;
+        assert_eq!(progress_line("ch6", 0, 10, d(3)), "somnurbs: progress ch6: 0/10 cells, elapsed 3s, eta unknown");
+        assert_eq!(progress_line("ch6", 5, 20, d(65)), "somnurbs: progress ch6: 5/20 cells, elapsed 1m05s, eta 3m15s");
+        assert_eq!(progress_line("x", 20, 20, d(3725)), "somnurbs: progress x: 20/20 cells, elapsed 1h02m05s, eta 0s");
     }
 
     #[test]

@@ -35,6 +35,9 @@ pub struct SpecFile {
     /// Output folder (overridden by `--out`).
     #[serde(default)]
     pub output: Option<String>,
+    /// How the data sets are scaled: per_axis (the thesis), uniform (aspect ratios kept) or none.
+    #[serde(default)]
+    pub normalise: crate::data::Normalise,
     /// Chapter 4: SOM models.
     #[serde(default)]
     pub som: Option<crate::families::som::spec::SomSpec>,
@@ -69,6 +72,127 @@ pub struct Spec {
     pub text: String,
     pub path: String,
     pub profile: Option<String>,
+    /// The command line's `--set`/`--sweep` as written (empty for a plain run).
+    pub cli: CliOverrides,
+    /// Which variant of the spec this is: its `key=value` changes (empty for a plain run).
+    pub variant: Variant,
+}
+
+/// The command line's changes to a spec, as written: `--set KEY=VALUE` (one value) and
+/// `--sweep KEY=V1,V2,...` (every combination of the swept values is one variant, all run into
+/// one folder). Recorded in the fingerprint and the manifest, so `--resume` and `merge` rebuild
+/// the same variants.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct CliOverrides {
+    pub set: Vec<String>,
+    pub sweep: Vec<String>,
+}
+
+/// One variant of a spec: the `key=value` changes of `--set` and those of `--sweep`, as written.
+/// A plain run has none, and its cell keys and seeds are those of the spec alone.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Variant {
+    pub set: Vec<String>,
+    pub swept: Vec<String>,
+}
+
+impl Variant {
+    /// What the cell keys (so the seeds) carry: every change, `--set` first (empty: plain run).
+    pub fn key(&self) -> String {
+        self.set.iter().chain(&self.swept).cloned().collect::<Vec<_>>().join(",")
+    }
+
+    /// The `variant` column of a sweep's rows: the swept values (empty without `--sweep`).
+    pub fn label(&self) -> String {
+        self.swept.join(",")
+    }
+}
+
+/// Keys a sweep may vary: optimiser settings only, so that every variant solves the same
+/// problems (same data, nets, search box) and the variants can be ranked like optimisers.
+const SWEEPABLE: &str = "optim.<ga|de|pso|csa|icsa>.*, optim.generations, optim.population, optim.init_range, optim.repeats";
+
+fn sweepable(key: &str) -> bool {
+    ["optim.ga.", "optim.de.", "optim.pso.", "optim.csa.", "optim.icsa."].iter().any(|p| key.starts_with(p))
+        || ["optim.generations", "optim.population", "optim.init_range", "optim.repeats"].contains(&key)
+}
+
+/// A command-line value as TOML (a number, a boolean, a quoted string, an array), else the text
+/// itself as a string (so `--set optim.knots=nurbs_book` needs no quotes).
+fn cli_value(raw: &str) -> toml::Value {
+    match toml::from_str::<toml::Table>(&format!("v = {raw}")) {
+        Ok(mut t) => t.remove("v").unwrap_or_else(|| toml::Value::String(raw.to_string())),
+        Err(_) => toml::Value::String(raw.to_string()),
+    }
+}
+
+impl CliOverrides {
+    pub fn is_empty(&self) -> bool {
+        self.set.is_empty() && self.sweep.is_empty()
+    }
+
+    /// Split `KEY=VALUE` (or `KEY=V1,V2` for a sweep) of `flag`, naming the flag on error.
+    fn split<'a>(flag: &str, arg: &'a str) -> Result<(&'a str, &'a str), SpecError> {
+        match arg.split_once('=') {
+            Some((k, v)) if !k.trim().is_empty() && !v.trim().is_empty() => Ok((k.trim(), v.trim())),
+            _ => Err(SpecError(format!("{flag} `{arg}`: expected KEY=VALUE, e.g. optim.de.f=0.5"))),
+        }
+    }
+
+    /// The variants of the spec at `path` (its text and profile): one for a plain run or `--set`
+    /// only, else one per combination of the swept values (the first `--sweep` outermost). Each
+    /// is parsed and validated exactly as if its values were written in the file; an unknown key,
+    /// a bad value, a key given twice or a swept value given twice is a one-line error naming
+    /// the key.
+    pub fn variants(&self, path: &str, text: &str, profile: Option<&str>) -> Result<Vec<Spec>, SpecError> {
+        let base = Spec::parse(path, text, profile)?;
+        if self.is_empty() {
+            return Ok(vec![base]);
+        }
+        let flags = self.set.iter().map(|a| ("--set", a)).chain(self.sweep.iter().map(|a| ("--sweep", a)));
+        let mut seen: Vec<String> = Vec::new();
+        for (flag, arg) in flags {
+            let (key, _) = Self::split(flag, arg)?;
+            if seen.iter().any(|k| k == key) {
+                return Err(SpecError(format!("{flag} {key}: the key is given twice (--set and --sweep take each key once)")));
+            }
+            seen.push(key.to_string());
+            if !key.starts_with("optim.") {
+                return Err(SpecError(format!("{flag} {key}: only keys of the [optim] section (optim.KEY) can be set or swept")));
+            }
+            if base.file.optim.is_none() {
+                return Err(SpecError(format!("{flag} {key}: {path} has no [optim] section (--set and --sweep work on Chapter 6 specs)")));
+            }
+            if flag == "--sweep" && !sweepable(key) {
+                return Err(SpecError(format!("{flag} {key}: a sweep varies optimiser settings only ({SWEEPABLE}), so that every variant solves the same problems")));
+            }
+        }
+        let set: Vec<(String, String)> = self.set.iter().map(|a| Self::split("--set", a).map(|(k, v)| (k.to_string(), v.to_string()))).collect::<Result<_, _>>()?;
+        // Every combination of the swept values, the first sweep outermost.
+        let mut combos: Vec<Vec<(String, String)>> = vec![Vec::new()];
+        for arg in &self.sweep {
+            let (key, values) = Self::split("--sweep", arg)?;
+            let values: Vec<&str> = values.split(',').map(str::trim).collect();
+            if values.iter().any(|v| v.is_empty()) {
+                return Err(SpecError(format!("--sweep {key}: an empty value in `{arg}`")));
+            }
+            if let Some(v) = values.iter().enumerate().find(|(k, v)| values[..*k].contains(v)).map(|(_, v)| v) {
+                return Err(SpecError(format!("--sweep {key}: the value {v} is given twice")));
+            }
+            combos = combos.into_iter().flat_map(|c| values.iter().map(move |v| [c.clone(), vec![(key.to_string(), v.to_string())]].concat())).collect();
+        }
+        combos
+            .into_iter()
+            .map(|swept| {
+                let overrides: Vec<Override> = set.iter().chain(&swept).map(|(k, v)| Override { key: k.clone(), value: cli_value(v) }).collect();
+                let mut spec = Spec::parse_with(path, text, profile, &overrides)?;
+                spec.cli = self.clone();
+                let pairs = |l: &[(String, String)]| l.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>();
+                spec.variant = Variant { set: pairs(&set), swept: pairs(&swept) };
+                Ok(spec)
+            })
+            .collect()
+    }
 }
 
 fn line_col(text: &str, offset: usize) -> (usize, usize) {
@@ -179,7 +303,7 @@ impl Spec {
                 })?
             }
         };
-        let spec = Spec { file, text: text.to_string(), path: path.to_string(), profile: profile.map(String::from) };
+        let spec = Spec { file, text: text.to_string(), path: path.to_string(), profile: profile.map(String::from), cli: CliOverrides::default(), variant: Variant::default() };
         spec.validate()?;
         Ok(spec)
     }
@@ -189,6 +313,13 @@ impl Spec {
         let shown = path.display().to_string();
         let text = std::fs::read_to_string(path).map_err(|e| SpecError(format!("{shown}: cannot read spec: {e}")))?;
         Spec::parse(&shown, &text, profile)
+    }
+
+    /// Read a spec file and make its variants ([`CliOverrides::variants`]).
+    pub fn load_variants(path: &Path, profile: Option<&str>, cli: &CliOverrides) -> Result<Vec<Spec>, SpecError> {
+        let shown = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| SpecError(format!("{shown}: cannot read spec: {e}")))?;
+        cli.variants(&shown, &text, profile)
     }
 
     /// An error naming the spec file and the key at fault.

@@ -125,9 +125,10 @@ fn recompute_map(spec: &Spec, ctx: &RunContext, data: &str, grid: GridSize, som:
         Some(s) => (s.master_seed.unwrap_or(spec.file.master_seed), SomParams { iterations: s.iterations, alpha0: s.alpha0, sigma0: None }),
         None => (spec.file.master_seed, SomParams::default()),
     };
-    let clouds = som::load_datasets(&[data.to_string()], ctx)?;
+    let clouds = som::load_datasets(spec, &[data.to_string()], ctx)?;
     let name = crate::data::registry::name_of(data);
     let cell = SomCell { dataset: name.clone(), model: Model::Dnsom, grid, repeat: 0 };
+    som::require_points(data, clouds[&name].points.len(), &cell)?;
     let run = som::run_cell(&cell, &clouds[&name].points, &params, seed)?;
     Ok(MapSource {
         grid: grid_from_weights(grid.nx, grid.ny, &run.weights),

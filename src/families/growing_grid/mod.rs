@@ -123,7 +123,7 @@ pub fn maps(spec: &Spec, ctx: &RunContext) -> Result<Vec<MapRun>> {
     let data: Vec<(String, Vec<Point3>)> = g
         .datasets
         .iter()
-        .map(|d| registry::load_dataset(d, &ctx.data_dir).map(|c| (c.name, c.points)).with_context(|| format!("growing_grid.datasets: `{d}`")))
+        .map(|d| ctx.loader(spec).load(d).map(|c| (c.name, c.points)).with_context(|| format!("growing_grid.datasets: `{d}`")))
         .collect::<Result<_>>()?;
     runner::run_cells(&data, ctx.jobs, "growing grids", |(d, points)| {
         let mut rng = seeds::cell_rng(spec.file.master_seed, &format!("seed001/map/{d}"));

@@ -19,10 +19,10 @@ pub fn friedman_table(rows: &[OptimRow]) -> (Vec<String>, Vec<Vec<f64>>) {
     let mut opts: Vec<String> = Vec::new();
     let mut cells: BTreeMap<CellKey, BTreeMap<String, (f64, usize)>> = BTreeMap::new();
     for r in rows {
-        if !opts.contains(&r.optimiser) {
-            opts.push(r.optimiser.clone());
+        if !opts.contains(&r.competitor()) {
+            opts.push(r.competitor());
         }
-        let e = cells.entry((r.dataset.clone(), r.grid_x, r.grid_y, r.cn_x, r.cn_y, r.parameterisation.clone())).or_default().entry(r.optimiser.clone()).or_default();
+        let e = cells.entry((r.dataset.clone(), r.grid_x, r.grid_y, r.cn_x, r.cn_y, r.parameterisation.clone())).or_default().entry(r.competitor()).or_default();
         e.0 += r.best;
         e.1 += 1;
     }
@@ -34,6 +34,12 @@ pub fn compare(args: &CompareArgs) -> Result<()> {
     if !(args.rope >= 0.0 && args.rope.is_finite()) || args.bayes_samples == 0 {
         anyhow::bail!("--rope must be finite and >= 0 (got {}) and --bayes-samples at least 1 (got {})", args.rope, args.bayes_samples);
     }
+    if !args.results.is_dir() {
+        anyhow::bail!("{}: no such results folder", args.results.display());
+    }
+    // compare writes its tables into the folder: one writer at a time (a run still writing it
+    // refuses this, naming itself).
+    let _lock = crate::io::outdir::lock(&args.results, "compare")?;
     let path = args.results.join("runs.csv");
     let mut reader = csv::Reader::from_path(&path).with_context(|| format!("cannot read {}", path.display()))?;
     let mut rows: Vec<OptimRow> = Vec::new();
@@ -46,11 +52,11 @@ pub fn compare(args: &CompareArgs) -> Result<()> {
     let mut opts: Vec<String> = Vec::new();
     let mut cells: BTreeMap<CellKey, BTreeMap<String, Vec<(usize, f64)>>> = BTreeMap::new();
     for r in &rows {
-        if !opts.contains(&r.optimiser) {
-            opts.push(r.optimiser.clone());
+        if !opts.contains(&r.competitor()) {
+            opts.push(r.competitor());
         }
         let key = (r.dataset.clone(), r.grid_x, r.grid_y, r.cn_x, r.cn_y, r.parameterisation.clone());
-        cells.entry(key).or_default().entry(r.optimiser.clone()).or_default().push((r.repeat, r.best));
+        cells.entry(key).or_default().entry(r.competitor()).or_default().push((r.repeat, r.best));
     }
     if opts.len() < 2 {
         anyhow::bail!("{}: only one optimiser ({}); nothing to compare", path.display(), opts[0]);
@@ -231,7 +237,7 @@ fn problems(rows: &[OptimRow], folder: &std::path::Path) -> Result<Vec<Problem>>
     let name = |r: &OptimRow| crate::families::optimise::ioh::problem_name(&r.dataset, &format!("{}x{}", r.grid_x, r.grid_y), &format!("{}x{}", r.cn_x, r.cn_y), &r.parameterisation);
     let mut expected: BTreeMap<(String, String), Vec<&OptimRow>> = BTreeMap::new();
     for r in rows {
-        expected.entry((name(r), r.optimiser.clone())).or_default().push(r);
+        expected.entry((name(r), r.competitor())).or_default().push(r);
     }
     let mut out: BTreeMap<String, Problem> = BTreeMap::new();
     for lp in crate::families::optimise::ioh::read(folder)? {
@@ -361,7 +367,7 @@ fn bayes_table(rows: &[OptimRow], opts: &[String], args: &CompareArgs) -> Result
     let mut cells: BTreeMap<CellKey, CellSums> = BTreeMap::new();
     for r in rows {
         let e = cells.entry((r.dataset.clone(), r.grid_x, r.grid_y, r.cn_x, r.cn_y, r.parameterisation.clone())).or_insert((r.b, BTreeMap::new()));
-        let s = e.1.entry(r.optimiser.clone()).or_default();
+        let s = e.1.entry(r.competitor()).or_default();
         s.0 += r.best;
         s.1 += 1;
     }

@@ -31,6 +31,9 @@ pub struct OptimRow {
     pub cn_y: usize,
     pub parameterisation: String,
     pub optimiser: String,
+    /// The swept settings of a `--sweep` run (e.g. `optim.de.f=0.5`); no column otherwise.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub variant: String,
     pub repeat: usize,
     pub seed: String,
     pub dimension: usize,
@@ -45,6 +48,17 @@ pub struct OptimRow {
     pub excursion: f64,
     pub max_control: f64,
     pub cpu_s: f64,
+}
+
+impl OptimRow {
+    /// What `compare` and the tables rank: the optimiser, or in a sweep `optimiser@variant`.
+    pub fn competitor(&self) -> String {
+        if self.variant.is_empty() {
+            self.optimiser.clone()
+        } else {
+            format!("{}@{}", self.optimiser, self.variant)
+        }
+    }
 }
 
 /// One optimiser run.
@@ -140,6 +154,7 @@ pub fn run_cell(spec: &Spec, cell: &OptimCell, problem: &ControlNetProblem) -> R
         cn_y: cell.cn.ny,
         parameterisation: cell.param.name().into(),
         optimiser: cell.optimiser.clone(),
+        variant: spec.variant.label(),
         repeat: cell.repeat,
         seed: seeds::seed_hex(spec.file.master_seed, &key),
         dimension: problem.dim(),
@@ -262,10 +277,22 @@ impl crate::experiment::family::Family for Optim {
         spec::cells(spec).iter().map(|c| c.key()).collect()
     }
     fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<crate::experiment::family::Outcome> {
-        let problems = problems(spec, ctx)?;
-        let exact = if tables { exact_optima(spec, ctx, &problems)? } else { BTreeMap::new() };
-        let runs = run(spec, ctx, &problems)?;
-        let section = if tables { Some(crate::families::optimise::report::write(&runs, &problems, &exact, &setting(spec), &ctx.out)?) } else { None };
+        self.run_variants(std::slice::from_ref(spec), ctx, tables)
+    }
+    /// Every variant's cells on the first variant's problems (a sweep varies optimiser settings
+    /// only), then one set of tables in which each `optimiser@variant` of a sweep is a column.
+    fn run_variants(&self, variants: &[Spec], ctx: &RunContext, tables: bool) -> Result<crate::experiment::family::Outcome> {
+        let [first, ..] = variants else { anyhow::bail!("no variant to run") };
+        let problems = problems(first, ctx)?;
+        let exact = if tables { exact_optima(first, ctx, &problems)? } else { BTreeMap::new() };
+        let mut runs = Vec::new();
+        for v in variants {
+            runs.extend(run(v, ctx, &problems)?.into_iter().map(|mut r| {
+                r.cell.optimiser = r.row.competitor();
+                r
+            }));
+        }
+        let section = if tables { Some(crate::families::optimise::report::write(&runs, &problems, &exact, &setting(first), &ctx.out)?) } else { None };
         Ok(crate::experiment::family::Outcome { section, cpu_s: runs.iter().map(|r| r.row.cpu_s).sum(), cells: runs.len() })
     }
 }

@@ -137,7 +137,7 @@ pub fn cells(spec: &Spec) -> Vec<OptimCell> {
                 let Ok(param) = p.parse() else { continue };
                 for opt in &o.optimisers {
                     for repeat in 0..o.repeats {
-                        cells.push(OptimCell { dataset: crate::data::registry::name_of(dataset), grid: o.grid, cn: *cn, param, optimiser: opt.clone(), repeat });
+                        cells.push(OptimCell { dataset: crate::data::registry::name_of(dataset), grid: o.grid, cn: *cn, param, optimiser: opt.clone(), repeat, variant: spec.variant.key() });
                     }
                 }
             }
@@ -155,6 +155,9 @@ pub struct OptimCell {
     pub param: crate::spline::Parameterisation,
     pub optimiser: String,
     pub repeat: usize,
+    /// The spec variant's changes ([`Variant::key`](crate::experiment::spec::Variant::key);
+    /// empty for a plain run).
+    pub variant: String,
 }
 
 impl crate::experiment::runner::Cell for OptimCell {
@@ -164,8 +167,11 @@ impl crate::experiment::runner::Cell for OptimCell {
 }
 
 impl OptimCell {
+    /// `optim/<data>/<grid>/<net>/<param>/<optimiser>/r<repeat>`; a variant's cells begin
+    /// `optim[<changes>]/`, so their seeds differ from the plain run's and from each other's.
     pub fn key(&self) -> String {
-        format!("optim/{}/{}/{}/{}/{}/r{}", self.dataset, self.grid, self.cn, self.param.name(), self.optimiser, self.repeat)
+        let head = if self.variant.is_empty() { "optim".to_string() } else { format!("optim[{}]", self.variant) };
+        format!("{head}/{}/{}/{}/{}/{}/r{}", self.dataset, self.grid, self.cn, self.param.name(), self.optimiser, self.repeat)
     }
 }
 

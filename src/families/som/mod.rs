@@ -84,15 +84,27 @@ impl SomRow {
 }
 
 /// Load every data set a spec names, once, by its name ([`crate::data::registry::dataset_name`]).
-pub fn load_datasets(names: &[String], ctx: &RunContext) -> Result<BTreeMap<String, Arc<PointCloud>>> {
+pub fn load_datasets(spec: &Spec, names: &[String], ctx: &RunContext) -> Result<BTreeMap<String, Arc<PointCloud>>> {
     let mut out = BTreeMap::new();
     for name in names {
         if !out.contains_key(&crate::data::registry::name_of(name)) {
-            let cloud = crate::data::registry::load_dataset(name, &ctx.data_dir)?;
+            let cloud = ctx.loader(spec).load(name)?;
             out.insert(cloud.name.clone(), Arc::new(cloud));
         }
     }
     Ok(out)
+}
+
+/// Refuse training a DNSOM `cell` on a data set (`entry`) of fewer points than its map has
+/// neurons: its map nodes become the grid the B-spline surfaces are fitted to (Chapters 5, 6).
+/// Other models may have more neurons than points (the thesis' 20x20x20 SOM3D on the 7352-point
+/// cube), so they are not checked.
+pub fn require_points(entry: &str, points: usize, cell: &SomCell) -> Result<()> {
+    if cell.model != crate::som::Model::Dnsom {
+        return Ok(());
+    }
+    let neurons = cell.model.topology(cell.grid.nx, cell.grid.ny).map_err(anyhow::Error::msg)?.counts().non;
+    Ok(crate::data::require_points(entry, points, neurons, &format!("{} {}", cell.model.key(), cell.grid))?)
 }
 
 /// Train one cell (pure apart from the CPU clock).
@@ -111,9 +123,15 @@ pub fn run_cell(cell: &SomCell, data: &[Point3], params: &SomParams, master_seed
 /// Run every SOM cell of a spec, logging each finished cell to the folder's cell log.
 pub fn run(spec: &Spec, ctx: &RunContext) -> Result<Vec<SomRun>> {
     let som_spec = spec.file.som.as_ref().context("spec has no [som] section")?;
-    let data = load_datasets(&som_spec.datasets, ctx)?;
+    let data = load_datasets(spec, &som_spec.datasets, ctx)?;
     let params = SomParams { iterations: som_spec.iterations, alpha0: som_spec.alpha0, sigma0: som_spec.sigma0 };
     let cells = spec::cells(spec);
+    for entry in &som_spec.datasets {
+        let name = crate::data::registry::name_of(entry);
+        for c in cells.iter().filter(|c| c.dataset == name) {
+            require_points(entry, data[&name].points.len(), c)?;
+        }
+    }
     runner::run_logged(&cells, ctx, &spec.file.name, |cell| run_cell(cell, &data[&cell.dataset].points, &params, spec.file.master_seed), |cell, (row, weights)| Ok(SomRun { cell: cell.clone(), row, weights }))
 }
 
