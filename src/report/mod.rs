@@ -8,6 +8,7 @@ pub mod ch6;
 pub mod claims;
 pub mod drift;
 pub mod fsio;
+pub mod html;
 pub mod ioh;
 pub mod markdown;
 pub mod plots;
@@ -16,6 +17,7 @@ pub mod seed002;
 pub mod seed003;
 pub mod seed001;
 pub mod seed004;
+pub mod views3d;
 
 use crate::experiment::spec::Spec;
 use crate::experiment::Manifest;
