@@ -4,7 +4,7 @@
 # order back, renders its first 3-D view to an image and counts the drawn pixels, and records every
 # script error (a script that failed to load included). Passes when the page says "pass" and
 # chromium's console log holds no uncaught exception.
-# Usage: scripts/check_report_html.sh results/thesis_quick
+# Usage: [VIEW_PNG=view.png] scripts/check_report_html.sh results/thesis_quick
 set -euo pipefail
 folder="${1:?usage: $0 <results folder with report.html>}"
 page="$(cd "$folder" && pwd)/report.html"
@@ -27,6 +27,10 @@ echo "chromium: $("$browser" --version 2>/dev/null | head -n 1), exit $rc, $(( $
 verdict="$(grep -o 'data-selftest="[a-z]*"' "$work/dom.html" | head -n 1 || true)"
 result="$(grep -o "data-selftest-result=\"[^\"]*\"" "$work/dom.html" | head -n 1 | sed 's/&quot;/"/g' || true)"
 echo "page self-test: ${verdict:-none} ${result}"
+# VIEW_PNG=file keeps the first 3-D view as the page rendered it (to look at).
+if [ -n "${VIEW_PNG:-}" ]; then
+  grep -o 'data-selftest-image="data:image/png;base64,[^"]*"' "$work/dom.html" | head -n 1 | sed 's/^data-selftest-image="data:image\/png;base64,//; s/"$//' | base64 -d >"$VIEW_PNG" || true
+fi
 uncaught="$(grep -a 'CONSOLE' "$work/log.txt" | grep -aiE 'uncaught|error' || true)"
 if [ -n "$uncaught" ]; then
   echo "console errors:"; echo "$uncaught"

@@ -145,7 +145,9 @@ fn build(root: &Path) -> Result<Page> {
         chapters.push(ch_take(&mut ch));
     }
     // The other report folders (the readings' runs), each a chapter of its own.
-    let uncovered: Vec<String> = folders.iter().filter(|f| !f.is_empty() && !covered.contains(f)).cloned().collect();
+    let mut uncovered: Vec<String> = folders.iter().filter(|f| !f.is_empty() && !covered.contains(f)).cloned().collect();
+    // In the order the root REPORT.md names them (its table of specs), the rest after.
+    uncovered.sort_by_key(|f| text.find(&format!("{f}/")).unwrap_or(usize::MAX));
     for f in &uncovered {
         let sub = read_text(&root.join(f).join("REPORT.md"))?;
         let body: Vec<&str> = sub.lines().skip_while(|l| !l.starts_with("# ")).skip(1).collect();

@@ -186,9 +186,9 @@
           g.drawImage(img, 0, 0);
           var d = g.getImageData(0, 0, cv.width, cv.height).data, n = 0;
           for (var i = 0; i < d.length; i += 4) { if (d[i + 3] > 0 && (d[i] < 235 || d[i + 1] < 235 || d[i + 2] < 235)) { n++; } }
-          resolve(n / (cv.width * cv.height));
+          resolve({ ink: n / (cv.width * cv.height), url: url });
         };
-        img.onerror = function () { resolve(-1); };
+        img.onerror = function () { resolve({ ink: -1, url: "" }); };
         img.src = url;
       });
     });
@@ -196,8 +196,10 @@
   if (/[?&]selftest\b/.test(location.search)) {
     var boxes = document.querySelectorAll(".views3d");
     Promise.all(pending).then(function () {
-      return boxes.length ? inked(boxes[0]) : 0;
-    }).then(function (ink) {
+      return boxes.length ? inked(boxes[0]) : { ink: 0, url: "" };
+    }).then(function (picture) {
+      var ink = picture.ink;
+      document.body.setAttribute("data-selftest-image", picture.url);
       var sort = sortCheck();
       var drawn = document.querySelectorAll(".views3d[data-drawn]").length;
       var result = { views: boxes.length, drawn: drawn, ink: ink, sort: sort, tables: document.querySelectorAll("table.sortable").length,

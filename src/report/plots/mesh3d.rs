@@ -39,7 +39,7 @@ pub fn magnified_difference(base: &[LineMesh], other: &[LineMesh], frac: f64) ->
     let max_diff = base.iter().zip(other).flat_map(|(b, o)| b.points.iter().zip(&o.points).map(|(p, q)| dist(p, q))).filter(|d| d.is_finite()).fold(0.0f64, f64::max);
     let (lo, hi) = base.iter().flat_map(|m| m.points.iter()).filter(|p| p.iter().all(|c| c.is_finite())).fold(([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]), |(lo, hi), p| ([0, 1, 2].map(|a| lo[a].min(p[a])), [0, 1, 2].map(|a| hi[a].max(p[a]))));
     let side = (0..3).map(|a| hi[a] - lo[a]).fold(0.0f64, f64::max);
-    if max_diff <= 0.0 || !(side > 0.0) {
+    if max_diff <= 0.0 || side.is_nan() || side <= 0.0 {
         return None;
     }
     let k = frac * side / max_diff;
