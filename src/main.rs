@@ -44,7 +44,10 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             let out = experiment::run_variants(&variants, &ctx)?;
             match shard {
                 Some(s) => eprintln!("somnurbs: wrote shard {s} to {} (combine the shards with `somnurbs merge`)", out.display()),
-                None => eprintln!("somnurbs: wrote {}", out.join("REPORT.md").display()),
+                None => {
+                    let html = somnurbs::report::html::write(&out)?;
+                    eprintln!("somnurbs: wrote {} and {}", out.join("REPORT.md").display(), html.display())
+                }
             }
             Ok(ExitCode::SUCCESS)
         }

@@ -172,6 +172,7 @@ pub fn reproduce(specs_dir: &Path, plan_name: &str, profile: &str, ctx: &RunCont
     }
     let path = ctx.out.join("REPORT.md");
     write_atomic(&path, report.as_bytes())?;
+    crate::report::html::write(&ctx.out)?;
     std::fs::remove_file(&incomplete).with_context(|| format!("cannot remove {}", incomplete.display()))?;
     crate::io::outdir::sync_dir(&ctx.out)?;
     Ok(path)

@@ -3,9 +3,11 @@
 
 pub mod claims;
 pub mod drift;
+pub mod html;
 pub mod markdown;
 pub mod plots;
 pub mod reference;
+pub mod views3d;
 
 /// The distinct items in order of first appearance.
 pub fn ordered<T: PartialEq + Clone>(items: impl Iterator<Item = T>) -> Vec<T> {

@@ -214,6 +214,10 @@ impl crate::experiment::family::Family for Fit {
         let origins: Vec<(String, String)> = maps.iter().map(|(d, m)| (d.clone(), m.origin.clone())).collect();
         let pictures = spec.file.fit.as_ref().map(|f| f.pictures).unwrap_or(false);
         let section = if tables { Some(crate::families::fit::report::write(&runs, &ctx.out, &origins, pictures)?) } else { None };
+        if tables && pictures {
+            let grids: Vec<_> = maps.iter().map(|(d, m)| (d.clone(), &m.grid)).collect();
+            crate::report::views3d::write(&ctx.out, &crate::families::fit::pictures::views(&runs, &grids))?;
+        }
         Ok(crate::experiment::family::Outcome { section, cpu_s: runs.iter().map(|r| r.row.cpu_s).sum(), cells: runs.len() })
     }
 }

@@ -269,11 +269,19 @@ pub fn write(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProble
                             plots::LineMesh { points: top, edges: te, colour: style::DNSOM_TOP, label: "top surface".into() },
                         ]
                     };
-                    panels.push(plots::Panel { title: format!("{} {cn} B ({:.4})", p.name(), problem.fitness(problem.initial_point())), meshes: meshes(problem.initial_point()) });
+                    let b = meshes(problem.initial_point());
+                    panels.push(plots::Panel { title: format!("{} {cn} B ({:.4})", p.name(), problem.fitness(problem.initial_point())), meshes: b.clone() });
+                    // The optimised surfaces differ from B by ~1e-4: each is drawn as its
+                    // difference from B, magnified, over B in grey.
+                    let grey: Vec<plots::LineMesh> = b.iter().map(|m| plots::LineMesh { colour: plotters::style::RGBColor(190, 190, 190), label: "B, under each optimiser's magnified difference".into(), ..m.clone() }).collect();
                     for o in &opts {
                         let min = g.iter().filter(|r| r.cell.dataset == d && r.cell.param == p && r.cell.cn == cn && &r.cell.optimiser == o).min_by(|a, b| a.row.best.total_cmp(&b.row.best));
                         if let Some(r) = min {
-                            panels.push(plots::Panel { title: format!("{} MIN {} ({:.4})", o.to_uppercase(), p.name(), r.row.best), meshes: meshes(&r.best_x) });
+                            let (title, shown) = match plots::magnified_difference(&b, &meshes(&r.best_x), 0.15) {
+                                Some((m, k, dmax)) => (format!("{}: (MIN - B) x{k:.0}, max {dmax:.0e}", o.to_uppercase()), grey.iter().cloned().chain(m).collect()),
+                                None => (format!("{} MIN ({:.4}) = B", o.to_uppercase(), r.row.best), b.clone()),
+                            };
+                            panels.push(plots::Panel { title, meshes: shown });
                         }
                     }
                 }
@@ -314,6 +322,16 @@ pub fn write(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProble
                         band.push((e as f64, q(0.25), q(0.75)));
                     }
                     series.push(Series { label: o.clone(), colour: style::optimiser_colour(o).unwrap_or_else(|| style::cycle_colour(k)), points: pts, band: Some(band) });
+                }
+                // B (where every run starts) and, where the folder has it, the certified optimum.
+                let (x0, x1) = series.iter().flat_map(|s| s.points.iter().map(|p| p.0)).fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(x), b.max(x)));
+                let level = |label: String, name: &str, y: f64| Series { label, colour: style::optimiser_colour(name).unwrap_or(style::GREY), points: vec![(x0, y), (x1, y)], band: None };
+                if let Some(problem) = problems.get(&(d.clone(), cn, p0)) {
+                    let b = problem.fitness(problem.initial_point());
+                    series.push(level(format!("B {b:.6}"), "b", b));
+                }
+                if let Some(e) = exact.get(&(d.clone(), cn, p0)) {
+                    series.push(level(format!("certified optimum {:.6}", e.f), "exact", e.f));
                 }
                 let conv = format!("png/convergence_{grid}_{d}_{}_{cn}.png", p0.name());
                 crate::io::ensure_dir(&out.join("png"))?;

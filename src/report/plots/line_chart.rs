@@ -61,6 +61,51 @@ pub fn line_chart_png(
     series: &[Series],
     log_y: bool,
 ) -> Result<(), PlotError> {
+    let (x_ext, y_axis) = axes(path, series, log_y)?;
+    render_png(path, style::CHART_SIZE, |root| {
+        draw_line_chart(root, title, x_label, y_label, series, x_ext, &y_axis)
+    })
+}
+
+/// Size of one panel of [`small_multiples_png`].
+pub const SMALL_PANEL: (u32, u32) = (600, 400);
+/// Height of the title band of [`small_multiples_png`].
+const SMALL_HEADER_PX: u32 = 44;
+
+/// Small multiples: one line chart per `(caption, series)` panel, `cols` per row, on one shared
+/// x range and y axis (so panels compare at a glance), under one page title. For many curves
+/// that overlap on one chart (e.g. four parameterisations x two approaches).
+pub fn small_multiples_png(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    panels: &[(String, Vec<Series>)],
+    cols: usize,
+    log_y: bool,
+) -> Result<(), PlotError> {
+    let all: Vec<Series> = panels.iter().flat_map(|p| p.1.iter().cloned()).collect();
+    let (x_ext, y_axis) = axes(path, &all, log_y)?;
+    let cols = cols.clamp(1, panels.len().max(1));
+    let rows = panels.len().div_ceil(cols) as u32;
+    let size = (SMALL_PANEL.0 * cols as u32, SMALL_PANEL.1 * rows + SMALL_HEADER_PX);
+    render_png(path, size, |root| {
+        let (header, body) = root.split_vertically(SMALL_HEADER_PX);
+        header.draw_text(
+            title,
+            &style::bold(style::TITLE_PX).pos(Pos::new(HPos::Center, VPos::Top)),
+            (size.0 as i32 / 2, 10),
+        )?;
+        let cells = body.split_evenly((rows as usize, cols));
+        for (cell, (caption, series)) in cells.iter().zip(panels) {
+            draw_line_chart(cell, caption, x_label, y_label, series, x_ext, &y_axis)?;
+        }
+        Ok(())
+    })
+}
+
+/// The x extent and the y axis that show every drawable point of `series`.
+fn axes(path: &Path, series: &[Series], log_y: bool) -> Result<((f64, f64), Axis), PlotError> {
     let ok_y = |y: f64| if log_y { y > 0.0 } else { true };
     let xs = series.iter().flat_map(|s| {
         s.points
@@ -104,9 +149,7 @@ pub fn line_chart_png(
     } else {
         Axis::linear(y_ext.0, y_ext.1, 7)
     };
-    render_png(path, style::CHART_SIZE, |root| {
-        draw_line_chart(root, title, x_label, y_label, series, x_ext, &y_axis)
-    })
+    Ok((x_ext, y_axis))
 }
 
 fn draw_line_chart(

@@ -26,6 +26,31 @@ pub struct LineMesh {
     pub label: String,
 }
 
+/// `other` drawn as its difference from `base` magnified: each point `b + k (o - b)`, with `k`
+/// chosen so the largest difference is `frac` of the base's largest bounding-box side (for two
+/// surfaces that differ by too little to see). Meshes pair up in order and must have as many
+/// points; returns the magnified meshes, `k` and the largest difference (None when nothing differs
+/// or the meshes do not pair up).
+pub fn magnified_difference(base: &[LineMesh], other: &[LineMesh], frac: f64) -> Option<(Vec<LineMesh>, f64, f64)> {
+    if base.len() != other.len() || base.iter().zip(other).any(|(b, o)| b.points.len() != o.points.len()) {
+        return None;
+    }
+    let dist = |a: &Point3, b: &Point3| ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
+    let max_diff = base.iter().zip(other).flat_map(|(b, o)| b.points.iter().zip(&o.points).map(|(p, q)| dist(p, q))).filter(|d| d.is_finite()).fold(0.0f64, f64::max);
+    let (lo, hi) = base.iter().flat_map(|m| m.points.iter()).filter(|p| p.iter().all(|c| c.is_finite())).fold(([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]), |(lo, hi), p| ([0, 1, 2].map(|a| lo[a].min(p[a])), [0, 1, 2].map(|a| hi[a].max(p[a]))));
+    let side = (0..3).map(|a| hi[a] - lo[a]).fold(0.0f64, f64::max);
+    if max_diff <= 0.0 || side.is_nan() || side <= 0.0 {
+        return None;
+    }
+    let k = frac * side / max_diff;
+    let meshes = base
+        .iter()
+        .zip(other)
+        .map(|(b, o)| LineMesh { points: b.points.iter().zip(&o.points).map(|(p, q)| [0, 1, 2].map(|a| p[a] + k * (q[a] - p[a]))).collect(), ..o.clone() })
+        .collect();
+    Some((meshes, k, max_diff))
+}
+
 /// Viewing direction of a 3-D picture (plotters' projection: yaw about the vertical axis, then
 /// pitch, in radians; `scale` shrinks the cube to fit its corners into the area).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -204,6 +229,12 @@ pub(crate) fn draw_meshes_with(
         format!("{:.*}", d, v)
     };
     let blank = |_: &f64| String::new();
+    // Two axes meet at each corner of the box: end labels there print on top of each other
+    // ("1.01.0"). The vertical axis and the depth axis leave out labels near their ends (the
+    // data's ends sit 7 % of a half side inside the box); the first axis keeps all of its labels.
+    let inside = |a: usize, v: f64| (v - (centre[a] - half)).min(centre[a] + half - v) >= 0.2 * half;
+    let fmt_vertical = |v: &f64| if inside(2, *v) { fmt(v) } else { String::new() };
+    let fmt_depth = |v: &f64| if inside(1, *v) { fmt(v) } else { String::new() };
     {
         let mut axes = chart.configure_axes();
         axes.light_grid_style(style::GRID.mix(0.5))
@@ -213,7 +244,7 @@ pub(crate) fn draw_meshes_with(
             .label_style(style::text(if small { 10.0 } else { 12.0 }).color(&style::GREY));
         if view.tick_labels {
             axes.x_labels(3).y_labels(3).z_labels(3).tick_size(4);
-            axes.x_formatter(&fmt).y_formatter(&fmt).z_formatter(&fmt);
+            axes.x_formatter(&fmt).y_formatter(&fmt_vertical).z_formatter(&fmt_depth);
         } else {
             axes.x_labels(3).y_labels(3).z_labels(3).tick_size(0);
             axes.x_formatter(&blank)

@@ -57,11 +57,14 @@ pub fn overview_png(
     }
     render_png(path, size, |root| {
         let (header, body) = root.split_vertically(HEADER_PX);
-        header.draw_text(
-            title,
-            &style::bold(style::TITLE_PX).pos(Pos::new(HPos::Center, VPos::Top)),
-            (size.0 as i32 / 2, 8),
-        )?;
+        let (lines, px) = fit_title(&header, title, size.0.saturating_sub(16))?;
+        for (k, line) in lines.iter().enumerate() {
+            header.draw_text(
+                line,
+                &style::bold(px).pos(Pos::new(HPos::Center, VPos::Top)),
+                (size.0 as i32 / 2, 6 + k as i32 * (px as i32 + 2)),
+            )?;
+        }
         draw_legend(&header, &legend, size.0)?;
         let rows = panels.len().div_ceil(cols);
         let cells = body.split_evenly((rows, cols));
@@ -82,6 +85,41 @@ pub fn overview_png(
         }
         Ok(())
     })
+}
+
+/// The title's lines and font size so that it fits `width` pixels: one line at the title size if
+/// it fits, else one line at a smaller size (down to the label size), else two lines split at the
+/// space nearest the middle.
+fn fit_title(
+    area: &DrawingArea<BitMapBackend<'_>, plotters::coord::Shift>,
+    title: &str,
+    width: u32,
+) -> Result<(Vec<String>, f64), DrawError> {
+    let fits = |text: &str, px: f64| -> Result<bool, DrawError> {
+        Ok(area.estimate_text_size(text, &style::bold(px))?.0 <= width)
+    };
+    let mut px = style::TITLE_PX;
+    while px >= style::LABEL_PX {
+        if fits(title, px)? {
+            return Ok((vec![title.to_string()], px));
+        }
+        px -= 1.0;
+    }
+    let mid = title.len() / 2;
+    let split = title
+        .char_indices()
+        .filter(|&(_, c)| c == ' ')
+        .map(|(i, _)| i)
+        .min_by_key(|&i| i.abs_diff(mid));
+    let lines = match split {
+        Some(i) => vec![title[..i].to_string(), title[i + 1..].to_string()],
+        None => vec![title.to_string()],
+    };
+    let mut px = style::LABEL_PX + 2.0;
+    while px > 8.0 && !lines.iter().map(|l| fits(l, px)).collect::<Result<Vec<_>, _>>()?.iter().all(|&f| f) {
+        px -= 1.0;
+    }
+    Ok((lines, px))
 }
 
 /// A one-line legend centred in the lower half of the header band.
@@ -195,6 +233,25 @@ mod tests {
         let e = overview_png(&q, "t", &[ok], 1).unwrap_err().to_string();
         assert!(e.contains(&q.display().to_string()), "{e}");
         assert!(listing(dir.path()).is_empty(), "{:?}", listing(dir.path()));
+    }
+
+    #[test]
+    fn a_long_title_fits_the_page() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("t.png");
+        let title = "Appendix D: CKSOM and DNSOM with different width and length of grid";
+        let mut lines = Vec::new();
+        render_png(&p, (600, 100), |root| {
+            let (l, px) = fit_title(root, title, 584)?;
+            for line in &l {
+                assert!(root.estimate_text_size(line, &style::bold(px))?.0 <= 584, "{line} at {px}");
+            }
+            lines = l;
+            Ok(())
+        })
+        .unwrap();
+        assert_eq!(lines.join(" "), title);
+        assert!(lines.len() <= 2);
     }
 
     #[test]
