@@ -90,7 +90,7 @@ fn read(path: &Path, hint: &str) -> Result<Vec<u8>, DataError> {
 fn where_to_get(file: &str) -> String {
     let source = match file {
         BUNNY_FILE => {
-            "http://graphics.stanford.edu/pub/3Dscanrep/bunny.tar.gz (the file bunny/reconstruction/bun_zipper.ply inside it)"
+            "the Stanford 3D Scanning Repository, http://graphics.stanford.edu/pub/3Dscanrep/bunny.tar.gz (the file bunny/reconstruction/bun_zipper.ply inside it)"
         }
         _ => "https://github.com/modenaxe/msk-STAPLE/raw/master/bone_datasets/TLEM2/stl/talus_r.stl",
     };
