@@ -35,7 +35,7 @@ pub fn compare(args: &CompareArgs) -> Result<()> {
         anyhow::bail!("--rope must be finite and >= 0 (got {}) and --bayes-samples at least 1 (got {})", args.rope, args.bayes_samples);
     }
     if !args.results.is_dir() {
-        anyhow::bail!("{}: no such results folder", args.results.display());
+        anyhow::bail!("{}: not found (no such results folder)", args.results.join("runs.csv").display());
     }
     // compare writes its tables into the folder: one writer at a time (a run still writing it
     // refuses this, naming itself).
