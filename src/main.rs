@@ -75,7 +75,8 @@ per-cell differences: {}", report.summary(10), out.display());
         Command::Merge(args) => {
             let ctx = RunContext::new(args.out.clone(), jobs(args.jobs)?, experiment::data_dir(args.data_dir.as_deref()));
             let out = experiment::merge(&args.shards, &ctx)?;
-            eprintln!("somnurbs: merged {} shards into {}", args.shards.len(), out.join("REPORT.md").display());
+            let html = somnurbs::report::html::write(&out)?;
+            eprintln!("somnurbs: merged {} shards into {} and {}", args.shards.len(), out.join("REPORT.md").display(), html.display());
             Ok(ExitCode::SUCCESS)
         }
         Command::Reproduce(args) => {

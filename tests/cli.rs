@@ -138,6 +138,8 @@ fn datasets_list_show_export() {
     c.ok(&["datasets", "export", "oiltank", "oil.csv"]);
     let (h, rows) = read_csv(&c.path("oil.csv"));
     assert_eq!((h.len(), rows.len()), (3, 5942));
+    // Exporting into a plain folder leaves only the file (no lock file of a results folder).
+    assert!(!c.path(".somnurbs.lock").exists(), "datasets export left a lock file behind");
     c.fails(&["datasets", "show", "teapot"], &["teapot"]);
 }
 

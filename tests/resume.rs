@@ -63,6 +63,8 @@ fn shards_merge_into_the_one_machine_run() {
     c.fails(&["merge", "shard1", "shard1", "shard2", "--out", "m2"], &["given twice"]);
     c.fails(&["merge", "one", "--out", "m3"], &["not a shard"]);
     c.ok(&["merge", "shard3", "shard1", "shard2", "--out", "merged"]);
+    // The merged folder gets the same report.html as a one-machine run.
+    assert!(c.path("merged/report.html").is_file() && c.path("one/report.html").is_file());
     let compared = same_tables(&c.path("one"), &c.path("merged"));
     assert!(compared >= 5);
     c.fails(&["run", "s.toml", "--shard", "4/3"], &["--shard"]);

@@ -37,9 +37,10 @@ pub fn datasets(action: DatasetsAction, data_dir: &Path) -> Result<()> {
                     let _ = writeln!(text, "{:?} {:?} {:?}", p[0], p[1], p[2]);
                 }
             }
-            // The file's folder has one writer at a time (a run writing there refuses this).
+            // A results folder has one writer at a time (a run writing there refuses this); the
+            // file itself is written atomically, so a plain folder gets no lock file.
             let folder = file.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-            let _lock = crate::io::outdir::lock(folder, "datasets export")?;
+            let _lock = crate::io::outdir::lock_if_shared(folder, "datasets export")?;
             crate::io::write_atomic(&file, text.as_bytes())?;
             eprintln!("somnurbs: wrote {} points to {}", cloud.points.len(), file.display());
         }

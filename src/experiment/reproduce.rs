@@ -434,19 +434,53 @@ fn combined_report(out: &Path, plan: &Plan, plan_name: &str, specs: &[Spec], don
             let _ = writeln!(s, "\n## {title}\n\n`{file}.csv` ({thesis}).\n\n{}", markdown_table(&h, &r));
         }
     }
+    let mut seen: Vec<(String, String)> = Vec::new();
     for spec in specs {
         let name = &spec.file.name;
         let path = out.join(name).join("REPORT.md");
         let text = std::fs::read_to_string(&path).with_context(|| format!("cannot read {}", path.display()))?;
         let _ = writeln!(s, "\n---\n\n# {name}\n");
-        for line in text.lines().skip_while(|l| l.starts_with("# ") || l.trim().is_empty()) {
-            // Sub-reports' headings one level down, their links into the sub-folder.
+        s.push_str(&sub_report(&text, name, &mut seen));
+    }
+    Ok(s)
+}
+
+/// A spec's REPORT.md inside the combined one: headings one level down, links into its folder,
+/// its claims left to the table at the top (a link to its `claims.csv` instead), and a
+/// sub-section said word for word by an earlier spec (the metric definitions) replaced by a
+/// pointer to it. `seen` holds (sub-section text, spec) of the specs so far.
+fn sub_report(text: &str, name: &str, seen: &mut Vec<(String, String)>) -> String {
+    let mut s = String::new();
+    // Split at the sub-sections ("### " in a spec's report); the part before the first is kept.
+    let mut parts: Vec<(Option<&str>, Vec<&str>)> = vec![(None, Vec::new())];
+    for line in text.lines().skip_while(|l| l.starts_with("# ") || l.trim().is_empty()) {
+        match line.strip_prefix("### ") {
+            Some(h) => parts.push((Some(h), Vec::new())),
+            None => parts.last_mut().expect("starts with one part").1.push(line),
+        }
+    }
+    for (heading, lines) in parts {
+        let body = lines.join("\n");
+        if let Some(h) = heading {
+            let _ = writeln!(s, "#### {h}");
+            if h.trim() == "Claims" {
+                let _ = writeln!(s, "\nIn the claims table at the top (`{name}/claims.csv`).\n");
+                continue;
+            }
+            let key = format!("{h}\n{body}");
+            if let Some((_, first)) = seen.iter().find(|(k, _)| *k == key) {
+                let _ = writeln!(s, "\nAs under [{first}](#{first}) above.\n");
+                continue;
+            }
+            seen.push((key, name.to_string()));
+        }
+        for line in lines {
             let line = if line.starts_with('#') { format!("#{line}") } else { line.to_string() };
             s.push_str(&relink(&line, name));
             s.push('\n');
         }
     }
-    Ok(s)
+    s
 }
 
 /// Chapter 6's claims over both grids (Tables 6.8 and 6.9): the per-grid counts summed, here
@@ -463,7 +497,7 @@ fn overall_claims(per_grid: &[Claim]) -> Vec<Claim> {
         }
         let ours = parts.iter().fold((0, 0), |a, c| (a.0 + c.ours.0, a.1 + c.ours.1));
         let thesis = parts.iter().try_fold((0, 0), |a, c| c.thesis.map(|t| (a.0 + t.0, a.1 + t.1)));
-        out.push(Claim { chapter: "6".into(), statement: statement.into(), ours, thesis, note: note.into() });
+        out.push(Claim { rival: None, chapter: "6".into(), statement: statement.into(), ours, thesis, note: note.into() });
     }
     out
 }

@@ -204,6 +204,18 @@ pub fn lock(dir: &Path, command: &str) -> Result<Lock> {
     Ok(Lock { file, path, stop, heartbeat })
 }
 
+/// Take the lock of `dir` only when it is a writer's folder already (it holds a lock file):
+/// a one-file command such as `datasets export` then waits its turn in a results folder, and
+/// leaves no lock file behind in a plain folder (the file can never be removed safely once made,
+/// as a waiting writer may hold it open).
+pub fn lock_if_shared(dir: &Path, command: &str) -> Result<Option<Lock>> {
+    if dir.join(LOCK_FILE).exists() {
+        lock(dir, command).map(Some)
+    } else {
+        Ok(None)
+    }
+}
+
 fn write_record(file: &mut File, text: &str) -> std::io::Result<()> {
     file.set_len(0)?;
     file.seek(SeekFrom::Start(0))?;

@@ -45,6 +45,9 @@ pub fn table(name: &str) -> Option<RefTable> {
         "appendix_l" => include_str!("../../experiments/reference/appendix_l.csv"),
         "appendix_m" => include_str!("../../experiments/reference/appendix_m.csv"),
         "appendix_n" => include_str!("../../experiments/reference/appendix_n.csv"),
+        // Section 4.3's text (thesis line "The QE and TE of the experiment were 0.049694 and
+        // 0.225400 ... CPU time ... 5.386289 seconds"), in Appendix B's columns, DNSOM only.
+        "section_4_bunny" => include_str!("../../experiments/reference/section_4_bunny.csv"),
         "seed003_table3" => include_str!("../../experiments/reference/seed003_table3.csv"),
         "seed003_table4" => include_str!("../../experiments/reference/seed003_table4.csv"),
         "seed003_table5" => include_str!("../../experiments/reference/seed003_table5.csv"),
@@ -55,10 +58,25 @@ pub fn table(name: &str) -> Option<RefTable> {
     Some(RefTable::parse(text))
 }
 
+/// Several published tables with the same columns read as one (e.g. Appendix B and the bunny
+/// figures of Section 4.3's text); None when none of them is known.
+pub fn joined(names: &[&str]) -> Option<RefTable> {
+    let mut parts = names.iter().filter_map(|n| table(n));
+    let mut first = parts.next()?;
+    for t in parts {
+        debug_assert_eq!(t.header, first.header, "joined reference tables must share their columns");
+        first.rows.extend(t.rows);
+    }
+    Some(first)
+}
+
 #[cfg(test)]
 mod tests {
     #[test]
     fn published_tables_load() {
+        let j = super::joined(&["appendix_b", "section_4_bunny"]).unwrap();
+        assert_eq!(j.value(&["data", "n"], &["bunny".into(), "30".into()], "qe_dnsom"), Some(0.049694));
+        assert_eq!(j.value(&["data", "n"], &["bunny".into(), "30".into()], "qe_som2d"), None);
         let b = super::table("appendix_b").unwrap();
         assert_eq!(b.rows.len(), 15);
         assert_eq!(b.value(&["data", "n"], &["spindle".into(), "30".into()], "cpu_s_dnsom"), Some(5.309147));

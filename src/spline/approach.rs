@@ -352,6 +352,15 @@ impl ControlNetParts {
         self.surfaces(x).map(|s| super::geometry::dense_wireframe(&s, &self.params_u, &self.params_v, super::DENSE_FACTOR))
     }
 
+    /// The surfaces (bottom, top) of a decision vector sampled `DENSE_FACTOR` times finer than
+    /// the data parameters: (points row-major, rows, columns) each, for 3-D views.
+    pub fn dense_grids(&self, x: &[f64]) -> [(Vec<Point3>, usize, usize); 2] {
+        self.surfaces(x).map(|s| {
+            let (points, du, dv) = super::geometry::dense_grid(&s, &self.params_u, &self.params_v, super::DENSE_FACTOR);
+            (points, du.len(), dv.len())
+        })
+    }
+
     /// The dense geometry of a decision vector's surfaces (B's shared parameters and knots).
     pub fn dense_geometry(&self, x: &[f64]) -> super::DenseGeometry {
         let [bottom, top] = self.surfaces(x);

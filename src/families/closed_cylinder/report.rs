@@ -119,6 +119,7 @@ pub fn write(s4: &Seed004Spec, runs: &[Run], sweep: &[(usize, f64)], floor: f64,
     if let Some((an, ga)) = row3(7) {
         claims.push(crate::report::claims::Claim {
             chapter: "seed004".into(),
+            rival: None,
             statement: "GA's least error beats the analytical method's at 7 control points (paper: 0.0164 vs 0.0174, 5.7471%)".into(),
             ours: ((ga < an) as usize, 1),
             thesis: Some(((0.0164 < 0.0174) as usize, 1)),
@@ -131,6 +132,7 @@ pub fn write(s4: &Seed004Spec, runs: &[Run], sweep: &[(usize, f64)], floor: f64,
     if let (Some((cp, v)), Some((pcp, _))) = (argmin(&ga_by_cp), argmin(&paper_by_cp)) {
         claims.push(crate::report::claims::Claim {
             chapter: "seed004".into(),
+            rival: None,
             statement: "The GA's fitness is best (least error) between 25 and 30 control points (Table III)".into(),
             ours: ((25..=30).contains(&cp) as usize, 1),
             thesis: Some(((25..=30).contains(&pcp) as usize, 1)),
@@ -140,6 +142,7 @@ pub fn write(s4: &Seed004Spec, runs: &[Run], sweep: &[(usize, f64)], floor: f64,
     if let Some((cp, v)) = argmin(sweep) {
         claims.push(crate::report::claims::Claim {
             chapter: "seed004".into(),
+            rival: None,
             statement: "The analytical method's least error is at 28 control points (0.001132)".into(),
             ours: ((cp == 28) as usize, 1),
             thesis: None,
@@ -149,6 +152,7 @@ pub fn write(s4: &Seed004Spec, runs: &[Run], sweep: &[(usize, f64)], floor: f64,
     let better = ga_by_cp.iter().filter(|(cp, ga)| row3(*cp).is_some_and(|(an, _)| *ga < an)).count();
     claims.push(crate::report::claims::Claim {
         chapter: "seed004".into(),
+        rival: None,
         statement: "The GA improves on the analytical control points for the other numbers of control points too".into(),
         ours: (better, ga_by_cp.len()),
         thesis: None,
@@ -157,6 +161,7 @@ pub fn write(s4: &Seed004Spec, runs: &[Run], sweep: &[(usize, f64)], floor: f64,
     let falls = runs.iter().filter(|r| r.population_best.last().is_some_and(|l| *l < r.population_best[0])).count();
     claims.push(crate::report::claims::Claim {
         chapter: "seed004".into(),
+        rival: None,
         statement: "The fitness improves (the error decreases) as the generations increase (Table II)".into(),
         ours: (falls, runs.len()),
         thesis: None,

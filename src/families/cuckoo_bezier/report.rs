@@ -285,6 +285,7 @@ fn write_tests(s: &Seed003Spec, runs: &[Run], examples: &[&str], others: &[&str]
             let paper: Vec<String> = rows.iter().map(|r| format!("{}: {} better", r[1], if r[3].is_empty() { "?" } else { &r[3] })).collect();
             crate::report::claims::Claim {
                 chapter: "seed003".into(),
+                rival: None,
                 statement: format!("CSA vs {o}: the better method and the significance of both Wilcoxon tests are as in the paper's Tables 4-5"),
                 ours: (rows.iter().filter(|r| r[10] == "yes").count(), rows.len()),
                 thesis: None,

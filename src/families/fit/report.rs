@@ -136,17 +136,20 @@ pub fn write(runs: &[FitRun], out: &Path, maps_origin: &[(String, String)], pict
             // Claim: the thesis' best parameterisation per approach.
             let thesis_best = if a == Approach::Conventional { Parameterisation::Exponential } else { Parameterisation::ChordLength };
             if let Some(k) = params.iter().position(|&p| p == thesis_best) {
-                let best_ours = totals.iter().max().copied().unwrap_or(0);
                 let t_counts = thesis.as_ref().map(|t| {
                     let te = thesis_error(t);
                     let tw = param_wins(&te, &data, &cns, &params, a);
                     let tt: Vec<usize> = (0..params.len()).map(|k| tw.iter().map(|x| x.1[k]).sum()).collect();
                     (tt[k], tw.iter().map(|x| x.2).sum::<usize>())
                 });
+                // Counted in cells, as the thesis counts them: X wins `totals[k]` of `cells` and
+                // holds when no other parameterisation wins as many.
+                let rival = totals.iter().enumerate().filter(|&(j, _)| j != k).map(|(_, &t)| t).max().unwrap_or(0);
                 claims.push(Claim {
                     chapter: "5".into(),
+                    rival: Some(rival),
                     statement: format!("{} is the best parameterisation for approach {} (grid {grid})", thesis_best.name(), a.letter()),
-                    ours: ((totals[k] == best_ours) as usize, 1),
+                    ours: (totals[k], cells),
                     thesis: t_counts.map(|(w, c)| (w, c)),
                     note: format!("wins here: {}", params.iter().zip(&totals).map(|(p, t)| format!("{} {t}", p.name())).collect::<Vec<_>>().join(", ")),
                 });
@@ -164,7 +167,7 @@ pub fn write(runs: &[FitRun], out: &Path, maps_origin: &[(String, String)], pict
                 let te = thesis_error(t);
                 approach_wins(&te, &data, &cns, &params).iter().fold((0, 0), |acc, x| (acc.0 + x.3, acc.1 + x.4))
             });
-            claims.push(Claim { chapter: "5".into(), statement: format!("B beats A in most cells (grid {grid})"), ours: (tb, tc), thesis: thesis_ab, note: "cells where B has the smaller surface error; verdict 'mostly holds' when more than half".into() });
+            claims.push(Claim { rival: None, chapter: "5".into(), statement: format!("B beats A in most cells (grid {grid})"), ours: (tb, tc), thesis: thesis_ab, note: "cells where B has the smaller surface error; verdict 'mostly holds' when more than half".into() });
             // Gaps.
             let gh: Vec<String> = ["data", "cn_x", "cn_y", "parameterisation", "gap_A", "gap_B"].iter().map(|s| s.to_string()).collect();
             let mut gap_rows = Vec::new();
@@ -184,7 +187,7 @@ pub fn write(runs: &[FitRun], out: &Path, maps_origin: &[(String, String)], pict
                 }
             }
             write_atomic(&out.join(format!("gaps_{grid}.csv")), csv_records(&gh, &gap_rows)?.as_bytes())?;
-            claims.push(Claim { chapter: "5".into(), statement: format!("The improved approach B leaves no gap (grid {grid})"), ours: (b_zero, b_all), thesis: None, note: format!("gap exactly 0; A has a positive gap in {a_pos} cells (`gaps_{grid}.csv`)") });
+            claims.push(Claim { rival: None, chapter: "5".into(), statement: format!("The improved approach B leaves no gap (grid {grid})"), ours: (b_zero, b_all), thesis: None, note: format!("gap exactly 0; A has a positive gap in {a_pos} cells (`gaps_{grid}.csv`)") });
         }
         // Error falls as the control net grows.
         let mut sorted = cns.clone();
@@ -205,7 +208,7 @@ pub fn write(runs: &[FitRun], out: &Path, maps_origin: &[(String, String)], pict
             (yes, all)
         };
         let t_series = thesis.as_ref().map(|t| series(&thesis_error(t)));
-        claims.push(Claim { chapter: "5".into(), statement: format!("Surface error falls as the control net grows (grid {grid})"), ours: series(&ours), thesis: t_series, note: "per (data, parameterisation, approach) series".into() });
+        claims.push(Claim { rival: None, chapter: "5".into(), statement: format!("Surface error falls as the control net grows (grid {grid})"), ours: series(&ours), thesis: t_series, note: "per (data, parameterisation, approach) series".into() });
         if let Some(t) = &thesis {
             let ratios = thesis_ratios(&ours, &thesis_error(t), &data, &cns, &params, &approaches);
             let (md, claim) = render_thesis_ratios(&ratios, grid, &app_name, out)?;
@@ -300,6 +303,7 @@ fn render_thesis_ratios(ratios: &[Ratio], grid: GridSize, app_name: &str, out: &
     let inside = ratios.iter().filter(|r| r.median >= RATIO_BAND.0 && r.median <= RATIO_BAND.1).count();
     let claim = Claim {
         chapter: "5".into(),
+        rival: None,
         statement: format!("Surface errors are of the thesis' magnitude (grid {grid})"),
         ours: (inside, ratios.len()),
         thesis: None,
@@ -347,6 +351,7 @@ fn render_geometry(geo: &[GeometryRow], runs: &[FitRun], grid: GridSize, out: &P
     let worst = runs.iter().max_by(|a, b| a.row.excursion.total_cmp(&b.row.excursion));
     let claim = Claim {
         chapter: "5".into(),
+        rival: None,
         statement: format!("The fitted surfaces stay near the data (grid {grid})"),
         ours: (near, runs.len()),
         thesis: None,

@@ -4,6 +4,7 @@
 
 pub mod compare;
 pub mod ioh;
+pub mod pictures;
 pub mod report;
 pub mod spec;
 
@@ -206,12 +207,19 @@ pub fn run(spec: &Spec, ctx: &RunContext, problems: &BTreeMap<ProblemKey, Contro
     Ok(runs)
 }
 
-/// Give the MIN run of every (data set, parameterisation, optimiser) at the largest net its best
-/// control points when it came from the cell log, by running that cell again; the re-run must
-/// reproduce the logged error exactly (a check of determinism across processes).
+/// Give the MIN run of every (data set, parameterisation, optimiser) at the largest net (the
+/// Appendix I/J pictures) and the run of each data set whose surfaces go furthest from the data
+/// (its 3-D view) their best control points when they are not at hand, by running that cell
+/// again; the re-run must reproduce the logged error exactly (a check of determinism across
+/// processes).
 fn picture_points<'a>(spec: &Spec, runs: &mut [OptimRun], largest: GridSize, problem: impl Fn(&OptimCell) -> &'a ControlNetProblem) -> Result<()> {
     let mut best: BTreeMap<(String, Parameterisation, String), usize> = BTreeMap::new();
+    let mut furthest: BTreeMap<String, usize> = BTreeMap::new();
     for (k, r) in runs.iter().enumerate() {
+        let f = furthest.entry(r.cell.dataset.clone()).or_insert(k);
+        if r.row.excursion > runs[*f].row.excursion {
+            *f = k;
+        }
         if !pictured(&r.cell, largest) {
             continue;
         }
@@ -220,7 +228,8 @@ fn picture_points<'a>(spec: &Spec, runs: &mut [OptimRun], largest: GridSize, pro
             *e = k;
         }
     }
-    for k in best.into_values() {
+    let wanted: std::collections::BTreeSet<usize> = best.into_values().chain(furthest.into_values()).collect();
+    for k in wanted {
         if runs[k].best_x.is_empty() {
             let again = run_cell(spec, &runs[k].cell, problem(&runs[k].cell))?;
             if again.row.best.to_bits() != runs[k].row.best.to_bits() {
@@ -293,6 +302,9 @@ impl crate::experiment::family::Family for Optim {
             }));
         }
         let section = if tables { Some(crate::families::optimise::report::write(&runs, &problems, &exact, &setting(first), &ctx.out)?) } else { None };
+        if tables {
+            crate::report::views3d::write(&ctx.out, &pictures::views(&runs, &problems))?;
+        }
         Ok(crate::experiment::family::Outcome { section, cpu_s: runs.iter().map(|r| r.row.cpu_s).sum(), cells: runs.len() })
     }
 }
