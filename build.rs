@@ -21,9 +21,15 @@ fn watched_git_files() -> Vec<PathBuf> {
     };
     let mut files = vec![git_dir.join("HEAD"), git_dir.join("index"), common.join("packed-refs")];
     // A loose branch ref, else its folder (a commit on a packed branch creates the loose file).
-    if let Some(branch) = run("git", &["rev-parse", "--symbolic-full-name", "HEAD"]).filter(|b| b.starts_with("refs/")) {
+    if let Some(branch) = run("git", &["rev-parse", "--symbolic-full-name", "HEAD"])
+        .filter(|b| b.starts_with("refs/"))
+    {
         let loose = common.join(&branch);
-        files.push(if loose.exists() { loose } else { loose.parent().map(PathBuf::from).unwrap_or(loose) });
+        files.push(if loose.exists() {
+            loose
+        } else {
+            loose.parent().map(PathBuf::from).unwrap_or(loose)
+        });
     }
     files.retain(|p| p.exists());
     files
@@ -33,7 +39,10 @@ fn main() {
     let commit = run("git", &["rev-parse", "HEAD"]).unwrap_or_default();
     // --no-optional-locks: a plain `git status` refreshes and rewrites the index, which is watched
     // below, so every next build would rerun this script and recompile the crate.
-    let dirty = run("git", &["--no-optional-locks", "status", "--porcelain", "--untracked-files=no"]).map(|s| !s.is_empty()).unwrap_or(false);
+    let dirty =
+        run("git", &["--no-optional-locks", "status", "--porcelain", "--untracked-files=no"])
+            .map(|s| !s.is_empty())
+            .unwrap_or(false);
     let rustc = std::env::var("RUSTC").unwrap_or_else(|_| "rustc".into());
     let rustc_version = run(&rustc, &["--version"]).unwrap_or_default();
     println!("cargo:rustc-env=SOMNURBS_GIT_COMMIT={commit}");

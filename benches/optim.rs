@@ -4,29 +4,54 @@
 //! (target under 0.2 s; scipy's differential_evolution 2.75 s; the thesis 48 s), and GA and PSO runs.
 
 use somnurbs::experiment::{runner, spec::GridSize};
-use somnurbs::families::som::spec::SomCell;
 use somnurbs::families;
-use somnurbs::optim::{default_optimiser, Budget, ExactOptions, Problem};
+use somnurbs::families::som::spec::SomCell;
 use somnurbs::geom::Point3;
-use somnurbs::spline::control_net::Isa;
-use somnurbs::spline::{BoxSpec, ControlNetProblem};
+use somnurbs::optim::{default_optimiser, Budget, ExactOptions, Problem};
 use somnurbs::som::{Model, SomParams};
+use somnurbs::spline::control_net::Isa;
 use somnurbs::spline::{fit_two_view, Approach, Parameterisation};
+use somnurbs::spline::{BoxSpec, ControlNetProblem};
 use std::time::Instant;
 
 fn main() {
-    let spindle = somnurbs::data::registry::load_dataset("spindle", &somnurbs::experiment::data_dir(None)).unwrap();
-    let cell = SomCell { dataset: "spindle".into(), model: Model::Dnsom, grid: GridSize { nx: 20, ny: 20 }, repeat: 0 };
+    let spindle =
+        somnurbs::data::registry::load_dataset("spindle", &somnurbs::experiment::data_dir(None))
+            .unwrap();
+    let cell = SomCell {
+        dataset: "spindle".into(),
+        model: Model::Dnsom,
+        grid: GridSize { nx: 20, ny: 20 },
+        repeat: 0,
+    };
     let run = families::som::run_cell(&cell, &spindle.points, &SomParams::default(), 2023).unwrap();
     let grid = families::fit::grid_from_weights(20, 20, &run.weights);
-    let fit = fit_two_view(&grid, 18, 18, Parameterisation::ChordLength, Approach::Improved, &Default::default()).unwrap();
-    let problem = ControlNetProblem::new(fit.control_net_parts(&grid).unwrap(), BoxSpec::Cover { fraction: 0.0 }).unwrap();
+    let fit = fit_two_view(
+        &grid,
+        18,
+        18,
+        Parameterisation::ChordLength,
+        Approach::Improved,
+        &Default::default(),
+    )
+    .unwrap();
+    let problem = ControlNetProblem::new(
+        fit.control_net_parts(&grid).unwrap(),
+        BoxSpec::Cover { fraction: 0.0 },
+    )
+    .unwrap();
     let x0 = problem.initial_point().to_vec();
-    println!("control-net problem 18x18 on 20x20: {} variables, B = {:.6}", problem.dim(), problem.fitness(&x0));
-    let reps: usize = std::env::var("BENCH_REPS").ok().and_then(|v| v.parse().ok()).unwrap_or(200_000);
+    println!(
+        "control-net problem 18x18 on 20x20: {} variables, B = {:.6}",
+        problem.dim(),
+        problem.fitness(&x0)
+    );
+    let reps: usize =
+        std::env::var("BENCH_REPS").ok().and_then(|v| v.parse().ok()).unwrap_or(200_000);
     // The machine may be shared: time BENCH_ROUNDS rounds of `reps` evaluations and keep the
     // fastest (the least disturbed), net of the cost of preparing x.
-    let rounds: usize = std::env::var("BENCH_ROUNDS").ok().and_then(|v| v.parse().ok()).unwrap_or(5);
+    let rounds: usize =
+        std::env::var("BENCH_ROUNDS").ok().and_then(|v| v.parse().ok()).unwrap_or(5);
     let mut xs = x0.clone();
     let mut round = |with_fitness: bool| {
         let t = runner::thread_cpu_seconds();
@@ -43,7 +68,8 @@ fn main() {
         std::hint::black_box(acc);
         runner::thread_cpu_seconds() - t
     };
-    let per = (0..rounds).map(|_| round(true) - round(false)).fold(f64::INFINITY, f64::min) / reps as f64;
+    let per =
+        (0..rounds).map(|_| round(true) - round(false)).fold(f64::INFINITY, f64::min) / reps as f64;
     println!("fitness: {:.3} us per evaluation ({:.2} M evaluations/s; target 1.5 us, numpy 8.3 us: {:.1}x, thesis DE ~600 us: {:.0}x)", per * 1e6, 1e-6 / per, 8.3e-6 / per, 600e-6 / per);
     let (model, mhz) = cpu_model();
     println!("CPU: {model}, {mhz:.0} MHz (nominal, from /proc/cpuinfo); load {}", load());
@@ -63,10 +89,15 @@ fn main() {
     if std::env::var("BENCH_SCALING").is_ok_and(|v| v != "0") {
         scaling(&spindle.points, mhz);
     }
-    let generations: usize = std::env::var("BENCH_GENERATIONS").ok().and_then(|v| v.parse().ok()).unwrap_or(2000);
+    let generations: usize =
+        std::env::var("BENCH_GENERATIONS").ok().and_then(|v| v.parse().ok()).unwrap_or(2000);
     // BENCH_ONLY=de,pso runs only those optimisers and skips the exact optimum (for profiling).
-    let only: Option<Vec<String>> = std::env::var("BENCH_ONLY").ok().map(|v| v.split(',').map(str::to_string).collect());
-    let exact_boxes = [("optimisers' box (data and B)", BoxSpec::Cover { fraction: 0.0 }), ("data range", BoxSpec::DataRange)];
+    let only: Option<Vec<String>> =
+        std::env::var("BENCH_ONLY").ok().map(|v| v.split(',').map(str::to_string).collect());
+    let exact_boxes = [
+        ("optimisers' box (data and B)", BoxSpec::Cover { fraction: 0.0 }),
+        ("data range", BoxSpec::DataRange),
+    ];
     for (label, bounds) in exact_boxes.into_iter().filter(|_| only.is_none()) {
         let pb = ControlNetProblem::new(problem.parts().clone(), bounds).unwrap();
         let t = Instant::now();
@@ -83,18 +114,35 @@ fn main() {
         );
     }
     // BENCH_INIT_RANGE sets the initial population's spread around x0 (the thesis' 5e-6 by default).
-    let init_range: f64 = std::env::var("BENCH_INIT_RANGE").ok().and_then(|v| v.parse().ok()).unwrap_or(5e-6);
-    let budget = Budget { generations: generations as u64, population: 40, init_range, trace_every_evals: 400 };
+    let init_range: f64 =
+        std::env::var("BENCH_INIT_RANGE").ok().and_then(|v| v.parse().ok()).unwrap_or(5e-6);
+    let budget = Budget {
+        generations: generations as u64,
+        population: 40,
+        init_range,
+        trace_every_evals: 400,
+    };
     // Per run: CPU seconds of this thread (the machine may be shared), per evaluation, and what
     // the optimiser itself costs per evaluation on top of the fitness (its per-coordinate work).
-    for name in ["de", "ga", "pso", "csa", "icsa"].into_iter().filter(|n| only.as_ref().is_none_or(|o| o.iter().any(|x| x == n))) {
+    for name in ["de", "ga", "pso", "csa", "icsa"]
+        .into_iter()
+        .filter(|n| only.as_ref().is_none_or(|o| o.iter().any(|x| x == n)))
+    {
         let opt = default_optimiser(name).unwrap();
         let mut rng = somnurbs::experiment::seeds::cell_rng(1, "bench");
         let t = runner::thread_cpu_seconds();
         let r = opt.run(&problem, &budget, &mut rng).unwrap();
         let s = runner::thread_cpu_seconds() - t;
         let per_eval = s / r.evaluations as f64;
-        let target = if name == "de" { format!(" (target 0.2 s; scipy 2.75 s: {:.1}x; thesis 48 s: {:.0}x)", 2.75 / s, 48.0 / s) } else { String::new() };
+        let target = if name == "de" {
+            format!(
+                " (target 0.2 s; scipy 2.75 s: {:.1}x; thesis 48 s: {:.0}x)",
+                2.75 / s,
+                48.0 / s
+            )
+        } else {
+            String::new()
+        };
         println!(
             "{name} {generations} x 40: {s:.3} s CPU, {} evaluations ({:.2} M/s), {:.3} us per evaluation = fitness + {:.3} us ({:.2}x the fitness alone), best {:.6}{target}",
             r.evaluations,
@@ -110,13 +158,24 @@ fn main() {
 /// The CPU model and nominal clock (MHz) from /proc/cpuinfo ("unknown", 0 elsewhere).
 fn cpu_model() -> (String, f64) {
     let info = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
-    let field = |name: &str| info.lines().find(|l| l.starts_with(name)).and_then(|l| l.split(':').nth(1)).map(|v| v.trim().to_string());
-    (field("model name").unwrap_or_else(|| "unknown".into()), field("cpu MHz").and_then(|v| v.parse().ok()).unwrap_or(0.0))
+    let field = |name: &str| {
+        info.lines()
+            .find(|l| l.starts_with(name))
+            .and_then(|l| l.split(':').nth(1))
+            .map(|v| v.trim().to_string())
+    };
+    (
+        field("model name").unwrap_or_else(|| "unknown".into()),
+        field("cpu MHz").and_then(|v| v.parse().ok()).unwrap_or(0.0),
+    )
 }
 
 /// The 1-minute load average (the machine may be shared).
 fn load() -> String {
-    std::fs::read_to_string("/proc/loadavg").ok().and_then(|l| l.split_whitespace().next().map(str::to_string)).unwrap_or_else(|| "unknown".into())
+    std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .and_then(|l| l.split_whitespace().next().map(str::to_string))
+        .unwrap_or_else(|| "unknown".into())
 }
 
 /// Floating-point lower bound of one fitness evaluation in cycles: pass 1 is 4 multiply(-add)s
@@ -150,7 +209,8 @@ fn best_fitness_ns(problem: &ControlNetProblem, x0: &[f64], rounds: usize) -> f6
 /// How cost grows: the fitness and one DE run (BENCH_SCALING_GENERATIONS, default 200, x 40)
 /// against net size on the 20x20 map, and against map size for an 18x18 net (BENCH_SCALING=1).
 fn scaling(points: &[Point3], mhz: f64) {
-    let generations: u64 = std::env::var("BENCH_SCALING_GENERATIONS").ok().and_then(|v| v.parse().ok()).unwrap_or(200);
+    let generations: u64 =
+        std::env::var("BENCH_SCALING_GENERATIONS").ok().and_then(|v| v.parse().ok()).unwrap_or(200);
     println!("\nscaling (spindle, DNSOM map, chord length, approach B; one DE run of {generations} x 40):");
     println!("| map | net | variables | fitness ns | cycles | FMA bound | ratio | DE run s | DE us per evaluation |");
     println!("|---|---|---|---|---|---|---|---|---|");
@@ -158,17 +218,35 @@ fn scaling(points: &[Point3], mhz: f64) {
     let mut maps: Vec<(usize, somnurbs::spline::TwoViewGrid)> = Vec::new();
     for (m, cn) in cases {
         if !maps.iter().any(|(k, _)| *k == m) {
-            let cell = SomCell { dataset: "spindle".into(), model: Model::Dnsom, grid: GridSize { nx: m, ny: m }, repeat: 0 };
+            let cell = SomCell {
+                dataset: "spindle".into(),
+                model: Model::Dnsom,
+                grid: GridSize { nx: m, ny: m },
+                repeat: 0,
+            };
             let run = families::som::run_cell(&cell, points, &SomParams::default(), 2023).unwrap();
             maps.push((m, families::fit::grid_from_weights(m, m, &run.weights)));
         }
         let grid = &maps.iter().find(|(k, _)| *k == m).unwrap().1;
-        let fit = fit_two_view(grid, cn, cn, Parameterisation::ChordLength, Approach::Improved, &Default::default()).unwrap();
-        let pb = ControlNetProblem::new(fit.control_net_parts(grid).unwrap(), BoxSpec::Cover { fraction: 0.0 }).unwrap();
+        let fit = fit_two_view(
+            grid,
+            cn,
+            cn,
+            Parameterisation::ChordLength,
+            Approach::Improved,
+            &Default::default(),
+        )
+        .unwrap();
+        let pb = ControlNetProblem::new(
+            fit.control_net_parts(grid).unwrap(),
+            BoxSpec::Cover { fraction: 0.0 },
+        )
+        .unwrap();
         let x0 = pb.initial_point().to_vec();
         let ns = best_fitness_ns(&pb, &x0, 3);
         let bound = fma_lower_bound_cycles(m, m, cn);
-        let budget = Budget { generations, population: 40, init_range: 5e-6, trace_every_evals: 400 };
+        let budget =
+            Budget { generations, population: 40, init_range: 5e-6, trace_every_evals: 400 };
         let mut rng = somnurbs::experiment::seeds::cell_rng(1, "bench");
         let t = runner::thread_cpu_seconds();
         let r = default_optimiser("de").unwrap().run(&pb, &budget, &mut rng).unwrap();

@@ -26,24 +26,40 @@ fn main() {
     }
     times.sort_by(|a, b| a.total_cmp(b));
     let med = times[2];
-    println!("dnsom 30x30 T=30000 spindle, one core: median {:.4} s (thesis 5.309147 s: {:.0}x faster)", med, 5.309147 / med);
+    println!(
+        "dnsom 30x30 T=30000 spindle, one core: median {:.4} s (thesis 5.309147 s: {:.0}x faster)",
+        med,
+        5.309147 / med
+    );
 
     // 2. The whole Appendix B grid on all cores.
-    let spec_path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/ch4_models.toml");
+    let spec_path =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/ch4_models.toml");
     let spec = Spec::load(&spec_path, None).expect("spec");
-    let cells: Vec<_> = families::som::spec::cells(&spec).into_iter().filter(|c| c.grid.nx == c.grid.ny).collect();
+    let cells: Vec<_> =
+        families::som::spec::cells(&spec).into_iter().filter(|c| c.grid.nx == c.grid.ny).collect();
     let jobs = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
     let ctx = RunContext { jobs, ..ctx };
-    let data = families::som::load_datasets(&spec, &spec.file.som.as_ref().unwrap().datasets, &ctx).expect("data sets");
+    let data = families::som::load_datasets(&spec, &spec.file.som.as_ref().unwrap().datasets, &ctx)
+        .expect("data sets");
     let t0 = Instant::now();
-    let runs = runner::run_cells(&cells, jobs, "appendix B", |c| families::som::run_cell(c, &data[&c.dataset].points, &params, spec.file.master_seed), |_, _| Ok(())).unwrap();
+    let runs = runner::run_cells(
+        &cells,
+        jobs,
+        "appendix B",
+        |c| families::som::run_cell(c, &data[&c.dataset].points, &params, spec.file.master_seed),
+        |_, _| Ok(()),
+    )
+    .unwrap();
     let wall = t0.elapsed().as_secs_f64();
     let cpu: f64 = runs.iter().map(|r| r.row.cpu_s).sum();
     let thesis = somnurbs::report::reference::table("appendix_b").unwrap();
     let thesis_cpu: f64 = thesis
         .rows
         .iter()
-        .flat_map(|r| Model::ALL.iter().map(move |m| r[&format!("cpu_s_{}", m.key())].parse::<f64>().unwrap()))
+        .flat_map(|r| {
+            Model::ALL.iter().map(move |m| r[&format!("cpu_s_{}", m.key())].parse::<f64>().unwrap())
+        })
         .sum();
     println!(
         "appendix B grid ({} cells), {} threads: {:.2} s wall, {:.2} s CPU in training (thesis: {:.1} s CPU; ratio {:.0}x by CPU, {:.0}x by wall)",

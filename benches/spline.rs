@@ -4,23 +4,33 @@
 //! 18x18 fit; geomdl's approximate_surface: 27 ms).
 
 use somnurbs::experiment::{runner, seeds};
-use somnurbs::families::som::spec::SomCell;
 use somnurbs::families;
+use somnurbs::families::som::spec::SomCell;
 use somnurbs::som::{Model, SomParams};
 use somnurbs::spline::{fit_two_view, Approach, Parameterisation, TwoViewGrid};
 use std::time::Instant;
 
 fn maps(grid: (usize, usize)) -> Vec<TwoViewGrid> {
     let dir = somnurbs::experiment::data_dir(None);
-    let names: Vec<String> = ["cube", "sphere", "spindle", "oiltank", "talus"].iter().map(|s| s.to_string()).collect();
-    let data: std::collections::BTreeMap<String, _> =
-        names.iter().map(|n| (n.clone(), somnurbs::data::registry::load_dataset(n, &dir).expect("data sets (talus needs SOMNURBS_DATA)"))).collect();
+    let names: Vec<String> =
+        ["cube", "sphere", "spindle", "oiltank", "talus"].iter().map(|s| s.to_string()).collect();
+    let data: std::collections::BTreeMap<String, _> = names
+        .iter()
+        .map(|n| {
+            (
+                n.clone(),
+                somnurbs::data::registry::load_dataset(n, &dir)
+                    .expect("data sets (talus needs SOMNURBS_DATA)"),
+            )
+        })
+        .collect();
     names
         .iter()
         .map(|d| {
             let g = somnurbs::experiment::spec::GridSize { nx: grid.0, ny: grid.1 };
             let cell = SomCell { dataset: d.clone(), model: Model::Dnsom, grid: g, repeat: 0 };
-            let run = families::som::run_cell(&cell, &data[d].points, &SomParams::default(), 2023).unwrap();
+            let run = families::som::run_cell(&cell, &data[d].points, &SomParams::default(), 2023)
+                .unwrap();
             families::fit::grid_from_weights(grid.0, grid.1, &run.weights)
         })
         .collect()
@@ -41,7 +51,9 @@ fn main() {
                 for &(cx, cy) in nets.iter() {
                     for p in Parameterisation::ALL {
                         for a in [Approach::Conventional, Approach::Improved] {
-                            std::hint::black_box(fit_two_view(g, cx, cy, p, a, &Default::default()).unwrap());
+                            std::hint::black_box(
+                                fit_two_view(g, cx, cy, p, a, &Default::default()).unwrap(),
+                            );
                             n += 1;
                         }
                     }
@@ -55,7 +67,17 @@ fn main() {
     let t0 = Instant::now();
     let reps = 200;
     for _ in 0..reps {
-        std::hint::black_box(fit_two_view(&same[2], 18, 18, Parameterisation::ChordLength, Approach::Improved, &Default::default()).unwrap());
+        std::hint::black_box(
+            fit_two_view(
+                &same[2],
+                18,
+                18,
+                Parameterisation::ChordLength,
+                Approach::Improved,
+                &Default::default(),
+            )
+            .unwrap(),
+        );
     }
     let per = t0.elapsed().as_secs_f64() / reps as f64;
     println!("one 18x18-net fit (both surfaces, approach B) on the 20x20 grid: {:.3} ms (numpy 1.2 ms: {:.1}x; geomdl 27 ms: {:.0}x)", per * 1e3, 1.2e-3 / per, 27e-3 / per);

@@ -32,27 +32,37 @@ pub enum Command {
     Datasets(DatasetsArgs),
     /// Fit cubic B-spline surfaces to a structured two-view grid (the CSV Chapter 4 saves in
     /// maps/) and write the control nets (CSV), an IGES file and an OBJ mesh.
-    #[command(after_help = "Examples (after `somnurbs reproduce`):\n  somnurbs fit --grid results/thesis/ch4_models/maps/dnsom_spindle_20x20.csv --cn 18x18 --out fit_spindle\n  somnurbs fit --grid results/thesis/ch4_models/maps/dnsom_cube_20x20.csv --cn 18x18 --knots nurbs_book --fairness 1e-4 --out fit_cube\n\nThe surfaces are also evaluated between the data points; a warning is printed when they leave\nthe data's bounding box by more than 10% of its diagonal.")]
+    #[command(
+        after_help = "Examples (after `somnurbs reproduce`):\n  somnurbs fit --grid results/thesis/ch4_models/maps/dnsom_spindle_20x20.csv --cn 18x18 --out fit_spindle\n  somnurbs fit --grid results/thesis/ch4_models/maps/dnsom_cube_20x20.csv --cn 18x18 --knots nurbs_book --fairness 1e-4 --out fit_cube\n\nThe surfaces are also evaluated between the data points; a warning is printed when they leave\nthe data's bounding box by more than 10% of its diagonal."
+    )]
     Fit(FitArgs),
     /// Compare the optimisers of a Chapter 6 results folder: per cell Wilcoxon signed-rank
     /// (repeats paired by index) and rank-sum tests with A12, and overall Friedman with
     /// Holm-corrected pairwise tests and a critical-difference diagram; the Bayesian signed-rank
     /// test; runtime ECDFs, ERT, fixed-budget curves and AOCC from the IOHprofiler traces.
-    #[command(after_help = "Examples (after `somnurbs reproduce`):\n  somnurbs compare results/thesis/ch6_same\n  somnurbs compare results/thesis/ch6_diff --alpha 0.01 --rope 1e-5")]
+    #[command(
+        after_help = "Examples (after `somnurbs reproduce`):\n  somnurbs compare results/thesis/ch6_same\n  somnurbs compare results/thesis/ch6_diff --alpha 0.01 --rope 1e-5"
+    )]
     Compare(CompareArgs),
     /// Regenerate the thesis: Chapters 4, 5 and 6 in order (each chapter's maps feed the next),
     /// then one REPORT.md with every table and picture, the thesis' figures beside ours, Tables
     /// 6.8/6.9 and the table of the thesis' claims with verdicts.
-    #[command(after_help = "Examples:\n  somnurbs reproduce --profile quick   # under a minute\n  somnurbs reproduce                   # the full protocol\n  somnurbs reproduce --plan seeds      # the other seeds' experiments (001-004)")]
+    #[command(
+        after_help = "Examples:\n  somnurbs reproduce --profile quick   # under a minute\n  somnurbs reproduce                   # the full protocol\n  somnurbs reproduce --plan seeds      # the other seeds' experiments (001-004)"
+    )]
     Reproduce(ReproduceArgs),
     /// Compare every table of a results folder with a baseline folder: numbers to per-column
     /// tolerances, timing columns reported but not judged. Exit 0: no drift; 1: drift (the moved
     /// cells are named, and all differences written to drift.csv); 2: bad input.
-    #[command(after_help = "Examples:\n  somnurbs drift results/baselines/quick results/thesis_quick\n  somnurbs drift results/baselines/quick results/thesis_quick --tol 'de_*=1e-6'\n  somnurbs drift --accept results/baselines/quick results/thesis_quick   # update the baseline on purpose")]
+    #[command(
+        after_help = "Examples:\n  somnurbs drift results/baselines/quick results/thesis_quick\n  somnurbs drift results/baselines/quick results/thesis_quick --tol 'de_*=1e-6'\n  somnurbs drift --accept results/baselines/quick results/thesis_quick   # update the baseline on purpose"
+    )]
     Drift(DriftArgs),
     /// Combine the shard folders of one spec (`run --shard I/N`) into one folder with its tables,
     /// identical to a one-machine run apart from timing.
-    #[command(after_help = "Example:\n  somnurbs run experiments/ch6_same.toml --shard 1/2 --out s1   # on one machine\n  somnurbs run experiments/ch6_same.toml --shard 2/2 --out s2   # on another\n  somnurbs merge s1 s2 --out results/ch6_same")]
+    #[command(
+        after_help = "Example:\n  somnurbs run experiments/ch6_same.toml --shard 1/2 --out s1   # on one machine\n  somnurbs run experiments/ch6_same.toml --shard 2/2 --out s2   # on another\n  somnurbs merge s1 s2 --out results/ch6_same"
+    )]
     Merge(MergeArgs),
 }
 

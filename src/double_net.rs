@@ -186,7 +186,8 @@ mod tests {
     fn figure_4_3_class_numbers_4x5() {
         let net = DoubleNet::new(4, 5).unwrap();
         // Figure 4.3 (b), top view, read as rows j = 4..0 and columns i = 0..3.
-        let top = [[5, 10, 15, 20], [4, 23, 26, 19], [3, 22, 25, 18], [2, 21, 24, 17], [1, 6, 11, 16]];
+        let top =
+            [[5, 10, 15, 20], [4, 23, 26, 19], [3, 22, 25, 18], [2, 21, 24, 17], [1, 6, 11, 16]];
         for (r, row) in top.iter().enumerate() {
             let j = 4 - r;
             for (i, &c) in row.iter().enumerate() {

@@ -2,7 +2,12 @@
 
 use clap::Parser;
 use somnurbs::cli::{Cli, Command, DatasetsAction};
-use somnurbs::experiment::{self, log::Shard, spec::{CliOverrides, Spec}, RunContext};
+use somnurbs::experiment::{
+    self,
+    log::Shard,
+    spec::{CliOverrides, Spec},
+    RunContext,
+};
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
@@ -19,7 +24,8 @@ fn main() -> ExitCode {
 
 /// Worker threads: the flag, else every core.
 fn jobs(flag: Option<usize>) -> anyhow::Result<usize> {
-    let jobs = flag.unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1));
+    let jobs =
+        flag.unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1));
     if jobs == 0 {
         anyhow::bail!("--jobs must be at least 1");
     }
@@ -40,13 +46,28 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
                 return Ok(ExitCode::SUCCESS);
             }
             let shard = args.shard.as_deref().map(Shard::parse).transpose()?;
-            let ctx = RunContext { resume: args.resume, shard, ..RunContext::new(spec.output_dir(args.out.as_deref()), jobs(args.jobs)?, experiment::data_dir(args.data_dir.as_deref())) };
+            let ctx = RunContext {
+                resume: args.resume,
+                shard,
+                ..RunContext::new(
+                    spec.output_dir(args.out.as_deref()),
+                    jobs(args.jobs)?,
+                    experiment::data_dir(args.data_dir.as_deref()),
+                )
+            };
             let out = experiment::run_variants(&variants, &ctx)?;
             match shard {
-                Some(s) => eprintln!("somnurbs: wrote shard {s} to {} (combine the shards with `somnurbs merge`)", out.display()),
+                Some(s) => eprintln!(
+                    "somnurbs: wrote shard {s} to {} (combine the shards with `somnurbs merge`)",
+                    out.display()
+                ),
                 None => {
                     let html = somnurbs::report::html::write(&out)?;
-                    eprintln!("somnurbs: wrote {} and {}", out.join("REPORT.md").display(), html.display())
+                    eprintln!(
+                        "somnurbs: wrote {} and {}",
+                        out.join("REPORT.md").display(),
+                        html.display()
+                    )
                 }
             }
             Ok(ExitCode::SUCCESS)
@@ -58,31 +79,70 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
                 for l in &said {
                     println!("{l}");
                 }
-                println!("baseline {} now holds the tables of {} ({} files changed)", args.baseline.display(), args.current.display(), said.len());
+                println!(
+                    "baseline {} now holds the tables of {} ({} files changed)",
+                    args.baseline.display(),
+                    args.current.display(),
+                    said.len()
+                );
                 return Ok(ExitCode::SUCCESS);
             }
-            let mut columns = args.tol.iter().map(|t| drift::parse_tol(t)).collect::<anyhow::Result<Vec<_>>>()?;
+            let mut columns =
+                args.tol.iter().map(|t| drift::parse_tol(t)).collect::<anyhow::Result<Vec<_>>>()?;
             let config = drift::read_config(&args.baseline)?;
-            columns.extend(config.tolerance.iter().map(|c| (c.column.clone(), drift::Tolerance { abs: c.abs, rel: c.rel })));
+            columns.extend(
+                config
+                    .tolerance
+                    .iter()
+                    .map(|c| (c.column.clone(), drift::Tolerance { abs: c.abs, rel: c.rel })),
+            );
             let opts = drift::DriftOptions { columns, config, ..Default::default() };
-            let report = drift::compare_dirs(&args.baseline, &args.current, &opts, args.allow_spec_change)?;
+            let report =
+                drift::compare_dirs(&args.baseline, &args.current, &opts, args.allow_spec_change)?;
             let out = args.out.clone().unwrap_or_else(|| args.current.join("drift.csv"));
             somnurbs::io::write_atomic(&out, report.csv()?.as_bytes())?;
-            println!("{}
-per-cell differences: {}", report.summary(10), out.display());
+            println!(
+                "{}
+per-cell differences: {}",
+                report.summary(10),
+                out.display()
+            );
             Ok(if report.drifted() { ExitCode::from(1) } else { ExitCode::SUCCESS })
         }
         Command::Merge(args) => {
-            let ctx = RunContext::new(args.out.clone(), jobs(args.jobs)?, experiment::data_dir(args.data_dir.as_deref()));
+            let ctx = RunContext::new(
+                args.out.clone(),
+                jobs(args.jobs)?,
+                experiment::data_dir(args.data_dir.as_deref()),
+            );
             let out = experiment::merge(&args.shards, &ctx)?;
             let html = somnurbs::report::html::write(&out)?;
-            eprintln!("somnurbs: merged {} shards into {} and {}", args.shards.len(), out.join("REPORT.md").display(), html.display());
+            eprintln!(
+                "somnurbs: merged {} shards into {} and {}",
+                args.shards.len(),
+                out.join("REPORT.md").display(),
+                html.display()
+            );
             Ok(ExitCode::SUCCESS)
         }
         Command::Reproduce(args) => {
-            let out = args.out.clone().unwrap_or_else(|| if args.profile == "quick" { format!("results/{}_quick", args.plan).into() } else { format!("results/{}", args.plan).into() });
-            let ctx = RunContext { resume: args.resume, ..RunContext::new(out, jobs(args.jobs)?, experiment::data_dir(args.data_dir.as_deref())) };
-            let report = experiment::reproduce::reproduce(&args.specs, &args.plan, &args.profile, &ctx)?;
+            let out = args.out.clone().unwrap_or_else(|| {
+                if args.profile == "quick" {
+                    format!("results/{}_quick", args.plan).into()
+                } else {
+                    format!("results/{}", args.plan).into()
+                }
+            });
+            let ctx = RunContext {
+                resume: args.resume,
+                ..RunContext::new(
+                    out,
+                    jobs(args.jobs)?,
+                    experiment::data_dir(args.data_dir.as_deref()),
+                )
+            };
+            let report =
+                experiment::reproduce::reproduce(&args.specs, &args.plan, &args.profile, &ctx)?;
             eprintln!("somnurbs: wrote {}", report.display());
             Ok(ExitCode::SUCCESS)
         }
@@ -96,7 +156,10 @@ per-cell differences: {}", report.summary(10), out.display());
         }
         Command::Datasets(args) => {
             let dir = experiment::data_dir(args.data_dir.as_deref());
-            somnurbs::experiment::datasets::datasets(args.action.unwrap_or(DatasetsAction::List), &dir)?;
+            somnurbs::experiment::datasets::datasets(
+                args.action.unwrap_or(DatasetsAction::List),
+                &dir,
+            )?;
             Ok(ExitCode::SUCCESS)
         }
     }

@@ -27,7 +27,18 @@ fn run_writes_every_table_with_the_thesis_columns() {
     c.write("tiny.toml", TINY);
     c.ok(&["run", "tiny.toml", "--out", "out", "--jobs", "2"]);
     let out = c.path("out");
-    for f in ["runs.csv", "appendix_b.csv", "appendix_c.csv", "table_4_9.csv", "table_4_13.csv", "table_4_14.csv", "manifest.toml", "REPORT.md", "maps/dnsom_sphere_6x5.csv", "maps/dnsom_cube_6x5.csv"] {
+    for f in [
+        "runs.csv",
+        "appendix_b.csv",
+        "appendix_c.csv",
+        "table_4_9.csv",
+        "table_4_13.csv",
+        "table_4_14.csv",
+        "manifest.toml",
+        "REPORT.md",
+        "maps/dnsom_sphere_6x5.csv",
+        "maps/dnsom_cube_6x5.csv",
+    ] {
         assert!(out.join(f).exists(), "missing {f}: {:?}", walk(&out));
     }
     assert!(out.join("cells.jsonl").exists() && out.join("fingerprint.toml").exists());
@@ -40,7 +51,8 @@ fn run_writes_every_table_with_the_thesis_columns() {
     let col = |name: &str| h.iter().position(|x| x == name).unwrap();
     for r in &rows {
         let qe: f64 = r[col("qe")].parse().unwrap();
-        let (mn, mx): (f64, f64) = (r[col("min_error")].parse().unwrap(), r[col("max_error")].parse().unwrap());
+        let (mn, mx): (f64, f64) =
+            (r[col("min_error")].parse().unwrap(), r[col("max_error")].parse().unwrap());
         assert!(mn <= qe && qe <= mx && mn >= 0.0, "{r:?}");
         let te: f64 = r[col("te")].parse().unwrap();
         assert!((0.0..=1.0).contains(&te));
@@ -67,8 +79,19 @@ fn results_do_not_depend_on_thread_count() {
     c.write("tiny.toml", TINY);
     c.ok(&["run", "tiny.toml", "--out", "j1", "--jobs", "1"]);
     c.ok(&["run", "tiny.toml", "--out", "j2", "--jobs", "2"]);
-    for f in ["runs.csv", "appendix_b.csv", "appendix_c.csv", "table_4_9.csv", "table_4_13.csv", "maps/dnsom_cube_6x5.csv"] {
-        assert_eq!(without_timing(&c.path("j1").join(f)), without_timing(&c.path("j2").join(f)), "{f} differs");
+    for f in [
+        "runs.csv",
+        "appendix_b.csv",
+        "appendix_c.csv",
+        "table_4_9.csv",
+        "table_4_13.csv",
+        "maps/dnsom_cube_6x5.csv",
+    ] {
+        assert_eq!(
+            without_timing(&c.path("j1").join(f)),
+            without_timing(&c.path("j2").join(f)),
+            "{f} differs"
+        );
     }
 }
 
@@ -99,12 +122,22 @@ fn bad_specs_fail_on_one_line_naming_line_and_key() {
 #[test]
 fn bad_data_fails_before_any_table_is_written() {
     let c = Case::new();
-    let spec = |data: &str| TINY.replace("datasets = [\"sphere\", \"cube\"]", &format!("datasets = [\"{data}\"]")).replace("save_maps = [\"6x5\"]", "");
+    let spec = |data: &str| {
+        TINY.replace("datasets = [\"sphere\", \"cube\"]", &format!("datasets = [\"{data}\"]"))
+            .replace("save_maps = [\"6x5\"]", "")
+    };
     // A data file that is not there: the error names it and the data directory.
     c.write("bunny.toml", &spec("bunny"));
-    let out = bin().args(["run", "bunny.toml", "--out", "o1", "--data-dir", "nowhere"]).current_dir(c.dir.path()).output().unwrap();
+    let out = bin()
+        .args(["run", "bunny.toml", "--out", "o1", "--data-dir", "nowhere"])
+        .current_dir(c.dir.path())
+        .output()
+        .unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(!out.status.success() && err.contains("bun_zipper.ply") && err.contains("nowhere"), "{err}");
+    assert!(
+        !out.status.success() && err.contains("bun_zipper.ply") && err.contains("nowhere"),
+        "{err}"
+    );
     assert!(!c.path("o1/appendix_b.csv").exists());
     // NaN and too few points in a user file.
     c.write("nan.xyz", "0 0 0\n1 1 1\n0.5 nan 0.5\n1 0 1\n0 1 0\n");
@@ -182,10 +215,22 @@ fn chapter_5_reads_or_recomputes_maps_and_writes_appendix_e() {
     c.ok(&["run", "fits2.toml", "--out", "recomputed"]);
     let map = "maps/dnsom_sphere_20x20.csv";
     let original = std::fs::read_to_string(c.path("ch4").join(map)).unwrap();
-    assert_eq!(original, std::fs::read_to_string(c.path("read").join(map)).unwrap(), "the map used is kept in the results folder");
-    assert_eq!(original, std::fs::read_to_string(c.path("recomputed").join(map)).unwrap(), "a recomputed map equals Chapter 4's");
-    assert_eq!(without_timing(&c.path("read/appendix_e.csv")), without_timing(&c.path("recomputed/appendix_e.csv")));
-    let reference = Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/reference/appendix_e.csv");
+    assert_eq!(
+        original,
+        std::fs::read_to_string(c.path("read").join(map)).unwrap(),
+        "the map used is kept in the results folder"
+    );
+    assert_eq!(
+        original,
+        std::fs::read_to_string(c.path("recomputed").join(map)).unwrap(),
+        "a recomputed map equals Chapter 4's"
+    );
+    assert_eq!(
+        without_timing(&c.path("read/appendix_e.csv")),
+        without_timing(&c.path("recomputed/appendix_e.csv"))
+    );
+    let reference =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/reference/appendix_e.csv");
     let (h, rows) = read_csv(&c.path("read/appendix_e.csv"));
     assert_eq!(h, read_csv(&reference).0);
     assert_eq!(rows.len(), 2);
@@ -199,7 +244,14 @@ fn chapter_5_reads_or_recomputes_maps_and_writes_appendix_e() {
     let ga = gh.iter().position(|x| x == "gap_A").unwrap();
     assert!(gaps.iter().all(|r| r[gb].parse::<f64>().unwrap() == 0.0));
     assert!(gaps.iter().any(|r| r[ga].parse::<f64>().unwrap() > 0.0));
-    for t in ["table_5_4.csv", "table_5_5.csv", "table_5_6.csv", "runs.csv", "REPORT.md", "manifest.toml"] {
+    for t in [
+        "table_5_4.csv",
+        "table_5_5.csv",
+        "table_5_6.csv",
+        "runs.csv",
+        "REPORT.md",
+        "manifest.toml",
+    ] {
         assert!(c.path("read").join(t).exists(), "{t}");
     }
 }
@@ -210,7 +262,19 @@ fn fit_writes_nets_iges_and_obj_and_refuses_bad_grids() {
     c.write("maps.toml", CH4_FOR_FIT);
     c.ok(&["run", "maps.toml", "--out", "ch4"]);
     let grid = "ch4/maps/dnsom_sphere_20x20.csv";
-    c.ok(&["fit", "--grid", grid, "--cn", "8x6", "--param", "centripetal", "--approach", "B", "--out", "f"]);
+    c.ok(&[
+        "fit",
+        "--grid",
+        grid,
+        "--cn",
+        "8x6",
+        "--param",
+        "centripetal",
+        "--approach",
+        "B",
+        "--out",
+        "f",
+    ]);
     let (_, nets) = read_csv(&c.path("f/control_nets.csv"));
     assert_eq!(nets.len(), 2 * 8 * 6);
     let igs = std::fs::read_to_string(c.path("f/surfaces.igs")).unwrap();
@@ -225,10 +289,31 @@ fn fit_writes_nets_iges_and_obj_and_refuses_bad_grids() {
     // knots and blows up under the NURBS Book's, which `fit` warns about; fairness tames it.
     let out = c.ok(&["fit", "--grid", grid, "--cn", "18x18", "--out", "f18"]);
     assert!(!String::from_utf8_lossy(&out.stderr).contains("warning"));
-    let out = c.ok(&["fit", "--grid", grid, "--cn", "18x18", "--knots", "nurbs_book", "--out", "f18b"]);
-    assert!(String::from_utf8_lossy(&out.stderr).contains("leave the data's bounding box"), "{}", String::from_utf8_lossy(&out.stderr));
-    let out = c.ok(&["fit", "--grid", grid, "--cn", "18x18", "--knots", "nurbs_book", "--fairness", "1e-3", "--out", "f18f"]);
-    assert!(!String::from_utf8_lossy(&out.stderr).contains("warning"), "{}", String::from_utf8_lossy(&out.stderr));
+    let out =
+        c.ok(&["fit", "--grid", grid, "--cn", "18x18", "--knots", "nurbs_book", "--out", "f18b"]);
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("leave the data's bounding box"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let out = c.ok(&[
+        "fit",
+        "--grid",
+        grid,
+        "--cn",
+        "18x18",
+        "--knots",
+        "nurbs_book",
+        "--fairness",
+        "1e-3",
+        "--out",
+        "f18f",
+    ]);
+    assert!(
+        !String::from_utf8_lossy(&out.stderr).contains("warning"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     c.fails(&["fit", "--grid", grid, "--cn", "8x8", "--knots", "9.69"], &["--knots", "9.69"]);
     assert!(std::fs::read_to_string(c.path("f/surfaces.obj")).unwrap().contains("o bottom"));
 
@@ -271,28 +356,47 @@ fn chapter_6_is_deterministic_paired_and_each_cell_reruns_alone() {
     c.ok(&["run", "opt.toml", "--out", "j1", "--jobs", "1"]);
     c.ok(&["run", "opt.toml", "--out", "j2", "--jobs", "2"]);
     for f in ["runs.csv", "appendix_k.csv", "table_6_4.csv"] {
-        assert_eq!(without_timing(&c.path("j1").join(f)), without_timing(&c.path("j2").join(f)), "{f}");
+        assert_eq!(
+            without_timing(&c.path("j1").join(f)),
+            without_timing(&c.path("j2").join(f)),
+            "{f}"
+        );
     }
-    let reference = Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/reference/appendix_k.csv");
+    let reference =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/reference/appendix_k.csv");
     assert_eq!(read_csv(&c.path("j1/appendix_k.csv")).0, read_csv(&reference).0);
-    assert_eq!(read_csv(&c.path("j1/appendix_m.csv")).0, read_csv(&Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/reference/appendix_m.csv")).0);
+    assert_eq!(
+        read_csv(&c.path("j1/appendix_m.csv")).0,
+        read_csv(
+            &Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/reference/appendix_m.csv")
+        )
+        .0
+    );
     let (h, rows) = read_csv(&c.path("j1/runs.csv"));
     assert_eq!(rows.len(), 2 * 3 * 2);
     let col = |n: &str| h.iter().position(|x| x == n).unwrap();
     for r in &rows {
-        let (best, init): (f64, f64) = (r[col("best")].parse().unwrap(), r[col("initial_best")].parse().unwrap());
+        let (best, init): (f64, f64) =
+            (r[col("best")].parse().unwrap(), r[col("initial_best")].parse().unwrap());
         assert!(best <= init, "{r:?}");
     }
     // Paired: every optimiser of a cell starts from the same B.
     for cn in ["6", "8"] {
-        let bs: std::collections::BTreeSet<&str> = rows.iter().filter(|r| r[col("cn_x")] == cn).map(|r| r[col("b")].as_str()).collect();
+        let bs: std::collections::BTreeSet<&str> =
+            rows.iter().filter(|r| r[col("cn_x")] == cn).map(|r| r[col("b")].as_str()).collect();
         assert_eq!(bs.len(), 1);
     }
     // One optimiser alone gives the same numbers as inside the full run.
-    c.write("de.toml", &CH6_TINY.replace("optimisers = [\"ga\", \"de\", \"pso\"]", "optimisers = [\"de\"]"));
+    c.write(
+        "de.toml",
+        &CH6_TINY.replace("optimisers = [\"ga\", \"de\", \"pso\"]", "optimisers = [\"de\"]"),
+    );
     c.ok(&["run", "de.toml", "--out", "alone"]);
     let alone = without_timing(&c.path("alone/runs.csv"));
-    let full: Vec<Vec<String>> = without_timing(&c.path("j1/runs.csv")).into_iter().filter(|r| r[col("optimiser")] == "de").collect();
+    let full: Vec<Vec<String>> = without_timing(&c.path("j1/runs.csv"))
+        .into_iter()
+        .filter(|r| r[col("optimiser")] == "de")
+        .collect();
     assert_eq!(alone, full);
 }
 
@@ -300,14 +404,21 @@ fn chapter_6_is_deterministic_paired_and_each_cell_reruns_alone() {
 fn bad_optimiser_specs_are_refused_before_any_run() {
     let c = Case::new();
     for (from, to, needle) in [
-        ("optimisers = [\"ga\", \"de\", \"pso\"]", "optimisers = [\"ga\", \"sa\"]", "optim.optimisers"),
+        (
+            "optimisers = [\"ga\", \"de\", \"pso\"]",
+            "optimisers = [\"ga\", \"sa\"]",
+            "optim.optimisers",
+        ),
         ("population = 8", "population = -1", "opt.toml:"),
         ("iterations = 500", "iterations = 500\n[optim.de]\ncr = 1.5", "de.cr"),
         ("control_nets = [\"6x6\", \"8x8\"]", "control_nets = []", "optim.control_nets"),
     ] {
         c.write("opt.toml", &CH6_TINY.replace(from, to));
         c.fails(&["run", "opt.toml", "--out", "o"], &[needle]);
-        assert!(!c.path("o/cells.jsonl").exists() && !c.path("o/maps").exists(), "{needle}: something ran");
+        assert!(
+            !c.path("o/cells.jsonl").exists() && !c.path("o/maps").exists(),
+            "{needle}: something ran"
+        );
     }
 }
 
@@ -342,16 +453,35 @@ fn compare_writes_runtime_distributions_and_bayesian_table() {
     c.write("opt.toml", &CH6_TINY.replace("repeats = 2", "repeats = 3"));
     c.ok(&["run", "opt.toml", "--out", "o"]);
     let ioh = c.path("o/ioh/de");
-    let json = std::fs::read_dir(&ioh).unwrap().flatten().map(|e| e.path()).find(|p| p.extension().is_some_and(|x| x == "json")).unwrap();
-    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
-    for k in ["version", "suite", "function_id", "function_name", "maximization", "algorithm", "attributes", "scenarios"] {
+    let json = std::fs::read_dir(&ioh)
+        .unwrap()
+        .flatten()
+        .map(|e| e.path())
+        .find(|p| p.extension().is_some_and(|x| x == "json"))
+        .unwrap();
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    for k in [
+        "version",
+        "suite",
+        "function_id",
+        "function_name",
+        "maximization",
+        "algorithm",
+        "attributes",
+        "scenarios",
+    ] {
         assert!(v.get(k).is_some(), "{k}");
     }
-    assert!(!std::fs::read_dir(&ioh).unwrap().flatten().any(|e| e.path().extension().is_some_and(|x| x == "info")));
+    assert!(!std::fs::read_dir(&ioh)
+        .unwrap()
+        .flatten()
+        .any(|e| e.path().extension().is_some_and(|x| x == "info")));
     let dat = ioh.join(v["scenarios"][0]["path"].as_str().unwrap());
     let text = std::fs::read_to_string(&dat).unwrap();
     let lines: Vec<&str> = text.lines().collect();
-    let starts: Vec<&str> = lines.windows(2).filter(|w| w[0] == "evaluations raw_y").map(|w| w[1]).collect();
+    let starts: Vec<&str> =
+        lines.windows(2).filter(|w| w[0] == "evaluations raw_y").map(|w| w[1]).collect();
     assert_eq!(starts.len(), 3);
     assert!(starts.iter().all(|l| l.starts_with("1 ")), "{starts:?}");
     let out = c.ok(&["compare", "o", "--bayes-samples", "2000"]);
@@ -360,11 +490,18 @@ fn compare_writes_runtime_distributions_and_bayesian_table() {
     assert_eq!(rows.len(), 3);
     let col = |n: &str| h.iter().position(|x| x == n).unwrap();
     for r in &rows {
-        let s: f64 = ["p_x_better", "p_rope", "p_y_better"].iter().map(|k| r[col(k)].parse::<f64>().unwrap()).sum();
+        let s: f64 = ["p_x_better", "p_rope", "p_y_better"]
+            .iter()
+            .map(|k| r[col(k)].parse::<f64>().unwrap())
+            .sum();
         assert!((s - 1.0).abs() < 1e-3, "{r:?}");
     }
     let (h, rows) = read_csv(&c.path("o/compare_ecdf.csv"));
-    let (g, o, e) = (h.iter().position(|x| x == "group").unwrap(), h.iter().position(|x| x == "optimiser").unwrap(), h.iter().position(|x| x == "ecdf").unwrap());
+    let (g, o, e) = (
+        h.iter().position(|x| x == "group").unwrap(),
+        h.iter().position(|x| x == "optimiser").unwrap(),
+        h.iter().position(|x| x == "ecdf").unwrap(),
+    );
     assert!(rows.iter().any(|r| r[g] == "all"));
     assert!(rows.iter().filter(|r| r[g] != "all").count() > 0);
     for w in rows.windows(2).filter(|w| w[0][g] == w[1][g] && w[0][o] == w[1][o]) {
@@ -375,12 +512,29 @@ fn compare_writes_runtime_distributions_and_bayesian_table() {
     let a = h.iter().position(|x| x == "aocc").unwrap();
     assert!(rows.iter().all(|r| (0.0..=1.0).contains(&r[a].parse::<f64>().unwrap())));
     let (h, rows) = read_csv(&c.path("o/compare_ert.csv"));
-    let (hi, ru) = (h.iter().position(|x| x == "hits").unwrap(), h.iter().position(|x| x == "runs").unwrap());
-    assert!(rows.iter().all(|r| r[hi].parse::<usize>().unwrap() <= r[ru].parse::<usize>().unwrap()));
-    assert!(c.path("o/compare_ecdf_all.png").exists() && c.path("o/compare_fixed_budget_all.png").exists());
-    for f in ["compare_cells", "compare_overall", "compare_bayes", "compare_ecdf", "compare_aocc", "compare_fixed_budget", "compare_ert"] {
+    let (hi, ru) =
+        (h.iter().position(|x| x == "hits").unwrap(), h.iter().position(|x| x == "runs").unwrap());
+    assert!(rows
+        .iter()
+        .all(|r| r[hi].parse::<usize>().unwrap() <= r[ru].parse::<usize>().unwrap()));
+    assert!(
+        c.path("o/compare_ecdf_all.png").exists()
+            && c.path("o/compare_fixed_budget_all.png").exists()
+    );
+    for f in [
+        "compare_cells",
+        "compare_overall",
+        "compare_bayes",
+        "compare_ecdf",
+        "compare_aocc",
+        "compare_fixed_budget",
+        "compare_ert",
+    ] {
         let (_, rows) = read_csv(&c.path(&format!("o/{f}.csv")));
-        assert!(!rows.iter().flatten().any(|x| x.starts_with('-') && x[1..].parse::<f64>() == Ok(0.0)), "{f}: negative zero");
+        assert!(
+            !rows.iter().flatten().any(|x| x.starts_with('-') && x[1..].parse::<f64>() == Ok(0.0)),
+            "{f}: negative zero"
+        );
     }
     c.fails(&["compare", "o", "--rope=-1"], &["--rope"]);
     // Traces that do not match runs.csv are refused, naming the folder.
@@ -391,7 +545,11 @@ fn compare_writes_runtime_distributions_and_bayesian_table() {
 #[test]
 fn exact_optimum_bounds_every_run_from_below() {
     let c = Case::new();
-    c.write("opt.toml", &CH6_TINY.replace("maps = \"nowhere\"", "maps = \"nowhere\"\nexact = true\ninit_range = 1e-3"));
+    c.write(
+        "opt.toml",
+        &CH6_TINY
+            .replace("maps = \"nowhere\"", "maps = \"nowhere\"\nexact = true\ninit_range = 1e-3"),
+    );
     c.ok(&["run", "opt.toml", "--out", "o"]);
     let (h, rows) = read_csv(&c.path("o/exact_20x20.csv"));
     let col = |n: &str| h.iter().position(|x| x == n).unwrap();
@@ -400,11 +558,15 @@ fn exact_optimum_bounds_every_run_from_below() {
     let best = rh.iter().position(|x| x == "best").unwrap();
     let cn = rh.iter().position(|x| x == "cn_x").unwrap();
     for r in &rows {
-        let (f, lb): (f64, f64) = (r[col("exact_f")].parse().unwrap(), r[col("lower_bound")].parse().unwrap());
+        let (f, lb): (f64, f64) =
+            (r[col("exact_f")].parse().unwrap(), r[col("lower_bound")].parse().unwrap());
         let b: f64 = r[col("b")].parse().unwrap();
         assert!(lb <= f && f <= b, "{r:?}");
         for run in runs.iter().filter(|x| x[cn] == r[col("cn_x")]) {
-            assert!(run[best].parse::<f64>().unwrap() >= lb, "{run:?} beats the certified bound {lb}");
+            assert!(
+                run[best].parse::<f64>().unwrap() >= lb,
+                "{run:?} beats the certified bound {lb}"
+            );
         }
     }
 }
@@ -417,7 +579,12 @@ fn exact_optimum_bounds_every_run_from_below() {
 fn readings_matrix_runs_each_reading_set_and_sets_claims_side_by_side() {
     let c = Case::new();
     c.write("specs/maps.toml", CH4_FOR_FIT);
-    c.write("specs/fits.toml", &CH5_TINY.replace("MAPS", "unused").replace(r#"["6x6", "12x12"]"#, r#"["6x6", "12x12", "18x18"]"#));
+    c.write(
+        "specs/fits.toml",
+        &CH5_TINY
+            .replace("MAPS", "unused")
+            .replace(r#"["6x6", "12x12"]"#, r#"["6x6", "12x12", "18x18"]"#),
+    );
     c.write(
         "specs/p.toml",
         r#"specs = ["maps", "fits"]
@@ -433,18 +600,33 @@ specs = ["fits"]
     c.ok(&["reproduce", "--specs", "specs", "--plan", "p", "--out", "out"]);
     let (h, rows) = read_csv(&c.path("out/readings.csv"));
     let col = |name: &str| h.iter().position(|x| x == name).unwrap();
-    let claims_of = |reading: &str| -> Vec<String> { rows.iter().filter(|r| r[col("reading")] == reading).map(|r| r[col("claim")].clone()).collect() };
+    let claims_of = |reading: &str| -> Vec<String> {
+        rows.iter()
+            .filter(|r| r[col("reading")] == reading)
+            .map(|r| r[col("claim")].clone())
+            .collect()
+    };
     assert!(!claims_of("eq2_10").is_empty());
     assert_eq!(claims_of("eq2_10"), claims_of("nurbs_book"), "every claim under both readings");
     let max_excursion = |path: &str, knots: &str| -> f64 {
         let (h, rows) = read_csv(&c.path(path));
-        let (k, e, cn) = (h.iter().position(|x| x == "knots").unwrap(), h.iter().position(|x| x == "excursion").unwrap(), h.iter().position(|x| x == "cn_x").unwrap());
+        let (k, e, cn) = (
+            h.iter().position(|x| x == "knots").unwrap(),
+            h.iter().position(|x| x == "excursion").unwrap(),
+            h.iter().position(|x| x == "cn_x").unwrap(),
+        );
         assert!(rows.iter().all(|r| r[k] == knots), "{path} records its knot reading");
-        rows.iter().filter(|r| r[cn] == "18").map(|r| r[e].parse::<f64>().unwrap()).fold(0.0, f64::max)
+        rows.iter()
+            .filter(|r| r[cn] == "18")
+            .map(|r| r[e].parse::<f64>().unwrap())
+            .fold(0.0, f64::max)
     };
     let faithful = max_excursion("out/fits/runs.csv", "eq2_10");
     let old = max_excursion("out/readings/nurbs_book/fits/runs.csv", "nurbs_book");
-    assert!(faithful < 0.1 && old > 10.0 * faithful.max(0.01), "eq2_10 {faithful}, nurbs_book {old}");
+    assert!(
+        faithful < 0.1 && old > 10.0 * faithful.max(0.01),
+        "eq2_10 {faithful}, nurbs_book {old}"
+    );
     let report = std::fs::read_to_string(c.path("out/REPORT.md")).unwrap();
     assert!(report.contains("# Readings matrix") && report.contains("`nurbs_book`"));
     // A reading set naming a spec the plan does not have is refused before anything runs.

@@ -44,7 +44,20 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static ALLOC: Counting = Counting;
 
-const NUMBERS: [&str; 12] = ["1000000000000", "1000000000000000000", "18446744073709551615", "-1", "0", "1e308", "-1e308", "inf", "nan", "4294967295", "2.5", "99999999999999999999999"];
+const NUMBERS: [&str; 12] = [
+    "1000000000000",
+    "1000000000000000000",
+    "18446744073709551615",
+    "-1",
+    "0",
+    "1e308",
+    "-1e308",
+    "inf",
+    "nan",
+    "4294967295",
+    "2.5",
+    "99999999999999999999999",
+];
 
 /// One random mutation of `seed`: byte flips, a number put in place of a digit run, a cut, a
 /// repeated slice, or a line dropped.
@@ -60,7 +73,9 @@ fn mutate(seed: &[u8], rng: &mut ChaCha8Rng) -> Vec<u8> {
             1 => {
                 // Replace the digit run at or after `at` by a troublesome number.
                 let start = (at..b.len()).find(|&k| b[k].is_ascii_digit()).unwrap_or(at);
-                let end = (start..b.len()).find(|&k| !b[k].is_ascii_digit() && b[k] != b'.').unwrap_or(b.len());
+                let end = (start..b.len())
+                    .find(|&k| !b[k].is_ascii_digit() && b[k] != b'.')
+                    .unwrap_or(b.len());
                 let n = NUMBERS[rng.gen_range(0..NUMBERS.len())].as_bytes();
                 b.splice(start..end, n.iter().copied());
             }
@@ -85,15 +100,19 @@ fn mutate(seed: &[u8], rng: &mut ChaCha8Rng) -> Vec<u8> {
 }
 
 fn ply_seeds() -> Vec<Vec<u8>> {
-    let verts: Vec<[f32; 3]> = (0..6).map(|k| [k as f32, (k * 2) as f32 * 0.5, 1.0 - k as f32]).collect();
-    let header = |fmt: &str| format!("ply\nformat {fmt} 1.0\ncomment fuzz\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n", verts.len());
+    let verts: Vec<[f32; 3]> =
+        (0..6).map(|k| [k as f32, (k * 2) as f32 * 0.5, 1.0 - k as f32]).collect();
+    let header = |fmt: &str| {
+        format!("ply\nformat {fmt} 1.0\ncomment fuzz\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n", verts.len())
+    };
     let mut ascii = header("ascii");
     for v in &verts {
         ascii.push_str(&format!("{} {} {} 7\n", v[0], v[1], v[2]));
     }
     ascii.push_str("3 0 1 2\n3 1 2 3\n");
     let binary = |big: bool| {
-        let mut b = header(if big { "binary_big_endian" } else { "binary_little_endian" }).into_bytes();
+        let mut b =
+            header(if big { "binary_big_endian" } else { "binary_little_endian" }).into_bytes();
         for v in &verts {
             for x in v {
                 b.extend(if big { x.to_be_bytes() } else { x.to_le_bytes() });
@@ -112,7 +131,10 @@ fn ply_seeds() -> Vec<Vec<u8>> {
 }
 
 fn stl_seeds() -> Vec<Vec<u8>> {
-    let tris = [[[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], [[0.0, 0.0, 1.0], [1.0, 0.0, 1.0], [0.0, 1.0, 2.0]]];
+    let tris = [
+        [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        [[0.0, 0.0, 1.0], [1.0, 0.0, 1.0], [0.0, 1.0, 2.0]],
+    ];
     let mut ascii = String::from("solid s\n");
     let mut bin = vec![b' '; 80];
     bin.extend((tris.len() as u32).to_le_bytes());
@@ -137,7 +159,11 @@ fn spec_seeds() -> Vec<Vec<u8>> {
     let mut out: Vec<Vec<u8>> = std::fs::read_dir(&dir)
         .unwrap()
         .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "toml") && !["thesis.toml", "seeds.toml", "all.toml"].contains(&p.file_name().unwrap().to_str().unwrap()))
+        .filter(|p| {
+            p.extension().is_some_and(|e| e == "toml")
+                && !["thesis.toml", "seeds.toml", "all.toml"]
+                    .contains(&p.file_name().unwrap().to_str().unwrap())
+        })
         .map(|p| std::fs::read(p).unwrap())
         .collect();
     out.sort();
@@ -145,7 +171,12 @@ fn spec_seeds() -> Vec<Vec<u8>> {
 }
 
 /// Run `parse` on `CASES_PER_SEED` mutations of each seed: no panic, each under a second.
-fn fuzz(what: &str, seeds: &[Vec<u8>], rng: &mut ChaCha8Rng, parse: impl Fn(&[u8]) -> bool) -> (usize, usize) {
+fn fuzz(
+    what: &str,
+    seeds: &[Vec<u8>],
+    rng: &mut ChaCha8Rng,
+    parse: impl Fn(&[u8]) -> bool,
+) -> (usize, usize) {
     let mut ok = 0;
     let mut total = 0;
     for seed in seeds {
@@ -158,7 +189,11 @@ fn fuzz(what: &str, seeds: &[Vec<u8>], rng: &mut ChaCha8Rng, parse: impl Fn(&[u8
             let shown = String::from_utf8_lossy(&input[..input.len().min(600)]).to_string();
             assert!(r.is_ok(), "{what}: panicked on\n{shown}");
             assert!(took < Duration::from_secs(1), "{what}: {took:?} on\n{shown}");
-            assert!(LARGEST.load(Ordering::Relaxed) <= MAX_ALLOCATION, "{what}: an allocation of {} bytes on\n{shown}", LARGEST.load(Ordering::Relaxed));
+            assert!(
+                LARGEST.load(Ordering::Relaxed) <= MAX_ALLOCATION,
+                "{what}: an allocation of {} bytes on\n{shown}",
+                LARGEST.load(Ordering::Relaxed)
+            );
             ok += r.unwrap() as usize;
             total += 1;
         }
@@ -172,8 +207,10 @@ fn readers_and_spec_loader_survive_random_mutations() {
     let mut rng = ChaCha8Rng::seed_from_u64(17);
     let ply = fuzz("PLY", &ply_seeds(), &mut rng, |b| ply::parse_ply(b).is_ok());
     let stl = fuzz("STL", &stl_seeds(), &mut rng, |b| stl::parse_stl(b).is_ok());
-    let xyz_seed = b"x,y,z\n# points\n0 0 0\n1,0,0\n0;1;0\n0.5 0.5 1 extra\n1e-3 2e-3 3e-3\n".to_vec();
-    let xyz = fuzz("XYZ", &[xyz_seed], &mut rng, |b| xyz::parse_xyz(&String::from_utf8_lossy(b)).is_ok());
+    let xyz_seed =
+        b"x,y,z\n# points\n0 0 0\n1,0,0\n0;1;0\n0.5 0.5 1 extra\n1e-3 2e-3 3e-3\n".to_vec();
+    let xyz =
+        fuzz("XYZ", &[xyz_seed], &mut rng, |b| xyz::parse_xyz(&String::from_utf8_lossy(b)).is_ok());
     let specs = fuzz("spec", &spec_seeds(), &mut rng, |b| {
         let text = String::from_utf8_lossy(b);
         let plain = Spec::parse("fuzz.toml", &text, None);

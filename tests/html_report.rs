@@ -44,10 +44,14 @@ fn a_chapter_5_run_writes_a_self_contained_report_html() {
     let html = std::fs::read_to_string(out.join("report.html")).unwrap();
     let views = std::fs::read_to_string(out.join("views3d.js")).unwrap();
     assert!(views.contains("sphere: DNSOM map 20x20"), "{}", &views[..200.min(views.len())]);
-    assert!(views.contains("sphere: A surfaces furthest from the data") && views.contains("sphere: B surfaces furthest from the data"));
+    assert!(
+        views.contains("sphere: A surfaces furthest from the data")
+            && views.contains("sphere: B surfaces furthest from the data")
+    );
     let js = std::fs::read(out.join(somnurbs::report::html::PLOTLY_PATH)).unwrap();
     assert_eq!(js, somnurbs::report::html::PLOTLY_JS, "the vendored library is copied as it is");
-    assert!(html.contains(&format!("<script src=\"{}\"></script>", somnurbs::report::html::PLOTLY_PATH)));
+    assert!(html
+        .contains(&format!("<script src=\"{}\"></script>", somnurbs::report::html::PLOTLY_PATH)));
     assert!(html.contains("<script src=\"views3d.js\" data-folder=\"\"></script>"));
     assert!(html.contains("class=\"sortable"), "no sortable table");
     // Every picture of the folder is on the page, and nothing is fetched from elsewhere.
@@ -57,12 +61,23 @@ fn a_chapter_5_run_writes_a_self_contained_report_html() {
     }
     assert!(!html.contains("http://") && !html.contains("https://"));
 
-    let Some(browser) = ["chromium", "chromium-browser"].iter().find(|b| std::process::Command::new(b).arg("--version").output().is_ok_and(|o| o.status.success())) else {
+    let Some(browser) = ["chromium", "chromium-browser"].iter().find(|b| {
+        std::process::Command::new(b).arg("--version").output().is_ok_and(|o| o.status.success())
+    }) else {
         println!("skipped the headless-browser half: chromium is not installed (scripts/install_chromium.sh installs it; CI does)");
         return;
     };
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/check_report_html.sh");
-    let run = std::process::Command::new("bash").arg(&script).arg(&out).env("CHROMIUM", browser).output().unwrap();
+    let run = std::process::Command::new("bash")
+        .arg(&script)
+        .arg(&out)
+        .env("CHROMIUM", browser)
+        .output()
+        .unwrap();
     let said = String::from_utf8_lossy(&run.stdout);
-    assert!(run.status.success() && said.contains("1 passed, 0 failed"), "{said}\n{}", String::from_utf8_lossy(&run.stderr));
+    assert!(
+        run.status.success() && said.contains("1 passed, 0 failed"),
+        "{said}\n{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
 }

@@ -20,12 +20,21 @@ fn a_killed_run_resumes_to_the_same_tables() {
     c.write("slow.toml", SLOW);
     c.ok(&["run", "slow.toml", "--out", "plain", "--jobs", "2"]);
     // Start again in another folder and kill it (SIGKILL) once some cells are logged.
-    let mut child = bin().args(["run", "slow.toml", "--out", "killed", "--jobs", "1"]).current_dir(c.dir.path()).env("SOMNURBS_DATA", shared_data()).stderr(std::process::Stdio::null()).spawn().unwrap();
+    let mut child = bin()
+        .args(["run", "slow.toml", "--out", "killed", "--jobs", "1"])
+        .current_dir(c.dir.path())
+        .env("SOMNURBS_DATA", shared_data())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
     let log = c.path("killed/cells.jsonl");
     let t0 = Instant::now();
     while log_keys(&log).len() < 8 {
         assert!(t0.elapsed() < Duration::from_secs(120), "no progress");
-        assert!(child.try_wait().unwrap().is_none(), "finished before it could be killed; make SLOW slower");
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "finished before it could be killed; make SLOW slower"
+        );
         std::thread::sleep(Duration::from_millis(20));
     }
     child.kill().unwrap();
@@ -35,11 +44,21 @@ fn a_killed_run_resumes_to_the_same_tables() {
     assert!(!c.path("killed/manifest.toml").exists() && !c.path("killed/runs.csv").exists());
     // A different seed may not resume there.
     c.write("other.toml", &SLOW.replace("master_seed = 11", "master_seed = 12"));
-    c.fails(&["run", "other.toml", "--out", "killed", "--resume"], &["cannot resume", "master seed: 11 vs 12"]);
-    c.fails(&["run", "slow.toml", "--out", "killed", "--resume", "--profile", "quick"], &["profile"]);
+    c.fails(
+        &["run", "other.toml", "--out", "killed", "--resume"],
+        &["cannot resume", "master seed: 11 vs 12"],
+    );
+    c.fails(
+        &["run", "slow.toml", "--out", "killed", "--resume", "--profile", "quick"],
+        &["profile"],
+    );
     // Resume: the rest runs, nothing is duplicated or lost, the tables equal the plain run's.
     let out = c.ok(&["run", "slow.toml", "--out", "killed", "--resume", "--jobs", "2"]);
-    assert!(String::from_utf8_lossy(&out.stderr).contains(&format!("{before} of 72 cells already done")) || before == 0);
+    assert!(
+        String::from_utf8_lossy(&out.stderr)
+            .contains(&format!("{before} of 72 cells already done"))
+            || before == 0
+    );
     let keys = log_keys(&log);
     assert_eq!(keys.len(), 72, "every cell logged once");
     assert_eq!(keys.iter().collect::<BTreeSet<_>>().len(), 72);
@@ -50,14 +69,17 @@ fn a_killed_run_resumes_to_the_same_tables() {
 #[test]
 fn shards_merge_into_the_one_machine_run() {
     let c = Case::new();
-    let spec = SLOW.replace("repeats = 12", "repeats = 2").replace("generations = 600", "generations = 40");
+    let spec = SLOW
+        .replace("repeats = 12", "repeats = 2")
+        .replace("generations = 600", "generations = 40");
     c.write("s.toml", &spec);
     c.ok(&["run", "s.toml", "--out", "one"]);
     for i in 1..=3 {
         c.ok(&["run", "s.toml", "--out", &format!("shard{i}"), "--shard", &format!("{i}/3")]);
         assert!(!c.path(&format!("shard{i}/runs.csv")).exists(), "a shard writes no tables");
     }
-    let sizes: Vec<usize> = (1..=3).map(|i| log_keys(&c.path(&format!("shard{i}/cells.jsonl"))).len()).collect();
+    let sizes: Vec<usize> =
+        (1..=3).map(|i| log_keys(&c.path(&format!("shard{i}/cells.jsonl"))).len()).collect();
     assert_eq!(sizes.iter().sum::<usize>(), 12);
     c.fails(&["merge", "shard1", "shard2", "--out", "m"], &["shard 3/3 is missing"]);
     c.fails(&["merge", "shard1", "shard1", "shard2", "--out", "m2"], &["given twice"]);
@@ -75,9 +97,26 @@ fn reproduce_quick_writes_one_report_with_claims_and_tables_6_8_6_9() {
     let c = Case::new();
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     let specs = root.join("experiments");
-    c.ok(&["reproduce", "--profile", "quick", "--out", "thesis", "--specs", specs.to_str().unwrap(), "--jobs", "2"]);
+    c.ok(&[
+        "reproduce",
+        "--profile",
+        "quick",
+        "--out",
+        "thesis",
+        "--specs",
+        specs.to_str().unwrap(),
+        "--jobs",
+        "2",
+    ]);
     let report = std::fs::read_to_string(c.path("thesis/REPORT.md")).unwrap();
-    for needle in ["## Claims", "B beats A in most cells", "DNSOM has the lowest TE", "Table 6.8", "Table 6.9", "](ch4_models/"] {
+    for needle in [
+        "## Claims",
+        "B beats A in most cells",
+        "DNSOM has the lowest TE",
+        "Table 6.8",
+        "Table 6.9",
+        "](ch4_models/",
+    ] {
         assert!(report.contains(needle), "REPORT.md lacks {needle:?}");
     }
     let (h, rows) = read_csv(&c.path("thesis/table_6_8.csv"));
@@ -85,12 +124,20 @@ fn reproduce_quick_writes_one_report_with_claims_and_tables_6_8_6_9() {
     assert_eq!(rows.last().unwrap()[0], "overall");
     // The overall wins add up to the cells of Tables 6.4 and 6.5.
     let cells: usize = rows.last().unwrap()[1].split('/').nth(1).unwrap().parse().unwrap();
-    let wins: usize = rows.last().unwrap()[1..].iter().map(|v| v.split('/').next().unwrap().parse::<usize>().unwrap()).sum();
+    let wins: usize = rows.last().unwrap()[1..]
+        .iter()
+        .map(|v| v.split('/').next().unwrap().parse::<usize>().unwrap())
+        .sum();
     assert!(wins >= cells && cells > 0, "{wins} wins over {cells} cells (ties count for each)");
     let (h, claims) = read_csv(&c.path("thesis/claims.csv"));
     let verdict = h.iter().position(|x| x == "verdict").unwrap();
     assert!(claims.len() >= 15);
-    assert!(claims.iter().all(|r| ["holds", "mostly holds", "does not hold"].contains(&r[verdict].as_str())), "{claims:?}");
+    assert!(
+        claims
+            .iter()
+            .all(|r| ["holds", "mostly holds", "does not hold"].contains(&r[verdict].as_str())),
+        "{claims:?}"
+    );
 }
 
 #[test]
@@ -98,16 +145,36 @@ fn reproduce_plan_seeds_runs_the_other_seeds_and_a_missing_plan_is_named() {
     let c = Case::new();
     let specs = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments");
     let specs = specs.to_str().unwrap();
-    c.ok(&["reproduce", "--plan", "seeds", "--profile", "quick", "--out", "seeds", "--specs", specs, "--jobs", "2"]);
+    c.ok(&[
+        "reproduce",
+        "--plan",
+        "seeds",
+        "--profile",
+        "quick",
+        "--out",
+        "seeds",
+        "--specs",
+        specs,
+        "--jobs",
+        "2",
+    ]);
     let report = std::fs::read_to_string(c.path("seeds/REPORT.md")).unwrap();
-    assert!(report.starts_with("# somnurbs: the other seeds' experiments"), "{}", &report[..200.min(report.len())]);
-    let plan: toml::Table = std::fs::read_to_string(format!("{specs}/seeds.toml")).unwrap().parse().unwrap();
+    assert!(
+        report.starts_with("# somnurbs: the other seeds' experiments"),
+        "{}",
+        &report[..200.min(report.len())]
+    );
+    let plan: toml::Table =
+        std::fs::read_to_string(format!("{specs}/seeds.toml")).unwrap().parse().unwrap();
     for name in plan["specs"].as_array().unwrap() {
         let name = name.as_str().unwrap();
         assert!(c.path(&format!("seeds/{name}/manifest.toml")).exists(), "{name} did not finish");
         assert!(report.contains(&format!("# {name}")), "REPORT.md lacks {name}");
     }
-    c.fails(&["reproduce", "--plan", "nosuch", "--profile", "quick", "--out", "x", "--specs", specs], &["--plan nosuch", "nosuch.toml"]);
+    c.fails(
+        &["reproduce", "--plan", "nosuch", "--profile", "quick", "--out", "x", "--specs", specs],
+        &["--plan nosuch", "nosuch.toml"],
+    );
 }
 
 /// With stderr in a file (a log), progress comes as plain lines: at the start, every
@@ -117,13 +184,30 @@ fn progress_lines_appear_in_a_log() {
     let c = Case::new();
     c.write("slow.toml", SLOW);
     let log = std::fs::File::create(c.path("stderr.log")).unwrap();
-    let status = bin().args(["run", "slow.toml", "--out", "o", "--jobs", "1"]).current_dir(c.dir.path()).env("SOMNURBS_DATA", shared_data()).env("SOMNURBS_PROGRESS_SECS", "0.2").stderr(log).status().unwrap();
+    let status = bin()
+        .args(["run", "slow.toml", "--out", "o", "--jobs", "1"])
+        .current_dir(c.dir.path())
+        .env("SOMNURBS_DATA", shared_data())
+        .env("SOMNURBS_PROGRESS_SECS", "0.2")
+        .stderr(log)
+        .status()
+        .unwrap();
     assert!(status.success());
     let text = std::fs::read_to_string(c.path("stderr.log")).unwrap();
-    let lines: Vec<&str> = text.lines().filter(|l| l.starts_with("somnurbs: progress slow: ")).collect();
-    assert!(lines.first().is_some_and(|l| l.contains(" 0/72 cells, elapsed 0s, eta unknown")), "{text}");
-    assert!(lines.last().is_some_and(|l| l.contains(" 72/72 cells") && l.ends_with("eta 0s")), "{text}");
+    let lines: Vec<&str> =
+        text.lines().filter(|l| l.starts_with("somnurbs: progress slow: ")).collect();
+    assert!(
+        lines.first().is_some_and(|l| l.contains(" 0/72 cells, elapsed 0s, eta unknown")),
+        "{text}"
+    );
+    assert!(
+        lines.last().is_some_and(|l| l.contains(" 72/72 cells") && l.ends_with("eta 0s")),
+        "{text}"
+    );
     let between = lines.iter().filter(|l| !l.contains(" 0/72 ") && !l.contains(" 72/72 ")).count();
-    assert!(between >= 1 && lines.iter().all(|l| l.contains(", elapsed ") && l.contains(", eta ")), "no progress during the run:\n{text}");
+    assert!(
+        between >= 1 && lines.iter().all(|l| l.contains(", elapsed ") && l.contains(", eta ")),
+        "no progress during the run:\n{text}"
+    );
     assert!(!text.contains('\r'), "a terminal bar was drawn into the log");
 }

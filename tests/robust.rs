@@ -24,15 +24,27 @@ fn code(out: &std::process::Output) -> i32 {
 
 /// Every file under `dir` with its bytes.
 fn snapshot(dir: &Path) -> Vec<(String, Vec<u8>)> {
-    walk(dir).into_iter().map(|p| (p.strip_prefix(dir).unwrap().display().to_string(), std::fs::read(&p).unwrap())).collect()
+    walk(dir)
+        .into_iter()
+        .map(|p| (p.strip_prefix(dir).unwrap().display().to_string(), std::fs::read(&p).unwrap()))
+        .collect()
 }
 
 /// Start a slow run in the background and wait until it holds its folder.
 fn start_slow(c: &Case, spec: &str, out: &str) -> std::process::Child {
-    let child = bin().args(["run", spec, "--out", out, "--jobs", "1"]).current_dir(c.dir.path()).env("SOMNURBS_DATA", shared_data()).stderr(Stdio::null()).spawn().unwrap();
+    let child = bin()
+        .args(["run", spec, "--out", out, "--jobs", "1"])
+        .current_dir(c.dir.path())
+        .env("SOMNURBS_DATA", shared_data())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
     let lock = c.path(&format!("{out}/.somnurbs.lock"));
     let t0 = Instant::now();
-    while !std::fs::read_to_string(&lock).unwrap_or_default().contains(&format!("pid = {}", child.id())) {
+    while !std::fs::read_to_string(&lock)
+        .unwrap_or_default()
+        .contains(&format!("pid = {}", child.id()))
+    {
         assert!(t0.elapsed() < Duration::from_secs(30), "the run never took its lock");
         std::thread::sleep(Duration::from_millis(10));
     }
@@ -54,7 +66,11 @@ fn drift_compares_non_finite_numbers_by_identity() {
     assert_eq!(code(&c.run(&["drift", "c", "e"])), 1);
     // Equal non-finite values are no drift, but said.
     let out = c.ok(&["drift", "c", "c"]);
-    assert!(String::from_utf8_lossy(&out.stdout).contains("a:v is inf in both"), "{}", String::from_utf8_lossy(&out.stdout));
+    assert!(
+        String::from_utf8_lossy(&out.stdout).contains("a:v is inf in both"),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
     c.write("f/t.csv", "k,v\na,1.5000000001e0\n");
     c.ok(&["drift", "b", "f"]);
 }
@@ -77,7 +93,10 @@ fn a_rerun_with_bad_inputs_leaves_a_finished_folder_as_it_was() {
     c.fails(&["run", "bunny.toml", "--out", "done", "--data-dir", "nowhere"], &["bun_zipper.ply"]);
     // Another spec whose data file is broken (a mistyped --out): refused before the folder changes.
     c.write("bad.xyz", "1e308 0 0\n-1e308 1 1\n0 0 2\n5 5 5\n");
-    c.write("bad.toml", &SPEC.replace("\"sphere\"", "\"bad.xyz\"").replace("master_seed = 3", "master_seed = 4"));
+    c.write(
+        "bad.toml",
+        &SPEC.replace("\"sphere\"", "\"bad.xyz\"").replace("master_seed = 3", "master_seed = 4"),
+    );
     c.fails(&["run", "bad.toml", "--out", "done"], &["bad.xyz", "non-finite"]);
     // Maps that do not load.
     c.write("maps/dnsom_sphere_20x20.csv", "i,j,view\n1,2\n");
@@ -108,17 +127,32 @@ fn one_writer_per_folder_and_readers_wait_for_it() {
     // Killed once it has logged a cell (the kernel drops its lock): the folder is unfinished,
     // and holds the first run's cells only.
     let t0 = Instant::now();
-    while std::fs::read_to_string(c.path("busy/cells.jsonl")).unwrap_or_default().lines().count() < 2 {
-        assert!(t0.elapsed() < Duration::from_secs(60) && child.try_wait().unwrap().is_none(), "no progress");
+    while std::fs::read_to_string(c.path("busy/cells.jsonl")).unwrap_or_default().lines().count()
+        < 2
+    {
+        assert!(
+            t0.elapsed() < Duration::from_secs(60) && child.try_wait().unwrap().is_none(),
+            "no progress"
+        );
         std::thread::sleep(Duration::from_millis(10));
     }
     child.kill().unwrap();
     child.wait().unwrap();
     c.fails(&["drift", "base", "busy"], &["unfinished", "no manifest.toml"]);
-    c.fails(&["run", "other.toml", "--out", "busy", "--resume"], &["cannot resume", "master seed: 11 vs 12"]);
-    for line in std::fs::read_to_string(c.path("busy/cells.jsonl")).unwrap().lines().filter(|l| l.ends_with('}')) {
+    c.fails(
+        &["run", "other.toml", "--out", "busy", "--resume"],
+        &["cannot resume", "master seed: 11 vs 12"],
+    );
+    for line in std::fs::read_to_string(c.path("busy/cells.jsonl"))
+        .unwrap()
+        .lines()
+        .filter(|l| l.ends_with('}'))
+    {
         let v: serde_json::Value = serde_json::from_str(line).unwrap();
-        assert_eq!(v["seed"].as_str().unwrap(), somnurbs::experiment::seeds::seed_hex(11, v["key"].as_str().unwrap()));
+        assert_eq!(
+            v["seed"].as_str().unwrap(),
+            somnurbs::experiment::seeds::seed_hex(11, v["key"].as_str().unwrap())
+        );
     }
     // The lock died with its holder: the next writer is not blocked.
     c.ok(&["run", "r.toml", "--out", "busy", "--jobs", "1"]);
@@ -127,7 +161,9 @@ fn one_writer_per_folder_and_readers_wait_for_it() {
 #[test]
 fn drift_merge_accept_and_resume_refuse_unfinished_or_mixed_folders() {
     let c = Case::new();
-    let spec = SLOW.replace("repeats = 12", "repeats = 2").replace("generations = 600", "generations = 40");
+    let spec = SLOW
+        .replace("repeats = 12", "repeats = 2")
+        .replace("generations = 600", "generations = 40");
     c.write("s.toml", &spec);
     c.ok(&["run", "s.toml", "--out", "one", "--jobs", "2"]);
     c.ok(&["drift", "--accept", "base", "one"]);
@@ -148,11 +184,22 @@ fn drift_merge_accept_and_resume_refuse_unfinished_or_mixed_folders() {
     let first: serde_json::Value = serde_json::from_str(log.lines().next().unwrap()).unwrap();
     let key = first["key"].as_str().unwrap().to_string();
     let moved = format!("{key}9");
-    let forged = log.replacen(&key, &moved, 1).replacen(first["seed"].as_str().unwrap(), &somnurbs::experiment::seeds::seed_hex(11, &moved), 1);
+    let forged = log.replacen(&key, &moved, 1).replacen(
+        first["seed"].as_str().unwrap(),
+        &somnurbs::experiment::seeds::seed_hex(11, &moved),
+        1,
+    );
     std::fs::write(c.path("sh2/cells.jsonl"), &forged).unwrap();
     c.fails(&["merge", "sh1", "sh2", "--out", "m1"], &["merge", "no shard logged cell", &key]);
-    std::fs::write(c.path("sh2/cells.jsonl"), format!("{log}{}\n", log.lines().next().unwrap().replace(&key, &moved))).unwrap();
-    c.fails(&["merge", "sh1", "sh2", "--out", "m2"], &["merge", "cells.jsonl", &moved, "mixes runs"]);
+    std::fs::write(
+        c.path("sh2/cells.jsonl"),
+        format!("{log}{}\n", log.lines().next().unwrap().replace(&key, &moved)),
+    )
+    .unwrap();
+    c.fails(
+        &["merge", "sh1", "sh2", "--out", "m2"],
+        &["merge", "cells.jsonl", &moved, "mixes runs"],
+    );
     std::fs::write(c.path("sh2/cells.jsonl"), &log).unwrap();
     c.ok(&["merge", "sh1", "sh2", "--out", "m3"]);
     c.ok(&["drift", "base", "m3"]);
@@ -160,9 +207,15 @@ fn drift_merge_accept_and_resume_refuse_unfinished_or_mixed_folders() {
     let own = std::fs::read_to_string(c.path("half/cells.jsonl")).unwrap();
     let line = own.lines().nth(1).unwrap();
     let rec: serde_json::Value = serde_json::from_str(line).unwrap();
-    let wrong = line.replace(rec["seed"].as_str().unwrap(), &somnurbs::experiment::seeds::seed_hex(12, rec["key"].as_str().unwrap()));
+    let wrong = line.replace(
+        rec["seed"].as_str().unwrap(),
+        &somnurbs::experiment::seeds::seed_hex(12, rec["key"].as_str().unwrap()),
+    );
     std::fs::write(c.path("half/cells.jsonl"), format!("{own}{wrong}\n")).unwrap();
-    c.fails(&["run", "s.toml", "--out", "half", "--resume"], &["cells.jsonl:", rec["key"].as_str().unwrap(), "mixes runs"]);
+    c.fails(
+        &["run", "s.toml", "--out", "half", "--resume"],
+        &["cells.jsonl:", rec["key"].as_str().unwrap(), "mixes runs"],
+    );
     std::fs::write(c.path("half/cells.jsonl"), &own).unwrap();
     c.ok(&["run", "s.toml", "--out", "half", "--resume"]);
     c.ok(&["drift", "base", "half"]);
@@ -176,7 +229,11 @@ fn drift_merge_accept_and_resume_refuse_unfinished_or_mixed_folders() {
     c.write("base/drift.toml", "timing_rows = [\"fastest\"]\n");
     c.ok(&["drift", "--accept", "base", "m3"]);
     assert!(c.path("base/drift.toml").exists() && c.path("base/manifest.toml").exists());
-    let left: Vec<String> = std::fs::read_dir(c.dir.path()).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).filter(|n| n.starts_with(".base")).collect();
+    let left: Vec<String> = std::fs::read_dir(c.dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with(".base"))
+        .collect();
     assert!(left.is_empty(), "temporary folders left: {left:?}");
 }
 
@@ -212,16 +269,28 @@ fn bad_inputs_are_refused_on_one_line_quickly() {
     c.write("same.toml", &som("same.xyz"));
     timed(&["run", "same.toml", "--out", "o6"], &["same.xyz", "same point"]);
     for o in ["o1", "o2", "o3", "o5", "o6"] {
-        assert!(!c.path(&format!("{o}/manifest.toml")).exists() && !c.path(&format!("{o}/cells.jsonl")).exists(), "{o}");
+        assert!(
+            !c.path(&format!("{o}/manifest.toml")).exists()
+                && !c.path(&format!("{o}/cells.jsonl")).exists(),
+            "{o}"
+        );
     }
     // Spec sizes, in validation (so --dry-run too).
     for (from, to, needles) in [
-        ("grids = [\"6x5\"]", "grids = [\"100000x100000\"]", vec!["som.group[0].grids", "100000x100000"]),
+        (
+            "grids = [\"6x5\"]",
+            "grids = [\"100000x100000\"]",
+            vec!["som.group[0].grids", "100000x100000"],
+        ),
         ("iterations = 200", "iterations = 200\nsigma0 = 1e5", vec!["som.sigma0"]),
         ("iterations = 200", "iterations = 200\nsigma0 = inf", vec!["som.sigma0"]),
         ("iterations = 200", "iterations = 1000000000000000", vec!["som.iterations"]),
         ("iterations = 200", "iterations = 200\nrepeats = 1000000000", vec!["som.repeats"]),
-        ("models = [\"dnsom\"]", "models = [\"dnsom\", \"dnsom\"]", vec!["som.group[0].models", "`dnsom` is listed twice"]),
+        (
+            "models = [\"dnsom\"]",
+            "models = [\"dnsom\", \"dnsom\"]",
+            vec!["som.group[0].models", "`dnsom` is listed twice"],
+        ),
         ("name = \"s\"", "name = \"..\"", vec!["name"]),
         ("name = \"s\"", "name = \".\"", vec!["name"]),
     ] {
@@ -234,16 +303,31 @@ fn bad_inputs_are_refused_on_one_line_quickly() {
         ("population = 8", "population = 1000000000000", vec!["optim.population"]),
         ("generations = 20", "generations = 1000000000000000000", vec!["optim.generations"]),
         ("population = 8", "population = 8\nsearch_range = 1e308", vec!["optim.search_range"]),
-        ("optimisers = [\"ga\", \"de\"]", "optimisers = [\"de\", \"ga\", \"de\"]", vec!["optim.optimisers", "`de` is listed twice"]),
-        ("parameterisations = [\"chord_length\"]", "parameterisations = [\"chord_length\", \"chord_length\"]", vec!["optim.parameterisations", "chord_length"]),
-        ("control_nets = [\"6x6\"]", "control_nets = [\"6x6\", \"6\"]", vec!["optim.control_nets", "6x6"]),
+        (
+            "optimisers = [\"ga\", \"de\"]",
+            "optimisers = [\"de\", \"ga\", \"de\"]",
+            vec!["optim.optimisers", "`de` is listed twice"],
+        ),
+        (
+            "parameterisations = [\"chord_length\"]",
+            "parameterisations = [\"chord_length\", \"chord_length\"]",
+            vec!["optim.parameterisations", "chord_length"],
+        ),
+        (
+            "control_nets = [\"6x6\"]",
+            "control_nets = [\"6x6\", \"6\"]",
+            vec!["optim.control_nets", "6x6"],
+        ),
     ] {
         c.write("bad.toml", &SPEC.replace(from, to));
         timed(&["run", "bad.toml", "--dry-run"], &needles);
     }
     assert!(!c.path("o7").exists());
     // Many repeats expand in linear time (the cell de-duplication was quadratic).
-    c.write("many.toml", &som("cube").replace("iterations = 200", "iterations = 200\nrepeats = 10000"));
+    c.write(
+        "many.toml",
+        &som("cube").replace("iterations = 200", "iterations = 200\nrepeats = 10000"),
+    );
     let t0 = Instant::now();
     let out = c.ok(&["run", "many.toml", "--dry-run"]);
     assert_eq!(String::from_utf8_lossy(&out.stdout).lines().count(), 10000);
@@ -253,15 +337,23 @@ fn bad_inputs_are_refused_on_one_line_quickly() {
 #[test]
 fn results_do_not_depend_on_where_a_data_file_lives_and_stay_in_the_output_folder() {
     let c = Case::new();
-    let points: String = (0..60).map(|k| format!("{} {} {}\n", (k as f64 * 0.37).sin(), (k as f64 * 0.11).cos(), k as f64 / 60.0)).collect();
+    let points: String = (0..60)
+        .map(|k| {
+            format!("{} {} {}\n", (k as f64 * 0.37).sin(), (k as f64 * 0.11).cos(), k as f64 / 60.0)
+        })
+        .collect();
     c.write("here/part.xyz", &points);
     c.write("deep/down/part.xyz", &points);
     let abs = c.path("deep/down/part.xyz");
-    let spec = |data: &str| SOM.replace("DATA", data).replace("iterations = 200", "iterations = 200\nsave_maps = [\"6x5\"]");
+    let spec = |data: &str| {
+        SOM.replace("DATA", data)
+            .replace("iterations = 200", "iterations = 200\nsave_maps = [\"6x5\"]")
+    };
     c.write("a.toml", &spec("here/part.xyz"));
     c.write("b.toml", &spec(abs.to_str().unwrap()));
     c.write("c.toml", &spec("here/../deep/down/part.xyz"));
-    let list = |spec: &str| String::from_utf8_lossy(&c.ok(&["run", spec, "--dry-run"]).stdout).to_string();
+    let list =
+        |spec: &str| String::from_utf8_lossy(&c.ok(&["run", spec, "--dry-run"]).stdout).to_string();
     let a = list("a.toml");
     assert!(a.starts_with("som/part/dnsom/6x5/r0\tseed "), "{a}");
     assert_eq!(a, list("b.toml"), "an absolute path changed keys or seeds");
@@ -270,19 +362,37 @@ fn results_do_not_depend_on_where_a_data_file_lives_and_stay_in_the_output_folde
     c.ok(&["run", "b.toml", "--out", "ob"]);
     // A path with ../ keeps the maps inside --out.
     c.ok(&["run", "c.toml", "--out", "oc"]);
-    assert!(c.path("oa/maps/dnsom_part_6x5.csv").exists() && c.path("oc/maps/dnsom_part_6x5.csv").exists());
-    let outside: Vec<String> = walk(c.dir.path()).iter().map(|p| p.strip_prefix(c.dir.path()).unwrap().display().to_string()).filter(|p| !["oa/", "ob/", "oc/", "here/", "deep/", "a.toml", "b.toml", "c.toml"].iter().any(|k| p.starts_with(k))).collect();
+    assert!(
+        c.path("oa/maps/dnsom_part_6x5.csv").exists()
+            && c.path("oc/maps/dnsom_part_6x5.csv").exists()
+    );
+    let outside: Vec<String> = walk(c.dir.path())
+        .iter()
+        .map(|p| p.strip_prefix(c.dir.path()).unwrap().display().to_string())
+        .filter(|p| {
+            !["oa/", "ob/", "oc/", "here/", "deep/", "a.toml", "b.toml", "c.toml"]
+                .iter()
+                .any(|k| p.starts_with(k))
+        })
+        .collect();
     assert!(outside.is_empty(), "written outside the output folders: {outside:?}");
-    assert_eq!(same_tables(&c.path("oa"), &c.path("ob")), same_tables(&c.path("oa"), &c.path("oc")));
+    assert_eq!(
+        same_tables(&c.path("oa"), &c.path("ob")),
+        same_tables(&c.path("oa"), &c.path("oc"))
+    );
     // Two files of one name in one spec are refused, naming both.
-    c.write("twice.toml", &SOM.replace("\"DATA\"", &format!("\"here/part.xyz\", \"{}\"", abs.display())));
+    c.write(
+        "twice.toml",
+        &SOM.replace("\"DATA\"", &format!("\"here/part.xyz\", \"{}\"", abs.display())),
+    );
     c.fails(&["run", "twice.toml", "--dry-run"], &["som.datasets", "both go by the name `part`"]);
 }
 
 #[test]
 fn big_endian_ply_reads_like_ascii() {
     let c = Case::new();
-    let pts: Vec<[f32; 3]> = (0..8).map(|k| [k as f32 * 0.5, (k * k) as f32 * 0.25, 1.0 - k as f32 * 0.125]).collect();
+    let pts: Vec<[f32; 3]> =
+        (0..8).map(|k| [k as f32 * 0.5, (k * k) as f32 * 0.25, 1.0 - k as f32 * 0.125]).collect();
     let mut ascii = format!("ply\nformat ascii 1.0\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nend_header\n", pts.len());
     let mut big = format!("ply\nformat binary_big_endian 1.0\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nend_header\n", pts.len()).into_bytes();
     for p in &pts {
@@ -293,7 +403,10 @@ fn big_endian_ply_reads_like_ascii() {
     }
     c.write("a.ply", &ascii);
     std::fs::write(c.path("b.ply"), &big).unwrap();
-    let show = |f: &str| String::from_utf8_lossy(&c.ok(&["datasets", "show", f]).stdout).replace(&format!("{}:", &f[..1]), ":");
+    let show = |f: &str| {
+        String::from_utf8_lossy(&c.ok(&["datasets", "show", f]).stdout)
+            .replace(&format!("{}:", &f[..1]), ":")
+    };
     assert_eq!(show("a.ply"), show("b.ply"));
 }
 
@@ -305,7 +418,10 @@ fn small_grid(n: usize) -> String {
             for j in 0..n {
                 let (x, y) = (i as f64 / (n - 1) as f64, j as f64 / (n - 1) as f64);
                 // The views meet on the border (z = 0 there), as a two-view grid must.
-                s.push_str(&format!("{i},{j},{view},0,{x},{y},{}\n", sign * x * (1.0 - x) * y * (1.0 - y)));
+                s.push_str(&format!(
+                    "{i},{j},{view},0,{x},{y},{}\n",
+                    sign * x * (1.0 - x) * y * (1.0 - y)
+                ));
             }
         }
     }
@@ -317,14 +433,24 @@ fn fit_export_and_compare_refuse_a_folder_another_writer_holds() {
     let c = Case::new();
     c.write("slow.toml", SLOW);
     c.write("g.csv", &small_grid(6));
-    c.write("r.toml", &SPEC.replace("control_nets = [\"6x6\"]", "control_nets = [\"6x6\", \"8x8\"]"));
+    c.write(
+        "r.toml",
+        &SPEC.replace("control_nets = [\"6x6\"]", "control_nets = [\"6x6\", \"8x8\"]"),
+    );
     c.ok(&["run", "r.toml", "--out", "done", "--jobs", "1"]);
     let mut child = start_slow(&c, "slow.toml", "busy");
     let pid = format!("pid {}", child.id());
-    c.fails(&["fit", "--grid", "g.csv", "--cn", "4x4", "--out", "busy"], &["in use", &pid, "run slow.toml"]);
+    c.fails(
+        &["fit", "--grid", "g.csv", "--cn", "4x4", "--out", "busy"],
+        &["in use", &pid, "run slow.toml"],
+    );
     c.fails(&["datasets", "export", "sphere", "busy/sphere.xyz"], &["in use", &pid]);
     c.fails(&["compare", "busy"], &["in use", &pid]);
-    assert!(!c.path("busy/control_nets.csv").exists() && !c.path("busy/sphere.xyz").exists() && !c.path("busy/compare_cells.csv").exists());
+    assert!(
+        !c.path("busy/control_nets.csv").exists()
+            && !c.path("busy/sphere.xyz").exists()
+            && !c.path("busy/compare_cells.csv").exists()
+    );
     child.kill().unwrap();
     child.wait().unwrap();
     // Free folders: each command writes, and leaves the lock released for the next writer.
@@ -339,11 +465,19 @@ fn fit_export_and_compare_refuse_a_folder_another_writer_holds() {
 #[test]
 fn data_with_fewer_points_than_the_maps_neurons_is_refused_naming_the_file() {
     let c = Case::new();
-    let pts: String = (0..60).map(|k| { let t = k as f64 * 0.7; format!("{} {} {}\n", t.cos(), t.sin(), (k as f64 * 0.37).sin()) }).collect();
+    let pts: String = (0..60)
+        .map(|k| {
+            let t = k as f64 * 0.7;
+            format!("{} {} {}\n", t.cos(), t.sin(), (k as f64 * 0.37).sin())
+        })
+        .collect();
     c.write("few.xyz", &pts);
     let som = "name = \"s\"\nmaster_seed = 1\n[som]\ndatasets = [\"few.xyz\"]\niterations = 50\n[[som.group]]\nmodels = [\"som2d\", \"dnsom\"]\ngrids = [\"GRID\"]\n";
     c.write("big.toml", &som.replace("GRID", "10x10"));
-    c.fails(&["run", "big.toml", "--out", "big"], &["few.xyz", "60 points", "fewer than the", "neurons of the dnsom 10x10"]);
+    c.fails(
+        &["run", "big.toml", "--out", "big"],
+        &["few.xyz", "60 points", "fewer than the", "neurons of the dnsom 10x10"],
+    );
     assert!(!c.path("big/cells.jsonl").exists() && !c.path("big/manifest.toml").exists());
     // A SOM2D may have more neurons than points (as the thesis' SOM3D does); a small DNSOM runs.
     c.write("s2d.toml", &som.replace("GRID", "10x10").replace("\"som2d\", \"dnsom\"", "\"som2d\""));

@@ -12,7 +12,8 @@ fn spec() -> PathBuf {
 
 fn run(out: &Path, extra: &[&str]) -> std::process::Output {
     let spec = spec();
-    let mut args = vec!["run", spec.to_str().unwrap(), "--profile", "quick", "--out", out.to_str().unwrap()];
+    let mut args =
+        vec!["run", spec.to_str().unwrap(), "--profile", "quick", "--out", out.to_str().unwrap()];
     args.extend_from_slice(extra);
     Command::new(env!("CARGO_BIN_EXE_somnurbs")).args(&args).output().unwrap()
 }
@@ -23,14 +24,29 @@ fn seed002_quick_profile_writes_consistent_tables() {
     let out = dir.path().join("res");
     let o = run(&out, &["-j", "2"]);
     assert!(o.status.success(), "stderr: {}", String::from_utf8_lossy(&o.stderr));
-    for f in ["REPORT.md", "manifest.toml", "runs.csv", "seed002_errors.csv", "seed002_traces.csv", "png/seed002_convergence_surface1.png", "png/seed002_convergence_surface4.png"] {
+    for f in [
+        "REPORT.md",
+        "manifest.toml",
+        "runs.csv",
+        "seed002_errors.csv",
+        "seed002_traces.csv",
+        "png/seed002_convergence_surface1.png",
+        "png/seed002_convergence_surface4.png",
+    ] {
         assert!(out.join(f).is_file(), "{f} missing");
     }
     // runs.csv: 4 surfaces x 3 optimisers x 2 repeats; RMSE = sqrt(SSE / n); the best of a run is
     // no worse than its initial population's best.
     let (h, rows) = read_csv(&out.join("runs.csv"));
     assert_eq!(rows.len(), 4 * 3 * 2);
-    let (sse, rmse, n, init, w11, dim) = (col(&h, "best_sse"), col(&h, "rmse"), col(&h, "n_points"), col(&h, "initial_best"), col(&h, "w11"), col(&h, "dimension"));
+    let (sse, rmse, n, init, w11, dim) = (
+        col(&h, "best_sse"),
+        col(&h, "rmse"),
+        col(&h, "n_points"),
+        col(&h, "initial_best"),
+        col(&h, "w11"),
+        col(&h, "dimension"),
+    );
     for r in &rows {
         let f = |i: usize| r[i].parse::<f64>().unwrap();
         assert_eq!(r[n], "81", "quick grid is 9x9");
@@ -42,7 +58,8 @@ fn seed002_quick_profile_writes_consistent_tables() {
     // Error table: best <= mean <= worst per (surface, optimiser), 12 rows of 2 runs.
     let (h, rows) = read_csv(&out.join("seed002_errors.csv"));
     assert_eq!(rows.len(), 12);
-    let (b, m, w, runs) = (col(&h, "best_sse"), col(&h, "mean_sse"), col(&h, "worst_sse"), col(&h, "runs"));
+    let (b, m, w, runs) =
+        (col(&h, "best_sse"), col(&h, "mean_sse"), col(&h, "worst_sse"), col(&h, "runs"));
     for r in &rows {
         let f = |i: usize| r[i].parse::<f64>().unwrap();
         assert_eq!(r[runs], "2");
@@ -59,7 +76,13 @@ fn seed002_quick_profile_writes_consistent_tables() {
     // Curves: SAM06 finds every generated corner; conics = 2 per corner; best <= mean.
     let (h, rows) = read_csv(&out.join("seed002_curve_runs.csv"));
     assert_eq!(rows.len(), 3 * 3 * 2);
-    let (t, f, m, c, sse) = (col(&h, "true_corners"), col(&h, "corners_found"), col(&h, "corners_matched"), col(&h, "conics"), col(&h, "sse"));
+    let (t, f, m, c, sse) = (
+        col(&h, "true_corners"),
+        col(&h, "corners_found"),
+        col(&h, "corners_matched"),
+        col(&h, "conics"),
+        col(&h, "sse"),
+    );
     for r in &rows {
         assert_eq!(r[t], r[f], "{r:?}");
         assert_eq!(r[t], r[m], "{r:?}");
@@ -70,9 +93,16 @@ fn seed002_quick_profile_writes_consistent_tables() {
     assert_eq!(rows.len(), 9);
     let (b, mn) = (col(&h, "best_sse"), col(&h, "mean_sse"));
     for r in &rows {
-        assert!(r[b].parse::<f64>().unwrap() <= r[mn].parse::<f64>().unwrap() * (1.0 + 1e-12), "{r:?}");
+        assert!(
+            r[b].parse::<f64>().unwrap() <= r[mn].parse::<f64>().unwrap() * (1.0 + 1e-12),
+            "{r:?}"
+        );
     }
-    for f in ["png/seed002_outline_square.png", "png/seed002_outline_letter_d.png", "png/seed002_outline_letter_p.png"] {
+    for f in [
+        "png/seed002_outline_square.png",
+        "png/seed002_outline_letter_d.png",
+        "png/seed002_outline_letter_p.png",
+    ] {
         assert!(out.join(f).is_file(), "{f} missing");
     }
     // Same seeds, one thread: identical runs (timing aside).
@@ -82,13 +112,18 @@ fn seed002_quick_profile_writes_consistent_tables() {
     let strip = |p: &Path| {
         let (h, rows) = read_csv(p);
         let cpu = col(&h, "cpu_s");
-        rows.into_iter().map(|mut r| {
-            r[cpu].clear();
-            r
-        }).collect::<Vec<_>>()
+        rows.into_iter()
+            .map(|mut r| {
+                r[cpu].clear();
+                r
+            })
+            .collect::<Vec<_>>()
     };
     assert_eq!(strip(&out.join("runs.csv")), strip(&out1.join("runs.csv")));
-    assert_eq!(strip(&out.join("seed002_curve_runs.csv")), strip(&out1.join("seed002_curve_runs.csv")));
+    assert_eq!(
+        strip(&out.join("seed002_curve_runs.csv")),
+        strip(&out1.join("seed002_curve_runs.csv"))
+    );
 }
 
 #[test]
@@ -97,7 +132,10 @@ fn seed002_bad_key_is_named() {
     let text = std::fs::read_to_string(spec()).unwrap().replace("grid = 21", "grid = 20");
     let p = dir.path().join("bad.toml");
     std::fs::write(&p, text).unwrap();
-    let o = Command::new(env!("CARGO_BIN_EXE_somnurbs")).args(["run", p.to_str().unwrap(), "--out", dir.path().join("o").to_str().unwrap()]).output().unwrap();
+    let o = Command::new(env!("CARGO_BIN_EXE_somnurbs"))
+        .args(["run", p.to_str().unwrap(), "--out", dir.path().join("o").to_str().unwrap()])
+        .output()
+        .unwrap();
     assert!(!o.status.success());
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("seed002.grid") && err.contains("odd"), "{err}");

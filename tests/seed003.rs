@@ -19,18 +19,46 @@ fn seed003_quick_profile_writes_the_papers_tables() {
     let case = Case::new();
     let spec = spec();
     let out2 = case.path("j2");
-    case.ok(&["run", spec.to_str().unwrap(), "--profile", "quick", "--out", out2.to_str().unwrap(), "--jobs", "2"]);
-    for f in ["REPORT.md", "manifest.toml", "runs.csv", "seed003_table3.csv", "seed003_table4.csv", "seed003_table5.csv", "seed003_agreement.csv", "seed003_traces.csv"] {
+    case.ok(&[
+        "run",
+        spec.to_str().unwrap(),
+        "--profile",
+        "quick",
+        "--out",
+        out2.to_str().unwrap(),
+        "--jobs",
+        "2",
+    ]);
+    for f in [
+        "REPORT.md",
+        "manifest.toml",
+        "runs.csv",
+        "seed003_table3.csv",
+        "seed003_table4.csv",
+        "seed003_table5.csv",
+        "seed003_agreement.csv",
+        "seed003_traces.csv",
+    ] {
         assert!(out2.join(f).is_file(), "{f} missing");
     }
     for e in ["example1", "example2", "example3"] {
-        assert!(out2.join(format!("png/seed003_convergence_{e}.png")).is_file(), "{e} picture missing");
+        assert!(
+            out2.join(format!("png/seed003_convergence_{e}.png")).is_file(),
+            "{e} picture missing"
+        );
     }
     // runs.csv: 3 examples x 5 methods x 4 runs; RMSE = sqrt(Y / n); CSA/ICSA never end above
     // their start population's best; the classical methods are one evaluation.
     let (h, rows) = read_csv(&out2.join("runs.csv"));
     assert_eq!(rows.len(), 3 * 5 * 4);
-    let (y, rmse, n, init, method, evals) = (col(&h, "y"), col(&h, "rmse"), col(&h, "n_points"), col(&h, "initial_best_y"), col(&h, "method"), col(&h, "evaluations"));
+    let (y, rmse, n, init, method, evals) = (
+        col(&h, "y"),
+        col(&h, "rmse"),
+        col(&h, "n_points"),
+        col(&h, "initial_best_y"),
+        col(&h, "method"),
+        col(&h, "evaluations"),
+    );
     let iters = col(&h, "iterations");
     for c in ["cell", "example", "run", "seed", "data_seed", "cpu_s", "dimension", "noise_sigma"] {
         col(&h, c);
@@ -48,18 +76,33 @@ fn seed003_quick_profile_writes_the_papers_tables() {
         }
     }
     // The paper's layouts.
-    assert_eq!(header(&out2.join("seed003_table3.csv")), ["statistic", "example1", "example2", "example3"]);
+    assert_eq!(
+        header(&out2.join("seed003_table3.csv")),
+        ["statistic", "example1", "example2", "example3"]
+    );
     let (_, t3) = read_csv(&out2.join("seed003_table3.csv"));
-    assert_eq!(t3.iter().map(|r| r[0].as_str()).collect::<Vec<_>>(), ["y_mean", "y_best", "y_var", "y_std", "rmse_mean", "rmse_best"]);
-    assert_eq!(header(&out2.join("seed003_table4.csv")), ["example", "statistic", "uniform", "chordal", "centripetal", "csa", "icsa"]);
+    assert_eq!(
+        t3.iter().map(|r| r[0].as_str()).collect::<Vec<_>>(),
+        ["y_mean", "y_best", "y_var", "y_std", "rmse_mean", "rmse_best"]
+    );
+    assert_eq!(
+        header(&out2.join("seed003_table4.csv")),
+        ["example", "statistic", "uniform", "chordal", "centripetal", "csa", "icsa"]
+    );
     let (_, t4) = read_csv(&out2.join("seed003_table4.csv"));
     assert_eq!(t4.len(), 3 * 10);
     for r in t4.iter().filter(|r| r[1].starts_with("er_")) {
         // The best method of an error-rate row is blank, the others are above 100 %.
         assert_eq!(r[2..].iter().filter(|v| v.is_empty()).count(), 1, "{r:?}");
-        assert!(r[2..].iter().filter(|v| !v.is_empty()).all(|v| v.parse::<f64>().unwrap() >= 100.0), "{r:?}");
+        assert!(
+            r[2..].iter().filter(|v| !v.is_empty()).all(|v| v.parse::<f64>().unwrap() >= 100.0),
+            "{r:?}"
+        );
     }
-    assert_eq!(header(&out2.join("seed003_table5.csv")), ["comparison", "index", "example1", "example2", "example3"]);
+    assert_eq!(
+        header(&out2.join("seed003_table5.csv")),
+        ["comparison", "index", "example1", "example2", "example3"]
+    );
     let (_, t5) = read_csv(&out2.join("seed003_table5.csv"));
     assert_eq!(t5.len(), 4 * 6);
     for r in &t5 {
@@ -69,7 +112,9 @@ fn seed003_quick_profile_writes_the_papers_tables() {
                 "p_sign" | "p_sum" => assert!((0.0..=1.0).contains(&v), "{r:?}"),
                 "h_sign" | "h_sum" => assert!(v == 0.0 || v == 1.0, "{r:?}"),
                 "signed_rank" => assert!((0.0..=10.0).contains(&v), "4 pairs: W+ in 0..=10, {r:?}"),
-                _ => assert!((10.0..=26.0).contains(&v), "4 + 4 values: rank sum in 10..=26, {r:?}"),
+                _ => {
+                    assert!((10.0..=26.0).contains(&v), "4 + 4 values: rank sum in 10..=26, {r:?}")
+                }
             }
         }
     }
@@ -84,7 +129,16 @@ fn seed003_quick_profile_writes_the_papers_tables() {
 
     // One thread: the same numbers.
     let out1 = case.path("j1");
-    case.ok(&["run", spec.to_str().unwrap(), "--profile", "quick", "--out", out1.to_str().unwrap(), "--jobs", "1"]);
+    case.ok(&[
+        "run",
+        spec.to_str().unwrap(),
+        "--profile",
+        "quick",
+        "--out",
+        out1.to_str().unwrap(),
+        "--jobs",
+        "1",
+    ]);
     assert_eq!(same_tables(&out1, &out2), 7);
 }
 

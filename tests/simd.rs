@@ -48,7 +48,10 @@ fn forced_copy_matches_scalar(simd: &str, supported: bool) {
         assert_eq!(err.trim_end().lines().count(), 1, "{err}");
         assert!(err.contains("SOMNURBS_SIMD") && err.contains("lacks"), "{err}");
         assert!(!case.path("forced").join("runs.csv").exists(), "nothing written");
-        println!("SOMNURBS_SIMD={simd}: this CPU lacks the copy, so only its refusal was tested: {}", err.trim_end());
+        println!(
+            "SOMNURBS_SIMD={simd}: this CPU lacks the copy, so only its refusal was tested: {}",
+            err.trim_end()
+        );
         return;
     }
     for (simd, out) in [("scalar", "scalar"), (simd, "forced")] {
@@ -87,7 +90,10 @@ fn malformed_simd_value_is_refused() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
-    assert!(err.contains("SOMNURBS_SIMD must be scalar, avx2, avx512 or auto, got 'sse9'"), "{err}");
+    assert!(
+        err.contains("SOMNURBS_SIMD must be scalar, avx2, avx512 or auto, got 'sse9'"),
+        "{err}"
+    );
 }
 
 #[test]
@@ -102,9 +108,16 @@ fn simd_values_are_parsed_and_checked_against_the_cpu() {
             Ok(got) => assert!(got == isa && isa.supported(), "{v}"),
             Err(e) => {
                 assert!(!isa.supported(), "{v}: {e}");
-                assert!(e.to_string().starts_with("SOMNURBS_SIMD asks for the") && e.to_string().contains("lacks"), "{e}");
+                assert!(
+                    e.to_string().starts_with("SOMNURBS_SIMD asks for the")
+                        && e.to_string().contains("lacks"),
+                    "{e}"
+                );
             }
         }
     }
-    assert_eq!(parse_simd(Some("sse")).unwrap_err().to_string(), "SOMNURBS_SIMD must be scalar, avx2, avx512 or auto, got 'sse'");
+    assert_eq!(
+        parse_simd(Some("sse")).unwrap_err().to_string(),
+        "SOMNURBS_SIMD must be scalar, avx2, avx512 or auto, got 'sse'"
+    );
 }

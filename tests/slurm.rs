@@ -72,7 +72,10 @@ fn array(c: &Case, args: &[&str], env: &[(&str, &str)]) -> Output {
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/slurm_array.sh");
     let path = format!("{}:{}", stand_ins(c).display(), std::env::var("PATH").unwrap_or_default());
     let mut cmd = Command::new(script);
-    cmd.args(args).current_dir(c.dir.path()).env("PATH", path).env("STANDIN_LOG", c.path("sbatch.log"));
+    cmd.args(args)
+        .current_dir(c.dir.path())
+        .env("PATH", path)
+        .env("STANDIN_LOG", c.path("sbatch.log"));
     cmd.env("SOMNURBS_BIN", env!("CARGO_BIN_EXE_somnurbs")).env_remove("CPUS");
     // The tiny spec needs no data files; pass the data folder only when there is one.
     match shared_data() {
@@ -86,7 +89,12 @@ fn array(c: &Case, args: &[&str], env: &[(&str, &str)]) -> Output {
 }
 
 fn show(out: &Output) -> String {
-    format!("status: {}\nstdout:\n{}\nstderr:\n{}", out.status, String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr))
+    format!(
+        "status: {}\nstdout:\n{}\nstderr:\n{}",
+        out.status,
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    )
 }
 
 #[test]
@@ -97,7 +105,10 @@ fn the_array_runs_the_shards_and_merges_into_the_one_machine_tables() {
     let out = array(&c, &["tiny.toml", "3"], &[("OUT", "arr")]);
     assert!(out.status.success(), "{}", show(&out));
     let said = String::from_utf8_lossy(&out.stdout);
-    assert!(said.contains("submitted array 101 (3 shards of tiny.toml") && said.contains("merge 102"), "{said}");
+    assert!(
+        said.contains("submitted array 101 (3 shards of tiny.toml") && said.contains("merge 102"),
+        "{said}"
+    );
     assert!(said.contains("progress: scripts/slurm_array.sh --status"), "{said}");
     // CPUs per task from the partition (2), and the merge runs after every task, whatever its end.
     let log = std::fs::read_to_string(c.path("sbatch.log")).unwrap();
@@ -107,20 +118,39 @@ fn the_array_runs_the_shards_and_merges_into_the_one_machine_tables() {
     assert!(compared >= 5, "{compared} tables");
     let status = array(&c, &["--status", "arr"], &[]);
     assert!(status.status.success(), "{}", show(&status));
-    assert!(String::from_utf8_lossy(&status.stdout).contains("shard 3/3: exit 0"), "{}", show(&status));
+    assert!(
+        String::from_utf8_lossy(&status.stdout).contains("shard 3/3: exit 0"),
+        "{}",
+        show(&status)
+    );
     // A second submission would merge into the finished folder: refused before submitting.
     let again = array(&c, &["tiny.toml", "3"], &[("OUT", "arr")]);
     assert_eq!(again.status.code(), Some(2), "{}", show(&again));
-    assert!(String::from_utf8_lossy(&again.stderr).contains("merged already exists"), "{}", show(&again));
+    assert!(
+        String::from_utf8_lossy(&again.stderr).contains("merged already exists"),
+        "{}",
+        show(&again)
+    );
 }
 
 #[test]
 fn a_failed_shard_fails_the_merge_naming_it_and_a_resubmission_resumes() {
     let c = Case::new();
     c.write("tiny.toml", SPEC);
-    let failing = c.write("failing", &format!("#!/bin/sh\n[ \"${{SLURM_ARRAY_TASK_ID:-}}\" = 2 ] && exit 3\nexec {} \"$@\"\n", env!("CARGO_BIN_EXE_somnurbs")));
-    std::fs::set_permissions(&failing, std::os::unix::fs::PermissionsExt::from_mode(0o755)).unwrap();
-    let out = array(&c, &["tiny.toml", "3"], &[("OUT", "arr"), ("SOMNURBS_BIN", failing.to_str().unwrap())]);
+    let failing = c.write(
+        "failing",
+        &format!(
+            "#!/bin/sh\n[ \"${{SLURM_ARRAY_TASK_ID:-}}\" = 2 ] && exit 3\nexec {} \"$@\"\n",
+            env!("CARGO_BIN_EXE_somnurbs")
+        ),
+    );
+    std::fs::set_permissions(&failing, std::os::unix::fs::PermissionsExt::from_mode(0o755))
+        .unwrap();
+    let out = array(
+        &c,
+        &["tiny.toml", "3"],
+        &[("OUT", "arr"), ("SOMNURBS_BIN", failing.to_str().unwrap())],
+    );
     assert!(out.status.success(), "{}", show(&out));
     let merge_log = std::fs::read_to_string(c.path("arr/logs/merge.log")).unwrap();
     assert!(merge_log.contains("merge refused: shard 2/3 failed (exit 3)"), "{merge_log}");
@@ -128,11 +158,19 @@ fn a_failed_shard_fails_the_merge_naming_it_and_a_resubmission_resumes() {
     assert!(!c.path("arr/merged").exists());
     let status = array(&c, &["--status", "arr"], &[]);
     assert_eq!(status.status.code(), Some(1), "{}", show(&status));
-    assert!(String::from_utf8_lossy(&status.stdout).contains("merge: failed: shard 2/3 failed"), "{}", show(&status));
+    assert!(
+        String::from_utf8_lossy(&status.stdout).contains("merge: failed: shard 2/3 failed"),
+        "{}",
+        show(&status)
+    );
     // The same command again (the shard no longer fails) resumes and merges.
     let out = array(&c, &["tiny.toml", "3"], &[("OUT", "arr")]);
     assert!(out.status.success(), "{}", show(&out));
-    assert!(c.path("arr/merged/manifest.toml").exists(), "{}", std::fs::read_to_string(c.path("arr/logs/merge.log")).unwrap_or_default());
+    assert!(
+        c.path("arr/merged/manifest.toml").exists(),
+        "{}",
+        std::fs::read_to_string(c.path("arr/logs/merge.log")).unwrap_or_default()
+    );
 }
 
 #[test]

@@ -8,7 +8,9 @@ use std::collections::{BTreeMap, BTreeSet};
 
 /// One optimiser, so that a sweep over its F is the whole comparison (two cells: Friedman needs two).
 fn de_only() -> String {
-    SPEC.replace("optimisers = [\"ga\", \"de\"]", "optimisers = [\"de\"]").replace("repeats = 2", "repeats = 3").replace("control_nets = [\"6x6\"]", "control_nets = [\"6x6\", \"8x8\"]")
+    SPEC.replace("optimisers = [\"ga\", \"de\"]", "optimisers = [\"de\"]")
+        .replace("repeats = 2", "repeats = 3")
+        .replace("control_nets = [\"6x6\"]", "control_nets = [\"6x6\", \"8x8\"]")
 }
 
 /// runs.csv of a folder as (cell key -> (seed, best)).
@@ -21,7 +23,13 @@ fn runs(c: &Case, dir: &str) -> BTreeMap<String, (String, String)> {
 /// Every table of `a` equals `b`'s (timing columns aside), except the CPU-time win counts
 /// (`table_6_6.csv`): variants of one optimiser take the same time, so who wins is the clock's.
 fn same_results(a: &std::path::Path, b: &std::path::Path) -> usize {
-    let csvs = |d: &std::path::Path| -> Vec<std::path::PathBuf> { walk(d).into_iter().filter(|p| p.extension().is_some_and(|e| e == "csv") && !p.ends_with("table_6_6.csv")).map(|p| p.strip_prefix(d).unwrap().to_path_buf()).collect() };
+    let csvs = |d: &std::path::Path| -> Vec<std::path::PathBuf> {
+        walk(d)
+            .into_iter()
+            .filter(|p| p.extension().is_some_and(|e| e == "csv") && !p.ends_with("table_6_6.csv"))
+            .map(|p| p.strip_prefix(d).unwrap().to_path_buf())
+            .collect()
+    };
     let (ta, tb) = (csvs(a), csvs(b));
     assert_eq!(ta, tb, "different tables in {} and {}", a.display(), b.display());
     for t in &ta {
@@ -45,22 +53,39 @@ fn set_changes_the_results_and_the_seeds_and_is_recorded() {
     assert!(plain.keys().all(|k| k.starts_with("optim/")), "{plain:?}");
     assert!(f5.keys().all(|k| k.starts_with("optim[optim.de.f=0.5]/")), "{f5:?}");
     let plain_seeds: BTreeSet<&String> = plain.values().map(|v| &v.0).collect();
-    assert!(f5.values().all(|v| !plain_seeds.contains(&v.0)), "a --set run reuses a plain run's stream");
-    let de_best = |m: &BTreeMap<String, (String, String)>| m.iter().filter(|(k, _)| k.contains("/de/")).map(|(_, v)| v.1.clone()).collect::<Vec<_>>();
+    assert!(
+        f5.values().all(|v| !plain_seeds.contains(&v.0)),
+        "a --set run reuses a plain run's stream"
+    );
+    let de_best = |m: &BTreeMap<String, (String, String)>| {
+        m.iter().filter(|(k, _)| k.contains("/de/")).map(|(_, v)| v.1.clone()).collect::<Vec<_>>()
+    };
     assert_ne!(de_best(&plain), de_best(&f5), "F = 0.5 gives DE the same results");
     let (h, _) = read_csv(&c.path("f5/runs.csv"));
     assert!(!h.contains(&"variant".to_string()), "--set alone adds no variant column: {h:?}");
     let manifest = std::fs::read_to_string(c.path("f5/manifest.toml")).unwrap();
     assert!(manifest.contains("set = [\"optim.de.f=0.5\"]"), "{manifest}");
-    assert!(std::fs::read_to_string(c.path("f5/REPORT.md")).unwrap().contains("--set optim.de.f=0.5"));
-    assert!(std::fs::read_to_string(c.path("f5/fingerprint.toml")).unwrap().contains("optim.de.f=0.5"));
+    assert!(std::fs::read_to_string(c.path("f5/REPORT.md"))
+        .unwrap()
+        .contains("--set optim.de.f=0.5"));
+    assert!(std::fs::read_to_string(c.path("f5/fingerprint.toml"))
+        .unwrap()
+        .contains("optim.de.f=0.5"));
     // The same --set again resumes; without it, or with another value, the folder is another run's.
     c.ok(&["run", "d.toml", "--out", "f5", "--resume", "--set", "optim.de.f=0.5"]);
     c.fails(&["run", "d.toml", "--out", "f5", "--resume"], &["cannot resume", "--set"]);
-    c.fails(&["run", "d.toml", "--out", "f5", "--resume", "--set", "optim.de.f=0.6"], &["cannot resume", "--set"]);
+    c.fails(
+        &["run", "d.toml", "--out", "f5", "--resume", "--set", "optim.de.f=0.6"],
+        &["cannot resume", "--set"],
+    );
     // The dry run lists the variant's keys and seeds.
-    let dry = String::from_utf8(c.ok(&["run", "d.toml", "--dry-run", "--set", "optim.de.f=0.5"]).stdout).unwrap();
-    assert!(dry.lines().count() == 4 && dry.lines().all(|l| l.starts_with("optim[optim.de.f=0.5]/")), "{dry}");
+    let dry =
+        String::from_utf8(c.ok(&["run", "d.toml", "--dry-run", "--set", "optim.de.f=0.5"]).stdout)
+            .unwrap();
+    assert!(
+        dry.lines().count() == 4 && dry.lines().all(|l| l.starts_with("optim[optim.de.f=0.5]/")),
+        "{dry}"
+    );
 }
 
 #[test]
@@ -81,7 +106,11 @@ fn bad_set_and_sweep_arguments_are_one_line_naming_the_key() {
         (&["--sweep", "optim.grid=10x10,20x20"], &["optim.grid", "optimiser settings"]),
     ];
     for (extra, needles) in cases {
-        let args: Vec<&str> = ["run", "d.toml", "--out", "bad"].iter().copied().chain(extra.iter().copied()).collect();
+        let args: Vec<&str> = ["run", "d.toml", "--out", "bad"]
+            .iter()
+            .copied()
+            .chain(extra.iter().copied())
+            .collect();
         c.fails(&args, needles);
         assert_eq!(exit_code(&c, &args), Some(2), "{args:?}");
         assert!(!c.path("bad").exists(), "{args:?} wrote the folder");
@@ -97,34 +126,58 @@ fn a_sweep_over_de_f_writes_one_folder_whose_variants_differ_and_compare_ranks_t
     c.ok(&["run", "d.toml", "--out", "sweep", "--sweep", "optim.de.f=0.3,0.5,0.8"]);
     let (h, rows) = read_csv(&c.path("sweep/runs.csv"));
     let (v, best, seed) = (col(&h, "variant"), col(&h, "best"), col(&h, "seed"));
-    let variants: Vec<String> = rows.iter().map(|r| r[v].clone()).collect::<BTreeSet<_>>().into_iter().collect();
+    let variants: Vec<String> =
+        rows.iter().map(|r| r[v].clone()).collect::<BTreeSet<_>>().into_iter().collect();
     assert_eq!(variants, vec!["optim.de.f=0.3", "optim.de.f=0.5", "optim.de.f=0.8"]);
     assert_eq!(rows.len(), 18);
-    let bests: BTreeSet<Vec<String>> = variants.iter().map(|x| rows.iter().filter(|r| &r[v] == x).map(|r| r[best].clone()).collect()).collect();
+    let bests: BTreeSet<Vec<String>> = variants
+        .iter()
+        .map(|x| rows.iter().filter(|r| &r[v] == x).map(|r| r[best].clone()).collect())
+        .collect();
     assert_eq!(bests.len(), 3, "the variants give the same results");
-    assert_eq!(rows.iter().map(|r| &r[seed]).collect::<BTreeSet<_>>().len(), 18, "two variants share a stream");
+    assert_eq!(
+        rows.iter().map(|r| &r[seed]).collect::<BTreeSet<_>>().len(),
+        18,
+        "two variants share a stream"
+    );
     // The variant with F = 0.3 is not the plain spec (F = 0.3 is not DE's default here), and a
     // --set run of one variant gives exactly that variant's rows.
     c.ok(&["run", "d.toml", "--out", "one", "--sweep", "optim.de.f=0.5"]);
     let one = read_csv(&c.path("one/runs.csv")).1;
     let cell = col(&h, "cell");
     for r in &one {
-        let same = rows.iter().find(|x| x[cell] == r[cell]).unwrap_or_else(|| panic!("{} not in the sweep", r[cell]));
+        let same = rows
+            .iter()
+            .find(|x| x[cell] == r[cell])
+            .unwrap_or_else(|| panic!("{} not in the sweep", r[cell]));
         assert_eq!((&same[best], &same[seed]), (&r[best], &r[seed]));
     }
     let manifest = std::fs::read_to_string(c.path("sweep/manifest.toml")).unwrap();
-    assert!(manifest.contains("sweep = [\"optim.de.f=0.3,0.5,0.8\"]") && manifest.contains("cells = 18"), "{manifest}");
+    assert!(
+        manifest.contains("sweep = [\"optim.de.f=0.3,0.5,0.8\"]")
+            && manifest.contains("cells = 18"),
+        "{manifest}"
+    );
     // compare ranks the variants like optimisers, with the runtime distributions and the Bayesian test.
     c.ok(&["compare", "sweep", "--bayes-samples", "2000"]);
     let (bh, brows) = read_csv(&c.path("sweep/compare_bayes.csv"));
     assert_eq!(brows.len(), 3, "{bh:?} {brows:?}");
-    let pairs: BTreeSet<(String, String)> = brows.iter().map(|r| (r[0].clone(), r[1].clone())).collect();
-    assert!(pairs.contains(&("de@optim.de.f=0.3".to_string(), "de@optim.de.f=0.5".to_string())), "{pairs:?}");
+    let pairs: BTreeSet<(String, String)> =
+        brows.iter().map(|r| (r[0].clone(), r[1].clone())).collect();
+    assert!(
+        pairs.contains(&("de@optim.de.f=0.3".to_string(), "de@optim.de.f=0.5".to_string())),
+        "{pairs:?}"
+    );
     let (eh, erows) = read_csv(&c.path("sweep/compare_aocc.csv"));
     let o = col(&eh, "optimiser");
     let ranked: BTreeSet<&str> = erows.iter().map(|r| r[o].as_str()).collect();
-    assert_eq!(ranked, ["de@optim.de.f=0.3", "de@optim.de.f=0.5", "de@optim.de.f=0.8"].into_iter().collect());
-    assert!(c.path("sweep/compare_overall.csv").exists() && c.path("sweep/compare_ert.csv").exists());
+    assert_eq!(
+        ranked,
+        ["de@optim.de.f=0.3", "de@optim.de.f=0.5", "de@optim.de.f=0.8"].into_iter().collect()
+    );
+    assert!(
+        c.path("sweep/compare_overall.csv").exists() && c.path("sweep/compare_ert.csv").exists()
+    );
 }
 
 #[test]
@@ -132,7 +185,9 @@ fn resume_and_shards_of_a_sweep_give_the_plain_sweeps_tables() {
     let c = Case::new();
     c.write("d.toml", SPEC);
     let sweep = ["--sweep", "optim.de.f=0.3,0.8", "--sweep", "optim.generations=10,20"];
-    let with = |base: &[&str]| -> Vec<String> { base.iter().chain(sweep.iter()).map(|s| s.to_string()).collect() };
+    let with = |base: &[&str]| -> Vec<String> {
+        base.iter().chain(sweep.iter()).map(|s| s.to_string()).collect()
+    };
     let ok = |args: Vec<String>| c.ok(&args.iter().map(String::as_str).collect::<Vec<_>>());
     ok(with(&["run", "d.toml", "--out", "one"]));
     let n = read_csv(&c.path("one/runs.csv")).1.len();
@@ -158,7 +213,18 @@ fn resume_and_shards_of_a_sweep_give_the_plain_sweeps_tables() {
     c.ok(&["merge", "shard1", "shard2", "shard3", "--out", "merged"]);
     assert!(same_results(&c.path("one"), &c.path("merged")) >= 5);
     // A shard of another sweep does not merge with these.
-    c.ok(&["run", "d.toml", "--out", "other3", "--shard", "3/3", "--sweep", "optim.de.f=0.3,0.9", "--sweep", "optim.generations=10,20"]);
+    c.ok(&[
+        "run",
+        "d.toml",
+        "--out",
+        "other3",
+        "--shard",
+        "3/3",
+        "--sweep",
+        "optim.de.f=0.3,0.9",
+        "--sweep",
+        "optim.generations=10,20",
+    ]);
     c.fails(&["merge", "shard1", "shard2", "other3", "--out", "m2"], &["another run", "--sweep"]);
 }
 
@@ -172,6 +238,10 @@ fn a_run_without_set_still_matches_the_quick_baseline() {
     c.ok(&["run", spec.to_str().unwrap(), "--profile", "quick", "--out", "ch6_same"]);
     let base = root.join("results/baselines/quick/ch6_same");
     for table in ["runs.csv", "appendix_k.csv"] {
-        assert_eq!(without_timing(&base.join(table)), without_timing(&c.path(&format!("ch6_same/{table}"))), "{table} moved");
+        assert_eq!(
+            without_timing(&base.join(table)),
+            without_timing(&c.path(&format!("ch6_same/{table}"))),
+            "{table} moved"
+        );
     }
 }

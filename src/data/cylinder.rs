@@ -76,7 +76,8 @@ mod tests {
         let data = sort_into_rings(&lattice_cylinder(5.0, 5.0, 0.1, 0.1), 1e-6);
         for (k, r) in data.rings.iter().enumerate() {
             assert!(r.iter().all(|p| (p[2] - k as f64 * 0.1).abs() < 1e-9));
-            let a: Vec<f64> = r.iter().map(|p| p[1].atan2(p[0]).rem_euclid(2.0 * std::f64::consts::PI)).collect();
+            let a: Vec<f64> =
+                r.iter().map(|p| p[1].atan2(p[0]).rem_euclid(2.0 * std::f64::consts::PI)).collect();
             assert!(a.windows(2).all(|w| w[0] < w[1]), "ring {k}");
         }
         assert_eq!(data.rings[0][0], [5.0, 0.0, 0.0]);

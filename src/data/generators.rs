@@ -28,7 +28,11 @@ pub fn cube() -> Vec<Point3> {
                 for (da, db) in [(0, 1), (0, 0), (1, 0), (1, 1)] {
                     let c = face(a + da, b + db);
                     if seen.insert(c) {
-                        out.push([c[0] as f64 / N as f64, c[1] as f64 / N as f64, c[2] as f64 / N as f64]);
+                        out.push([
+                            c[0] as f64 / N as f64,
+                            c[1] as f64 / N as f64,
+                            c[2] as f64 / N as f64,
+                        ]);
                     }
                 }
             }
@@ -173,12 +177,24 @@ mod tests {
     #[test]
     fn thesis_first_points_table_3_1() {
         let c = cube();
-        let want = [[0.0, 0.0, 1.0], [0.0, 0.0, 0.971430], [0.028580, 0.0, 0.971430], [0.028580, 0.0, 1.0], [0.057150, 0.0, 0.971430]];
+        let want = [
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, 0.971430],
+            [0.028580, 0.0, 0.971430],
+            [0.028580, 0.0, 1.0],
+            [0.057150, 0.0, 0.971430],
+        ];
         for (k, w) in want.iter().enumerate() {
             assert!(close(c[k], *w, 2e-5), "cube point {k}: {:?}", c[k]);
         }
         let s = sphere();
-        let want = [[0.5, 1.0, 0.5], [0.5, 0.999315, 0.473830], [0.498630, 0.999315, 0.473865], [0.497265, 0.999315, 0.473975], [0.495905, 0.999315, 0.474155]];
+        let want = [
+            [0.5, 1.0, 0.5],
+            [0.5, 0.999315, 0.473830],
+            [0.498630, 0.999315, 0.473865],
+            [0.497265, 0.999315, 0.473975],
+            [0.495905, 0.999315, 0.474155],
+        ];
         for (k, w) in want.iter().enumerate() {
             assert!(close(s[k], *w, 5e-6), "sphere point {k}: {:?}", s[k]);
         }
@@ -189,12 +205,18 @@ mod tests {
 
     #[test]
     fn primitives_lie_in_the_unit_cube_with_no_duplicates() {
-        for (name, pts) in [("cube", cube()), ("sphere", sphere()), ("spindle", spindle()), ("oiltank", oiltank())] {
+        for (name, pts) in
+            [("cube", cube()), ("sphere", sphere()), ("spindle", spindle()), ("oiltank", oiltank())]
+        {
             let (lo, hi) = crate::geom::bounding_box(&pts).unwrap();
             for a in 0..3 {
-                assert!(lo[a] >= -1e-12 && hi[a] <= 1.0 + 1e-12 && hi[a] - lo[a] > 0.99, "{name} axis {a}: {lo:?} {hi:?}");
+                assert!(
+                    lo[a] >= -1e-12 && hi[a] <= 1.0 + 1e-12 && hi[a] - lo[a] > 0.99,
+                    "{name} axis {a}: {lo:?} {hi:?}"
+                );
             }
-            let keys: HashSet<[i64; 3]> = pts.iter().map(|p| p.map(|v| (v * 1e9).round() as i64)).collect();
+            let keys: HashSet<[i64; 3]> =
+                pts.iter().map(|p| p.map(|v| (v * 1e9).round() as i64)).collect();
             assert_eq!(keys.len(), pts.len(), "{name} has duplicate points");
         }
     }

@@ -8,27 +8,54 @@ use crate::geom::Point3;
 /// Parse the grid CSV (sizes from the largest i and j; every position of both views exactly once).
 pub fn parse_two_view_grid(text: &str) -> Result<TwoViewGrid, DataError> {
     let mut r = csv::ReaderBuilder::new().trim(csv::Trim::All).from_reader(text.as_bytes());
-    let header: Vec<String> = r.headers().map_err(|e| DataError::parse("line 1", e.to_string()))?.iter().map(|s| s.to_string()).collect();
-    let col = |name: &str| header.iter().position(|h| h == name).ok_or_else(|| DataError::parse("line 1", format!("no `{name}` column (expected i,j,view,class,x,y,z)")));
-    let (ci, cj, cv, cx, cy, cz) = (col("i")?, col("j")?, col("view")?, col("x")?, col("y")?, col("z")?);
+    let header: Vec<String> = r
+        .headers()
+        .map_err(|e| DataError::parse("line 1", e.to_string()))?
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    let col = |name: &str| {
+        header.iter().position(|h| h == name).ok_or_else(|| {
+            DataError::parse(
+                "line 1",
+                format!("no `{name}` column (expected i,j,view,class,x,y,z)"),
+            )
+        })
+    };
+    let (ci, cj, cv, cx, cy, cz) =
+        (col("i")?, col("j")?, col("view")?, col("x")?, col("y")?, col("z")?);
     let mut rows = Vec::new();
     for (n, rec) in r.records().enumerate() {
         let line = n + 2;
         let rec = rec.map_err(|e| DataError::parse(format!("line {line}"), e.to_string()))?;
         let field = |c: usize| rec.get(c).unwrap_or("");
-        let int = |c: usize| field(c).parse::<usize>().map_err(|_| DataError::parse(format!("line {line}"), format!("`{}` is not an index", field(c))));
+        let int = |c: usize| {
+            field(c).parse::<usize>().map_err(|_| {
+                DataError::parse(format!("line {line}"), format!("`{}` is not an index", field(c)))
+            })
+        };
         let num = |c: usize| -> Result<f64, DataError> {
-            let v: f64 = field(c).parse().map_err(|_| DataError::parse(format!("line {line}"), format!("`{}` is not a number", field(c))))?;
+            let v: f64 = field(c).parse().map_err(|_| {
+                DataError::parse(format!("line {line}"), format!("`{}` is not a number", field(c)))
+            })?;
             if v.is_finite() {
                 Ok(v)
             } else {
-                Err(DataError::parse(format!("line {line}"), format!("non-finite coordinate `{}`", field(c))))
+                Err(DataError::parse(
+                    format!("line {line}"),
+                    format!("non-finite coordinate `{}`", field(c)),
+                ))
             }
         };
         let top = match field(cv) {
             "bottom" => false,
             "top" => true,
-            other => return Err(DataError::parse(format!("line {line}"), format!("view must be bottom or top, got `{other}`"))),
+            other => {
+                return Err(DataError::parse(
+                    format!("line {line}"),
+                    format!("view must be bottom or top, got `{other}`"),
+                ))
+            }
         };
         rows.push((int(ci)?, int(cj)?, top, [num(cx)?, num(cy)?, num(cz)?], line));
     }
@@ -38,21 +65,36 @@ pub fn parse_two_view_grid(text: &str) -> Result<TwoViewGrid, DataError> {
     let nx = rows.iter().map(|r| r.0).max().unwrap_or(0) + 1;
     let ny = rows.iter().map(|r| r.1).max().unwrap_or(0) + 1;
     if nx < 2 || ny < 2 {
-        return Err(DataError::Invalid(format!("the grid is {nx}x{ny}; both sides must be at least 2")));
+        return Err(DataError::Invalid(format!(
+            "the grid is {nx}x{ny}; both sides must be at least 2"
+        )));
     }
     if rows.len() != 2 * nx * ny {
-        return Err(DataError::Invalid(format!("a {nx}x{ny} two-view grid needs {} rows (both views), found {}", 2 * nx * ny, rows.len())));
+        return Err(DataError::Invalid(format!(
+            "a {nx}x{ny} two-view grid needs {} rows (both views), found {}",
+            2 * nx * ny,
+            rows.len()
+        )));
     }
     let mut bottom = vec![None; nx * ny];
     let mut top = vec![None; nx * ny];
     for (i, j, is_top, p, line) in rows {
         let slot = if is_top { &mut top[i * ny + j] } else { &mut bottom[i * ny + j] };
         if slot.is_some() {
-            return Err(DataError::parse(format!("line {line}"), format!("position ({i}, {j}) of the {} view appears twice", if is_top { "top" } else { "bottom" })));
+            return Err(DataError::parse(
+                format!("line {line}"),
+                format!(
+                    "position ({i}, {j}) of the {} view appears twice",
+                    if is_top { "top" } else { "bottom" }
+                ),
+            ));
         }
         *slot = Some(p);
     }
-    let bottom: Vec<Point3> = bottom.into_iter().map(|p| p.expect("every position filled: counts match and no duplicates")).collect();
+    let bottom: Vec<Point3> = bottom
+        .into_iter()
+        .map(|p| p.expect("every position filled: counts match and no duplicates"))
+        .collect();
     let top: Vec<Point3> = top.into_iter().map(|p| p.expect("every position filled")).collect();
     Ok(TwoViewGrid { nx, ny, bottom, top })
 }
@@ -66,7 +108,10 @@ mod tests {
         for view in ["bottom", "top"] {
             for i in 0..nx {
                 for j in 0..ny {
-                    s.push_str(&format!("{i},{j},{view},0,{i},{j},{}\n", if view == "top" { 1 } else { 0 }));
+                    s.push_str(&format!(
+                        "{i},{j},{view},0,{i},{j},{}\n",
+                        if view == "top" { 1 } else { 0 }
+                    ));
                 }
             }
         }

@@ -41,7 +41,9 @@ impl DataError {
     /// Prefix the error with the file it came from.
     pub fn in_file(self, path: &str) -> DataError {
         match self {
-            DataError::Parse { context, message } => DataError::Parse { context: format!("{path}: {context}"), message },
+            DataError::Parse { context, message } => {
+                DataError::Parse { context: format!("{path}: {context}"), message }
+            }
             DataError::Invalid(m) => DataError::Invalid(format!("{path}: {m}")),
             other => other,
         }
@@ -109,12 +111,19 @@ pub fn validate(points: &[Point3], min_points: usize) -> Result<(), DataError> {
     for (k, p) in points.iter().enumerate() {
         for (a, axis) in ["x", "y", "z"].iter().enumerate() {
             if !p[a].is_finite() {
-                return Err(DataError::Invalid(format!("point {} has a non-finite {axis} ({})", k + 1, p[a])));
+                return Err(DataError::Invalid(format!(
+                    "point {} has a non-finite {axis} ({})",
+                    k + 1,
+                    p[a]
+                )));
             }
         }
     }
     if points.len() < min_points {
-        return Err(DataError::Invalid(format!("{} points, at least {min_points} needed", points.len())));
+        return Err(DataError::Invalid(format!(
+            "{} points, at least {min_points} needed",
+            points.len()
+        )));
     }
     Ok(())
 }
@@ -122,7 +131,12 @@ pub fn validate(points: &[Point3], min_points: usize) -> Result<(), DataError> {
 /// Refuse a cloud of fewer points than the map trained on it has neurons: units would be left
 /// with no data of their own, so the map could not organise over the surface. `entry` names the
 /// data set as the spec wrote it (its file).
-pub fn require_points(entry: &str, points: usize, neurons: usize, map: &str) -> Result<(), DataError> {
+pub fn require_points(
+    entry: &str,
+    points: usize,
+    neurons: usize,
+    map: &str,
+) -> Result<(), DataError> {
     if points < neurons {
         return Err(DataError::Invalid(format!("data set `{entry}`: {points} points, fewer than the {neurons} neurons of the {map} map trained on it (use a smaller grid or more points)")));
     }

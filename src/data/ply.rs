@@ -93,7 +93,10 @@ pub fn parse_ply(bytes: &[u8]) -> Result<Vec<Point3>, DataError> {
     let mut pos = 0;
     let mut lines = Vec::new();
     loop {
-        let end = bytes[pos..].iter().position(|&b| b == b'\n').ok_or_else(|| err("header".into(), "no end_header line"))?;
+        let end = bytes[pos..]
+            .iter()
+            .position(|&b| b == b'\n')
+            .ok_or_else(|| err("header".into(), "no end_header line"))?;
         let line = String::from_utf8_lossy(&bytes[pos..pos + end]).trim().to_string();
         pos += end + 1;
         let done = line == "end_header";
@@ -120,23 +123,41 @@ pub fn parse_ply(bytes: &[u8]) -> Result<Vec<Point3>, DataError> {
                 })
             }
             Some("element") => {
-                let count: usize = w.get(2).and_then(|c| c.parse().ok()).ok_or_else(|| err(ctx.clone(), "element needs a name and a count"))?;
+                let count: usize = w
+                    .get(2)
+                    .and_then(|c| c.parse().ok())
+                    .ok_or_else(|| err(ctx.clone(), "element needs a name and a count"))?;
                 if w.len() > 3 {
                     return Err(err(ctx, "element takes a name and a count only"));
                 }
-                elements.push(Element { name: w.get(1).unwrap_or(&"").to_string(), count, props: Vec::new() });
+                elements.push(Element {
+                    name: w.get(1).unwrap_or(&"").to_string(),
+                    count,
+                    props: Vec::new(),
+                });
             }
             Some("property") => {
-                let el = elements.last_mut().ok_or_else(|| err(ctx.clone(), "property before any element"))?;
+                let el = elements
+                    .last_mut()
+                    .ok_or_else(|| err(ctx.clone(), "property before any element"))?;
                 let prop = if w.get(1) == Some(&"list") {
-                    let count = w.get(2).and_then(|t| Scalar::parse(t)).ok_or_else(|| err(ctx.clone(), "bad list count type"))?;
+                    let count = w
+                        .get(2)
+                        .and_then(|t| Scalar::parse(t))
+                        .ok_or_else(|| err(ctx.clone(), "bad list count type"))?;
                     if !count.is_integer() {
                         return Err(err(ctx, "a list's count type must be an integer type (uchar, ushort, uint, ...)"));
                     }
-                    let item = w.get(3).and_then(|t| Scalar::parse(t)).ok_or_else(|| err(ctx.clone(), "bad list item type"))?;
+                    let item = w
+                        .get(3)
+                        .and_then(|t| Scalar::parse(t))
+                        .ok_or_else(|| err(ctx.clone(), "bad list item type"))?;
                     Property::List { count, item }
                 } else {
-                    let ty = w.get(1).and_then(|t| Scalar::parse(t)).ok_or_else(|| err(ctx.clone(), "unknown property type"))?;
+                    let ty = w
+                        .get(1)
+                        .and_then(|t| Scalar::parse(t))
+                        .ok_or_else(|| err(ctx.clone(), "unknown property type"))?;
                     Property::Scalar { name: w.get(2).unwrap_or(&"").to_string(), ty }
                 };
                 el.props.push(prop);
@@ -146,9 +167,18 @@ pub fn parse_ply(bytes: &[u8]) -> Result<Vec<Point3>, DataError> {
         }
     }
     let format = binary.ok_or_else(|| err("header".into(), "no format line"))?;
-    let vi = elements.iter().position(|e| e.name == "vertex").ok_or_else(|| err("header".into(), "no vertex element"))?;
+    let vi = elements
+        .iter()
+        .position(|e| e.name == "vertex")
+        .ok_or_else(|| err("header".into(), "no vertex element"))?;
     let axis = |name: &str| {
-        elements[vi].props.iter().position(|p| matches!(p, Property::Scalar { name: n, .. } if n == name)).ok_or_else(|| err("header".into(), &format!("vertex element has no `{name}` property")))
+        elements[vi]
+            .props
+            .iter()
+            .position(|p| matches!(p, Property::Scalar { name: n, .. } if n == name))
+            .ok_or_else(|| {
+                err("header".into(), &format!("vertex element has no `{name}` property"))
+            })
     };
     let (ix, iy, iz) = (axis("x")?, axis("y")?, axis("z")?);
     // Every element up to the vertices must fit in what the file has left: at least its scalar
@@ -161,10 +191,14 @@ pub fn parse_ply(bytes: &[u8]) -> Result<Vec<Point3>, DataError> {
             return Err(err(format!("element {}", el.name), "has items but no properties"));
         }
         let per = match format {
-            Format::Binary { .. } => el.props.iter().map(|p| match p {
-                Property::Scalar { ty, .. } => ty.size(),
-                Property::List { count, .. } => count.size(),
-            }).sum(),
+            Format::Binary { .. } => el
+                .props
+                .iter()
+                .map(|p| match p {
+                    Property::Scalar { ty, .. } => ty.size(),
+                    Property::List { count, .. } => count.size(),
+                })
+                .sum(),
             Format::Ascii => 2 * el.props.len().max(1),
         };
         need = per.checked_mul(el.count).and_then(|n| n.checked_add(need)).filter(|&n| n <= left).ok_or_else(|| {
@@ -178,7 +212,8 @@ pub fn parse_ply(bytes: &[u8]) -> Result<Vec<Point3>, DataError> {
             for k in 0..el.count {
                 let mut vals = [0.0f64; 3];
                 for (p, prop) in el.props.iter().enumerate() {
-                    let short = || err(format!("{} {}", el.name, k + 1), "file ends inside this element");
+                    let short =
+                        || err(format!("{} {}", el.name, k + 1), "file ends inside this element");
                     match prop {
                         Property::Scalar { ty, .. } => {
                             let b = bytes.get(at..at + ty.size()).ok_or_else(short)?;
@@ -198,7 +233,10 @@ pub fn parse_ply(bytes: &[u8]) -> Result<Vec<Point3>, DataError> {
                             let b = bytes.get(at..at + count.size()).ok_or_else(short)?;
                             let n = count.read(b, big);
                             if n < 0.0 {
-                                return Err(err(format!("{} {}", el.name, k + 1), &format!("negative list count {n}")));
+                                return Err(err(
+                                    format!("{} {}", el.name, k + 1),
+                                    &format!("negative list count {n}"),
+                                ));
                             }
                             at += count.size() + n as usize * item.size();
                             if at > bytes.len() {
@@ -221,12 +259,17 @@ pub fn parse_ply(bytes: &[u8]) -> Result<Vec<Point3>, DataError> {
         let header_lines = lines.len();
         for (e, el) in elements.iter().enumerate() {
             for k in 0..el.count {
-                let (n, line) = rows.next().ok_or_else(|| err(format!("{} {}", el.name, k + 1), "file ends before this element"))?;
+                let (n, line) = rows.next().ok_or_else(|| {
+                    err(format!("{} {}", el.name, k + 1), "file ends before this element")
+                })?;
                 if e == vi {
                     let ctx = format!("line {}", header_lines + n + 1);
                     let w: Vec<&str> = line.split_whitespace().collect();
                     let get = |p: usize| -> Result<f64, DataError> {
-                        w.get(p).ok_or_else(|| err(ctx.clone(), "too few values"))?.parse::<f64>().map_err(|_| err(ctx.clone(), &format!("`{}` is not a number", w[p])))
+                        w.get(p)
+                            .ok_or_else(|| err(ctx.clone(), "too few values"))?
+                            .parse::<f64>()
+                            .map_err(|_| err(ctx.clone(), &format!("`{}` is not a number", w[p])))
                     };
                     points.push([get(ix)?, get(iy)?, get(iz)?]);
                 }
@@ -243,7 +286,12 @@ pub fn parse_ply(bytes: &[u8]) -> Result<Vec<Point3>, DataError> {
 mod tests {
     use super::*;
 
-    const VERTS: [[f64; 3]; 4] = [[-0.0378297, 0.12794, 0.00447467], [1.5, -2.25, 3.0], [0.0, 0.0, 0.0], [1e-3, 2e-3, -3e-3]];
+    const VERTS: [[f64; 3]; 4] = [
+        [-0.0378297, 0.12794, 0.00447467],
+        [1.5, -2.25, 3.0],
+        [0.0, 0.0, 0.0],
+        [1e-3, 2e-3, -3e-3],
+    ];
 
     fn binary_ply() -> Vec<u8> {
         let mut b = b"ply\nformat binary_little_endian 1.0\ncomment made by a test\nelement vertex 4\nproperty float x\nproperty double y\nproperty float z\nproperty uchar red\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n".to_vec();
@@ -293,7 +341,8 @@ mod tests {
         cut.truncate(header_end + 20);
         let e = parse_ply(&cut).unwrap_err().to_string();
         assert!(e.contains("vertex"), "{e}");
-        let e = parse_ply(b"ply\nformat binary_big_endian 1.0\nend_header\n").unwrap_err().to_string();
+        let e =
+            parse_ply(b"ply\nformat binary_big_endian 1.0\nend_header\n").unwrap_err().to_string();
         assert!(e.contains("no vertex element"), "{e}");
     }
 
@@ -315,7 +364,9 @@ mod tests {
 
     #[test]
     fn counts_beyond_the_file_and_float_list_counts_are_refused_at_once() {
-        let head = |fmt: &str, count: &str| format!("ply\nformat {fmt} 1.0\nelement vertex {count}\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n");
+        let head = |fmt: &str, count: &str| {
+            format!("ply\nformat {fmt} 1.0\nelement vertex {count}\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n")
+        };
         for fmt in ["ascii", "binary_little_endian", "binary_big_endian"] {
             let e = parse_ply(head(fmt, "1000000000000").as_bytes()).unwrap_err().to_string();
             assert!(e.contains("1000000000000 items"), "{e}");

@@ -6,7 +6,17 @@ use rand::SeedableRng;
 use std::path::{Path, PathBuf};
 
 /// Built-in data-set names.
-pub const BUILTIN: &[&str] = &["cube", "sphere", "spindle", "oiltank", "talus", "bunny", "cylinder", "semi_sphere", "saddle"];
+pub const BUILTIN: &[&str] = &[
+    "cube",
+    "sphere",
+    "spindle",
+    "oiltank",
+    "talus",
+    "bunny",
+    "cylinder",
+    "semi_sphere",
+    "saddle",
+];
 
 /// Number of points sampled on the talus mesh (the thesis' talus has 5253 points).
 pub const TALUS_POINTS: usize = 5253;
@@ -28,9 +38,13 @@ pub fn name_of(entry: &str) -> String {
 fn split_count(entry: &str) -> Result<(&str, Option<usize>), DataError> {
     match entry.rsplit_once(':') {
         Some((f, n)) if f.to_ascii_lowercase().ends_with(".stl") => {
-            let n: usize = n.parse().map_err(|_| DataError::Invalid(format!("{entry}: `{n}` is not a point count")))?;
+            let n: usize = n
+                .parse()
+                .map_err(|_| DataError::Invalid(format!("{entry}: `{n}` is not a point count")))?;
             if !(4..=MAX_STL_POINTS).contains(&n) {
-                return Err(DataError::Invalid(format!("{entry}: {n} points is outside [4, {MAX_STL_POINTS}]")));
+                return Err(DataError::Invalid(format!(
+                    "{entry}: {n} points is outside [4, {MAX_STL_POINTS}]"
+                )));
             }
             Ok((f, Some(n)))
         }
@@ -49,11 +63,16 @@ pub fn dataset_name(entry: &str) -> Result<String, DataError> {
     let (file, _) = split_count(entry)?;
     let lower = file.to_ascii_lowercase();
     if !EXTENSIONS.iter().any(|e| lower.ends_with(e)) {
-        return Err(DataError::Invalid(format!("unknown data set `{entry}` (built-in: {}; or a .ply/.stl/.xyz/.csv/.txt file)", BUILTIN.join(", "))));
+        return Err(DataError::Invalid(format!(
+            "unknown data set `{entry}` (built-in: {}; or a .ply/.stl/.xyz/.csv/.txt file)",
+            BUILTIN.join(", ")
+        )));
     }
     let stem = Path::new(file).file_stem().and_then(|s| s.to_str()).unwrap_or("");
     if stem.is_empty() || stem == "." || stem == ".." || stem.starts_with('.') {
-        return Err(DataError::Invalid(format!("data set `{entry}`: its file name gives no usable name (`{stem}`)")));
+        return Err(DataError::Invalid(format!(
+            "data set `{entry}`: its file name gives no usable name (`{stem}`)"
+        )));
     }
     Ok(stem.to_string())
 }
@@ -157,12 +176,18 @@ impl Loader {
             "bunny" => {
                 let path = data_dir.join(BUNNY_FILE);
                 let shown = path.display().to_string();
-                ply::parse_ply(&read(&path, &where_to_get(BUNNY_FILE))?).map_err(|e| e.in_file(&shown))?
+                ply::parse_ply(&read(&path, &where_to_get(BUNNY_FILE))?)
+                    .map_err(|e| e.in_file(&shown))?
             }
             "talus" => {
                 let path = data_dir.join(TALUS_FILE);
                 let shown = path.display().to_string();
-                sample_stl(&read(&path, &where_to_get(TALUS_FILE))?, TALUS_POINTS, TALUS_SAMPLE_SEED, &shown)?
+                sample_stl(
+                    &read(&path, &where_to_get(TALUS_FILE))?,
+                    TALUS_POINTS,
+                    TALUS_SAMPLE_SEED,
+                    &shown,
+                )?
             }
             other => {
                 self.require_file(other)?;
@@ -174,7 +199,12 @@ impl Loader {
                 if lower.ends_with(".ply") {
                     ply::parse_ply(&bytes).map_err(|e| e.in_file(&shown))?
                 } else if lower.ends_with(".stl") {
-                    sample_stl(&bytes, count.unwrap_or(DEFAULT_STL_POINTS), TALUS_SAMPLE_SEED, &shown)?
+                    sample_stl(
+                        &bytes,
+                        count.unwrap_or(DEFAULT_STL_POINTS),
+                        TALUS_SAMPLE_SEED,
+                        &shown,
+                    )?
                 } else {
                     let text = String::from_utf8_lossy(&bytes);
                     xyz::parse_xyz(&text).map_err(|e| e.in_file(&shown))?
@@ -184,9 +214,16 @@ impl Loader {
         validate(&points, 4).map_err(|e| e.in_file(name))?;
         self.normalise.apply(&mut points);
         // Coordinates near the f64 limit overflow the ranges into inf and the points into NaN.
-        validate(&points, 4).map_err(|e| DataError::Invalid(format!("{name}: after normalisation: {e} (coordinates too large to normalise)")))?;
+        validate(&points, 4).map_err(|e| {
+            DataError::Invalid(format!(
+                "{name}: after normalisation: {e} (coordinates too large to normalise)"
+            ))
+        })?;
         if points.iter().all(|p| *p == points[0]) {
-            return Err(DataError::Invalid(format!("{name}: all {} points are the same point", points.len())));
+            return Err(DataError::Invalid(format!(
+                "{name}: all {} points are the same point",
+                points.len()
+            )));
         }
         Ok(PointCloud { name: dataset_name(name)?, points })
     }
@@ -207,7 +244,8 @@ mod tests {
 
     #[test]
     fn bunny_first_point_after_normalisation() {
-        let b = load_dataset("bunny", &test_data_dir()).expect("bun_zipper.ply in SOMNURBS_DATA or ../shared/data");
+        let b = load_dataset("bunny", &test_data_dir())
+            .expect("bun_zipper.ply in SOMNURBS_DATA or ../shared/data");
         assert_eq!(b.points.len(), 35947);
         let want = [0.365193, 0.615243, 0.549817];
         for k in 0..3 {
@@ -217,7 +255,8 @@ mod tests {
 
     #[test]
     fn talus_is_a_fixed_sample() {
-        let a = load_dataset("talus", &test_data_dir()).expect("talus_r.stl in SOMNURBS_DATA or ../shared/data");
+        let a = load_dataset("talus", &test_data_dir())
+            .expect("talus_r.stl in SOMNURBS_DATA or ../shared/data");
         assert_eq!(a.points.len(), TALUS_POINTS);
         let b = load_dataset("talus", &test_data_dir()).unwrap();
         assert_eq!(a, b);
@@ -227,7 +266,12 @@ mod tests {
     #[test]
     fn missing_files_say_where_to_get_them() {
         let e = load_dataset("bunny", Path::new("/nonexistent")).unwrap_err().to_string();
-        assert!(e.contains("/nonexistent/bun_zipper.ply") && e.contains("Stanford") && e.contains("SOMNURBS_DATA"), "{e}");
+        assert!(
+            e.contains("/nonexistent/bun_zipper.ply")
+                && e.contains("Stanford")
+                && e.contains("SOMNURBS_DATA"),
+            "{e}"
+        );
         let e = load_dataset("teapot", Path::new(".")).unwrap_err().to_string();
         assert!(e.contains("teapot") && e.contains("cube"), "{e}");
     }
@@ -253,7 +297,11 @@ mod tests {
         let own = Loader { base: dir.path().to_path_buf(), ..Loader::default() };
         assert!(own.load("same.csv").unwrap_err().to_string().contains("same point"));
         let e = own.load("sub/none.xyz").unwrap_err().to_string();
-        assert!(e.contains(&dir.path().join("sub/none.xyz").display().to_string()) && e.contains("spec's folder"), "{e}");
+        assert!(
+            e.contains(&dir.path().join("sub/none.xyz").display().to_string())
+                && e.contains("spec's folder"),
+            "{e}"
+        );
         let ok = dir.path().join("ok.xyz");
         std::fs::write(&ok, "0 0 0\n1 0 0\n0 1 0\n0 0 1\n").unwrap();
         assert_eq!(load_dataset(ok.to_str().unwrap(), dir.path()).unwrap().name, "ok");

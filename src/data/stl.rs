@@ -11,7 +11,9 @@ pub fn parse_stl(bytes: &[u8]) -> Result<Vec<[Point3; 3]>, DataError> {
     if bytes.len() >= 84 {
         let n = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as usize;
         if bytes.len() == 84 + 50 * n {
-            let f = |o: usize| f32::from_le_bytes([bytes[o], bytes[o + 1], bytes[o + 2], bytes[o + 3]]) as f64;
+            let f = |o: usize| {
+                f32::from_le_bytes([bytes[o], bytes[o + 1], bytes[o + 2], bytes[o + 3]]) as f64
+            };
             return Ok((0..n)
                 .map(|t| {
                     let o = 84 + 50 * t + 12;
@@ -20,9 +22,17 @@ pub fn parse_stl(bytes: &[u8]) -> Result<Vec<[Point3; 3]>, DataError> {
                 .collect());
         }
     }
-    let text = std::str::from_utf8(bytes).map_err(|_| DataError::parse("STL", "neither binary STL (size does not match its triangle count) nor text"))?;
+    let text = std::str::from_utf8(bytes).map_err(|_| {
+        DataError::parse(
+            "STL",
+            "neither binary STL (size does not match its triangle count) nor text",
+        )
+    })?;
     if !text.trim_start().starts_with("solid") {
-        return Err(DataError::parse("line 1", "not an STL file (no `solid` and the size does not fit binary STL)"));
+        return Err(DataError::parse(
+            "line 1",
+            "not an STL file (no `solid` and the size does not fit binary STL)",
+        ));
     }
     let mut tris = Vec::new();
     let mut current: Vec<Point3> = Vec::new();
@@ -32,13 +42,20 @@ pub fn parse_stl(bytes: &[u8]) -> Result<Vec<[Point3; 3]>, DataError> {
             let ctx = format!("line {}", n + 1);
             let mut v = [0.0; 3];
             for k in 0..3 {
-                let s = w.get(k + 1).ok_or_else(|| DataError::parse(ctx.clone(), "vertex needs three numbers"))?;
-                v[k] = s.parse().map_err(|_| DataError::parse(ctx.clone(), format!("`{s}` is not a number")))?;
+                let s = w
+                    .get(k + 1)
+                    .ok_or_else(|| DataError::parse(ctx.clone(), "vertex needs three numbers"))?;
+                v[k] = s
+                    .parse()
+                    .map_err(|_| DataError::parse(ctx.clone(), format!("`{s}` is not a number")))?;
             }
             current.push(v);
         } else if w.first() == Some(&"endloop") {
             if current.len() != 3 {
-                return Err(DataError::parse(format!("line {}", n + 1), format!("a facet has {} vertices, 3 expected", current.len())));
+                return Err(DataError::parse(
+                    format!("line {}", n + 1),
+                    format!("a facet has {} vertices, 3 expected", current.len()),
+                ));
             }
             tris.push([current[0], current[1], current[2]]);
             current.clear();
@@ -55,7 +72,11 @@ fn area(t: &[Point3; 3]) -> f64 {
 /// proportional to its area (cumulative areas, binary search), then a uniform point in it
 /// (the sqrt trick: P = (1 - sqrt r1) A + sqrt r1 (1 - r2) B + sqrt r1 r2 C). Zero-area triangles
 /// are never chosen.
-pub fn sample_surface(triangles: &[[Point3; 3]], n: usize, rng: &mut ChaCha8Rng) -> Result<Vec<Point3>, DataError> {
+pub fn sample_surface(
+    triangles: &[[Point3; 3]],
+    n: usize,
+    rng: &mut ChaCha8Rng,
+) -> Result<Vec<Point3>, DataError> {
     let mut cum = Vec::with_capacity(triangles.len());
     let mut total = 0.0;
     for t in triangles {
@@ -64,7 +85,9 @@ pub fn sample_surface(triangles: &[[Point3; 3]], n: usize, rng: &mut ChaCha8Rng)
         cum.push(total);
     }
     if !(total > 0.0) {
-        return Err(DataError::Invalid("the mesh has no triangle of positive area to sample".into()));
+        return Err(DataError::Invalid(
+            "the mesh has no triangle of positive area to sample".into(),
+        ));
     }
     Ok((0..n)
         .map(|_| {
@@ -86,7 +109,10 @@ mod tests {
 
     fn tris() -> Vec<[Point3; 3]> {
         // Areas 1 and 3 (right triangles in the z = 0 and x = 5 planes).
-        vec![[[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 1.0, 0.0]], [[5.0, 0.0, 0.0], [5.0, 3.0, 0.0], [5.0, 0.0, 2.0]]]
+        vec![
+            [[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+            [[5.0, 0.0, 0.0], [5.0, 3.0, 0.0], [5.0, 0.0, 2.0]],
+        ]
     }
 
     fn binary(t: &[[Point3; 3]]) -> Vec<u8> {
@@ -117,7 +143,9 @@ mod tests {
         a.push_str("endsolid test\n");
         assert_eq!(parse_stl(a.as_bytes()).unwrap(), tris());
         assert_eq!(parse_stl(&binary(&tris())).unwrap(), tris());
-        let e = parse_stl(b"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 zero\n").unwrap_err().to_string();
+        let e = parse_stl(b"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 zero\n")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("line 4") && e.contains("zero"), "{e}");
     }
 
@@ -132,7 +160,9 @@ mod tests {
                 assert!((p[0] - 5.0).abs() < 1e-12);
                 assert!(p[1] >= 0.0 && p[2] >= 0.0 && p[1] / 3.0 + p[2] / 2.0 <= 1.0 + 1e-12);
             } else {
-                assert!(p[2] == 0.0 && p[0] >= 0.0 && p[1] >= 0.0 && p[0] / 2.0 + p[1] <= 1.0 + 1e-12);
+                assert!(
+                    p[2] == 0.0 && p[0] >= 0.0 && p[1] >= 0.0 && p[0] / 2.0 + p[1] <= 1.0 + 1e-12
+                );
             }
         }
         let degenerate = vec![[[0.0; 3], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]]];

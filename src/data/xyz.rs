@@ -14,18 +14,29 @@ pub fn parse_xyz(text: &str) -> Result<Vec<Point3>, DataError> {
         if line.is_empty() {
             continue;
         }
-        let fields: Vec<&str> = line.split(|c: char| c.is_whitespace() || c == ',' || c == ';').filter(|f| !f.is_empty()).collect();
+        let fields: Vec<&str> = line
+            .split(|c: char| c.is_whitespace() || c == ',' || c == ';')
+            .filter(|f| !f.is_empty())
+            .collect();
         let nums: Vec<Option<f64>> = fields.iter().take(3).map(|f| f.parse::<f64>().ok()).collect();
         if !seen_data && !header_used && nums.iter().all(|v| v.is_none()) {
             header_used = true;
             continue;
         }
         if fields.len() < 3 {
-            return Err(DataError::parse(format!("line {}", n + 1), format!("needs three numbers, got `{line}`")));
+            return Err(DataError::parse(
+                format!("line {}", n + 1),
+                format!("needs three numbers, got `{line}`"),
+            ));
         }
         let mut p = [0.0; 3];
         for k in 0..3 {
-            p[k] = nums[k].ok_or_else(|| DataError::parse(format!("line {}", n + 1), format!("`{}` is not a number", fields[k])))?;
+            p[k] = nums[k].ok_or_else(|| {
+                DataError::parse(
+                    format!("line {}", n + 1),
+                    format!("`{}` is not a number", fields[k]),
+                )
+            })?;
         }
         seen_data = true;
         out.push(p);

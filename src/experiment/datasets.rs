@@ -17,8 +17,15 @@ pub fn datasets(action: DatasetsAction, data_dir: &Path) -> Result<()> {
         DatasetsAction::Show { name } => {
             let cloud = registry::load_dataset(&name, data_dir)?;
             let (lo, hi) = crate::geom::bounding_box(&cloud.points).unwrap_or(([0.0; 3], [0.0; 3]));
-            println!("{}: {} points (normalised per axis to [0,1])", cloud.name, cloud.points.len());
-            println!("bounds x [{:.6}, {:.6}] y [{:.6}, {:.6}] z [{:.6}, {:.6}]", lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]);
+            println!(
+                "{}: {} points (normalised per axis to [0,1])",
+                cloud.name,
+                cloud.points.len()
+            );
+            println!(
+                "bounds x [{:.6}, {:.6}] y [{:.6}, {:.6}] z [{:.6}, {:.6}]",
+                lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]
+            );
             for p in cloud.points.iter().take(5) {
                 println!("  {:.6} {:.6} {:.6}", p[0], p[1], p[2]);
             }
@@ -39,7 +46,8 @@ pub fn datasets(action: DatasetsAction, data_dir: &Path) -> Result<()> {
             }
             // A results folder has one writer at a time (a run writing there refuses this); the
             // file itself is written atomically, so a plain folder gets no lock file.
-            let folder = file.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+            let folder =
+                file.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
             let _lock = crate::io::outdir::lock_if_shared(folder, "datasets export")?;
             crate::io::write_atomic(&file, text.as_bytes())?;
             eprintln!("somnurbs: wrote {} points to {}", cloud.points.len(), file.display());

@@ -52,7 +52,10 @@ pub trait Family: Sync {
     fn run_variants(&self, variants: &[Spec], ctx: &RunContext, tables: bool) -> Result<Outcome> {
         match variants {
             [one] => self.run(one, ctx, tables),
-            _ => anyhow::bail!("--sweep: [{}] specs run one variant at a time (sweeps work on [optim] specs)", self.section()),
+            _ => anyhow::bail!(
+                "--sweep: [{}] specs run one variant at a time (sweeps work on [optim] specs)",
+                self.section()
+            ),
         }
     }
 }
@@ -65,5 +68,9 @@ pub fn present(spec: &Spec) -> Vec<&'static dyn Family> {
 
 /// The section names, as `[som], [fit], ...`, for messages.
 pub fn section_list() -> String {
-    crate::families::FAMILIES.iter().map(|f| format!("[{}]", f.section())).collect::<Vec<_>>().join(", ")
+    crate::families::FAMILIES
+        .iter()
+        .map(|f| format!("[{}]", f.section()))
+        .collect::<Vec<_>>()
+        .join(", ")
 }

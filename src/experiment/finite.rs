@@ -47,7 +47,11 @@ impl Finder {
             return Ok(());
         }
         let at = self.path.concat();
-        Err(Stop::Found(if at.is_empty() { format!("{v}") } else { format!("{} = {v}", at.trim_start_matches('.')) }))
+        Err(Stop::Found(if at.is_empty() {
+            format!("{v}")
+        } else {
+            format!("{} = {v}", at.trim_start_matches('.'))
+        }))
     }
 
     fn at<T: Serialize + ?Sized>(&mut self, step: String, v: &T) -> Result<(), Stop> {
@@ -95,10 +99,20 @@ impl<'a> ser::Serializer for &'a mut Finder {
     fn serialize_unit_variant(self, _: &'static str, _: u32, _: &'static str) -> Result<(), Stop> {
         Ok(())
     }
-    fn serialize_newtype_struct<T: Serialize + ?Sized>(self, _: &'static str, v: &T) -> Result<(), Stop> {
+    fn serialize_newtype_struct<T: Serialize + ?Sized>(
+        self,
+        _: &'static str,
+        v: &T,
+    ) -> Result<(), Stop> {
         v.serialize(self)
     }
-    fn serialize_newtype_variant<T: Serialize + ?Sized>(self, _: &'static str, _: u32, variant: &'static str, v: &T) -> Result<(), Stop> {
+    fn serialize_newtype_variant<T: Serialize + ?Sized>(
+        self,
+        _: &'static str,
+        _: u32,
+        variant: &'static str,
+        v: &T,
+    ) -> Result<(), Stop> {
         self.at(format!(".{variant}"), v)
     }
     fn serialize_seq(self, _: Option<usize>) -> Result<Seq<'a>, Stop> {
@@ -110,7 +124,13 @@ impl<'a> ser::Serializer for &'a mut Finder {
     fn serialize_tuple_struct(self, _: &'static str, _: usize) -> Result<Seq<'a>, Stop> {
         Ok(Seq { f: self, index: 0, bracket: false })
     }
-    fn serialize_tuple_variant(self, _: &'static str, _: u32, _: &'static str, _: usize) -> Result<Seq<'a>, Stop> {
+    fn serialize_tuple_variant(
+        self,
+        _: &'static str,
+        _: u32,
+        _: &'static str,
+        _: usize,
+    ) -> Result<Seq<'a>, Stop> {
         Ok(Seq { f: self, index: 0, bracket: false })
     }
     fn serialize_map(self, _: Option<usize>) -> Result<Seq<'a>, Stop> {
@@ -119,7 +139,13 @@ impl<'a> ser::Serializer for &'a mut Finder {
     fn serialize_struct(self, _: &'static str, _: usize) -> Result<Seq<'a>, Stop> {
         Ok(Seq { f: self, index: 0, bracket: false })
     }
-    fn serialize_struct_variant(self, _: &'static str, _: u32, _: &'static str, _: usize) -> Result<Seq<'a>, Stop> {
+    fn serialize_struct_variant(
+        self,
+        _: &'static str,
+        _: u32,
+        _: &'static str,
+        _: usize,
+    ) -> Result<Seq<'a>, Stop> {
         Ok(Seq { f: self, index: 0, bracket: false })
     }
 }
@@ -134,7 +160,8 @@ struct Seq<'a> {
 
 impl Seq<'_> {
     fn element<T: Serialize + ?Sized>(&mut self, v: &T) -> Result<(), Stop> {
-        let step = if self.bracket { format!("[{}]", self.index) } else { format!(".{}", self.index) };
+        let step =
+            if self.bracket { format!("[{}]", self.index) } else { format!(".{}", self.index) };
         self.index += 1;
         self.f.at(step, v)
     }
@@ -155,7 +182,12 @@ macro_rules! compound {
     };
 }
 
-compound!(SerializeSeq::serialize_element, SerializeTuple::serialize_element, SerializeTupleStruct::serialize_field, SerializeTupleVariant::serialize_field);
+compound!(
+    SerializeSeq::serialize_element,
+    SerializeTuple::serialize_element,
+    SerializeTupleStruct::serialize_field,
+    SerializeTupleVariant::serialize_field
+);
 
 impl ser::SerializeMap for Seq<'_> {
     type Ok = ();
@@ -205,9 +237,15 @@ mod tests {
         assert_eq!(first_non_finite(&ok), None);
         let bad = (Row { name: "a".into(), qe: f64::INFINITY, te: None }, vec![(1u64, 2.0f64)]);
         assert_eq!(first_non_finite(&bad).unwrap(), "0.qe = inf");
-        let bad = (Row { name: "a".into(), qe: 1.0, te: Some(f64::NAN) }, vec![(1u64, 2.0f64), (3, f64::NEG_INFINITY)]);
+        let bad = (
+            Row { name: "a".into(), qe: 1.0, te: Some(f64::NAN) },
+            vec![(1u64, 2.0f64), (3, f64::NEG_INFINITY)],
+        );
         assert_eq!(first_non_finite(&bad).unwrap(), "0.te = NaN");
-        let bad = (Row { name: "a".into(), qe: 1.0, te: None }, vec![(1u64, 2.0f64), (3, f64::NEG_INFINITY)]);
+        let bad = (
+            Row { name: "a".into(), qe: 1.0, te: None },
+            vec![(1u64, 2.0f64), (3, f64::NEG_INFINITY)],
+        );
         assert_eq!(first_non_finite(&bad).unwrap(), "1[1].1 = -inf");
         assert_eq!(first_non_finite(&vec![vec![0.0f32, f32::NAN]]).unwrap(), "[0][1] = NaN");
     }

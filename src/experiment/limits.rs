@@ -54,27 +54,52 @@ impl Check<'_> {
     }
 
     /// A finite number in [lo, hi] (lo itself allowed or not).
-    pub fn real(&self, key: &str, v: f64, lo: f64, lo_allowed: bool, hi: f64) -> Result<(), SpecError> {
+    pub fn real(
+        &self,
+        key: &str,
+        v: f64,
+        lo: f64,
+        lo_allowed: bool,
+        hi: f64,
+    ) -> Result<(), SpecError> {
         let above_lo = if lo_allowed { v >= lo } else { v > lo };
         if v.is_finite() && above_lo && v <= hi {
             return Ok(());
         }
-        Err(self.err(key, format!("must be a finite number in {}{lo}, {hi}], got {v}", if lo_allowed { "[" } else { "(" })))
+        Err(self.err(
+            key,
+            format!(
+                "must be a finite number in {}{lo}, {hi}], got {v}",
+                if lo_allowed { "[" } else { "(" }
+            ),
+        ))
     }
 
-    pub fn grids<'g>(&self, key: &str, grids: impl IntoIterator<Item = &'g GridSize>) -> Result<(), SpecError> {
+    pub fn grids<'g>(
+        &self,
+        key: &str,
+        grids: impl IntoIterator<Item = &'g GridSize>,
+    ) -> Result<(), SpecError> {
         for g in grids {
             if g.nx > MAX_GRID_SIDE || g.ny > MAX_GRID_SIDE {
-                return Err(self.err(key, format!("{g} has a side above the limit {MAX_GRID_SIDE}")));
+                return Err(
+                    self.err(key, format!("{g} has a side above the limit {MAX_GRID_SIDE}"))
+                );
             }
         }
         Ok(())
     }
 
     /// No entry twice, and not too many entries.
-    pub fn list<T: Display + Eq + std::hash::Hash>(&self, key: &str, list: &[T]) -> Result<(), SpecError> {
+    pub fn list<T: Display + Eq + std::hash::Hash>(
+        &self,
+        key: &str,
+        list: &[T],
+    ) -> Result<(), SpecError> {
         if list.len() > MAX_LIST {
-            return Err(self.err(key, format!("{} entries, above the limit {MAX_LIST}", list.len())));
+            return Err(
+                self.err(key, format!("{} entries, above the limit {MAX_LIST}", list.len()))
+            );
         }
         let mut seen = HashSet::new();
         match list.iter().find(|v| !seen.insert(*v)) {
@@ -100,12 +125,20 @@ impl Check<'_> {
     pub fn cells(&self, key: &str, factors: &[usize]) -> Result<(), SpecError> {
         let n = factors.iter().fold(1u64, |a, &f| a.saturating_mul(f as u64));
         if n > MAX_CELLS {
-            return Err(self.err(key, format!("the spec has {n} cells, above the limit {MAX_CELLS}")));
+            return Err(
+                self.err(key, format!("the spec has {n} cells, above the limit {MAX_CELLS}"))
+            );
         }
         Ok(())
     }
 
-    pub fn optimiser_run(&self, section: &str, repeats: usize, generations: usize, population: usize) -> Result<(), SpecError> {
+    pub fn optimiser_run(
+        &self,
+        section: &str,
+        repeats: usize,
+        generations: usize,
+        population: usize,
+    ) -> Result<(), SpecError> {
         self.int(&format!("{section}.repeats"), repeats, MAX_REPEATS)?;
         self.int(&format!("{section}.generations"), generations, MAX_GENERATIONS)?;
         self.int(&format!("{section}.population"), population, MAX_POPULATION)
@@ -158,16 +191,32 @@ mod tests {
     fn every_size_has_a_bound_named_by_its_key() {
         Spec::parse("t.toml", SPEC, None).unwrap();
         refused("grid = \"20x20\"", "grid = \"100000x100000\"", "optim.grid");
-        refused("control_nets = [\"6x6\"]", "control_nets = [\"6x6\", \"6x100000\"]", "optim.control_nets");
+        refused(
+            "control_nets = [\"6x6\"]",
+            "control_nets = [\"6x6\", \"6x100000\"]",
+            "optim.control_nets",
+        );
         refused("generations = 10", "generations = 1000000000000", "optim.generations");
         refused("population = 8", "population = 1000000000000", "optim.population");
         refused("repeats = 2", "repeats = 100000000", "optim.repeats");
         refused("population = 8", "population = 8\nsearch_range = 1e308", "optim.search_range");
         refused("population = 8", "population = 8\nsearch_range = inf", "optim.search_range");
         refused("population = 8", "population = 8\ninit_range = nan", "optim.init_range");
-        refused("optimisers = [\"ga\", \"de\"]", "optimisers = [\"ga\", \"de\", \"ga\"]", "optim.optimisers: `ga` is listed twice");
-        refused("control_nets = [\"6x6\"]", "control_nets = [\"6x6\", \"6\"]", "optim.control_nets: `6x6` is listed twice");
-        refused("datasets = [\"sphere\"]", "datasets = [\"a/x.xyz\", \"b/x.xyz\"]", "both go by the name `x`");
+        refused(
+            "optimisers = [\"ga\", \"de\"]",
+            "optimisers = [\"ga\", \"de\", \"ga\"]",
+            "optim.optimisers: `ga` is listed twice",
+        );
+        refused(
+            "control_nets = [\"6x6\"]",
+            "control_nets = [\"6x6\", \"6\"]",
+            "optim.control_nets: `6x6` is listed twice",
+        );
+        refused(
+            "datasets = [\"sphere\"]",
+            "datasets = [\"a/x.xyz\", \"b/x.xyz\"]",
+            "both go by the name `x`",
+        );
         refused("datasets = [\"sphere\"]", "datasets = [\"..\"]", "optim.datasets");
         refused("name = \"t\"", "name = \"..\"", "name");
         refused("name = \"t\"", "name = \".\"", "name");
@@ -177,10 +226,16 @@ mod tests {
             ("grids = [\"10x10\"]\n[som.x]", "unknown field"),
             ("grids = [\"10x10\", \"10x10\"]", "`10x10` is listed twice"),
         ] {
-            let e = Spec::parse("s.toml", &som.replace("grids = [\"10x10\"]", to), None).unwrap_err().0;
+            let e =
+                Spec::parse("s.toml", &som.replace("grids = [\"10x10\"]", to), None).unwrap_err().0;
             assert!(e.contains(key), "{e}");
         }
-        for (to, key) in [("iterations = 100000000000", "som.iterations"), ("iterations = 10\nsigma0 = 1e5", "som.sigma0"), ("iterations = 10\nsigma0 = inf", "som.sigma0"), ("iterations = 10\nrepeats = 1000000000", "som.repeats")] {
+        for (to, key) in [
+            ("iterations = 100000000000", "som.iterations"),
+            ("iterations = 10\nsigma0 = 1e5", "som.sigma0"),
+            ("iterations = 10\nsigma0 = inf", "som.sigma0"),
+            ("iterations = 10\nrepeats = 1000000000", "som.repeats"),
+        ] {
             let e = Spec::parse("s.toml", &som.replace("iterations = 10", to), None).unwrap_err().0;
             assert!(e.contains(key), "{e}");
         }
@@ -199,6 +254,12 @@ mod tests {
     fn file_names_become_stems_in_keys() {
         let text = SPEC.replace("datasets = [\"sphere\"]", "datasets = [\"/some/where/part.xyz\"]");
         let spec = Spec::parse("t.toml", &text, None).unwrap();
-        assert!(crate::families::optimise::spec::cells(&spec).iter().all(|c| c.key().starts_with("optim/part/")), "{:?}", crate::families::optimise::spec::cells(&spec)[0].key());
+        assert!(
+            crate::families::optimise::spec::cells(&spec)
+                .iter()
+                .all(|c| c.key().starts_with("optim/part/")),
+            "{:?}",
+            crate::families::optimise::spec::cells(&spec)[0].key()
+        );
     }
 }

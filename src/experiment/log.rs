@@ -27,8 +27,12 @@ pub struct Shard {
 impl Shard {
     /// Parse `I/N` with 1 <= I <= N.
     pub fn parse(s: &str) -> Result<Shard> {
-        let (i, n) = s.split_once('/').with_context(|| format!("--shard `{s}`: expected I/N, e.g. 2/8"))?;
-        let (index, count): (usize, usize) = (i.trim().parse().with_context(|| format!("--shard `{s}`: I is not a number"))?, n.trim().parse().with_context(|| format!("--shard `{s}`: N is not a number"))?);
+        let (i, n) =
+            s.split_once('/').with_context(|| format!("--shard `{s}`: expected I/N, e.g. 2/8"))?;
+        let (index, count): (usize, usize) = (
+            i.trim().parse().with_context(|| format!("--shard `{s}`: I is not a number"))?,
+            n.trim().parse().with_context(|| format!("--shard `{s}`: N is not a number"))?,
+        );
         if count == 0 || index == 0 || index > count {
             bail!("--shard `{s}`: need 1 <= I <= N");
         }
@@ -79,7 +83,11 @@ impl Fingerprint {
             ("profile", self.profile.clone(), other.profile.clone()),
             ("spec text (sha256)", self.spec_sha256.clone(), other.spec_sha256.clone()),
             ("cell count", self.cells.to_string(), other.cells.to_string()),
-            ("shard", self.shard.clone().unwrap_or_else(|| "none".into()), other.shard.clone().unwrap_or_else(|| "none".into())),
+            (
+                "shard",
+                self.shard.clone().unwrap_or_else(|| "none".into()),
+                other.shard.clone().unwrap_or_else(|| "none".into()),
+            ),
             ("--set", shown(&self.set), shown(&other.set)),
             ("--sweep", shown(&self.sweep), shown(&other.sweep)),
         ];
@@ -96,8 +104,10 @@ impl Fingerprint {
         if !path.exists() {
             return Ok(None);
         }
-        let text = std::fs::read_to_string(&path).with_context(|| format!("cannot read {}", path.display()))?;
-        let fp = toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {}", path.display(), e.message()))?;
+        let text = std::fs::read_to_string(&path)
+            .with_context(|| format!("cannot read {}", path.display()))?;
+        let fp = toml::from_str(&text)
+            .map_err(|e| anyhow::anyhow!("{}: {}", path.display(), e.message()))?;
         Ok(Some(fp))
     }
 
@@ -128,13 +138,17 @@ struct Line<T> {
 /// last line (no newline: the write was cut short) is dropped and cut off the file; any other
 /// malformed line is an error naming the file and line, and so is a line whose seed is not the
 /// cell's seed under `master_seed` (a log that mixes runs).
-pub fn read_records<T: DeserializeOwned>(dir: &Path, master_seed: u64) -> Result<BTreeMap<String, T>> {
+pub fn read_records<T: DeserializeOwned>(
+    dir: &Path,
+    master_seed: u64,
+) -> Result<BTreeMap<String, T>> {
     let path = dir.join(LOG_FILE);
     let mut out = BTreeMap::new();
     if !path.exists() {
         return Ok(out);
     }
-    let text = std::fs::read_to_string(&path).with_context(|| format!("cannot read {}", path.display()))?;
+    let text = std::fs::read_to_string(&path)
+        .with_context(|| format!("cannot read {}", path.display()))?;
     let complete = match text.rfind('\n') {
         Some(k) => k + 1,
         None => 0,
@@ -143,7 +157,9 @@ pub fn read_records<T: DeserializeOwned>(dir: &Path, master_seed: u64) -> Result
         if line.trim().is_empty() {
             continue;
         }
-        let l: Line<T> = serde_json::from_str(line).map_err(|e| anyhow::anyhow!("{}:{}: malformed cell record: {e}", path.display(), n + 1))?;
+        let l: Line<T> = serde_json::from_str(line).map_err(|e| {
+            anyhow::anyhow!("{}:{}: malformed cell record: {e}", path.display(), n + 1)
+        })?;
         let want = super::seeds::seed_hex(master_seed, &l.key);
         if l.seed.as_deref() != Some(want.as_str()) {
             bail!("{}:{}: cell {} was logged with seed {}, but its seed in this run is {want} (the folder mixes runs: start afresh without --resume)", path.display(), n + 1, l.key, l.seed.as_deref().unwrap_or("none"));
@@ -151,8 +167,12 @@ pub fn read_records<T: DeserializeOwned>(dir: &Path, master_seed: u64) -> Result
         out.insert(l.key, l.record);
     }
     if complete < text.len() {
-        let f = OpenOptions::new().write(true).open(&path).with_context(|| format!("cannot open {}", path.display()))?;
-        f.set_len(complete as u64).with_context(|| format!("cannot cut the torn last line of {}", path.display()))?;
+        let f = OpenOptions::new()
+            .write(true)
+            .open(&path)
+            .with_context(|| format!("cannot open {}", path.display()))?;
+        f.set_len(complete as u64)
+            .with_context(|| format!("cannot cut the torn last line of {}", path.display()))?;
     }
     Ok(out)
 }
@@ -185,9 +205,12 @@ impl CellLog {
 
     pub fn push<T: Serialize>(&mut self, key: &str, record: &T) -> Result<()> {
         let seed = Some(super::seeds::seed_hex(self.master_seed, key));
-        let mut line = serde_json::to_string(&Line { key: key.to_string(), seed, record }).context("cannot serialise a cell record")?;
+        let mut line = serde_json::to_string(&Line { key: key.to_string(), seed, record })
+            .context("cannot serialise a cell record")?;
         line.push('\n');
-        self.file.write_all(line.as_bytes()).with_context(|| format!("cannot append to {}", self.path.display()))?;
+        self.file
+            .write_all(line.as_bytes())
+            .with_context(|| format!("cannot append to {}", self.path.display()))?;
         self.file.flush().with_context(|| format!("cannot flush {}", self.path.display()))
     }
 }
@@ -199,7 +222,8 @@ mod tests {
     #[test]
     fn shards_partition_the_cells() {
         let n = 3;
-        let shards: Vec<Shard> = (1..=n).map(|i| Shard::parse(&format!("{i}/{n}")).unwrap()).collect();
+        let shards: Vec<Shard> =
+            (1..=n).map(|i| Shard::parse(&format!("{i}/{n}")).unwrap()).collect();
         for k in 0..20 {
             assert_eq!(shards.iter().filter(|s| s.contains(k)).count(), 1);
         }
@@ -233,8 +257,14 @@ mod tests {
         // Lines of another run (another master seed) mixed in are named.
         CellLog::open(dir.path(), true, 6).unwrap().push("d", &vec![5.0]).unwrap();
         let e = read_records::<Vec<f64>>(dir.path(), 5).unwrap_err().to_string();
-        assert!(e.contains("cells.jsonl:4") && e.contains("cell d") && e.contains("mixes runs"), "{e}");
-        let a = format!("{{\"key\":\"a\",\"seed\":\"{}\",\"record\":[1]}}", crate::experiment::seeds::seed_hex(5, "a"));
+        assert!(
+            e.contains("cells.jsonl:4") && e.contains("cell d") && e.contains("mixes runs"),
+            "{e}"
+        );
+        let a = format!(
+            "{{\"key\":\"a\",\"seed\":\"{}\",\"record\":[1]}}",
+            crate::experiment::seeds::seed_hex(5, "a")
+        );
         std::fs::write(&path, format!("{a}\nnot json\n")).unwrap();
         let e = read_records::<Vec<f64>>(dir.path(), 5).unwrap_err().to_string();
         assert!(e.contains("cells.jsonl:2"), "{e}");
@@ -243,15 +273,36 @@ mod tests {
     #[test]
     fn records_keep_every_bit_of_a_float() {
         let dir = tempfile::tempdir().unwrap();
-        let xs: Vec<f64> = vec![10.552161934452197, 0.1 + 0.2, 1e-300, f64::MIN_POSITIVE, 2.0f64.sqrt(), -1.0 / 3.0];
+        let xs: Vec<f64> = vec![
+            10.552161934452197,
+            0.1 + 0.2,
+            1e-300,
+            f64::MIN_POSITIVE,
+            2.0f64.sqrt(),
+            -1.0 / 3.0,
+        ];
         CellLog::open(dir.path(), false, 1).unwrap().push("k", &xs).unwrap();
         let back: BTreeMap<String, Vec<f64>> = read_records(dir.path(), 1).unwrap();
-        assert_eq!(back["k"].iter().map(|v| v.to_bits()).collect::<Vec<_>>(), xs.iter().map(|v| v.to_bits()).collect::<Vec<_>>());
+        assert_eq!(
+            back["k"].iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+            xs.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
+        );
     }
 
     #[test]
     fn fingerprint_names_the_first_difference() {
-        let a = Fingerprint { spec_name: "s".into(), spec_path: "s.toml".into(), spec_sha256: "ab".into(), profile: "quick".into(), master_seed: 1, cells: 4, shard: None, spec_text: String::new(), set: Vec::new(), sweep: Vec::new() };
+        let a = Fingerprint {
+            spec_name: "s".into(),
+            spec_path: "s.toml".into(),
+            spec_sha256: "ab".into(),
+            profile: "quick".into(),
+            master_seed: 1,
+            cells: 4,
+            shard: None,
+            spec_text: String::new(),
+            set: Vec::new(),
+            sweep: Vec::new(),
+        };
         assert_eq!(a.difference(&a.clone()), None);
         let b = Fingerprint { master_seed: 2, ..a.clone() };
         assert_eq!(a.difference(&b).unwrap(), "master seed: 1 vs 2");

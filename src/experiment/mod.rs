@@ -47,11 +47,13 @@ impl RunContext {
     /// fingerprint and starts the cell log (kept when resuming); later calls do nothing.
     pub fn begin(&self) -> Result<()> {
         let Some(session) = &self.session else { return Ok(()) };
-        let mut pending = session.pending.lock().map_err(|_| anyhow::anyhow!("run state lock poisoned"))?;
+        let mut pending =
+            session.pending.lock().map_err(|_| anyhow::anyhow!("run state lock poisoned"))?;
         if let Some(fp) = pending.take() {
             let manifest = self.out.join(crate::io::outdir::MANIFEST);
             if manifest.exists() {
-                std::fs::remove_file(&manifest).with_context(|| format!("cannot remove {}", manifest.display()))?;
+                std::fs::remove_file(&manifest)
+                    .with_context(|| format!("cannot remove {}", manifest.display()))?;
                 crate::io::outdir::sync_dir(&self.out)?;
             }
             fp.write(&self.out)?;
@@ -64,7 +66,11 @@ impl RunContext {
     /// own folder, scaled by the spec's `normalise`.
     pub fn loader(&self, spec: &Spec) -> crate::data::registry::Loader {
         let base = Path::new(&spec.path).parent().map(Path::to_path_buf).unwrap_or_default();
-        crate::data::registry::Loader { data_dir: self.data_dir.clone(), base, normalise: spec.file.normalise }
+        crate::data::registry::Loader {
+            data_dir: self.data_dir.clone(),
+            base,
+            normalise: spec.file.normalise,
+        }
     }
 
     /// The master seed the cell log tags records with (0 outside `run_spec`).
@@ -191,7 +197,9 @@ pub fn run_variants(variants: &[Spec], ctx: &RunContext) -> Result<PathBuf> {
     let spec = variants.first().context("no spec to run")?;
     // A data file the spec names but that is not there: refused before the folder is touched.
     for d in limits::dataset_entries(spec) {
-        ctx.loader(spec).require_file(d).with_context(|| format!("{}: data set `{d}`", spec.path))?;
+        ctx.loader(spec)
+            .require_file(d)
+            .with_context(|| format!("{}: data set `{d}`", spec.path))?;
     }
     let _lock = crate::io::outdir::lock(&ctx.out, &format!("run {}", spec.path))?;
     run_spec_locked(variants, ctx)
@@ -208,19 +216,31 @@ fn run_spec_locked(variants: &[Spec], ctx: &RunContext) -> Result<PathBuf> {
                     anyhow::bail!("cannot resume in {}: it holds a different run ({diff}); use another --out or drop --resume", ctx.out.display());
                 }
             }
-            None if ctx.out.join(log::LOG_FILE).exists() => anyhow::bail!("cannot resume in {}: it has a cell log but no {}", ctx.out.display(), log::FINGERPRINT_FILE),
+            None if ctx.out.join(log::LOG_FILE).exists() => anyhow::bail!(
+                "cannot resume in {}: it has a cell log but no {}",
+                ctx.out.display(),
+                log::FINGERPRINT_FILE
+            ),
             None => {}
         }
     }
     let manifest_path = ctx.out.join(crate::io::outdir::MANIFEST);
-    let session = Arc::new(Session { master_seed: spec.file.master_seed, pending: std::sync::Mutex::new(Some(fp.clone())) });
+    let session = Arc::new(Session {
+        master_seed: spec.file.master_seed,
+        pending: std::sync::Mutex::new(Some(fp.clone())),
+    });
     let ctx = &RunContext { session: Some(session), ..ctx.clone() };
     let started = Instant::now();
-    let started_unix = std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map(|d| d.as_secs()).unwrap_or(0);
+    let started_unix = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| d.as_secs())
+        .unwrap_or(0);
     let tables = ctx.shard.is_none();
 
-    let family = family::present(spec).into_iter().next().context("the spec has no experiment section")?;
-    let family::Outcome { section, cpu_s: cpu, cells } = family.run_variants(variants, ctx, tables)?;
+    let family =
+        family::present(spec).into_iter().next().context("the spec has no experiment section")?;
+    let family::Outcome { section, cpu_s: cpu, cells } =
+        family.run_variants(variants, ctx, tables)?;
     ctx.begin()?;
 
     let manifest = Manifest {
@@ -261,7 +281,15 @@ pub fn report_md(spec: &Spec, m: &Manifest, sections: &[String]) -> String {
     if !spec.file.description.is_empty() {
         let _ = writeln!(s, "{}\n", spec.file.description.trim());
     }
-    let commit = if m.git_commit.is_empty() { "unknown".to_string() } else { format!("{}{}", &m.git_commit[..m.git_commit.len().min(12)], if m.git_dirty { " (dirty)" } else { "" }) };
+    let commit = if m.git_commit.is_empty() {
+        "unknown".to_string()
+    } else {
+        format!(
+            "{}{}",
+            &m.git_commit[..m.git_commit.len().min(12)],
+            if m.git_dirty { " (dirty)" } else { "" }
+        )
+    };
     let _ = writeln!(
         s,
         "Spec `{}` (sha256 {}), profile `{}`, master seed {}, somnurbs {} at commit {}, {} on {} with {} thread(s): {} cells in {:.1} s wall, {:.1} s CPU in cells. Re-run: `somnurbs run {}{}{}`.\n",
@@ -307,9 +335,18 @@ pub fn merge(shards: &[PathBuf], ctx: &RunContext) -> Result<PathBuf> {
     let mut records: BTreeMap<String, serde_json::Value> = BTreeMap::new();
     for dir in shards {
         crate::io::outdir::require_not_being_written(dir).context("merge")?;
-        let fp = log::Fingerprint::read(dir)?.with_context(|| format!("merge: {} has no {} (not a somnurbs output folder?)", dir.display(), log::FINGERPRINT_FILE))?;
-        let shard = fp.shard.as_deref().with_context(|| format!("merge: {} is not a shard (it was run without --shard)", dir.display()))?;
-        let shard = log::Shard::parse(shard).with_context(|| format!("merge: {}", dir.display()))?;
+        let fp = log::Fingerprint::read(dir)?.with_context(|| {
+            format!(
+                "merge: {} has no {} (not a somnurbs output folder?)",
+                dir.display(),
+                log::FINGERPRINT_FILE
+            )
+        })?;
+        let shard = fp.shard.as_deref().with_context(|| {
+            format!("merge: {} is not a shard (it was run without --shard)", dir.display())
+        })?;
+        let shard =
+            log::Shard::parse(shard).with_context(|| format!("merge: {}", dir.display()))?;
         if !dir.join(crate::io::outdir::MANIFEST).exists() {
             anyhow::bail!("merge: shard {shard} in {} did not finish (no manifest.toml); resume it with --resume first", dir.display());
         }
@@ -321,31 +358,59 @@ pub fn merge(shards: &[PathBuf], ctx: &RunContext) -> Result<PathBuf> {
             }
             Some(f) => {
                 if let Some(diff) = f.difference(&plain) {
-                    anyhow::bail!("merge: {} belongs to another run than {} ({diff})", dir.display(), shards[0].display());
+                    anyhow::bail!(
+                        "merge: {} belongs to another run than {} ({diff})",
+                        dir.display(),
+                        shards[0].display()
+                    );
                 }
                 if shard.count != count {
-                    anyhow::bail!("merge: {} is shard {shard} but {} has {count} shards", dir.display(), shards[0].display());
+                    anyhow::bail!(
+                        "merge: {} is shard {shard} but {} has {count} shards",
+                        dir.display(),
+                        shards[0].display()
+                    );
                 }
             }
         }
         if let Some(other) = seen.insert(shard.index, dir.clone()) {
-            anyhow::bail!("merge: shard {shard} given twice ({} and {})", other.display(), dir.display());
+            anyhow::bail!(
+                "merge: shard {shard} given twice ({} and {})",
+                other.display(),
+                dir.display()
+            );
         }
-        records.extend(log::read_records::<serde_json::Value>(dir, fp.master_seed).context("merge")?);
+        records
+            .extend(log::read_records::<serde_json::Value>(dir, fp.master_seed).context("merge")?);
     }
     if let Some(missing) = (1..=count).find(|i| !seen.contains_key(i)) {
         anyhow::bail!("merge: shard {missing}/{count} is missing");
     }
     let fp = first.expect("at least one shard");
-    let variants = fp.overrides().variants(&fp.spec_path, &fp.spec_text, if fp.profile == "default" { None } else { Some(fp.profile.as_str()) }).context("merge: the shards' spec")?;
-    let expected: std::collections::BTreeSet<String> = logged_variant_keys(&variants).into_iter().collect();
+    let variants = fp
+        .overrides()
+        .variants(
+            &fp.spec_path,
+            &fp.spec_text,
+            if fp.profile == "default" { None } else { Some(fp.profile.as_str()) },
+        )
+        .context("merge: the shards' spec")?;
+    let expected: std::collections::BTreeSet<String> =
+        logged_variant_keys(&variants).into_iter().collect();
     if let Some(k) = expected.iter().find(|k| !records.contains_key(*k)) {
-        anyhow::bail!("merge: no shard logged cell {k} (the shards hold {} of the spec's {} cells)", expected.iter().filter(|k| records.contains_key(*k)).count(), expected.len());
+        anyhow::bail!(
+            "merge: no shard logged cell {k} (the shards hold {} of the spec's {} cells)",
+            expected.iter().filter(|k| records.contains_key(*k)).count(),
+            expected.len()
+        );
     }
     if let Some(k) = records.keys().find(|k| !expected.contains(*k)) {
         anyhow::bail!("merge: the shards log cell {k}, which the spec does not have");
     }
-    if ctx.out.join(log::LOG_FILE).exists() || ctx.out.join(crate::io::outdir::MANIFEST).exists() || ctx.out.join(log::FINGERPRINT_FILE).exists() {
+    if ctx.out.join(log::LOG_FILE).exists()
+        || ctx.out.join(crate::io::outdir::MANIFEST).exists()
+        || ctx.out.join(log::FINGERPRINT_FILE).exists()
+    {
         anyhow::bail!("merge: {} already holds a run; choose an empty folder", ctx.out.display());
     }
     {

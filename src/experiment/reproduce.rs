@@ -6,8 +6,8 @@
 
 use super::spec::{Override, Spec};
 use super::{run_spec, RunContext};
-use crate::report::claims::{self, Claim};
 use crate::io::{csv_records, write_atomic};
+use crate::report::claims::{self, Claim};
 use anyhow::{Context, Result};
 use serde::Deserialize;
 use std::fmt::Write;
@@ -60,7 +60,8 @@ fn default_reading() -> String {
 
 /// A reading-set name is a folder name: lower-case letters, digits and `_`.
 fn valid_name(name: &str) -> bool {
-    !name.is_empty() && name.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_')
+    !name.is_empty()
+        && name.chars().all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_')
 }
 
 fn default_title() -> String {
@@ -69,8 +70,10 @@ fn default_title() -> String {
 
 impl Plan {
     pub fn load(path: &Path) -> Result<Plan> {
-        let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-        let plan: Plan = toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {}", path.display(), e.message()))?;
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read {}", path.display()))?;
+        let plan: Plan = toml::from_str(&text)
+            .map_err(|e| anyhow::anyhow!("{}: {}", path.display(), e.message()))?;
         if plan.specs.is_empty() {
             anyhow::bail!("{}: specs: is empty", path.display());
         }
@@ -80,14 +83,22 @@ impl Plan {
         let mut names = vec![plan.reading.as_str()];
         for r in &plan.readings {
             if !valid_name(&r.name) {
-                anyhow::bail!("{}: readings: name `{}` must be lower-case letters, digits and _", path.display(), r.name);
+                anyhow::bail!(
+                    "{}: readings: name `{}` must be lower-case letters, digits and _",
+                    path.display(),
+                    r.name
+                );
             }
             if names.contains(&r.name.as_str()) {
                 anyhow::bail!("{}: readings: the name `{}` is used twice", path.display(), r.name);
             }
             names.push(&r.name);
             if let Some(s) = r.specs.iter().find(|s| !plan.specs.contains(s)) {
-                anyhow::bail!("{}: readings.{}.specs: `{s}` is not one of the plan's specs", path.display(), r.name);
+                anyhow::bail!(
+                    "{}: readings.{}.specs: `{s}` is not one of the plan's specs",
+                    path.display(),
+                    r.name
+                );
             }
             if r.set.is_empty() {
                 anyhow::bail!("{}: readings.{}.set: is empty", path.display(), r.name);
@@ -100,15 +111,29 @@ impl Plan {
 /// Load every spec of the plan (all before any runs, so a bad one stops nothing half-way), with
 /// the maps of the later ones pointed at `<out>/<maps_from>/maps`; `names` and `overrides` select
 /// a reading set's specs and apply its keys.
-fn load_specs(dir: &Path, plan: &Plan, names: &[String], overrides: &[Override], profile: Option<&str>, out: &Path) -> Result<Vec<Spec>> {
-    let maps = plan.maps_from.as_ref().map(|m| out.join(m).join("maps").to_string_lossy().into_owned());
+fn load_specs(
+    dir: &Path,
+    plan: &Plan,
+    names: &[String],
+    overrides: &[Override],
+    profile: Option<&str>,
+    out: &Path,
+) -> Result<Vec<Spec>> {
+    let maps =
+        plan.maps_from.as_ref().map(|m| out.join(m).join("maps").to_string_lossy().into_owned());
     names
         .iter()
         .map(|name| {
             let path = dir.join(format!("{name}.toml"));
             let shown = path.display().to_string();
-            let text = std::fs::read_to_string(&path).with_context(|| format!("{shown}: cannot read spec"))?;
-            let mut spec = Spec::parse_with(&shown, &text, profile.filter(|p| has_profile(&path, p)), overrides)?;
+            let text = std::fs::read_to_string(&path)
+                .with_context(|| format!("{shown}: cannot read spec"))?;
+            let mut spec = Spec::parse_with(
+                &shown,
+                &text,
+                profile.filter(|p| has_profile(&path, p)),
+                overrides,
+            )?;
             if let Some(maps) = &maps {
                 for family in super::family::present(&spec) {
                     family.use_maps(&mut spec, maps);
@@ -122,11 +147,20 @@ fn load_specs(dir: &Path, plan: &Plan, names: &[String], overrides: &[Override],
 /// Whether a spec defines the profile (a spec without `quick` runs as it is, e.g. one that is
 /// already quick).
 fn has_profile(path: &Path, profile: &str) -> bool {
-    std::fs::read_to_string(path).ok().and_then(|t| t.parse::<toml::Table>().ok()).and_then(|t| t.get("profiles").and_then(|p| p.get(profile)).map(|_| ())).is_some()
+    std::fs::read_to_string(path)
+        .ok()
+        .and_then(|t| t.parse::<toml::Table>().ok())
+        .and_then(|t| t.get("profiles").and_then(|p| p.get(profile)).map(|_| ()))
+        .is_some()
 }
 
 /// Run the plan into `ctx.out` and write the combined REPORT.md; returns its path.
-pub fn reproduce(specs_dir: &Path, plan_name: &str, profile: &str, ctx: &RunContext) -> Result<PathBuf> {
+pub fn reproduce(
+    specs_dir: &Path,
+    plan_name: &str,
+    profile: &str,
+    ctx: &RunContext,
+) -> Result<PathBuf> {
     let plan_path = specs_dir.join(format!("{plan_name}.toml"));
     if !plan_path.exists() {
         anyhow::bail!("--plan {plan_name}: no plan file {}", plan_path.display());
@@ -134,8 +168,13 @@ pub fn reproduce(specs_dir: &Path, plan_name: &str, profile: &str, ctx: &RunCont
     let plan = Plan::load(&plan_path)?;
     let profile = if profile == "full" { None } else { Some(profile) };
     let specs = load_specs(specs_dir, &plan, &plan.specs, &[], profile, &ctx.out)?;
-    let reading_specs: Vec<(&ReadingSet, Vec<Spec>)> =
-        plan.readings.iter().map(|r| Ok((r, load_specs(specs_dir, &plan, &r.specs, &r.overrides(), profile, &ctx.out)?))).collect::<Result<_>>()?;
+    let reading_specs: Vec<(&ReadingSet, Vec<Spec>)> = plan
+        .readings
+        .iter()
+        .map(|r| {
+            Ok((r, load_specs(specs_dir, &plan, &r.specs, &r.overrides(), profile, &ctx.out)?))
+        })
+        .collect::<Result<_>>()?;
     // Every data set of every spec loads before the folder changes (a bad --data-dir changes nothing).
     for spec in &specs {
         for d in super::limits::dataset_entries(spec) {
@@ -145,7 +184,14 @@ pub fn reproduce(specs_dir: &Path, plan_name: &str, profile: &str, ctx: &RunCont
     let _lock = crate::io::outdir::lock(&ctx.out, &format!("reproduce --plan {plan_name}"))?;
     // Every spec has loaded: the folder is unfinished until the combined REPORT.md is written.
     let incomplete = ctx.out.join(crate::io::outdir::INCOMPLETE);
-    write_atomic(&incomplete, format!("reproduce --plan {plan_name} --profile {} started here\n", profile.unwrap_or("full")).as_bytes())?;
+    write_atomic(
+        &incomplete,
+        format!(
+            "reproduce --plan {plan_name} --profile {} started here\n",
+            profile.unwrap_or("full")
+        )
+        .as_bytes(),
+    )?;
     let started = Instant::now();
     let mut done = Vec::new();
     for spec in &specs {
@@ -159,13 +205,26 @@ pub fn reproduce(specs_dir: &Path, plan_name: &str, profile: &str, ctx: &RunCont
         for spec in rspecs {
             let folder = Path::new(READINGS_DIR).join(&reading.name).join(&spec.file.name);
             let sub = RunContext { out: ctx.out.join(&folder), ..ctx.clone() };
-            eprintln!("somnurbs: reproduce: {} under the readings `{}` -> {}", spec.file.name, reading.name, sub.out.display());
+            eprintln!(
+                "somnurbs: reproduce: {} under the readings `{}` -> {}",
+                spec.file.name,
+                reading.name,
+                sub.out.display()
+            );
             let t = Instant::now();
             run_spec(spec, &sub)?;
             done.push((folder.to_string_lossy().into_owned(), t.elapsed().as_secs_f64()));
         }
     }
-    let mut report = combined_report(&ctx.out, &plan, plan_name, &specs, &done, profile.unwrap_or("full"), started.elapsed().as_secs_f64())?;
+    let mut report = combined_report(
+        &ctx.out,
+        &plan,
+        plan_name,
+        &specs,
+        &done,
+        profile.unwrap_or("full"),
+        started.elapsed().as_secs_f64(),
+    )?;
     if !plan.readings.is_empty() {
         let matrix = readings_matrix(&ctx.out, &plan)?;
         report.push_str(&render_readings(&ctx.out, &plan, &matrix)?);
@@ -173,7 +232,8 @@ pub fn reproduce(specs_dir: &Path, plan_name: &str, profile: &str, ctx: &RunCont
     let path = ctx.out.join("REPORT.md");
     write_atomic(&path, report.as_bytes())?;
     crate::report::html::write(&ctx.out)?;
-    std::fs::remove_file(&incomplete).with_context(|| format!("cannot remove {}", incomplete.display()))?;
+    std::fs::remove_file(&incomplete)
+        .with_context(|| format!("cannot remove {}", incomplete.display()))?;
     crate::io::outdir::sync_dir(&ctx.out)?;
     Ok(path)
 }
@@ -204,7 +264,11 @@ fn readings_matrix(out: &Path, plan: &Plan) -> Result<Vec<ReadingClaim>> {
         let path = folder.join("claims.csv");
         if path.exists() {
             for claim in claims::read(&path)? {
-                rows.push(ReadingClaim { reading: reading.to_string(), folder: name.to_string(), claim });
+                rows.push(ReadingClaim {
+                    reading: reading.to_string(),
+                    folder: name.to_string(),
+                    claim,
+                });
             }
         }
         Ok(())
@@ -223,10 +287,25 @@ fn readings_matrix(out: &Path, plan: &Plan) -> Result<Vec<ReadingClaim>> {
 /// `readings.csv` and the REPORT.md section: one row per (spec, claim), one column per reading,
 /// and whether the verdict changes with the reading.
 fn render_readings(out: &Path, plan: &Plan, rows: &[ReadingClaim]) -> Result<String> {
-    let header: Vec<String> = ["spec", "chapter", "claim", "reading", "verdict", "holds", "checked", "note"].iter().map(|s| s.to_string()).collect();
+    let header: Vec<String> =
+        ["spec", "chapter", "claim", "reading", "verdict", "holds", "checked", "note"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
     let csv_rows: Vec<Vec<String>> = rows
         .iter()
-        .map(|r| vec![r.folder.clone(), r.claim.chapter.clone(), r.claim.statement.clone(), r.reading.clone(), r.claim.verdict().to_string(), r.claim.ours.0.to_string(), r.claim.ours.1.to_string(), r.claim.note.clone()])
+        .map(|r| {
+            vec![
+                r.folder.clone(),
+                r.claim.chapter.clone(),
+                r.claim.statement.clone(),
+                r.reading.clone(),
+                r.claim.verdict().to_string(),
+                r.claim.ours.0.to_string(),
+                r.claim.ours.1.to_string(),
+                r.claim.note.clone(),
+            ]
+        })
         .collect();
     write_atomic(&out.join("readings.csv"), csv_records(&header, &csv_rows)?.as_bytes())?;
     let mut readings = vec![plan.reading.clone()];
@@ -235,7 +314,15 @@ fn render_readings(out: &Path, plan: &Plan, rows: &[ReadingClaim]) -> Result<Str
     let _ = write!(s, " (reading `{}`) and again under each reading set below, from the same maps and seeds; every claim is shown under every reading, so a reader sees which conclusions rest on which reading (`readings.csv`).\n\n", plan.reading);
     for r in &plan.readings {
         let keys: Vec<String> = r.set.iter().map(|(k, v)| format!("`{k} = {v}`")).collect();
-        let _ = writeln!(s, "- `{}`: {} ({}; specs {}; folders `readings/{}/`)", r.name, r.description, keys.join(", "), r.specs.join(", "), r.name);
+        let _ = writeln!(
+            s,
+            "- `{}`: {} ({}; specs {}; folders `readings/{}/`)",
+            r.name,
+            r.description,
+            keys.join(", "),
+            r.specs.join(", "),
+            r.name
+        );
     }
     let mut keys: Vec<(String, String)> = Vec::new();
     for r in rows {
@@ -250,16 +337,32 @@ fn render_readings(out: &Path, plan: &Plan, rows: &[ReadingClaim]) -> Result<Str
     let mut md_rows = Vec::new();
     let mut changing = 0;
     for (folder, statement) in &keys {
-        let cells: Vec<Option<&Claim>> = readings.iter().map(|rd| rows.iter().find(|r| &r.reading == rd && &r.folder == folder && &r.claim.statement == statement).map(|r| &r.claim)).collect();
+        let cells: Vec<Option<&Claim>> = readings
+            .iter()
+            .map(|rd| {
+                rows.iter()
+                    .find(|r| {
+                        &r.reading == rd && &r.folder == folder && &r.claim.statement == statement
+                    })
+                    .map(|r| &r.claim)
+            })
+            .collect();
         let verdicts: Vec<&str> = cells.iter().flatten().map(|c| c.verdict()).collect();
         let changes = verdicts.windows(2).any(|w| w[0] != w[1]);
         changing += changes as usize;
         let mut row = vec![folder.clone(), statement.clone()];
-        row.extend(cells.iter().map(|c| c.map(|c| format!("{} {}/{}", c.verdict(), c.ours.0, c.ours.1)).unwrap_or_else(|| "-".into())));
+        row.extend(cells.iter().map(|c| {
+            c.map(|c| format!("{} {}/{}", c.verdict(), c.ours.0, c.ours.1))
+                .unwrap_or_else(|| "-".into())
+        }));
         row.push(if changes { "**yes**".into() } else { "no".into() });
         md_rows.push(row);
     }
-    let _ = writeln!(s, "\n{changing} of {} claims change their verdict with the reading.\n", keys.len());
+    let _ = writeln!(
+        s,
+        "\n{changing} of {} claims change their verdict with the reading.\n",
+        keys.len()
+    );
     s.push_str(&markdown_table(&h, &md_rows));
     if let Some(chart) = error_vs_excursion(out, plan)? {
         let _ = writeln!(s, "\n![{chart}]({chart})\n\nSurface error against the largest distance of the fitted surfaces from the data's bounding box (log scale), one point per control net, for one data set under each reading: a reading can lower the error at the data points while its surfaces leave the data between them.");
@@ -281,24 +384,58 @@ struct FitPoint {
 /// The chart of surface error against excursion across readings: the first Chapter 5 spec every
 /// reading ran, its first data set, chord length, approach B. Returns its path in `out`.
 fn error_vs_excursion(out: &Path, plan: &Plan) -> Result<Option<String>> {
-    let Some(spec) = plan.specs.iter().find(|s| plan.readings.iter().all(|r| r.specs.contains(s)) && out.join(s).join("runs.csv").exists() && is_fit_runs(&out.join(s).join("runs.csv"))) else {
+    let Some(spec) = plan.specs.iter().find(|s| {
+        plan.readings.iter().all(|r| r.specs.contains(s))
+            && out.join(s).join("runs.csv").exists()
+            && is_fit_runs(&out.join(s).join("runs.csv"))
+    }) else {
         return Ok(None);
     };
     let mut folders = vec![(plan.reading.clone(), out.join(spec))];
-    folders.extend(plan.readings.iter().map(|r| (r.name.clone(), out.join(READINGS_DIR).join(&r.name).join(spec))));
+    folders.extend(
+        plan.readings
+            .iter()
+            .map(|r| (r.name.clone(), out.join(READINGS_DIR).join(&r.name).join(spec))),
+    );
     let mut series = Vec::new();
     let mut data_set = None;
     for (k, (name, folder)) in folders.iter().enumerate() {
         let path = folder.join("runs.csv");
         let points: Vec<FitPoint> = crate::io::read_rows(&path)?;
-        let d = data_set.get_or_insert_with(|| points.first().map(|p| p.dataset.clone()).unwrap_or_default()).clone();
-        let mut pts: Vec<(usize, f64, f64)> = points.iter().filter(|p| p.dataset == d && p.parameterisation == "chord_length" && p.approach == "B" && p.excursion > 0.0).map(|p| (p.cn_x, p.excursion.log10(), p.surface_error)).collect();
+        let d = data_set
+            .get_or_insert_with(|| points.first().map(|p| p.dataset.clone()).unwrap_or_default())
+            .clone();
+        let mut pts: Vec<(usize, f64, f64)> = points
+            .iter()
+            .filter(|p| {
+                p.dataset == d
+                    && p.parameterisation == "chord_length"
+                    && p.approach == "B"
+                    && p.excursion > 0.0
+            })
+            .map(|p| (p.cn_x, p.excursion.log10(), p.surface_error))
+            .collect();
         pts.sort_by_key(|p| p.0);
-        series.push(crate::report::plots::Series { label: name.clone(), colour: crate::report::plots::style::cycle_colour(k), points: pts.iter().map(|p| (p.1, p.2)).collect(), band: None });
+        series.push(crate::report::plots::Series {
+            label: name.clone(),
+            colour: crate::report::plots::style::cycle_colour(k),
+            points: pts.iter().map(|p| (p.1, p.2)).collect(),
+            band: None,
+        });
     }
     let name = format!("readings_error_vs_excursion_{spec}.png");
-    let title = format!("{spec}, {}, chord length, B: one point per control net", data_set.unwrap_or_default());
-    match crate::report::plots::line_chart_png(&out.join(&name), &title, "log10 excursion from the data's box", "surface error (Eq. 5.13)", &series, false) {
+    let title = format!(
+        "{spec}, {}, chord length, B: one point per control net",
+        data_set.unwrap_or_default()
+    );
+    match crate::report::plots::line_chart_png(
+        &out.join(&name),
+        &title,
+        "log10 excursion from the data's box",
+        "surface error (Eq. 5.13)",
+        &series,
+        false,
+    ) {
         Ok(()) => Ok(Some(name)),
         Err(e) => {
             eprintln!("somnurbs: warning: picture skipped: {e}");
@@ -308,7 +445,14 @@ fn error_vs_excursion(out: &Path, plan: &Plan) -> Result<Option<String>> {
 }
 
 fn is_fit_runs(path: &Path) -> bool {
-    std::fs::read_to_string(path).ok().and_then(|t| t.lines().next().map(|h| h.split(',').any(|c| c == "excursion") && h.split(',').any(|c| c == "approach"))).unwrap_or(false)
+    std::fs::read_to_string(path)
+        .ok()
+        .and_then(|t| {
+            t.lines().next().map(|h| {
+                h.split(',').any(|c| c == "excursion") && h.split(',').any(|c| c == "approach")
+            })
+        })
+        .unwrap_or(false)
 }
 
 /// A win-count table (Tables 6.4-6.7: data, parameterisation, one column per optimiser, cells).
@@ -316,9 +460,19 @@ fn win_table(path: &Path) -> Result<Option<(Vec<String>, Vec<usize>)>> {
     if !path.exists() {
         return Ok(None);
     }
-    let mut rd = csv::Reader::from_path(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
-    let header: Vec<String> = rd.headers().map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?.iter().map(String::from).collect();
-    let opts: Vec<String> = header.iter().filter(|h| !["data", "parameterisation", "cells"].contains(&h.as_str())).cloned().collect();
+    let mut rd =
+        csv::Reader::from_path(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let header: Vec<String> = rd
+        .headers()
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?
+        .iter()
+        .map(String::from)
+        .collect();
+    let opts: Vec<String> = header
+        .iter()
+        .filter(|h| !["data", "parameterisation", "cells"].contains(&h.as_str()))
+        .cloned()
+        .collect();
     let mut sums = vec![0usize; opts.len() + 1];
     for (n, rec) in rd.records().enumerate() {
         let rec = rec.map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
@@ -327,7 +481,9 @@ fn win_table(path: &Path) -> Result<Option<(Vec<String>, Vec<usize>)>> {
         }
         for (k, name) in opts.iter().chain(std::iter::once(&"cells".to_string())).enumerate() {
             let col = header.iter().position(|h| h == name).context("column")?;
-            sums[k] += rec.get(col).unwrap_or("").parse::<usize>().map_err(|_| anyhow::anyhow!("{}: line {}: {name} is not a count", path.display(), n + 2))?;
+            sums[k] += rec.get(col).unwrap_or("").parse::<usize>().map_err(|_| {
+                anyhow::anyhow!("{}: line {}: {name} is not a count", path.display(), n + 2)
+            })?;
         }
     }
     Ok(Some((opts, sums)))
@@ -335,7 +491,11 @@ fn win_table(path: &Path) -> Result<Option<(Vec<String>, Vec<usize>)>> {
 
 /// Table 6.8 (errors) or 6.9 (CPU time): one row per source table, `wins/cells` per optimiser,
 /// and a total row; `None` if neither source table exists.
-fn overall(out: &Path, sources: &[(&str, &str)], name: &str) -> Result<Option<(String, Vec<String>, Vec<Vec<String>>)>> {
+fn overall(
+    out: &Path,
+    sources: &[(&str, &str)],
+    name: &str,
+) -> Result<Option<(String, Vec<String>, Vec<Vec<String>>)>> {
     let mut rows = Vec::new();
     let mut opts: Vec<String> = Vec::new();
     let mut total: Vec<usize> = Vec::new();
@@ -346,7 +506,9 @@ fn overall(out: &Path, sources: &[(&str, &str)], name: &str) -> Result<Option<(S
                 total = vec![0; o.len() + 1];
             }
             if o != opts {
-                anyhow::bail!("{spec}/{table}.csv has optimisers {o:?}, another table has {opts:?}");
+                anyhow::bail!(
+                    "{spec}/{table}.csv has optimisers {o:?}, another table has {opts:?}"
+                );
             }
             let cells = sums[o.len()];
             let mut row = vec![format!("Table {}", &table["table_".len()..].replace('_', "."))];
@@ -371,7 +533,11 @@ fn overall(out: &Path, sources: &[(&str, &str)], name: &str) -> Result<Option<(S
 }
 
 fn markdown_table(header: &[String], rows: &[Vec<String>]) -> String {
-    let mut s = format!("| {} |\n|{}|\n", header.join(" | "), header.iter().map(|_| "---").collect::<Vec<_>>().join("|"));
+    let mut s = format!(
+        "| {} |\n|{}|\n",
+        header.join(" | "),
+        header.iter().map(|_| "---").collect::<Vec<_>>().join("|")
+    );
     for r in rows {
         let _ = writeln!(s, "| {} |", r.join(" | "));
     }
@@ -380,7 +546,15 @@ fn markdown_table(header: &[String], rows: &[Vec<String>]) -> String {
 
 /// The combined REPORT.md: header, claims, Tables 6.8/6.9, then each chapter's report with its
 /// links pointed into its sub-folder.
-fn combined_report(out: &Path, plan: &Plan, plan_name: &str, specs: &[Spec], done: &[(String, f64)], profile: &str, wall: f64) -> Result<String> {
+fn combined_report(
+    out: &Path,
+    plan: &Plan,
+    plan_name: &str,
+    specs: &[Spec],
+    done: &[(String, f64)],
+    profile: &str,
+    wall: f64,
+) -> Result<String> {
     let mut s = format!("# somnurbs: {}\n\n", plan.title);
     let commit = env!("SOMNURBS_GIT_COMMIT");
     let _ = writeln!(
@@ -398,7 +572,12 @@ fn combined_report(out: &Path, plan: &Plan, plan_name: &str, specs: &[Spec], don
         let _ = writeln!(s, "| {name} | [`{name}/`]({name}/REPORT.md) | {secs:.1} |");
     }
     let names: Vec<&str> = specs.iter().map(|sp| sp.file.name.as_str()).collect();
-    let find = |grid_same: bool| names.iter().copied().find(|n| n.starts_with("ch6") && n.ends_with(if grid_same { "same" } else { "diff" }));
+    let find = |grid_same: bool| {
+        names
+            .iter()
+            .copied()
+            .find(|n| n.starts_with("ch6") && n.ends_with(if grid_same { "same" } else { "diff" }))
+    };
     let (same, diff) = (find(true), find(false));
     let mut all: Vec<Claim> = Vec::new();
     let mut thesis_ch6: Vec<Claim> = Vec::new();
@@ -425,20 +604,37 @@ fn combined_report(out: &Path, plan: &Plan, plan_name: &str, specs: &[Spec], don
         let _ = writeln!(s, "\n## Claims\n\nEach claim of the thesis (or, for the other seeds, of the paper) is counted on this reproduction (`here`) and, where the published tables allow, on the source's own figures; {holding} of {} hold in every case checked here. Also in `claims.csv`.\n", all.len());
         s.push_str(&table);
     }
-    let sources = |a: &'static str, b: &'static str| -> Vec<(&str, &str)> { same.map(|n| (n, a)).into_iter().chain(diff.map(|n| (n, b))).collect() };
+    let sources = |a: &'static str, b: &'static str| -> Vec<(&str, &str)> {
+        same.map(|n| (n, a)).into_iter().chain(diff.map(|n| (n, b))).collect()
+    };
     for (name, title, thesis, src) in [
-        ("table_6_8", "Table 6.8: least average optimised surface error, overall", "thesis: GA 0/280, DE 243/280, PSO 37/280", sources("table_6_4", "table_6_5")),
-        ("table_6_9", "Table 6.9: least average CPU time, overall", "thesis: GA 280/280, DE 0/280, PSO 0/280", sources("table_6_6", "table_6_7")),
+        (
+            "table_6_8",
+            "Table 6.8: least average optimised surface error, overall",
+            "thesis: GA 0/280, DE 243/280, PSO 37/280",
+            sources("table_6_4", "table_6_5"),
+        ),
+        (
+            "table_6_9",
+            "Table 6.9: least average CPU time, overall",
+            "thesis: GA 280/280, DE 0/280, PSO 0/280",
+            sources("table_6_6", "table_6_7"),
+        ),
     ] {
         if let Some((file, h, r)) = overall(out, &src, name)? {
-            let _ = writeln!(s, "\n## {title}\n\n`{file}.csv` ({thesis}).\n\n{}", markdown_table(&h, &r));
+            let _ = writeln!(
+                s,
+                "\n## {title}\n\n`{file}.csv` ({thesis}).\n\n{}",
+                markdown_table(&h, &r)
+            );
         }
     }
     let mut seen: Vec<(String, String)> = Vec::new();
     for spec in specs {
         let name = &spec.file.name;
         let path = out.join(name).join("REPORT.md");
-        let text = std::fs::read_to_string(&path).with_context(|| format!("cannot read {}", path.display()))?;
+        let text = std::fs::read_to_string(&path)
+            .with_context(|| format!("cannot read {}", path.display()))?;
         let _ = writeln!(s, "\n---\n\n# {name}\n");
         s.push_str(&sub_report(&text, name, &mut seen));
     }
@@ -524,22 +720,48 @@ mod tests {
 
     #[test]
     fn links_point_into_the_sub_folder() {
-        assert_eq!(relink("![a](png/a.png) and [b](https://x) [c](#c)", "ch4"), "![a](ch4/png/a.png) and [b](https://x) [c](#c)");
+        assert_eq!(
+            relink("![a](png/a.png) and [b](https://x) [c](#c)", "ch4"),
+            "![a](ch4/png/a.png) and [b](https://x) [c](#c)"
+        );
     }
 
     #[test]
     fn overall_tables_sum_the_win_counts() {
         let dir = tempfile::tempdir().unwrap();
-        for (spec, table, rows) in [("ch6_same", "table_6_4", "cube,uniform,0,6,1,7\nsphere,uniform,1,5,1,7\ntotal,,1,11,2,14\n"), ("ch6_diff", "table_6_5", "cube,uniform,0,7,0,7\n")] {
+        for (spec, table, rows) in [
+            (
+                "ch6_same",
+                "table_6_4",
+                "cube,uniform,0,6,1,7\nsphere,uniform,1,5,1,7\ntotal,,1,11,2,14\n",
+            ),
+            ("ch6_diff", "table_6_5", "cube,uniform,0,7,0,7\n"),
+        ] {
             std::fs::create_dir_all(dir.path().join(spec)).unwrap();
-            std::fs::write(dir.path().join(spec).join(format!("{table}.csv")), format!("data,parameterisation,ga,de,pso,cells\n{rows}")).unwrap();
+            std::fs::write(
+                dir.path().join(spec).join(format!("{table}.csv")),
+                format!("data,parameterisation,ga,de,pso,cells\n{rows}"),
+            )
+            .unwrap();
         }
-        let (_, h, r) = overall(dir.path(), &[("ch6_same", "table_6_4"), ("ch6_diff", "table_6_5")], "table_6_8").unwrap().unwrap();
+        let (_, h, r) = overall(
+            dir.path(),
+            &[("ch6_same", "table_6_4"), ("ch6_diff", "table_6_5")],
+            "table_6_8",
+        )
+        .unwrap()
+        .unwrap();
         assert_eq!(h, vec!["table", "ga", "de", "pso"]);
         assert_eq!(r[0], vec!["Table 6.4", "1/14", "11/14", "2/14"]);
         assert_eq!(r[2], vec!["overall", "1/21", "18/21", "2/21"]);
-        std::fs::write(dir.path().join("ch6_diff/table_6_5.csv"), "data,parameterisation,ga,de,pso,cells\ncube,uniform,x,7,0,7\n").unwrap();
-        let e = overall(dir.path(), &[("ch6_same", "table_6_4"), ("ch6_diff", "table_6_5")], "t").unwrap_err().to_string();
+        std::fs::write(
+            dir.path().join("ch6_diff/table_6_5.csv"),
+            "data,parameterisation,ga,de,pso,cells\ncube,uniform,x,7,0,7\n",
+        )
+        .unwrap();
+        let e = overall(dir.path(), &[("ch6_same", "table_6_4"), ("ch6_diff", "table_6_5")], "t")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("table_6_5.csv: line 2: ga"), "{e}");
     }
 }

@@ -15,7 +15,11 @@ pub const PROGRESS_ENV: &str = "SOMNURBS_PROGRESS_SECS";
 /// The interval of the plain progress lines: [`PROGRESS_ENV`] if it holds a positive number of
 /// seconds, else [`PROGRESS_SECS`].
 fn progress_interval() -> std::time::Duration {
-    let secs = std::env::var(PROGRESS_ENV).ok().and_then(|v| v.trim().parse::<f64>().ok()).filter(|s| *s > 0.0 && s.is_finite()).unwrap_or(PROGRESS_SECS);
+    let secs = std::env::var(PROGRESS_ENV)
+        .ok()
+        .and_then(|v| v.trim().parse::<f64>().ok())
+        .filter(|s| *s > 0.0 && s.is_finite())
+        .unwrap_or(PROGRESS_SECS);
     std::time::Duration::from_secs_f64(secs.min(86_400.0))
 }
 
@@ -30,7 +34,12 @@ fn clock(d: std::time::Duration) -> String {
 }
 
 /// One plain progress line: `somnurbs: progress LABEL: DONE/TOTAL cells, elapsed E, eta T`.
-pub fn progress_line(label: &str, done: usize, total: usize, elapsed: std::time::Duration) -> String {
+pub fn progress_line(
+    label: &str,
+    done: usize,
+    total: usize,
+    elapsed: std::time::Duration,
+) -> String {
     let eta = if done == 0 {
         "unknown".to_string()
     } else if done >= total {
@@ -38,7 +47,10 @@ pub fn progress_line(label: &str, done: usize, total: usize, elapsed: std::time:
     } else {
         clock(elapsed.mul_f64((total - done) as f64 / done as f64))
     };
-    format!("somnurbs: progress {label}: {done}/{total} cells, elapsed {}, eta {eta}", clock(elapsed))
+    format!(
+        "somnurbs: progress {label}: {done}/{total} cells, elapsed {}, eta {eta}",
+        clock(elapsed)
+    )
 }
 
 /// Run `work` over `cells` on `jobs` threads. On a terminal a progress bar shows; otherwise (a
@@ -57,12 +69,17 @@ where
 {
     use std::io::IsTerminal;
     use std::sync::atomic::{AtomicUsize, Ordering};
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(jobs.max(1)).build().context("cannot start worker threads")?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(jobs.max(1))
+        .build()
+        .context("cannot start worker threads")?;
     let plain = !std::io::stderr().is_terminal() && !cells.is_empty();
     let bar = if plain { ProgressBar::hidden() } else { ProgressBar::new(cells.len() as u64) };
     bar.set_style(
-        ProgressStyle::with_template("{prefix} [{elapsed_precise}] {wide_bar} {pos}/{len} cells, eta {eta}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        ProgressStyle::with_template(
+            "{prefix} [{elapsed_precise}] {wide_bar} {pos}/{len} cells, eta {eta}",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     bar.set_prefix(label.to_string());
     let finished = AtomicUsize::new(0);
@@ -76,11 +93,20 @@ where
                 let interval = progress_interval();
                 let mut stopped = stop.0.lock().unwrap_or_else(|e| e.into_inner());
                 loop {
-                    stopped = stop.1.wait_timeout(stopped, interval).unwrap_or_else(|e| e.into_inner()).0;
+                    stopped =
+                        stop.1.wait_timeout(stopped, interval).unwrap_or_else(|e| e.into_inner()).0;
                     if *stopped {
                         break;
                     }
-                    eprintln!("{}", progress_line(label, finished.load(Ordering::Relaxed), cells.len(), started.elapsed()));
+                    eprintln!(
+                        "{}",
+                        progress_line(
+                            label,
+                            finished.load(Ordering::Relaxed),
+                            cells.len(),
+                            started.elapsed()
+                        )
+                    );
                 }
             });
         }
@@ -110,7 +136,12 @@ where
 
 /// The cells of a two-list x repeats design in the specs' fixed order (a outer, b, then the
 /// repeat 0..repeats inner), built by `make`.
-pub fn product_cells<A, B, C>(a: &[A], b: &[B], repeats: usize, make: impl Fn(&A, &B, usize) -> C) -> Vec<C> {
+pub fn product_cells<A, B, C>(
+    a: &[A],
+    b: &[B],
+    repeats: usize,
+    make: impl Fn(&A, &B, usize) -> C,
+) -> Vec<C> {
     let mut out = Vec::with_capacity(a.len() * b.len() * repeats);
     for x in a {
         for y in b {
@@ -138,29 +169,57 @@ pub trait Logged: Send + Sized {
 /// order. Each finished cell is appended to the folder's cell log at once; with `ctx.resume`,
 /// cells already in the log are not run again but rebuilt by `restore` from their record, so a
 /// resumed run gives the results of an uninterrupted one.
-pub fn run_logged<C, R>(cells: &[C], ctx: &super::RunContext, label: &str, work: impl Fn(&C) -> Result<R> + Sync, restore: impl Fn(&C, R::Record) -> Result<R>) -> Result<Vec<R>>
+pub fn run_logged<C, R>(
+    cells: &[C],
+    ctx: &super::RunContext,
+    label: &str,
+    work: impl Fn(&C) -> Result<R> + Sync,
+    restore: impl Fn(&C, R::Record) -> Result<R>,
+) -> Result<Vec<R>>
 where
     C: Cell,
     R: Logged,
 {
     // The log may hold other cell families of the same spec: only this family's keys are read.
-    let mut logged: BTreeMap<String, serde_json::Value> = if ctx.resume { super::log::read_records(&ctx.out, ctx.master_seed())? } else { BTreeMap::new() };
-    let slice: Vec<&C> = cells.iter().enumerate().filter(|(k, _)| ctx.shard.is_none_or(|s| s.contains(*k))).map(|(_, c)| c).collect();
+    let mut logged: BTreeMap<String, serde_json::Value> = if ctx.resume {
+        super::log::read_records(&ctx.out, ctx.master_seed())?
+    } else {
+        BTreeMap::new()
+    };
+    let slice: Vec<&C> = cells
+        .iter()
+        .enumerate()
+        .filter(|(k, _)| ctx.shard.is_none_or(|s| s.contains(*k)))
+        .map(|(_, c)| c)
+        .collect();
     let todo: Vec<&C> = slice.iter().copied().filter(|c| !logged.contains_key(&c.key())).collect();
     if ctx.resume && todo.len() < slice.len() {
-        eprintln!("somnurbs: resuming {}: {} of {} cells already done", ctx.out.display(), slice.len() - todo.len(), slice.len());
+        eprintln!(
+            "somnurbs: resuming {}: {} of {} cells already done",
+            ctx.out.display(),
+            slice.len() - todo.len(),
+            slice.len()
+        );
     }
     // Every input has loaded: the folder becomes this run's (once per run), then the log
     // (empty unless resuming) gets one line per finished cell; every family appends.
     ctx.begin()?;
     let log = std::sync::Mutex::new(super::log::CellLog::append(&ctx.out, ctx.master_seed())?);
-    let computed = run_cells(&todo, ctx.jobs, label, |c| work(c), |c, r: &R| {
-        let record = r.record();
-        if let Some(at) = super::finite::first_non_finite(&record) {
-            anyhow::bail!("cell {}: its result is not finite ({at})", c.key());
-        }
-        log.lock().map_err(|_| anyhow::anyhow!("cell log lock poisoned"))?.push(&c.key(), &record)
-    })?;
+    let computed = run_cells(
+        &todo,
+        ctx.jobs,
+        label,
+        |c| work(c),
+        |c, r: &R| {
+            let record = r.record();
+            if let Some(at) = super::finite::first_non_finite(&record) {
+                anyhow::bail!("cell {}: its result is not finite ({at})", c.key());
+            }
+            log.lock()
+                .map_err(|_| anyhow::anyhow!("cell log lock poisoned"))?
+                .push(&c.key(), &record)
+        },
+    )?;
     let mut computed: BTreeMap<String, R> = todo.iter().map(|c| c.key()).zip(computed).collect();
     slice
         .into_iter()
@@ -169,9 +228,14 @@ where
             match computed.remove(&key) {
                 Some(r) => Ok(r),
                 None => {
-                    let rec = logged.remove(&key).with_context(|| format!("cell {key} is neither logged nor computed"))?;
-                    let rec: R::Record = serde_json::from_value(rec).with_context(|| format!("cell {key}: its logged record does not fit this version's record"))?;
-                    restore(c, rec).with_context(|| format!("cannot restore cell {key} from the cell log"))
+                    let rec = logged
+                        .remove(&key)
+                        .with_context(|| format!("cell {key} is neither logged nor computed"))?;
+                    let rec: R::Record = serde_json::from_value(rec).with_context(|| {
+                        format!("cell {key}: its logged record does not fit this version's record")
+                    })?;
+                    restore(c, rec)
+                        .with_context(|| format!("cannot restore cell {key} from the cell log"))
                 }
             }
         })
@@ -198,24 +262,45 @@ mod tests {
         let cells: Vec<u64> = (0..50).collect();
         for jobs in [1, 2, 4] {
             let seen = std::sync::Mutex::new(Vec::new());
-            let out = run_cells(&cells, jobs, "t", |c| Ok(c * c), |c, _| {
-                seen.lock().unwrap().push(*c);
-                Ok(())
-            })
+            let out = run_cells(
+                &cells,
+                jobs,
+                "t",
+                |c| Ok(c * c),
+                |c, _| {
+                    seen.lock().unwrap().push(*c);
+                    Ok(())
+                },
+            )
             .unwrap();
             assert_eq!(out, cells.iter().map(|c| c * c).collect::<Vec<_>>());
             assert_eq!(seen.lock().unwrap().len(), 50);
         }
-        let err = run_cells(&cells, 2, "t", |c| if *c == 7 { anyhow::bail!("cell 7 failed") } else { Ok(*c) }, |_, _| Ok(()));
+        let err = run_cells(
+            &cells,
+            2,
+            "t",
+            |c| if *c == 7 { anyhow::bail!("cell 7 failed") } else { Ok(*c) },
+            |_, _| Ok(()),
+        );
         assert!(format!("{:#}", err.unwrap_err()).contains("cell 7"));
     }
 
     #[test]
     fn progress_lines_say_done_total_elapsed_and_eta() {
         let d = std::time::Duration::from_secs;
-        assert_eq!(progress_line("ch6", 0, 10, d(3)), "somnurbs: progress ch6: 0/10 cells, elapsed 3s, eta unknown");
-        assert_eq!(progress_line("ch6", 5, 20, d(65)), "somnurbs: progress ch6: 5/20 cells, elapsed 1m05s, eta 3m15s");
-        assert_eq!(progress_line("x", 20, 20, d(3725)), "somnurbs: progress x: 20/20 cells, elapsed 1h02m05s, eta 0s");
+        assert_eq!(
+            progress_line("ch6", 0, 10, d(3)),
+            "somnurbs: progress ch6: 0/10 cells, elapsed 3s, eta unknown"
+        );
+        assert_eq!(
+            progress_line("ch6", 5, 20, d(65)),
+            "somnurbs: progress ch6: 5/20 cells, elapsed 1m05s, eta 3m15s"
+        );
+        assert_eq!(
+            progress_line("x", 20, 20, d(3725)),
+            "somnurbs: progress x: 20/20 cells, elapsed 1h02m05s, eta 0s"
+        );
     }
 
     #[test]

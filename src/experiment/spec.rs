@@ -113,8 +113,11 @@ impl Variant {
 const SWEEPABLE: &str = "optim.<ga|de|pso|csa|icsa>.*, optim.generations, optim.population, optim.init_range, optim.repeats";
 
 fn sweepable(key: &str) -> bool {
-    ["optim.ga.", "optim.de.", "optim.pso.", "optim.csa.", "optim.icsa."].iter().any(|p| key.starts_with(p))
-        || ["optim.generations", "optim.population", "optim.init_range", "optim.repeats"].contains(&key)
+    ["optim.ga.", "optim.de.", "optim.pso.", "optim.csa.", "optim.icsa."]
+        .iter()
+        .any(|p| key.starts_with(p))
+        || ["optim.generations", "optim.population", "optim.init_range", "optim.repeats"]
+            .contains(&key)
 }
 
 /// A command-line value as TOML (a number, a boolean, a quoted string, an array), else the text
@@ -134,7 +137,9 @@ impl CliOverrides {
     /// Split `KEY=VALUE` (or `KEY=V1,V2` for a sweep) of `flag`, naming the flag on error.
     fn split<'a>(flag: &str, arg: &'a str) -> Result<(&'a str, &'a str), SpecError> {
         match arg.split_once('=') {
-            Some((k, v)) if !k.trim().is_empty() && !v.trim().is_empty() => Ok((k.trim(), v.trim())),
+            Some((k, v)) if !k.trim().is_empty() && !v.trim().is_empty() => {
+                Ok((k.trim(), v.trim()))
+            }
             _ => Err(SpecError(format!("{flag} `{arg}`: expected KEY=VALUE, e.g. optim.de.f=0.5"))),
         }
     }
@@ -144,17 +149,25 @@ impl CliOverrides {
     /// is parsed and validated exactly as if its values were written in the file; an unknown key,
     /// a bad value, a key given twice or a swept value given twice is a one-line error naming
     /// the key.
-    pub fn variants(&self, path: &str, text: &str, profile: Option<&str>) -> Result<Vec<Spec>, SpecError> {
+    pub fn variants(
+        &self,
+        path: &str,
+        text: &str,
+        profile: Option<&str>,
+    ) -> Result<Vec<Spec>, SpecError> {
         let base = Spec::parse(path, text, profile)?;
         if self.is_empty() {
             return Ok(vec![base]);
         }
-        let flags = self.set.iter().map(|a| ("--set", a)).chain(self.sweep.iter().map(|a| ("--sweep", a)));
+        let flags =
+            self.set.iter().map(|a| ("--set", a)).chain(self.sweep.iter().map(|a| ("--sweep", a)));
         let mut seen: Vec<String> = Vec::new();
         for (flag, arg) in flags {
             let (key, _) = Self::split(flag, arg)?;
             if seen.iter().any(|k| k == key) {
-                return Err(SpecError(format!("{flag} {key}: the key is given twice (--set and --sweep take each key once)")));
+                return Err(SpecError(format!(
+                    "{flag} {key}: the key is given twice (--set and --sweep take each key once)"
+                )));
             }
             seen.push(key.to_string());
             if !key.starts_with("optim.") {
@@ -167,7 +180,11 @@ impl CliOverrides {
                 return Err(SpecError(format!("{flag} {key}: a sweep varies optimiser settings only ({SWEEPABLE}), so that every variant solves the same problems")));
             }
         }
-        let set: Vec<(String, String)> = self.set.iter().map(|a| Self::split("--set", a).map(|(k, v)| (k.to_string(), v.to_string()))).collect::<Result<_, _>>()?;
+        let set: Vec<(String, String)> = self
+            .set
+            .iter()
+            .map(|a| Self::split("--set", a).map(|(k, v)| (k.to_string(), v.to_string())))
+            .collect::<Result<_, _>>()?;
         // Every combination of the swept values, the first sweep outermost.
         let mut combos: Vec<Vec<(String, String)>> = vec![Vec::new()];
         for arg in &self.sweep {
@@ -176,18 +193,33 @@ impl CliOverrides {
             if values.iter().any(|v| v.is_empty()) {
                 return Err(SpecError(format!("--sweep {key}: an empty value in `{arg}`")));
             }
-            if let Some(v) = values.iter().enumerate().find(|(k, v)| values[..*k].contains(v)).map(|(_, v)| v) {
+            if let Some(v) =
+                values.iter().enumerate().find(|(k, v)| values[..*k].contains(v)).map(|(_, v)| v)
+            {
                 return Err(SpecError(format!("--sweep {key}: the value {v} is given twice")));
             }
-            combos = combos.into_iter().flat_map(|c| values.iter().map(move |v| [c.clone(), vec![(key.to_string(), v.to_string())]].concat())).collect();
+            combos = combos
+                .into_iter()
+                .flat_map(|c| {
+                    values
+                        .iter()
+                        .map(move |v| [c.clone(), vec![(key.to_string(), v.to_string())]].concat())
+                })
+                .collect();
         }
         combos
             .into_iter()
             .map(|swept| {
-                let overrides: Vec<Override> = set.iter().chain(&swept).map(|(k, v)| Override { key: k.clone(), value: cli_value(v) }).collect();
+                let overrides: Vec<Override> = set
+                    .iter()
+                    .chain(&swept)
+                    .map(|(k, v)| Override { key: k.clone(), value: cli_value(v) })
+                    .collect();
                 let mut spec = Spec::parse_with(path, text, profile, &overrides)?;
                 spec.cli = self.clone();
-                let pairs = |l: &[(String, String)]| l.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>();
+                let pairs = |l: &[(String, String)]| {
+                    l.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>()
+                };
                 spec.variant = Variant { set: pairs(&set), swept: pairs(&swept) };
                 Ok(spec)
             })
@@ -251,7 +283,8 @@ fn apply_override(table: &mut toml::Table, over: &Override) -> Result<bool, Stri
     }
     let mut t = table;
     for p in &parts[..parts.len() - 1] {
-        let entry = t.entry(p.to_string()).or_insert_with(|| toml::Value::Table(toml::Table::new()));
+        let entry =
+            t.entry(p.to_string()).or_insert_with(|| toml::Value::Table(toml::Table::new()));
         t = match entry {
             toml::Value::Table(inner) => inner,
             _ => return Err(format!("`{}`: `{p}` is not a table", over.key)),
@@ -264,12 +297,18 @@ fn apply_override(table: &mut toml::Table, over: &Override) -> Result<bool, Stri
 impl Spec {
     /// Parse spec text with a reading set's overrides applied after the profile (each validated
     /// as if written in the file); `path` is used in messages only.
-    pub fn parse_with(path: &str, text: &str, profile: Option<&str>, overrides: &[Override]) -> Result<Spec, SpecError> {
+    pub fn parse_with(
+        path: &str,
+        text: &str,
+        profile: Option<&str>,
+        overrides: &[Override],
+    ) -> Result<Spec, SpecError> {
         let mut spec = Spec::parse(path, text, profile)?;
         if overrides.is_empty() {
             return Ok(spec);
         }
-        let mut table: toml::Table = toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
+        let mut table: toml::Table =
+            toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
         if let Some(over) = profile.and_then(|p| spec.file.profiles.get(p)) {
             merge(&mut table, &over.clone());
         }
@@ -277,7 +316,13 @@ impl Spec {
             apply_override(&mut table, o).map_err(|e| SpecError(format!("{path}: {e}")))?;
         }
         let merged = toml::to_string(&table).map_err(|e| SpecError(format!("{path}: {e}")))?;
-        spec.file = toml::from_str(&merged).map_err(|e| SpecError(format!("{path}: with {}: {}", overrides.iter().map(|o| o.to_string()).collect::<Vec<_>>().join(", "), e.message().replace('\n', " "))))?;
+        spec.file = toml::from_str(&merged).map_err(|e| {
+            SpecError(format!(
+                "{path}: with {}: {}",
+                overrides.iter().map(|o| o.to_string()).collect::<Vec<_>>().join(", "),
+                e.message().replace('\n', " ")
+            ))
+        })?;
         spec.validate()?;
         Ok(spec)
     }
@@ -295,15 +340,27 @@ impl Spec {
                         if known.is_empty() { "none".to_string() } else { known.join(", ") }
                     ))
                 })?;
-                let mut table: toml::Table = toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
+                let mut table: toml::Table =
+                    toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
                 merge(&mut table, over);
-                let merged = toml::to_string(&table).map_err(|e| SpecError(format!("{path}: {e}")))?;
+                let merged =
+                    toml::to_string(&table).map_err(|e| SpecError(format!("{path}: {e}")))?;
                 toml::from_str(&merged).map_err(|e| {
-                    SpecError(format!("{path}: [profiles.{name}]: {}", e.message().replace('\n', " ")))
+                    SpecError(format!(
+                        "{path}: [profiles.{name}]: {}",
+                        e.message().replace('\n', " ")
+                    ))
                 })?
             }
         };
-        let spec = Spec { file, text: text.to_string(), path: path.to_string(), profile: profile.map(String::from), cli: CliOverrides::default(), variant: Variant::default() };
+        let spec = Spec {
+            file,
+            text: text.to_string(),
+            path: path.to_string(),
+            profile: profile.map(String::from),
+            cli: CliOverrides::default(),
+            variant: Variant::default(),
+        };
         spec.validate()?;
         Ok(spec)
     }
@@ -311,14 +368,20 @@ impl Spec {
     /// Read and parse a spec file.
     pub fn load(path: &Path, profile: Option<&str>) -> Result<Spec, SpecError> {
         let shown = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| SpecError(format!("{shown}: cannot read spec: {e}")))?;
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| SpecError(format!("{shown}: cannot read spec: {e}")))?;
         Spec::parse(&shown, &text, profile)
     }
 
     /// Read a spec file and make its variants ([`CliOverrides::variants`]).
-    pub fn load_variants(path: &Path, profile: Option<&str>, cli: &CliOverrides) -> Result<Vec<Spec>, SpecError> {
+    pub fn load_variants(
+        path: &Path,
+        profile: Option<&str>,
+        cli: &CliOverrides,
+    ) -> Result<Vec<Spec>, SpecError> {
         let shown = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| SpecError(format!("{shown}: cannot read spec: {e}")))?;
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| SpecError(format!("{shown}: cannot read spec: {e}")))?;
         cli.variants(&shown, &text, profile)
     }
 
@@ -337,10 +400,17 @@ impl Spec {
         super::limits::check(self)?;
         let families = super::family::present(self);
         match families.len() {
-            0 => return Err(SpecError(format!("{}: the spec has no experiment section (add one of {})", self.path, super::family::section_list()))),
+            0 => {
+                return Err(SpecError(format!(
+                    "{}: the spec has no experiment section (add one of {})",
+                    self.path,
+                    super::family::section_list()
+                )))
+            }
             1 => {}
             _ => {
-                let names: Vec<String> = families.iter().map(|f| format!("[{}]", f.section())).collect();
+                let names: Vec<String> =
+                    families.iter().map(|f| format!("[{}]", f.section())).collect();
                 return Err(SpecError(format!("{}: one experiment section per spec, this one has {} (they write the same files: split the spec)", self.path, names.join(" and "))));
             }
         }
@@ -349,7 +419,15 @@ impl Spec {
 
     /// The checks every optimisation section shares: its optimiser names (from `allowed`),
     /// repeats, generations and population, each error naming `<section>.<key>`.
-    pub(crate) fn validate_runs(&self, section: &str, optimisers: &[String], allowed: &[&str], repeats: usize, generations: u64, population: usize) -> Result<(), SpecError> {
+    pub(crate) fn validate_runs(
+        &self,
+        section: &str,
+        optimisers: &[String],
+        allowed: &[&str],
+        repeats: usize,
+        generations: u64,
+        population: usize,
+    ) -> Result<(), SpecError> {
         let key = |k: &str| format!("{section}.{k}");
         if optimisers.is_empty() {
             return Err(self.err(&key("optimisers"), "is empty"));
@@ -361,7 +439,10 @@ impl Spec {
         };
         for name in optimisers {
             if !allowed.contains(&name.as_str()) {
-                return Err(self.err(&key("optimisers"), format!("unknown optimiser `{name}` (expected {expected})")));
+                return Err(self.err(
+                    &key("optimisers"),
+                    format!("unknown optimiser `{name}` (expected {expected})"),
+                ));
             }
         }
         if repeats == 0 {
@@ -371,16 +452,25 @@ impl Spec {
             return Err(self.err(&key("generations"), "must be at least 1"));
         }
         if population < 4 {
-            return Err(self.err(&key("population"), format!("must be at least 4 (DE/rand/1 needs four), got {population}")));
+            return Err(self.err(
+                &key("population"),
+                format!("must be at least 4 (DE/rand/1 needs four), got {population}"),
+            ));
         }
         Ok(())
     }
 
     /// The optimisers' own parameter checks, their keys placed under `section`.
-    pub(crate) fn validate_optimiser_params<const N: usize>(&self, section: &str, checks: [Result<(), crate::optim::OptimError>; N]) -> Result<(), SpecError> {
+    pub(crate) fn validate_optimiser_params<const N: usize>(
+        &self,
+        section: &str,
+        checks: [Result<(), crate::optim::OptimError>; N],
+    ) -> Result<(), SpecError> {
         for check in checks {
             check.map_err(|e| match e {
-                crate::optim::OptimError::InvalidParameter { key, message } => self.err(&format!("{section}.{key}"), message),
+                crate::optim::OptimError::InvalidParameter { key, message } => {
+                    self.err(&format!("{section}.{key}"), message)
+                }
                 other => self.err(section, other),
             })?;
         }
@@ -432,17 +522,34 @@ iterations = 7
         let ov = |k: &str, v: toml::Value| Override { key: k.into(), value: v };
         let plain = Spec::parse("f.toml", text, Some("quick")).unwrap();
         let fit = plain.file.fit.as_ref().unwrap();
-        assert_eq!((fit.knots, fit.error_a, fit.fairness), (crate::spline::KnotRule::Eq2_10, crate::spline::ErrorA::PerSurface, 0.5));
-        let set = [ov("fit.knots", "nurbs_book".into()), ov("fit.error_a", "nov_bottom".into()), ov("optim.knots", "nurbs_book".into())];
+        assert_eq!(
+            (fit.knots, fit.error_a, fit.fairness),
+            (crate::spline::KnotRule::Eq2_10, crate::spline::ErrorA::PerSurface, 0.5)
+        );
+        let set = [
+            ov("fit.knots", "nurbs_book".into()),
+            ov("fit.error_a", "nov_bottom".into()),
+            ov("optim.knots", "nurbs_book".into()),
+        ];
         let s = Spec::parse_with("f.toml", text, Some("quick"), &set).unwrap();
         let fit = s.file.fit.as_ref().unwrap();
-        assert_eq!((fit.knots, fit.error_a, fit.fairness), (crate::spline::KnotRule::NurbsBook, crate::spline::ErrorA::NovBottom, 0.5));
+        assert_eq!(
+            (fit.knots, fit.error_a, fit.fairness),
+            (crate::spline::KnotRule::NurbsBook, crate::spline::ErrorA::NovBottom, 0.5)
+        );
         assert!(s.file.optim.is_none(), "a key of an absent section is skipped");
-        let e = Spec::parse_with("f.toml", text, None, &[ov("fit.knots", "9.69".into())]).unwrap_err().to_string();
+        let e = Spec::parse_with("f.toml", text, None, &[ov("fit.knots", "9.69".into())])
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("fit.knots") && e.contains("9.69"), "{e}");
-        let e = Spec::parse_with("f.toml", text, None, &[ov("fit.fairness", toml::Value::Float(-1.0))]).unwrap_err().to_string();
+        let e =
+            Spec::parse_with("f.toml", text, None, &[ov("fit.fairness", toml::Value::Float(-1.0))])
+                .unwrap_err()
+                .to_string();
         assert!(e.contains("fit.fairness"), "{e}");
-        let e = Spec::parse_with("f.toml", text, None, &[ov("fit.colour", "red".into())]).unwrap_err().to_string();
+        let e = Spec::parse_with("f.toml", text, None, &[ov("fit.colour", "red".into())])
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("colour"), "{e}");
     }
 
@@ -450,7 +557,10 @@ iterations = 7
     fn exactly_one_experiment_section() {
         let none = "name = \"t\"\nmaster_seed = 1\n";
         let e = Spec::parse("t.toml", none, None).unwrap_err().0;
-        assert!(e.contains("no experiment section") && e.contains("[som]") && e.contains("[seed002]"), "{e}");
+        assert!(
+            e.contains("no experiment section") && e.contains("[som]") && e.contains("[seed002]"),
+            "{e}"
+        );
         let two = format!("{SPEC}\n[seed002]\nsurfaces = [\"surface1\"]\n");
         let e = Spec::parse("t.toml", &two, None).unwrap_err().0;
         assert!(e.contains("[som] and [seed002]"), "{e}");

@@ -13,4 +13,12 @@ pub mod som;
 use crate::experiment::family::Family;
 
 /// Every family the harness knows, in the order their sections are named in messages.
-pub static FAMILIES: &[&dyn Family] = &[&som::Som, &fit::Fit, &optimise::Optim, &growing_grid::Seed001, &rational_bezier::Seed002, &cuckoo_bezier::Seed003, &closed_cylinder::Seed004];
+pub static FAMILIES: &[&dyn Family] = &[
+    &som::Som,
+    &fit::Fit,
+    &optimise::Optim,
+    &growing_grid::Seed001,
+    &rational_bezier::Seed002,
+    &cuckoo_bezier::Seed003,
+    &closed_cylinder::Seed004,
+];

@@ -39,19 +39,25 @@ pub fn read_text(path: &Path) -> Result<String> {
     fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))
 }
 
-
 /// Typed rows of a CSV file (extra columns ignored); errors name the file and line.
 pub fn read_rows<T: serde::de::DeserializeOwned>(path: &Path) -> Result<Vec<T>> {
     let text = read_text(path)?;
     let mut rd = csv::Reader::from_reader(text.as_bytes());
-    rd.deserialize().enumerate().map(|(k, r)| r.with_context(|| format!("{}: line {}", path.display(), k + 2))).collect()
+    rd.deserialize()
+        .enumerate()
+        .map(|(k, r)| r.with_context(|| format!("{}: line {}", path.display(), k + 2)))
+        .collect()
 }
 
 /// A CSV field with a negative zero ("-0", "-0.0000", "-0e0": an empty f64 sum, or a small negative
 /// value rounded for print) written as zero; every other field unchanged.
 fn no_negative_zero(field: &str) -> &str {
     match field.strip_prefix('-') {
-        Some(rest) if rest.starts_with(|c: char| c.is_ascii_digit()) && rest.parse::<f64>() == Ok(0.0) => rest,
+        Some(rest)
+            if rest.starts_with(|c: char| c.is_ascii_digit()) && rest.parse::<f64>() == Ok(0.0) =>
+        {
+            rest
+        }
         _ => field,
     }
 }
@@ -94,7 +100,15 @@ mod tests {
     #[test]
     fn no_negative_zero_in_csv() {
         let h = vec!["a".to_string(), "b".to_string(), "c".to_string(), "d".to_string()];
-        let rows = vec![vec!["-0".to_string(), "-0.0000".to_string(), "-1e-300".to_string(), "-x".to_string()], vec![format!("{}", -0.0f64), format!("{:e}", -0.0f64), "-0.5".to_string(), "-".to_string()]];
+        let rows = vec![
+            vec!["-0".to_string(), "-0.0000".to_string(), "-1e-300".to_string(), "-x".to_string()],
+            vec![
+                format!("{}", -0.0f64),
+                format!("{:e}", -0.0f64),
+                "-0.5".to_string(),
+                "-".to_string(),
+            ],
+        ];
         assert_eq!(csv_records(&h, &rows).unwrap(), "a,b,c,d\n0,0.0000,-1e-300,-x\n0,0e0,-0.5,-\n");
         let t = csv_text(&[Row { name: "-0", v: -0.0 }, Row { name: "a,b", v: -2.5 }]).unwrap();
         assert_eq!(t, "name,v\n0,0.0\n\"a,b\",-2.5\n");
@@ -106,7 +120,11 @@ mod tests {
         let p = dir.path().join("a/b.csv");
         write_atomic(&p, b"x,y\n").unwrap();
         assert_eq!(fs::read_to_string(&p).unwrap(), "x,y\n");
-        assert_eq!(fs::read_dir(dir.path().join("a")).unwrap().count(), 1, "no temporary file left");
+        assert_eq!(
+            fs::read_dir(dir.path().join("a")).unwrap().count(),
+            1,
+            "no temporary file left"
+        );
         let blocked = dir.path().join("a/b.csv/c.csv");
         let e = format!("{:#}", write_atomic(&blocked, b"1").unwrap_err());
         assert!(e.contains("b.csv"), "{e}");

@@ -54,7 +54,9 @@ pub fn temp_name(path: &Path, what: &str) -> PathBuf {
 /// `fsync` a folder, so that renames and creations in it are durable.
 pub fn sync_dir(dir: &Path) -> Result<()> {
     let dir = if dir.as_os_str().is_empty() { Path::new(".") } else { dir };
-    File::open(dir).and_then(|f| f.sync_all()).with_context(|| format!("cannot sync folder {}", dir.display()))
+    File::open(dir)
+        .and_then(|f| f.sync_all())
+        .with_context(|| format!("cannot sync folder {}", dir.display()))
 }
 
 pub fn host_name() -> String {
@@ -79,11 +81,19 @@ struct Holder {
 
 impl Holder {
     fn me(command: &str) -> Holder {
-        Holder { host: host_name(), pid: std::process::id(), since: now_unix(), command: command.to_string() }
+        Holder {
+            host: host_name(),
+            pid: std::process::id(),
+            since: now_unix(),
+            command: command.to_string(),
+        }
     }
 
     fn text(&self) -> String {
-        format!("host = {:?}\npid = {}\nsince_unix = {}\ncommand = {:?}\n", self.host, self.pid, self.since, self.command)
+        format!(
+            "host = {:?}\npid = {}\nsince_unix = {}\ncommand = {:?}\n",
+            self.host, self.pid, self.since, self.command
+        )
     }
 
     fn parse(text: &str) -> Option<Holder> {
@@ -99,7 +109,10 @@ impl Holder {
     }
 
     fn describe(&self) -> String {
-        format!("`somnurbs {}`, pid {} on host {}, since unix time {}", self.command, self.pid, self.host, self.since)
+        format!(
+            "`somnurbs {}`, pid {} on host {}, since unix time {}",
+            self.command, self.pid, self.host, self.since
+        )
     }
 }
 
@@ -126,7 +139,9 @@ fn try_flock(f: &File, op: libc::c_int) -> Result<Flock> {
     let e = std::io::Error::last_os_error();
     match e.raw_os_error() {
         Some(libc::EWOULDBLOCK) => Ok(Flock::Busy),
-        Some(libc::ENOLCK) | Some(libc::EINVAL) | Some(libc::EOPNOTSUPP) | Some(libc::ENOSYS) => Ok(Flock::Unsupported),
+        Some(libc::ENOLCK) | Some(libc::EINVAL) | Some(libc::EOPNOTSUPP) | Some(libc::ENOSYS) => {
+            Ok(Flock::Unsupported)
+        }
         _ => Err(e.into()),
     }
 }
@@ -147,7 +162,12 @@ fn live_record(holder: &Holder, file: &File, flock_held: bool) -> Option<String>
         // flock is authoritative on one host: if we hold it, the recorded process is gone.
         return (!flock_held && pid_alive(holder.pid)).then(|| holder.describe());
     }
-    let age = file.metadata().and_then(|m| m.modified()).ok().and_then(|t| SystemTime::now().duration_since(t).ok()).unwrap_or(Duration::ZERO);
+    let age = file
+        .metadata()
+        .and_then(|m| m.modified())
+        .ok()
+        .and_then(|t| SystemTime::now().duration_since(t).ok())
+        .unwrap_or(Duration::ZERO);
     (age < STALE_AFTER).then(|| format!("{} (its last heartbeat {} s ago; a record older than {} s counts as left by a dead writer)", holder.describe(), age.as_secs(), STALE_AFTER.as_secs()))
 }
 
@@ -170,11 +190,29 @@ impl std::fmt::Debug for Lock {
 pub fn lock(dir: &Path, command: &str) -> Result<Lock> {
     crate::io::ensure_dir(dir)?;
     let path = dir.join(LOCK_FILE);
-    let mut file = OpenOptions::new().read(true).write(true).create(true).truncate(false).open(&path).with_context(|| format!("output folder {} is not writable (cannot open {LOCK_FILE})", dir.display()))?;
-    let refused = |who: String| anyhow::anyhow!("output folder {} is in use by another writer: {who}; wait for it to finish or choose another folder", dir.display());
-    let held = match try_flock(&file, libc::LOCK_EX).with_context(|| format!("cannot lock {}", path.display()))? {
+    let mut file = OpenOptions::new()
+        .read(true)
+        .write(true)
+        .create(true)
+        .truncate(false)
+        .open(&path)
+        .with_context(|| {
+            format!("output folder {} is not writable (cannot open {LOCK_FILE})", dir.display())
+        })?;
+    let refused = |who: String| {
+        anyhow::anyhow!("output folder {} is in use by another writer: {who}; wait for it to finish or choose another folder", dir.display())
+    };
+    let held = match try_flock(&file, libc::LOCK_EX)
+        .with_context(|| format!("cannot lock {}", path.display()))?
+    {
         Flock::Held => true,
-        Flock::Busy => return Err(refused(read_holder(&mut file).map(|h| h.describe()).unwrap_or_else(|| "a process that has not written its record yet".into()))),
+        Flock::Busy => {
+            return Err(refused(
+                read_holder(&mut file)
+                    .map(|h| h.describe())
+                    .unwrap_or_else(|| "a process that has not written its record yet".into()),
+            ))
+        }
         Flock::Unsupported => false,
     };
     if let Some(h) = read_holder(&mut file) {
@@ -183,10 +221,14 @@ pub fn lock(dir: &Path, command: &str) -> Result<Lock> {
         }
     }
     let me = Holder::me(command);
-    write_record(&mut file, &me.text()).with_context(|| format!("cannot write {}", path.display()))?;
+    write_record(&mut file, &me.text())
+        .with_context(|| format!("cannot write {}", path.display()))?;
     let stop = Arc::new(AtomicBool::new(false));
     let heartbeat = {
-        let (stop, file) = (stop.clone(), file.try_clone().with_context(|| format!("cannot lock {}", path.display()))?);
+        let (stop, file) = (
+            stop.clone(),
+            file.try_clone().with_context(|| format!("cannot lock {}", path.display()))?,
+        );
         std::thread::Builder::new()
             .name("somnurbs-lock".into())
             .spawn(move || {
@@ -239,9 +281,13 @@ impl Drop for Lock {
 pub fn require_not_being_written(dir: &Path) -> Result<()> {
     let path = dir.join(LOCK_FILE);
     let Ok(mut file) = File::open(&path) else { return Ok(()) };
-    let held = match try_flock(&file, libc::LOCK_SH).with_context(|| format!("cannot check the lock {}", path.display()))? {
+    let held = match try_flock(&file, libc::LOCK_SH)
+        .with_context(|| format!("cannot check the lock {}", path.display()))?
+    {
         Flock::Busy => {
-            let who = read_holder(&mut file).map(|h| h.describe()).unwrap_or_else(|| "another process".into());
+            let who = read_holder(&mut file)
+                .map(|h| h.describe())
+                .unwrap_or_else(|| "another process".into());
             bail!("{} is being written by {who}; wait for it to finish", dir.display());
         }
         Flock::Held => true,
@@ -261,18 +307,25 @@ pub fn walk(dir: &Path) -> Result<(Vec<PathBuf>, Vec<PathBuf>)> {
     let mut stack = vec![(PathBuf::new(), 0usize)];
     while let Some((rel, depth)) = stack.pop() {
         let here = dir.join(&rel);
-        let rd = fs::read_dir(&here).with_context(|| format!("cannot read folder {}", here.display()))?;
+        let rd = fs::read_dir(&here)
+            .with_context(|| format!("cannot read folder {}", here.display()))?;
         for e in rd {
             let e = e.with_context(|| format!("cannot read folder {}", here.display()))?;
-            let ty = e.file_type().with_context(|| format!("cannot read {}", e.path().display()))?;
+            let ty =
+                e.file_type().with_context(|| format!("cannot read {}", e.path().display()))?;
             let sub = rel.join(e.file_name());
             if ty.is_dir() {
                 if depth + 1 > MAX_DEPTH {
-                    bail!("{}: folders nested more than {MAX_DEPTH} deep", dir.join(&sub).display());
+                    bail!(
+                        "{}: folders nested more than {MAX_DEPTH} deep",
+                        dir.join(&sub).display()
+                    );
                 }
                 dirs.push(sub.clone());
                 stack.push((sub, depth + 1));
-            } else if ty.is_file() || (ty.is_symlink() && fs::metadata(e.path()).is_ok_and(|m| m.is_file())) {
+            } else if ty.is_file()
+                || (ty.is_symlink() && fs::metadata(e.path()).is_ok_and(|m| m.is_file()))
+            {
                 files.push(sub);
             }
         }
@@ -313,8 +366,10 @@ pub fn require_finished(dir: &Path, role: &str) -> Result<()> {
             continue;
         }
         let p = shown.join(MANIFEST);
-        let text = fs::read_to_string(&p).with_context(|| format!("cannot read {}", p.display()))?;
-        let m: ManifestShard = toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {}", p.display(), e.message()))?;
+        let text =
+            fs::read_to_string(&p).with_context(|| format!("cannot read {}", p.display()))?;
+        let m: ManifestShard = toml::from_str(&text)
+            .map_err(|e| anyhow::anyhow!("{}: {}", p.display(), e.message()))?;
         if let Some(s) = m.shard {
             bail!("{role} {} holds shard {s} of a run only (no tables); combine the shards with `somnurbs merge` first", shown.display());
         }
@@ -334,23 +389,31 @@ pub fn replace_dir(target: &Path, build: impl FnOnce(&Path) -> Result<()>) -> Re
         let _ = fs::remove_dir_all(&staged);
         return Err(e);
     }
-    let swapped = if target.exists() { exchange(&staged, target) } else { fs::rename(&staged, target).map(|()| true) };
+    let swapped = if target.exists() {
+        exchange(&staged, target)
+    } else {
+        fs::rename(&staged, target).map(|()| true)
+    };
     match swapped {
         Ok(true) => {}
         Ok(false) => {
             // No RENAME_EXCHANGE here: move the old folder aside, then the new one in.
             let old = temp_name(target, "old");
-            fs::rename(target, &old).with_context(|| format!("cannot move {} aside", target.display()))?;
+            fs::rename(target, &old)
+                .with_context(|| format!("cannot move {} aside", target.display()))?;
             if let Err(e) = fs::rename(&staged, target) {
                 let _ = fs::rename(&old, target);
                 let _ = fs::remove_dir_all(&staged);
-                return Err(e).with_context(|| format!("cannot move the new {} in place", target.display()));
+                return Err(e)
+                    .with_context(|| format!("cannot move the new {} in place", target.display()));
             }
             let _ = fs::remove_dir_all(&old);
         }
         Err(e) => {
             let _ = fs::remove_dir_all(&staged);
-            return Err(e).with_context(|| format!("cannot swap {} into {}", staged.display(), target.display()));
+            return Err(e).with_context(|| {
+                format!("cannot swap {} into {}", staged.display(), target.display())
+            });
         }
     }
     // After an exchange, `staged` holds the old folder.
@@ -363,10 +426,22 @@ pub fn replace_dir(target: &Path, build: impl FnOnce(&Path) -> Result<()>) -> Re
 /// Atomically exchange two paths; Ok(false) if the file system cannot.
 fn exchange(a: &Path, b: &Path) -> std::io::Result<bool> {
     use std::os::unix::ffi::OsStrExt;
-    let c = |p: &Path| std::ffi::CString::new(p.as_os_str().as_bytes()).map_err(|_| std::io::Error::new(std::io::ErrorKind::InvalidInput, "path holds a NUL byte"));
+    let c = |p: &Path| {
+        std::ffi::CString::new(p.as_os_str().as_bytes()).map_err(|_| {
+            std::io::Error::new(std::io::ErrorKind::InvalidInput, "path holds a NUL byte")
+        })
+    };
     let (ca, cb) = (c(a)?, c(b)?);
     // SAFETY: two NUL-terminated paths relative to the working folder.
-    let rc = unsafe { libc::renameat2(libc::AT_FDCWD, ca.as_ptr(), libc::AT_FDCWD, cb.as_ptr(), libc::RENAME_EXCHANGE) };
+    let rc = unsafe {
+        libc::renameat2(
+            libc::AT_FDCWD,
+            ca.as_ptr(),
+            libc::AT_FDCWD,
+            cb.as_ptr(),
+            libc::RENAME_EXCHANGE,
+        )
+    };
     if rc == 0 {
         return Ok(true);
     }
@@ -386,7 +461,12 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let a = lock(dir.path(), "run a.toml").unwrap();
         let e = lock(dir.path(), "run b.toml").unwrap_err().to_string();
-        assert!(e.contains("in use") && e.contains(&format!("pid {}", std::process::id())) && e.contains("run a.toml"), "{e}");
+        assert!(
+            e.contains("in use")
+                && e.contains(&format!("pid {}", std::process::id()))
+                && e.contains("run a.toml"),
+            "{e}"
+        );
         assert!(require_not_being_written(dir.path()).is_err());
         drop(a);
         require_not_being_written(dir.path()).unwrap();
@@ -396,15 +476,26 @@ mod tests {
     #[test]
     fn a_fresh_record_of_another_host_refuses_and_a_stale_one_does_not() {
         let dir = tempfile::tempdir().unwrap();
-        let other = Holder { host: "elsewhere-node-17".into(), pid: 4242, since: 1, command: "run x.toml".into() };
+        let other = Holder {
+            host: "elsewhere-node-17".into(),
+            pid: 4242,
+            since: 1,
+            command: "run x.toml".into(),
+        };
         fs::write(dir.path().join(LOCK_FILE), other.text()).unwrap();
         let e = lock(dir.path(), "run y.toml").unwrap_err().to_string();
         assert!(e.contains("elsewhere-node-17") && e.contains("pid 4242"), "{e}");
         let old = SystemTime::now() - STALE_AFTER - Duration::from_secs(5);
-        File::options().write(true).open(dir.path().join(LOCK_FILE)).unwrap().set_modified(old).unwrap();
+        File::options()
+            .write(true)
+            .open(dir.path().join(LOCK_FILE))
+            .unwrap()
+            .set_modified(old)
+            .unwrap();
         drop(lock(dir.path(), "run y.toml").unwrap());
         // A dead process of this host does not hold a folder either.
-        let dead = Holder { host: host_name(), pid: 999_999_999, since: 1, command: "run z.toml".into() };
+        let dead =
+            Holder { host: host_name(), pid: 999_999_999, since: 1, command: "run z.toml".into() };
         fs::write(dir.path().join(LOCK_FILE), dead.text()).unwrap();
         drop(lock(dir.path(), "run y.toml").unwrap());
     }
@@ -429,14 +520,20 @@ mod tests {
         fs::write(run.join("runs.csv"), "a\n1\n").unwrap();
         fs::write(run.join("cells.jsonl"), "").unwrap();
         let e = require_finished(dir.path(), "the current folder").unwrap_err().to_string();
-        assert!(e.contains("ch4") && e.contains("no manifest.toml") && e.contains("cells.jsonl"), "{e}");
+        assert!(
+            e.contains("ch4") && e.contains("no manifest.toml") && e.contains("cells.jsonl"),
+            "{e}"
+        );
         fs::write(run.join(MANIFEST), "shard = \"2/3\"\n").unwrap();
         let e = require_finished(dir.path(), "x").unwrap_err().to_string();
         assert!(e.contains("shard 2/3"), "{e}");
         fs::write(run.join(MANIFEST), "spec_name = \"x\"\n").unwrap();
         require_finished(dir.path(), "x").unwrap();
         fs::write(dir.path().join(INCOMPLETE), "").unwrap();
-        assert!(require_finished(dir.path(), "x").unwrap_err().to_string().contains("reproduction did not complete"));
+        assert!(require_finished(dir.path(), "x")
+            .unwrap_err()
+            .to_string()
+            .contains("reproduction did not complete"));
     }
 
     #[test]
@@ -453,7 +550,10 @@ mod tests {
         assert_eq!(fs::read_to_string(target.join("a.csv")).unwrap(), "old");
         replace_dir(&target, |d| Ok(fs::write(d.join("b.csv"), "new")?)).unwrap();
         assert!(!target.join("a.csv").exists() && target.join("b.csv").exists());
-        let names: Vec<String> = fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect();
+        let names: Vec<String> = fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
         assert_eq!(names, vec!["base"], "no temporary folder left behind");
     }
 }

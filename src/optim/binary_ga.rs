@@ -71,7 +71,10 @@ impl BinaryGaRun {
 impl BinaryGa {
     pub fn validate(&self) -> Result<(), OptimError> {
         if !(1..=32).contains(&self.bits) {
-            return Err(OptimError::param("binary_ga.bits", format!("must be in [1,32], got {}", self.bits)));
+            return Err(OptimError::param(
+                "binary_ga.bits",
+                format!("must be in [1,32], got {}", self.bits),
+            ));
         }
         check_range("binary_ga.pc", self.pc, 0.0, 1.0)?;
         check_range("binary_ga.swap", self.swap, 0.0, 1.0)?;
@@ -86,7 +89,9 @@ impl BinaryGa {
             return vec![1.0];
         }
         let alpha = 2.0 - self.beta;
-        (0..mu).map(|r| (alpha + r as f64 / (mu - 1) as f64 * (self.beta - alpha)) / mu as f64).collect()
+        (0..mu)
+            .map(|r| (alpha + r as f64 / (mu - 1) as f64 * (self.beta - alpha)) / mu as f64)
+            .collect()
     }
 
     /// Decode variable `j` of a chromosome (bits MSB first, packed 64 to a word).
@@ -98,30 +103,50 @@ impl BinaryGa {
             for t in j * b..(j + 1) * b {
                 k = (k << 1) | ((chrom[t / 64] >> (t % 64)) & 1);
             }
-            *xj = if hi[j] > lo[j] { (lo[j] + (hi[j] - lo[j]) * (k as f64 / top)).min(hi[j]) } else { lo[j] };
+            *xj = if hi[j] > lo[j] {
+                (lo[j] + (hi[j] - lo[j]) * (k as f64 / top)).min(hi[j])
+            } else {
+                lo[j]
+            };
         }
     }
 
     /// One run with its per-generation history.
-    pub fn run_with_history(&self, problem: &dyn Problem, budget: &Budget, rng: &mut ChaCha8Rng) -> Result<BinaryGaRun, OptimError> {
+    pub fn run_with_history(
+        &self,
+        problem: &dyn Problem,
+        budget: &Budget,
+        rng: &mut ChaCha8Rng,
+    ) -> Result<BinaryGaRun, OptimError> {
         self.validate()?;
         budget.validate(2)?;
         check_problem(problem)?;
         if self.elitism >= budget.population {
-            return Err(OptimError::param("binary_ga.elitism", format!("must be below the population ({}), got {}", budget.population, self.elitism)));
+            return Err(OptimError::param(
+                "binary_ga.elitism",
+                format!(
+                    "must be below the population ({}), got {}",
+                    budget.population, self.elitism
+                ),
+            ));
         }
         let d = problem.dim();
         let (lo, hi) = problem.bounds();
         let nbits = d * self.bits as usize;
         let words = nbits.div_ceil(64);
-        let tail_mask = if nbits.is_multiple_of(64) { u64::MAX } else { (1u64 << (nbits % 64)) - 1 };
+        let tail_mask =
+            if nbits.is_multiple_of(64) { u64::MAX } else { (1u64 << (nbits % 64)) - 1 };
         let mu = budget.population;
         let mut eval = Evaluator::new(problem, budget);
         let mut x = vec![0.0; d];
         let mut best_x = vec![0.0; d];
         // The best individual so far (the first evaluated one until a finite value improves on it).
         let mut best_f: Option<f64> = None;
-        let evaluate = |chrom: &[u64], eval: &mut Evaluator, x: &mut [f64], best_x: &mut [f64], best_f: &mut Option<f64>| {
+        let evaluate = |chrom: &[u64],
+                        eval: &mut Evaluator,
+                        x: &mut [f64],
+                        best_x: &mut [f64],
+                        best_f: &mut Option<f64>| {
             self.decode(chrom, lo, hi, x);
             let f = eval.eval(x);
             if best_f.is_none_or(|b| f < b) {
@@ -139,7 +164,8 @@ impl BinaryGa {
                 c
             })
             .collect();
-        let mut f: Vec<f64> = pop.iter().map(|c| evaluate(c, &mut eval, &mut x, &mut best_x, &mut best_f)).collect();
+        let mut f: Vec<f64> =
+            pop.iter().map(|c| evaluate(c, &mut eval, &mut x, &mut best_x, &mut best_f)).collect();
         let pop_best = |f: &[f64]| f.iter().cloned().fold(f64::INFINITY, f64::min);
         let initial_best = pop_best(&f);
         let mut population_best = vec![initial_best];
@@ -190,7 +216,10 @@ impl BinaryGa {
             for c in children.iter_mut() {
                 mutation.for_each(nbits, &mut pool, rng, |t| c[t / 64] ^= 1u64 << (t % 64));
             }
-            let mut fc: Vec<f64> = children.iter().map(|c| evaluate(c, &mut eval, &mut x, &mut best_x, &mut best_f)).collect();
+            let mut fc: Vec<f64> = children
+                .iter()
+                .map(|c| evaluate(c, &mut eval, &mut x, &mut best_x, &mut best_f))
+                .collect();
             if self.elitism > 0 {
                 // order is worst-first over the parents: the best are at its end.
                 let mut child_order: Vec<usize> = (0..mu).collect();
@@ -216,7 +245,12 @@ impl Optimiser for BinaryGa {
         "binary_ga"
     }
 
-    fn run(&self, problem: &dyn Problem, budget: &Budget, rng: &mut ChaCha8Rng) -> Result<RunResult, OptimError> {
+    fn run(
+        &self,
+        problem: &dyn Problem,
+        budget: &Budget,
+        rng: &mut ChaCha8Rng,
+    ) -> Result<RunResult, OptimError> {
         self.run_with_history(problem, budget, rng).map(|r| r.result)
     }
 }
@@ -231,7 +265,9 @@ mod tests {
     #[test]
     fn binary_ga_passes_the_common_checks() {
         check(&BinaryGa::default(), |b| b.population as u64 * (b.generations + 1));
-        check(&BinaryGa { elitism: 1, pc: 0.9, ..BinaryGa::default() }, |b| b.population as u64 * (b.generations + 1));
+        check(&BinaryGa { elitism: 1, pc: 0.9, ..BinaryGa::default() }, |b| {
+            b.population as u64 * (b.generations + 1)
+        });
     }
 
     #[test]
@@ -269,10 +305,13 @@ mod tests {
         let ga = BinaryGa::default();
         let p = ga.rank_probabilities(5);
         let mut rng = ChaCha8Rng::seed_from_u64(9);
-        let cum: Vec<f64> = p.iter().scan(0.0, |s, v| {
-            *s += v;
-            Some(*s)
-        }).collect();
+        let cum: Vec<f64> = p
+            .iter()
+            .scan(0.0, |s, v| {
+                *s += v;
+                Some(*s)
+            })
+            .collect();
         let mut counts = [0usize; 5];
         let n = 100_000;
         for _ in 0..n {
@@ -288,8 +327,11 @@ mod tests {
     #[test]
     fn history_is_consistent_and_without_elitism_the_population_best_may_rise() {
         let p = Sphere::new(6);
-        let budget = Budget { generations: 60, population: 10, init_range: 0.0, trace_every_evals: 10 };
-        let r = BinaryGa::default().run_with_history(&p, &budget, &mut ChaCha8Rng::seed_from_u64(4)).unwrap();
+        let budget =
+            Budget { generations: 60, population: 10, init_range: 0.0, trace_every_evals: 10 };
+        let r = BinaryGa::default()
+            .run_with_history(&p, &budget, &mut ChaCha8Rng::seed_from_u64(4))
+            .unwrap();
         assert_eq!(r.population_best.len(), 61);
         assert_eq!(r.best_so_far.len(), 61);
         assert_eq!(r.population_best[0], r.result.initial_best_fitness);
@@ -301,17 +343,30 @@ mod tests {
         }
         assert_eq!(r.best_so_far[r.best_generation()], r.result.best_fitness);
         // With one elite the population best never rises.
-        let e = BinaryGa { elitism: 1, ..BinaryGa::default() }.run_with_history(&p, &budget, &mut ChaCha8Rng::seed_from_u64(4)).unwrap();
+        let e = BinaryGa { elitism: 1, ..BinaryGa::default() }
+            .run_with_history(&p, &budget, &mut ChaCha8Rng::seed_from_u64(4))
+            .unwrap();
         assert!(e.population_best.windows(2).all(|w| w[1] <= w[0]));
     }
 
     #[test]
     fn parameters_are_validated_by_key() {
-        assert_eq!(BinaryGa { beta: 2.5, ..BinaryGa::default() }.validate().unwrap_err().to_string(), "binary_ga.beta must be in [1,2], got 2.5");
-        assert!(BinaryGa { bits: 0, ..BinaryGa::default() }.validate().unwrap_err().to_string().starts_with("binary_ga.bits"));
+        assert_eq!(
+            BinaryGa { beta: 2.5, ..BinaryGa::default() }.validate().unwrap_err().to_string(),
+            "binary_ga.beta must be in [1,2], got 2.5"
+        );
+        assert!(BinaryGa { bits: 0, ..BinaryGa::default() }
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .starts_with("binary_ga.bits"));
         let p = Sphere::new(2);
-        let budget = Budget { generations: 2, population: 4, init_range: 0.0, trace_every_evals: 4 };
-        let e = BinaryGa { elitism: 4, ..BinaryGa::default() }.run(&p, &budget, &mut ChaCha8Rng::seed_from_u64(1)).unwrap_err().to_string();
+        let budget =
+            Budget { generations: 2, population: 4, init_range: 0.0, trace_every_evals: 4 };
+        let e = BinaryGa { elitism: 4, ..BinaryGa::default() }
+            .run(&p, &budget, &mut ChaCha8Rng::seed_from_u64(1))
+            .unwrap_err()
+            .to_string();
         assert!(e.starts_with("binary_ga.elitism"), "{e}");
         let g: BinaryGa = toml::from_str("bits = 12").unwrap();
         assert_eq!(g, BinaryGa { bits: 12, ..BinaryGa::default() });

@@ -32,9 +32,9 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::aligned::Aligned;
-use super::problem::{check_problem, Budget, Evaluator, Optimiser, Population, Problem, RunResult};
 use super::kernels::{clamp, de_trial, DeSources};
 use super::levy::{levy_fill, neg_ln};
+use super::problem::{check_problem, Budget, Evaluator, Optimiser, Population, Problem, RunResult};
 use super::sampling::{bernoulli_threshold_32, index, mantegna_sigma_u, unit, DeLanes};
 use super::{check_range, OptimError};
 use rand_chacha::ChaCha8Rng;
@@ -80,10 +80,16 @@ impl Default for Icsa {
 
 fn check_alpha_beta(prefix: &str, alpha: f64, beta: f64) -> Result<(), OptimError> {
     if !(alpha > 0.0 && alpha.is_finite()) {
-        return Err(OptimError::param(&format!("{prefix}.alpha"), format!("must be finite and > 0, got {alpha}")));
+        return Err(OptimError::param(
+            &format!("{prefix}.alpha"),
+            format!("must be finite and > 0, got {alpha}"),
+        ));
     }
     if !(beta > 0.0 && beta < 2.0) {
-        return Err(OptimError::param(&format!("{prefix}.beta"), format!("must be in (0,2), got {beta}")));
+        return Err(OptimError::param(
+            &format!("{prefix}.beta"),
+            format!("must be in (0,2), got {beta}"),
+        ));
     }
     Ok(())
 }
@@ -102,7 +108,10 @@ impl Icsa {
         check_alpha_beta("icsa", self.alpha, self.beta)?;
         if let Some(a) = self.alpha_min {
             if !(a > 0.0 && a.is_finite()) {
-                return Err(OptimError::param("icsa.alpha_min", format!("must be finite and > 0, got {a}")));
+                return Err(OptimError::param(
+                    "icsa.alpha_min",
+                    format!("must be finite and > 0, got {a}"),
+                ));
             }
         }
         Ok(())
@@ -125,7 +134,12 @@ impl Optimiser for Csa {
         "csa"
     }
 
-    fn run(&self, problem: &dyn Problem, budget: &Budget, rng: &mut ChaCha8Rng) -> Result<RunResult, OptimError> {
+    fn run(
+        &self,
+        problem: &dyn Problem,
+        budget: &Budget,
+        rng: &mut ChaCha8Rng,
+    ) -> Result<RunResult, OptimError> {
         self.validate()?;
         cuckoo_search(problem, budget, rng, self.beta, &|_| (self.pa, self.alpha))
     }
@@ -136,7 +150,12 @@ impl Optimiser for Icsa {
         "icsa"
     }
 
-    fn run(&self, problem: &dyn Problem, budget: &Budget, rng: &mut ChaCha8Rng) -> Result<RunResult, OptimError> {
+    fn run(
+        &self,
+        problem: &dyn Problem,
+        budget: &Budget,
+        rng: &mut ChaCha8Rng,
+    ) -> Result<RunResult, OptimError> {
         self.validate()?;
         cuckoo_search(problem, budget, rng, self.beta, &|t| self.schedule(t, budget.generations))
     }
@@ -270,10 +289,25 @@ mod tests {
 
     #[test]
     fn parameters_are_validated_by_key() {
-        assert_eq!(Csa { pa: 2.0, ..Csa::default() }.validate().unwrap_err().to_string(), "csa.pa must be in [0,1], got 2");
-        assert!(Icsa { pa_min: -0.5, ..Icsa::default() }.validate().unwrap_err().to_string().starts_with("icsa.pa_min"));
-        assert!(Csa { beta: 2.5, ..Csa::default() }.validate().unwrap_err().to_string().starts_with("csa.beta"));
-        assert!(Icsa { alpha_min: Some(0.0), ..Icsa::default() }.validate().unwrap_err().to_string().starts_with("icsa.alpha_min"));
+        assert_eq!(
+            Csa { pa: 2.0, ..Csa::default() }.validate().unwrap_err().to_string(),
+            "csa.pa must be in [0,1], got 2"
+        );
+        assert!(Icsa { pa_min: -0.5, ..Icsa::default() }
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .starts_with("icsa.pa_min"));
+        assert!(Csa { beta: 2.5, ..Csa::default() }
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .starts_with("csa.beta"));
+        assert!(Icsa { alpha_min: Some(0.0), ..Icsa::default() }
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .starts_with("icsa.alpha_min"));
     }
 
     #[test]
@@ -316,7 +350,8 @@ mod tests {
         levy_factors(&mut s, &mut v, sigma, 1.5, &mut lanes);
         let mut s2 = vec![0.0; n];
         levy_factors(&mut s2, &mut v, sigma, 1.4999999999, &mut lanes);
-        let frac = |s: &[f64], t: f64| s.iter().filter(|x| x.abs() > t).count() as f64 / s.len() as f64;
+        let frac =
+            |s: &[f64], t: f64| s.iter().filter(|x| x.abs() > t).count() as f64 / s.len() as f64;
         for t in [0.05, 0.5, 2.0, 10.0, 100.0] {
             let (a, b) = (frac(&s, t), frac(&s2, t));
             let sd = (a * (1.0 - a) / n as f64).sqrt() * 2f64.sqrt();

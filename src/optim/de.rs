@@ -72,7 +72,12 @@ impl Optimiser for De {
         "de"
     }
 
-    fn run(&self, problem: &dyn Problem, budget: &Budget, rng: &mut ChaCha8Rng) -> Result<RunResult, OptimError> {
+    fn run(
+        &self,
+        problem: &dyn Problem,
+        budget: &Budget,
+        rng: &mut ChaCha8Rng,
+    ) -> Result<RunResult, OptimError> {
         self.validate()?;
         budget.validate(4)?;
         check_problem(problem)?;
@@ -96,10 +101,12 @@ impl Optimiser for De {
             for i in 0..n {
                 let (r1, r2, r3) = three_others(i, n, rng);
                 let j_rand = index(rng, d);
-                let (a, b, c, x) = (&pop.x[r1][..d], &pop.x[r2][..d], &pop.x[r3][..d], &pop.x[i][..d]);
+                let (a, b, c, x) =
+                    (&pop.x[r1][..d], &pop.x[r2][..d], &pop.x[r3][..d], &pop.x[i][..d]);
                 let t = &mut t_buf[..d];
                 de_trial(t, DeSources { a, b, c, x, lo, hi }, fw, &mut lanes, threshold);
-                t[j_rand] = de_mutant_gene(a[j_rand], b[j_rand], c[j_rand], fw, lo[j_rand], hi[j_rand]);
+                t[j_rand] =
+                    de_mutant_gene(a[j_rand], b[j_rand], c[j_rand], fw, lo[j_rand], hi[j_rand]);
                 let ft = eval.eval(t);
                 if ft <= pop.f[i] {
                     let next = spare.pop().unwrap_or_else(|| Aligned::zeros(d));
@@ -131,7 +138,10 @@ mod tests {
 
     #[test]
     fn parameters_are_validated_by_key() {
-        assert_eq!(De { cr: 1.5, f: 0.3 }.validate().unwrap_err().to_string(), "de.cr must be in [0,1], got 1.5");
+        assert_eq!(
+            De { cr: 1.5, f: 0.3 }.validate().unwrap_err().to_string(),
+            "de.cr must be in [0,1], got 1.5"
+        );
         assert!(De { cr: 0.5, f: -1.0 }.validate().unwrap_err().to_string().starts_with("de.f "));
         let p: De = toml::from_str("f = 0.8\ncr = 0.01").unwrap();
         assert_eq!(p, De::thesis_prose());
@@ -179,7 +189,8 @@ mod tests {
             let de = De { cr, f: 0.5 };
             // One generation from a population spread by init_range: every trial is accepted, so
             // the new population's genes equal a mutant gene with probability CR (+1/d).
-            let budget = Budget { generations: 1, population: 10, init_range: 0.5, trace_every_evals: 1000 };
+            let budget =
+                Budget { generations: 1, population: 10, init_range: 0.5, trace_every_evals: 1000 };
             let mut rng = ChaCha8Rng::seed_from_u64(9);
             let init = {
                 let mut r2 = rng.clone();

@@ -130,7 +130,15 @@ pub struct ExactResult {
 
 /// The certified lower bound LB(y) for a dual point y (rescaled into the unit balls if needed),
 /// evaluated around x (any x gives the same value in exact arithmetic; r must be A x - d).
-fn lower_bound_with(y: &mut [Point3], r: &[Point3], x: &[f64], lower: &[f64], upper: &[f64], pb: &dyn SumOfNorms, g: &mut [f64]) -> f64 {
+fn lower_bound_with(
+    y: &mut [Point3],
+    r: &[Point3],
+    x: &[f64],
+    lower: &[f64],
+    upper: &[f64],
+    pb: &dyn SumOfNorms,
+    g: &mut [f64],
+) -> f64 {
     let mut s = 0.0;
     for (yk, rk) in y.iter_mut().zip(r) {
         let n = crate::geom::norm(*yk);
@@ -308,7 +316,9 @@ fn reverse_cuthill_mckee(adj: &[Vec<usize>]) -> Vec<usize> {
                 if dist[w] == usize::MAX {
                     dist[w] = dist[v] + 1;
                     queue.push_back(w);
-                    if dist[w] > dist[last] || (dist[w] == dist[last] && adj[w].len() < adj[last].len()) {
+                    if dist[w] > dist[last]
+                        || (dist[w] == dist[last] && adj[w].len() < adj[last].len())
+                    {
                         last = w;
                     }
                 }
@@ -364,7 +374,15 @@ const SHIFT: f64 = 1e-14;
 const REFINE_STEPS: usize = 2;
 
 /// out = H v with H = sum_k A_k^T B_k A_k, B_k = (I - r r^T / s^2) / s (s^2 = |r|^2 + mu^2).
-fn hessian_apply(pb: &dyn SumOfNorms, r: &[Point3], mu: f64, v: &[f64], av: &mut [Point3], w: &mut [Point3], out: &mut [f64]) {
+fn hessian_apply(
+    pb: &dyn SumOfNorms,
+    r: &[Point3],
+    mu: f64,
+    v: &[f64],
+    av: &mut [Point3],
+    w: &mut [Point3],
+    out: &mut [f64],
+) {
     pb.residuals(v, av);
     for k in 0..r.len() {
         let data = pb.term(k).data;
@@ -379,7 +397,12 @@ fn hessian_apply(pb: &dyn SumOfNorms, r: &[Point3], mu: f64, v: &[f64], av: &mut
 }
 
 /// Check the inputs of the solver.
-fn check_inputs(pb: &dyn SumOfNorms, lower: &[f64], upper: &[f64], x_start: &[f64]) -> Result<(), OptimError> {
+fn check_inputs(
+    pb: &dyn SumOfNorms,
+    lower: &[f64],
+    upper: &[f64],
+    x_start: &[f64],
+) -> Result<(), OptimError> {
     let n = 3 * pb.n_points();
     if lower.len() != n || upper.len() != n || x_start.len() != n {
         return Err(OptimError::Problem(format!(
@@ -390,13 +413,22 @@ fn check_inputs(pb: &dyn SumOfNorms, lower: &[f64], upper: &[f64], x_start: &[f6
             x_start.len()
         )));
     }
-    if let Some(j) = (0..n).find(|&j| !lower[j].is_finite() || !upper[j].is_finite() || lower[j] > upper[j]) {
-        return Err(OptimError::Problem(format!("box of coordinate {j} is not a finite interval: [{}, {}]", lower[j], upper[j])));
+    if let Some(j) =
+        (0..n).find(|&j| !lower[j].is_finite() || !upper[j].is_finite() || lower[j] > upper[j])
+    {
+        return Err(OptimError::Problem(format!(
+            "box of coordinate {j} is not a finite interval: [{}, {}]",
+            lower[j], upper[j]
+        )));
     }
     for k in 0..pb.n_terms() {
         let t = pb.term(k);
         if t.points.len() != t.coefs.len() || t.points.iter().any(|&p| p >= pb.n_points()) {
-            return Err(OptimError::Problem(format!("term {k}: points {:?} do not match coefficients or exceed {}", t.points, pb.n_points())));
+            return Err(OptimError::Problem(format!(
+                "term {k}: points {:?} do not match coefficients or exceed {}",
+                t.points,
+                pb.n_points()
+            )));
         }
     }
     if x_start.iter().any(|v| !v.is_finite()) {
@@ -407,7 +439,13 @@ fn check_inputs(pb: &dyn SumOfNorms, lower: &[f64], upper: &[f64], x_start: &[f6
 
 /// Minimise f over the box [lower, upper] from `x_start` (clamped into the box), returning the
 /// best point found and a certified lower bound.
-pub fn solve_exact(pb: &dyn SumOfNorms, lower: &[f64], upper: &[f64], x_start: &[f64], opts: &ExactOptions) -> Result<ExactResult, OptimError> {
+pub fn solve_exact(
+    pb: &dyn SumOfNorms,
+    lower: &[f64],
+    upper: &[f64],
+    x_start: &[f64],
+    opts: &ExactOptions,
+) -> Result<ExactResult, OptimError> {
     check_inputs(pb, lower, upper, x_start)?;
     let np = pb.n_points();
     let n = 3 * np;
@@ -418,7 +456,9 @@ pub fn solve_exact(pb: &dyn SumOfNorms, lower: &[f64], upper: &[f64], x_start: &
             let mut s = o.clone();
             s.sort_unstable();
             if s != (0..np).collect::<Vec<_>>() {
-                return Err(OptimError::Problem("point_order is not a permutation of the points".into()));
+                return Err(OptimError::Problem(
+                    "point_order is not a permutation of the points".into(),
+                ));
             }
             o
         }
@@ -485,7 +525,9 @@ pub fn solve_exact(pb: &dyn SumOfNorms, lower: &[f64], upper: &[f64], x_start: &
     let mut rhs = vec![0.0; n];
     pb.residuals(&x, &mut r);
     let norm_sum = |r: &[Point3]| r.iter().map(|v| crate::geom::norm(*v)).sum::<f64>();
-    let smooth = |r: &[Point3], mu: f64| r.iter().map(|v| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + mu * mu).sqrt()).sum::<f64>();
+    let smooth = |r: &[Point3], mu: f64| {
+        r.iter().map(|v| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + mu * mu).sqrt()).sum::<f64>()
+    };
     let mut f = norm_sum(&r);
     let mut best_x = x.clone();
     let mut best_f = f;
@@ -507,7 +549,8 @@ pub fn solve_exact(pb: &dyn SumOfNorms, lower: &[f64], upper: &[f64], x_start: &
         // The smoothed certificate's gap splits into the smoothing part f - sum y.r and the box
         // part from the gradient left on the free variables; a stage ends when Newton has made
         // the latter smaller than the former.
-        let y_dot_r: f64 = y.iter().zip(&r).map(|(a, b)| a[0] * b[0] + a[1] * b[1] + a[2] * b[2]).sum();
+        let y_dot_r: f64 =
+            y.iter().zip(&r).map(|(a, b)| a[0] * b[0] + a[1] * b[1] + a[2] * b[2]).sum();
         let box_loss = (y_dot_r - lb_smooth).max(0.0);
         let smoothing_gap = (f - y_dot_r).max(0.0);
         let mut y_unit: Vec<Point3> = r
@@ -667,7 +710,11 @@ pub fn solve_exact(pb: &dyn SumOfNorms, lower: &[f64], upper: &[f64], x_start: &
             let s2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + mu * mu;
             let s = s2.sqrt();
             let vu = (v[0] * u[0] + v[1] * u[1] + v[2] * u[2]) / s2;
-            y_dual[k] = [y[k][0] + (u[0] - v[0] * vu) / s, y[k][1] + (u[1] - v[1] * vu) / s, y[k][2] + (u[2] - v[2] * vu) / s];
+            y_dual[k] = [
+                y[k][0] + (u[0] - v[0] * vu) / s,
+                y[k][1] + (u[1] - v[1] * vu) / s,
+                y[k][2] + (u[2] - v[2] * vu) / s,
+            ];
         }
         let lb_dual = lower_bound_with(&mut y_dual, &r, &x, lower, upper, pb, &mut g_scratch);
         best_lb = best_lb.max(lb_dual);
@@ -735,15 +782,22 @@ pub fn solve_exact(pb: &dyn SumOfNorms, lower: &[f64], upper: &[f64], x_start: &
         }
     }
     let gap = (best_f - best_lb).max(0.0);
-    Ok(ExactResult { x: best_x, f: best_f, lower_bound: best_lb, gap, iterations: steps, converged })
+    Ok(ExactResult {
+        x: best_x,
+        f: best_f,
+        lower_bound: best_lb,
+        gap,
+        iterations: steps,
+        converged,
+    })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::optim::problem::Problem;
     use crate::spline::control_net::test_support::sphere_problem;
     use crate::spline::control_net::BoxSpec;
-    use crate::optim::problem::Problem;
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
@@ -781,7 +835,11 @@ mod tests {
             }
             coefs.push(pts.iter().map(|_| rng.gen_range(-1.0..1.0)).collect());
             points.push(pts);
-            data.push([rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0)]);
+            data.push([
+                rng.gen_range(-1.0..1.0),
+                rng.gen_range(-1.0..1.0),
+                rng.gen_range(-1.0..1.0),
+            ]);
         }
         Plain { n, points, coefs, data }
     }
@@ -792,7 +850,17 @@ mod tests {
         let n: usize = 7;
         let first: Vec<usize> = (0..n).map(|r| r.saturating_sub(2)).collect();
         let mut env = Envelope::new(first);
-        let dense = |r: usize, c: usize| if r == c { 4.0 } else if r.abs_diff(c) == 1 { -1.0 } else if r.abs_diff(c) == 2 { 0.5 } else { 0.0 };
+        let dense = |r: usize, c: usize| {
+            if r == c {
+                4.0
+            } else if r.abs_diff(c) == 1 {
+                -1.0
+            } else if r.abs_diff(c) == 2 {
+                0.5
+            } else {
+                0.0
+            }
+        };
         for r in 0..n {
             for c in env.first[r]..=r {
                 let at = env.at(r, c);
@@ -811,7 +879,12 @@ mod tests {
     #[test]
     fn one_term_closed_form() {
         // f(x) = |2 x - d| for one point: min over the box is 2 |P(d/2) - d/2|.
-        let pb = Plain { n: 1, points: vec![vec![0]], coefs: vec![vec![2.0]], data: vec![[1.0, -3.0, 0.5]] };
+        let pb = Plain {
+            n: 1,
+            points: vec![vec![0]],
+            coefs: vec![vec![2.0]],
+            data: vec![[1.0, -3.0, 0.5]],
+        };
         let lower = [-1.0, -1.0, -1.0];
         let upper = [1.0, 1.0, 1.0];
         let tight = ExactOptions { tol_rel_gap: 1e-12, ..ExactOptions::default() };
@@ -855,7 +928,14 @@ mod tests {
             let lower = vec![-0.5; 3 * n];
             let upper = vec![0.7; 3 * n];
             let x0 = vec![0.1; 3 * n];
-            let res = solve_exact(&pb, &lower, &upper, &x0, &ExactOptions { max_newton_steps: 3, ..ExactOptions::default() }).unwrap();
+            let res = solve_exact(
+                &pb,
+                &lower,
+                &upper,
+                &x0,
+                &ExactOptions { max_newton_steps: 3, ..ExactOptions::default() },
+            )
+            .unwrap();
             // Certificates at arbitrary points are lower bounds too.
             let xa: Vec<f64> = (0..3 * n).map(|_| rng.gen_range(-0.5..0.7)).collect();
             let (_, lb_a) = certify(&pb, &lower, &upper, &xa);
@@ -896,14 +976,31 @@ mod tests {
         let pb = sphere_problem(20, 20, 10, 10, BoxSpec::Widened { fraction: 0.25 });
         let res = pb.exact_optimum(&ExactOptions::default()).unwrap();
         let f0 = pb.fitness(pb.initial_point());
-        assert!(res.gap <= 1e-6 * res.f, "{} {} {} after {} steps", res.f, res.lower_bound, res.gap, res.iterations);
+        assert!(
+            res.gap <= 1e-6 * res.f,
+            "{} {} {} after {} steps",
+            res.f,
+            res.lower_bound,
+            res.gap,
+            res.iterations
+        );
         assert!(res.f < f0, "{} vs start {f0}", res.f);
         assert!((pb.fitness(&res.x) - res.f).abs() < 1e-12 * res.f);
-        let budget = crate::optim::Budget { generations: 40, population: 10, init_range: 1e-3, trace_every_evals: 100 };
+        let budget = crate::optim::Budget {
+            generations: 40,
+            population: 10,
+            init_range: 1e-3,
+            trace_every_evals: 100,
+        };
         for name in ["ga", "de", "pso", "csa", "icsa"] {
             let opt = crate::optim::default_optimiser(name).unwrap();
             let run = opt.run(&pb, &budget, &mut ChaCha8Rng::seed_from_u64(1)).unwrap();
-            assert!(run.best_fitness >= res.lower_bound, "{name}: {} < {}", run.best_fitness, res.lower_bound);
+            assert!(
+                run.best_fitness >= res.lower_bound,
+                "{name}: {} < {}",
+                run.best_fitness,
+                res.lower_bound
+            );
         }
     }
 }
@@ -912,9 +1009,9 @@ mod tests {
 #[cfg(test)]
 mod timing {
     use super::*;
+    use crate::optim::problem::Problem;
     use crate::spline::control_net::test_support::sphere_problem;
     use crate::spline::control_net::BoxSpec;
-    use crate::optim::problem::Problem;
 
     #[test]
     #[ignore]
@@ -930,7 +1027,8 @@ mod timing {
             let pb = sphere_problem(nx, ny, cx, cy, bx.clone());
             let (lo, hi) = pb.bounds();
             let t = std::time::Instant::now();
-            let res = solve_exact(&pb, lo, hi, pb.initial_point(), &ExactOptions::default()).unwrap();
+            let res =
+                solve_exact(&pb, lo, hi, pb.initial_point(), &ExactOptions::default()).unwrap();
             println!(
                 "grid {nx}x{ny} cn {cx}x{cy} {bx:?}: f0 {:.6e} f* {:.9e} lb {:.9e} rel gap {:.2e} steps {} in {:.2?} (x0 outside box: {})",
                 pb.fitness(pb.initial_point()),

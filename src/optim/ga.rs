@@ -48,10 +48,16 @@ impl Ga {
         check_range("ga.pc", self.pc, 0.0, 1.0)?;
         check_range("ga.pm", self.pm, 0.0, 1.0)?;
         if !(1..=MAX_TOURNAMENT).contains(&self.tournament) {
-            return Err(OptimError::param("ga.tournament", format!("must be in [1,{MAX_TOURNAMENT}], got {}", self.tournament)));
+            return Err(OptimError::param(
+                "ga.tournament",
+                format!("must be in [1,{MAX_TOURNAMENT}], got {}", self.tournament),
+            ));
         }
         if self.swap != 0.5 {
-            return Err(OptimError::param("ga.swap", format!("must be 0.5 (uniform crossover), got {}", self.swap)));
+            return Err(OptimError::param(
+                "ga.swap",
+                format!("must be 0.5 (uniform crossover), got {}", self.swap),
+            ));
         }
         Ok(())
     }
@@ -83,7 +89,12 @@ impl Optimiser for Ga {
         "ga"
     }
 
-    fn run(&self, problem: &dyn Problem, budget: &Budget, rng: &mut ChaCha8Rng) -> Result<RunResult, OptimError> {
+    fn run(
+        &self,
+        problem: &dyn Problem,
+        budget: &Budget,
+        rng: &mut ChaCha8Rng,
+    ) -> Result<RunResult, OptimError> {
         self.validate()?;
         budget.validate(self.tournament)?;
         check_problem(problem)?;
@@ -154,8 +165,16 @@ mod tests {
     fn parameters_are_validated_by_key() {
         let e = Ga { pc: 1.5, ..Ga::default() }.validate().unwrap_err().to_string();
         assert_eq!(e, "ga.pc must be in [0,1], got 1.5");
-        assert!(Ga { pm: -0.1, ..Ga::default() }.validate().unwrap_err().to_string().starts_with("ga.pm"));
-        assert!(Ga { tournament: 0, ..Ga::default() }.validate().unwrap_err().to_string().starts_with("ga.tournament"));
+        assert!(Ga { pm: -0.1, ..Ga::default() }
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .starts_with("ga.pm"));
+        assert!(Ga { tournament: 0, ..Ga::default() }
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .starts_with("ga.tournament"));
         let g: Ga = toml::from_str("pc = 0.9").unwrap();
         assert_eq!(g, Ga { pc: 0.9, ..Ga::default() });
         assert!(toml::from_str::<Ga>("pcc = 0.9").is_err());
@@ -186,7 +205,8 @@ mod tests {
         // Pc = 0, Pm = 1: every offspring is x0 + U[-r, r], so the best stays within r of x0.
         let p = Sphere::new(5);
         let ga = Ga { pc: 0.0, pm: 1.0, ..Ga::default() };
-        let budget = Budget { generations: 50, population: 8, init_range: 0.01, trace_every_evals: 10 };
+        let budget =
+            Budget { generations: 50, population: 8, init_range: 0.01, trace_every_evals: 10 };
         let r = ga.run(&p, &budget, &mut ChaCha8Rng::seed_from_u64(3)).unwrap();
         assert!(r.best_x.iter().zip(&p.x0).all(|(a, b)| (a - b).abs() <= 0.01));
     }

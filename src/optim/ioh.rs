@@ -52,7 +52,10 @@ impl IohMeta {
 
     /// The raw-data file, relative to the meta-data file.
     pub fn dat_path(&self) -> String {
-        format!("data_f{}_{}/IOHprofiler_f{}_DIM{}.dat", self.function_id, self.function_name, self.function_id, self.dimension)
+        format!(
+            "data_f{}_{}/IOHprofiler_f{}_DIM{}.dat",
+            self.function_id, self.function_name, self.function_id, self.dimension
+        )
     }
 }
 
@@ -130,11 +133,21 @@ pub fn json_text(meta: &IohMeta, runs: &[IohRun]) -> String {
     let _ = writeln!(out, "  \"function_id\": {},", meta.function_id);
     let _ = writeln!(out, "  \"function_name\": {},", json_str(&meta.function_name));
     let _ = writeln!(out, "  \"maximization\": false,");
-    let _ = writeln!(out, "  \"algorithm\": {{\"name\": {}, \"info\": {}}},", json_str(&meta.algorithm), json_str(&meta.algorithm_info));
+    let _ = writeln!(
+        out,
+        "  \"algorithm\": {{\"name\": {}, \"info\": {}}},",
+        json_str(&meta.algorithm),
+        json_str(&meta.algorithm_info)
+    );
     let attrs: Vec<String> = ATTRIBUTES.iter().map(|a| json_str(a)).collect();
     let _ = writeln!(out, "  \"attributes\": [{}],", attrs.join(", "));
     let _ = writeln!(out, "  \"scenarios\": [");
-    let _ = writeln!(out, "    {{\"dimension\": {}, \"path\": {}, \"runs\": [", meta.dimension, json_str(&meta.dat_path()));
+    let _ = writeln!(
+        out,
+        "    {{\"dimension\": {}, \"path\": {}, \"runs\": [",
+        meta.dimension,
+        json_str(&meta.dat_path())
+    );
     for (k, run) in runs.iter().enumerate() {
         let xs: Vec<String> = run.best_x.iter().map(|&v| json_num(v)).collect();
         let (at, best) = run.best();
@@ -170,13 +183,16 @@ pub fn parse_dat(text: &str) -> Result<Vec<Vec<(u64, f64)>>, String> {
         let (Some(e), Some(y)) = (cols.next(), cols.next()) else {
             return Err(format!("line {}: expected `evaluations value`, got {line:?}", n + 1));
         };
-        let e: u64 = e.parse().map_err(|_| format!("line {}: evaluations {e:?} is not a count", n + 1))?;
+        let e: u64 =
+            e.parse().map_err(|_| format!("line {}: evaluations {e:?} is not a count", n + 1))?;
         let y: f64 = match y {
             "Inf" => f64::INFINITY,
             "-Inf" => f64::NEG_INFINITY,
             y => y.parse().map_err(|_| format!("line {}: value {y:?} is not a number", n + 1))?,
         };
-        runs.last_mut().ok_or_else(|| format!("line {}: a row before the first header", n + 1))?.push((e, y));
+        runs.last_mut()
+            .ok_or_else(|| format!("line {}: a row before the first header", n + 1))?
+            .push((e, y));
     }
     Ok(runs)
 }
@@ -188,7 +204,14 @@ mod tests {
     const IMP: [(u64, f64); 3] = [(1, 2.0), (3, 1.5), (70, 0.25)];
 
     fn meta() -> IohMeta {
-        IohMeta { suite: "somnurbs".into(), function_id: 3, function_name: "sphere_cn6x6".into(), algorithm: "de".into(), algorithm_info: "CR=0.8 \"F\"=0.3".into(), dimension: 2 }
+        IohMeta {
+            suite: "somnurbs".into(),
+            function_id: 3,
+            function_name: "sphere_cn6x6".into(),
+            algorithm: "de".into(),
+            algorithm_info: "CR=0.8 \"F\"=0.3".into(),
+            dimension: 2,
+        }
     }
 
     #[test]
@@ -215,7 +238,16 @@ mod tests {
         let b = IohRun { evaluations: 90, improvements: &IMP[..2], best_x: &[] };
         let json = json_text(&meta(), &[a, b]);
         let v: serde_json::Value = serde_json::from_str(&json).unwrap();
-        for k in ["version", "suite", "function_id", "function_name", "maximization", "algorithm", "attributes", "scenarios"] {
+        for k in [
+            "version",
+            "suite",
+            "function_id",
+            "function_name",
+            "maximization",
+            "algorithm",
+            "attributes",
+            "scenarios",
+        ] {
             assert!(v.get(k).is_some(), "{k}");
         }
         assert_eq!(v["version"], "0.3.22");
@@ -225,7 +257,10 @@ mod tests {
         let s = &v["scenarios"][0];
         assert_eq!(s["path"], "data_f3_sphere_cn6x6/IOHprofiler_f3_DIM2.dat");
         assert_eq!(s["dimension"], 2);
-        assert_eq!(s["runs"][0], serde_json::json!({"instance": 1, "evals": 90, "best": {"evals": 70, "y": 0.25, "x": [0.5, -1.25]}}));
+        assert_eq!(
+            s["runs"][0],
+            serde_json::json!({"instance": 1, "evals": 90, "best": {"evals": 70, "y": 0.25, "x": [0.5, -1.25]}})
+        );
         assert_eq!(s["runs"][1]["best"], serde_json::json!({"evals": 3, "y": 1.5, "x": []}));
         assert_eq!(meta().json_file_name(), "IOHprofiler_f3_sphere_cn6x6.json");
     }

@@ -68,7 +68,9 @@ pub fn avx2_fma() -> bool {
 /// AVX2, FMA, AVX-512F and AVX-512VL).
 #[cfg(target_arch = "x86_64")]
 pub fn avx512vl() -> bool {
-    avx2_fma() && std::arch::is_x86_feature_detected!("avx512f") && std::arch::is_x86_feature_detected!("avx512vl")
+    avx2_fma()
+        && std::arch::is_x86_feature_detected!("avx512f")
+        && std::arch::is_x86_feature_detected!("avx512vl")
 }
 
 /// The environment variable that forces one compiled copy of every SIMD kernel (the fitness,
@@ -84,10 +86,16 @@ pub fn parse_simd(value: Option<&str>) -> Result<Isa, OptimError> {
         Some("scalar") => Isa::Baseline,
         Some("avx2") => Isa::Avx2,
         Some("avx512") => Isa::Avx512Vl,
-        Some(other) => return Err(OptimError::param(SIMD_ENV, format!("must be scalar, avx2, avx512 or auto, got '{other}'"))),
+        Some(other) => {
+            return Err(OptimError::param(
+                SIMD_ENV,
+                format!("must be scalar, avx2, avx512 or auto, got '{other}'"),
+            ))
+        }
     };
     if !isa.supported() {
-        let needs = if isa == Isa::Avx2 { "AVX2 and FMA" } else { "AVX2, FMA, AVX-512F and AVX-512VL" };
+        let needs =
+            if isa == Isa::Avx2 { "AVX2 and FMA" } else { "AVX2, FMA, AVX-512F and AVX-512VL" };
         return Err(OptimError::param(
             SIMD_ENV,
             format!("asks for the {} copy, which needs {needs}, but this CPU lacks them (the fastest copy here is {:?})", value.unwrap_or_default().trim(), Isa::fastest()),
@@ -128,20 +136,34 @@ pub fn use_avx512() -> bool {
 /// shifts, two-input logic and signed compares (exact here: the compared values are below 2^33).
 #[cfg(target_arch = "x86_64")]
 macro_rules! simd {
-    (avx512vl, rol, $x:expr, $k:literal) => { _mm256_rol_epi64::<$k>($x) };
+    (avx512vl, rol, $x:expr, $k:literal) => {
+        _mm256_rol_epi64::<$k>($x)
+    };
     (avx2, rol, $x:expr, $k:literal) => {{
         let x = $x;
         _mm256_or_si256(_mm256_slli_epi64::<$k>(x), _mm256_srli_epi64::<{ 64 - $k }>(x))
     }};
     // a ^ b ^ c
-    (avx512vl, xor3, $a:expr, $b:expr, $c:expr) => { _mm256_ternarylogic_epi64::<0x96>($a, $b, $c) };
-    (avx2, xor3, $a:expr, $b:expr, $c:expr) => { _mm256_xor_si256(_mm256_xor_si256($a, $b), $c) };
+    (avx512vl, xor3, $a:expr, $b:expr, $c:expr) => {
+        _mm256_ternarylogic_epi64::<0x96>($a, $b, $c)
+    };
+    (avx2, xor3, $a:expr, $b:expr, $c:expr) => {
+        _mm256_xor_si256(_mm256_xor_si256($a, $b), $c)
+    };
     // (a & b) | c
-    (avx512vl, and_or, $a:expr, $b:expr, $c:expr) => { _mm256_ternarylogic_epi64::<0xEA>($a, $b, $c) };
-    (avx2, and_or, $a:expr, $b:expr, $c:expr) => { _mm256_or_si256(_mm256_and_si256($a, $b), $c) };
+    (avx512vl, and_or, $a:expr, $b:expr, $c:expr) => {
+        _mm256_ternarylogic_epi64::<0xEA>($a, $b, $c)
+    };
+    (avx2, and_or, $a:expr, $b:expr, $c:expr) => {
+        _mm256_or_si256(_mm256_and_si256($a, $b), $c)
+    };
     // Per 64-bit lane: h < threshold (both below 2^33) ? m : x.
-    (avx512vl, choose, $h:expr, $thr:expr, $x:expr, $m:expr) => { _mm256_mask_blend_pd(_mm256_cmplt_epu64_mask($h, $thr), $x, $m) };
-    (avx2, choose, $h:expr, $thr:expr, $x:expr, $m:expr) => { _mm256_blendv_pd($x, $m, _mm256_castsi256_pd(_mm256_cmpgt_epi64($thr, $h))) };
+    (avx512vl, choose, $h:expr, $thr:expr, $x:expr, $m:expr) => {
+        _mm256_mask_blend_pd(_mm256_cmplt_epu64_mask($h, $thr), $x, $m)
+    };
+    (avx2, choose, $h:expr, $thr:expr, $x:expr, $m:expr) => {
+        _mm256_blendv_pd($x, $m, _mm256_castsi256_pd(_mm256_cmpgt_epi64($thr, $h)))
+    };
 }
 
 /// One xoshiro256++ step of four lanes in 256-bit instructions: `$s` is the four state rows, one
@@ -152,7 +174,12 @@ macro_rules! xoshiro4 {
         let [a0, a1, a2, a3] = $s;
         let word = _mm256_add_epi64(simd!($isa, rol, _mm256_add_epi64(a0, a3), 23), a0);
         let t = _mm256_slli_epi64::<17>(a1);
-        $s = [simd!($isa, xor3, a0, a3, a1), simd!($isa, xor3, a1, a2, a0), simd!($isa, xor3, a2, a0, t), simd!($isa, rol, _mm256_xor_si256(a3, a1), 45)];
+        $s = [
+            simd!($isa, xor3, a0, a3, a1),
+            simd!($isa, xor3, a1, a2, a0),
+            simd!($isa, xor3, a2, a0, t),
+            simd!($isa, rol, _mm256_xor_si256(a3, a1), 45),
+        ];
         word
     }};
 }
@@ -171,7 +198,14 @@ const DE_BLOCK: usize = 2 * DE_LANES;
 /// each block of eight genes steps the four lanes once (also a partial last block); gene j is
 /// the mutant's when its 32-bit uniform h is below `threshold`, else the target's.
 #[inline(always)]
-fn de_trial_scalar(t: &mut [f64], src: DeSources, f: f64, rng: &mut DeLanes, threshold: u64, from: usize) {
+fn de_trial_scalar(
+    t: &mut [f64],
+    src: DeSources,
+    f: f64,
+    rng: &mut DeLanes,
+    threshold: u64,
+    from: usize,
+) {
     let n = t.len();
     for start in (from..n).step_by(DE_BLOCK) {
         let words = rng.next_words();
@@ -179,7 +213,11 @@ fn de_trial_scalar(t: &mut [f64], src: DeSources, f: f64, rng: &mut DeLanes, thr
         for (i, tj) in t[start..end].iter_mut().enumerate() {
             let j = start + i;
             let h = if i < DE_LANES { words[i] & 0xffff_ffff } else { words[i - DE_LANES] >> 32 };
-            *tj = if h < threshold { de_mutant_gene(src.a[j], src.b[j], src.c[j], f, src.lo[j], src.hi[j]) } else { src.x[j] };
+            *tj = if h < threshold {
+                de_mutant_gene(src.a[j], src.b[j], src.c[j], f, src.lo[j], src.hi[j])
+            } else {
+                src.x[j]
+            };
         }
     }
 }
@@ -198,7 +236,14 @@ pub struct DeSources<'a> {
 impl<'a> DeSources<'a> {
     /// Every vector cut to length n (so the loops index without bounds checks).
     fn cut(self, n: usize) -> DeSources<'a> {
-        DeSources { a: &self.a[..n], b: &self.b[..n], c: &self.c[..n], x: &self.x[..n], lo: &self.lo[..n], hi: &self.hi[..n] }
+        DeSources {
+            a: &self.a[..n],
+            b: &self.b[..n],
+            c: &self.c[..n],
+            x: &self.x[..n],
+            lo: &self.lo[..n],
+            hi: &self.hi[..n],
+        }
     }
 }
 
@@ -220,16 +265,27 @@ macro_rules! de_trial_simd {
         let state = $rng.state_mut();
         // SAFETY (all blocks below): every row holds DE_LANES = 4 words; j + 8 <= full <= n
         // bounds every vector (all cut to n).
-        let mut s: [__m256i; 4] = unsafe { [0, 1, 2, 3].map(|r| _mm256_loadu_si256(state[r].as_ptr().cast())) };
-        let (fv, thr, low32) = (_mm256_set1_pd($f), _mm256_set1_epi64x($threshold as i64), _mm256_set1_epi64x(0xffff_ffff));
+        let mut s: [__m256i; 4] =
+            unsafe { [0, 1, 2, 3].map(|r| _mm256_loadu_si256(state[r].as_ptr().cast())) };
+        let (fv, thr, low32) = (
+            _mm256_set1_pd($f),
+            _mm256_set1_epi64x($threshold as i64),
+            _mm256_set1_epi64x(0xffff_ffff),
+        );
         // A macro, not a closure: closures do not inherit the function's target features.
         macro_rules! gene4 {
             ($j:expr, $h:expr) => {{
                 let j: usize = $j;
-                let b_c = _mm256_sub_pd(_mm256_loadu_pd(src.b.as_ptr().add(j)), _mm256_loadu_pd(src.c.as_ptr().add(j)));
+                let b_c = _mm256_sub_pd(
+                    _mm256_loadu_pd(src.b.as_ptr().add(j)),
+                    _mm256_loadu_pd(src.c.as_ptr().add(j)),
+                );
                 let m = _mm256_fmadd_pd(fv, b_c, _mm256_loadu_pd(src.a.as_ptr().add(j)));
                 // max(lo, m) = m < lo ? lo : m and min(hi, .) likewise, as `clamp`.
-                let m = _mm256_min_pd(_mm256_loadu_pd(src.hi.as_ptr().add(j)), _mm256_max_pd(_mm256_loadu_pd(src.lo.as_ptr().add(j)), m));
+                let m = _mm256_min_pd(
+                    _mm256_loadu_pd(src.hi.as_ptr().add(j)),
+                    _mm256_max_pd(_mm256_loadu_pd(src.lo.as_ptr().add(j)), m),
+                );
                 let t = simd!($isa, choose, $h, thr, _mm256_loadu_pd(src.x.as_ptr().add(j)), m);
                 _mm256_storeu_pd($t.as_mut_ptr().add(j), t);
             }};
@@ -302,7 +358,8 @@ fn lanes_fill_avx2(words: &mut [u64], rng: &mut DeLanes) {
     let state = rng.state_mut();
     // SAFETY: every state row holds 4 words; every store writes words[4 q..4 q + 4], q < len / 4.
     unsafe {
-        let mut s: [__m256i; 4] = [0, 1, 2, 3].map(|r| _mm256_loadu_si256(state[r].as_ptr().cast()));
+        let mut s: [__m256i; 4] =
+            [0, 1, 2, 3].map(|r| _mm256_loadu_si256(state[r].as_ptr().cast()));
         for w in words.chunks_exact_mut(DE_LANES) {
             let word = xoshiro4!(avx2, s);
             _mm256_storeu_si256(w.as_mut_ptr().cast(), word);
@@ -332,7 +389,17 @@ pub struct PsoBounds<'a> {
 /// One coordinate's move from its 64-bit word: (new x, new v).
 #[allow(clippy::too_many_arguments)] // one coordinate's values, as the vector copies read them
 #[inline(always)]
-fn pso_coordinate(x: f64, v: f64, p: f64, g: f64, lo: f64, hi: f64, vmax: f64, word: u64, co: PsoCoefficients) -> (f64, f64) {
+fn pso_coordinate(
+    x: f64,
+    v: f64,
+    p: f64,
+    g: f64,
+    lo: f64,
+    hi: f64,
+    vmax: f64,
+    word: u64,
+    co: PsoCoefficients,
+) -> (f64, f64) {
     let (u1, u2) = two_units_plus_one(word);
     // c r = c (u - 1) with r = u - 1 exact, so c u - c in one rounding is the same number.
     let (a1, a2) = (co.c1.mul_add(u1, -co.c1), co.c2.mul_add(u2, -co.c2));
@@ -344,16 +411,34 @@ fn pso_coordinate(x: f64, v: f64, p: f64, g: f64, lo: f64, hi: f64, vmax: f64, w
 /// baseline copy from 0; the vector copies for the coordinates after their last whole vector).
 #[allow(clippy::too_many_arguments)] // the vector copies' arguments and where they stopped
 #[inline(always)]
-fn pso_move_scalar(x: &mut [f64], v: &mut [f64], p: &[f64], g: &[f64], b: PsoBounds, rng: &mut PsoLanes, co: PsoCoefficients, from: usize) {
+fn pso_move_scalar(
+    x: &mut [f64],
+    v: &mut [f64],
+    p: &[f64],
+    g: &[f64],
+    b: PsoBounds,
+    rng: &mut PsoLanes,
+    co: PsoCoefficients,
+    from: usize,
+) {
     let n = x.len();
-    let (v, p, g, lo, hi, vmax) = (&mut v[..n], &p[..n], &g[..n], &b.lo[..n], &b.hi[..n], &b.vmax[..n]);
+    let (v, p, g, lo, hi, vmax) =
+        (&mut v[..n], &p[..n], &g[..n], &b.lo[..n], &b.hi[..n], &b.vmax[..n]);
     for j in from..n {
         let word = rng.next_word(j % PSO_LANES);
         (x[j], v[j]) = pso_coordinate(x[j], v[j], p[j], g[j], lo[j], hi[j], vmax[j], word, co);
     }
 }
 
-fn pso_move_generic(x: &mut [f64], v: &mut [f64], p: &[f64], g: &[f64], rng: &mut PsoLanes, co: PsoCoefficients, b: PsoBounds) {
+fn pso_move_generic(
+    x: &mut [f64],
+    v: &mut [f64],
+    p: &[f64],
+    g: &[f64],
+    rng: &mut PsoLanes,
+    co: PsoCoefficients,
+    b: PsoBounds,
+) {
     pso_move_scalar(x, v, p, g, b, rng, co, 0)
 }
 
@@ -367,7 +452,8 @@ macro_rules! pso_move_simd {
         use std::arch::x86_64::*;
         let (x, co) = ($x, $co);
         let n = x.len();
-        let (v, p, g, lo, hi, vmax) = (&mut $v[..n], &$p[..n], &$g[..n], &$b.lo[..n], &$b.hi[..n], &$b.vmax[..n]);
+        let (v, p, g, lo, hi, vmax) =
+            (&mut $v[..n], &$p[..n], &$g[..n], &$b.lo[..n], &$b.hi[..n], &$b.vmax[..n]);
         let mantissa_top32 = _mm256_set1_epi64x(0x000f_ffff_fff0_0000);
         let one = _mm256_set1_epi64x(0x3ff0_0000_0000_0000);
         let (c1, c2, k) = (_mm256_set1_pd(co.c1), _mm256_set1_pd(co.c2), _mm256_set1_pd(co.k));
@@ -377,26 +463,47 @@ macro_rules! pso_move_simd {
         // Lanes 0-3 (coordinates 8q..8q+3) and 4-7 (8q+4..8q+7), one register per state row
         // each. SAFETY (all blocks below): every row holds PSO_LANES = 8 words; j + 4 <= n
         // bounds every coordinate slice (all cut to n above).
-        let mut low: [__m256i; 4] = unsafe { [0, 1, 2, 3].map(|r| _mm256_loadu_si256(state[r].as_ptr().cast())) };
-        let mut high: [__m256i; 4] = unsafe { [0, 1, 2, 3].map(|r| _mm256_loadu_si256(state[r].as_ptr().add(4).cast())) };
+        let mut low: [__m256i; 4] =
+            unsafe { [0, 1, 2, 3].map(|r| _mm256_loadu_si256(state[r].as_ptr().cast())) };
+        let mut high: [__m256i; 4] =
+            unsafe { [0, 1, 2, 3].map(|r| _mm256_loadu_si256(state[r].as_ptr().add(4).cast())) };
         // A macro, not a closure: closures do not inherit the function's target features.
         macro_rules! move4 {
             ($j:expr, $word:expr) => {{
                 let (j, word): (usize, __m256i) = ($j, $word);
-                let u1 = _mm256_castsi256_pd(simd!($isa, and_or, _mm256_srli_epi64::<12>(word), mantissa_top32, one));
-                let u2 = _mm256_castsi256_pd(simd!($isa, and_or, _mm256_slli_epi64::<20>(word), mantissa_top32, one));
+                let u1 = _mm256_castsi256_pd(simd!(
+                    $isa,
+                    and_or,
+                    _mm256_srli_epi64::<12>(word),
+                    mantissa_top32,
+                    one
+                ));
+                let u2 = _mm256_castsi256_pd(simd!(
+                    $isa,
+                    and_or,
+                    _mm256_slli_epi64::<20>(word),
+                    mantissa_top32,
+                    one
+                ));
                 let (w1, w2) = (_mm256_fmadd_pd(c1, u1, nc1), _mm256_fmadd_pd(c2, u2, nc2));
                 let xj = _mm256_loadu_pd(x.as_ptr().add(j));
                 let dp = _mm256_sub_pd(_mm256_loadu_pd(p.as_ptr().add(j)), xj);
                 let dg = _mm256_sub_pd(_mm256_loadu_pd(g.as_ptr().add(j)), xj);
-                let vel = _mm256_fmadd_pd(w2, dg, _mm256_fmadd_pd(w1, dp, _mm256_loadu_pd(v.as_ptr().add(j))));
+                let vel = _mm256_fmadd_pd(
+                    w2,
+                    dg,
+                    _mm256_fmadd_pd(w1, dp, _mm256_loadu_pd(v.as_ptr().add(j))),
+                );
                 let vel = _mm256_mul_pd(k, vel);
                 // max(a, b) is a > b ? a : b, so max(lo, v) = v < lo ? lo : v, as `clamp`.
                 let vm = _mm256_loadu_pd(vmax.as_ptr().add(j));
                 let vel = _mm256_min_pd(vm, _mm256_max_pd(_mm256_xor_pd(vm, sign), vel));
                 _mm256_storeu_pd(v.as_mut_ptr().add(j), vel);
                 let xn = _mm256_add_pd(xj, vel);
-                let xn = _mm256_min_pd(_mm256_loadu_pd(hi.as_ptr().add(j)), _mm256_max_pd(_mm256_loadu_pd(lo.as_ptr().add(j)), xn));
+                let xn = _mm256_min_pd(
+                    _mm256_loadu_pd(hi.as_ptr().add(j)),
+                    _mm256_max_pd(_mm256_loadu_pd(lo.as_ptr().add(j)), xn),
+                );
                 _mm256_storeu_pd(x.as_mut_ptr().add(j), xn);
             }};
         }
@@ -424,20 +531,44 @@ macro_rules! pso_move_simd {
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-fn pso_move_avx2(x: &mut [f64], v: &mut [f64], p: &[f64], g: &[f64], rng: &mut PsoLanes, co: PsoCoefficients, b: PsoBounds) {
+fn pso_move_avx2(
+    x: &mut [f64],
+    v: &mut [f64],
+    p: &[f64],
+    g: &[f64],
+    rng: &mut PsoLanes,
+    co: PsoCoefficients,
+    b: PsoBounds,
+) {
     pso_move_simd!(avx2, x, v, p, g, rng, co, b)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma,avx512f,avx512vl")]
-fn pso_move_avx512vl(x: &mut [f64], v: &mut [f64], p: &[f64], g: &[f64], rng: &mut PsoLanes, co: PsoCoefficients, b: PsoBounds) {
+fn pso_move_avx512vl(
+    x: &mut [f64],
+    v: &mut [f64],
+    p: &[f64],
+    g: &[f64],
+    rng: &mut PsoLanes,
+    co: PsoCoefficients,
+    b: PsoBounds,
+) {
     pso_move_simd!(avx512vl, x, v, p, g, rng, co, b)
 }
 
 /// One constricted PSO move of one particle. Coordinate j takes r1, r2 from the two 32-bit
 /// halves of the next word of lane j % 8 of `rng` (the generation and the move are one
 /// vectorised loop).
-pub fn pso_move(x: &mut [f64], v: &mut [f64], p: &[f64], g: &[f64], rng: &mut PsoLanes, co: PsoCoefficients, bounds: PsoBounds) {
+pub fn pso_move(
+    x: &mut [f64],
+    v: &mut [f64],
+    p: &[f64],
+    g: &[f64],
+    rng: &mut PsoLanes,
+    co: PsoCoefficients,
+    bounds: PsoBounds,
+) {
     #[cfg(target_arch = "x86_64")]
     {
         if use_avx512() {
@@ -484,7 +615,8 @@ mod tests {
         #[cfg(target_arch = "x86_64")]
         type Trial = unsafe fn(&mut [f64], DeSources, f64, &mut DeLanes, u64);
         #[cfg(target_arch = "x86_64")]
-        let trial_copies: [(bool, Trial); 2] = [(avx2_fma(), de_trial_avx2), (avx512vl(), de_trial_avx512vl)];
+        let trial_copies: [(bool, Trial); 2] =
+            [(avx2_fma(), de_trial_avx2), (avx512vl(), de_trial_avx512vl)];
         for cr in [0.0, 0.3, 0.8, 1.0] {
             let threshold = bernoulli_threshold_32(cr);
             let lanes = DeLanes::from_rng(&mut ChaCha8Rng::seed_from_u64(3));
@@ -495,12 +627,21 @@ mod tests {
                 copy(&mut t2, &mut lanes);
                 (t1, t2, lanes)
             };
-            let generic = trials(lanes.clone(), &|t, l| de_trial_generic(t, src, 0.3, l, threshold));
-            assert_eq!(generic, trials(lanes.clone(), &|t, l| de_trial(t, src, 0.3, l, threshold)), "n {n} cr {cr}");
+            let generic =
+                trials(lanes.clone(), &|t, l| de_trial_generic(t, src, 0.3, l, threshold));
+            assert_eq!(
+                generic,
+                trials(lanes.clone(), &|t, l| de_trial(t, src, 0.3, l, threshold)),
+                "n {n} cr {cr}"
+            );
             #[cfg(target_arch = "x86_64")]
             for (_, copy) in trial_copies.iter().filter(|c| c.0) {
                 // SAFETY: the CPU reports the copy's features.
-                assert_eq!(generic, trials(lanes.clone(), &|t, l| unsafe { copy(t, src, 0.3, l, threshold) }), "n {n} cr {cr}");
+                assert_eq!(
+                    generic,
+                    trials(lanes.clone(), &|t, l| unsafe { copy(t, src, 0.3, l, threshold) }),
+                    "n {n} cr {cr}"
+                );
             }
             // The formula: block q of eight genes steps the four lanes once; gene 8q + i takes
             // the low half of lane i's word (i < 4), gene 8q + 4 + i the high half.
@@ -508,13 +649,19 @@ mod tests {
             for t in [&generic.0, &generic.1] {
                 for q in 0..n.div_ceil(8) {
                     let [s0, s1, s2, s3] = single.state_mut();
-                    let words: Vec<u64> = (0..4).map(|l| xoshiro_step(&mut s0[l], &mut s1[l], &mut s2[l], &mut s3[l])).collect();
+                    let words: Vec<u64> = (0..4)
+                        .map(|l| xoshiro_step(&mut s0[l], &mut s1[l], &mut s2[l], &mut s3[l]))
+                        .collect();
                     for j in 8 * q..(8 * q + 8).min(n) {
                         let i = j - 8 * q;
                         let h = if i < 4 { words[i] as u32 } else { (words[i - 4] >> 32) as u32 };
                         let mutant = 0.3f64.mul_add(b[j] - c[j], a[j]).clamp(-1.0, 1.5);
                         let take = (h as u64) < threshold;
-                        assert_eq!(t[j], if take { mutant } else { x[j] }, "n {n} cr {cr} gene {j}");
+                        assert_eq!(
+                            t[j],
+                            if take { mutant } else { x[j] },
+                            "n {n} cr {cr} gene {j}"
+                        );
                         if cr == 0.0 || cr == 1.0 {
                             assert_eq!(take, cr == 1.0);
                         }
@@ -537,8 +684,17 @@ mod tests {
         // Each compiled copy this CPU can run, not only the one `pso_move` picks.
         #[cfg(target_arch = "x86_64")]
         {
-            type Move = unsafe fn(&mut [f64], &mut [f64], &[f64], &[f64], &mut PsoLanes, PsoCoefficients, PsoBounds);
-            let copies: [(bool, Move); 2] = [(avx2_fma(), pso_move_avx2), (avx512vl(), pso_move_avx512vl)];
+            type Move = unsafe fn(
+                &mut [f64],
+                &mut [f64],
+                &[f64],
+                &[f64],
+                &mut PsoLanes,
+                PsoCoefficients,
+                PsoBounds,
+            );
+            let copies: [(bool, Move); 2] =
+                [(avx2_fma(), pso_move_avx2), (avx512vl(), pso_move_avx512vl)];
             for (_, copy) in copies.into_iter().filter(|c| c.0) {
                 let (mut x3, mut v3, mut g3) = (a.clone(), b.clone(), gen.clone());
                 for _ in 0..2 {
@@ -555,12 +711,18 @@ mod tests {
             for j in 0..n {
                 let [s0, s1, s2, s3] = g3.state_mut();
                 let l = j % PSO_LANES;
-                let (r1, r2) = two_units(xoshiro_step(&mut s0[l], &mut s1[l], &mut s2[l], &mut s3[l]));
+                let (r1, r2) =
+                    two_units(xoshiro_step(&mut s0[l], &mut s1[l], &mut s2[l], &mut s3[l]));
                 let vmax = 0.2 * (1.5 - -1.0);
                 let (u1, u2) = (r1 + 1.0, r2 + 1.0);
                 // The folded c u - c is exactly c r.
-                assert_eq!((2.05f64.mul_add(u1, -2.05), 2.05f64.mul_add(u2, -2.05)), (2.05 * r1, 2.05 * r2));
-                let vj: f64 = (0.729 * (2.05 * r2).mul_add(hi[j] - x3[j], (2.05 * r1).mul_add(c[j] - x3[j], v3[j]))).clamp(-vmax, vmax);
+                assert_eq!(
+                    (2.05f64.mul_add(u1, -2.05), 2.05f64.mul_add(u2, -2.05)),
+                    (2.05 * r1, 2.05 * r2)
+                );
+                let vj: f64 = (0.729
+                    * (2.05 * r2).mul_add(hi[j] - x3[j], (2.05 * r1).mul_add(c[j] - x3[j], v3[j])))
+                .clamp(-vmax, vmax);
                 v3[j] = vj;
                 x3[j] = (x3[j] + vj).clamp(-1.0, 1.5);
             }
@@ -592,7 +754,10 @@ mod tests {
             let per_slot = (trials * n / 8) as f64;
             for (slot, &k) in by_slot.iter().enumerate() {
                 let sd = (per_slot * cr * (1.0 - cr)).sqrt();
-                assert!((k as f64 - per_slot * cr).abs() < 5.0 * sd, "cr {cr} slot {slot}: {k} of {per_slot}");
+                assert!(
+                    (k as f64 - per_slot * cr).abs() < 5.0 * sd,
+                    "cr {cr} slot {slot}: {k} of {per_slot}"
+                );
             }
         }
     }
@@ -632,23 +797,43 @@ mod timing {
         let mut t = vec![0.0; n];
         let threshold = crate::optim::sampling::bernoulli_threshold_32(0.8);
         type Trial = unsafe fn(&mut [f64], DeSources, f64, &mut DeLanes, u64);
-        let trials: [(&str, bool, Trial); 3] =
-            [("baseline", true, |t, s, f, l, th| de_trial_generic(t, s, f, l, th)), ("avx2", avx2_fma(), de_trial_avx2), ("avx512vl", avx512vl(), de_trial_avx512vl)];
+        let trials: [(&str, bool, Trial); 3] = [
+            ("baseline", true, |t, s, f, l, th| de_trial_generic(t, s, f, l, th)),
+            ("avx2", avx2_fma(), de_trial_avx2),
+            ("avx512vl", avx512vl(), de_trial_avx512vl),
+        ];
         for (name, _, copy) in trials.into_iter().filter(|c| c.1) {
             // SAFETY: the CPU reports the copy's features.
-            println!("DE trial {name}: {:.3} ns per gene", best_ns(n, || unsafe { copy(&mut t, src, 0.3, &mut lanes, threshold) }));
+            println!(
+                "DE trial {name}: {:.3} ns per gene",
+                best_ns(n, || unsafe { copy(&mut t, src, 0.3, &mut lanes, threshold) })
+            );
         }
         let vmax = vec![0.5; n];
         let bounds = PsoBounds { lo: &lo, hi: &hi, vmax: &vmax };
         let co = PsoCoefficients { k: 0.729, c1: 2.05, c2: 2.05 };
         let mut gen = PsoLanes::from_rng(&mut ChaCha8Rng::seed_from_u64(2));
         let (mut x, mut vel) = (v.clone(), vec![0.0; n]);
-        type Move = unsafe fn(&mut [f64], &mut [f64], &[f64], &[f64], &mut PsoLanes, PsoCoefficients, PsoBounds);
-        let moves: [(&str, bool, Move); 3] =
-            [("baseline", true, |x, v, p, g, r, c, b| pso_move_generic(x, v, p, g, r, c, b)), ("avx2", avx2_fma(), pso_move_avx2), ("avx512vl", avx512vl(), pso_move_avx512vl)];
+        type Move = unsafe fn(
+            &mut [f64],
+            &mut [f64],
+            &[f64],
+            &[f64],
+            &mut PsoLanes,
+            PsoCoefficients,
+            PsoBounds,
+        );
+        let moves: [(&str, bool, Move); 3] = [
+            ("baseline", true, |x, v, p, g, r, c, b| pso_move_generic(x, v, p, g, r, c, b)),
+            ("avx2", avx2_fma(), pso_move_avx2),
+            ("avx512vl", avx512vl(), pso_move_avx512vl),
+        ];
         for (name, _, copy) in moves.into_iter().filter(|c| c.1) {
             // SAFETY: the CPU reports the copy's features.
-            println!("PSO move {name}: {:.3} ns per coordinate", best_ns(n, || unsafe { copy(&mut x, &mut vel, &v, &hi, &mut gen, co, bounds) }));
+            println!(
+                "PSO move {name}: {:.3} ns per coordinate",
+                best_ns(n, || unsafe { copy(&mut x, &mut vel, &v, &hi, &mut gen, co, bounds) })
+            );
         }
     }
 }

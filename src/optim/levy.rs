@@ -82,7 +82,10 @@ pub fn neg_ln(u: f64) -> f64 {
         + z * (1.0 / 5.0
             + z * (1.0 / 7.0
                 + z * (1.0 / 9.0
-                    + z * (1.0 / 11.0 + z * (1.0 / 13.0 + z * (1.0 / 15.0 + z * (1.0 / 17.0 + z * (1.0 / 19.0 + z * (1.0 / 21.0)))))))));
+                    + z * (1.0 / 11.0
+                        + z * (1.0 / 13.0
+                            + z * (1.0 / 15.0
+                                + z * (1.0 / 17.0 + z * (1.0 / 19.0 + z * (1.0 / 21.0)))))))));
     let s2 = s + s;
     -(e * LN2 + (s2 + s2 * (z * p)))
 }
@@ -97,10 +100,16 @@ pub fn sin_cos_octant(h: f64) -> (f64, f64) {
     let t = h * FRAC_PI_4;
     let z = t * t;
     let sp = -inv_fact(3)
-        + z * (inv_fact(5) + z * (-inv_fact(7) + z * (inv_fact(9) + z * (-inv_fact(11) + z * (inv_fact(13) + z * -inv_fact(15))))));
+        + z * (inv_fact(5)
+            + z * (-inv_fact(7)
+                + z * (inv_fact(9)
+                    + z * (-inv_fact(11) + z * (inv_fact(13) + z * -inv_fact(15))))));
     let cp = -inv_fact(2)
         + z * (inv_fact(4)
-            + z * (-inv_fact(6) + z * (inv_fact(8) + z * (-inv_fact(10) + z * (inv_fact(12) + z * (-inv_fact(14) + z * inv_fact(16)))))));
+            + z * (-inv_fact(6)
+                + z * (inv_fact(8)
+                    + z * (-inv_fact(10)
+                        + z * (inv_fact(12) + z * (-inv_fact(14) + z * inv_fact(16)))))));
     (t + t * (z * sp), 1.0 + z * cp)
 }
 
@@ -129,7 +138,10 @@ pub fn sin_quadrant(h: f64) -> f64 {
     let p = -INV_FACT[3]
         + z * (INV_FACT[5]
             + z * (-INV_FACT[7]
-                + z * (INV_FACT[9] + z * (-INV_FACT[11] + z * (INV_FACT[13] + z * (-INV_FACT[15] + z * (INV_FACT[17] + z * -INV_FACT[19])))))));
+                + z * (INV_FACT[9]
+                    + z * (-INV_FACT[11]
+                        + z * (INV_FACT[13]
+                            + z * (-INV_FACT[15] + z * (INV_FACT[17] + z * -INV_FACT[19])))))));
     t + t * (z * p)
 }
 
@@ -227,7 +239,16 @@ mod tests {
     fn neg_ln_matches_the_library() {
         let mut rng = ChaCha8Rng::seed_from_u64(4);
         let mut worst = 0.0f64;
-        let probes = [HALF_ULP, 1.0 - HALF_ULP, 0.5, 0.5f64.sqrt(), 0.5f64.sqrt() * (1.0 + f64::EPSILON), 0.25, 0.999, 1e-10];
+        let probes = [
+            HALF_ULP,
+            1.0 - HALF_ULP,
+            0.5,
+            0.5f64.sqrt(),
+            0.5f64.sqrt() * (1.0 + f64::EPSILON),
+            0.25,
+            0.999,
+            1e-10,
+        ];
         for u in (0..200_000).map(|_| open_unit(rng.next_u64(), 12)).chain(probes) {
             let want = -u.ln();
             let got = neg_ln(u);
@@ -240,7 +261,11 @@ mod tests {
     fn octant_sine_and_cosine_match_the_library() {
         let mut rng = ChaCha8Rng::seed_from_u64(5);
         let mut worst = 0.0f64;
-        for h in (0..200_000).map(|_| open_unit(rng.next_u64(), 10)).chain([HALF_ULP, 1.0 - HALF_ULP, 0.5]) {
+        for h in (0..200_000).map(|_| open_unit(rng.next_u64(), 10)).chain([
+            HALF_ULP,
+            1.0 - HALF_ULP,
+            0.5,
+        ]) {
             let t = h * FRAC_PI_4;
             let (s, c) = sin_cos_octant(h);
             worst = worst.max(((s - t.sin()) / t.sin()).abs()).max(((c - t.cos()) / t.cos()).abs());
@@ -252,7 +277,11 @@ mod tests {
     fn quadrant_sine_matches_the_library() {
         let mut rng = ChaCha8Rng::seed_from_u64(7);
         let mut worst = 0.0f64;
-        for h in (0..200_000).map(|_| open_unit(rng.next_u64(), 11)).chain([HALF_ULP, 1.0 - HALF_ULP, 0.5]) {
+        for h in (0..200_000).map(|_| open_unit(rng.next_u64(), 11)).chain([
+            HALF_ULP,
+            1.0 - HALF_ULP,
+            0.5,
+        ]) {
             let want = (h * std::f64::consts::FRAC_PI_2).sin();
             worst = worst.max(((sin_quadrant(h) - want) / want).abs());
         }
@@ -302,11 +331,13 @@ mod tests {
         let mut r = ChaCha8Rng::seed_from_u64(10);
         let want: Vec<f64> = (0..n)
             .map(|_| {
-                let (u, v, p): (f64, f64, f64) = (r.sample(StandardNormal), r.sample(StandardNormal), r.sample(StandardNormal));
+                let (u, v, p): (f64, f64, f64) =
+                    (r.sample(StandardNormal), r.sample(StandardNormal), r.sample(StandardNormal));
                 sigma * u * p * v.abs().powf(-2.0 / 3.0)
             })
             .collect();
-        let frac = |s: &[f64], t: f64| s.iter().filter(|x| x.abs() > t).count() as f64 / s.len() as f64;
+        let frac =
+            |s: &[f64], t: f64| s.iter().filter(|x| x.abs() > t).count() as f64 / s.len() as f64;
         for t in [0.05, 0.3, 1.0, 3.0, 10.0, 100.0] {
             let (a, b) = (frac(&got, t), frac(&want, t));
             let sd = (b * (1.0 - b) / n as f64).sqrt() * 2f64.sqrt();

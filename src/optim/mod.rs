@@ -5,10 +5,10 @@
 //! guessed. Pure code: no file or terminal I/O (the IOHprofiler export returns text).
 
 pub mod aligned;
+pub mod binary_ga;
 pub mod cuckoo;
 pub mod de;
 pub mod exact;
-pub mod binary_ga;
 pub mod ga;
 pub mod ioh;
 pub mod kernels;
@@ -18,10 +18,10 @@ pub mod pso;
 pub mod sampling;
 
 pub use aligned::Aligned;
+pub use binary_ga::BinaryGa;
 pub use cuckoo::{Csa, Icsa};
 pub use de::De;
 pub use exact::{certify, solve_exact, ExactOptions, ExactResult, SumOfNorms};
-pub use binary_ga::BinaryGa;
 pub use ga::Ga;
 pub use problem::{Budget, Evaluator, Optimiser, Problem, RunResult};
 pub use pso::Pso;
@@ -56,7 +56,14 @@ pub(crate) fn check_range(key: &str, value: f64, lo: f64, hi: f64) -> Result<(),
 }
 
 /// The optimiser named `name` ("ga", "de", "pso", "csa", "icsa") with the given parameters.
-pub fn named(name: &str, ga: &Ga, de: &De, pso: &Pso, csa: &Csa, icsa: &Icsa) -> Option<Box<dyn Optimiser>> {
+pub fn named(
+    name: &str,
+    ga: &Ga,
+    de: &De,
+    pso: &Pso,
+    csa: &Csa,
+    icsa: &Icsa,
+) -> Option<Box<dyn Optimiser>> {
     Some(match name {
         "ga" => Box::new(ga.clone()),
         "de" => Box::new(de.clone()),
@@ -95,7 +102,8 @@ pub(crate) mod optimiser_tests {
     /// best_fitness = f(best_x), a monotone trace on the fixed checkpoints, improvement.
     pub fn check(opt: &dyn Optimiser, expected_evals: impl Fn(&Budget) -> u64) {
         let p = boxed_sphere(25);
-        let budget = Budget { generations: 150, population: 12, init_range: 0.1, trace_every_evals: 50 };
+        let budget =
+            Budget { generations: 150, population: 12, init_range: 0.1, trace_every_evals: 50 };
         let run = |seed| opt.run(&p, &budget, &mut ChaCha8Rng::seed_from_u64(seed)).unwrap();
         let a = run(7);
         let b = run(7);
@@ -104,12 +112,22 @@ pub(crate) mod optimiser_tests {
         assert_ne!(a.best_x, c.best_x, "{}: another seed, another run", opt.name());
         assert_eq!(a.evaluations, expected_evals(&budget), "{}: evaluations", opt.name());
         assert!(a.best_fitness <= a.initial_best_fitness, "{}", opt.name());
-        assert_eq!(a.best_fitness, p.fitness(&a.best_x), "{}: best_fitness = f(best_x)", opt.name());
+        assert_eq!(
+            a.best_fitness,
+            p.fitness(&a.best_x),
+            "{}: best_fitness = f(best_x)",
+            opt.name()
+        );
         for (j, v) in a.best_x.iter().enumerate() {
-            assert!(*v >= p.lo[j] && *v <= p.hi[j], "{}: coordinate {j} = {v} out of bounds", opt.name());
+            assert!(
+                *v >= p.lo[j] && *v <= p.hi[j],
+                "{}: coordinate {j} = {v} out of bounds",
+                opt.name()
+            );
         }
         let marks: Vec<u64> = a.trace.iter().map(|t| t.0).collect();
-        let mut want: Vec<u64> = (1..).map(|k| k * 50).take_while(|&e| e <= a.evaluations).collect();
+        let mut want: Vec<u64> =
+            (1..).map(|k| k * 50).take_while(|&e| e <= a.evaluations).collect();
         if want.last() != Some(&a.evaluations) {
             want.push(a.evaluations);
         }

@@ -27,7 +27,12 @@ pub trait Optimiser: Send + Sync {
     fn name(&self) -> &'static str;
     /// One run. Errors only for a malformed problem, budget or parameter set (checked before the
     /// first evaluation).
-    fn run(&self, problem: &dyn Problem, budget: &Budget, rng: &mut ChaCha8Rng) -> Result<RunResult, OptimError>;
+    fn run(
+        &self,
+        problem: &dyn Problem,
+        budget: &Budget,
+        rng: &mut ChaCha8Rng,
+    ) -> Result<RunResult, OptimError>;
 }
 
 /// How much one run may do (thesis Table 6.1: 2000 generations of 40, initial range 5e-6).
@@ -56,14 +61,23 @@ impl Budget {
         if self.population < min_population {
             return Err(OptimError::param(
                 "budget.population",
-                format!("must be at least {min_population} for this optimiser, got {}", self.population),
+                format!(
+                    "must be at least {min_population} for this optimiser, got {}",
+                    self.population
+                ),
             ));
         }
         if !(self.init_range >= 0.0 && self.init_range.is_finite()) {
-            return Err(OptimError::param("budget.init_range", format!("must be finite and >= 0, got {}", self.init_range)));
+            return Err(OptimError::param(
+                "budget.init_range",
+                format!("must be finite and >= 0, got {}", self.init_range),
+            ));
         }
         if self.trace_every_evals == 0 {
-            return Err(OptimError::param("budget.trace_every_evals", "must be at least 1, got 0".to_string()));
+            return Err(OptimError::param(
+                "budget.trace_every_evals",
+                "must be at least 1, got 0".to_string(),
+            ));
         }
         Ok(())
     }
@@ -109,10 +123,16 @@ pub fn check_problem(problem: &dyn Problem) -> Result<(), OptimError> {
         )));
     }
     if let Some(j) = x0.iter().position(|v| !v.is_finite()) {
-        return Err(OptimError::Problem(format!("initial point coordinate {j} is not finite ({})", x0[j])));
+        return Err(OptimError::Problem(format!(
+            "initial point coordinate {j} is not finite ({})",
+            x0[j]
+        )));
     }
     if let Some(j) = (0..d).find(|&j| lo[j].is_nan() || hi[j].is_nan() || lo[j] > hi[j]) {
-        return Err(OptimError::Problem(format!("bounds of coordinate {j} are not an interval: [{}, {}]", lo[j], hi[j])));
+        return Err(OptimError::Problem(format!(
+            "bounds of coordinate {j} are not an interval: [{}, {}]",
+            lo[j], hi[j]
+        )));
     }
     Ok(())
 }
@@ -149,7 +169,16 @@ fn mark_after(e: u64) -> u64 {
 
 impl<'a> Evaluator<'a> {
     pub fn new(problem: &'a dyn Problem, budget: &Budget) -> Evaluator<'a> {
-        Evaluator { problem, evaluations: 0, best: f64::INFINITY, every: budget.trace_every_evals.max(1), trace: Vec::new(), improvements: Vec::new(), next_mark: 1, pending: None }
+        Evaluator {
+            problem,
+            evaluations: 0,
+            best: f64::INFINITY,
+            every: budget.trace_every_evals.max(1),
+            trace: Vec::new(),
+            improvements: Vec::new(),
+            next_mark: 1,
+            pending: None,
+        }
     }
 
     /// Evaluate `x`, counting it and updating the best and the trace.
@@ -190,7 +219,14 @@ impl<'a> Evaluator<'a> {
             self.trace.push((self.evaluations, self.best));
         }
         self.improvements.extend(self.pending.take());
-        RunResult { best_x, best_fitness: self.best, initial_best_fitness, evaluations: self.evaluations, trace: self.trace, improvements: self.improvements }
+        RunResult {
+            best_x,
+            best_fitness: self.best,
+            initial_best_fitness,
+            evaluations: self.evaluations,
+            trace: self.trace,
+            improvements: self.improvements,
+        }
     }
 }
 
@@ -213,13 +249,19 @@ pub struct Population {
 impl Population {
     /// The thesis' initialisation (6.2.4.1 step 1): x0 + U[-r, r] per coordinate, clamped to the
     /// bounds, each individual evaluated once.
-    pub fn initial(problem: &dyn Problem, budget: &Budget, eval: &mut Evaluator, rng: &mut ChaCha8Rng) -> Population {
+    pub fn initial(
+        problem: &dyn Problem,
+        budget: &Budget,
+        eval: &mut Evaluator,
+        rng: &mut ChaCha8Rng,
+    ) -> Population {
         let x0 = problem.initial_point();
         let (lo, hi) = problem.bounds();
         let mut x = Vec::with_capacity(budget.population);
         let mut f = Vec::with_capacity(budget.population);
         for _ in 0..budget.population {
-            let mut v: Aligned = x0.iter().map(|&c| c + symmetric(rng, budget.init_range)).collect();
+            let mut v: Aligned =
+                x0.iter().map(|&c| c + symmetric(rng, budget.init_range)).collect();
             clamp_into(&mut v, lo, hi);
             f.push(eval.eval(&v));
             x.push(v);
@@ -324,7 +366,11 @@ pub(crate) mod tests {
             e.eval(&[1.0 / (1.0 + k as f64)]);
         }
         let r = e.finish(vec![0.0], 1.0);
-        assert!(r.improvements.len() <= 20 * 5 + 2 && r.improvements.len() >= 80, "{}", r.improvements.len());
+        assert!(
+            r.improvements.len() <= 20 * 5 + 2 && r.improvements.len() >= 80,
+            "{}",
+            r.improvements.len()
+        );
         assert_eq!(r.improvements[0], (1, 1.0));
         assert_eq!(*r.improvements.last().unwrap(), (n, r.best_fitness));
         for &(ev, f) in &r.improvements {

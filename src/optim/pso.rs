@@ -15,9 +15,9 @@
 //! stream ([`super::sampling::PsoLanes`]; coordinate j from lane j % 8), generated and consumed
 //! in the vectorised move loop.
 
-use super::problem::{check_problem, Budget, Evaluator, Optimiser, Population, Problem, RunResult};
-use super::kernels::{pso_move, PsoBounds, PsoCoefficients};
 use super::aligned::Aligned;
+use super::kernels::{pso_move, PsoBounds, PsoCoefficients};
+use super::problem::{check_problem, Budget, Evaluator, Optimiser, Population, Problem, RunResult};
 use super::sampling::PsoLanes;
 use super::{check_range, OptimError};
 use rand_chacha::ChaCha8Rng;
@@ -57,14 +57,20 @@ impl Optimiser for Pso {
         "pso"
     }
 
-    fn run(&self, problem: &dyn Problem, budget: &Budget, rng: &mut ChaCha8Rng) -> Result<RunResult, OptimError> {
+    fn run(
+        &self,
+        problem: &dyn Problem,
+        budget: &Budget,
+        rng: &mut ChaCha8Rng,
+    ) -> Result<RunResult, OptimError> {
         self.validate()?;
         budget.validate(1)?;
         check_problem(problem)?;
         let d = problem.dim();
         let (lo, hi) = problem.bounds();
         let mut eval = Evaluator::new(problem, budget);
-        let Population { x: mut pos, f: mut fit } = Population::initial(problem, budget, &mut eval, rng);
+        let Population { x: mut pos, f: mut fit } =
+            Population::initial(problem, budget, &mut eval, rng);
         let n = pos.len();
         let mut vel = vec![Aligned::zeros(d); n];
         let mut pbest = pos.clone();
@@ -116,8 +122,15 @@ mod tests {
 
     #[test]
     fn parameters_are_validated_by_key() {
-        assert_eq!(Pso { k: 1.2, ..Pso::default() }.validate().unwrap_err().to_string(), "pso.k must be in [0,1], got 1.2");
-        assert!(Pso { c2: -1.0, ..Pso::default() }.validate().unwrap_err().to_string().starts_with("pso.c2"));
+        assert_eq!(
+            Pso { k: 1.2, ..Pso::default() }.validate().unwrap_err().to_string(),
+            "pso.k must be in [0,1], got 1.2"
+        );
+        assert!(Pso { c2: -1.0, ..Pso::default() }
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .starts_with("pso.c2"));
     }
 
     /// A single particle with v0 = 0 at its own best stays put: the velocity update is
@@ -127,7 +140,8 @@ mod tests {
         use crate::optim::problem::tests::Sphere;
         use rand::SeedableRng;
         let p = Sphere::new(4);
-        let budget = Budget { generations: 20, population: 1, init_range: 0.0, trace_every_evals: 5 };
+        let budget =
+            Budget { generations: 20, population: 1, init_range: 0.0, trace_every_evals: 5 };
         let r = Pso::default().run(&p, &budget, &mut ChaCha8Rng::seed_from_u64(1)).unwrap();
         assert_eq!(r.best_x, p.x0);
         assert_eq!(r.evaluations, 21);

@@ -50,7 +50,10 @@ pub fn symmetric(rng: &mut ChaCha8Rng, r: f64) -> f64 {
 pub fn two_units_plus_one(word: u64) -> (f64, f64) {
     const ONE: u64 = 0x3ff0_0000_0000_0000;
     const MANTISSA_TOP32: u64 = 0x000f_ffff_fff0_0000;
-    (f64::from_bits(((word >> 12) & MANTISSA_TOP32) | ONE), f64::from_bits(((word << 20) & MANTISSA_TOP32) | ONE))
+    (
+        f64::from_bits(((word >> 12) & MANTISSA_TOP32) | ONE),
+        f64::from_bits(((word << 20) & MANTISSA_TOP32) | ONE),
+    )
 }
 
 /// The uniforms in [0, 1) themselves (the tests' reference for the folded form).
@@ -108,7 +111,8 @@ impl<const L: usize> BulkLanes<L> {
     /// The next word of lane `l`.
     #[inline(always)]
     pub fn next_word(&mut self, l: usize) -> u64 {
-        let (word, [a, b, c, d]) = xoshiro_next([self.s[0][l], self.s[1][l], self.s[2][l], self.s[3][l]]);
+        let (word, [a, b, c, d]) =
+            xoshiro_next([self.s[0][l], self.s[1][l], self.s[2][l], self.s[3][l]]);
         (self.s[0][l], self.s[1][l], self.s[2][l], self.s[3][l]) = (a, b, c, d);
         word
     }
@@ -296,8 +300,15 @@ impl Geometric {
     /// positions and the random bits drawn are exactly those of the walk with `skip` and
     /// `next_after`, with the table's checks hoisted out of the loop.
     #[inline]
-    pub fn for_each<F: FnMut(usize)>(&self, n: usize, pool: &mut BitPool, rng: &mut ChaCha8Rng, mut visit: F) {
-        let table: Option<&[u16; 1 << BUCKET_BITS]> = self.table.as_deref().map(|t| t.try_into().expect("4096 buckets"));
+    pub fn for_each<F: FnMut(usize)>(
+        &self,
+        n: usize,
+        pool: &mut BitPool,
+        rng: &mut ChaCha8Rng,
+        mut visit: F,
+    ) {
+        let table: Option<&[u16; 1 << BUCKET_BITS]> =
+            self.table.as_deref().map(|t| t.try_into().expect("4096 buckets"));
         match table {
             Some(table) if self.p > 0.0 && self.p < 1.0 => {
                 // A skip is at most MIXED - 1 from the table, or the formula's value (which may
@@ -405,7 +416,8 @@ mod tests {
             let g = Geometric::new(p);
             for n in [0, 1, 7, 1740, 20_000] {
                 for pre in [0, 5, 7, 13] {
-                    let (mut r1, mut r2) = (ChaCha8Rng::seed_from_u64(11), ChaCha8Rng::seed_from_u64(11));
+                    let (mut r1, mut r2) =
+                        (ChaCha8Rng::seed_from_u64(11), ChaCha8Rng::seed_from_u64(11));
                     let (mut b1, mut b2) = (BitPool::new(), BitPool::new());
                     if pre > 0 {
                         assert_eq!(b1.take(pre, &mut r1), b2.take(pre, &mut r2));
@@ -451,7 +463,11 @@ mod tests {
             }
             for (count, q) in [(g0, p), (g1, p * (1.0 - p))] {
                 let sd = (draws as f64 * q * (1.0 - q)).sqrt();
-                assert!((count as f64 - draws as f64 * q).abs() < 5.0 * sd + 1.0, "p {p}: {count} vs {}", draws as f64 * q);
+                assert!(
+                    (count as f64 - draws as f64 * q).abs() < 5.0 * sd + 1.0,
+                    "p {p}: {count} vs {}",
+                    draws as f64 * q
+                );
             }
         }
     }
@@ -473,7 +489,11 @@ mod tests {
     #[test]
     fn mantegna_sigma_for_beta_one_and_a_half() {
         // Yang's reference code: sigma_u = 0.6966 for beta = 3/2.
-        assert!((mantegna_sigma_u(1.5) - 0.696_574_502_557_0).abs() < 1e-9, "{}", mantegna_sigma_u(1.5));
+        assert!(
+            (mantegna_sigma_u(1.5) - 0.696_574_502_557_0).abs() < 1e-9,
+            "{}",
+            mantegna_sigma_u(1.5)
+        );
         // beta = 1: Gamma(2) sin(pi/2) / (Gamma(1) 1 2^0) = 1.
         assert!((mantegna_sigma_u(1.0) - 1.0).abs() < 1e-12);
     }
@@ -501,7 +521,14 @@ mod tests {
         let scale = 1.0 / (1u64 << 32) as f64;
         for w in (0..10_000).map(|_| rng.next_u64()).chain([0, u64::MAX, 1 << 32, 0xffff_ffff]) {
             let (h, l) = two_units(w);
-            assert_eq!((h.to_bits(), l.to_bits()), (((w >> 32) as f64 * scale).to_bits(), ((w & 0xffff_ffff) as f64 * scale).to_bits()), "{w:x}");
+            assert_eq!(
+                (h.to_bits(), l.to_bits()),
+                (
+                    ((w >> 32) as f64 * scale).to_bits(),
+                    ((w & 0xffff_ffff) as f64 * scale).to_bits()
+                ),
+                "{w:x}"
+            );
         }
     }
 
@@ -525,7 +552,11 @@ mod tests {
                 let words = stepped.next_words();
                 for l in 0..L {
                     let want = single[l].next_u64();
-                    assert_eq!(xoshiro_step(&mut s0[l], &mut s1[l], &mut s2[l], &mut s3[l]), want, "lane {l}");
+                    assert_eq!(
+                        xoshiro_step(&mut s0[l], &mut s1[l], &mut s2[l], &mut s3[l]),
+                        want,
+                        "lane {l}"
+                    );
                     assert_eq!(words[l], want, "lane {l}");
                 }
             }

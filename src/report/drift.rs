@@ -89,11 +89,13 @@ impl DriftOptions {
 
 /// Parse `--tol COLUMN=ABS[,REL]`.
 pub fn parse_tol(s: &str) -> Result<(String, Tolerance)> {
-    let (col, v) = s.split_once('=').with_context(|| format!("--tol `{s}`: expected COLUMN=ABS[,REL]"))?;
+    let (col, v) =
+        s.split_once('=').with_context(|| format!("--tol `{s}`: expected COLUMN=ABS[,REL]"))?;
     let mut it = v.split(',');
     let num = |x: Option<&str>, what: &str| -> Result<f64> {
         let x = x.unwrap_or("0").trim();
-        let v: f64 = x.parse().map_err(|_| anyhow::anyhow!("--tol `{s}`: {what} `{x}` is not a number"))?;
+        let v: f64 =
+            x.parse().map_err(|_| anyhow::anyhow!("--tol `{s}`: {what} `{x}` is not a number"))?;
         if !(v >= 0.0 && v.is_finite()) {
             bail!("--tol `{s}`: {what} must be a finite number >= 0");
         }
@@ -111,7 +113,10 @@ pub fn glob(pattern: &str, s: &str) -> bool {
         return pattern == s;
     }
     let (first, last) = (parts[0], parts[parts.len() - 1]);
-    if !s.starts_with(first) || !s[first.len()..].ends_with(last) || s.len() < first.len() + last.len() {
+    if !s.starts_with(first)
+        || !s[first.len()..].ends_with(last)
+        || s.len() < first.len() + last.len()
+    {
         return false;
     }
     let mut rest = &s[first.len()..s.len() - last.len()];
@@ -126,31 +131,70 @@ pub fn glob(pattern: &str, s: &str) -> bool {
 
 /// Columns that hold measured time: reported, never judged.
 pub fn is_timing_column(name: &str) -> bool {
-    name.ends_with("_s") || name.contains("cpu") || name.contains("seconds") || name.starts_with("time")
+    name.ends_with("_s")
+        || name.contains("cpu")
+        || name.contains("seconds")
+        || name.starts_with("time")
 }
 
 /// Columns that identify a row even when numeric.
-const IDENTITY: [&str; 9] = ["cn_x", "cn_y", "grid_x", "grid_y", "nx", "ny", "repeat", "n", "cells"];
+const IDENTITY: [&str; 9] =
+    ["cn_x", "cn_y", "grid_x", "grid_y", "nx", "ny", "repeat", "n", "cells"];
 
 /// One difference.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Finding {
-    MissingTable { table: String },
-    ExtraTable { table: String },
-    MissingColumn { table: String, column: String },
-    ExtraColumn { table: String, column: String },
-    RowCount { table: String, baseline: usize, current: usize },
-    RowKey { table: String, row: usize, baseline: String, current: String },
-    Cell { table: String, row: String, column: String, baseline: String, current: String, abs: f64, rel: f64, judged: bool },
+    MissingTable {
+        table: String,
+    },
+    ExtraTable {
+        table: String,
+    },
+    MissingColumn {
+        table: String,
+        column: String,
+    },
+    ExtraColumn {
+        table: String,
+        column: String,
+    },
+    RowCount {
+        table: String,
+        baseline: usize,
+        current: usize,
+    },
+    RowKey {
+        table: String,
+        row: usize,
+        baseline: String,
+        current: String,
+    },
+    Cell {
+        table: String,
+        row: String,
+        column: String,
+        baseline: String,
+        current: String,
+        abs: f64,
+        rel: f64,
+        judged: bool,
+    },
     /// A non-finite number equal on both sides (not drift, but never silent).
-    NonFinite { table: String, row: String, column: String, value: String },
+    NonFinite {
+        table: String,
+        row: String,
+        column: String,
+        value: String,
+    },
 }
 
 impl Finding {
     /// Whether it counts as drift (an extra table or a timing cell does not).
     pub fn drifted(&self) -> bool {
         match self {
-            Finding::ExtraTable { .. } | Finding::ExtraColumn { .. } | Finding::NonFinite { .. } => false,
+            Finding::ExtraTable { .. }
+            | Finding::ExtraColumn { .. }
+            | Finding::NonFinite { .. } => false,
             Finding::Cell { judged, .. } => *judged,
             _ => true,
         }
@@ -160,13 +204,24 @@ impl Finding {
         match self {
             Finding::MissingTable { table } => format!("{table}: missing in the current folder"),
             Finding::ExtraTable { table } => format!("{table}: new table (not in the baseline)"),
-            Finding::MissingColumn { table, column } => format!("{table}: column {column} is missing"),
+            Finding::MissingColumn { table, column } => {
+                format!("{table}: column {column} is missing")
+            }
             Finding::ExtraColumn { table, column } => format!("{table}: new column {column}"),
-            Finding::NonFinite { table, row, column, value } => format!("{table}:{row}:{column} is {value} in both folders"),
-            Finding::RowCount { table, baseline, current } => format!("{table}: {baseline} rows in the baseline, {current} now"),
-            Finding::RowKey { table, row, baseline, current } => format!("{table}: row {row} is {current}, the baseline has {baseline}"),
+            Finding::NonFinite { table, row, column, value } => {
+                format!("{table}:{row}:{column} is {value} in both folders")
+            }
+            Finding::RowCount { table, baseline, current } => {
+                format!("{table}: {baseline} rows in the baseline, {current} now")
+            }
+            Finding::RowKey { table, row, baseline, current } => {
+                format!("{table}: row {row} is {current}, the baseline has {baseline}")
+            }
             Finding::Cell { table, row, column, baseline, current, rel, judged, .. } => {
-                format!("{table}:{row}:{column} {baseline} -> {current} (rel {rel:.2e}){}", if *judged { "" } else { " [timing, not judged]" })
+                format!(
+                    "{table}:{row}:{column} {baseline} -> {current} (rel {rel:.2e}){}",
+                    if *judged { "" } else { " [timing, not judged]" }
+                )
             }
         }
     }
@@ -195,9 +250,14 @@ impl DriftReport {
             let mut per_table: BTreeMap<&str, (usize, f64)> = BTreeMap::new();
             for f in &drifted {
                 let (t, rel) = match f {
-                    Finding::MissingTable { table } | Finding::MissingColumn { table, .. } | Finding::RowCount { table, .. } | Finding::RowKey { table, .. } => (table.as_str(), f64::INFINITY),
+                    Finding::MissingTable { table }
+                    | Finding::MissingColumn { table, .. }
+                    | Finding::RowCount { table, .. }
+                    | Finding::RowKey { table, .. } => (table.as_str(), f64::INFINITY),
                     Finding::Cell { table, rel, .. } => (table.as_str(), *rel),
-                    Finding::ExtraTable { table } | Finding::ExtraColumn { table, .. } | Finding::NonFinite { table, .. } => (table.as_str(), 0.0),
+                    Finding::ExtraTable { table }
+                    | Finding::ExtraColumn { table, .. }
+                    | Finding::NonFinite { table, .. } => (table.as_str(), 0.0),
                 };
                 let e = per_table.entry(t).or_insert((0, 0.0));
                 e.0 += 1;
@@ -208,7 +268,8 @@ impl DriftReport {
                 let _ = write!(s, "\n  {t}: {n} moved (largest relative change {rel:.2e})");
             }
             // Structural findings (a missing table, column or row) always show, before the cells.
-            let structural: Vec<&&Finding> = drifted.iter().filter(|f| !matches!(f, Finding::Cell { .. })).collect();
+            let structural: Vec<&&Finding> =
+                drifted.iter().filter(|f| !matches!(f, Finding::Cell { .. })).collect();
             for f in &structural {
                 let _ = write!(s, "\n  {}", f.describe());
             }
@@ -217,11 +278,23 @@ impl DriftReport {
                 let _ = write!(s, "\n  {}", f.describe());
             }
         }
-        let timing = self.findings.iter().filter(|f| matches!(f, Finding::Cell { judged: false, .. })).count();
+        let timing = self
+            .findings
+            .iter()
+            .filter(|f| matches!(f, Finding::Cell { judged: false, .. }))
+            .count();
         if timing > 0 {
-            let _ = write!(s, "\n{timing} timing cells differ (reported in the diff CSV, not judged)");
+            let _ =
+                write!(s, "\n{timing} timing cells differ (reported in the diff CSV, not judged)");
         }
-        for f in self.findings.iter().filter(|f| matches!(f, Finding::ExtraTable { .. } | Finding::ExtraColumn { .. } | Finding::NonFinite { .. })) {
+        for f in self.findings.iter().filter(|f| {
+            matches!(
+                f,
+                Finding::ExtraTable { .. }
+                    | Finding::ExtraColumn { .. }
+                    | Finding::NonFinite { .. }
+            )
+        }) {
             let _ = write!(s, "\nnote: {}", f.describe());
         }
         s
@@ -229,20 +302,54 @@ impl DriftReport {
 
     /// The per-cell diff CSV.
     pub fn csv(&self) -> Result<String> {
-        let header: Vec<String> = ["table", "row", "column", "baseline", "current", "abs_diff", "rel_diff", "judged", "drifted", "what"].iter().map(|h| h.to_string()).collect();
+        let header: Vec<String> = [
+            "table", "row", "column", "baseline", "current", "abs_diff", "rel_diff", "judged",
+            "drifted", "what",
+        ]
+        .iter()
+        .map(|h| h.to_string())
+        .collect();
         let rows: Vec<Vec<String>> = self
             .findings
             .iter()
             .map(|f| match f {
                 Finding::Cell { table, row, column, baseline, current, abs, rel, judged } => {
-                    vec![table.clone(), row.clone(), column.clone(), baseline.clone(), current.clone(), format!("{abs:e}"), format!("{rel:e}"), yes(*judged), yes(f.drifted()), "cell".into()]
+                    vec![
+                        table.clone(),
+                        row.clone(),
+                        column.clone(),
+                        baseline.clone(),
+                        current.clone(),
+                        format!("{abs:e}"),
+                        format!("{rel:e}"),
+                        yes(*judged),
+                        yes(f.drifted()),
+                        "cell".into(),
+                    ]
                 }
                 other => {
                     let table = match other {
-                        Finding::MissingTable { table } | Finding::ExtraTable { table } | Finding::MissingColumn { table, .. } | Finding::ExtraColumn { table, .. } | Finding::RowCount { table, .. } | Finding::RowKey { table, .. } | Finding::NonFinite { table, .. } => table.clone(),
+                        Finding::MissingTable { table }
+                        | Finding::ExtraTable { table }
+                        | Finding::MissingColumn { table, .. }
+                        | Finding::ExtraColumn { table, .. }
+                        | Finding::RowCount { table, .. }
+                        | Finding::RowKey { table, .. }
+                        | Finding::NonFinite { table, .. } => table.clone(),
                         Finding::Cell { .. } => unreachable!(),
                     };
-                    vec![table, String::new(), String::new(), String::new(), String::new(), String::new(), String::new(), "yes".into(), yes(other.drifted()), other.describe()]
+                    vec![
+                        table,
+                        String::new(),
+                        String::new(),
+                        String::new(),
+                        String::new(),
+                        String::new(),
+                        String::new(),
+                        "yes".into(),
+                        yes(other.drifted()),
+                        other.describe(),
+                    ]
                 }
             })
             .collect();
@@ -264,7 +371,12 @@ pub struct Table {
 impl Table {
     pub fn parse(name: &str, text: &str) -> Result<Table> {
         let mut rd = csv::ReaderBuilder::new().has_headers(true).from_reader(text.as_bytes());
-        let header: Vec<String> = rd.headers().map_err(|e| anyhow::anyhow!("{name}: malformed CSV header: {e}"))?.iter().map(String::from).collect();
+        let header: Vec<String> = rd
+            .headers()
+            .map_err(|e| anyhow::anyhow!("{name}: malformed CSV header: {e}"))?
+            .iter()
+            .map(String::from)
+            .collect();
         let mut rows = Vec::new();
         for rec in rd.records() {
             let rec = rec.map_err(|e| {
@@ -278,7 +390,13 @@ impl Table {
 }
 
 /// Compare one table (pure).
-pub fn compare_table(name: &str, base: &Table, cur: &Table, opts: &DriftOptions, report: &mut DriftReport) {
+pub fn compare_table(
+    name: &str,
+    base: &Table,
+    cur: &Table,
+    opts: &DriftOptions,
+    report: &mut DriftReport,
+) {
     report.tables += 1;
     let timing_table = opts.config.timing_tables.iter().any(|g| glob(g, name));
     for c in &base.header {
@@ -292,28 +410,67 @@ pub fn compare_table(name: &str, base: &Table, cur: &Table, opts: &DriftOptions,
         }
     }
     if base.rows.len() != cur.rows.len() {
-        report.findings.push(Finding::RowCount { table: name.into(), baseline: base.rows.len(), current: cur.rows.len() });
+        report.findings.push(Finding::RowCount {
+            table: name.into(),
+            baseline: base.rows.len(),
+            current: cur.rows.len(),
+        });
     }
-    let cols: Vec<(usize, usize, &String)> = base.header.iter().enumerate().filter_map(|(i, c)| cur.header.iter().position(|d| d == c).map(|j| (i, j, c))).collect();
-    let is_key = |c: &str, v: &str| IDENTITY.contains(&c) || (!v.is_empty() && v.parse::<f64>().is_err());
+    let cols: Vec<(usize, usize, &String)> = base
+        .header
+        .iter()
+        .enumerate()
+        .filter_map(|(i, c)| cur.header.iter().position(|d| d == c).map(|j| (i, j, c)))
+        .collect();
+    let is_key =
+        |c: &str, v: &str| IDENTITY.contains(&c) || (!v.is_empty() && v.parse::<f64>().is_err());
     for (r, (b, c)) in base.rows.iter().zip(&cur.rows).enumerate() {
-        let key_cols: Vec<(usize, usize)> = cols.iter().filter(|(i, _, name)| is_key(name, b.get(*i).map(String::as_str).unwrap_or(""))).map(|(i, j, _)| (*i, *j)).collect();
-        let kb = key_cols.iter().map(|(i, _)| b.get(*i).cloned().unwrap_or_default()).collect::<Vec<_>>().join("/");
-        let kc = key_cols.iter().map(|(_, j)| c.get(*j).cloned().unwrap_or_default()).collect::<Vec<_>>().join("/");
+        let key_cols: Vec<(usize, usize)> = cols
+            .iter()
+            .filter(|(i, _, name)| is_key(name, b.get(*i).map(String::as_str).unwrap_or("")))
+            .map(|(i, j, _)| (*i, *j))
+            .collect();
+        let kb = key_cols
+            .iter()
+            .map(|(i, _)| b.get(*i).cloned().unwrap_or_default())
+            .collect::<Vec<_>>()
+            .join("/");
+        let kc = key_cols
+            .iter()
+            .map(|(_, j)| c.get(*j).cloned().unwrap_or_default())
+            .collect::<Vec<_>>()
+            .join("/");
         // A timing-dependent row (e.g. a claim about speed) may change its text cells too (its
         // verdict): those are reported as unjudged cells, not as a different row.
-        let timing_row = opts.config.timing_rows.iter().any(|t| b.iter().chain(c).any(|v| v.contains(t.as_str())));
+        let timing_row = opts
+            .config
+            .timing_rows
+            .iter()
+            .any(|t| b.iter().chain(c).any(|v| v.contains(t.as_str())));
         if kb != kc && !timing_row {
-            report.findings.push(Finding::RowKey { table: name.into(), row: r + 1, baseline: kb, current: kc });
+            report.findings.push(Finding::RowKey {
+                table: name.into(),
+                row: r + 1,
+                baseline: kb,
+                current: kc,
+            });
             continue;
         }
         let key = if kb.is_empty() { format!("row {}", r + 1) } else { kb };
         for &(i, j, col) in &cols {
-            let (vb, vc) = (b.get(i).map(String::as_str).unwrap_or(""), c.get(j).map(String::as_str).unwrap_or(""));
+            let (vb, vc) = (
+                b.get(i).map(String::as_str).unwrap_or(""),
+                c.get(j).map(String::as_str).unwrap_or(""),
+            );
             report.cells += 1;
             if vb == vc {
                 if vb.parse::<f64>().is_ok_and(|x| !x.is_finite()) {
-                    report.findings.push(Finding::NonFinite { table: name.into(), row: key.clone(), column: col.clone(), value: vb.into() });
+                    report.findings.push(Finding::NonFinite {
+                        table: name.into(),
+                        row: key.clone(),
+                        column: col.clone(),
+                        value: vb.into(),
+                    });
                 }
                 continue;
             }
@@ -324,10 +481,32 @@ pub fn compare_table(name: &str, base: &Table, cur: &Table, opts: &DriftOptions,
                         continue;
                     }
                     let abs = (x - y).abs();
-                    let rel = if x.is_finite() && y.is_finite() { abs / x.abs().max(y.abs()).max(f64::MIN_POSITIVE) } else { f64::INFINITY };
-                    report.findings.push(Finding::Cell { table: name.into(), row: key.clone(), column: col.clone(), baseline: vb.into(), current: vc.into(), abs, rel, judged });
+                    let rel = if x.is_finite() && y.is_finite() {
+                        abs / x.abs().max(y.abs()).max(f64::MIN_POSITIVE)
+                    } else {
+                        f64::INFINITY
+                    };
+                    report.findings.push(Finding::Cell {
+                        table: name.into(),
+                        row: key.clone(),
+                        column: col.clone(),
+                        baseline: vb.into(),
+                        current: vc.into(),
+                        abs,
+                        rel,
+                        judged,
+                    });
                 }
-                _ => report.findings.push(Finding::Cell { table: name.into(), row: key.clone(), column: col.clone(), baseline: vb.into(), current: vc.into(), abs: f64::NAN, rel: f64::INFINITY, judged }),
+                _ => report.findings.push(Finding::Cell {
+                    table: name.into(),
+                    row: key.clone(),
+                    column: col.clone(),
+                    baseline: vb.into(),
+                    current: vc.into(),
+                    abs: f64::NAN,
+                    rel: f64::INFINITY,
+                    judged,
+                }),
             }
         }
     }
@@ -339,9 +518,18 @@ pub fn tables(dir: &Path) -> Result<Vec<PathBuf>> {
     if !dir.is_dir() {
         bail!("{} is not a folder", dir.display());
     }
-    let skipped = |p: &Path| p.components().any(|c| ["png", "ioh", "maps"].iter().any(|s| c.as_os_str() == *s));
+    let skipped = |p: &Path| {
+        p.components().any(|c| ["png", "ioh", "maps"].iter().any(|s| c.as_os_str() == *s))
+    };
     let (files, _) = crate::io::outdir::walk(dir)?;
-    Ok(files.into_iter().filter(|f| f.extension().is_some_and(|e| e == "csv") && f.file_name().is_some_and(|n| n != "drift.csv") && !skipped(f.parent().unwrap_or(Path::new("")))).collect())
+    Ok(files
+        .into_iter()
+        .filter(|f| {
+            f.extension().is_some_and(|e| e == "csv")
+                && f.file_name().is_some_and(|n| n != "drift.csv")
+                && !skipped(f.parent().unwrap_or(Path::new("")))
+        })
+        .collect())
 }
 
 /// The run identity of every `manifest.toml` under a folder, by relative folder.
@@ -353,11 +541,20 @@ fn identities(dir: &Path) -> Result<BTreeMap<PathBuf, (String, String, String)>>
         master_seed: u64,
     }
     let mut out = BTreeMap::new();
-    for f in crate::io::outdir::walk(dir)?.0.into_iter().filter(|f| f.file_name().is_some_and(|n| n == crate::io::outdir::MANIFEST)) {
+    for f in crate::io::outdir::walk(dir)?
+        .0
+        .into_iter()
+        .filter(|f| f.file_name().is_some_and(|n| n == crate::io::outdir::MANIFEST))
+    {
         let m = dir.join(&f);
-        let text = std::fs::read_to_string(&m).with_context(|| format!("cannot read {}", m.display()))?;
-        let id: Id = toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {}", m.display(), e.message()))?;
-        out.insert(f.parent().unwrap_or(Path::new("")).to_path_buf(), (id.spec_sha256, id.profile, id.master_seed.to_string()));
+        let text =
+            std::fs::read_to_string(&m).with_context(|| format!("cannot read {}", m.display()))?;
+        let id: Id = toml::from_str(&text)
+            .map_err(|e| anyhow::anyhow!("{}: {}", m.display(), e.message()))?;
+        out.insert(
+            f.parent().unwrap_or(Path::new("")).to_path_buf(),
+            (id.spec_sha256, id.profile, id.master_seed.to_string()),
+        );
     }
     Ok(out)
 }
@@ -368,12 +565,18 @@ pub fn read_config(baseline: &Path) -> Result<DriftConfig> {
     if !p.exists() {
         return Ok(DriftConfig::default());
     }
-    let text = std::fs::read_to_string(&p).with_context(|| format!("cannot read {}", p.display()))?;
+    let text =
+        std::fs::read_to_string(&p).with_context(|| format!("cannot read {}", p.display()))?;
     toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {}", p.display(), e.message().trim()))
 }
 
 /// Compare two folders. `allow_spec_change`: runs of other specs are compared anyway.
-pub fn compare_dirs(baseline: &Path, current: &Path, opts: &DriftOptions, allow_spec_change: bool) -> Result<DriftReport> {
+pub fn compare_dirs(
+    baseline: &Path,
+    current: &Path,
+    opts: &DriftOptions,
+    allow_spec_change: bool,
+) -> Result<DriftReport> {
     crate::io::outdir::require_finished(baseline, "the baseline")?;
     crate::io::outdir::require_finished(current, "the current folder")?;
     let (tb, tc) = (tables(baseline)?, tables(current)?);
@@ -389,7 +592,11 @@ pub fn compare_dirs(baseline: &Path, current: &Path, opts: &DriftOptions, allow_
                 } else if pb != pc {
                     Some(format!("profile {pb} vs {pc}"))
                 } else if sb != sc {
-                    Some(format!("spec sha256 {} vs {}", &sb[..12.min(sb.len())], &sc[..12.min(sc.len())]))
+                    Some(format!(
+                        "spec sha256 {} vs {}",
+                        &sb[..12.min(sb.len())],
+                        &sc[..12.min(sc.len())]
+                    ))
                 } else {
                     None
                 };
@@ -408,7 +615,8 @@ pub fn compare_dirs(baseline: &Path, current: &Path, opts: &DriftOptions, allow_
         }
         let read = |root: &Path| -> Result<Table> {
             let p = root.join(t);
-            let text = std::fs::read_to_string(&p).with_context(|| format!("cannot read {}", p.display()))?;
+            let text = std::fs::read_to_string(&p)
+                .with_context(|| format!("cannot read {}", p.display()))?;
             Table::parse(&p.display().to_string(), &text)
         };
         compare_table(&name, &read(baseline)?, &read(current)?, opts, &mut report);
@@ -439,20 +647,31 @@ pub fn accept(baseline: &Path, current: &Path) -> Result<Vec<String>> {
     crate::io::outdir::replace_dir(baseline, |staged| {
         // The old baseline's files first (not lock files, nor the tables the current run lacks) ...
         let lock = |f: &Path| f.file_name().is_some_and(|n| n == crate::io::outdir::LOCK_FILE);
-        for f in old_files.iter().filter(|f| !tc.contains(f) && !tb.contains(f) && !files.contains(f) && !lock(f)) {
-            let text = std::fs::read(baseline.join(f)).with_context(|| format!("cannot read {}", baseline.join(f).display()))?;
+        for f in old_files
+            .iter()
+            .filter(|f| !tc.contains(f) && !tb.contains(f) && !files.contains(f) && !lock(f))
+        {
+            let text = std::fs::read(baseline.join(f))
+                .with_context(|| format!("cannot read {}", baseline.join(f).display()))?;
             write_atomic(&staged.join(f), &text)?;
         }
         // ... then the current run's tables and manifests.
         for f in &files {
-            let text = std::fs::read(current.join(f)).with_context(|| format!("cannot read {}", current.join(f).display()))?;
+            let text = std::fs::read(current.join(f))
+                .with_context(|| format!("cannot read {}", current.join(f).display()))?;
             let old = std::fs::read(baseline.join(f)).ok();
             write_atomic(&staged.join(f), &text)?;
             if old.as_deref() != Some(&text[..]) {
-                said.push(format!("{} {}", if old.is_some() { "replaced" } else { "added" }, f.display()));
+                said.push(format!(
+                    "{} {}",
+                    if old.is_some() { "replaced" } else { "added" },
+                    f.display()
+                ));
             }
         }
-        said.extend(tb.iter().filter(|f| !tc.contains(f)).map(|f| format!("removed {}", f.display())));
+        said.extend(
+            tb.iter().filter(|f| !tc.contains(f)).map(|f| format!("removed {}", f.display())),
+        );
         Ok(())
     })?;
     Ok(said)
@@ -488,11 +707,17 @@ mod tests {
         assert!(r.drifted());
         assert_eq!(r.findings.len(), 1);
         let Finding::Cell { row, column, baseline, current, .. } = &r.findings[0] else { panic!() };
-        assert_eq!((row.as_str(), column.as_str(), baseline.as_str(), current.as_str()), ("cube/8", "err", "1.25", "1.2500001"));
+        assert_eq!(
+            (row.as_str(), column.as_str(), baseline.as_str(), current.as_str()),
+            ("cube/8", "err", "1.25", "1.2500001")
+        );
         assert!(r.summary(5).contains("t.csv:cube/8:err 1.25 -> 1.2500001"));
         let tiny = BASE.replace("1.25,", "1.25000000000001,");
         assert!(!cmp(BASE, &tiny, &DriftOptions::default()).drifted());
-        let loose = DriftOptions { columns: vec![("e*".into(), Tolerance { abs: 1e-3, rel: 0.0 })], ..DriftOptions::default() };
+        let loose = DriftOptions {
+            columns: vec![("e*".into(), Tolerance { abs: 1e-3, rel: 0.0 })],
+            ..DriftOptions::default()
+        };
         assert!(!cmp(BASE, &moved, &loose).drifted());
     }
 
@@ -504,27 +729,51 @@ mod tests {
         assert!(matches!(&r.findings[0], Finding::Cell { judged: false, .. }));
         assert!(r.summary(5).contains("1 timing cells differ"));
         // A table declared timing-dependent.
-        let opts = DriftOptions { config: DriftConfig { timing_tables: vec!["t.*".into()], ..DriftConfig::default() }, ..DriftOptions::default() };
+        let opts = DriftOptions {
+            config: DriftConfig { timing_tables: vec!["t.*".into()], ..DriftConfig::default() },
+            ..DriftOptions::default()
+        };
         assert!(!cmp(BASE, &BASE.replace("1.25,", "9,"), &opts).drifted());
-        let rows = DriftOptions { config: DriftConfig { timing_rows: vec!["cube".into()], ..DriftConfig::default() }, ..DriftOptions::default() };
+        let rows = DriftOptions {
+            config: DriftConfig { timing_rows: vec!["cube".into()], ..DriftConfig::default() },
+            ..DriftOptions::default()
+        };
         assert!(!cmp(BASE, &BASE.replace("1.25,", "9,"), &rows).drifted());
         // A claim about speed whose verdict (a text cell, part of the row key) flips on timing
         // noise is reported, not judged; the same flip in another row is drift.
         let claims = "claim,verdict,holds\nA is the fastest,holds,5\nB is exact,holds,5\n";
-        let speed = DriftOptions { config: DriftConfig { timing_rows: vec!["fastest".into()], ..DriftConfig::default() }, ..DriftOptions::default() };
+        let speed = DriftOptions {
+            config: DriftConfig { timing_rows: vec!["fastest".into()], ..DriftConfig::default() },
+            ..DriftOptions::default()
+        };
         let r = cmp(claims, &claims.replace("fastest,holds,5", "fastest,mostly holds,4"), &speed);
-        assert!(!r.drifted() && r.findings.iter().all(|f| matches!(f, Finding::Cell { judged: false, .. })), "{:?}", r.findings);
+        assert!(
+            !r.drifted()
+                && r.findings.iter().all(|f| matches!(f, Finding::Cell { judged: false, .. })),
+            "{:?}",
+            r.findings
+        );
         assert!(cmp(claims, &claims.replace("exact,holds", "exact,mostly holds"), &speed).drifted());
     }
 
     #[test]
     fn missing_columns_rows_and_moved_keys_drift() {
         let r = cmp(BASE, "data,cn_x,cpu_s\ncube,6,0.01\n", &DriftOptions::default());
-        assert!(r.findings.iter().any(|f| matches!(f, Finding::MissingColumn { column, .. } if column == "err")));
-        assert!(r.findings.iter().any(|f| matches!(f, Finding::RowCount { baseline: 2, current: 1, .. })));
+        assert!(r
+            .findings
+            .iter()
+            .any(|f| matches!(f, Finding::MissingColumn { column, .. } if column == "err")));
+        assert!(r
+            .findings
+            .iter()
+            .any(|f| matches!(f, Finding::RowCount { baseline: 2, current: 1, .. })));
         let r = cmp(BASE, &BASE.replace("cube,8", "cube,10"), &DriftOptions::default());
         assert!(matches!(&r.findings[0], Finding::RowKey { row: 2, .. }), "{:?}", r.findings);
-        let r = cmp(BASE, "data,cn_x,err,cpu_s,new\ncube,6,1.5,0.01,1\ncube,8,1.25,0.02,2\n", &DriftOptions::default());
+        let r = cmp(
+            BASE,
+            "data,cn_x,err,cpu_s,new\ncube,6,1.5,0.01,1\ncube,8,1.25,0.02,2\n",
+            &DriftOptions::default(),
+        );
         assert!(!r.drifted(), "a new column is noted, not drift");
     }
 
@@ -536,27 +785,53 @@ mod tests {
 
     #[test]
     fn tolerances_and_globs_parse() {
-        assert_eq!(parse_tol("err=1e-6").unwrap(), ("err".into(), Tolerance { abs: 1e-6, rel: 0.0 }));
+        assert_eq!(
+            parse_tol("err=1e-6").unwrap(),
+            ("err".into(), Tolerance { abs: 1e-6, rel: 0.0 })
+        );
         assert_eq!(parse_tol("*_avg=0,1e-3").unwrap().1, Tolerance { abs: 0.0, rel: 1e-3 });
-        assert!(parse_tol("err").is_err() && parse_tol("err=-1").is_err() && parse_tol("err=x").is_err());
-        assert!(glob("*_avg", "de_avg") && glob("ch6*/table_6_6.csv", "ch6_same/table_6_6.csv") && !glob("a*b", "ac") && glob("x", "x"));
-        assert!(Tolerance::default().equal(f64::NAN, f64::NAN) && !Tolerance::default().equal(1.0, f64::NAN));
+        assert!(
+            parse_tol("err").is_err()
+                && parse_tol("err=-1").is_err()
+                && parse_tol("err=x").is_err()
+        );
+        assert!(
+            glob("*_avg", "de_avg")
+                && glob("ch6*/table_6_6.csv", "ch6_same/table_6_6.csv")
+                && !glob("a*b", "ac")
+                && glob("x", "x")
+        );
+        assert!(
+            Tolerance::default().equal(f64::NAN, f64::NAN)
+                && !Tolerance::default().equal(1.0, f64::NAN)
+        );
     }
 
     #[test]
     fn non_finite_numbers_compare_by_identity_and_are_reported() {
         let t = Tolerance { abs: 1e-9, rel: 1e-9 };
         let (inf, nan) = (f64::INFINITY, f64::NAN);
-        assert!(!t.equal(1.5, inf) && !t.equal(inf, 1.5) && !t.equal(-inf, inf) && !t.equal(inf, nan));
+        assert!(
+            !t.equal(1.5, inf) && !t.equal(inf, 1.5) && !t.equal(-inf, inf) && !t.equal(inf, nan)
+        );
         assert!(t.equal(inf, inf) && t.equal(-inf, -inf) && t.equal(nan, nan));
         let loose = Tolerance { abs: 1e300, rel: 1.0 };
         assert!(!loose.equal(f64::MAX, inf));
         let base = "k,v\na,1.5\nb,inf\n";
         let r = cmp(base, "k,v\na,inf\nb,inf\n", &DriftOptions::default());
         assert!(r.drifted(), "{:?}", r.findings);
-        assert!(r.summary(5).contains("t.csv:a:v 1.5 -> inf") && r.summary(5).contains("b:v is inf in both"), "{}", r.summary(5));
+        assert!(
+            r.summary(5).contains("t.csv:a:v 1.5 -> inf")
+                && r.summary(5).contains("b:v is inf in both"),
+            "{}",
+            r.summary(5)
+        );
         assert!(cmp(base, "k,v\na,1.5\nb,-inf\n", &DriftOptions::default()).drifted());
         let r = cmp(base, base, &DriftOptions::default());
-        assert!(!r.drifted() && r.summary(5).contains("note: t.csv:b:v is inf in both folders"), "{}", r.summary(5));
+        assert!(
+            !r.drifted() && r.summary(5).contains("note: t.csv:b:v is inf in both folders"),
+            "{}",
+            r.summary(5)
+        );
     }
 }

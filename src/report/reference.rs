@@ -13,7 +13,8 @@ pub struct RefTable {
 impl RefTable {
     pub fn parse(text: &str) -> RefTable {
         let mut r = csv::Reader::from_reader(text.as_bytes());
-        let header: Vec<String> = r.headers().map(|h| h.iter().map(String::from).collect()).unwrap_or_default();
+        let header: Vec<String> =
+            r.headers().map(|h| h.iter().map(String::from).collect()).unwrap_or_default();
         let rows = r
             .records()
             .filter_map(|rec| rec.ok())
@@ -24,7 +25,9 @@ impl RefTable {
 
     /// The row whose key columns equal `key` (in order).
     pub fn find(&self, key_cols: &[&str], key: &[String]) -> Option<&BTreeMap<String, String>> {
-        self.rows.iter().find(|row| key_cols.iter().zip(key).all(|(c, k)| row.get(*c).map(|v| v == k).unwrap_or(false)))
+        self.rows.iter().find(|row| {
+            key_cols.iter().zip(key).all(|(c, k)| row.get(*c).map(|v| v == k).unwrap_or(false))
+        })
     }
 
     /// A numeric cell.
@@ -64,7 +67,10 @@ pub fn joined(names: &[&str]) -> Option<RefTable> {
     let mut parts = names.iter().filter_map(|n| table(n));
     let mut first = parts.next()?;
     for t in parts {
-        debug_assert_eq!(t.header, first.header, "joined reference tables must share their columns");
+        debug_assert_eq!(
+            t.header, first.header,
+            "joined reference tables must share their columns"
+        );
         first.rows.extend(t.rows);
     }
     Some(first)
@@ -75,11 +81,17 @@ mod tests {
     #[test]
     fn published_tables_load() {
         let j = super::joined(&["appendix_b", "section_4_bunny"]).unwrap();
-        assert_eq!(j.value(&["data", "n"], &["bunny".into(), "30".into()], "qe_dnsom"), Some(0.049694));
+        assert_eq!(
+            j.value(&["data", "n"], &["bunny".into(), "30".into()], "qe_dnsom"),
+            Some(0.049694)
+        );
         assert_eq!(j.value(&["data", "n"], &["bunny".into(), "30".into()], "qe_som2d"), None);
         let b = super::table("appendix_b").unwrap();
         assert_eq!(b.rows.len(), 15);
-        assert_eq!(b.value(&["data", "n"], &["spindle".into(), "30".into()], "cpu_s_dnsom"), Some(5.309147));
+        assert_eq!(
+            b.value(&["data", "n"], &["spindle".into(), "30".into()], "cpu_s_dnsom"),
+            Some(5.309147)
+        );
         assert_eq!(super::table("appendix_k").unwrap().rows.len(), 140);
     }
 }

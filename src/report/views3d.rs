@@ -7,8 +7,8 @@
 //! [`MAX_SIDE`] rows and columns (always keeping the first and last), which keeps a quick
 //! reproduction's folder small.
 
-use crate::io::write_atomic;
 use crate::geom::Point3;
+use crate::io::write_atomic;
 use anyhow::Result;
 use std::fmt::Write;
 use std::path::Path;
@@ -83,7 +83,16 @@ fn trace_js(t: &Trace) -> String {
                 }
                 line_pts.extend(l.iter().map(|&i| points.get(i).copied()));
             }
-            let lc = |c: usize| format!("[{}]", line_pts.iter().map(|p| p.map(|p| num(p[c])).unwrap_or_else(|| "null".into())).collect::<Vec<_>>().join(","));
+            let lc = |c: usize| {
+                format!(
+                    "[{}]",
+                    line_pts
+                        .iter()
+                        .map(|p| p.map(|p| num(p[c])).unwrap_or_else(|| "null".into()))
+                        .collect::<Vec<_>>()
+                        .join(",")
+                )
+            };
             format!(
                 "{{\"kind\":\"points\",\"label\":{},\"colour\":{},\"x\":{},\"y\":{},\"z\":{},\"lx\":{},\"ly\":{},\"lz\":{}}}",
                 string(label),
@@ -99,10 +108,20 @@ fn trace_js(t: &Trace) -> String {
         Trace::Surface { label, colour, rows, cols, points } => {
             let (ri, ci) = (thin(*rows, MAX_SIDE), thin(*cols, MAX_SIDE));
             let grid = |c: usize| {
-                let rows: Vec<String> = ri.iter().map(|&i| coords(ci.iter().map(|&j| points[i * cols + j]), c)).collect();
+                let rows: Vec<String> = ri
+                    .iter()
+                    .map(|&i| coords(ci.iter().map(|&j| points[i * cols + j]), c))
+                    .collect();
                 format!("[{}]", rows.join(","))
             };
-            format!("{{\"kind\":\"surface\",\"label\":{},\"colour\":{},\"x\":{},\"y\":{},\"z\":{}}}", string(label), string(colour), grid(0), grid(1), grid(2))
+            format!(
+                "{{\"kind\":\"surface\",\"label\":{},\"colour\":{},\"x\":{},\"y\":{},\"z\":{}}}",
+                string(label),
+                string(colour),
+                grid(0),
+                grid(1),
+                grid(2)
+            )
         }
     }
 }
@@ -113,7 +132,13 @@ pub fn script(views: &[View]) -> String {
     let mut s = String::from("// somnurbs 3-D views (report.html draws them)\n(window.somnurbsViews = window.somnurbsViews || []).push({folder: document.currentScript ? document.currentScript.getAttribute(\"data-folder\") : \"\", views: [\n");
     for (k, v) in views.iter().enumerate() {
         let traces: Vec<String> = v.traces.iter().map(trace_js).collect();
-        let _ = writeln!(s, "{{\"title\":{},\"traces\":[{}]}}{}", string(&v.title), traces.join(","), if k + 1 < views.len() { "," } else { "" });
+        let _ = writeln!(
+            s,
+            "{{\"title\":{},\"traces\":[{}]}}{}",
+            string(&v.title),
+            traces.join(","),
+            if k + 1 < views.len() { "," } else { "" }
+        );
     }
     s.push_str("]});\n");
     s
@@ -155,8 +180,19 @@ mod tests {
         let v = View {
             title: "t \"q\"".into(),
             traces: vec![
-                Trace::Points { label: "map".into(), colour: "#112233".into(), points: vec![[0.0, 1.0, 2.0], [3.0, 4.0, 5.0]], lines: vec![vec![0, 1]] },
-                Trace::Surface { label: "s".into(), colour: "#445566".into(), rows: 2, cols: 2, points: vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.5]] },
+                Trace::Points {
+                    label: "map".into(),
+                    colour: "#112233".into(),
+                    points: vec![[0.0, 1.0, 2.0], [3.0, 4.0, 5.0]],
+                    lines: vec![vec![0, 1]],
+                },
+                Trace::Surface {
+                    label: "s".into(),
+                    colour: "#445566".into(),
+                    rows: 2,
+                    cols: 2,
+                    points: vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.5]],
+                },
             ],
         };
         let s = script(&[v]);

@@ -70,7 +70,9 @@ mod tests {
 
     #[test]
     fn table_4_9_counts() {
-        for (n, non, nov, nor) in [(10, 600, 488, 112), (20, 2400, 2168, 232), (30, 5400, 5048, 352)] {
+        for (n, non, nov, nor) in
+            [(10, 600, 488, 112), (20, 2400, 2168, 232), (30, 5400, 5048, 352)]
+        {
             let c = Cksom::new(n, n).counts();
             assert_eq!((c.non, c.nov, c.nor), (non, nov, nor));
         }

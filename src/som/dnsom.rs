@@ -29,7 +29,10 @@ impl Dnsom {
             })
             .collect();
         let mut adjacency = vec![Vec::new(); net.nov()];
-        for (a, b) in grid_class_edges(&net, View::Bottom).into_iter().chain(grid_class_edges(&net, View::Top)) {
+        for (a, b) in grid_class_edges(&net, View::Bottom)
+            .into_iter()
+            .chain(grid_class_edges(&net, View::Top))
+        {
             adjacency[a as usize].push(b);
             adjacency[b as usize].push(a);
         }
@@ -98,9 +101,8 @@ mod tests {
     #[test]
     fn table_4_4_distances_from_class_7() {
         let d = Dnsom::new(4, 5);
-        let want = [
-            3, 2, 3, 6, 11, 2, 0, 1, 4, 10, 3, 1, 2, 5, 11, 6, 5, 6, 9, 14, 4, 5, 8, 5, 6, 9,
-        ];
+        let want =
+            [3, 2, 3, 6, 11, 2, 0, 1, 4, 10, 3, 1, 2, 5, 11, 6, 5, 6, 9, 14, 4, 5, 8, 5, 6, 9];
         for (c, &w) in want.iter().enumerate() {
             assert_eq!(d.lattice.dist2(6, c), w, "class number {}", c + 1);
         }

@@ -59,7 +59,17 @@ pub struct GrowingGridParams {
 
 impl Default for GrowingGridParams {
     fn default() -> Self {
-        GrowingGridParams { nx: 20, ny: 20, lambda_g: 30, eps_g: 0.05, lambda_f: 100, eps_f0: 0.05, eps_f1: 0.0005, sigma: 0.7, reach2: 4 }
+        GrowingGridParams {
+            nx: 20,
+            ny: 20,
+            lambda_g: 30,
+            eps_g: 0.05,
+            lambda_f: 100,
+            eps_f0: 0.05,
+            eps_f1: 0.0005,
+            sigma: 0.7,
+            reach2: 4,
+        }
     }
 }
 
@@ -86,7 +96,10 @@ impl GrowingGrid {
 impl GrowingGridParams {
     pub fn validate(&self) -> Result<(), String> {
         if self.nx < 2 || self.ny < 2 {
-            return Err(format!("target grid {}x{} is too small: both sides must be at least 2", self.nx, self.ny));
+            return Err(format!(
+                "target grid {}x{} is too small: both sides must be at least 2",
+                self.nx, self.ny
+            ));
         }
         if self.lambda_g == 0 {
             return Err("lambda_g must be at least 1".into());
@@ -158,7 +171,9 @@ impl State {
                 for j in 0..ny {
                     w.push(match i.cmp(&(a + 1)) {
                         std::cmp::Ordering::Less => self.w[i * ny + j],
-                        std::cmp::Ordering::Equal => mid(self.w[a * ny + j], self.w[(a + 1) * ny + j]),
+                        std::cmp::Ordering::Equal => {
+                            mid(self.w[a * ny + j], self.w[(a + 1) * ny + j])
+                        }
                         std::cmp::Ordering::Greater => self.w[(i - 1) * ny + j],
                     });
                 }
@@ -169,7 +184,9 @@ impl State {
                 for j in 0..=ny {
                     w.push(match j.cmp(&(a + 1)) {
                         std::cmp::Ordering::Less => self.w[i * ny + j],
-                        std::cmp::Ordering::Equal => mid(self.w[i * ny + a], self.w[i * ny + a + 1]),
+                        std::cmp::Ordering::Equal => {
+                            mid(self.w[i * ny + a], self.w[i * ny + a + 1])
+                        }
                         std::cmp::Ordering::Greater => self.w[i * ny + j - 1],
                     });
                 }
@@ -182,13 +199,23 @@ impl State {
 }
 
 /// Grow a grid over `data` (at least one point) with the stream `rng`.
-pub fn grow(data: &[Point3], p: &GrowingGridParams, rng: &mut ChaCha8Rng) -> Result<GrowingGrid, String> {
+pub fn grow(
+    data: &[Point3],
+    p: &GrowingGridParams,
+    rng: &mut ChaCha8Rng,
+) -> Result<GrowingGrid, String> {
     p.validate()?;
     if data.is_empty() {
         return Err("no data points".into());
     }
-    let gauss: Vec<f64> = (0..=p.reach2).map(|d2| (-(d2 as f64) / (2.0 * p.sigma * p.sigma)).exp()).collect();
-    let mut s = State { nx: 2, ny: 2, w: (0..4).map(|_| data[rng.gen_range(0..data.len())]).collect(), tau: vec![0.0; 4] };
+    let gauss: Vec<f64> =
+        (0..=p.reach2).map(|d2| (-(d2 as f64) / (2.0 * p.sigma * p.sigma)).exp()).collect();
+    let mut s = State {
+        nx: 2,
+        ny: 2,
+        w: (0..4).map(|_| data[rng.gen_range(0..data.len())]).collect(),
+        tau: vec![0.0; 4],
+    };
     let (mut insertions, mut growth_steps) = (0, 0);
     while s.nx < p.nx || s.ny < p.ny {
         let steps = p.lambda_g * s.w.len();
@@ -243,10 +270,12 @@ mod tests {
 
     fn plane(n: usize) -> Vec<Point3> {
         // An n x n lattice on the unit square in the plane z = 0.3 x + 0.1 y.
-        (0..n * n).map(|k| {
-            let (x, y) = ((k / n) as f64 / (n - 1) as f64, (k % n) as f64 / (n - 1) as f64);
-            [x, y, 0.3 * x + 0.1 * y]
-        }).collect()
+        (0..n * n)
+            .map(|k| {
+                let (x, y) = ((k / n) as f64 / (n - 1) as f64, (k % n) as f64 / (n - 1) as f64);
+                [x, y, 0.3 * x + 0.1 * y]
+            })
+            .collect()
     }
 
     #[test]
@@ -265,7 +294,10 @@ mod tests {
         let mut row_mono = 0;
         for i in 0..g.nx {
             let row: Vec<Point3> = (0..g.ny).map(|j| g.weights[i * g.ny + j]).collect();
-            let inc = (0..2).any(|k| row.windows(2).all(|w| w[1][k] > w[0][k]) || row.windows(2).all(|w| w[1][k] < w[0][k]));
+            let inc = (0..2).any(|k| {
+                row.windows(2).all(|w| w[1][k] > w[0][k])
+                    || row.windows(2).all(|w| w[1][k] < w[0][k])
+            });
             row_mono += inc as usize;
         }
         assert_eq!(row_mono, g.nx, "every row should be monotone in x or y");
@@ -284,7 +316,12 @@ mod tests {
 
     #[test]
     fn insertion_averages_neighbours_and_validation_names_the_constant() {
-        let mut s = State { nx: 2, ny: 2, w: vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 2.0, 0.0], [1.0, 2.0, 0.0]], tau: vec![0.0; 4] };
+        let mut s = State {
+            nx: 2,
+            ny: 2,
+            w: vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 2.0, 0.0], [1.0, 2.0, 0.0]],
+            tau: vec![0.0; 4],
+        };
         s.insert(0, 0);
         assert_eq!((s.nx, s.ny), (3, 2));
         assert_eq!(s.w[2], [0.0, 1.0, 0.0]);
@@ -293,6 +330,8 @@ mod tests {
         assert_eq!(s.w[4], [0.5, 1.0, 0.0]);
         let bad = GrowingGridParams { eps_g: 0.0, ..GrowingGridParams::default() };
         assert!(bad.validate().unwrap_err().contains("eps_g"));
-        assert!(grow(&[], &GrowingGridParams::default(), &mut ChaCha8Rng::seed_from_u64(1)).is_err());
+        assert!(
+            grow(&[], &GrowingGridParams::default(), &mut ChaCha8Rng::seed_from_u64(1)).is_err()
+        );
     }
 }

@@ -70,7 +70,13 @@ impl Lattice {
     /// (strictly: dist < radius, the thesis' "dist smaller than the radius decay"), skipping units
     /// whose k index differs from the centre's by exactly `skip_dk`.
     #[inline]
-    pub fn for_each_within(&self, centre: usize, radius: f64, skip_dk: Option<i32>, mut f: impl FnMut(usize, i32)) {
+    pub fn for_each_within(
+        &self,
+        centre: usize,
+        radius: f64,
+        skip_dk: Option<i32>,
+        mut f: impl FnMut(usize, i32),
+    ) {
         let skip = skip_dk.unwrap_or(-1);
         let c = self.index[centre];
         let r2 = radius * radius;
@@ -139,16 +145,16 @@ mod tests {
         for centre in 0..lat.len() {
             for radius in [0.5, 1.0, 1.5, 2.0, 2.3, 3.7, 9.0] {
                 for skip in [None, Some(1), Some(2)] {
-                let mut got = Vec::new();
-                lat.for_each_within(centre, radius, skip, |u, d2| got.push((u, d2)));
-                got.sort();
-                let ck = lat.index_vector(centre)[2];
-                let want: Vec<_> = (0..lat.len())
-                    .filter(|&u| (lat.dist2(centre, u) as f64).sqrt() < radius)
-                    .filter(|&u| skip != Some((lat.index_vector(u)[2] - ck).abs()))
-                    .map(|u| (u, lat.dist2(centre, u)))
-                    .collect();
-                assert_eq!(got, want, "centre {centre} radius {radius} skip {skip:?}");
+                    let mut got = Vec::new();
+                    lat.for_each_within(centre, radius, skip, |u, d2| got.push((u, d2)));
+                    got.sort();
+                    let ck = lat.index_vector(centre)[2];
+                    let want: Vec<_> = (0..lat.len())
+                        .filter(|&u| (lat.dist2(centre, u) as f64).sqrt() < radius)
+                        .filter(|&u| skip != Some((lat.index_vector(u)[2] - ck).abs()))
+                        .map(|u| (u, lat.dist2(centre, u)))
+                        .collect();
+                    assert_eq!(got, want, "centre {centre} radius {radius} skip {skip:?}");
                 }
             }
         }

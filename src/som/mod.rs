@@ -86,7 +86,9 @@ impl FromStr for Model {
             "som3d" | "3dsom" => Ok(Model::Som3d),
             "cksom" => Ok(Model::Cksom),
             "dnsom" => Ok(Model::Dnsom),
-            _ => Err(format!("unknown SOM model `{s}` (expected one of som2d, som3d, cksom, dnsom)")),
+            _ => {
+                Err(format!("unknown SOM model `{s}` (expected one of som2d, som3d, cksom, dnsom)"))
+            }
         }
     }
 }

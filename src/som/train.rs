@@ -118,7 +118,9 @@ pub fn train(
     }
     let sigma0 = params.sigma0.unwrap_or_else(|| topology.sigma0());
     if !(sigma0 > 1.0) {
-        return Err(format!("initial radius sigma0 = {sigma0} must exceed 1 (tau = T / ln sigma0)"));
+        return Err(format!(
+            "initial radius sigma0 = {sigma0} must exceed 1 (tau = T / ln sigma0)"
+        ));
     }
     let t_max = params.iterations;
     if t_max == 0 {
@@ -126,7 +128,8 @@ pub fn train(
     }
     let tau = t_max as f64 / sigma0.ln();
 
-    let init: Vec<Point3> = (0..units).map(|_| [rng.gen::<f64>(), rng.gen::<f64>(), rng.gen::<f64>()]).collect();
+    let init: Vec<Point3> =
+        (0..units).map(|_| [rng.gen::<f64>(), rng.gen::<f64>(), rng.gen::<f64>()]).collect();
     let mut w = Weights::from_points(&init);
 
     let (mut sum_err, mut not_adjacent) = (0.0, 0usize);
@@ -150,7 +153,10 @@ pub fn train(
         // dist^2 is an integer below sigma^2: tabulate the gains once per iteration (the same
         // expression, so the same bits, as computing each one on its own).
         gains.clear();
-        gains.extend((0..=(sigma * sigma).ceil() as usize).map(|d2| alpha * (-(d2 as f64) * inv_two_sigma2).exp()));
+        gains.extend(
+            (0..=(sigma * sigma).ceil() as usize)
+                .map(|d2| alpha * (-(d2 as f64) * inv_two_sigma2).exp()),
+        );
         lattice.for_each_within(win, sigma, frozen, |u, dist2| {
             let g = gains[dist2 as usize];
             w.x[u] += g * (x[0] - w.x[u]);
@@ -169,7 +175,11 @@ pub fn train(
 }
 
 /// QE and TE of a trained map over every data point.
-pub fn final_map_metrics(topology: &dyn Topology, weights: &[Point3], data: &[Point3]) -> FinalMetrics {
+pub fn final_map_metrics(
+    topology: &dyn Topology,
+    weights: &[Point3],
+    data: &[Point3],
+) -> FinalMetrics {
     let mut w = Weights::from_points(weights);
     let (mut sum, mut bad) = (0.0, 0usize);
     for &p in data {
@@ -211,8 +221,18 @@ mod tests {
         let b = train(topo.as_ref(), &data, &p, &mut ChaCha8Rng::seed_from_u64(7)).unwrap();
         assert_eq!(a.weights, b.weights);
         assert_eq!(a.online, b.online);
-        let random = final_map_metrics(topo.as_ref(), &a.weights[..0].iter().copied().chain(
-            (0..a.weights.len()).map(|u| [(u % 7) as f64 / 7.0, (u % 5) as f64 / 5.0, (u % 3) as f64 / 3.0])).collect::<Vec<_>>(), &data);
+        let random =
+            final_map_metrics(
+                topo.as_ref(),
+                &a.weights[..0]
+                    .iter()
+                    .copied()
+                    .chain((0..a.weights.len()).map(|u| {
+                        [(u % 7) as f64 / 7.0, (u % 5) as f64 / 5.0, (u % 3) as f64 / 3.0]
+                    }))
+                    .collect::<Vec<_>>(),
+                &data,
+            );
         let trained = final_map_metrics(topo.as_ref(), &a.weights, &data);
         assert!(trained.qe < 0.5 * random.qe, "trained {trained:?} vs untrained {random:?}");
         assert!(a.online.min_error <= a.online.qe && a.online.qe <= a.online.max_error);
@@ -230,14 +250,18 @@ mod tests {
         let mut rng = ChaCha8Rng::seed_from_u64(3);
         let init: Vec<Point3> = (0..36).map(|_| [rng.gen(), rng.gen(), rng.gen()]).collect();
         let win = (0..36)
-            .min_by(|&a, &b| crate::geom::dist2(init[a], data[0]).total_cmp(&crate::geom::dist2(init[b], data[0])))
+            .min_by(|&a, &b| {
+                crate::geom::dist2(init[a], data[0])
+                    .total_cmp(&crate::geom::dist2(init[b], data[0]))
+            })
             .unwrap();
         let (sigma0, tau) = (3.0f64, 1.0 / 3f64.ln());
         let decay = (-1.0 / tau).exp();
         let (alpha, sigma) = (0.9 * decay, sigma0 * decay);
         for u in 0..36 {
             let d2 = topo.lattice().dist2(win, u) as f64;
-            let g = if d2.sqrt() < sigma { alpha * (-d2 / (2.0 * sigma * sigma)).exp() } else { 0.0 };
+            let g =
+                if d2.sqrt() < sigma { alpha * (-d2 / (2.0 * sigma * sigma)).exp() } else { 0.0 };
             for a in 0..3 {
                 let want = init[u][a] + g * (data[0][a] - init[u][a]);
                 assert!((r.weights[u][a] - want).abs() < 1e-15, "unit {u}");
@@ -259,12 +283,19 @@ mod tests {
             let mut rng = ChaCha8Rng::seed_from_u64(seed);
             let r = train(topo.as_ref(), &data, &p, &mut rng).unwrap();
             let mut rng = ChaCha8Rng::seed_from_u64(seed);
-            let init: Vec<Point3> = (0..lat.len()).map(|_| [rng.gen(), rng.gen(), rng.gen()]).collect();
+            let init: Vec<Point3> =
+                (0..lat.len()).map(|_| [rng.gen(), rng.gen(), rng.gen()]).collect();
             let win = (0..lat.len())
-                .min_by(|&a, &b| crate::geom::dist2(init[a], data[0]).total_cmp(&crate::geom::dist2(init[b], data[0])))
+                .min_by(|&a, &b| {
+                    crate::geom::dist2(init[a], data[0])
+                        .total_cmp(&crate::geom::dist2(init[b], data[0]))
+                })
                 .unwrap();
             let win2 = (0..lat.len())
-                .min_by(|&a, &b| crate::geom::dist2(r.weights[a], data[0]).total_cmp(&crate::geom::dist2(r.weights[b], data[0])))
+                .min_by(|&a, &b| {
+                    crate::geom::dist2(r.weights[a], data[0])
+                        .total_cmp(&crate::geom::dist2(r.weights[b], data[0]))
+                })
                 .unwrap();
             for u in (0..lat.len()).filter(|&u| u != win2) {
                 let k_gap = (lat.index_vector(win)[2] - lat.index_vector(u)[2]).abs();

@@ -34,7 +34,9 @@ use std::str::FromStr;
 
 /// How approach A's surface error is scored (thesis Section 5.2.4 defines Eq. 5.13 "for the
 /// improved approach" only; a named reading, README "Readings").
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default, Serialize, Deserialize)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default, Serialize, Deserialize,
+)]
 #[serde(rename_all = "snake_case")]
 pub enum ErrorA {
     /// Sum of |D - D^G| over all 2 nx ny map neurons, each surface against its own fitted points
@@ -67,7 +69,10 @@ impl fmt::Display for ErrorA {
 impl FromStr for ErrorA {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        ErrorA::ALL.into_iter().find(|e| e.name() == s).ok_or_else(|| format!("unknown reading `{s}` (expected per_surface or nov_bottom)"))
+        ErrorA::ALL
+            .into_iter()
+            .find(|e| e.name() == s)
+            .ok_or_else(|| format!("unknown reading `{s}` (expected per_surface or nov_bottom)"))
     }
 }
 
@@ -118,19 +123,34 @@ impl TwoViewGrid {
     /// Sizes, finiteness and the shared border.
     pub fn validate(&self) -> Result<(), SplineError> {
         if self.nx < 2 || self.ny < 2 {
-            return Err(SplineError::Grid(format!("the grid is {}x{}; both sides must be at least 2", self.nx, self.ny)));
+            return Err(SplineError::Grid(format!(
+                "the grid is {}x{}; both sides must be at least 2",
+                self.nx, self.ny
+            )));
         }
         for (name, v) in [("bottom", &self.bottom), ("top", &self.top)] {
             if v.len() != self.nx * self.ny {
-                return Err(SplineError::Grid(format!("the {name} view has {} points, {}x{} needs {}", v.len(), self.nx, self.ny, self.nx * self.ny)));
+                return Err(SplineError::Grid(format!(
+                    "the {name} view has {} points, {}x{} needs {}",
+                    v.len(),
+                    self.nx,
+                    self.ny,
+                    self.nx * self.ny
+                )));
             }
             if let Some(k) = v.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
-                return Err(SplineError::Grid(format!("the {name} view has a non-finite point at ({}, {})", k / self.ny, k % self.ny)));
+                return Err(SplineError::Grid(format!(
+                    "the {name} view has a non-finite point at ({}, {})",
+                    k / self.ny,
+                    k % self.ny
+                )));
             }
         }
         for i in 0..self.nx {
             for j in 0..self.ny {
-                if (i == 0 || j == 0 || i + 1 == self.nx || j + 1 == self.ny) && self.bottom[i * self.ny + j] != self.top[i * self.ny + j] {
+                if (i == 0 || j == 0 || i + 1 == self.nx || j + 1 == self.ny)
+                    && self.bottom[i * self.ny + j] != self.top[i * self.ny + j]
+                {
                     return Err(SplineError::Grid(format!("the views differ at border position ({i}, {j}); a two-view grid shares its border")));
                 }
             }
@@ -174,20 +194,34 @@ struct ViewFit {
 }
 
 /// Fit both views of `grid` with a `cn_x x cn_y` cubic control net each (Eq. 5.1-5.7, 5.12, 5.13).
-pub fn fit_two_view(grid: &TwoViewGrid, cn_x: usize, cn_y: usize, param: Parameterisation, approach: Approach, opts: &FitOptions) -> Result<TwoSurfaceFit, SplineError> {
+pub fn fit_two_view(
+    grid: &TwoViewGrid,
+    cn_x: usize,
+    cn_y: usize,
+    param: Parameterisation,
+    approach: Approach,
+    opts: &FitOptions,
+) -> Result<TwoSurfaceFit, SplineError> {
     grid.validate()?;
     if cn_x < 4 || cn_y < 4 {
-        return Err(SplineError::ControlNet(format!("control net {cn_x}x{cn_y} is smaller than 4 (cubic needs p + 1 = 4 a side)")));
+        return Err(SplineError::ControlNet(format!(
+            "control net {cn_x}x{cn_y} is smaller than 4 (cubic needs p + 1 = 4 a side)"
+        )));
     }
     if cn_x > grid.nx || cn_y > grid.ny {
-        return Err(SplineError::ControlNet(format!("control net {cn_x}x{cn_y} is larger than the grid {}x{}", grid.nx, grid.ny)));
+        return Err(SplineError::ControlNet(format!(
+            "control net {cn_x}x{cn_y} is larger than the grid {}x{}",
+            grid.nx, grid.ny
+        )));
     }
     let (nx, ny) = (grid.nx, grid.ny);
     let own = [grid_params(&grid.bottom, nx, ny, param), grid_params(&grid.top, nx, ny, param)];
     let params: [(Vec<f64>, Vec<f64>); 2] = match approach {
         Approach::Conventional => own,
         Approach::Improved => {
-            let mean = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| (x + y) / 2.0).collect::<Vec<f64>>();
+            let mean = |a: &[f64], b: &[f64]| {
+                a.iter().zip(b).map(|(x, y)| (x + y) / 2.0).collect::<Vec<f64>>()
+            };
             let u = mean(&own[0].0, &own[1].0);
             let v = mean(&own[0].1, &own[1].1);
             [(u.clone(), v.clone()), (u, v)]
@@ -200,7 +234,11 @@ pub fn fit_two_view(grid: &TwoViewGrid, cn_x: usize, cn_y: usize, param: Paramet
         let knots_v = knot_vector(&v, cn_y, 3, opts.knots).map_err(SplineError::ControlNet)?;
         let nu = basis_matrix(&u, &knots_u, 3, cn_x);
         let nv = basis_matrix(&v, &knots_v, 3, cn_y);
-        let net = if opts.fairness > 0.0 { faired_net(grid.view(*view), &nu, &nv, opts.fairness) } else { least_squares_net(grid.view(*view), &nu, &nv) };
+        let net = if opts.fairness > 0.0 {
+            faired_net(grid.view(*view), &nu, &nv, opts.fairness)
+        } else {
+            least_squares_net(grid.view(*view), &nu, &nv)
+        };
         let net = net.map_err(SplineError::Singular)?;
         fits.push(ViewFit { u, v, knots_u, knots_v, net });
     }
@@ -221,15 +259,31 @@ pub fn fit_two_view(grid: &TwoViewGrid, cn_x: usize, cn_y: usize, param: Paramet
     }
     let fitted: Vec<Vec<Point3>> = fits
         .iter()
-        .map(|f| fitted_grid(&f.net, &basis_matrix(&f.u, &f.knots_u, 3, cn_x), &basis_matrix(&f.v, &f.knots_v, 3, cn_y)))
+        .map(|f| {
+            fitted_grid(
+                &f.net,
+                &basis_matrix(&f.u, &f.knots_u, 3, cn_x),
+                &basis_matrix(&f.v, &f.knots_v, 3, cn_y),
+            )
+        })
         .collect();
     let net = DoubleNet::new(nx, ny).expect("validated sides");
     let surface_error = match (approach, opts.error_a) {
-        (Approach::Conventional, ErrorA::PerSurface) => per_surface_error(grid, &fitted[0], &fitted[1]),
+        (Approach::Conventional, ErrorA::PerSurface) => {
+            per_surface_error(grid, &fitted[0], &fitted[1])
+        }
         _ => surface_error(grid, &net, &fitted[0], &fitted[1]),
     };
     let gap = border_gap(&net, &fitted[0], &fitted[1]);
-    let surface = |f: &ViewFit| BSplineSurface { p: 3, q: 3, knots_u: f.knots_u.clone(), knots_v: f.knots_v.clone(), cn_x, cn_y, control: f.net.clone() };
+    let surface = |f: &ViewFit| BSplineSurface {
+        p: 3,
+        q: 3,
+        knots_u: f.knots_u.clone(),
+        knots_v: f.knots_v.clone(),
+        cn_x,
+        cn_y,
+        control: f.net.clone(),
+    };
     let (bottom, top) = (surface(&fits[0]), surface(&fits[1]));
     let mut fitted = fitted.into_iter();
     Ok(TwoSurfaceFit {
@@ -247,7 +301,12 @@ pub fn fit_two_view(grid: &TwoViewGrid, cn_x: usize, cn_y: usize, param: Paramet
 }
 
 /// Eq. 5.13: sum over the NOV grid classes of |D - D^G| at each class's first allocation.
-pub fn surface_error(grid: &TwoViewGrid, net: &DoubleNet, fitted_bottom: &[Point3], fitted_top: &[Point3]) -> f64 {
+pub fn surface_error(
+    grid: &TwoViewGrid,
+    net: &DoubleNet,
+    fitted_bottom: &[Point3],
+    fitted_top: &[Point3],
+) -> f64 {
     (0..net.nov())
         .map(|c| {
             let (view, i, j) = net.first_allocation(c);
@@ -261,8 +320,14 @@ pub fn surface_error(grid: &TwoViewGrid, net: &DoubleNet, fitted_bottom: &[Point
 }
 
 /// Approach A's error under `per_surface`: sum of |D - D^G| over every position of both views.
-pub fn per_surface_error(grid: &TwoViewGrid, fitted_bottom: &[Point3], fitted_top: &[Point3]) -> f64 {
-    let one = |data: &[Point3], fitted: &[Point3]| data.iter().zip(fitted).map(|(d, g)| geom::dist(*d, *g)).sum::<f64>();
+pub fn per_surface_error(
+    grid: &TwoViewGrid,
+    fitted_bottom: &[Point3],
+    fitted_top: &[Point3],
+) -> f64 {
+    let one = |data: &[Point3], fitted: &[Point3]| {
+        data.iter().zip(fitted).map(|(d, g)| geom::dist(*d, *g)).sum::<f64>()
+    };
     one(&grid.bottom, fitted_bottom) + one(&grid.top, fitted_top)
 }
 
@@ -303,19 +368,36 @@ impl TwoSurfaceFit {
     /// The surfaces between the data points (see `geometry`), sampled `DENSE_FACTOR` times finer.
     pub fn dense_geometry(&self, grid: &TwoViewGrid) -> super::DenseGeometry {
         let data: Vec<Point3> = grid.bottom.iter().chain(&grid.top).copied().collect();
-        let params = [(&self.params_u[0][..], &self.params_v[0][..]), (&self.params_u[1][..], &self.params_v[1][..])];
-        super::geometry::dense_geometry([&self.bottom, &self.top], params, &data, super::DENSE_FACTOR)
+        let params = [
+            (&self.params_u[0][..], &self.params_v[0][..]),
+            (&self.params_u[1][..], &self.params_v[1][..]),
+        ];
+        super::geometry::dense_geometry(
+            [&self.bottom, &self.top],
+            params,
+            &data,
+            super::DENSE_FACTOR,
+        )
     }
 
     /// Dense wireframes (bottom, top) of the fitted surfaces, for pictures.
     pub fn dense_wireframes(&self) -> [(Vec<Point3>, Vec<(u32, u32)>); 2] {
-        [(&self.bottom, 0), (&self.top, 1)].map(|(s, k)| super::geometry::dense_wireframe(s, &self.params_u[k], &self.params_v[k], super::DENSE_FACTOR))
+        [(&self.bottom, 0), (&self.top, 1)].map(|(s, k)| {
+            super::geometry::dense_wireframe(
+                s,
+                &self.params_u[k],
+                &self.params_v[k],
+                super::DENSE_FACTOR,
+            )
+        })
     }
 
     /// The control-net problem of Chapter 6 (approach B only: one set of knots and parameters).
     pub fn control_net_parts(&self, grid: &TwoViewGrid) -> Result<ControlNetParts, SplineError> {
         if self.approach != Approach::Improved {
-            return Err(SplineError::ControlNet("the control-net problem is defined on approach B".into()));
+            return Err(SplineError::ControlNet(
+                "the control-net problem is defined on approach B".into(),
+            ));
         }
         let (cn_x, cn_y) = (self.bottom.cn_x, self.bottom.cn_y);
         let cn = DoubleNet::new(cn_x, cn_y).expect("control nets at least 4 a side");
@@ -349,14 +431,26 @@ impl TwoSurfaceFit {
 impl ControlNetParts {
     /// Dense wireframes (bottom, top) of a decision vector's surfaces, for pictures.
     pub fn dense_wireframes(&self, x: &[f64]) -> [(Vec<Point3>, Vec<(u32, u32)>); 2] {
-        self.surfaces(x).map(|s| super::geometry::dense_wireframe(&s, &self.params_u, &self.params_v, super::DENSE_FACTOR))
+        self.surfaces(x).map(|s| {
+            super::geometry::dense_wireframe(
+                &s,
+                &self.params_u,
+                &self.params_v,
+                super::DENSE_FACTOR,
+            )
+        })
     }
 
     /// The surfaces (bottom, top) of a decision vector sampled `DENSE_FACTOR` times finer than
     /// the data parameters: (points row-major, rows, columns) each, for 3-D views.
     pub fn dense_grids(&self, x: &[f64]) -> [(Vec<Point3>, usize, usize); 2] {
         self.surfaces(x).map(|s| {
-            let (points, du, dv) = super::geometry::dense_grid(&s, &self.params_u, &self.params_v, super::DENSE_FACTOR);
+            let (points, du, dv) = super::geometry::dense_grid(
+                &s,
+                &self.params_u,
+                &self.params_v,
+                super::DENSE_FACTOR,
+            );
             (points, du.len(), dv.len())
         })
     }
@@ -367,7 +461,12 @@ impl ControlNetParts {
         let u = &self.params_u[..];
         let v = &self.params_v[..];
         let data: Vec<Point3> = self.data_bottom.iter().chain(&self.data_top).copied().collect();
-        super::geometry::dense_geometry([&bottom, &top], [(u, v), (u, v)], &data, super::DENSE_FACTOR)
+        super::geometry::dense_geometry(
+            [&bottom, &top],
+            [(u, v), (u, v)],
+            &data,
+            super::DENSE_FACTOR,
+        )
     }
 
     /// The two surfaces (bottom, top) of a decision vector x (one point per control-net class).
@@ -398,7 +497,12 @@ impl ControlNetParts {
         let [bottom, top] = self.surfaces(x);
         let fb = fitted_grid(&bottom.control, &nu, &nv);
         let ft = fitted_grid(&top.control, &nu, &nv);
-        let grid = TwoViewGrid { nx: self.nx, ny: self.ny, bottom: self.data_bottom.clone(), top: self.data_top.clone() };
+        let grid = TwoViewGrid {
+            nx: self.nx,
+            ny: self.ny,
+            bottom: self.data_bottom.clone(),
+            top: self.data_top.clone(),
+        };
         surface_error(&grid, &grid_net, &fb, &ft)
     }
 }
@@ -414,10 +518,14 @@ pub mod tests {
         let mut top = vec![[0.0; 3]; nx * ny];
         for i in 0..nx {
             for j in 0..ny {
-                let (s, t) = (i as f64 / (nx - 1) as f64 * 2.0 - 1.0, j as f64 / (ny - 1) as f64 * 2.0 - 1.0);
+                let (s, t) = (
+                    i as f64 / (nx - 1) as f64 * 2.0 - 1.0,
+                    j as f64 / (ny - 1) as f64 * 2.0 - 1.0,
+                );
                 let r = s.abs().max(t.abs());
                 let h = if net.is_border(i, j) { 0.0 } else { (1.0 - r * r).sqrt() * 0.5 };
-                let wobble = if net.is_border(i, j) { 0.0 } else { noise * ((7 * i + 3 * j) as f64).sin() };
+                let wobble =
+                    if net.is_border(i, j) { 0.0 } else { noise * ((7 * i + 3 * j) as f64).sin() };
                 bottom[i * ny + j] = [0.5 + 0.5 * s, 0.5 + 0.5 * t, 0.5 - h - wobble];
                 top[i * ny + j] = [0.5 + 0.5 * s, 0.5 + 0.5 * t, 0.5 + h + 0.7 * wobble];
             }
@@ -430,15 +538,29 @@ pub mod tests {
         let g = test_grid(20, 20, 0.02);
         for p in Parameterisation::ALL {
             for cn in [6, 10, 18] {
-                let b = fit_two_view(&g, cn, cn, p, Approach::Improved, &FitOptions::default()).unwrap();
+                let b = fit_two_view(&g, cn, cn, p, Approach::Improved, &FitOptions::default())
+                    .unwrap();
                 assert_eq!(b.gap, 0.0, "{p} {cn}");
-                let a = fit_two_view(&g, cn, cn, p, Approach::Conventional, &FitOptions::default()).unwrap();
+                let a = fit_two_view(&g, cn, cn, p, Approach::Conventional, &FitOptions::default())
+                    .unwrap();
                 assert!(a.gap > 0.0, "{p} {cn}");
                 assert!(a.surface_error > 0.0 && b.surface_error > 0.0);
             }
         }
         let g = test_grid(18, 30, 0.02);
-        assert_eq!(fit_two_view(&g, 16, 28, Parameterisation::ChordLength, Approach::Improved, &FitOptions::default()).unwrap().gap, 0.0);
+        assert_eq!(
+            fit_two_view(
+                &g,
+                16,
+                28,
+                Parameterisation::ChordLength,
+                Approach::Improved,
+                &FitOptions::default()
+            )
+            .unwrap()
+            .gap,
+            0.0
+        );
     }
 
     /// Hand-computed: a 4x5 map, bottom fitted 0.1 off everywhere, top fitted exactly but for a
@@ -466,9 +588,33 @@ pub mod tests {
         for cn in [6, 12] {
             let per = FitOptions::default();
             let nov = FitOptions { error_a: ErrorA::NovBottom, ..per };
-            let (a1, a2) = (fit_two_view(&g, cn, cn, Parameterisation::ChordLength, Approach::Conventional, &per).unwrap(), fit_two_view(&g, cn, cn, Parameterisation::ChordLength, Approach::Conventional, &nov).unwrap());
+            let (a1, a2) = (
+                fit_two_view(
+                    &g,
+                    cn,
+                    cn,
+                    Parameterisation::ChordLength,
+                    Approach::Conventional,
+                    &per,
+                )
+                .unwrap(),
+                fit_two_view(
+                    &g,
+                    cn,
+                    cn,
+                    Parameterisation::ChordLength,
+                    Approach::Conventional,
+                    &nov,
+                )
+                .unwrap(),
+            );
             assert!(a1.surface_error > a2.surface_error);
-            let (b1, b2) = (fit_two_view(&g, cn, cn, Parameterisation::ChordLength, Approach::Improved, &per).unwrap(), fit_two_view(&g, cn, cn, Parameterisation::ChordLength, Approach::Improved, &nov).unwrap());
+            let (b1, b2) = (
+                fit_two_view(&g, cn, cn, Parameterisation::ChordLength, Approach::Improved, &per)
+                    .unwrap(),
+                fit_two_view(&g, cn, cn, Parameterisation::ChordLength, Approach::Improved, &nov)
+                    .unwrap(),
+            );
             assert_eq!(b1.surface_error.to_bits(), b2.surface_error.to_bits());
         }
     }
@@ -480,10 +626,13 @@ pub mod tests {
         let g = test_grid(20, 20, 0.02);
         for knots in KnotRule::ALL {
             let o = FitOptions { knots, ..FitOptions::default() };
-            let b = fit_two_view(&g, 10, 10, Parameterisation::ChordLength, Approach::Improved, &o).unwrap();
+            let b = fit_two_view(&g, 10, 10, Parameterisation::ChordLength, Approach::Improved, &o)
+                .unwrap();
             let gb = b.dense_geometry(&g);
             assert_eq!(gb.border_gap, 0.0);
-            let a = fit_two_view(&g, 10, 10, Parameterisation::ChordLength, Approach::Conventional, &o).unwrap();
+            let a =
+                fit_two_view(&g, 10, 10, Parameterisation::ChordLength, Approach::Conventional, &o)
+                    .unwrap();
             let ga = a.dense_geometry(&g);
             assert!(ga.border_gap >= a.gap && a.gap > 0.0, "{ga:?} {}", a.gap);
             assert!(gb.excursion.is_finite() && gb.max_control > 0.0);
@@ -497,34 +646,102 @@ pub mod tests {
     fn error_is_zero_when_the_net_is_as_large_as_the_grid() {
         // n_ctrl = n_params: the least squares interpolates every data point.
         let g = test_grid(9, 11, 0.03);
-        let a = fit_two_view(&g, 9, 11, Parameterisation::ChordLength, Approach::Conventional, &FitOptions::default()).unwrap();
+        let a = fit_two_view(
+            &g,
+            9,
+            11,
+            Parameterisation::ChordLength,
+            Approach::Conventional,
+            &FitOptions::default(),
+        )
+        .unwrap();
         assert!(a.surface_error < 1e-9, "{}", a.surface_error);
     }
 
     #[test]
     fn bad_sizes_are_refused() {
         let g = test_grid(10, 10, 0.0);
-        assert!(fit_two_view(&g, 3, 8, Parameterisation::Uniform, Approach::Improved, &FitOptions::default()).unwrap_err().to_string().contains("smaller than 4"));
-        assert!(fit_two_view(&g, 11, 8, Parameterisation::Uniform, Approach::Improved, &FitOptions::default()).unwrap_err().to_string().contains("larger than the grid"));
+        assert!(fit_two_view(
+            &g,
+            3,
+            8,
+            Parameterisation::Uniform,
+            Approach::Improved,
+            &FitOptions::default()
+        )
+        .unwrap_err()
+        .to_string()
+        .contains("smaller than 4"));
+        assert!(fit_two_view(
+            &g,
+            11,
+            8,
+            Parameterisation::Uniform,
+            Approach::Improved,
+            &FitOptions::default()
+        )
+        .unwrap_err()
+        .to_string()
+        .contains("larger than the grid"));
         let mut bad = g.clone();
         bad.top[17][1] = f64::NAN;
-        assert!(fit_two_view(&bad, 6, 6, Parameterisation::Uniform, Approach::Improved, &FitOptions::default()).unwrap_err().to_string().contains("non-finite"));
+        assert!(fit_two_view(
+            &bad,
+            6,
+            6,
+            Parameterisation::Uniform,
+            Approach::Improved,
+            &FitOptions::default()
+        )
+        .unwrap_err()
+        .to_string()
+        .contains("non-finite"));
         let mut bad = g.clone();
         bad.top[0][0] += 1.0;
-        assert!(fit_two_view(&bad, 6, 6, Parameterisation::Uniform, Approach::Improved, &FitOptions::default()).unwrap_err().to_string().contains("border position (0, 0)"));
+        assert!(fit_two_view(
+            &bad,
+            6,
+            6,
+            Parameterisation::Uniform,
+            Approach::Improved,
+            &FitOptions::default()
+        )
+        .unwrap_err()
+        .to_string()
+        .contains("border position (0, 0)"));
         bad.top.pop();
-        assert!(fit_two_view(&bad, 6, 6, Parameterisation::Uniform, Approach::Improved, &FitOptions::default()).is_err());
+        assert!(fit_two_view(
+            &bad,
+            6,
+            6,
+            Parameterisation::Uniform,
+            Approach::Improved,
+            &FitOptions::default()
+        )
+        .is_err());
     }
 
     #[test]
     fn control_net_parts_reproduce_the_surface_error() {
         let g = test_grid(20, 20, 0.02);
         for cn in [(6, 6), (12, 9), (18, 18)] {
-            let b = fit_two_view(&g, cn.0, cn.1, Parameterisation::Centripetal, Approach::Improved, &FitOptions::default()).unwrap();
+            let b = fit_two_view(
+                &g,
+                cn.0,
+                cn.1,
+                Parameterisation::Centripetal,
+                Approach::Improved,
+                &FitOptions::default(),
+            )
+            .unwrap();
             let parts = b.control_net_parts(&g).unwrap();
             assert_eq!(parts.x0.len(), 3 * DoubleNet::new(cn.0, cn.1).unwrap().nov());
             let e = parts.surface_error(&parts.x0);
-            assert!((e - b.surface_error).abs() <= 1e-12 * b.surface_error, "{e} vs {}", b.surface_error);
+            assert!(
+                (e - b.surface_error).abs() <= 1e-12 * b.surface_error,
+                "{e} vs {}",
+                b.surface_error
+            );
         }
     }
 }

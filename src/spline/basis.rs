@@ -57,7 +57,8 @@ pub struct SparseBasis {
 impl SparseBasis {
     /// Cubic basis at each parameter.
     pub fn cubic(params: &[f64], knots: &[f64], n_ctrl: usize) -> SparseBasis {
-        let (mut first, mut w) = (Vec::with_capacity(params.len()), Vec::with_capacity(params.len()));
+        let (mut first, mut w) =
+            (Vec::with_capacity(params.len()), Vec::with_capacity(params.len()));
         for &u in params {
             let span = find_span(n_ctrl, 3, u, knots);
             let b = basis_funs(span, u, 3, knots);
@@ -128,8 +129,16 @@ mod tests {
             if p == 0 {
                 return if t[i] <= u && u < t[i + 1] { 1.0 } else { 0.0 };
             }
-            let a = if t[i + p] > t[i] { (u - t[i]) / (t[i + p] - t[i]) * n(i, p - 1, u, t) } else { 0.0 };
-            let b = if t[i + p + 1] > t[i + 1] { (t[i + p + 1] - u) / (t[i + p + 1] - t[i + 1]) * n(i + 1, p - 1, u, t) } else { 0.0 };
+            let a = if t[i + p] > t[i] {
+                (u - t[i]) / (t[i + p] - t[i]) * n(i, p - 1, u, t)
+            } else {
+                0.0
+            };
+            let b = if t[i + p + 1] > t[i + 1] {
+                (t[i + p + 1] - u) / (t[i + p + 1] - t[i + 1]) * n(i + 1, p - 1, u, t)
+            } else {
+                0.0
+            };
             a + b
         }
         let k = knots();

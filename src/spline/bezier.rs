@@ -69,9 +69,18 @@ impl BezierSurface {
 /// the design matrix A = QR (Golub and Van Loan's R-SVD: A and R have the same singular values
 /// and right singular vectors, so the solution is A's pseudo-inverse solution), with
 /// Y = ||R x - c1||^2 + ||c2||^2 for Q^T b = (c1, c2): one tall QR instead of a tall SVD.
-pub fn fit_poles(du: usize, dv: usize, uv: &[(f64, f64)], points: &[Point3]) -> Result<(BezierSurface, f64), SplineError> {
+pub fn fit_poles(
+    du: usize,
+    dv: usize,
+    uv: &[(f64, f64)],
+    points: &[Point3],
+) -> Result<(BezierSurface, f64), SplineError> {
     if uv.len() != points.len() || points.is_empty() {
-        return Err(SplineError::Grid(format!("{} parameters for {} points", uv.len(), points.len())));
+        return Err(SplineError::Grid(format!(
+            "{} parameters for {} points",
+            uv.len(),
+            points.len()
+        )));
     }
     let ncols = (du + 1) * (dv + 1);
     let a = design(du, dv, uv);
@@ -129,7 +138,8 @@ fn column_basis(deg: usize, t: &[f64]) -> DMatrix<f64> {
     }
     let svd = b.svd(true, false);
     let u = svd.u.expect("left singular vectors requested");
-    let keep: Vec<usize> = (0..svd.singular_values.len()).filter(|&k| svd.singular_values[k] > 1e-12).collect();
+    let keep: Vec<usize> =
+        (0..svd.singular_values.len()).filter(|&k| svd.singular_values[k] > 1e-12).collect();
     DMatrix::from_fn(t.len(), keep.len(), |r, c| u[(r, keep[c])])
 }
 
@@ -173,7 +183,10 @@ pub fn grid_sse(du: usize, dv: usize, u: &[f64], v: &[f64], data: &GridData) -> 
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Layout {
     /// `nu` columns by `nv` rows; point (i, j) at index j * nu + i.
-    Grid { nu: usize, nv: usize },
+    Grid {
+        nu: usize,
+        nv: usize,
+    },
     Scattered,
 }
 
@@ -191,24 +204,45 @@ pub struct BezierParamProblem {
 
 impl BezierParamProblem {
     /// `start` is the initial decision vector (e.g. a classical parameterisation).
-    pub fn new(du: usize, dv: usize, layout: Layout, points: Vec<Point3>, start: Vec<f64>) -> Result<Self, SplineError> {
+    pub fn new(
+        du: usize,
+        dv: usize,
+        layout: Layout,
+        points: Vec<Point3>,
+        start: Vec<f64>,
+    ) -> Result<Self, SplineError> {
         let dim = match layout {
             Layout::Grid { nu, nv } => {
                 if nu * nv != points.len() {
-                    return Err(SplineError::Grid(format!("{nu}x{nv} grid but {} points", points.len())));
+                    return Err(SplineError::Grid(format!(
+                        "{nu}x{nv} grid but {} points",
+                        points.len()
+                    )));
                 }
                 nu + nv
             }
             Layout::Scattered => 2 * points.len(),
         };
         if start.len() != dim {
-            return Err(SplineError::Grid(format!("start has {} values, expected {dim}", start.len())));
+            return Err(SplineError::Grid(format!(
+                "start has {} values, expected {dim}",
+                start.len()
+            )));
         }
         let grid = match layout {
             Layout::Grid { nu, nv } => Some(GridData::new(&points, nu, nv)),
             Layout::Scattered => None,
         };
-        Ok(BezierParamProblem { du, dv, layout, points, grid, start, lo: vec![0.0; dim], hi: vec![1.0; dim] })
+        Ok(BezierParamProblem {
+            du,
+            dv,
+            layout,
+            points,
+            grid,
+            start,
+            lo: vec![0.0; dim],
+            hi: vec![1.0; dim],
+        })
     }
 
     /// The (u, v) of every point encoded by decision vector x (grid parameters sorted).
@@ -262,9 +296,17 @@ impl Problem for BezierParamProblem {
 
 /// The classical (uniform, chordal, centripetal) start vector for grid data, in the problem's
 /// encoding (u of the nu columns, then v of the nv rows), from `param::grid_params`.
-pub fn classical_grid_start(points: &[Point3], nu: usize, nv: usize, method: super::Parameterisation) -> Vec<f64> {
+pub fn classical_grid_start(
+    points: &[Point3],
+    nu: usize,
+    nv: usize,
+    method: super::Parameterisation,
+) -> Vec<f64> {
     // grid_params wants view[i * nv + j]; our layout is points[j * nu + i]
-    let view: Vec<Point3> = (0..nu).flat_map(|i| (0..nv).map(move |j| (i, j))).map(|(i, j)| points[j * nu + i]).collect();
+    let view: Vec<Point3> = (0..nu)
+        .flat_map(|i| (0..nv).map(move |j| (i, j)))
+        .map(|(i, j)| points[j * nu + i])
+        .collect();
     let (u, v) = super::param::grid_params(&view, nu, nv, method);
     u.into_iter().chain(v).collect()
 }
@@ -283,14 +325,17 @@ pub fn classical_scattered_start(points: &[Point3], method: super::Parameterisat
             c[k] += p[k] / n;
         }
     }
-    let cov = nalgebra::Matrix3::from_fn(|a, b| points.iter().map(|p| (p[a] - c[a]) * (p[b] - c[b])).sum::<f64>() / n);
+    let cov = nalgebra::Matrix3::from_fn(|a, b| {
+        points.iter().map(|p| (p[a] - c[a]) * (p[b] - c[b])).sum::<f64>() / n
+    });
     let eig = nalgebra::SymmetricEigen::new(cov);
     let mut order: Vec<usize> = (0..3).collect();
     order.sort_by(|&a, &b| eig.eigenvalues[b].total_cmp(&eig.eigenvalues[a]));
     let mut out = vec![0.0; 2 * points.len()];
     for (slot, &axis) in order.iter().take(2).enumerate() {
         let e = eig.eigenvectors.column(axis);
-        let proj: Vec<f64> = points.iter().map(|p| (0..3).map(|k| (p[k] - c[k]) * e[k]).sum()).collect();
+        let proj: Vec<f64> =
+            points.iter().map(|p| (0..3).map(|k| (p[k] - c[k]) * e[k]).sum()).collect();
         let mut idx: Vec<usize> = (0..points.len()).collect();
         idx.sort_by(|&a, &b| proj[a].total_cmp(&proj[b]));
         let line: Vec<Point3> = idx.iter().map(|&k| points[k]).collect();
@@ -312,7 +357,9 @@ pub fn franke(x: f64, y: f64) -> f64 {
 
 /// MATLAB's "peaks" function.
 pub fn peaks(x: f64, y: f64) -> f64 {
-    3.0 * (1.0 - x).powi(2) * (-x * x - (y + 1.0).powi(2)).exp() - 10.0 * (x / 5.0 - x.powi(3) - y.powi(5)) * (-x * x - y * y).exp() - (-(x + 1.0).powi(2) - y * y).exp() / 3.0
+    3.0 * (1.0 - x).powi(2) * (-x * x - (y + 1.0).powi(2)).exp()
+        - 10.0 * (x / 5.0 - x.powi(3) - y.powi(5)) * (-x * x - y * y).exp()
+        - (-(x + 1.0).powi(2) - y * y).exp() / 3.0
 }
 
 /// An n x n grid of z = f(x, y) over [a, b]^2 (point (i, j) at j * n + i, x along i).
@@ -325,7 +372,9 @@ pub fn height_grid(f: fn(f64, f64) -> f64, n: usize, a: f64, b: f64) -> Vec<Poin
 /// random poles in [-1, 1]^3 whose four corner poles coincide (self-intersecting).
 pub fn example3(n: usize, rng: &mut ChaCha8Rng) -> (BezierSurface, Vec<Point3>) {
     let (du, dv) = (5, 5);
-    let mut poles: Vec<Point3> = (0..(du + 1) * (dv + 1)).map(|_| [rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0)]).collect();
+    let mut poles: Vec<Point3> = (0..(du + 1) * (dv + 1))
+        .map(|_| [rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0)])
+        .collect();
     let corner = poles[0];
     for idx in [dv, du * (dv + 1), (du + 1) * (dv + 1) - 1] {
         poles[idx] = corner;
@@ -338,7 +387,8 @@ pub fn example3(n: usize, rng: &mut ChaCha8Rng) -> (BezierSurface, Vec<Point3>) 
 /// Add i.i.d. Gaussian noise to every coordinate at the given SNR (dB; definition in the module
 /// doc). Returns sigma.
 pub fn add_noise(points: &mut [Point3], snr_db: f64, rng: &mut ChaCha8Rng) -> f64 {
-    let p_signal = points.iter().flat_map(|p| p.iter()).map(|c| c * c).sum::<f64>() / (3 * points.len()) as f64;
+    let p_signal = points.iter().flat_map(|p| p.iter()).map(|c| c * c).sum::<f64>()
+        / (3 * points.len()) as f64;
     let sigma = (p_signal / 10f64.powf(snr_db / 10.0)).sqrt();
     let normal = Normal::new(0.0, sigma).expect("finite sigma");
     for p in points.iter_mut() {
@@ -374,7 +424,8 @@ mod tests {
     fn exact_recovery_of_known_surface() {
         let mut rng = ChaCha8Rng::seed_from_u64(7);
         let (s, _) = example3(10, &mut rng);
-        let uv: Vec<(f64, f64)> = (0..200).map(|_| (rng.gen_range(0.0..1.0), rng.gen_range(0.0..1.0))).collect();
+        let uv: Vec<(f64, f64)> =
+            (0..200).map(|_| (rng.gen_range(0.0..1.0), rng.gen_range(0.0..1.0))).collect();
         let pts: Vec<Point3> = uv.iter().map(|&(u, v)| s.eval(u, v)).collect();
         let (fit, y) = fit_poles(5, 5, &uv, &pts).unwrap();
         assert!(y < 1e-18, "Y = {y}");
@@ -386,10 +437,14 @@ mod tests {
         // and through the grid problem: an 8x7 grid at known sorted parameters (shuffled in x)
         let u: Vec<f64> = (0..8).map(|i| (i as f64 / 7.0).powf(1.3)).collect();
         let v: Vec<f64> = (0..7).map(|j| (j as f64 / 6.0).sqrt()).collect();
-        let pts: Vec<Point3> = (0..7).flat_map(|j| (0..8).map(move |i| (i, j))).map(|(i, j)| s.eval(u[i], v[j])).collect();
+        let pts: Vec<Point3> = (0..7)
+            .flat_map(|j| (0..8).map(move |i| (i, j)))
+            .map(|(i, j)| s.eval(u[i], v[j]))
+            .collect();
         let mut x: Vec<f64> = u.iter().rev().cloned().collect();
         x.extend(v.iter().rev());
-        let prob = BezierParamProblem::new(5, 5, Layout::Grid { nu: 8, nv: 7 }, pts, x.clone()).unwrap();
+        let prob =
+            BezierParamProblem::new(5, 5, Layout::Grid { nu: 8, nv: 7 }, pts, x.clone()).unwrap();
         assert!(prob.fitness(&x) < 1e-20, "Y = {}", prob.fitness(&x));
     }
 
@@ -399,14 +454,25 @@ mod tests {
     fn exact_recovery_on_examples_grids() {
         let mut rng = ChaCha8Rng::seed_from_u64(12);
         for (n, d) in [(29, 5), (41, 9)] {
-            let poles: Vec<Point3> = (0..(d + 1) * (d + 1)).map(|_| [rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0)]).collect();
+            let poles: Vec<Point3> = (0..(d + 1) * (d + 1))
+                .map(|_| {
+                    [rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0)]
+                })
+                .collect();
             let s = BezierSurface { du: d, dv: d, poles };
             let u: Vec<f64> = (0..n).map(|i| (i as f64 / (n - 1) as f64).powf(1.7)).collect();
-            let v: Vec<f64> = (0..n).map(|j| 0.5 - 0.5 * (std::f64::consts::PI * j as f64 / (n - 1) as f64).cos()).collect();
-            let pts: Vec<Point3> = (0..n).flat_map(|j| (0..n).map(move |i| (i, j))).map(|(i, j)| s.eval(u[i], v[j])).collect();
+            let v: Vec<f64> = (0..n)
+                .map(|j| 0.5 - 0.5 * (std::f64::consts::PI * j as f64 / (n - 1) as f64).cos())
+                .collect();
+            let pts: Vec<Point3> = (0..n)
+                .flat_map(|j| (0..n).map(move |i| (i, j)))
+                .map(|(i, j)| s.eval(u[i], v[j]))
+                .collect();
             let x: Vec<f64> = u.iter().chain(&v).cloned().collect();
             let uniform: Vec<f64> = (0..2 * n).map(|k| (k % n) as f64 / (n - 1) as f64).collect();
-            let prob = BezierParamProblem::new(d, d, Layout::Grid { nu: n, nv: n }, pts, uniform.clone()).unwrap();
+            let prob =
+                BezierParamProblem::new(d, d, Layout::Grid { nu: n, nv: n }, pts, uniform.clone())
+                    .unwrap();
             assert!(prob.fitness(&x) < 1e-20, "n={n}: Y = {}", prob.fitness(&x));
             assert!(prob.fitness(&uniform) > 1e-6, "n={n}: uniform Y = {}", prob.fitness(&uniform));
         }
@@ -417,7 +483,9 @@ mod tests {
         let pts = height_grid(franke, 9, 0.0, 1.0);
         let mut rng = ChaCha8Rng::seed_from_u64(3);
         let x: Vec<f64> = (0..18).map(|_| rng.gen_range(0.0..1.0)).collect();
-        let prob = BezierParamProblem::new(3, 4, Layout::Grid { nu: 9, nv: 9 }, pts.clone(), x.clone()).unwrap();
+        let prob =
+            BezierParamProblem::new(3, 4, Layout::Grid { nu: 9, nv: 9 }, pts.clone(), x.clone())
+                .unwrap();
         let y = prob.fitness(&x);
         // dense normal equations, independent of the SVD path
         let uv = prob.params(&x);
@@ -447,7 +515,11 @@ mod tests {
     #[test]
     fn separable_grid_sse_equals_full_svd() {
         let mut rng = ChaCha8Rng::seed_from_u64(21);
-        for (f, n, a, b, du, dv) in [(franke as fn(f64, f64) -> f64, 29, 0.0, 1.0, 5, 5), (peaks, 41, -3.0, 3.0, 9, 9), (franke, 12, 0.0, 1.0, 3, 7)] {
+        for (f, n, a, b, du, dv) in [
+            (franke as fn(f64, f64) -> f64, 29, 0.0, 1.0, 5, 5),
+            (peaks, 41, -3.0, 3.0, 9, 9),
+            (franke, 12, 0.0, 1.0, 3, 7),
+        ] {
             let mut pts = height_grid(f, n, a, b);
             add_noise(&mut pts, 15.0, &mut rng);
             let data = GridData::new(&pts, n, n);
@@ -456,7 +528,14 @@ mod tests {
                 if trial == 3 {
                     x.iter_mut().take(n).for_each(|t| *t = 0.4 + 0.2 * *t);
                 }
-                let prob = BezierParamProblem::new(du, dv, Layout::Grid { nu: n, nv: n }, pts.clone(), x.clone()).unwrap();
+                let prob = BezierParamProblem::new(
+                    du,
+                    dv,
+                    Layout::Grid { nu: n, nv: n },
+                    pts.clone(),
+                    x.clone(),
+                )
+                .unwrap();
                 let (_, y_svd) = prob.fit(&x).unwrap();
                 let mut u = x[..n].to_vec();
                 let mut v = x[n..].to_vec();
@@ -467,7 +546,10 @@ mod tests {
                 // ill-conditioned: products of singular values reach the full path's 1e-12 cut,
                 // which the separable path applies to the factors, so the two agree less there.
                 let tol = if trial == 3 { 1e-6 } else { 1e-10 };
-                assert!((y_sep - y_svd).abs() <= tol * y_svd, "n={n} trial {trial}: {y_sep} vs {y_svd}");
+                assert!(
+                    (y_sep - y_svd).abs() <= tol * y_svd,
+                    "n={n} trial {trial}: {y_sep} vs {y_svd}"
+                );
                 assert_eq!(prob.fitness(&x), y_sep);
             }
         }
@@ -483,7 +565,9 @@ mod tests {
         for t in x.iter_mut().take(9) {
             *t = if *t < 0.5 { 0.25 } else { 0.75 };
         }
-        let prob = BezierParamProblem::new(3, 3, Layout::Grid { nu: 9, nv: 9 }, pts.clone(), x.clone()).unwrap();
+        let prob =
+            BezierParamProblem::new(3, 3, Layout::Grid { nu: 9, nv: 9 }, pts.clone(), x.clone())
+                .unwrap();
         let (_, y_svd) = prob.fit(&x).unwrap();
         let y = prob.fitness(&x);
         assert!((y - y_svd).abs() <= 1e-9 * y_svd, "{y} vs {y_svd}");
@@ -502,9 +586,15 @@ mod tests {
                 assert!((v - k as f64 / 49.0).abs() < 1e-12);
             }
         }
-        for m in [crate::spline::Parameterisation::ChordLength, crate::spline::Parameterisation::Centripetal] {
+        for m in [
+            crate::spline::Parameterisation::ChordLength,
+            crate::spline::Parameterisation::Centripetal,
+        ] {
             let s = classical_scattered_start(&pts, m);
-            assert!(s.iter().all(|t| (0.0..=1.0).contains(t)) && s.iter().filter(|t| **t == 1.0).count() == 2);
+            assert!(
+                s.iter().all(|t| (0.0..=1.0).contains(t))
+                    && s.iter().filter(|t| **t == 1.0).count() == 2
+            );
         }
     }
 
@@ -516,7 +606,11 @@ mod tests {
             let mut noisy = clean.clone();
             add_noise(&mut noisy, snr, &mut rng);
             let ps: f64 = clean.iter().flat_map(|p| p.iter()).map(|c| c * c).sum();
-            let pn: f64 = clean.iter().zip(&noisy).flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).powi(2))).sum();
+            let pn: f64 = clean
+                .iter()
+                .zip(&noisy)
+                .flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).powi(2)))
+                .sum();
             let measured = 10.0 * (ps / pn).log10();
             assert!((measured - snr).abs() < 0.2, "{measured} vs {snr}");
         }
@@ -529,8 +623,10 @@ mod tests {
         let mut pts = height_grid(franke, 9, 0.0, 1.0);
         add_noise(&mut pts, 20.75, &mut rng);
         let uniform: Vec<f64> = (0..18).map(|k| (k % 9) as f64 / 8.0).collect();
-        let prob = BezierParamProblem::new(3, 3, Layout::Grid { nu: 9, nv: 9 }, pts, uniform).unwrap();
-        let budget = Budget { generations: 30, population: 10, init_range: 1.0, trace_every_evals: 50 };
+        let prob =
+            BezierParamProblem::new(3, 3, Layout::Grid { nu: 9, nv: 9 }, pts, uniform).unwrap();
+        let budget =
+            Budget { generations: 30, population: 10, init_range: 1.0, trace_every_evals: 50 };
         let opts: [&dyn Optimiser; 2] = [&Csa::default(), &Icsa::default()];
         for opt in opts {
             let r = opt.run(&prob, &budget, &mut rng).unwrap();
@@ -548,7 +644,9 @@ mod tests {
             assert!((t - (k % 11) as f64 / 10.0).abs() < 1e-12);
         }
         let cen = classical_grid_start(&pts, 11, 11, crate::spline::Parameterisation::Centripetal);
-        assert!(cen[..11].windows(2).all(|w| w[0] < w[1]) && cen[11..].windows(2).all(|w| w[0] < w[1]));
+        assert!(
+            cen[..11].windows(2).all(|w| w[0] < w[1]) && cen[11..].windows(2).all(|w| w[0] < w[1])
+        );
         assert!(cen[0].abs() < 1e-12 && (cen[10] - 1.0).abs() < 1e-12);
     }
 }
@@ -567,8 +665,18 @@ mod timing {
         let mut rng = ChaCha8Rng::seed_from_u64(1);
         let (_, ex3) = example3(628, &mut rng);
         let cases = [
-            ("example1 29x29 (5,5) grid", 5, Layout::Grid { nu: 29, nv: 29 }, height_grid(franke, 29, 0.0, 1.0)),
-            ("example2 41x41 (9,9) grid", 9, Layout::Grid { nu: 41, nv: 41 }, height_grid(peaks, 41, -3.0, 3.0)),
+            (
+                "example1 29x29 (5,5) grid",
+                5,
+                Layout::Grid { nu: 29, nv: 29 },
+                height_grid(franke, 29, 0.0, 1.0),
+            ),
+            (
+                "example2 41x41 (9,9) grid",
+                9,
+                Layout::Grid { nu: 41, nv: 41 },
+                height_grid(peaks, 41, -3.0, 3.0),
+            ),
             ("example3 628 scattered (5,5)", 5, Layout::Scattered, ex3),
         ];
         for (name, d, layout, pts) in cases {
@@ -576,7 +684,8 @@ mod timing {
                 Layout::Grid { nu, nv } => nu + nv,
                 Layout::Scattered => 2 * pts.len(),
             };
-            let xs: Vec<Vec<f64>> = (0..64).map(|_| (0..dim).map(|_| rng.gen_range(0.0..1.0)).collect()).collect();
+            let xs: Vec<Vec<f64>> =
+                (0..64).map(|_| (0..dim).map(|_| rng.gen_range(0.0..1.0)).collect()).collect();
             let prob = BezierParamProblem::new(d, d, layout, pts, xs[0].clone()).unwrap();
             let t = Instant::now();
             let mut n = 0u64;
@@ -586,7 +695,11 @@ mod timing {
                 n += 1;
             }
             let secs = t.elapsed().as_secs_f64();
-            println!("{name}: {:.0} evaluations/s ({:.1} us each; checksum {acc:.3e})", n as f64 / secs, 1e6 * secs / n as f64);
+            println!(
+                "{name}: {:.0} evaluations/s ({:.1} us each; checksum {acc:.3e})",
+                n as f64 / secs,
+                1e6 * secs / n as f64
+            );
             if let Layout::Grid { .. } = layout {
                 let t = Instant::now();
                 let mut m = 0u64;
@@ -594,7 +707,10 @@ mod timing {
                     let _ = prob.fit(&xs[m as usize % xs.len()]);
                     m += 1;
                 }
-                println!("  full-design SVD path: {:.0} evaluations/s", m as f64 / t.elapsed().as_secs_f64());
+                println!(
+                    "  full-design SVD path: {:.0} evaluations/s",
+                    m as f64 / t.elapsed().as_secs_f64()
+                );
             }
         }
     }

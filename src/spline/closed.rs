@@ -134,13 +134,24 @@ impl ClosedNetShape {
             return Err(SplineError::ControlNet(format!("{} control points around are too few for order {} (at least the order, and order >= 2)", self.n_around, self.order_around)));
         }
         if self.order_up < 2 || self.rows < self.order_up {
-            return Err(SplineError::ControlNet(format!("{} rows are too few for order {} up (at least the order, and order >= 2)", self.rows, self.order_up)));
+            return Err(SplineError::ControlNet(format!(
+                "{} rows are too few for order {} up (at least the order, and order >= 2)",
+                self.rows, self.order_up
+            )));
         }
         if data.rings.len() < self.rows {
-            return Err(SplineError::Grid(format!("{} rings for {} rows of control points", data.rings.len(), self.rows)));
+            return Err(SplineError::Grid(format!(
+                "{} rings for {} rows of control points",
+                data.rings.len(),
+                self.rows
+            )));
         }
         if let Some(k) = data.rings.iter().position(|r| r.len() < self.n_around) {
-            return Err(SplineError::Grid(format!("ring {k} has {} points for {} control points around", data.rings[k].len(), self.n_around)));
+            return Err(SplineError::Grid(format!(
+                "ring {k} has {} points for {} control points around",
+                data.rings[k].len(),
+                self.n_around
+            )));
         }
         Ok(())
     }
@@ -158,7 +169,8 @@ pub struct ClosedFit {
 pub fn fit_closed(data: &RingData, shape: ClosedNetShape) -> Result<ClosedFit, SplineError> {
     shape.check(data)?;
     let vs = data.row_parameters();
-    let knots_v = knot_vector(&vs, shape.rows, shape.order_up - 1, KnotRule::NurbsBook).map_err(SplineError::ControlNet)?;
+    let knots_v = knot_vector(&vs, shape.rows, shape.order_up - 1, KnotRule::NurbsBook)
+        .map_err(SplineError::ControlNet)?;
     let mut uv = Vec::with_capacity(data.n_points());
     for (ring, &v) in data.rings.iter().zip(&vs) {
         uv.extend(RingData::ring_parameters(ring, shape.n_around).into_iter().map(|u| (u, v)));
@@ -169,9 +181,18 @@ pub fn fit_closed(data: &RingData, shape: ClosedNetShape) -> Result<ClosedFit, S
 
 /// The SVD least-squares net (Eq. 11-13, minimum-norm if rank deficient) for points with given
 /// parameters and knots up.
-pub fn fit_closed_at(points: &[Point3], uv: Vec<(f64, f64)>, shape: ClosedNetShape, knots_v: Vec<f64>) -> Result<ClosedFit, SplineError> {
+pub fn fit_closed_at(
+    points: &[Point3],
+    uv: Vec<(f64, f64)>,
+    shape: ClosedNetShape,
+    knots_v: Vec<f64>,
+) -> Result<ClosedFit, SplineError> {
     if uv.len() != points.len() || points.is_empty() {
-        return Err(SplineError::Grid(format!("{} parameters for {} points", uv.len(), points.len())));
+        return Err(SplineError::Grid(format!(
+            "{} parameters for {} points",
+            uv.len(),
+            points.len()
+        )));
     }
     let (n, q) = (points.len(), shape.order_up - 1);
     let ncols = shape.n_around * shape.rows;
@@ -188,11 +209,22 @@ pub fn fit_closed_at(points: &[Point3], uv: Vec<(f64, f64)>, shape: ClosedNetSha
         }
     }
     let d = DMatrix::from_fn(n, 3, |r, x| points[r][x]);
-    let b = c.clone().svd(true, true).solve(&d, 1e-12).map_err(|e| SplineError::Singular(e.to_string()))?;
+    let b = c
+        .clone()
+        .svd(true, true)
+        .solve(&d, 1e-12)
+        .map_err(|e| SplineError::Singular(e.to_string()))?;
     let resid = &c * &b - &d;
     let rms = (resid.iter().map(|e| e * e).sum::<f64>() / n as f64).sqrt();
     let control = (0..ncols).map(|k| [b[(k, 0)], b[(k, 1)], b[(k, 2)]]).collect();
-    let surface = ClosedSurface { order_around: shape.order_around, order_up: shape.order_up, n_around: shape.n_around, rows: shape.rows, knots_v, control };
+    let surface = ClosedSurface {
+        order_around: shape.order_around,
+        order_up: shape.order_up,
+        n_around: shape.n_around,
+        rows: shape.rows,
+        knots_v,
+        control,
+    };
     Ok(ClosedFit { surface, uv, rms })
 }
 
@@ -221,7 +253,10 @@ impl RingNetProblem {
             .flat_map(|i| {
                 let col = &s.control[i * rows..(i + 1) * rows];
                 let m = rows as f64;
-                [col.iter().map(|p| p[0]).sum::<f64>() / m, col.iter().map(|p| p[1]).sum::<f64>() / m]
+                [
+                    col.iter().map(|p| p[0]).sum::<f64>() / m,
+                    col.iter().map(|p| p[1]).sum::<f64>() / m,
+                ]
             })
             .collect();
         let (mut at, mut w, mut target, mut z_sse) = (Vec::new(), Vec::new(), Vec::new(), 0.0);
@@ -271,7 +306,9 @@ impl Problem for RingNetProblem {
     fn fitness(&self, x: &[f64]) -> f64 {
         let k = self.fit.surface.order_around;
         let mut sse = self.z_sse;
-        for ((t, w), at) in self.target.iter().zip(self.w.chunks_exact(k)).zip(self.at.chunks_exact(k)) {
+        for ((t, w), at) in
+            self.target.iter().zip(self.w.chunks_exact(k)).zip(self.at.chunks_exact(k))
+        {
             let (mut px, mut py) = (0.0, 0.0);
             for (a, &j) in w.iter().zip(at) {
                 px += a * x[j];
@@ -315,7 +352,8 @@ mod tests {
             let t = u - 2.0;
             let (first, b) = periodic_basis(6, 3, u);
             assert_eq!(first, 0);
-            let want = [(1.0 - t) * (1.0 - t) / 2.0, (1.0 + 2.0 * t - 2.0 * t * t) / 2.0, t * t / 2.0];
+            let want =
+                [(1.0 - t) * (1.0 - t) / 2.0, (1.0 + 2.0 * t - 2.0 * t * t) / 2.0, t * t / 2.0];
             for (a, w) in b.iter().zip(want) {
                 assert!((a - w).abs() < 1e-14);
             }
@@ -330,12 +368,33 @@ mod tests {
         // its net and reproduces its samples.
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
         for (n, k, rows, q) in [(7, 3, 2, 2), (9, 4, 4, 3), (5, 2, 3, 2)] {
-            let knots_v = knot_vector(&(0..20).map(|s| s as f64 / 19.0).collect::<Vec<_>>(), rows, q - 1, KnotRule::NurbsBook).unwrap();
-            let control: Vec<Point3> = (0..n * rows).map(|_| [rng.gen(), rng.gen(), rng.gen()]).collect();
-            let surf = ClosedSurface { order_around: k, order_up: q, n_around: n, rows, knots_v: knots_v.clone(), control: control.clone() };
-            let uv: Vec<(f64, f64)> = (0..600).map(|_| (rng.gen::<f64>() * n as f64, rng.gen::<f64>())).collect();
+            let knots_v = knot_vector(
+                &(0..20).map(|s| s as f64 / 19.0).collect::<Vec<_>>(),
+                rows,
+                q - 1,
+                KnotRule::NurbsBook,
+            )
+            .unwrap();
+            let control: Vec<Point3> =
+                (0..n * rows).map(|_| [rng.gen(), rng.gen(), rng.gen()]).collect();
+            let surf = ClosedSurface {
+                order_around: k,
+                order_up: q,
+                n_around: n,
+                rows,
+                knots_v: knots_v.clone(),
+                control: control.clone(),
+            };
+            let uv: Vec<(f64, f64)> =
+                (0..600).map(|_| (rng.gen::<f64>() * n as f64, rng.gen::<f64>())).collect();
             let pts: Vec<Point3> = uv.iter().map(|&(u, v)| surf.eval(u, v)).collect();
-            let fit = fit_closed_at(&pts, uv, ClosedNetShape { order_around: k, order_up: q, n_around: n, rows }, knots_v).unwrap();
+            let fit = fit_closed_at(
+                &pts,
+                uv,
+                ClosedNetShape { order_around: k, order_up: q, n_around: n, rows },
+                knots_v,
+            )
+            .unwrap();
             assert!(fit.rms < 1e-12, "{}", fit.rms);
             for (a, b) in fit.surface.control.iter().zip(&control) {
                 for c in 0..3 {
@@ -353,11 +412,19 @@ mod tests {
         let pts = crate::data::generators::cylinder();
         let rings: Vec<Vec<Point3>> = pts.chunks(76).map(|c| c.to_vec()).collect();
         let data = RingData { rings };
-        let rms = |n| fit_closed(&data, ClosedNetShape { order_around: 3, order_up: 2, n_around: n, rows: 2 }).unwrap().rms;
+        let rms = |n| {
+            fit_closed(&data, ClosedNetShape { order_around: 3, order_up: 2, n_around: n, rows: 2 })
+                .unwrap()
+                .rms
+        };
         let (r5, r10, r20) = (rms(5), rms(10), rms(20));
         assert!(r5 > r10 && r10 > r20, "{r5} {r10} {r20}");
         assert!(r20 < 1e-3 && r10 / r20 > 8.0, "{r10} {r20}");
-        let fit = fit_closed(&data, ClosedNetShape { order_around: 3, order_up: 2, n_around: 7, rows: 2 }).unwrap();
+        let fit = fit_closed(
+            &data,
+            ClosedNetShape { order_around: 3, order_up: 2, n_around: 7, rows: 2 },
+        )
+        .unwrap();
         // z is linear in v and the rows sit at z = 0 and 5.
         for (k, c) in fit.surface.control.iter().enumerate() {
             assert!((c[2] - if k % 2 == 0 { 0.0 } else { 5.0 }).abs() < 1e-9, "{c:?}");
@@ -366,12 +433,31 @@ mod tests {
         assert_eq!(problem.dim(), 14);
         assert!((problem.fitness(problem.initial_point()) - fit.rms).abs() < 1e-12);
         // The fitness is the RMS distance to the surface evaluated point by point.
-        let x: Vec<f64> = problem.initial_point().iter().enumerate().map(|(j, v)| v + 0.01 * (j as f64).cos()).collect();
+        let x: Vec<f64> = problem
+            .initial_point()
+            .iter()
+            .enumerate()
+            .map(|(j, v)| v + 0.01 * (j as f64).cos())
+            .collect();
         let s = problem.surface(&x);
-        let direct = (data.points().zip(&fit.uv).map(|(p, &(u, v))| crate::geom::dist2(*p, s.eval(u, v))).sum::<f64>() / data.n_points() as f64).sqrt();
+        let direct = (data
+            .points()
+            .zip(&fit.uv)
+            .map(|(p, &(u, v))| crate::geom::dist2(*p, s.eval(u, v)))
+            .sum::<f64>()
+            / data.n_points() as f64)
+            .sqrt();
         assert!((problem.fitness(&x) - direct).abs() < 1e-12);
         // Too few points or control points are refused by name.
-        assert!(fit_closed(&data, ClosedNetShape { order_around: 3, order_up: 2, n_around: 2, rows: 2 }).is_err());
-        assert!(fit_closed(&data, ClosedNetShape { order_around: 3, order_up: 3, n_around: 7, rows: 2 }).is_err());
+        assert!(fit_closed(
+            &data,
+            ClosedNetShape { order_around: 3, order_up: 2, n_around: 2, rows: 2 }
+        )
+        .is_err());
+        assert!(fit_closed(
+            &data,
+            ClosedNetShape { order_around: 3, order_up: 3, n_around: 7, rows: 2 }
+        )
+        .is_err());
     }
 }

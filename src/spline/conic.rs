@@ -16,15 +16,25 @@ pub type P2 = [f64; 2];
 /// Walk a closed path of pieces, sampling one point every `spacing` of arc length.
 #[derive(Debug, Clone, Copy)]
 pub enum Piece {
-    Line { from: P2, to: P2 },
+    Line {
+        from: P2,
+        to: P2,
+    },
     /// Arc of a circle: centre, radius, start angle, signed sweep (radians).
-    Arc { centre: P2, radius: f64, start: f64, sweep: f64 },
+    Arc {
+        centre: P2,
+        radius: f64,
+        start: f64,
+        sweep: f64,
+    },
 }
 
 impl Piece {
     fn length(&self) -> f64 {
         match *self {
-            Piece::Line { from, to } => ((to[0] - from[0]).powi(2) + (to[1] - from[1]).powi(2)).sqrt(),
+            Piece::Line { from, to } => {
+                ((to[0] - from[0]).powi(2) + (to[1] - from[1]).powi(2)).sqrt()
+            }
             Piece::Arc { radius, sweep, .. } => radius * sweep.abs(),
         }
     }
@@ -74,7 +84,12 @@ pub fn outline(name: &str) -> Option<(Vec<Piece>, Vec<P2>)> {
         "letter_d" => {
             let pieces = vec![
                 line([0.0, 0.0], [20.0, 0.0]),
-                Piece::Arc { centre: [20.0, 40.0], radius: 40.0, start: -std::f64::consts::FRAC_PI_2, sweep: std::f64::consts::PI },
+                Piece::Arc {
+                    centre: [20.0, 40.0],
+                    radius: 40.0,
+                    start: -std::f64::consts::FRAC_PI_2,
+                    sweep: std::f64::consts::PI,
+                },
                 line([20.0, 80.0], [0.0, 80.0]),
                 line([0.0, 80.0], [0.0, 0.0]),
             ];
@@ -88,7 +103,12 @@ pub fn outline(name: &str) -> Option<(Vec<Piece>, Vec<P2>)> {
                 line([0.0, 0.0], [20.0, 0.0]),
                 line([20.0, 0.0], [20.0, 50.0]),
                 line([20.0, 50.0], [35.0, 50.0]),
-                Piece::Arc { centre: [35.0, 75.0], radius: 25.0, start: -std::f64::consts::FRAC_PI_2, sweep: std::f64::consts::PI },
+                Piece::Arc {
+                    centre: [35.0, 75.0],
+                    radius: 25.0,
+                    start: -std::f64::consts::FRAC_PI_2,
+                    sweep: std::f64::consts::PI,
+                },
                 line([35.0, 100.0], [0.0, 100.0]),
                 line([0.0, 100.0], [0.0, 0.0]),
             ];
@@ -156,7 +176,10 @@ pub fn sam06(points: &[P2], l: usize, d: f64, r: usize) -> Vec<usize> {
 pub fn chord_length_params(points: &[P2]) -> Vec<f64> {
     let mut t = vec![0.0; points.len()];
     for k in 1..points.len() {
-        t[k] = t[k - 1] + ((points[k][0] - points[k - 1][0]).powi(2) + (points[k][1] - points[k - 1][1]).powi(2)).sqrt();
+        t[k] = t[k - 1]
+            + ((points[k][0] - points[k - 1][0]).powi(2)
+                + (points[k][1] - points[k - 1][1]).powi(2))
+            .sqrt();
     }
     let total = *t.last().unwrap_or(&0.0);
     if total > 0.0 {
@@ -215,7 +238,8 @@ impl ConicProblem {
         let ext = (mx[0] - mn[0]).max(mx[1] - mn[1]).max(1e-9);
         let lo = vec![mn[0] - margin * ext, mn[1] - margin * ext, w_lo];
         let hi = vec![mx[0] + margin * ext, mx[1] + margin * ext, w_hi];
-        let x0 = vec![b1[0].clamp(lo[0], hi[0]), b1[1].clamp(lo[1], hi[1]), 1.0f64.clamp(w_lo, w_hi)];
+        let x0 =
+            vec![b1[0].clamp(lo[0], hi[0]), b1[1].clamp(lo[1], hi[1]), 1.0f64.clamp(w_lo, w_hi)];
         ConicProblem { points, t, x0, lo, hi }
     }
 
@@ -283,7 +307,10 @@ mod tests {
         let total = 5f64.sqrt() + 8f64.sqrt() + 17f64.sqrt();
         assert_eq!(t[0], 0.0);
         assert!((t[1] - 5f64.sqrt() / total).abs() < 1e-15 && (t[1] - 0.2434).abs() < 5e-5);
-        assert!((t[2] - (5f64.sqrt() + 8f64.sqrt()) / total).abs() < 1e-15 && (t[2] - 0.5512).abs() < 5e-5);
+        assert!(
+            (t[2] - (5f64.sqrt() + 8f64.sqrt()) / total).abs() < 1e-15
+                && (t[2] - 0.5512).abs() < 5e-5
+        );
         assert_eq!(t[3], 1.0);
     }
 
@@ -293,9 +320,17 @@ mod tests {
             let (pieces, truth) = outline(name).unwrap();
             let pts = sample_closed(&pieces, 1.0);
             let found = sam06(&pts, 14, 2.6, 14);
-            assert_eq!(found.len(), truth.len(), "{name}: found {:?}", found.iter().map(|&i| pts[i]).collect::<Vec<_>>());
+            assert_eq!(
+                found.len(),
+                truth.len(),
+                "{name}: found {:?}",
+                found.iter().map(|&i| pts[i]).collect::<Vec<_>>()
+            );
             for c in &truth {
-                assert!(found.iter().any(|&i| near(pts[i], *c, 1.0)), "{name}: corner {c:?} not found");
+                assert!(
+                    found.iter().any(|&i| near(pts[i], *c, 1.0)),
+                    "{name}: corner {c:?} not found"
+                );
             }
         }
     }
@@ -306,17 +341,25 @@ mod tests {
         // b1 at the tangents' intersection, w = cos(60 deg). With the conic's own parameters the
         // closed-form least-squares b1 at the exact w is the exact b1 (zero residual).
         let theta = std::f64::consts::PI / 3.0;
-        let b = [[10.0 * theta.cos(), -10.0 * theta.sin()], [10.0 / theta.cos(), 0.0], [10.0 * theta.cos(), 10.0 * theta.sin()]];
+        let b = [
+            [10.0 * theta.cos(), -10.0 * theta.sin()],
+            [10.0 / theta.cos(), 0.0],
+            [10.0 * theta.cos(), 10.0 * theta.sin()],
+        ];
         let ts: Vec<f64> = (0..=40).map(|k| k as f64 / 40.0).collect();
         let pts: Vec<P2> = ts.iter().map(|&t| conic_point(&b, theta.cos(), t)).collect();
         let b1 = ConicProblem::best_b1(&pts, &ts, theta.cos());
         assert!(near(b1, b[1], 1e-10), "{b1:?}");
         let p = ConicProblem::new(pts.clone(), 0.5, 0.01, 10.0);
         let x = [b[1][0], b[1][1], theta.cos()];
-        let direct: f64 = pts.iter().zip(&p.t).map(|(q, &t)| {
-            let r = conic_point(&b, theta.cos(), t);
-            (r[0] - q[0]).powi(2) + (r[1] - q[1]).powi(2)
-        }).sum();
+        let direct: f64 = pts
+            .iter()
+            .zip(&p.t)
+            .map(|(q, &t)| {
+                let r = conic_point(&b, theta.cos(), t);
+                (r[0] - q[0]).powi(2) + (r[1] - q[1]).powi(2)
+            })
+            .sum();
         assert!((p.fitness(&x) - direct).abs() < 1e-12);
     }
 

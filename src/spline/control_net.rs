@@ -92,7 +92,12 @@ fn finite(p: &Point3) -> bool {
     p.iter().all(|v| v.is_finite())
 }
 
-fn check_basis(name: &str, b: &SparseBasis, n_grid: usize, n_ctrl: usize) -> Result<(), OptimError> {
+fn check_basis(
+    name: &str,
+    b: &SparseBasis,
+    n_grid: usize,
+    n_ctrl: usize,
+) -> Result<(), OptimError> {
     if b.first.len() != n_grid || b.w.len() != n_grid {
         return Err(OptimError::ControlNet(format!(
             "{name} must have {n_grid} entries (one per grid index), has {} first indices and {} weight sets",
@@ -102,10 +107,14 @@ fn check_basis(name: &str, b: &SparseBasis, n_grid: usize, n_ctrl: usize) -> Res
     }
     for (k, (&f, w)) in b.first.iter().zip(&b.w).enumerate() {
         if f + 4 > n_ctrl {
-            return Err(OptimError::ControlNet(format!("{name}[{k}]: first basis index {f} + 4 exceeds {n_ctrl} control points")));
+            return Err(OptimError::ControlNet(format!(
+                "{name}[{k}]: first basis index {f} + 4 exceeds {n_ctrl} control points"
+            )));
         }
         if !w.iter().all(|v| v.is_finite()) {
-            return Err(OptimError::ControlNet(format!("{name}[{k}]: weights {w:?} are not finite")));
+            return Err(OptimError::ControlNet(format!(
+                "{name}[{k}]: weights {w:?} are not finite"
+            )));
         }
     }
     Ok(())
@@ -117,13 +126,22 @@ fn validate_parts(p: &ControlNetParts) -> Result<(), OptimError> {
         return Err(OptimError::ControlNet(format!("grid {}x{} is smaller than 2x2", p.nx, p.ny)));
     }
     if p.cn_x < 4 || p.cn_y < 4 {
-        return Err(OptimError::ControlNet(format!("control net {}x{} is smaller than 4x4 (cubic)", p.cn_x, p.cn_y)));
+        return Err(OptimError::ControlNet(format!(
+            "control net {}x{} is smaller than 4x4 (cubic)",
+            p.cn_x, p.cn_y
+        )));
     }
     check_basis("nu", &p.nu, p.nx, p.cn_x)?;
     check_basis("nv", &p.nv, p.ny, p.cn_y)?;
     for (name, d) in [("data_bottom", &p.data_bottom), ("data_top", &p.data_top)] {
         if d.len() != p.nx * p.ny {
-            return Err(OptimError::ControlNet(format!("{name} has {} points, the {}x{} grid needs {}", d.len(), p.nx, p.ny, p.nx * p.ny)));
+            return Err(OptimError::ControlNet(format!(
+                "{name} has {} points, the {}x{} grid needs {}",
+                d.len(),
+                p.nx,
+                p.ny,
+                p.nx * p.ny
+            )));
         }
         if let Some(k) = d.iter().position(|p| !finite(p)) {
             return Err(OptimError::ControlNet(format!("{name}[{k}] = {:?} is not finite", d[k])));
@@ -169,7 +187,8 @@ fn padded(n: usize) -> usize {
 #[inline(always)]
 fn transpose_rows(lanes: usize, k3p: usize, r: &[f64], rt: &mut [f64]) {
     for ch in 0..lanes.div_ceil(CHUNK) {
-        let src: [&[f64]; CHUNK] = std::array::from_fn(|l| &r[(ch * CHUNK + l) * k3p..(ch * CHUNK + l + 1) * k3p]);
+        let src: [&[f64]; CHUNK] =
+            std::array::from_fn(|l| &r[(ch * CHUNK + l) * k3p..(ch * CHUNK + l + 1) * k3p]);
         let dst = &mut rt[ch * k3p * CHUNK..(ch + 1) * k3p * CHUNK];
         for (k, out) in dst.chunks_exact_mut(CHUNK).enumerate() {
             for l in 0..CHUNK {
@@ -185,7 +204,14 @@ fn transpose_rows(lanes: usize, k3p: usize, r: &[f64], rt: &mut [f64]) {
 /// Pass 2 and distances: per chunk of lanes, over all grid columns, in registers:
 /// D^G = sum_t Nv[j][t] RT[first_j + t] (Eq. 5.3), fused multiply-adds in a fixed order.
 #[inline(always)]
-fn pass2_error(lanes: usize, cols: Range<usize>, k3p: usize, nv: &SparseBasis, data: &[f64], rt: &[f64]) -> f64 {
+fn pass2_error(
+    lanes: usize,
+    cols: Range<usize>,
+    k3p: usize,
+    nv: &SparseBasis,
+    data: &[f64],
+    rt: &[f64],
+) -> f64 {
     let nc = cols.len();
     if lanes == 0 || nc == 0 {
         return 0.0;
@@ -198,13 +224,35 @@ fn pass2_error(lanes: usize, cols: Range<usize>, k3p: usize, nv: &SparseBasis, d
         for (lj, j) in cols.clone().enumerate() {
             let base = nv.first[j] * 3 * CHUNK;
             let q: &[f64; 12 * CHUNK] = block[base..base + 12 * CHUNK].try_into().expect("12 rows");
-            let d: &[f64; 3 * CHUNK] = dchunk[lj * 3 * CHUNK..(lj + 1) * 3 * CHUNK].try_into().expect("3 rows");
+            let d: &[f64; 3 * CHUNK] =
+                dchunk[lj * 3 * CHUNK..(lj + 1) * 3 * CHUNK].try_into().expect("3 rows");
             let w = &nv.w[j];
             // Row (t, c) of the 4 x 3 block starts at (3 t + c) * CHUNK.
             for l in 0..CHUNK {
-                let ex = w[3].mul_add(q[9 * CHUNK + l], w[2].mul_add(q[6 * CHUNK + l], w[1].mul_add(q[3 * CHUNK + l], w[0].mul_add(q[l], -d[l]))));
-                let ey = w[3].mul_add(q[10 * CHUNK + l], w[2].mul_add(q[7 * CHUNK + l], w[1].mul_add(q[4 * CHUNK + l], w[0].mul_add(q[CHUNK + l], -d[CHUNK + l]))));
-                let ez = w[3].mul_add(q[11 * CHUNK + l], w[2].mul_add(q[8 * CHUNK + l], w[1].mul_add(q[5 * CHUNK + l], w[0].mul_add(q[2 * CHUNK + l], -d[2 * CHUNK + l]))));
+                let ex = w[3].mul_add(
+                    q[9 * CHUNK + l],
+                    w[2].mul_add(
+                        q[6 * CHUNK + l],
+                        w[1].mul_add(q[3 * CHUNK + l], w[0].mul_add(q[l], -d[l])),
+                    ),
+                );
+                let ey = w[3].mul_add(
+                    q[10 * CHUNK + l],
+                    w[2].mul_add(
+                        q[7 * CHUNK + l],
+                        w[1].mul_add(q[4 * CHUNK + l], w[0].mul_add(q[CHUNK + l], -d[CHUNK + l])),
+                    ),
+                );
+                let ez = w[3].mul_add(
+                    q[11 * CHUNK + l],
+                    w[2].mul_add(
+                        q[8 * CHUNK + l],
+                        w[1].mul_add(
+                            q[5 * CHUNK + l],
+                            w[0].mul_add(q[2 * CHUNK + l], -d[2 * CHUNK + l]),
+                        ),
+                    ),
+                );
                 acc[l] += ez.mul_add(ez, ey.mul_add(ey, ex * ex)).sqrt();
             }
         }
@@ -218,7 +266,15 @@ fn pass2_error(lanes: usize, cols: Range<usize>, k3p: usize, nv: &SparseBasis, d
 /// Sum of distances of one view from its pass-1 rows `r` (row li at li * k3p, zero padded):
 /// transpose into `rt`, then [`pass2_error`].
 #[inline(always)]
-fn view_error(lanes: usize, cols: Range<usize>, k3: usize, nv: &SparseBasis, data: &[f64], r: &[f64], rt: &mut [f64]) -> f64 {
+fn view_error(
+    lanes: usize,
+    cols: Range<usize>,
+    k3: usize,
+    nv: &SparseBasis,
+    data: &[f64],
+    r: &[f64],
+    rt: &mut [f64],
+) -> f64 {
     let k3p = padded(k3);
     transpose_rows(lanes, k3p, r, rt);
     pass2_error(lanes, cols, k3p, nv, data, rt)
@@ -233,7 +289,14 @@ fn kernel(pb: &ControlNetProblem, x: &[f64], s: &mut Scratch) -> f64 {
     // Bottom view: its classes are 0..cn_x*cn_y in row-major order, so its P is a prefix of x.
     for i in 0..nx {
         let f = nu.first[i] * k3;
-        lin4(&mut s.r_b[i * k3p..i * k3p + k3], &x[f..f + k3], &x[f + k3..f + 2 * k3], &x[f + 2 * k3..f + 3 * k3], &x[f + 3 * k3..f + 4 * k3], &nu.w[i]);
+        lin4(
+            &mut s.r_b[i * k3p..i * k3p + k3],
+            &x[f..f + k3],
+            &x[f + k3..f + 2 * k3],
+            &x[f + 2 * k3..f + 3 * k3],
+            &x[f + 3 * k3..f + 4 * k3],
+            &nu.w[i],
+        );
     }
     let bottom = view_error(nx, 0..ny, k3, &parts.nv, &pb.data_b, &s.r_b, &mut s.rt_b);
     // Top view, read in place: its P rows 0 and cn_x - 1 are the bottom's, and every other row
@@ -300,7 +363,13 @@ mod fused {
     /// One block: the rows of the first `VALID` lanes over k..k + 4 (from `src[l] + off`; the
     /// other lanes are zeros), transposed, and its four k rows stored at `out + 4 k`.
     #[inline(always)]
-    unsafe fn block<const VALID: usize>(src: &[*const f64; CHUNK], s: usize, w: &[[__m256d; 4]; CHUNK], off: usize, out: *mut f64) {
+    unsafe fn block<const VALID: usize>(
+        src: &[*const f64; CHUNK],
+        s: usize,
+        w: &[[__m256d; 4]; CHUNK],
+        off: usize,
+        out: *mut f64,
+    ) {
         let mut r = [_mm256_setzero_pd(); CHUNK];
         for l in 0..VALID {
             r[l] = row4(src[l].add(off), s, &w[l]);
@@ -325,7 +394,13 @@ mod fused {
     /// that recomputes up to three k (and rewrites them with the same bits).
     #[inline(always)]
     #[allow(clippy::pointers_in_nomem_asm_block)]
-    unsafe fn segment<const VALID: usize>(src: &[*const f64; CHUNK], s: usize, w: &[[__m256d; 4]; CHUNK], len: usize, out: *mut f64) {
+    unsafe fn segment<const VALID: usize>(
+        src: &[*const f64; CHUNK],
+        s: usize,
+        w: &[[__m256d; 4]; CHUNK],
+        len: usize,
+        out: *mut f64,
+    ) {
         // The lanes' pointers move with the block and each load is one pointer plus a multiple
         // of the stride. The empty `asm!` hides the pointers' progression from the compiler,
         // which would otherwise keep all sixteen row pointers apart (more than the general
@@ -335,7 +410,11 @@ mod fused {
         while k + 4 <= len {
             for p in at.iter_mut().take(VALID) {
                 // The asm is empty: it reads and writes no memory, it only passes the pointer on.
-                std::arch::asm!("/* {0} */", inout(reg) *p, options(pure, nomem, nostack, preserves_flags));
+                std::arch::asm!(
+                    "/* {0} */",
+                    inout(reg) * p,
+                    options(pure, nomem, nostack, preserves_flags)
+                );
             }
             block::<VALID>(&at, s, w, 0, out.add(k * CHUNK));
             for p in at.iter_mut() {
@@ -362,7 +441,11 @@ mod fused {
 
     /// The broadcast weights Nu[i0 + l][t] of the chunk's first `valid` lanes (zeros after).
     #[inline(always)]
-    unsafe fn weights(nu: &crate::spline::SparseBasis, i0: usize, valid: usize) -> [[__m256d; 4]; CHUNK] {
+    unsafe fn weights(
+        nu: &crate::spline::SparseBasis,
+        i0: usize,
+        valid: usize,
+    ) -> [[__m256d; 4]; CHUNK] {
         let mut w = [[_mm256_setzero_pd(); 4]; CHUNK];
         for (l, wl) in w.iter_mut().enumerate().take(valid) {
             for (t, wt) in wl.iter_mut().enumerate() {
@@ -376,12 +459,24 @@ mod fused {
     /// column's four broadcast weights serve all `G` chunks and each chunk keeps its running sum
     /// in a register. Per lane the same operations in the same order, so the same bits.
     #[inline(always)]
-    unsafe fn pass2_group<const G: usize>(ch0: usize, cols: std::ops::Range<usize>, k3p: usize, nv: &crate::spline::SparseBasis, data: *const f64, rt: *const f64) -> [__m256d; G] {
+    unsafe fn pass2_group<const G: usize>(
+        ch0: usize,
+        cols: std::ops::Range<usize>,
+        k3p: usize,
+        nv: &crate::spline::SparseBasis,
+        data: *const f64,
+        rt: *const f64,
+    ) -> [__m256d; G] {
         let nc = cols.len();
         let mut acc = [_mm256_setzero_pd(); G];
         for (lj, j) in cols.enumerate() {
             let w = &nv.w[j];
-            let (w0, w1, w2, w3) = (_mm256_set1_pd(w[0]), _mm256_set1_pd(w[1]), _mm256_set1_pd(w[2]), _mm256_set1_pd(w[3]));
+            let (w0, w1, w2, w3) = (
+                _mm256_set1_pd(w[0]),
+                _mm256_set1_pd(w[1]),
+                _mm256_set1_pd(w[2]),
+                _mm256_set1_pd(w[3]),
+            );
             let base = nv.first[j] * 3 * CHUNK;
             for (g, a) in acc.iter_mut().enumerate() {
                 let ch = ch0 + g;
@@ -389,7 +484,11 @@ mod fused {
                 let d = data.add((ch * nc + lj) * 3 * CHUNK);
                 let mut e = [_mm256_setzero_pd(); 3];
                 for (c, ec) in e.iter_mut().enumerate() {
-                    let v = _mm256_fmsub_pd(w0, _mm256_loadu_pd(q.add(c * CHUNK)), _mm256_loadu_pd(d.add(c * CHUNK)));
+                    let v = _mm256_fmsub_pd(
+                        w0,
+                        _mm256_loadu_pd(q.add(c * CHUNK)),
+                        _mm256_loadu_pd(d.add(c * CHUNK)),
+                    );
                     let v = _mm256_fmadd_pd(w1, _mm256_loadu_pd(q.add((3 + c) * CHUNK)), v);
                     let v = _mm256_fmadd_pd(w2, _mm256_loadu_pd(q.add((6 + c) * CHUNK)), v);
                     *ec = _mm256_fmadd_pd(w3, _mm256_loadu_pd(q.add((9 + c) * CHUNK)), v);
@@ -405,7 +504,14 @@ mod fused {
 
     /// [`pass2_error`] in groups of up to five chunks ([`pass2_group`]).
     #[inline(always)]
-    unsafe fn pass2_grouped(lanes: usize, cols: std::ops::Range<usize>, k3p: usize, nv: &crate::spline::SparseBasis, data: &[f64], rt: &[f64]) -> f64 {
+    unsafe fn pass2_grouped(
+        lanes: usize,
+        cols: std::ops::Range<usize>,
+        k3p: usize,
+        nv: &crate::spline::SparseBasis,
+        data: &[f64],
+        rt: &[f64],
+    ) -> f64 {
         let nc = cols.len();
         if lanes == 0 || nc == 0 {
             return 0.0;
@@ -485,7 +591,8 @@ mod fused {
         for (e, first_row) in [0, cx - 4].into_iter().enumerate() {
             for t in 0..4 {
                 // Inline vector copies (ki >= 6): shorter than calls to memcpy.
-                let (from, to) = (xp.add(row(first_row + t)), s.edge.as_mut_ptr().add((4 * e + t) * ki));
+                let (from, to) =
+                    (xp.add(row(first_row + t)), s.edge.as_mut_ptr().add((4 * e + t) * ki));
                 let mut k = 0;
                 while k + 4 <= ki {
                     _mm256_storeu_pd(to.add(k), _mm256_loadu_pd(from.add(k)));
@@ -526,7 +633,8 @@ impl ControlNetProblem {
     /// Check the parts, lay out the kernel's data and build the box.
     pub fn new(parts: ControlNetParts, bounds: BoxSpec) -> Result<ControlNetProblem, OptimError> {
         validate_parts(&parts)?;
-        let net = DoubleNet::new(parts.cn_x, parts.cn_y).expect("control net checked to be at least 4x4");
+        let net =
+            DoubleNet::new(parts.cn_x, parts.cn_y).expect("control net checked to be at least 4x4");
         let (nx, ny) = (parts.nx, parts.ny);
         let all: Vec<Point3> = parts.data_bottom.iter().chain(&parts.data_top).copied().collect();
         let (dlo, dhi) = crate::geom::bounding_box(&all).expect("grid has points");
@@ -534,7 +642,10 @@ impl ControlNetProblem {
             BoxSpec::DataRange => (dlo, dhi),
             BoxSpec::Widened { fraction } | BoxSpec::Cover { fraction } => {
                 if !(fraction >= 0.0 && fraction.is_finite()) {
-                    return Err(OptimError::param("bounds.fraction", format!("must be finite and >= 0, got {fraction}")));
+                    return Err(OptimError::param(
+                        "bounds.fraction",
+                        format!("must be finite and >= 0, got {fraction}"),
+                    ));
                 }
                 let (mut lo, mut hi) = (dlo, dhi);
                 if matches!(bounds, BoxSpec::Cover { .. }) {
@@ -552,7 +663,10 @@ impl ControlNetProblem {
             }
             BoxSpec::AroundStart { half_width } => {
                 if !(half_width > 0.0 && half_width.is_finite()) {
-                    return Err(OptimError::param("search_range", format!("must be finite and > 0, got {half_width}")));
+                    return Err(OptimError::param(
+                        "search_range",
+                        format!("must be finite and > 0, got {half_width}"),
+                    ));
                 }
                 let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
                 for (k, &v) in parts.x0.iter().enumerate() {
@@ -562,16 +676,26 @@ impl ControlNetProblem {
                 (lo, hi)
             }
             BoxSpec::Axes { lower, upper } => {
-                if let Some(a) = (0..3).find(|&a| lower[a].partial_cmp(&upper[a]).is_none_or(|o| o.is_gt())) {
-                    return Err(OptimError::param("bounds", format!("axis {a}: lower {} is not <= upper {}", lower[a], upper[a])));
+                if let Some(a) =
+                    (0..3).find(|&a| lower[a].partial_cmp(&upper[a]).is_none_or(|o| o.is_gt()))
+                {
+                    return Err(OptimError::param(
+                        "bounds",
+                        format!("axis {a}: lower {} is not <= upper {}", lower[a], upper[a]),
+                    ));
                 }
                 (lower, upper)
             }
         };
         let nov = net.nov();
         let (lower, upper): (Vec<f64>, Vec<f64>) = match bounds {
-            BoxSpec::AroundStart { half_width } => parts.x0.iter().map(|&v| (v - half_width, v + half_width)).unzip(),
-            _ => ((0..3 * nov).map(|k| box_axes.0[k % 3]).collect(), (0..3 * nov).map(|k| box_axes.1[k % 3]).collect()),
+            BoxSpec::AroundStart { half_width } => {
+                parts.x0.iter().map(|&v| (v - half_width, v + half_width)).unzip()
+            }
+            _ => (
+                (0..3 * nov).map(|k| box_axes.0[k % 3]).collect(),
+                (0..3 * nov).map(|k| box_axes.1[k % 3]).collect(),
+            ),
         };
         // Grid data chunk-major: [chunk of CHUNK grid rows][grid column][xyz][lane], zero padded.
         let layout = |d: &[Point3], rows: Range<usize>, cols: Range<usize>| {
@@ -661,7 +785,12 @@ impl ControlNetProblem {
     /// How many coordinates of x0 lie outside the box (they are clamped in the initial
     /// population; a box that cuts x0 changes the problem, so report it).
     pub fn initial_outside_box(&self) -> usize {
-        self.parts.x0.iter().enumerate().filter(|(k, v)| **v < self.lower[*k] || **v > self.upper[*k]).count()
+        self.parts
+            .x0
+            .iter()
+            .enumerate()
+            .filter(|(k, v)| **v < self.lower[*k] || **v > self.upper[*k])
+            .count()
     }
 
     /// Eq. 6.2 with caller-owned scratch (no thread-local look-up). NaN if `x` has the wrong
@@ -807,12 +936,26 @@ pub(crate) mod test_support {
     /// Approach B's parts for a `cn_x` x `cn_y` net on an `nx` x `ny` test grid.
     pub fn test_parts(nx: usize, ny: usize, cn_x: usize, cn_y: usize) -> ControlNetParts {
         let grid = crate::spline::approach::tests::test_grid(nx, ny, 0.02);
-        let fit = fit_two_view(&grid, cn_x, cn_y, Parameterisation::ChordLength, Approach::Improved, &Default::default()).expect("test fit");
+        let fit = fit_two_view(
+            &grid,
+            cn_x,
+            cn_y,
+            Parameterisation::ChordLength,
+            Approach::Improved,
+            &Default::default(),
+        )
+        .expect("test fit");
         fit.control_net_parts(&grid).expect("approach B")
     }
 
     /// The control-net problem of [`test_parts`] in the given box.
-    pub fn sphere_problem(nx: usize, ny: usize, cn_x: usize, cn_y: usize, bounds: BoxSpec) -> ControlNetProblem {
+    pub fn sphere_problem(
+        nx: usize,
+        ny: usize,
+        cn_x: usize,
+        cn_y: usize,
+        bounds: BoxSpec,
+    ) -> ControlNetProblem {
         ControlNetProblem::new(test_parts(nx, ny, cn_x, cn_y), bounds).unwrap()
     }
 }
@@ -862,7 +1005,9 @@ mod tests {
 
     #[test]
     fn fast_fitness_equals_the_dense_reference() {
-        for (nx, ny, cx, cy) in [(20, 20, 18, 18), (18, 30, 16, 28), (9, 7, 4, 5), (5, 5, 4, 4), (4, 4, 4, 4)] {
+        for (nx, ny, cx, cy) in
+            [(20, 20, 18, 18), (18, 30, 16, 28), (9, 7, 4, 5), (5, 5, 4, 4), (4, 4, 4, 4)]
+        {
             let pb = sphere_problem(nx, ny, cx, cy, BoxSpec::DataRange);
             let mut x = pb.initial_point().to_vec();
             for (k, v) in x.iter_mut().enumerate() {
@@ -876,7 +1021,10 @@ mod tests {
                     // 1e-12 relative; near interpolation (least-squares x0 of a large net) the
                     // sum itself is ~1e-5 and both sides carry ~1e-16 absolute rounding per term.
                     let tol = 1e-12 * want + 1e-15 * pb.n_terms() as f64;
-                    assert!((got - want).abs() < tol, "{nx}x{ny} cn {cx}x{cy} {isa:?}: {got} vs {want}");
+                    assert!(
+                        (got - want).abs() < tol,
+                        "{nx}x{ny} cn {cx}x{cy} {isa:?}: {got} vs {want}"
+                    );
                 }
             }
         }
@@ -885,12 +1033,30 @@ mod tests {
     #[test]
     fn all_kernel_copies_are_bit_identical() {
         // Square and oblong grids and nets, lane counts with and without padding, the smallest net.
-        for (nx, ny, cx, cy) in [(20, 20, 18, 18), (18, 30, 16, 28), (20, 20, 6, 6), (9, 7, 4, 5), (7, 9, 5, 4), (5, 5, 4, 4), (4, 4, 4, 4), (6, 9, 4, 6)] {
+        for (nx, ny, cx, cy) in [
+            (20, 20, 18, 18),
+            (18, 30, 16, 28),
+            (20, 20, 6, 6),
+            (9, 7, 4, 5),
+            (7, 9, 5, 4),
+            (5, 5, 4, 4),
+            (4, 4, 4, 4),
+            (6, 9, 4, 6),
+        ] {
             let pb = sphere_problem(nx, ny, cx, cy, BoxSpec::DataRange);
-            let x: Vec<f64> = pb.initial_point().iter().enumerate().map(|(k, v)| v + 1e-4 * (k % 5) as f64).collect();
+            let x: Vec<f64> = pb
+                .initial_point()
+                .iter()
+                .enumerate()
+                .map(|(k, v)| v + 1e-4 * (k % 5) as f64)
+                .collect();
             let base = pb.clone().with_isa(Isa::Baseline).fitness(&x);
             for isa in Isa::ALL {
-                assert_eq!(pb.clone().with_isa(isa).fitness(&x).to_bits(), base.to_bits(), "{nx}x{ny} cn {cx}x{cy} {isa:?}");
+                assert_eq!(
+                    pb.clone().with_isa(isa).fitness(&x).to_bits(),
+                    base.to_bits(),
+                    "{nx}x{ny} cn {cx}x{cy} {isa:?}"
+                );
             }
         }
     }
@@ -924,11 +1090,13 @@ mod tests {
     fn box_defaults_to_the_data_range_and_can_widen() {
         let pb = sphere_problem(10, 10, 6, 6, BoxSpec::DataRange);
         let (lo, hi) = pb.box_axes();
-        let all: Vec<Point3> = pb.parts().data_bottom.iter().chain(&pb.parts().data_top).copied().collect();
+        let all: Vec<Point3> =
+            pb.parts().data_bottom.iter().chain(&pb.parts().data_top).copied().collect();
         assert_eq!(crate::geom::bounding_box(&all).unwrap(), (lo, hi));
         let (l, u) = pb.bounds();
         assert_eq!((l[4], u[4]), (lo[1], hi[1]));
-        let wide = ControlNetProblem::new(pb.parts().clone(), BoxSpec::Widened { fraction: 0.5 }).unwrap();
+        let wide =
+            ControlNetProblem::new(pb.parts().clone(), BoxSpec::Widened { fraction: 0.5 }).unwrap();
         let (wl, wh) = wide.box_axes();
         for a in 0..3 {
             assert!((wh[a] - wl[a] - 2.0 * (hi[a] - lo[a])).abs() < 1e-12);
@@ -936,8 +1104,12 @@ mod tests {
         assert!(wide.initial_outside_box() <= pb.initial_outside_box());
         // Cover always holds x0; with fraction 0 it is the hull of data and x0 per axis.
         let big = sphere_problem(20, 20, 18, 18, BoxSpec::DataRange);
-        assert!(big.initial_outside_box() > 0, "a near-square least-squares net overshoots the data");
-        let cover = ControlNetProblem::new(big.parts().clone(), BoxSpec::Cover { fraction: 0.0 }).unwrap();
+        assert!(
+            big.initial_outside_box() > 0,
+            "a near-square least-squares net overshoots the data"
+        );
+        let cover =
+            ControlNetProblem::new(big.parts().clone(), BoxSpec::Cover { fraction: 0.0 }).unwrap();
         assert_eq!(cover.initial_outside_box(), 0);
         let (cl, ch) = cover.box_axes();
         let x0 = big.initial_point();
@@ -956,7 +1128,13 @@ mod tests {
             assert_eq!((lo[k], hi[k]), (v - 5e-6, v + 5e-6));
         }
         assert_eq!(pb.initial_outside_box(), 0);
-        assert!(ControlNetProblem::new(pb.parts().clone(), BoxSpec::AroundStart { half_width: 0.0 }).unwrap_err().to_string().contains("search_range"));
+        assert!(ControlNetProblem::new(
+            pb.parts().clone(),
+            BoxSpec::AroundStart { half_width: 0.0 }
+        )
+        .unwrap_err()
+        .to_string()
+        .contains("search_range"));
     }
 
     #[test]
@@ -974,7 +1152,12 @@ mod tests {
         parts.data_top[5][1] = f64::NAN;
         let e = ControlNetProblem::new(parts, BoxSpec::DataRange).unwrap_err().to_string();
         assert!(e.contains("data_top[5]"), "{e}");
-        let e = ControlNetProblem::new(pb.parts().clone(), BoxSpec::Axes { lower: [0.0; 3], upper: [1.0, -1.0, 1.0] }).unwrap_err().to_string();
+        let e = ControlNetProblem::new(
+            pb.parts().clone(),
+            BoxSpec::Axes { lower: [0.0; 3], upper: [1.0, -1.0, 1.0] },
+        )
+        .unwrap_err()
+        .to_string();
         assert!(e.contains("axis 1"), "{e}");
         assert!(pb.fitness(&[0.0; 5]).is_nan());
     }

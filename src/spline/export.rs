@@ -77,7 +77,21 @@ pub fn write_iges(surfaces: &[(&str, &BSplineSurface)], units_mm: bool) -> Strin
     for (e, (name, s)) in surfaces.iter().enumerate() {
         let de = 2 * e + 1;
         let (k1, k2) = (s.cn_x - 1, s.cn_y - 1);
-        let mut t: Vec<String> = ["128", &k1.to_string(), &k2.to_string(), &s.p.to_string(), &s.q.to_string(), "0", "0", "1", "0", "0"].iter().map(|x| x.to_string()).collect();
+        let mut t: Vec<String> = [
+            "128",
+            &k1.to_string(),
+            &k2.to_string(),
+            &s.p.to_string(),
+            &s.q.to_string(),
+            "0",
+            "0",
+            "1",
+            "0",
+            "0",
+        ]
+        .iter()
+        .map(|x| x.to_string())
+        .collect();
         t.extend(s.knots_u.iter().map(|&x| real(x)));
         t.extend(s.knots_v.iter().map(|&x| real(x)));
         t.extend(std::iter::repeat_n("1.0".to_string(), s.cn_x * s.cn_y));
@@ -94,16 +108,40 @@ pub fn write_iges(surfaces: &[(&str, &BSplineSurface)], units_mm: bool) -> Strin
             p_count += 1;
             let _ = writeln!(params, "{:<64} {:>7}P{:>7}", l, de, p_count);
         }
-        let label: String = name.chars().filter(|c| c.is_ascii_alphanumeric()).take(8).collect::<String>().to_uppercase();
-        directory.push(format!("{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}", 128, first, 0, 0, 0, 0, 0, 0, "00000000"));
-        directory.push(format!("{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}", 128, 0, 0, lines.len(), 0, "", "", label, e + 1));
+        let label: String = name
+            .chars()
+            .filter(|c| c.is_ascii_alphanumeric())
+            .take(8)
+            .collect::<String>()
+            .to_uppercase();
+        directory.push(format!(
+            "{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}",
+            128, first, 0, 0, 0, 0, 0, 0, "00000000"
+        ));
+        directory.push(format!(
+            "{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}{:>8}",
+            128,
+            0,
+            0,
+            lines.len(),
+            0,
+            "",
+            "",
+            label,
+            e + 1
+        ));
     }
     let mut out = String::new();
     section_lines(&start, 'S', &mut out);
     section_lines(&global, 'G', &mut out);
     section_lines(&directory, 'D', &mut out);
     out.push_str(&params);
-    let _ = writeln!(out, "{:<72}T{:>7}", format!("S{:>7}G{:>7}D{:>7}P{:>7}", start.len(), global.len(), directory.len(), p_count), 1);
+    let _ = writeln!(
+        out,
+        "{:<72}T{:>7}",
+        format!("S{:>7}G{:>7}D{:>7}P{:>7}", start.len(), global.len(), directory.len(), p_count),
+        1
+    );
     out
 }
 
@@ -115,7 +153,10 @@ pub fn parse_iges_128(text: &str) -> Result<Vec<BSplineSurface>, SplineError> {
             return Err(SplineError::Iges(format!("line {} is shorter than 73 columns", n + 1)));
         }
         if &line[72..73] == "P" {
-            let de: usize = line[65..72].trim().parse().map_err(|_| SplineError::Iges(format!("line {}: bad DE pointer", n + 1)))?;
+            let de: usize = line[65..72]
+                .trim()
+                .parse()
+                .map_err(|_| SplineError::Iges(format!("line {}: bad DE pointer", n + 1)))?;
             match data.last_mut() {
                 Some((d, s)) if *d == de => s.push_str(&line[..64]),
                 _ => data.push((de, line[..64].to_string())),
@@ -127,12 +168,20 @@ pub fn parse_iges_128(text: &str) -> Result<Vec<BSplineSurface>, SplineError> {
         let body = body.split(';').next().unwrap_or("");
         let v: Vec<&str> = body.split(',').map(|s| s.trim()).collect();
         let bad = |what: &str| SplineError::Iges(format!("entity at DE {de}: {what}"));
-        let int = |k: usize| v.get(k).and_then(|s| s.parse::<usize>().ok()).ok_or_else(|| bad(&format!("field {k} is not an integer")));
+        let int = |k: usize| {
+            v.get(k)
+                .and_then(|s| s.parse::<usize>().ok())
+                .ok_or_else(|| bad(&format!("field {k} is not an integer")))
+        };
         if int(0)? != 128 {
             continue;
         }
         let (k1, k2, m1, m2) = (int(1)?, int(2)?, int(3)?, int(4)?);
-        let num = |k: usize| v.get(k).and_then(|s| s.replace('D', "E").parse::<f64>().ok()).ok_or_else(|| bad(&format!("field {k} is not a number")));
+        let num = |k: usize| {
+            v.get(k)
+                .and_then(|s| s.replace('D', "E").parse::<f64>().ok())
+                .ok_or_else(|| bad(&format!("field {k} is not a number")))
+        };
         let mut at = 10;
         let mut take = |n: usize| -> Result<Vec<f64>, SplineError> {
             let r = (at..at + n).map(num).collect::<Result<Vec<f64>, SplineError>>()?;
@@ -161,7 +210,11 @@ pub fn parse_iges_128(text: &str) -> Result<Vec<BSplineSurface>, SplineError> {
 
 /// Wavefront OBJ: each surface evaluated on a uniform `samples_u x samples_v` parameter grid, as
 /// an object of quads.
-pub fn write_obj(surfaces: &[(&str, &BSplineSurface)], samples_u: usize, samples_v: usize) -> String {
+pub fn write_obj(
+    surfaces: &[(&str, &BSplineSurface)],
+    samples_u: usize,
+    samples_v: usize,
+) -> String {
     let (su, sv) = (samples_u.max(2), samples_v.max(2));
     let mut out = String::from("# somnurbs: evaluated cubic B-spline surfaces\n");
     let mut base = 1;
@@ -192,7 +245,8 @@ mod tests {
 
     fn surface(cn_x: usize, cn_y: usize, seed: u64) -> BSplineSurface {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-        let t = |n: usize| (0..n).map(|k| (k as f64 / (n - 1) as f64).powf(1.3)).collect::<Vec<f64>>();
+        let t =
+            |n: usize| (0..n).map(|k| (k as f64 / (n - 1) as f64).powf(1.3)).collect::<Vec<f64>>();
         BSplineSurface {
             p: 3,
             q: 3,
@@ -200,7 +254,9 @@ mod tests {
             knots_v: knot_vector(&t(30), cn_y, 3, KnotRule::NurbsBook).unwrap(),
             cn_x,
             cn_y,
-            control: (0..cn_x * cn_y).map(|_| [rng.gen::<f64>() * 100.0 - 50.0, rng.gen::<f64>() * 1e-6, rng.gen()]).collect(),
+            control: (0..cn_x * cn_y)
+                .map(|_| [rng.gen::<f64>() * 100.0 - 50.0, rng.gen::<f64>() * 1e-6, rng.gen()])
+                .collect(),
         }
     }
 
@@ -234,7 +290,10 @@ mod tests {
         let text = write_obj(&[("s", &s)], 11, 9);
         assert_eq!(text.lines().filter(|l| l.starts_with("v ")).count(), 99);
         assert_eq!(text.lines().filter(|l| l.starts_with("f ")).count(), 80);
-        let v: Vec<f64> = text.lines().find(|l| l.starts_with("v ")).unwrap()[2..].split(' ').map(|x| x.parse().unwrap()).collect();
+        let v: Vec<f64> = text.lines().find(|l| l.starts_with("v ")).unwrap()[2..]
+            .split(' ')
+            .map(|x| x.parse().unwrap())
+            .collect();
         assert_eq!(v, s.eval(0.0, 0.0).to_vec());
     }
 }

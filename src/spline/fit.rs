@@ -10,11 +10,19 @@ use crate::geom::Point3;
 use nalgebra::{Cholesky, DMatrix};
 
 /// Least-squares control net of one view: `cn_x x cn_y` points, row-major.
-pub fn least_squares_net(view: &[Point3], nu: &DMatrix<f64>, nv: &DMatrix<f64>) -> Result<Vec<Point3>, String> {
+pub fn least_squares_net(
+    view: &[Point3],
+    nu: &DMatrix<f64>,
+    nv: &DMatrix<f64>,
+) -> Result<Vec<Point3>, String> {
     let (nx, cn_x) = nu.shape();
     let (ny, cn_y) = nv.shape();
-    let a = Cholesky::new(nu.transpose() * nu).ok_or("the u-direction normal equations are singular (a knot span holds no data parameter)")?;
-    let b = Cholesky::new(nv.transpose() * nv).ok_or("the v-direction normal equations are singular (a knot span holds no data parameter)")?;
+    let a = Cholesky::new(nu.transpose() * nu).ok_or(
+        "the u-direction normal equations are singular (a knot span holds no data parameter)",
+    )?;
+    let b = Cholesky::new(nv.transpose() * nv).ok_or(
+        "the v-direction normal equations are singular (a knot span holds no data parameter)",
+    )?;
     let mut net = vec![[0.0; 3]; cn_x * cn_y];
     for c in 0..3 {
         let d = DMatrix::from_fn(nx, ny, |i, j| view[i * ny + j][c]);
@@ -36,7 +44,12 @@ pub fn least_squares_net(view: &[Point3], nu: &DMatrix<f64>, nv: &DMatrix<f64>) 
 /// weight of a control point, so that lambda means the same for every net size). Solved on the
 /// Kronecker form of the normal equations (at most a few hundred unknowns) by Cholesky. With
 /// lambda = 0 it is Eq. 5.5-5.6 up to rounding; use [`least_squares_net`] then.
-pub fn faired_net(view: &[Point3], nu: &DMatrix<f64>, nv: &DMatrix<f64>, lambda: f64) -> Result<Vec<Point3>, String> {
+pub fn faired_net(
+    view: &[Point3],
+    nu: &DMatrix<f64>,
+    nv: &DMatrix<f64>,
+    lambda: f64,
+) -> Result<Vec<Point3>, String> {
     let (nx, cn_x) = nu.shape();
     let (ny, cn_y) = nv.shape();
     let uu = nu.transpose() * nu;
@@ -80,7 +93,14 @@ pub fn faired_net(view: &[Point3], nu: &DMatrix<f64>, nv: &DMatrix<f64>, lambda:
 }
 
 /// The corner rule: the four corner control points := the four corner data points.
-pub fn pin_corners(net: &mut [Point3], cn_x: usize, cn_y: usize, view: &[Point3], nx: usize, ny: usize) {
+pub fn pin_corners(
+    net: &mut [Point3],
+    cn_x: usize,
+    cn_y: usize,
+    view: &[Point3],
+    nx: usize,
+    ny: usize,
+) {
     net[0] = view[0];
     net[cn_y - 1] = view[ny - 1];
     net[(cn_x - 1) * cn_y] = view[(nx - 1) * ny];
@@ -128,7 +148,11 @@ pub fn fitted_grid(net: &[Point3], nu: &DMatrix<f64>, nv: &DMatrix<f64>) -> Vec<
 
 #[cfg(test)]
 mod tests {
-    use super::super::{basis::basis_matrix, knots::{knot_vector, KnotRule}, surface::BSplineSurface};
+    use super::super::{
+        basis::basis_matrix,
+        knots::{knot_vector, KnotRule},
+        surface::BSplineSurface,
+    };
     use super::*;
     use rand::{Rng, SeedableRng};
 
@@ -147,8 +171,17 @@ mod tests {
         vs[ny - 1] = 1.0;
         let ku = knot_vector(&us, cn_x, 3, KnotRule::NurbsBook).unwrap();
         let kv = knot_vector(&vs, cn_y, 3, KnotRule::NurbsBook).unwrap();
-        let control: Vec<Point3> = (0..cn_x * cn_y).map(|_| [rng.gen(), rng.gen(), rng.gen()]).collect();
-        let surf = BSplineSurface { p: 3, q: 3, knots_u: ku.clone(), knots_v: kv.clone(), cn_x, cn_y, control: control.clone() };
+        let control: Vec<Point3> =
+            (0..cn_x * cn_y).map(|_| [rng.gen(), rng.gen(), rng.gen()]).collect();
+        let surf = BSplineSurface {
+            p: 3,
+            q: 3,
+            knots_u: ku.clone(),
+            knots_v: kv.clone(),
+            cn_x,
+            cn_y,
+            control: control.clone(),
+        };
         let grid = surf.eval_grid(&us, &vs);
         let nu = basis_matrix(&us, &ku, 3, cn_x);
         let nv = basis_matrix(&vs, &kv, 3, cn_y);
@@ -184,7 +217,8 @@ mod tests {
         for a in 0..cn_x {
             for b in 1..cn_y - 1 {
                 for c in 0..3 {
-                    let d2 = flat[a * cn_y + b - 1][c] - 2.0 * flat[a * cn_y + b][c] + flat[a * cn_y + b + 1][c];
+                    let d2 = flat[a * cn_y + b - 1][c] - 2.0 * flat[a * cn_y + b][c]
+                        + flat[a * cn_y + b + 1][c];
                     assert!(d2.abs() < 1e-6, "second difference {d2}");
                 }
             }

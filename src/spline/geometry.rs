@@ -68,7 +68,12 @@ pub fn distance_to_box(p: Point3, lo: Point3, hi: Point3) -> f64 {
 }
 
 /// `surf` at every dense (u, v), row-major over u; returns the points and the dense u and v.
-pub fn dense_grid(surf: &BSplineSurface, params_u: &[f64], params_v: &[f64], factor: usize) -> (Vec<Point3>, Vec<f64>, Vec<f64>) {
+pub fn dense_grid(
+    surf: &BSplineSurface,
+    params_u: &[f64],
+    params_v: &[f64],
+    factor: usize,
+) -> (Vec<Point3>, Vec<f64>, Vec<f64>) {
     let du = dense_params(params_u, &surf.knots_u, factor);
     let dv = dense_params(params_v, &surf.knots_v, factor);
     let nu = basis_matrix(&du, &surf.knots_u, surf.p, surf.cn_x);
@@ -79,7 +84,12 @@ pub fn dense_grid(surf: &BSplineSurface, params_u: &[f64], params_v: &[f64], fac
 /// A wireframe of `surf` for pictures: the iso-parameter lines through the data parameters, each
 /// drawn through the dense parameters of the other direction, so whatever the surface does between
 /// the data points shows. Returns the points and the edges (index pairs) between them.
-pub fn dense_wireframe(surf: &BSplineSurface, params_u: &[f64], params_v: &[f64], factor: usize) -> (Vec<Point3>, Vec<(u32, u32)>) {
+pub fn dense_wireframe(
+    surf: &BSplineSurface,
+    params_u: &[f64],
+    params_v: &[f64],
+    factor: usize,
+) -> (Vec<Point3>, Vec<(u32, u32)>) {
     let (points, du, dv) = dense_grid(surf, params_u, params_v, factor);
     let (mu, mv) = (du.len(), dv.len());
     let id = |i: usize, j: usize| (i * mv + j) as u32;
@@ -103,7 +113,12 @@ fn at_index(params: &[f64], s: f64) -> f64 {
 
 /// The dense measures of a two-view pair: `surfaces` = [bottom, top] with their data parameters
 /// `params` = [(u, v) of bottom, (u, v) of top]; `data` is every map point (for the box).
-pub fn dense_geometry(surfaces: [&BSplineSurface; 2], params: [(&[f64], &[f64]); 2], data: &[Point3], factor: usize) -> DenseGeometry {
+pub fn dense_geometry(
+    surfaces: [&BSplineSurface; 2],
+    params: [(&[f64], &[f64]); 2],
+    data: &[Point3],
+    factor: usize,
+) -> DenseGeometry {
     let (lo, hi) = bounding_box(data);
     let mut g = DenseGeometry::default();
     for (surf, (u, v)) in surfaces.iter().zip(params) {
@@ -165,10 +180,22 @@ mod tests {
         let (cn, p) = (6, 3);
         let knots = knot_vector(&t, cn, p, KnotRule::NurbsBook).unwrap();
         // Greville abscissae reproduce linear functions exactly.
-        let grev: Vec<f64> = (0..cn).map(|a| knots[a + 1..a + 1 + p].iter().sum::<f64>() / p as f64).collect();
-        let control: Vec<Point3> = (0..cn * cn).map(|k| [grev[k / cn], grev[k % cn], (grev[k / cn] + grev[k % cn]) / 2.0]).collect();
-        let mut surf = BSplineSurface { p, q: p, knots_u: knots.clone(), knots_v: knots.clone(), cn_x: cn, cn_y: cn, control };
-        let data: Vec<Point3> = t.iter().flat_map(|&u| t.iter().map(move |&v| [u, v, (u + v) / 2.0])).collect();
+        let grev: Vec<f64> =
+            (0..cn).map(|a| knots[a + 1..a + 1 + p].iter().sum::<f64>() / p as f64).collect();
+        let control: Vec<Point3> = (0..cn * cn)
+            .map(|k| [grev[k / cn], grev[k % cn], (grev[k / cn] + grev[k % cn]) / 2.0])
+            .collect();
+        let mut surf = BSplineSurface {
+            p,
+            q: p,
+            knots_u: knots.clone(),
+            knots_v: knots.clone(),
+            cn_x: cn,
+            cn_y: cn,
+            control,
+        };
+        let data: Vec<Point3> =
+            t.iter().flat_map(|&u| t.iter().map(move |&v| [u, v, (u + v) / 2.0])).collect();
         let g = dense_geometry([&surf, &surf], [(&t, &t), (&t, &t)], &data, DENSE_FACTOR);
         assert!(g.excursion < 1e-12 && g.border_gap == 0.0, "{g:?}");
         assert!((g.max_control - 1.0).abs() < 1e-12);
@@ -176,12 +203,18 @@ mod tests {
         let h = 10.0;
         surf.control[2 * cn + 3][2] += h;
         let fine: Vec<f64> = (0..=2000).map(|k| k as f64 / 2000.0).collect();
-        let peak = |a: usize| fine.iter().map(|&u| basis_matrix(&[u], &knots, p, cn)[(0, a)]).fold(0.0, f64::max);
+        let peak = |a: usize| {
+            fine.iter().map(|&u| basis_matrix(&[u], &knots, p, cn)[(0, a)]).fold(0.0, f64::max)
+        };
         let rise = h * peak(2) * peak(3);
         let g = dense_geometry([&surf, &surf], [(&t, &t), (&t, &t)], &data, DENSE_FACTOR);
         // The peak of z = (u+v)/2 + rise lies over a point whose plane height is below 1, so the
         // excursion is at least rise - (1 - lowest plane height) and at most rise.
-        assert!(g.excursion <= rise + 1e-9 && g.excursion > rise - 1.0, "{} vs {rise}", g.excursion);
+        assert!(
+            g.excursion <= rise + 1e-9 && g.excursion > rise - 1.0,
+            "{} vs {rise}",
+            g.excursion
+        );
         assert!((g.max_control - (h + (grev[2] + grev[3]) / 2.0)).abs() < 1e-12);
     }
 }

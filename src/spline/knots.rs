@@ -17,7 +17,9 @@ use std::fmt;
 use std::str::FromStr;
 
 /// How interior knots are placed when the net is smaller than the grid.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default, Serialize, Deserialize)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default, Serialize, Deserialize,
+)]
 #[serde(rename_all = "snake_case")]
 pub enum KnotRule {
     /// Eq. 2.10 literally, with n = CN - 1 (the thesis' own formula).
@@ -49,16 +51,27 @@ impl fmt::Display for KnotRule {
 impl FromStr for KnotRule {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        KnotRule::ALL.into_iter().find(|k| k.name() == s).ok_or_else(|| format!("unknown knot rule `{s}` (expected eq2_10 or nurbs_book)"))
+        KnotRule::ALL
+            .into_iter()
+            .find(|k| k.name() == s)
+            .ok_or_else(|| format!("unknown knot rule `{s}` (expected eq2_10 or nurbs_book)"))
     }
 }
 
 /// Clamped knot vector of degree `p` for `n_ctrl` control points fitted to `params` (non-decreasing,
 /// first 0, last 1) by `rule`. Errors when n_ctrl > params.len() or n_ctrl < p + 1.
-pub fn knot_vector(params: &[f64], n_ctrl: usize, p: usize, rule: KnotRule) -> Result<Vec<f64>, String> {
+pub fn knot_vector(
+    params: &[f64],
+    n_ctrl: usize,
+    p: usize,
+    rule: KnotRule,
+) -> Result<Vec<f64>, String> {
     let m1 = params.len();
     if n_ctrl < p + 1 {
-        return Err(format!("{n_ctrl} control points are too few for degree {p} (at least {})", p + 1));
+        return Err(format!(
+            "{n_ctrl} control points are too few for degree {p} (at least {})",
+            p + 1
+        ));
     }
     if n_ctrl > m1 {
         return Err(format!("{n_ctrl} control points exceed the {m1} data parameters"));
@@ -92,7 +105,18 @@ mod tests {
     #[test]
     fn averaging_when_sizes_match_under_both_rules() {
         let t = [0.0, 0.1, 0.3, 0.6, 0.7, 1.0];
-        let want = [0.0, 0.0, 0.0, 0.0, (0.1 + 0.3 + 0.6) / 3.0, (0.3 + 0.6 + 0.7) / 3.0, 1.0, 1.0, 1.0, 1.0];
+        let want = [
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+            (0.1 + 0.3 + 0.6) / 3.0,
+            (0.3 + 0.6 + 0.7) / 3.0,
+            1.0,
+            1.0,
+            1.0,
+            1.0,
+        ];
         for rule in KnotRule::ALL {
             let k = knot_vector(&t, 6, 3, rule).unwrap();
             for (a, b) in k.iter().zip(want) {

@@ -17,11 +17,13 @@ pub mod param;
 pub mod rational_bezier;
 pub mod surface;
 
-pub use approach::{fit_two_view, Approach, ControlNetParts, ErrorA, FitOptions, TwoSurfaceFit, TwoViewGrid};
-pub use geometry::{DenseGeometry, DENSE_FACTOR};
-pub use knots::KnotRule;
+pub use approach::{
+    fit_two_view, Approach, ControlNetParts, ErrorA, FitOptions, TwoSurfaceFit, TwoViewGrid,
+};
 pub use basis::SparseBasis;
 pub use control_net::{BoxSpec, ControlNetProblem};
+pub use geometry::{DenseGeometry, DENSE_FACTOR};
+pub use knots::KnotRule;
 pub use param::Parameterisation;
 pub use surface::BSplineSurface;
 

@@ -35,7 +35,15 @@ pub struct OpenSurfaceProblem {
 
 impl OpenSurfaceProblem {
     /// Parameterise the grid, build the knot vectors, fit the least-squares net.
-    pub fn new(grid: &[Point3], nx: usize, ny: usize, cn_x: usize, cn_y: usize, param: Parameterisation, margin: f64) -> Result<OpenSurfaceProblem, String> {
+    pub fn new(
+        grid: &[Point3],
+        nx: usize,
+        ny: usize,
+        cn_x: usize,
+        cn_y: usize,
+        param: Parameterisation,
+        margin: f64,
+    ) -> Result<OpenSurfaceProblem, String> {
         if grid.len() != nx * ny {
             return Err(format!("grid has {} points, expected {nx} x {ny}", grid.len()));
         }
@@ -43,23 +51,54 @@ impl OpenSurfaceProblem {
             return Err(format!("box margin must be >= 0, got {margin}"));
         }
         let (us, vs) = grid_params(grid, nx, ny, param);
-        let knots_u = knot_vector(&us, cn_x, 3, KnotRule::NurbsBook).map_err(|e| format!("u: {e}"))?;
-        let knots_v = knot_vector(&vs, cn_y, 3, KnotRule::NurbsBook).map_err(|e| format!("v: {e}"))?;
-        let net = least_squares_net(grid, &basis_matrix(&us, &knots_u, 3, cn_x), &basis_matrix(&vs, &knots_v, 3, cn_y))?;
+        let knots_u =
+            knot_vector(&us, cn_x, 3, KnotRule::NurbsBook).map_err(|e| format!("u: {e}"))?;
+        let knots_v =
+            knot_vector(&vs, cn_y, 3, KnotRule::NurbsBook).map_err(|e| format!("v: {e}"))?;
+        let net = least_squares_net(
+            grid,
+            &basis_matrix(&us, &knots_u, 3, cn_x),
+            &basis_matrix(&vs, &knots_v, 3, cn_y),
+        )?;
         let x0: Vec<f64> = net.iter().flat_map(|p| p.iter().copied()).collect();
         let all: Vec<Point3> = grid.iter().chain(&net).copied().collect();
         let (lo, hi) = geom::bounding_box(&all).ok_or("empty grid")?;
-        let lower: Vec<f64> = (0..x0.len()).map(|k| lo[k % 3] - margin * (hi[k % 3] - lo[k % 3])).collect();
-        let upper: Vec<f64> = (0..x0.len()).map(|k| hi[k % 3] + margin * (hi[k % 3] - lo[k % 3])).collect();
+        let lower: Vec<f64> =
+            (0..x0.len()).map(|k| lo[k % 3] - margin * (hi[k % 3] - lo[k % 3])).collect();
+        let upper: Vec<f64> =
+            (0..x0.len()).map(|k| hi[k % 3] + margin * (hi[k % 3] - lo[k % 3])).collect();
         let bu = SparseBasis::cubic(&us, &knots_u, cn_x);
         let bv = SparseBasis::cubic(&vs, &knots_v, cn_y);
-        Ok(OpenSurfaceProblem { grid: grid.to_vec(), nx, ny, cn_x, cn_y, us, vs, knots_u, knots_v, bu, bv, x0, lower, upper })
+        Ok(OpenSurfaceProblem {
+            grid: grid.to_vec(),
+            nx,
+            ny,
+            cn_x,
+            cn_y,
+            us,
+            vs,
+            knots_u,
+            knots_v,
+            bu,
+            bv,
+            x0,
+            lower,
+            upper,
+        })
     }
 
     /// The surface of a decision vector.
     pub fn surface(&self, x: &[f64]) -> BSplineSurface {
         let control = x.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
-        BSplineSurface { p: 3, q: 3, knots_u: self.knots_u.clone(), knots_v: self.knots_v.clone(), cn_x: self.cn_x, cn_y: self.cn_y, control }
+        BSplineSurface {
+            p: 3,
+            q: 3,
+            knots_u: self.knots_u.clone(),
+            knots_v: self.knots_v.clone(),
+            cn_x: self.cn_x,
+            cn_y: self.cn_y,
+            control,
+        }
     }
 
     /// The fitted grid S(u_i, v_j), row-major, by the sparse tensor product.
@@ -120,11 +159,13 @@ mod tests {
     use rand::{Rng, SeedableRng};
 
     fn wavy_grid(nx: usize, ny: usize) -> Vec<Point3> {
-        (0..nx * ny).map(|k| {
-            let (i, j) = ((k / ny) as f64, (k % ny) as f64);
-            let (x, y) = (i * i / 40.0, j / 3.0);
-            [x, y, (x * 2.0).sin() * y.cos()]
-        }).collect()
+        (0..nx * ny)
+            .map(|k| {
+                let (i, j) = ((k / ny) as f64, (k % ny) as f64);
+                let (x, y) = (i * i / 40.0, j / 3.0);
+                [x, y, (x * 2.0).sin() * y.cos()]
+            })
+            .collect()
     }
 
     /// The sparse fitness equals a dense computation D^G = Nu P Nv^T at random points.
@@ -138,7 +179,8 @@ mod tests {
             let nu = basis_matrix(&pr.us, &pr.knots_u, 3, cx);
             let nv = basis_matrix(&pr.vs, &pr.knots_v, 3, cy);
             for _ in 0..5 {
-                let x: Vec<f64> = pr.initial_point().iter().map(|v| v + rng.gen_range(-0.3..0.3)).collect();
+                let x: Vec<f64> =
+                    pr.initial_point().iter().map(|v| v + rng.gen_range(-0.3..0.3)).collect();
                 let net: Vec<Point3> = x.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
                 // Dense triple loop, independent of the two-pass code.
                 let mut want = 0.0;
@@ -157,7 +199,11 @@ mod tests {
                 }
                 let got = pr.fitness(&x);
                 assert!((got - want).abs() <= 1e-12 * want.max(1.0), "{param}: {got} vs {want}");
-                let dense: f64 = fitted_grid(&net, &nu, &nv).iter().zip(&grid).map(|(s, d)| geom::dist(*s, *d)).sum();
+                let dense: f64 = fitted_grid(&net, &nu, &nv)
+                    .iter()
+                    .zip(&grid)
+                    .map(|(s, d)| geom::dist(*s, *d))
+                    .sum();
                 assert!((got - dense).abs() <= 1e-12 * want.max(1.0));
             }
             // The least-squares start lies in its box and fits this smooth grid closely.
@@ -175,12 +221,34 @@ mod tests {
         let vs: Vec<f64> = (0..ny).map(|k| k as f64 / (ny - 1) as f64).collect();
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
         // A genuinely open patch: control points on a perturbed plane.
-        let control: Vec<Point3> = (0..cx * cy).map(|k| [(k / cy) as f64 + rng.gen_range(-0.2..0.2), (k % cy) as f64 + rng.gen_range(-0.2..0.2), rng.gen_range(-1.0..1.0)]).collect();
-        let truth = BSplineSurface { p: 3, q: 3, knots_u: knot_vector(&us, cx, 3, KnotRule::NurbsBook).unwrap(), knots_v: knot_vector(&vs, cy, 3, KnotRule::NurbsBook).unwrap(), cn_x: cx, cn_y: cy, control: control.clone() };
+        let control: Vec<Point3> = (0..cx * cy)
+            .map(|k| {
+                [
+                    (k / cy) as f64 + rng.gen_range(-0.2..0.2),
+                    (k % cy) as f64 + rng.gen_range(-0.2..0.2),
+                    rng.gen_range(-1.0..1.0),
+                ]
+            })
+            .collect();
+        let truth = BSplineSurface {
+            p: 3,
+            q: 3,
+            knots_u: knot_vector(&us, cx, 3, KnotRule::NurbsBook).unwrap(),
+            knots_v: knot_vector(&vs, cy, 3, KnotRule::NurbsBook).unwrap(),
+            cn_x: cx,
+            cn_y: cy,
+            control: control.clone(),
+        };
         let grid = truth.eval_grid(&us, &vs);
-        let pr = OpenSurfaceProblem::new(&grid, nx, ny, cx, cy, Parameterisation::Uniform, 0.0).unwrap();
+        let pr =
+            OpenSurfaceProblem::new(&grid, nx, ny, cx, cy, Parameterisation::Uniform, 0.0).unwrap();
         // The same knots up to rounding (the uniform parameters are averaged over the columns).
-        assert!(pr.knots_u.iter().zip(&truth.knots_u).chain(pr.knots_v.iter().zip(&truth.knots_v)).all(|(a, b)| (a - b).abs() < 1e-14));
+        assert!(pr
+            .knots_u
+            .iter()
+            .zip(&truth.knots_u)
+            .chain(pr.knots_v.iter().zip(&truth.knots_v))
+            .all(|(a, b)| (a - b).abs() < 1e-14));
         for (a, b) in pr.initial_point().chunks_exact(3).zip(&control) {
             for c in 0..3 {
                 assert!((a[c] - b[c]).abs() < 1e-9, "{a:?} vs {b:?}");
@@ -199,6 +267,8 @@ mod tests {
         let grid = wavy_grid(6, 6);
         assert!(OpenSurfaceProblem::new(&grid, 6, 5, 4, 4, Parameterisation::Uniform, 0.0).is_err());
         assert!(OpenSurfaceProblem::new(&grid, 6, 6, 7, 4, Parameterisation::Uniform, 0.0).is_err());
-        assert!(OpenSurfaceProblem::new(&grid, 6, 6, 4, 4, Parameterisation::Uniform, -1.0).is_err());
+        assert!(
+            OpenSurfaceProblem::new(&grid, 6, 6, 4, 4, Parameterisation::Uniform, -1.0).is_err()
+        );
     }
 }

@@ -14,7 +14,8 @@ pub enum Parameterisation {
 }
 
 impl Parameterisation {
-    pub const ALL: [Parameterisation; 4] = [Self::Uniform, Self::ChordLength, Self::Centripetal, Self::Exponential];
+    pub const ALL: [Parameterisation; 4] =
+        [Self::Uniform, Self::ChordLength, Self::Centripetal, Self::Exponential];
 
     /// Column stem in the thesis' Appendix E/F CSV.
     pub fn name(self) -> &'static str {
@@ -84,7 +85,12 @@ pub fn polyline_params(points: &[Point3], method: Parameterisation) -> Vec<f64> 
 /// Averaged parameters of a row-major `nx x ny` view: u (length nx) along i, the mean over the ny
 /// columns j of each column's polyline parameters (Eq. 5.1); v (length ny) along j, the mean over
 /// the nx rows (Eq. 5.2).
-pub fn grid_params(view: &[Point3], nx: usize, ny: usize, method: Parameterisation) -> (Vec<f64>, Vec<f64>) {
+pub fn grid_params(
+    view: &[Point3],
+    nx: usize,
+    ny: usize,
+    method: Parameterisation,
+) -> (Vec<f64>, Vec<f64>) {
     let mut u = vec![0.0; nx];
     for j in 0..ny {
         let col: Vec<Point3> = (0..nx).map(|i| view[i * ny + j]).collect();
@@ -115,17 +121,31 @@ mod tests {
             assert!((a - b).abs() < 1e-4, "{t:?}");
         }
         let c = polyline_params(&q, Parameterisation::Centripetal);
-        let d: Vec<f64> = [5f64.sqrt(), 8f64.sqrt(), 17f64.sqrt()].iter().map(|x| x.sqrt()).collect();
+        let d: Vec<f64> =
+            [5f64.sqrt(), 8f64.sqrt(), 17f64.sqrt()].iter().map(|x| x.sqrt()).collect();
         let tot: f64 = d.iter().sum();
         assert!((c[1] - d[0] / tot).abs() < 1e-15 && (c[2] - (d[0] + d[1]) / tot).abs() < 1e-15);
-        assert_eq!(polyline_params(&q, Parameterisation::Uniform), vec![0.0, 1.0 / 3.0, 2.0 / 3.0, 1.0]);
+        assert_eq!(
+            polyline_params(&q, Parameterisation::Uniform),
+            vec![0.0, 1.0 / 3.0, 2.0 / 3.0, 1.0]
+        );
     }
 
     #[test]
     fn degenerate_polyline_is_uniform_and_grid_averages() {
-        assert_eq!(polyline_params(&[[1.0; 3]; 3], Parameterisation::ChordLength), vec![0.0, 0.5, 1.0]);
+        assert_eq!(
+            polyline_params(&[[1.0; 3]; 3], Parameterisation::ChordLength),
+            vec![0.0, 0.5, 1.0]
+        );
         // A 3 x 2 grid whose two columns have different spacing: u is their mean.
-        let view = [[0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [4.0, 0.0, 0.0], [2.0, 1.0, 0.0]];
+        let view = [
+            [0.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [4.0, 0.0, 0.0],
+            [2.0, 1.0, 0.0],
+        ];
         let (u, v) = grid_params(&view, 3, 2, Parameterisation::ChordLength);
         assert!((u[1] - (0.25 + 0.5) / 2.0).abs() < 1e-15, "{u:?}");
         assert_eq!(v, vec![0.0, 1.0]);

@@ -51,7 +51,14 @@ pub fn patch_point(p: &[[[f64; 3]; 3]; 3], w: &[[f64; 3]; 3], u: f64, v: f64) ->
 }
 
 /// Homogeneous patch value and its u- and v-derivatives (numerator 3-vector and denominator).
-fn patch_homog(p: &[[[f64; 3]; 3]; 3], w: &[[f64; 3]; 3], u: f64, v: f64, du: usize, dv: usize) -> ([f64; 3], f64) {
+fn patch_homog(
+    p: &[[[f64; 3]; 3]; 3],
+    w: &[[f64; 3]; 3],
+    u: f64,
+    v: f64,
+    du: usize,
+    dv: usize,
+) -> ([f64; 3], f64) {
     let basis = |t: f64, d: usize| -> [f64; 3] {
         match d {
             0 => bernstein2(t),
@@ -75,7 +82,12 @@ fn patch_homog(p: &[[[f64; 3]; 3]; 3], w: &[[f64; 3]; 3], u: f64, v: f64, du: us
 }
 
 /// Partial derivatives (S_u, S_v) of a rational patch by the quotient rule.
-pub fn patch_derivatives(p: &[[[f64; 3]; 3]; 3], w: &[[f64; 3]; 3], u: f64, v: f64) -> ([f64; 3], [f64; 3]) {
+pub fn patch_derivatives(
+    p: &[[[f64; 3]; 3]; 3],
+    w: &[[f64; 3]; 3],
+    u: f64,
+    v: f64,
+) -> ([f64; 3], [f64; 3]) {
     let (n, d) = patch_homog(p, w, u, v, 0, 0);
     let (nu, du) = patch_homog(p, w, u, v, 1, 0);
     let (nv, dv) = patch_homog(p, w, u, v, 0, 1);
@@ -91,9 +103,11 @@ pub fn patch_derivatives(p: &[[[f64; 3]; 3]; 3], w: &[[f64; 3]; 3], u: f64, v: f
 /// Number of optimisation variables: 7 free points x 3 coordinates + w11.
 pub const FREE_DIM: usize = 22;
 /// The free net entries (i, j) in the order of the decision vector.
-pub const FREE_ENTRIES: [(usize, usize); 7] = [(0, 1), (1, 0), (1, 1), (1, 2), (1, 4), (2, 1), (4, 1)];
+pub const FREE_ENTRIES: [(usize, usize); 7] =
+    [(0, 1), (1, 0), (1, 1), (1, 2), (1, 4), (2, 1), (4, 1)];
 /// The fixed net entries, taken from the data.
-pub const FIXED_ENTRIES: [(usize, usize); 9] = [(0, 0), (0, 2), (0, 4), (2, 0), (2, 2), (2, 4), (4, 0), (4, 2), (4, 4)];
+pub const FIXED_ENTRIES: [(usize, usize); 9] =
+    [(0, 0), (0, 2), (0, 4), (2, 0), (2, 2), (2, 4), (4, 0), (4, 2), (4, 4)];
 
 /// The four-patch surface: a full 5x5 net and weights.
 #[derive(Debug, Clone, PartialEq)]
@@ -121,9 +135,15 @@ impl FourPatchSurface {
         w[1][3] = 2.0 - w11;
         w[3][1] = 2.0 - w11;
         // Homogeneous reflection of entry `a` through `m` into `r`: W_r P_r = 2 W_m P_m - W_a P_a.
-        let reflect = |p: &mut [[[f64; 3]; 5]; 5], w: &[[f64; 5]; 5], r: (usize, usize), m: (usize, usize), a: (usize, usize)| {
+        let reflect = |p: &mut [[[f64; 3]; 5]; 5],
+                       w: &[[f64; 5]; 5],
+                       r: (usize, usize),
+                       m: (usize, usize),
+                       a: (usize, usize)| {
             for k in 0..3 {
-                p[r.0][r.1][k] = (2.0 * w[m.0][m.1] * p[m.0][m.1][k] - w[a.0][a.1] * p[a.0][a.1][k]) / w[r.0][r.1];
+                p[r.0][r.1][k] = (2.0 * w[m.0][m.1] * p[m.0][m.1][k]
+                    - w[a.0][a.1] * p[a.0][a.1][k])
+                    / w[r.0][r.1];
             }
         };
         // Column 3 from columns 1 and 2 in rows 0, 1, 2, 4.
@@ -182,11 +202,15 @@ impl GridData {
     pub fn interp(&self, s: f64, t: f64) -> [f64; 3] {
         let m = (self.n - 1) as f64;
         let (fs, ft) = (s * m, t * m);
-        let (i0, j0) = ((fs.floor() as usize).min(self.n - 2), (ft.floor() as usize).min(self.n - 2));
+        let (i0, j0) =
+            ((fs.floor() as usize).min(self.n - 2), (ft.floor() as usize).min(self.n - 2));
         let (a, b) = (fs - i0 as f64, ft - j0 as f64);
         let mut out = [0.0; 3];
         for k in 0..3 {
-            out[k] = (1.0 - a) * (1.0 - b) * self.at(i0, j0)[k] + a * (1.0 - b) * self.at(i0 + 1, j0)[k] + (1.0 - a) * b * self.at(i0, j0 + 1)[k] + a * b * self.at(i0 + 1, j0 + 1)[k];
+            out[k] = (1.0 - a) * (1.0 - b) * self.at(i0, j0)[k]
+                + a * (1.0 - b) * self.at(i0 + 1, j0)[k]
+                + (1.0 - a) * b * self.at(i0, j0 + 1)[k]
+                + a * b * self.at(i0 + 1, j0 + 1)[k];
         }
         out
     }
@@ -207,7 +231,12 @@ pub enum TestSurface {
 }
 
 impl TestSurface {
-    pub const ALL: [TestSurface; 4] = [TestSurface::Surface1, TestSurface::Surface2, TestSurface::Surface3, TestSurface::Surface4];
+    pub const ALL: [TestSurface; 4] = [
+        TestSurface::Surface1,
+        TestSurface::Surface2,
+        TestSurface::Surface3,
+        TestSurface::Surface4,
+    ];
 
     pub fn by_name(name: &str) -> Option<TestSurface> {
         TestSurface::ALL.into_iter().find(|s| s.name() == name)
@@ -240,7 +269,9 @@ impl TestSurface {
     pub fn eval(self, x: f64, y: f64) -> f64 {
         match self {
             TestSurface::Surface1 => x.sin() * y.cos() + 0.91,
-            TestSurface::Surface2 => (1.0 + 2.0 * (-3.0 * ((x * x + y * y).sqrt() - 6.7)).exp()).powf(-0.5),
+            TestSurface::Surface2 => {
+                (1.0 + 2.0 * (-3.0 * ((x * x + y * y).sqrt() - 6.7)).exp()).powf(-0.5)
+            }
             TestSurface::Surface3 => {
                 let r2 = (x - 0.5).powi(2) + (y - 0.5).powi(2);
                 24.234 * r2 * (0.75 - r2)
@@ -389,11 +420,19 @@ mod tests {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
         let mut fixed = [[0.0; 3]; 9];
         for (k, &(i, j)) in FIXED_ENTRIES.iter().enumerate() {
-            fixed[k] = [i as f64 + rng.gen_range(-0.3..0.3), j as f64 + rng.gen_range(-0.3..0.3), rng.gen_range(-1.0..1.0)];
+            fixed[k] = [
+                i as f64 + rng.gen_range(-0.3..0.3),
+                j as f64 + rng.gen_range(-0.3..0.3),
+                rng.gen_range(-1.0..1.0),
+            ];
         }
         let mut x = Vec::new();
         for &(i, j) in FREE_ENTRIES.iter() {
-            x.extend_from_slice(&[i as f64 + rng.gen_range(-0.3..0.3), j as f64 + rng.gen_range(-0.3..0.3), rng.gen_range(-1.0..1.0)]);
+            x.extend_from_slice(&[
+                i as f64 + rng.gen_range(-0.3..0.3),
+                j as f64 + rng.gen_range(-0.3..0.3),
+                rng.gen_range(-1.0..1.0),
+            ]);
         }
         x.push(rng.gen_range(0.3..1.7));
         FourPatchSurface::from_free(&fixed, &x)
@@ -419,7 +458,10 @@ mod tests {
                     let n0 = unit(cross(su0, sv0));
                     let n1 = unit(cross(su1, sv1));
                     for q in 0..3 {
-                        assert!((n0[q] - n1[q]).abs() < 1e-12, "normal differs across row join: {n0:?} {n1:?}");
+                        assert!(
+                            (n0[q] - n1[q]).abs() < 1e-12,
+                            "normal differs across row join: {n0:?} {n1:?}"
+                        );
                     }
                 }
                 // Join along columns: patch (a,0) at v=1 against patch (a,1) at v=0.
@@ -431,7 +473,10 @@ mod tests {
                     let n0 = unit(cross(su0, sv0));
                     let n1 = unit(cross(su1, sv1));
                     for q in 0..3 {
-                        assert!((n0[q] - n1[q]).abs() < 1e-12, "normal differs across column join: {n0:?} {n1:?}");
+                        assert!(
+                            (n0[q] - n1[q]).abs() < 1e-12,
+                            "normal differs across column join: {n0:?} {n1:?}"
+                        );
                     }
                 }
             }
@@ -447,7 +492,13 @@ mod tests {
         let n = 9;
         let prob = SurfaceSse::new(TestSurface::Surface4.grid(n), 0.25, 0.01);
         let knot = |i: usize| -1.0 + 0.5 * i as f64;
-        let c = |i: usize| if i.is_multiple_of(2) { knot(i) * knot(i) } else { knot(i - 1) * knot(i + 1) };
+        let c = |i: usize| {
+            if i.is_multiple_of(2) {
+                knot(i) * knot(i)
+            } else {
+                knot(i - 1) * knot(i + 1)
+            }
+        };
         let mut x = Vec::new();
         for &(i, j) in FREE_ENTRIES.iter() {
             x.extend_from_slice(&[knot(i), knot(j), 2.0 * (c(i) + c(j))]);
@@ -465,7 +516,11 @@ mod tests {
         // intersection, w = cos(theta).
         for &theta in &[0.3f64, 0.7, 1.2] {
             let r = 2.0;
-            let b = [[r * theta.cos(), -r * theta.sin()], [r / theta.cos(), 0.0], [r * theta.cos(), r * theta.sin()]];
+            let b = [
+                [r * theta.cos(), -r * theta.sin()],
+                [r / theta.cos(), 0.0],
+                [r * theta.cos(), r * theta.sin()],
+            ];
             for k in 0..=50 {
                 let p = conic_point(&b, theta.cos(), k as f64 / 50.0);
                 let rad = (p[0] * p[0] + p[1] * p[1]).sqrt();
@@ -499,6 +554,13 @@ mod tests {
         }
         let f = prob.fitness(&x);
         assert!(f > 1e-6 && (f - direct).abs() < 1e-12 * direct.max(1.0), "{f} vs {direct}");
-        assert_eq!(prob.fitness(&{ let mut y = x.clone(); y[21] = 2.0; y }), f64::INFINITY);
+        assert_eq!(
+            prob.fitness(&{
+                let mut y = x.clone();
+                y[21] = 2.0;
+                y
+            }),
+            f64::INFINITY
+        );
     }
 }

@@ -37,7 +37,14 @@ pub struct BayesSignedRank {
 /// The test on paired errors `a`, `b` (smaller is better) with a region of practical equivalence
 /// of half-width `rope` (>= 0) on the difference, `samples` Monte Carlo draws from a stream seeded
 /// with `seed`.
-pub fn signed_rank(a: &[f64], b: &[f64], rope: f64, prior: f64, samples: usize, seed: u64) -> Result<BayesSignedRank, StatsError> {
+pub fn signed_rank(
+    a: &[f64],
+    b: &[f64],
+    rope: f64,
+    prior: f64,
+    samples: usize,
+    seed: u64,
+) -> Result<BayesSignedRank, StatsError> {
     if a.len() != b.len() {
         return Err(StatsError::LengthMismatch(a.len(), b.len()));
     }
@@ -53,7 +60,15 @@ pub fn signed_rank(a: &[f64], b: &[f64], rope: f64, prior: f64, samples: usize, 
     let mut d = vec![0.0];
     d.extend(b.iter().zip(a).map(|(y, x)| y - x));
     let m = d.len();
-    let heaviside = |v: f64| if v > 0.0 { 1.0 } else if v == 0.0 { 0.5 } else { 0.0 };
+    let heaviside = |v: f64| {
+        if v > 0.0 {
+            1.0
+        } else if v == 0.0 {
+            0.5
+        } else {
+            0.0
+        }
+    };
     // H matrices, row-major; sums as baycomp forms them (d_i + d_j against 2 rope).
     let mut above = vec![0.0; m * m];
     let mut below = vec![0.0; m * m];
@@ -64,11 +79,17 @@ pub fn signed_rank(a: &[f64], b: &[f64], rope: f64, prior: f64, samples: usize, 
             below[i * m + j] = heaviside(-s - 2.0 * rope);
         }
     }
-    let gammas: Vec<Gamma<f64>> = (0..m).map(|i| Gamma::new(if i == 0 { prior } else { 1.0 }, 1.0).expect("positive shape")).collect();
+    let gammas: Vec<Gamma<f64>> = (0..m)
+        .map(|i| Gamma::new(if i == 0 { prior } else { 1.0 }, 1.0).expect("positive shape"))
+        .collect();
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut w = vec![0.0; m];
     let mut wins = [0usize; 3];
-    let quad = |h: &[f64], w: &[f64]| -> f64 { (0..m).map(|i| w[i] * h[i * m..(i + 1) * m].iter().zip(w).map(|(x, y)| x * y).sum::<f64>()).sum() };
+    let quad = |h: &[f64], w: &[f64]| -> f64 {
+        (0..m)
+            .map(|i| w[i] * h[i * m..(i + 1) * m].iter().zip(w).map(|(x, y)| x * y).sum::<f64>())
+            .sum()
+    };
     for _ in 0..samples {
         let mut total = 0.0;
         for (wi, g) in w.iter_mut().zip(&gammas) {
@@ -93,7 +114,13 @@ pub fn signed_rank(a: &[f64], b: &[f64], rope: f64, prior: f64, samples: usize, 
         wins[k] += 1;
     }
     let s = samples as f64;
-    Ok(BayesSignedRank { p_b_better: wins[0] as f64 / s, p_rope: wins[1] as f64 / s, p_a_better: wins[2] as f64 / s, n: a.len(), samples })
+    Ok(BayesSignedRank {
+        p_b_better: wins[0] as f64 / s,
+        p_rope: wins[1] as f64 / s,
+        p_a_better: wins[2] as f64 / s,
+        n: a.len(),
+        samples,
+    })
 }
 
 #[cfg(test)]
@@ -109,13 +136,24 @@ mod tests {
         let mut n = 0;
         for (k, line) in text.lines().skip(1).enumerate() {
             let cols: Vec<&str> = line.split(',').collect();
-            let parse = |s: &str| -> Vec<f64> { s.split(';').map(|v| v.parse().unwrap()).collect() };
+            let parse =
+                |s: &str| -> Vec<f64> { s.split(';').map(|v| v.parse().unwrap()).collect() };
             let (a, b, rope) = (parse(cols[1]), parse(cols[2]), cols[3].parse::<f64>().unwrap());
-            let (left, mid, right): (f64, f64, f64) = (cols[4].parse().unwrap(), cols[5].parse().unwrap(), cols[6].parse().unwrap());
+            let (left, mid, right): (f64, f64, f64) =
+                (cols[4].parse().unwrap(), cols[5].parse().unwrap(), cols[6].parse().unwrap());
             let r = signed_rank(&a, &b, rope, PRIOR, SAMPLES, 7 + k as u64).unwrap();
             // baycomp(x = a, y = b): left = x larger = B better for errors; right = A better.
-            for (ours, theirs, what) in [(r.p_b_better, left, "B better"), (r.p_rope, mid, "rope"), (r.p_a_better, right, "A better")] {
-                assert!((ours - theirs).abs() < 0.015, "fixture {} ({}): {what} {ours} vs baycomp {theirs}", k + 1, cols[0]);
+            for (ours, theirs, what) in [
+                (r.p_b_better, left, "B better"),
+                (r.p_rope, mid, "rope"),
+                (r.p_a_better, right, "A better"),
+            ] {
+                assert!(
+                    (ours - theirs).abs() < 0.015,
+                    "fixture {} ({}): {what} {ours} vs baycomp {theirs}",
+                    k + 1,
+                    cols[0]
+                );
             }
             n += 1;
         }

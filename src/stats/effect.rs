@@ -9,7 +9,13 @@ pub fn a12(x: &[f64], y: &[f64]) -> f64 {
     let mut s = 0.0;
     for a in x {
         for b in y {
-            s += if a > b { 1.0 } else if a == b { 0.5 } else { 0.0 };
+            s += if a > b {
+                1.0
+            } else if a == b {
+                0.5
+            } else {
+                0.0
+            };
         }
     }
     s / (x.len() * y.len()) as f64

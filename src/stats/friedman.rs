@@ -31,7 +31,9 @@ pub fn friedman(table: &[Vec<f64>]) -> Result<Friedman, StatsError> {
     }
     let k = table[0].len();
     if k < 2 || table.iter().any(|r| r.len() != k) {
-        return Err(StatsError::TooFew("every block needs the same number (at least 2) of treatments".into()));
+        return Err(StatsError::TooFew(
+            "every block needs the same number (at least 2) of treatments".into(),
+        ));
     }
     let mut sums = vec![0.0; k];
     let mut ties_total = 0.0;
@@ -44,7 +46,8 @@ pub fn friedman(table: &[Vec<f64>]) -> Result<Friedman, StatsError> {
         }
     }
     let (nf, kf) = (n as f64, k as f64);
-    let stat = 12.0 / (nf * kf * (kf + 1.0)) * sums.iter().map(|r| r * r).sum::<f64>() - 3.0 * nf * (kf + 1.0);
+    let stat = 12.0 / (nf * kf * (kf + 1.0)) * sums.iter().map(|r| r * r).sum::<f64>()
+        - 3.0 * nf * (kf + 1.0);
     let chi = stat / (1.0 - ties_total / (nf * (kf * kf * kf - kf)));
     use statrs::distribution::{ChiSquared, ContinuousCDF};
     // The survival function, not 1 - cdf: large statistics keep their tiny p-values.
@@ -60,8 +63,18 @@ pub fn friedman(table: &[Vec<f64>]) -> Result<Friedman, StatsError> {
         }
     }
     let adjusted = holm(&pairs.iter().map(|p| p.3).collect::<Vec<f64>>());
-    let pairwise = pairs.into_iter().zip(adjusted).map(|((i, j, z, p), a)| (i, j, z, p, a)).collect();
-    Ok(Friedman { blocks: n, treatments: k, chi_squared: chi, df: k - 1, p_value, mean_ranks, critical_difference, pairwise })
+    let pairwise =
+        pairs.into_iter().zip(adjusted).map(|((i, j, z, p), a)| (i, j, z, p, a)).collect();
+    Ok(Friedman {
+        blocks: n,
+        treatments: k,
+        chi_squared: chi,
+        df: k - 1,
+        p_value,
+        mean_ranks,
+        critical_difference,
+        pairwise,
+    })
 }
 
 #[cfg(test)]
@@ -83,9 +96,11 @@ mod tests {
     #[test]
     fn rounding_times() {
         let v = [
-            5.40, 5.50, 5.55, 5.85, 5.70, 5.75, 5.20, 5.60, 5.50, 5.55, 5.50, 5.40, 5.90, 5.85, 5.70, 5.45, 5.55, 5.60, 5.40, 5.40, 5.35, 5.45, 5.50,
-            5.35, 5.25, 5.15, 5.00, 5.85, 5.80, 5.70, 5.25, 5.20, 5.10, 5.65, 5.55, 5.45, 5.60, 5.35, 5.45, 5.05, 5.00, 4.95, 5.50, 5.50, 5.40, 5.45,
-            5.55, 5.50, 5.55, 5.55, 5.35, 5.45, 5.50, 5.55, 5.50, 5.45, 5.25, 5.65, 5.60, 5.40, 5.70, 5.65, 5.55, 6.30, 6.30, 6.25,
+            5.40, 5.50, 5.55, 5.85, 5.70, 5.75, 5.20, 5.60, 5.50, 5.55, 5.50, 5.40, 5.90, 5.85,
+            5.70, 5.45, 5.55, 5.60, 5.40, 5.40, 5.35, 5.45, 5.50, 5.35, 5.25, 5.15, 5.00, 5.85,
+            5.80, 5.70, 5.25, 5.20, 5.10, 5.65, 5.55, 5.45, 5.60, 5.35, 5.45, 5.05, 5.00, 4.95,
+            5.50, 5.50, 5.40, 5.45, 5.55, 5.50, 5.55, 5.55, 5.35, 5.45, 5.50, 5.55, 5.50, 5.45,
+            5.25, 5.65, 5.60, 5.40, 5.70, 5.65, 5.55, 6.30, 6.30, 6.25,
         ];
         let table: Vec<Vec<f64>> = v.chunks(3).map(|c| c.to_vec()).collect();
         assert_eq!(table.len(), 22);
@@ -98,7 +113,8 @@ mod tests {
     /// Demsar (2006) section 3.2.2: four methods, 14 data sets, CD = 2.569 sqrt(4*5/(6*14)) = 1.25.
     #[test]
     fn nemenyi_cd_and_holm_pairs() {
-        let table: Vec<Vec<f64>> = (0..14).map(|b| vec![1.0 + (b % 3) as f64, 2.0, 3.0, 4.0 - (b % 2) as f64]).collect();
+        let table: Vec<Vec<f64>> =
+            (0..14).map(|b| vec![1.0 + (b % 3) as f64, 2.0, 3.0, 4.0 - (b % 2) as f64]).collect();
         let f = friedman(&table).unwrap();
         assert!((f.critical_difference.unwrap() - 2.569 * (20.0f64 / 84.0).sqrt()).abs() < 1e-12);
         assert_eq!(f.pairwise.len(), 6);

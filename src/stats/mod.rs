@@ -8,8 +8,8 @@ pub mod describe;
 pub mod effect;
 pub mod friedman;
 pub mod holm;
-pub mod ranks;
 pub mod rank_sum;
+pub mod ranks;
 pub mod runtime;
 pub mod wilcoxon;
 

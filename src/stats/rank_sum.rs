@@ -98,7 +98,8 @@ mod tests {
     /// R (0.876 with signum's 1 for 0).
     #[test]
     fn statistic_at_its_mean_gives_p_one() {
-        let r = rank_sum(&[1.0, 2.0, 2.0, 3.0], &[3.0, 2.0, 1.0, 2.0], Alternative::TwoSided).unwrap();
+        let r =
+            rank_sum(&[1.0, 2.0, 2.0, 3.0], &[3.0, 2.0, 1.0, 2.0], Alternative::TwoSided).unwrap();
         assert_eq!((r.w, r.method), (8.0, Method::Normal));
         assert_eq!((r.z, r.p_value), (Some(0.0), 1.0));
     }

@@ -21,7 +21,12 @@ impl Trace<'_> {
 
     /// The best value after `budget` evaluations (+inf before the first improvement).
     pub fn best_at(&self, budget: u64) -> f64 {
-        self.improvements.iter().take_while(|r| r.0 <= budget).last().map(|r| r.1).unwrap_or(f64::INFINITY)
+        self.improvements
+            .iter()
+            .take_while(|r| r.0 <= budget)
+            .last()
+            .map(|r| r.1)
+            .unwrap_or(f64::INFINITY)
     }
 }
 
@@ -33,7 +38,9 @@ pub fn log_targets(start: f64, best: f64, count: usize, decades: f64) -> Vec<f64
     if gap.is_nan() || gap <= 0.0 || count < 2 {
         return vec![best];
     }
-    let mut t: Vec<f64> = (0..count - 1).map(|k| best + gap * 10f64.powf(-decades * k as f64 / (count - 2).max(1) as f64)).collect();
+    let mut t: Vec<f64> = (0..count - 1)
+        .map(|k| best + gap * 10f64.powf(-decades * k as f64 / (count - 2).max(1) as f64))
+        .collect();
     t.push(best);
     t
 }
@@ -76,7 +83,8 @@ pub fn aocc(times: &[Option<u64>], budget: u64) -> f64 {
         return 0.0;
     }
     let b = budget as f64;
-    times.iter().flatten().filter(|&&h| h <= budget).map(|&h| (b - h as f64 + 1.0) / b).sum::<f64>() / times.len() as f64
+    times.iter().flatten().filter(|&&h| h <= budget).map(|&h| (b - h as f64 + 1.0) / b).sum::<f64>()
+        / times.len() as f64
 }
 
 /// `count` budgets from 1 to `max`, evenly spaced in log10 and rounded to whole evaluations
@@ -86,7 +94,9 @@ pub fn log_budgets(max: u64, count: usize) -> Vec<u64> {
         return vec![max.max(1)];
     }
     let l = (max as f64).log10();
-    let mut v: Vec<u64> = (0..count).map(|k| (10f64.powf(l * k as f64 / (count - 1) as f64).round() as u64).clamp(1, max)).collect();
+    let mut v: Vec<u64> = (0..count)
+        .map(|k| (10f64.powf(l * k as f64 / (count - 1) as f64).round() as u64).clamp(1, max))
+        .collect();
     v.push(max);
     v.sort_unstable();
     v.dedup();
@@ -107,7 +117,10 @@ mod tests {
     #[test]
     fn hitting_times_ert_and_fixed_budget_by_hand() {
         let [a, b] = runs();
-        assert_eq!((a.hitting_time(4.0), a.hitting_time(3.9), b.hitting_time(9.0)), (Some(5), Some(20), Some(1)));
+        assert_eq!(
+            (a.hitting_time(4.0), a.hitting_time(3.9), b.hitting_time(9.0)),
+            (Some(5), Some(20), Some(1))
+        );
         assert_eq!((a.best_at(4), a.best_at(5), a.best_at(0)), (10.0, 4.0, f64::INFINITY));
         // Target 5: a at 5, b at 10: ERT (5 + 10) / 2. Target 2: a at 20, b fails after 40.
         assert_eq!(ert(&runs(), 5.0), (7.5, 2));
@@ -131,7 +144,12 @@ mod tests {
     fn targets_and_budgets() {
         let t = log_targets(11.0, 1.0, 4, 2.0);
         assert_eq!(t.len(), 4);
-        assert!((t[0] - 11.0).abs() < 1e-12 && (t[1] - 2.0).abs() < 1e-12 && (t[2] - 1.1).abs() < 1e-12 && t[3] == 1.0);
+        assert!(
+            (t[0] - 11.0).abs() < 1e-12
+                && (t[1] - 2.0).abs() < 1e-12
+                && (t[2] - 1.1).abs() < 1e-12
+                && t[3] == 1.0
+        );
         assert_eq!(log_targets(1.0, 1.0, 5, 3.0), vec![1.0]);
         assert_eq!(log_budgets(100, 3), vec![1, 10, 100]);
         assert_eq!(*log_budgets(4040, 30).last().unwrap(), 4040);

@@ -45,7 +45,8 @@ pub fn signed_rank(x: &[f64], y: &[f64], alt: Alternative) -> Result<SignedRank,
     }
     let (ranks, ties) = midranks(&d.iter().map(|v| v.abs()).collect::<Vec<f64>>());
     // + 0.0: an empty f64 sum is -0.0, which would print as "-0".
-    let w_plus: f64 = d.iter().zip(&ranks).filter(|(v, _)| **v > 0.0).map(|(_, r)| r).sum::<f64>() + 0.0;
+    let w_plus: f64 =
+        d.iter().zip(&ranks).filter(|(v, _)| **v > 0.0).map(|(_, r)| r).sum::<f64>() + 0.0;
     let total = (n * (n + 1)) as f64 / 2.0;
     let w_minus = total - w_plus;
     let rank_biserial = (w_plus - w_minus) / total;
@@ -60,13 +61,29 @@ pub fn signed_rank(x: &[f64], y: &[f64], alt: Alternative) -> Result<SignedRank,
             Alternative::Less => le,
             Alternative::TwoSided => (2.0 * le.min(ge)).min(1.0),
         };
-        return Ok(SignedRank { n, w_plus, w_minus, z: None, p_value: p, method: Method::Exact, rank_biserial });
+        return Ok(SignedRank {
+            n,
+            w_plus,
+            w_minus,
+            z: None,
+            p_value: p,
+            method: Method::Exact,
+            rank_biserial,
+        });
     }
     let nf = n as f64;
     let mean = nf * (nf + 1.0) / 4.0;
     let var = nf * (nf + 1.0) * (2.0 * nf + 1.0) / 24.0 - tie_sum(&ties) / 48.0;
     let (z, p) = normal_approximation(w_plus - mean, var, alt);
-    Ok(SignedRank { n, w_plus, w_minus, z: Some(z), p_value: p, method: Method::Normal, rank_biserial })
+    Ok(SignedRank {
+        n,
+        w_plus,
+        w_minus,
+        z: Some(z),
+        p_value: p,
+        method: Method::Normal,
+        rank_biserial,
+    })
 }
 
 #[cfg(test)]
@@ -85,7 +102,9 @@ mod tests {
         assert_eq!((r.n, r.w_plus, r.method), (9, 40.0, Method::Exact));
         assert!((r.p_value - 0.01953).abs() < 5e-6, "{}", r.p_value);
         // Exact two-sided = 2 x one-sided here: 0.03906.
-        assert!((signed_rank(&x, &y, Alternative::TwoSided).unwrap().p_value - 0.0390625).abs() < 1e-12);
+        assert!(
+            (signed_rank(&x, &y, Alternative::TwoSided).unwrap().p_value - 0.0390625).abs() < 1e-12
+        );
     }
 
     /// With ties the normal approximation: d = (1, 2, 2, 3, -4, 5, 6, 7, 8, 9, 10, 11) by hand:
@@ -108,7 +127,8 @@ mod tests {
     /// correction=True, method="approx") and R's wilcox.test give (0.785 with signum's 1 for 0).
     #[test]
     fn statistic_at_its_mean_gives_p_one() {
-        let r = signed_rank(&[1.0, 2.0, 2.0, 3.0], &[3.0, 2.0, 1.0, 2.0], Alternative::TwoSided).unwrap();
+        let r = signed_rank(&[1.0, 2.0, 2.0, 3.0], &[3.0, 2.0, 1.0, 2.0], Alternative::TwoSided)
+            .unwrap();
         assert_eq!((r.n, r.w_plus, r.method), (3, 3.0, Method::Normal));
         assert_eq!((r.z, r.p_value), (Some(0.0), 1.0));
         // No positive difference: W+ is +0, not -0.
@@ -121,6 +141,9 @@ mod tests {
         let c = subset_sum_counts(10);
         assert_eq!(c.iter().sum::<f64>(), 1024.0);
         assert_eq!(signed_rank(&[1.0], &[1.0], Alternative::TwoSided), Err(StatsError::AllZero));
-        assert_eq!(signed_rank(&[1.0], &[1.0, 2.0], Alternative::TwoSided), Err(StatsError::LengthMismatch(1, 2)));
+        assert_eq!(
+            signed_rank(&[1.0], &[1.0, 2.0], Alternative::TwoSided),
+            Err(StatsError::LengthMismatch(1, 2))
+        );
     }
 }

@@ -34,11 +34,19 @@ impl Case {
         path
     }
     pub fn run(&self, args: &[&str]) -> Output {
-        let out = bin().args(args).current_dir(self.dir.path()).env("SOMNURBS_DATA", shared_data()).output().unwrap();
+        let out = bin()
+            .args(args)
+            .current_dir(self.dir.path())
+            .env("SOMNURBS_DATA", shared_data())
+            .output()
+            .unwrap();
         out
     }
     pub fn explain(&self, args: &[&str], out: &Output) -> String {
-        let listing: Vec<String> = walk(self.dir.path()).iter().map(|p| p.strip_prefix(self.dir.path()).unwrap().display().to_string()).collect();
+        let listing: Vec<String> = walk(self.dir.path())
+            .iter()
+            .map(|p| p.strip_prefix(self.dir.path()).unwrap().display().to_string())
+            .collect();
         format!(
             "command: somnurbs {}\nfolder: {:?}\nstatus: {}\nstdout:\n{}\nstderr:\n{}",
             args.join(" "),
@@ -58,7 +66,12 @@ impl Case {
         let out = self.run(args);
         let err = String::from_utf8_lossy(&out.stderr).to_string();
         assert!(!out.status.success(), "expected failure\n{}", self.explain(args, &out));
-        assert_eq!(err.trim_end().lines().count(), 1, "error is not one line\n{}", self.explain(args, &out));
+        assert_eq!(
+            err.trim_end().lines().count(),
+            1,
+            "error is not one line\n{}",
+            self.explain(args, &out)
+        );
         for n in needles {
             assert!(err.contains(n), "error lacks {n:?}\n{}", self.explain(args, &out));
         }
@@ -93,10 +106,14 @@ pub fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
 pub fn without_timing(path: &Path) -> Vec<Vec<String>> {
     let (h, rows) = read_csv(path);
     rows.into_iter()
-        .map(|r| r.into_iter().zip(&h).map(|(v, c)| if is_timing(c) { String::new() } else { v }).collect())
+        .map(|r| {
+            r.into_iter()
+                .zip(&h)
+                .map(|(v, c)| if is_timing(c) { String::new() } else { v })
+                .collect()
+        })
         .collect()
 }
-
 
 /// The index of a column, or a panic naming it and the header.
 pub fn col(h: &[String], name: &str) -> usize {
@@ -111,7 +128,13 @@ pub fn is_timing(column: &str) -> bool {
 /// Every CSV under `a` equals the one at the same place under `b` apart from timing columns
 /// (and `b` has no CSV that `a` lacks); returns how many tables were compared.
 pub fn same_tables(a: &Path, b: &Path) -> usize {
-    let csvs = |d: &Path| -> Vec<PathBuf> { walk(d).into_iter().filter(|p| p.extension().is_some_and(|e| e == "csv")).map(|p| p.strip_prefix(d).unwrap().to_path_buf()).collect() };
+    let csvs = |d: &Path| -> Vec<PathBuf> {
+        walk(d)
+            .into_iter()
+            .filter(|p| p.extension().is_some_and(|e| e == "csv"))
+            .map(|p| p.strip_prefix(d).unwrap().to_path_buf())
+            .collect()
+    };
     let (ta, tb) = (csvs(a), csvs(b));
     assert_eq!(ta, tb, "different tables in {} and {}", a.display(), b.display());
     for t in &ta {

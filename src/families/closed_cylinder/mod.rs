@@ -6,14 +6,14 @@
 pub mod report;
 pub mod spec;
 
-use crate::experiment::spec::Spec;
-use spec::Seed004Spec;
-use crate::experiment::{runner, seeds, RunContext};
 use crate::data::cylinder::{lattice_cylinder, sort_into_rings};
+use crate::experiment::spec::Spec;
+use crate::experiment::{runner, seeds, RunContext};
 use crate::optim::{Budget, Problem};
 use crate::spline::closed::{fit_closed, ClosedNetShape, RingData, RingNetProblem};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
+use spec::Seed004Spec;
 
 /// One (number of control points around, repeat).
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -77,7 +77,12 @@ pub struct Run {
 impl runner::Logged for Run {
     type Record = (Row, Vec<f64>, Vec<f64>, Vec<f64>);
     fn record(&self) -> Self::Record {
-        (self.row.clone(), self.population_best.clone(), self.best_so_far.clone(), self.best_x.clone())
+        (
+            self.row.clone(),
+            self.population_best.clone(),
+            self.best_so_far.clone(),
+            self.best_x.clone(),
+        )
     }
 }
 
@@ -88,21 +93,35 @@ fn section(spec: &Spec) -> Result<&Seed004Spec> {
 /// The flat list of cells.
 pub fn cells(spec: &Spec) -> Vec<Cell> {
     let Some(s) = &spec.file.seed004 else { return Vec::new() };
-    s.control_points.iter().flat_map(|&control_points| (0..s.repeats).map(move |repeat| Cell { control_points, repeat })).collect()
+    s.control_points
+        .iter()
+        .flat_map(|&control_points| {
+            (0..s.repeats).map(move |repeat| Cell { control_points, repeat })
+        })
+        .collect()
 }
 
 /// The paper's data: lattice cylinder sorted into rings.
 pub fn data(s: &Seed004Spec) -> RingData {
-    sort_into_rings(&lattice_cylinder(s.radius, s.height, s.grid_step, s.accuracy), s.grid_step * 1e-3)
+    sort_into_rings(
+        &lattice_cylinder(s.radius, s.height, s.grid_step, s.accuracy),
+        s.grid_step * 1e-3,
+    )
 }
 
 pub fn shape(s: &Seed004Spec, control_points: usize) -> ClosedNetShape {
-    ClosedNetShape { order_around: s.order_around, order_up: s.order_vertical, n_around: control_points, rows: s.rows }
+    ClosedNetShape {
+        order_around: s.order_around,
+        order_up: s.order_vertical,
+        n_around: control_points,
+        rows: s.rows,
+    }
 }
 
 /// The GA problem (and analytical fit) for a number of control points.
 pub fn problem(s: &Seed004Spec, data: &RingData, control_points: usize) -> Result<RingNetProblem> {
-    let fit = fit_closed(data, shape(s, control_points)).map_err(|e| anyhow::anyhow!("seed004, {control_points} control points: {e}"))?;
+    let fit = fit_closed(data, shape(s, control_points))
+        .map_err(|e| anyhow::anyhow!("seed004, {control_points} control points: {e}"))?;
     Ok(RingNetProblem::new(data, fit, s.search_range))
 }
 
@@ -114,11 +133,18 @@ pub fn run_cell(spec: &Spec, data: &RingData, cell: &Cell) -> Result<Run> {
 /// Run one cell on its number of control points' problem (built once for all its repeats).
 fn run_cell_on(spec: &Spec, problem: &RingNetProblem, cell: &Cell) -> Result<Run> {
     let s = section(spec)?;
-    let budget = Budget { generations: s.generations as u64, population: s.population, init_range: 0.0, trace_every_evals: s.population as u64 };
+    let budget = Budget {
+        generations: s.generations as u64,
+        population: s.population,
+        init_range: 0.0,
+        trace_every_evals: s.population as u64,
+    };
     let key = cell.key();
     let mut rng = seeds::cell_rng(spec.file.master_seed, &key);
     let t0 = runner::thread_cpu_seconds();
-    let r = s.ga.run_with_history(problem, &budget, &mut rng).map_err(|e| anyhow::anyhow!("{key}: {e}"))?;
+    let r =
+        s.ga.run_with_history(problem, &budget, &mut rng)
+            .map_err(|e| anyhow::anyhow!("{key}: {e}"))?;
     let cpu_s = runner::thread_cpu_seconds() - t0;
     let analytical = problem.analytical().rms;
     let row = Row {
@@ -141,7 +167,13 @@ fn run_cell_on(spec: &Spec, problem: &RingNetProblem, cell: &Cell) -> Result<Run
         evaluations: r.result.evaluations,
         cpu_s,
     };
-    Ok(Run { cell: cell.clone(), row, population_best: r.population_best, best_so_far: r.best_so_far, best_x: r.result.best_x })
+    Ok(Run {
+        cell: cell.clone(),
+        row,
+        population_best: r.population_best,
+        best_so_far: r.best_so_far,
+        best_x: r.result.best_x,
+    })
 }
 
 /// Run every cell of the spec on `data` (the analytical fit of each number of control points
@@ -149,15 +181,32 @@ fn run_cell_on(spec: &Spec, problem: &RingNetProblem, cell: &Cell) -> Result<Run
 pub fn run(spec: &Spec, ctx: &RunContext, data: &RingData) -> Result<Vec<Run>> {
     let s = section(spec)?;
     let cps: Vec<usize> = crate::report::ordered(s.control_points.iter().copied());
-    let problems = runner::run_cells(&cps, ctx.jobs, "seed004 analytical fits", |&cp| problem(s, data, cp), |_, _| Ok(()))?;
-    let by_cp: std::collections::BTreeMap<usize, &RingNetProblem> = cps.iter().copied().zip(problems.iter()).collect();
+    let problems = runner::run_cells(
+        &cps,
+        ctx.jobs,
+        "seed004 analytical fits",
+        |&cp| problem(s, data, cp),
+        |_, _| Ok(()),
+    )?;
+    let by_cp: std::collections::BTreeMap<usize, &RingNetProblem> =
+        cps.iter().copied().zip(problems.iter()).collect();
     let cells = cells(spec);
     runner::run_logged(
         &cells,
         ctx,
         &spec.file.name,
-        |cell| run_cell_on(spec, by_cp.get(&cell.control_points).context("seed004: no problem for a cell's control points")?, cell),
-        |cell, (row, population_best, best_so_far, best_x)| Ok(Run { cell: cell.clone(), row, population_best, best_so_far, best_x }),
+        |cell| {
+            run_cell_on(
+                spec,
+                by_cp
+                    .get(&cell.control_points)
+                    .context("seed004: no problem for a cell's control points")?,
+                cell,
+            )
+        },
+        |cell, (row, population_best, best_so_far, best_x)| {
+            Ok(Run { cell: cell.clone(), row, population_best, best_so_far, best_x })
+        },
     )
 }
 
@@ -165,15 +214,28 @@ pub fn run(spec: &Spec, ctx: &RunContext, data: &RingData) -> Result<Vec<Run>> {
 /// largest of the spec's list (deterministic and cheap: not logged): (control points, RMS).
 pub fn analytical_sweep(spec: &Spec, data: &RingData) -> Result<Vec<(usize, f64)>> {
     let s = section(spec)?;
-    let (lo, hi) = (s.control_points.iter().min().copied().unwrap_or(0), s.control_points.iter().max().copied().unwrap_or(0));
-    (lo..=hi).map(|n| Ok((n, fit_closed(data, shape(s, n)).map_err(|e| anyhow::anyhow!("seed004, {n} control points: {e}"))?.rms))).collect()
+    let (lo, hi) = (
+        s.control_points.iter().min().copied().unwrap_or(0),
+        s.control_points.iter().max().copied().unwrap_or(0),
+    );
+    (lo..=hi)
+        .map(|n| {
+            Ok((
+                n,
+                fit_closed(data, shape(s, n))
+                    .map_err(|e| anyhow::anyhow!("seed004, {n} control points: {e}"))?
+                    .rms,
+            ))
+        })
+        .collect()
 }
 
 /// RMS distance of the data to the exact cylinder (sqrt(x^2 + y^2) - radius): a floor under
 /// every fit's RMS error at the data's own radial scatter.
 pub fn data_floor(spec: &Spec, data: &RingData) -> Result<f64> {
     let s = section(spec)?;
-    let sse: f64 = data.points().map(|p| ((p[0] * p[0] + p[1] * p[1]).sqrt() - s.radius).powi(2)).sum();
+    let sse: f64 =
+        data.points().map(|p| ((p[0] * p[0] + p[1] * p[1]).sqrt() - s.radius).powi(2)).sum();
     Ok((sse / data.n_points().max(1) as f64).sqrt())
 }
 
@@ -192,14 +254,28 @@ pub struct TopView {
 }
 
 /// The top view of the lowest-RMS run at `control_points` (None if there is no such run).
-pub fn top_view(spec: &Spec, data: &RingData, runs: &[Run], control_points: usize) -> Result<Option<TopView>> {
+pub fn top_view(
+    spec: &Spec,
+    data: &RingData,
+    runs: &[Run],
+    control_points: usize,
+) -> Result<Option<TopView>> {
     let s = section(spec)?;
-    let Some(best) = runs.iter().filter(|r| r.cell.control_points == control_points && !r.best_x.is_empty()).min_by(|a, b| a.row.best_rms.total_cmp(&b.row.best_rms)) else { return Ok(None) };
+    let Some(best) = runs
+        .iter()
+        .filter(|r| r.cell.control_points == control_points && !r.best_x.is_empty())
+        .min_by(|a, b| a.row.best_rms.total_cmp(&b.row.best_rms))
+    else {
+        return Ok(None);
+    };
     let problem = problem(s, data, control_points)?;
     let ga = problem.surface(&best.best_x);
     let an = &problem.analytical().surface;
     let curve = |surf: &crate::spline::closed::ClosedSurface| -> Vec<(f64, f64)> {
-        (0..=400).map(|k| surf.eval(k as f64 / 400.0 * control_points as f64, 0.0)).map(|p| (p[0], p[1])).collect()
+        (0..=400)
+            .map(|k| surf.eval(k as f64 / 400.0 * control_points as f64, 0.0))
+            .map(|p| (p[0], p[1]))
+            .collect()
     };
     let mut ga_control: Vec<(f64, f64)> = best.best_x.chunks(2).map(|c| (c[0], c[1])).collect();
     ga_control.push(ga_control[0]);
@@ -208,7 +284,11 @@ pub fn top_view(spec: &Spec, data: &RingData, runs: &[Run], control_points: usiz
         cell: best.row.cell.clone(),
         best_rms: best.row.best_rms,
         analytical_rms: best.row.analytical_rms,
-        data: data.rings.first().map(|r| r.iter().map(|p| (p[0], p[1])).collect()).unwrap_or_default(),
+        data: data
+            .rings
+            .first()
+            .map(|r| r.iter().map(|p| (p[0], p[1])).collect())
+            .unwrap_or_default(),
         ga_curve: curve(&ga),
         ga_control,
         analytical_curve: curve(an),
@@ -225,7 +305,10 @@ impl crate::experiment::family::Family for Seed004 {
     fn present(&self, spec: &Spec) -> bool {
         spec.file.seed004.is_some()
     }
-    fn check_limits(&self, c: &crate::experiment::limits::Check) -> Result<(), crate::experiment::spec::SpecError> {
+    fn check_limits(
+        &self,
+        c: &crate::experiment::limits::Check,
+    ) -> Result<(), crate::experiment::spec::SpecError> {
         match &c.spec.file.seed004 {
             Some(s) => self::spec::limits(c, s),
             None => Ok(()),
@@ -240,7 +323,12 @@ impl crate::experiment::family::Family for Seed004 {
     fn logged_keys(&self, spec: &Spec) -> Vec<String> {
         cells(spec).iter().map(|c| c.key()).collect()
     }
-    fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<crate::experiment::family::Outcome> {
+    fn run(
+        &self,
+        spec: &Spec,
+        ctx: &RunContext,
+        tables: bool,
+    ) -> Result<crate::experiment::family::Outcome> {
         let s4 = section(spec)?;
         // The lattice and its rings once, for the runs and the report.
         let data = data(s4);
@@ -248,10 +336,21 @@ impl crate::experiment::family::Family for Seed004 {
         let section = if tables {
             let sweep = analytical_sweep(spec, &data)?;
             let top = top_view(spec, &data, &runs, 7)?;
-            Some(crate::families::closed_cylinder::report::write(s4, &runs, &sweep, data_floor(spec, &data)?, top.as_ref(), &ctx.out)?)
+            Some(crate::families::closed_cylinder::report::write(
+                s4,
+                &runs,
+                &sweep,
+                data_floor(spec, &data)?,
+                top.as_ref(),
+                &ctx.out,
+            )?)
         } else {
             None
         };
-        Ok(crate::experiment::family::Outcome { section, cpu_s: runs.iter().map(|r| r.row.cpu_s).sum(), cells: runs.len() })
+        Ok(crate::experiment::family::Outcome {
+            section,
+            cpu_s: runs.iter().map(|r| r.row.cpu_s).sum(),
+            cells: runs.len(),
+        })
     }
 }

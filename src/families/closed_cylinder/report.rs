@@ -3,12 +3,12 @@
 //! paper's transcribed numbers (`experiments/reference/seed004_table{2,3}.csv`), the paper's
 //! claims checked on the runs (verdicts computed), and the Fig. 2(a), 3 and 5 analogues.
 
+use super::spec::Seed004Spec;
+use crate::families::closed_cylinder::{Run, TopView};
 use crate::report::markdown::{num, table};
 use crate::report::plots::boxplot::quantile_type7;
 use crate::report::plots::{self, style, Series};
 use crate::report::reference::RefTable;
-use crate::families::closed_cylinder::{Run, TopView};
-use super::spec::Seed004Spec;
 use anyhow::Result;
 use plotters::style::RGBColor;
 use std::fmt::Write;
@@ -34,7 +34,15 @@ fn summary(v: &[f64]) -> Summary {
     let mut s = v.to_vec();
     s.sort_by(|a, b| a.total_cmp(b));
     let (mean, var) = crate::stats::describe::mean_var(&s);
-    Summary { min: s[0], mean, q1: quantile_type7(&s, 0.25), median: quantile_type7(&s, 0.5), q3: quantile_type7(&s, 0.75), max: s[s.len() - 1], std: var.sqrt() }
+    Summary {
+        min: s[0],
+        mean,
+        q1: quantile_type7(&s, 0.25),
+        median: quantile_type7(&s, 0.5),
+        q3: quantile_type7(&s, 0.75),
+        max: s[s.len() - 1],
+        std: var.sqrt(),
+    }
 }
 
 fn e(v: f64) -> String {
@@ -46,16 +54,30 @@ fn header(cols: &[&str]) -> Vec<String> {
 }
 
 /// Write the tables and charts; return the REPORT.md section.
-pub fn write(s4: &Seed004Spec, runs: &[Run], sweep: &[(usize, f64)], floor: f64, top: Option<&TopView>, out: &Path) -> Result<String> {
+pub fn write(
+    s4: &Seed004Spec,
+    runs: &[Run],
+    sweep: &[(usize, f64)],
+    floor: f64,
+    top: Option<&TopView>,
+    out: &Path,
+) -> Result<String> {
     let rows: Vec<_> = runs.iter().map(|r| r.row.clone()).collect();
     crate::io::write_atomic(&out.join("runs.csv"), crate::io::csv_text(&rows)?.as_bytes())?;
     let cps = crate::report::ordered(runs.iter().map(|r| r.cell.control_points));
-    let of = |cp: usize| -> Vec<&Run> { runs.iter().filter(|r| r.cell.control_points == cp).collect() };
+    let of =
+        |cp: usize| -> Vec<&Run> { runs.iter().filter(|r| r.cell.control_points == cp).collect() };
     let mut s = String::new();
-    let _ = writeln!(s, "## Seed 004: closed B-spline surface of a cylinder by a binary-coded GA\n");
+    let _ =
+        writeln!(s, "## Seed 004: closed B-spline surface of a cylinder by a binary-coded GA\n");
     let n_points = runs.first().map(|r| r.row.n_points).unwrap_or(0);
     let p3 = paper_table("seed004_table3");
-    let paper_min_ratio = p3.rows.iter().filter_map(|r| r.get("best_fitness")?.parse::<f64>().ok()).fold(f64::INFINITY, f64::min) / floor;
+    let paper_min_ratio = p3
+        .rows
+        .iter()
+        .filter_map(|r| r.get("best_fitness")?.parse::<f64>().ok())
+        .fold(f64::INFINITY, f64::min)
+        / floor;
     let _ = writeln!(
         s,
         "Data: the lattice points (step {}) with |x^2 + y^2 - {}^2| <= {} and 0 <= z <= {}: {n_points} points (the paper: 3876), sorted into rings by height and by angle. Surface: closed uniform B-spline of order {} around (Eq. 5), clamped order {} up, net {} x N; analytical method: chord-length parameters (Eq. 8) and least squares by SVD. GA: {} bits per variable, x and y of each control column (shared by its rows; z fixed at the analytical net's), box = analytical +- {}, population {}, {} generations, linear ranking beta = {}, uniform crossover with probability {} (bit swap {}), bit flip {}, elitism {}. Fitness = RMS distance of the data to the surface at their parameters. {} repeats per number of control points. The data scatter about the exact cylinder by {floor:.5} RMS (radial distance of the lattice points); a surface with N control points around can follow that scatter only in part, and the paper's least Table III error is {paper_min_ratio:.2} times this scatter.\n",
@@ -70,24 +92,69 @@ pub fn write(s4: &Seed004Spec, runs: &[Run], sweep: &[(usize, f64)], floor: f64,
         let sel = of(cp);
         let analytical = sel[0].row.analytical_rms;
         for &g in &s4.table2_generations {
-            let so_far: Vec<f64> = sel.iter().filter_map(|r| r.best_so_far.get(g).copied()).collect();
-            let pop: Vec<f64> = sel.iter().filter_map(|r| r.population_best.get(g).copied()).collect();
+            let so_far: Vec<f64> =
+                sel.iter().filter_map(|r| r.best_so_far.get(g).copied()).collect();
+            let pop: Vec<f64> =
+                sel.iter().filter_map(|r| r.population_best.get(g).copied()).collect();
             if so_far.is_empty() {
                 continue;
             }
             let (a, b) = (summary(&so_far), summary(&pop));
-            t2.push(vec![cp.to_string(), g.to_string(), e(analytical), e(a.min), e(a.mean), e(a.median), e(b.min), e(b.mean), so_far.len().to_string()]);
+            t2.push(vec![
+                cp.to_string(),
+                g.to_string(),
+                e(analytical),
+                e(a.min),
+                e(a.mean),
+                e(a.median),
+                e(b.min),
+                e(b.mean),
+                so_far.len().to_string(),
+            ]);
             let paper = p2.value(&["generation"], &[g.to_string()], &format!("best_rms_{cp}cp"));
-            md2.push(vec![cp.to_string(), if g == 0 { "initial".into() } else { g.to_string() }, num(Some(a.min), 4), num(Some(a.mean), 4), num(Some(b.mean), 4), num(Some(analytical), 4), num(paper, 4)]);
+            md2.push(vec![
+                cp.to_string(),
+                if g == 0 { "initial".into() } else { g.to_string() },
+                num(Some(a.min), 4),
+                num(Some(a.mean), 4),
+                num(Some(b.mean), 4),
+                num(Some(analytical), 4),
+                num(paper, 4),
+            ]);
         }
     }
     crate::io::write_atomic(
         &out.join("seed004_table2.csv"),
-        crate::io::csv_records(&header(&["control_points", "generation", "analytical_rms", "ga_best_rms", "ga_mean_rms", "ga_median_rms", "ga_population_best_rms", "ga_population_mean_rms", "runs"]), &t2)?.as_bytes(),
+        crate::io::csv_records(
+            &header(&[
+                "control_points",
+                "generation",
+                "analytical_rms",
+                "ga_best_rms",
+                "ga_mean_rms",
+                "ga_median_rms",
+                "ga_population_best_rms",
+                "ga_population_mean_rms",
+                "runs",
+            ]),
+            &t2,
+        )?
+        .as_bytes(),
     )?;
     let _ = writeln!(s, "### Table II: best RMS against generation (ours beside the paper)\n");
     let _ = writeln!(s, "GA best / mean = best-so-far RMS at that generation, lowest and mean over the repeats; population mean = the mean over repeats of the best RMS in that generation's population (without elitism it can rise, as the paper's does from 200 to 300).\n");
-    s.push_str(&table(&header(&["control points", "generation", "GA best", "GA mean", "population mean", "analytical", "paper best RMS"]), &md2));
+    s.push_str(&table(
+        &header(&[
+            "control points",
+            "generation",
+            "GA best",
+            "GA mean",
+            "population mean",
+            "analytical",
+            "paper best RMS",
+        ]),
+        &md2,
+    ));
 
     // Table III.
     let mut t3 = Vec::new();
@@ -96,26 +163,86 @@ pub fn write(s4: &Seed004Spec, runs: &[Run], sweep: &[(usize, f64)], floor: f64,
         let sel = of(cp);
         let best: Vec<f64> = sel.iter().map(|r| r.row.best_rms).collect();
         let sm = summary(&best);
-        let winner = sel.iter().min_by(|a, b| a.row.best_rms.total_cmp(&b.row.best_rms)).expect("non-empty");
-        let mean_gen = sel.iter().map(|r| r.row.best_generation as f64).sum::<f64>() / sel.len() as f64;
+        let winner =
+            sel.iter().min_by(|a, b| a.row.best_rms.total_cmp(&b.row.best_rms)).expect("non-empty");
+        let mean_gen =
+            sel.iter().map(|r| r.row.best_generation as f64).sum::<f64>() / sel.len() as f64;
         let an = winner.row.analytical_rms;
         let impr = (an - sm.min) / an * 100.0;
-        t3.push(vec![cp.to_string(), e(an), e(sm.min), e(sm.mean), e(sm.max), e(sm.std), winner.row.best_generation.to_string(), format!("{mean_gen}"), format!("{impr}"), sel.len().to_string()]);
+        t3.push(vec![
+            cp.to_string(),
+            e(an),
+            e(sm.min),
+            e(sm.mean),
+            e(sm.max),
+            e(sm.std),
+            winner.row.best_generation.to_string(),
+            format!("{mean_gen}"),
+            format!("{impr}"),
+            sel.len().to_string(),
+        ]);
         let key = [cp.to_string()];
-        md3.push(vec![cp.to_string(), num(Some(an), 5), num(Some(sm.min), 5), num(Some(sm.mean), 5), winner.row.best_generation.to_string(), format!("{impr:.2}%"), num(p3.value(&["control_points"], &key, "best_fitness"), 5), p3.find(&["control_points"], &key).and_then(|r| r.get("generation").cloned()).unwrap_or_else(|| "-".into())]);
+        md3.push(vec![
+            cp.to_string(),
+            num(Some(an), 5),
+            num(Some(sm.min), 5),
+            num(Some(sm.mean), 5),
+            winner.row.best_generation.to_string(),
+            format!("{impr:.2}%"),
+            num(p3.value(&["control_points"], &key, "best_fitness"), 5),
+            p3.find(&["control_points"], &key)
+                .and_then(|r| r.get("generation").cloned())
+                .unwrap_or_else(|| "-".into()),
+        ]);
     }
     crate::io::write_atomic(
         &out.join("seed004_table3.csv"),
-        crate::io::csv_records(&header(&["control_points", "analytical_rms", "ga_best_rms", "ga_mean_rms", "ga_worst_rms", "ga_std_rms", "best_generation", "mean_best_generation", "improvement_pct", "runs"]), &t3)?.as_bytes(),
+        crate::io::csv_records(
+            &header(&[
+                "control_points",
+                "analytical_rms",
+                "ga_best_rms",
+                "ga_mean_rms",
+                "ga_worst_rms",
+                "ga_std_rms",
+                "best_generation",
+                "mean_best_generation",
+                "improvement_pct",
+                "runs",
+            ]),
+            &t3,
+        )?
+        .as_bytes(),
     )?;
-    let sweep_rows: Vec<Vec<String>> = sweep.iter().map(|(n, r)| vec![n.to_string(), e(*r)]).collect();
-    crate::io::write_atomic(&out.join("seed004_analytical.csv"), crate::io::csv_records(&header(&["control_points", "analytical_rms"]), &sweep_rows)?.as_bytes())?;
+    let sweep_rows: Vec<Vec<String>> =
+        sweep.iter().map(|(n, r)| vec![n.to_string(), e(*r)]).collect();
+    crate::io::write_atomic(
+        &out.join("seed004_analytical.csv"),
+        crate::io::csv_records(&header(&["control_points", "analytical_rms"]), &sweep_rows)?
+            .as_bytes(),
+    )?;
     let _ = writeln!(s, "\n### Table III: best fitness (RMS) against the number of control points (ours beside the paper)\n");
-    s.push_str(&table(&header(&["control points", "analytical", "GA best", "GA mean", "generation of GA best", "GA vs analytical", "paper best fitness", "paper generation"]), &md3));
+    s.push_str(&table(
+        &header(&[
+            "control points",
+            "analytical",
+            "GA best",
+            "GA mean",
+            "generation of GA best",
+            "GA vs analytical",
+            "paper best fitness",
+            "paper generation",
+        ]),
+        &md3,
+    ));
 
     // Claims, each computed from the runs (and, where the transcribed tables allow, the paper's own numbers).
     let mut claims = Vec::new();
-    let row3 = |cp: usize| t3.iter().find(|r| r[0] == cp.to_string()).map(|r| (r[1].parse::<f64>().unwrap_or(f64::NAN), r[2].parse::<f64>().unwrap_or(f64::NAN)));
+    let row3 = |cp: usize| {
+        t3.iter().find(|r| r[0] == cp.to_string()).map(|r| {
+            (r[1].parse::<f64>().unwrap_or(f64::NAN), r[2].parse::<f64>().unwrap_or(f64::NAN))
+        })
+    };
     if let Some((an, ga)) = row3(7) {
         claims.push(crate::report::claims::Claim {
             chapter: "seed004".into(),
@@ -127,8 +254,15 @@ pub fn write(s4: &Seed004Spec, runs: &[Run], sweep: &[(usize, f64)], floor: f64,
         });
     }
     let argmin = |v: &[(usize, f64)]| v.iter().copied().min_by(|a, b| a.1.total_cmp(&b.1));
-    let ga_by_cp: Vec<(usize, f64)> = t3.iter().map(|r| (r[0].parse().unwrap_or(0), r[2].parse().unwrap_or(f64::NAN))).collect();
-    let paper_by_cp: Vec<(usize, f64)> = p3.rows.iter().filter_map(|r| Some((r.get("control_points")?.parse().ok()?, r.get("best_fitness")?.parse().ok()?))).collect();
+    let ga_by_cp: Vec<(usize, f64)> =
+        t3.iter().map(|r| (r[0].parse().unwrap_or(0), r[2].parse().unwrap_or(f64::NAN))).collect();
+    let paper_by_cp: Vec<(usize, f64)> = p3
+        .rows
+        .iter()
+        .filter_map(|r| {
+            Some((r.get("control_points")?.parse().ok()?, r.get("best_fitness")?.parse().ok()?))
+        })
+        .collect();
     if let (Some((cp, v)), Some((pcp, _))) = (argmin(&ga_by_cp), argmin(&paper_by_cp)) {
         claims.push(crate::report::claims::Claim {
             chapter: "seed004".into(),
@@ -143,13 +277,19 @@ pub fn write(s4: &Seed004Spec, runs: &[Run], sweep: &[(usize, f64)], floor: f64,
         claims.push(crate::report::claims::Claim {
             chapter: "seed004".into(),
             rival: None,
-            statement: "The analytical method's least error is at 28 control points (0.001132)".into(),
+            statement: "The analytical method's least error is at 28 control points (0.001132)"
+                .into(),
             ours: ((cp == 28) as usize, 1),
             thesis: None,
-            note: format!("here: least analytical RMS {v:.6} at {cp} of {}..{} control points", sweep.first().map(|x| x.0).unwrap_or(0), sweep.last().map(|x| x.0).unwrap_or(0)),
+            note: format!(
+                "here: least analytical RMS {v:.6} at {cp} of {}..{} control points",
+                sweep.first().map(|x| x.0).unwrap_or(0),
+                sweep.last().map(|x| x.0).unwrap_or(0)
+            ),
         });
     }
-    let better = ga_by_cp.iter().filter(|(cp, ga)| row3(*cp).is_some_and(|(an, _)| *ga < an)).count();
+    let better =
+        ga_by_cp.iter().filter(|(cp, ga)| row3(*cp).is_some_and(|(an, _)| *ga < an)).count();
     claims.push(crate::report::claims::Claim {
         chapter: "seed004".into(),
         rival: None,
@@ -158,14 +298,20 @@ pub fn write(s4: &Seed004Spec, runs: &[Run], sweep: &[(usize, f64)], floor: f64,
         thesis: None,
         note: "numbers of control points where the GA's best RMS is below the analytical RMS (the paper states it but gives analytical numbers only at 7 and 28)".into(),
     });
-    let falls = runs.iter().filter(|r| r.population_best.last().is_some_and(|l| *l < r.population_best[0])).count();
+    let falls = runs
+        .iter()
+        .filter(|r| r.population_best.last().is_some_and(|l| *l < r.population_best[0]))
+        .count();
     claims.push(crate::report::claims::Claim {
         chapter: "seed004".into(),
         rival: None,
-        statement: "The fitness improves (the error decreases) as the generations increase (Table II)".into(),
+        statement:
+            "The fitness improves (the error decreases) as the generations increase (Table II)"
+                .into(),
         ours: (falls, runs.len()),
         thesis: None,
-        note: "runs whose last population's best RMS is below their initial population's best".into(),
+        note: "runs whose last population's best RMS is below their initial population's best"
+            .into(),
     });
     let _ = writeln!(s, "\n### The paper's claims, checked here\n");
     s.push_str(&crate::report::claims::write(out, &claims)?);
@@ -185,33 +331,138 @@ pub fn write(s4: &Seed004Spec, runs: &[Run], sweep: &[(usize, f64)], floor: f64,
     for (k, &cp) in s4.table2_control_points.iter().filter(|cp| cps.contains(cp)).enumerate() {
         let sel = of(cp);
         let len = sel.iter().map(|r| r.best_so_far.len()).min().unwrap_or(0);
-        let sums: Vec<(f64, Summary)> = (0..len).map(|g| (g as f64, summary(&sel.iter().map(|r| r.best_so_far[g]).collect::<Vec<_>>()))).collect();
+        let sums: Vec<(f64, Summary)> = (0..len)
+            .map(|g| (g as f64, summary(&sel.iter().map(|r| r.best_so_far[g]).collect::<Vec<_>>())))
+            .collect();
         let colour = style::cycle_colour(k);
-        conv.push(Series { label: format!("{cp} cp: GA median (quartiles)"), colour, points: sums.iter().map(|(g, m)| (*g, m.median)).collect(), band: Some(sums.iter().map(|(g, m)| (*g, m.q1, m.q3)).collect()) });
-        conv.push(Series { label: format!("{cp} cp: analytical"), colour: RGBColor(colour.0 / 2, colour.1 / 2, colour.2 / 2), points: vec![(0.0, sel[0].row.analytical_rms), ((len.max(1) - 1) as f64, sel[0].row.analytical_rms)], band: None });
-        let paper: Vec<(f64, f64)> = p2.rows.iter().filter_map(|r| Some((r.get("generation")?.parse().ok()?, r.get(&format!("best_rms_{cp}cp"))?.parse().ok()?))).collect();
+        conv.push(Series {
+            label: format!("{cp} cp: GA median (quartiles)"),
+            colour,
+            points: sums.iter().map(|(g, m)| (*g, m.median)).collect(),
+            band: Some(sums.iter().map(|(g, m)| (*g, m.q1, m.q3)).collect()),
+        });
+        conv.push(Series {
+            label: format!("{cp} cp: analytical"),
+            colour: RGBColor(colour.0 / 2, colour.1 / 2, colour.2 / 2),
+            points: vec![
+                (0.0, sel[0].row.analytical_rms),
+                ((len.max(1) - 1) as f64, sel[0].row.analytical_rms),
+            ],
+            band: None,
+        });
+        let paper: Vec<(f64, f64)> = p2
+            .rows
+            .iter()
+            .filter_map(|r| {
+                Some((
+                    r.get("generation")?.parse().ok()?,
+                    r.get(&format!("best_rms_{cp}cp"))?.parse().ok()?,
+                ))
+            })
+            .collect();
         if !paper.is_empty() {
-            conv.push(Series { label: format!("{cp} cp: paper Table II"), colour: RGBColor(120, 120, 120), points: paper, band: None });
+            conv.push(Series {
+                label: format!("{cp} cp: paper Table II"),
+                colour: RGBColor(120, 120, 120),
+                points: paper,
+                band: None,
+            });
         }
     }
     if !conv.is_empty() {
-        pictures.push(("png/seed004_convergence.png", plots::line_chart_png(&out.join("png/seed004_convergence.png"), "Best RMS so far vs generation (Fig. 3 analogue)", "generation", "RMS error", &conv, true)));
+        pictures.push((
+            "png/seed004_convergence.png",
+            plots::line_chart_png(
+                &out.join("png/seed004_convergence.png"),
+                "Best RMS so far vs generation (Fig. 3 analogue)",
+                "generation",
+                "RMS error",
+                &conv,
+                true,
+            ),
+        ));
     }
     let mut fit_series = vec![
-        Series { label: "GA best over repeats".into(), colour: style::cycle_colour(0), points: ga_by_cp.iter().map(|&(c, v)| (c as f64, v)).collect(), band: None },
-        Series { label: "GA mean over repeats".into(), colour: style::cycle_colour(1), points: t3.iter().map(|r| (r[0].parse().unwrap_or(f64::NAN), r[3].parse().unwrap_or(f64::NAN))).collect(), band: None },
-        Series { label: "analytical (every N)".into(), colour: style::cycle_colour(2), points: sweep.iter().map(|&(c, v)| (c as f64, v)).collect(), band: None },
+        Series {
+            label: "GA best over repeats".into(),
+            colour: style::cycle_colour(0),
+            points: ga_by_cp.iter().map(|&(c, v)| (c as f64, v)).collect(),
+            band: None,
+        },
+        Series {
+            label: "GA mean over repeats".into(),
+            colour: style::cycle_colour(1),
+            points: t3
+                .iter()
+                .map(|r| (r[0].parse().unwrap_or(f64::NAN), r[3].parse().unwrap_or(f64::NAN)))
+                .collect(),
+            band: None,
+        },
+        Series {
+            label: "analytical (every N)".into(),
+            colour: style::cycle_colour(2),
+            points: sweep.iter().map(|&(c, v)| (c as f64, v)).collect(),
+            band: None,
+        },
     ];
-    fit_series.push(Series { label: "paper Table III".into(), colour: RGBColor(120, 120, 120), points: paper_by_cp.iter().map(|&(c, v)| (c as f64, v)).collect(), band: None });
-    pictures.push(("png/seed004_fitness_vs_control_points.png", plots::line_chart_png(&out.join("png/seed004_fitness_vs_control_points.png"), "Best fitness (RMS) vs number of control points (Fig. 5 analogue)", "control points around", "RMS error", &fit_series, true)));
+    fit_series.push(Series {
+        label: "paper Table III".into(),
+        colour: RGBColor(120, 120, 120),
+        points: paper_by_cp.iter().map(|&(c, v)| (c as f64, v)).collect(),
+        band: None,
+    });
+    pictures.push((
+        "png/seed004_fitness_vs_control_points.png",
+        plots::line_chart_png(
+            &out.join("png/seed004_fitness_vs_control_points.png"),
+            "Best fitness (RMS) vs number of control points (Fig. 5 analogue)",
+            "control points around",
+            "RMS error",
+            &fit_series,
+            true,
+        ),
+    ));
     if let Some(t) = top {
         let series = vec![
-            Series { label: "data (bottom ring)".into(), colour: RGBColor(170, 170, 170), points: t.data.iter().chain(t.data.first()).copied().collect(), band: None },
-            Series { label: format!("GA curve (RMS {:.5})", t.best_rms), colour: style::cycle_colour(0), points: t.ga_curve.clone(), band: None },
-            Series { label: "GA control polygon".into(), colour: RGBColor(200, 0, 0), points: t.ga_control.clone(), band: None },
-            Series { label: format!("analytical curve (RMS {:.5})", t.analytical_rms), colour: style::cycle_colour(2), points: t.analytical_curve.clone(), band: None },
+            Series {
+                label: "data (bottom ring)".into(),
+                colour: RGBColor(170, 170, 170),
+                points: t.data.iter().chain(t.data.first()).copied().collect(),
+                band: None,
+            },
+            Series {
+                label: format!("GA curve (RMS {:.5})", t.best_rms),
+                colour: style::cycle_colour(0),
+                points: t.ga_curve.clone(),
+                band: None,
+            },
+            Series {
+                label: "GA control polygon".into(),
+                colour: RGBColor(200, 0, 0),
+                points: t.ga_control.clone(),
+                band: None,
+            },
+            Series {
+                label: format!("analytical curve (RMS {:.5})", t.analytical_rms),
+                colour: style::cycle_colour(2),
+                points: t.analytical_curve.clone(),
+                band: None,
+            },
         ];
-        pictures.push(("png/seed004_top_view.png", plots::line_chart_png(&out.join("png/seed004_top_view.png"), &format!("Top view, {} control points, best GA run (Fig. 2a analogue)", t.control_points), "x", "y", &series, false)));
+        pictures.push((
+            "png/seed004_top_view.png",
+            plots::line_chart_png(
+                &out.join("png/seed004_top_view.png"),
+                &format!(
+                    "Top view, {} control points, best GA run (Fig. 2a analogue)",
+                    t.control_points
+                ),
+                "x",
+                "y",
+                &series,
+                false,
+            ),
+        ));
     }
     for (png, r) in pictures {
         match r {

@@ -83,19 +83,33 @@ pub(crate) fn validate(spec: &Spec, s: &Seed004Spec) -> Result<(), SpecError> {
         return Err(spec.err("seed004.control_points", "is empty"));
     }
     if s.order_around < 2 || s.order_around > 8 {
-        return Err(spec.err("seed004.order_around", format!("must be in [2, 8], got {}", s.order_around)));
+        return Err(
+            spec.err("seed004.order_around", format!("must be in [2, 8], got {}", s.order_around))
+        );
     }
     if let Some(n) = s.control_points.iter().find(|&&n| n < s.order_around || n > 200) {
-        return Err(spec.err("seed004.control_points", format!("{n} is outside [order_around = {}, 200]", s.order_around)));
+        return Err(spec.err(
+            "seed004.control_points",
+            format!("{n} is outside [order_around = {}, 200]", s.order_around),
+        ));
     }
     if let Some(n) = s.table2_control_points.iter().find(|n| !s.control_points.contains(n)) {
-        return Err(spec.err("seed004.table2_control_points", format!("{n} is not in seed004.control_points")));
+        return Err(spec.err(
+            "seed004.table2_control_points",
+            format!("{n} is not in seed004.control_points"),
+        ));
     }
     if let Some(g) = s.table2_generations.iter().find(|&&g| g > s.generations) {
-        return Err(spec.err("seed004.table2_generations", format!("{g} exceeds seed004.generations = {}", s.generations)));
+        return Err(spec.err(
+            "seed004.table2_generations",
+            format!("{g} exceeds seed004.generations = {}", s.generations),
+        ));
     }
     if s.order_vertical < 2 || s.rows < s.order_vertical {
-        return Err(spec.err("seed004.order_vertical", format!("must be at least 2 and at most rows = {}, got {}", s.rows, s.order_vertical)));
+        return Err(spec.err(
+            "seed004.order_vertical",
+            format!("must be at least 2 and at most rows = {}, got {}", s.rows, s.order_vertical),
+        ));
     }
     if s.repeats == 0 {
         return Err(spec.err("seed004.repeats", "must be at least 1"));
@@ -104,18 +118,34 @@ pub(crate) fn validate(spec: &Spec, s: &Seed004Spec) -> Result<(), SpecError> {
         return Err(spec.err("seed004.generations", "must be at least 1"));
     }
     if s.population < 2 || s.population <= s.ga.elitism {
-        return Err(spec.err("seed004.population", format!("must be at least 2 and above seed004.ga.elitism, got {}", s.population)));
+        return Err(spec.err(
+            "seed004.population",
+            format!("must be at least 2 and above seed004.ga.elitism, got {}", s.population),
+        ));
     }
-    for (key, v) in [("radius", s.radius), ("height", s.height), ("grid_step", s.grid_step), ("accuracy", s.accuracy), ("search_range", s.search_range)] {
+    for (key, v) in [
+        ("radius", s.radius),
+        ("height", s.height),
+        ("grid_step", s.grid_step),
+        ("accuracy", s.accuracy),
+        ("search_range", s.search_range),
+    ] {
         if !(v > 0.0 && v.is_finite()) {
-            return Err(spec.err(&format!("seed004.{key}"), format!("must be a positive number, got {v}")));
+            return Err(
+                spec.err(&format!("seed004.{key}"), format!("must be a positive number, got {v}"))
+            );
         }
     }
     if s.radius / s.grid_step > 2000.0 || s.height / s.grid_step > 2000.0 {
-        return Err(spec.err("seed004.grid_step", format!("{} makes more than 2000 lattice steps across the cylinder", s.grid_step)));
+        return Err(spec.err(
+            "seed004.grid_step",
+            format!("{} makes more than 2000 lattice steps across the cylinder", s.grid_step),
+        ));
     }
     s.ga.validate().map_err(|e| match e {
-        crate::optim::OptimError::InvalidParameter { key, message } => spec.err(&format!("seed004.{}", key.replace("binary_ga", "ga")), message),
+        crate::optim::OptimError::InvalidParameter { key, message } => {
+            spec.err(&format!("seed004.{}", key.replace("binary_ga", "ga")), message)
+        }
         other => spec.err("seed004.ga", other),
     })?;
     Ok(())
@@ -128,7 +158,13 @@ pub(crate) fn limits(c: &Check, s: &Seed004Spec) -> Result<(), SpecError> {
     c.list("seed004.table2_generations", &s.table2_generations)?;
     c.optimiser_run("seed004", s.repeats, s.generations, s.population)?;
     c.int("seed004.rows", s.rows, limits::MAX_GRID_SIDE as u64)?;
-    for (key, v) in [("radius", s.radius), ("height", s.height), ("grid_step", s.grid_step), ("accuracy", s.accuracy), ("search_range", s.search_range)] {
+    for (key, v) in [
+        ("radius", s.radius),
+        ("height", s.height),
+        ("grid_step", s.grid_step),
+        ("accuracy", s.accuracy),
+        ("search_range", s.search_range),
+    ] {
         c.real(&format!("seed004.{key}"), v, 0.0, false, limits::MAX_LENGTH)?;
     }
     c.cells("seed004", &[s.control_points.len(), s.repeats])?;

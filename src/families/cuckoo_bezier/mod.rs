@@ -81,13 +81,21 @@ impl Seed003Spec {
             return bad("examples", "is empty".into());
         }
         if let Some(e) = self.examples.iter().find(|e| !EXAMPLES.contains(&e.as_str())) {
-            return bad("examples", format!("unknown example `{e}` (expected example1, example2 or example3)"));
+            return bad(
+                "examples",
+                format!("unknown example `{e}` (expected example1, example2 or example3)"),
+            );
         }
         if self.methods.is_empty() {
             return bad("methods", "is empty".into());
         }
         if let Some(m) = self.methods.iter().find(|m| !METHODS.contains(&m.as_str())) {
-            return bad("methods", format!("unknown method `{m}` (expected uniform, chordal, centripetal, csa or icsa)"));
+            return bad(
+                "methods",
+                format!(
+                    "unknown method `{m}` (expected uniform, chordal, centripetal, csa or icsa)"
+                ),
+            );
         }
         if self.runs == 0 {
             return bad("runs", "must be at least 1".into());
@@ -104,12 +112,24 @@ impl Seed003Spec {
         for name in EXAMPLES {
             let e = self.example(name).expect("known example");
             let key = |k: &str| format!("{name}.{k}");
-            let min = if name == "example3" { (e.degree + 1) * (e.degree + 1) } else { e.degree + 1 };
+            let min =
+                if name == "example3" { (e.degree + 1) * (e.degree + 1) } else { e.degree + 1 };
             if e.degree == 0 || e.size < min.max(3) {
-                return bad(&key("size"), format!("{} is too small for degree {} (at least {})", e.size, e.degree, min.max(3)));
+                return bad(
+                    &key("size"),
+                    format!(
+                        "{} is too small for degree {} (at least {})",
+                        e.size,
+                        e.degree,
+                        min.max(3)
+                    ),
+                );
             }
             if !(e.snr_db.is_finite()) {
-                return bad(&key("snr_db"), format!("must be a finite number of dB, got {}", e.snr_db));
+                return bad(
+                    &key("snr_db"),
+                    format!("must be a finite number of dB, got {}", e.snr_db),
+                );
             }
             if e.generations == 0 {
                 return bad(&key("generations"), "must be at least 1".into());
@@ -189,7 +209,11 @@ fn section(spec: &Spec) -> Result<&Seed003Spec> {
 /// The flat list of cells: examples x methods x runs.
 pub fn cells(spec: &Spec) -> Vec<Cell> {
     let Some(s) = &spec.file.seed003 else { return Vec::new() };
-    runner::product_cells(&s.examples, &s.methods, s.runs, |e, m, run| Cell { example: e.clone(), method: m.clone(), run })
+    runner::product_cells(&s.examples, &s.methods, s.runs, |e, m, run| Cell {
+        example: e.clone(),
+        method: m.clone(),
+        run,
+    })
 }
 
 /// Data of one run: the points, their layout, and the noise sigma.
@@ -202,8 +226,14 @@ pub struct Data {
 /// The clean data of an example (Example III from its fixed stream).
 pub fn clean(master_seed: u64, example: &str, e: &ExampleSpec) -> Result<(Vec<Point3>, Layout)> {
     Ok(match example {
-        "example1" => (bezier::height_grid(bezier::franke, e.size, 0.0, 1.0), Layout::Grid { nu: e.size, nv: e.size }),
-        "example2" => (bezier::height_grid(bezier::peaks, e.size, -3.0, 3.0), Layout::Grid { nu: e.size, nv: e.size }),
+        "example1" => (
+            bezier::height_grid(bezier::franke, e.size, 0.0, 1.0),
+            Layout::Grid { nu: e.size, nv: e.size },
+        ),
+        "example2" => (
+            bezier::height_grid(bezier::peaks, e.size, -3.0, 3.0),
+            Layout::Grid { nu: e.size, nv: e.size },
+        ),
         "example3" => {
             let mut rng = seeds::cell_rng(master_seed, "seed003/example3/surface");
             (bezier::example3(e.size, &mut rng).1, Layout::Scattered)
@@ -245,36 +275,51 @@ pub fn classical_start(d: &Data, p: Parameterisation) -> Vec<f64> {
 /// [0, 1]^dim (centre 0.5, half-width 0.5), one trace point every `trace_every` iterations (2N
 /// evaluations per iteration).
 pub fn budget(s: &Seed003Spec, e: &ExampleSpec) -> Budget {
-    Budget { generations: e.generations as u64, population: s.nests, init_range: 0.5, trace_every_evals: (2 * s.nests * s.trace_every) as u64 }
+    Budget {
+        generations: e.generations as u64,
+        population: s.nests,
+        init_range: 0.5,
+        trace_every_evals: (2 * s.nests * s.trace_every) as u64,
+    }
 }
 
 /// Run one cell (alone it gives the same numbers as inside the full run).
 pub fn run_cell(spec: &Spec, cell: &Cell) -> Result<Run> {
     let s = section(spec)?;
-    let e = s.example(&cell.example).with_context(|| format!("seed003.examples: unknown example `{}`", cell.example))?;
+    let e = s
+        .example(&cell.example)
+        .with_context(|| format!("seed003.examples: unknown example `{}`", cell.example))?;
     let key = cell.key();
     let master = spec.file.master_seed;
     let d = data(master, &cell.example, e, cell.run)?;
     let n = d.points.len();
     let t0 = runner::thread_cpu_seconds();
-    let (y, initial, evaluations, iterations, trace, dim) = if let Some(p) = classical(&cell.method) {
+    let (y, initial, evaluations, iterations, trace, dim) = if let Some(p) = classical(&cell.method)
+    {
         let x = classical_start(&d, p);
-        let prob = BezierParamProblem::new(e.degree, e.degree, d.layout, d.points, x.clone()).map_err(|err| anyhow::anyhow!("{key}: {err}"))?;
+        let prob = BezierParamProblem::new(e.degree, e.degree, d.layout, d.points, x.clone())
+            .map_err(|err| anyhow::anyhow!("{key}: {err}"))?;
         let y = prob.fitness(&x);
         (y, y, 1, 0, Vec::new(), prob.dim())
     } else {
-        let centre = vec![0.5; match d.layout {
-            Layout::Grid { nu, nv } => nu + nv,
-            Layout::Scattered => 2 * n,
-        }];
-        let prob = BezierParamProblem::new(e.degree, e.degree, d.layout, d.points, centre).map_err(|err| anyhow::anyhow!("{key}: {err}"))?;
+        let centre = vec![
+            0.5;
+            match d.layout {
+                Layout::Grid { nu, nv } => nu + nv,
+                Layout::Scattered => 2 * n,
+            }
+        ];
+        let prob = BezierParamProblem::new(e.degree, e.degree, d.layout, d.points, centre)
+            .map_err(|err| anyhow::anyhow!("{key}: {err}"))?;
         let opt: Box<dyn Optimiser> = match cell.method.as_str() {
             "csa" => Box::new(s.csa.clone()),
             "icsa" => Box::new(s.icsa.clone()),
             other => anyhow::bail!("seed003.methods: unknown method `{other}`"),
         };
         let mut rng = seeds::cell_rng(master, &key);
-        let r = opt.run(&prob, &budget(s, e), &mut rng).map_err(|err| anyhow::anyhow!("{key}: {err}"))?;
+        let r = opt
+            .run(&prob, &budget(s, e), &mut rng)
+            .map_err(|err| anyhow::anyhow!("{key}: {err}"))?;
         (r.best_fitness, r.initial_best_fitness, r.evaluations, e.generations, r.trace, prob.dim())
     };
     let cpu_s = runner::thread_cpu_seconds() - t0;
@@ -303,7 +348,13 @@ pub fn run_cell(spec: &Spec, cell: &Cell) -> Result<Run> {
 /// Run every cell of the spec.
 pub fn run(spec: &Spec, ctx: &RunContext) -> Result<Vec<Run>> {
     let cells = cells(spec);
-    runner::run_logged(&cells, ctx, &spec.file.name, |cell| run_cell(spec, cell), |_, (row, trace)| Ok(Run { row, trace }))
+    runner::run_logged(
+        &cells,
+        ctx,
+        &spec.file.name,
+        |cell| run_cell(spec, cell),
+        |_, (row, trace)| Ok(Run { row, trace }),
+    )
 }
 
 /// Seed 003's family: the `[seed003]` section.
@@ -316,7 +367,10 @@ impl crate::experiment::family::Family for Seed003 {
     fn present(&self, spec: &Spec) -> bool {
         spec.file.seed003.is_some()
     }
-    fn check_limits(&self, c: &crate::experiment::limits::Check) -> Result<(), crate::experiment::spec::SpecError> {
+    fn check_limits(
+        &self,
+        c: &crate::experiment::limits::Check,
+    ) -> Result<(), crate::experiment::spec::SpecError> {
         match &c.spec.file.seed003 {
             Some(s) => self::spec::limits(c, s),
             None => Ok(()),
@@ -330,10 +384,23 @@ impl crate::experiment::family::Family for Seed003 {
     fn logged_keys(&self, spec: &Spec) -> Vec<String> {
         cells(spec).iter().map(|c| c.key()).collect()
     }
-    fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<crate::experiment::family::Outcome> {
+    fn run(
+        &self,
+        spec: &Spec,
+        ctx: &RunContext,
+        tables: bool,
+    ) -> Result<crate::experiment::family::Outcome> {
         let s3 = section(spec)?;
         let runs = run(spec, ctx)?;
-        let section = if tables { Some(crate::families::cuckoo_bezier::report::write(s3, &runs, &ctx.out)?) } else { None };
-        Ok(crate::experiment::family::Outcome { section, cpu_s: runs.iter().map(|r| r.row.cpu_s).sum(), cells: runs.len() })
+        let section = if tables {
+            Some(crate::families::cuckoo_bezier::report::write(s3, &runs, &ctx.out)?)
+        } else {
+            None
+        };
+        Ok(crate::experiment::family::Outcome {
+            section,
+            cpu_s: runs.iter().map(|r| r.row.cpu_s).sum(),
+            cells: runs.len(),
+        })
     }
 }

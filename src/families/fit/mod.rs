@@ -4,17 +4,17 @@ pub mod pictures;
 pub mod report;
 pub mod spec;
 
+use crate::double_net::{DoubleNet, View};
 use crate::experiment::spec::{GridSize, Spec};
-use spec::{FitCell, FitSom};
 use crate::experiment::{runner, RunContext};
 use crate::families::som;
-use crate::double_net::{DoubleNet, View};
 use crate::families::som::spec::SomCell;
 use crate::io::write_atomic;
 use crate::som::{Model, SomParams};
 use crate::spline::{fit_two_view, FitOptions, TwoSurfaceFit, TwoViewGrid};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
+use spec::{FitCell, FitSom};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -74,7 +74,12 @@ pub fn map_file_name(dataset: &str, grid: GridSize) -> String {
 /// A trained DNSOM's weights as a two-view grid (border positions share their class's weight).
 pub fn grid_from_weights(nx: usize, ny: usize, weights: &[crate::geom::Point3]) -> TwoViewGrid {
     let net = DoubleNet::new(nx, ny).expect("grid sides at least 2");
-    let view = |v: View| (0..nx).flat_map(|i| (0..ny).map(move |j| (i, j))).map(|(i, j)| weights[net.class(v, i, j)]).collect();
+    let view = |v: View| {
+        (0..nx)
+            .flat_map(|i| (0..ny).map(move |j| (i, j)))
+            .map(|(i, j)| weights[net.class(v, i, j)])
+            .collect()
+    };
     TwoViewGrid { nx, ny, bottom: view(View::Bottom), top: view(View::Top) }
 }
 
@@ -86,7 +91,14 @@ pub fn maps(spec: &Spec, ctx: &RunContext) -> Result<BTreeMap<String, MapSource>
 }
 
 /// The maps of `datasets` at `grid`, from `maps_dir` or recomputed with `som` settings.
-pub fn maps_for(spec: &Spec, ctx: &RunContext, datasets: &[String], grid: GridSize, maps_dir: Option<&str>, som: Option<&FitSom>) -> Result<BTreeMap<String, MapSource>> {
+pub fn maps_for(
+    spec: &Spec,
+    ctx: &RunContext,
+    datasets: &[String],
+    grid: GridSize,
+    maps_dir: Option<&str>,
+    som: Option<&FitSom>,
+) -> Result<BTreeMap<String, MapSource>> {
     let dir: Option<PathBuf> = maps_dir.map(PathBuf::from);
     let mut out = BTreeMap::new();
     for entry in datasets {
@@ -113,16 +125,26 @@ pub fn maps_for(spec: &Spec, ctx: &RunContext, datasets: &[String], grid: GridSi
 
 fn read_map(path: &Path, grid: GridSize) -> Result<MapSource> {
     let text = crate::io::read_text(path)?;
-    let g = crate::data::grid_csv::parse_two_view_grid(&text).with_context(|| path.display().to_string())?;
+    let g = crate::data::grid_csv::parse_two_view_grid(&text)
+        .with_context(|| path.display().to_string())?;
     if (g.nx, g.ny) != (grid.nx, grid.ny) {
         anyhow::bail!("{}: map is {}x{}, the spec's grid is {grid}", path.display(), g.nx, g.ny);
     }
     Ok(MapSource { grid: g, origin: path.display().to_string() })
 }
 
-fn recompute_map(spec: &Spec, ctx: &RunContext, data: &str, grid: GridSize, som: Option<&FitSom>) -> Result<MapSource> {
+fn recompute_map(
+    spec: &Spec,
+    ctx: &RunContext,
+    data: &str,
+    grid: GridSize,
+    som: Option<&FitSom>,
+) -> Result<MapSource> {
     let (seed, params) = match som {
-        Some(s) => (s.master_seed.unwrap_or(spec.file.master_seed), SomParams { iterations: s.iterations, alpha0: s.alpha0, sigma0: None }),
+        Some(s) => (
+            s.master_seed.unwrap_or(spec.file.master_seed),
+            SomParams { iterations: s.iterations, alpha0: s.alpha0, sigma0: None },
+        ),
         None => (spec.file.master_seed, SomParams::default()),
     };
     let clouds = som::load_datasets(spec, &[data.to_string()], ctx)?;
@@ -132,18 +154,28 @@ fn recompute_map(spec: &Spec, ctx: &RunContext, data: &str, grid: GridSize, som:
     let run = som::run_cell(&cell, &clouds[&name].points, &params, seed)?;
     Ok(MapSource {
         grid: grid_from_weights(grid.nx, grid.ny, &run.weights),
-        origin: format!("recomputed: {} with master seed {seed}, T = {}", cell.key(), params.iterations),
+        origin: format!(
+            "recomputed: {} with master seed {seed}, T = {}",
+            cell.key(),
+            params.iterations
+        ),
     })
 }
 
 /// Fit one cell.
 pub fn run_cell(cell: &FitCell, grid: &TwoViewGrid, opts: &FitOptions) -> Result<FitRun> {
     let t0 = runner::thread_cpu_seconds();
-    let fit = fit_two_view(grid, cell.cn.nx, cell.cn.ny, cell.param, cell.approach, opts).with_context(|| cell.key())?;
+    let fit = fit_two_view(grid, cell.cn.nx, cell.cn.ny, cell.param, cell.approach, opts)
+        .with_context(|| cell.key())?;
     let cpu_s = runner::thread_cpu_seconds() - t0;
     let dense = fit.dense_geometry(grid);
     if !(fit.surface_error.is_finite() && dense.excursion.is_finite()) {
-        anyhow::bail!("{}: the fit is not finite (surface error {}, excursion {})", cell.key(), fit.surface_error, dense.excursion);
+        anyhow::bail!(
+            "{}: the fit is not finite (surface error {}, excursion {})",
+            cell.key(),
+            fit.surface_error,
+            dense.excursion
+        );
     }
     let row = FitRow {
         cell: cell.key(),
@@ -167,12 +199,22 @@ pub fn run_cell(cell: &FitCell, grid: &TwoViewGrid, opts: &FitOptions) -> Result
 }
 
 /// Run every fit cell of a spec.
-pub fn run(spec: &Spec, ctx: &RunContext, maps: &BTreeMap<String, MapSource>) -> Result<Vec<FitRun>> {
+pub fn run(
+    spec: &Spec,
+    ctx: &RunContext,
+    maps: &BTreeMap<String, MapSource>,
+) -> Result<Vec<FitRun>> {
     let cells = spec::cells(spec);
     let opts = spec.file.fit.as_ref().context("spec has no [fit] section")?.fit_options();
     // A logged cell's fit is rebuilt from its map (deterministic, a fraction of a millisecond);
     // the logged row, with its CPU time, is kept.
-    runner::run_logged(&cells, ctx, &spec.file.name, |cell| run_cell(cell, &maps[&cell.dataset].grid, &opts), |cell, row| Ok(FitRun { row, ..run_cell(cell, &maps[&cell.dataset].grid, &opts)? }))
+    runner::run_logged(
+        &cells,
+        ctx,
+        &spec.file.name,
+        |cell| run_cell(cell, &maps[&cell.dataset].grid, &opts),
+        |cell, row| Ok(FitRun { row, ..run_cell(cell, &maps[&cell.dataset].grid, &opts)? }),
+    )
 }
 
 /// Chapter 5's family: the `[fit]` section.
@@ -185,7 +227,10 @@ impl crate::experiment::family::Family for Fit {
     fn present(&self, spec: &Spec) -> bool {
         spec.file.fit.is_some()
     }
-    fn check_limits(&self, c: &crate::experiment::limits::Check) -> Result<(), crate::experiment::spec::SpecError> {
+    fn check_limits(
+        &self,
+        c: &crate::experiment::limits::Check,
+    ) -> Result<(), crate::experiment::spec::SpecError> {
         match &c.spec.file.fit {
             Some(s) => self::spec::limits(c, s),
             None => Ok(()),
@@ -208,16 +253,33 @@ impl crate::experiment::family::Family for Fit {
     fn logged_keys(&self, spec: &Spec) -> Vec<String> {
         spec::cells(spec).iter().map(|c| c.key()).collect()
     }
-    fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<crate::experiment::family::Outcome> {
+    fn run(
+        &self,
+        spec: &Spec,
+        ctx: &RunContext,
+        tables: bool,
+    ) -> Result<crate::experiment::family::Outcome> {
         let maps = maps(spec, ctx)?;
         let runs = run(spec, ctx, &maps)?;
-        let origins: Vec<(String, String)> = maps.iter().map(|(d, m)| (d.clone(), m.origin.clone())).collect();
+        let origins: Vec<(String, String)> =
+            maps.iter().map(|(d, m)| (d.clone(), m.origin.clone())).collect();
         let pictures = spec.file.fit.as_ref().map(|f| f.pictures).unwrap_or(false);
-        let section = if tables { Some(crate::families::fit::report::write(&runs, &ctx.out, &origins, pictures)?) } else { None };
+        let section = if tables {
+            Some(crate::families::fit::report::write(&runs, &ctx.out, &origins, pictures)?)
+        } else {
+            None
+        };
         if tables && pictures {
             let grids: Vec<_> = maps.iter().map(|(d, m)| (d.clone(), &m.grid)).collect();
-            crate::report::views3d::write(&ctx.out, &crate::families::fit::pictures::views(&runs, &grids))?;
+            crate::report::views3d::write(
+                &ctx.out,
+                &crate::families::fit::pictures::views(&runs, &grids),
+            )?;
         }
-        Ok(crate::experiment::family::Outcome { section, cpu_s: runs.iter().map(|r| r.row.cpu_s).sum(), cells: runs.len() })
+        Ok(crate::experiment::family::Outcome {
+            section,
+            cpu_s: runs.iter().map(|r| r.row.cpu_s).sum(),
+            cells: runs.len(),
+        })
     }
 }

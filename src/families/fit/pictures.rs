@@ -2,9 +2,9 @@
 //! columns: each parameterisation's A beside B; the fitted surfaces as two-colour wireframes
 //! evaluated densely between the data parameters), and a chart of surface error against control-net size.
 
-use crate::report::plots::{self, style, LineMesh, Panel, Series};
-use crate::families::fit::FitRun;
 use crate::experiment::spec::GridSize;
+use crate::families::fit::FitRun;
+use crate::report::plots::{self, style, LineMesh, Panel, Series};
 use crate::spline::Approach;
 use anyhow::Result;
 use std::path::Path;
@@ -14,7 +14,12 @@ use std::path::Path;
 fn surface_meshes(run: &FitRun) -> Vec<LineMesh> {
     let [(bottom, be), (top, te)] = run.fit.dense_wireframes();
     vec![
-        LineMesh { points: bottom, edges: be, colour: style::DNSOM_BOTTOM, label: "bottom surface".into() },
+        LineMesh {
+            points: bottom,
+            edges: be,
+            colour: style::DNSOM_BOTTOM,
+            label: "bottom surface".into(),
+        },
         LineMesh { points: top, edges: te, colour: style::DNSOM_TOP, label: "top surface".into() },
     ]
 }
@@ -45,8 +50,16 @@ pub fn write(runs: &[FitRun], grid: GridSize, out: &Path) -> Result<Vec<String>>
         let mut panels = Vec::new();
         for &cn in &cns {
             for &(p, a) in &columns {
-                let run = runs.iter().find(|r| &r.cell.dataset == d && r.cell.cn == cn && r.cell.param == p && r.cell.approach == a);
-                panels.push(Panel { title: format!("{cn} {} {}", p.name(), a.letter()), meshes: run.map(surface_meshes).unwrap_or_default() });
+                let run = runs.iter().find(|r| {
+                    &r.cell.dataset == d
+                        && r.cell.cn == cn
+                        && r.cell.param == p
+                        && r.cell.approach == a
+                });
+                panels.push(Panel {
+                    title: format!("{cn} {} {}", p.name(), a.letter()),
+                    meshes: run.map(surface_meshes).unwrap_or_default(),
+                });
             }
         }
         let name = format!("png/{appendix}_{d}.png");
@@ -66,11 +79,22 @@ pub fn write(runs: &[FitRun], grid: GridSize, out: &Path) -> Result<Vec<String>>
                     .iter()
                     .filter(|c| c.0 == p)
                     .map(|&(_, a)| Series {
-                        label: format!("{} ({})", a.letter(), if a == Approach::Improved { "improved" } else { "conventional" }),
+                        label: format!(
+                            "{} ({})",
+                            a.letter(),
+                            if a == Approach::Improved { "improved" } else { "conventional" }
+                        ),
                         colour: if a == Approach::Improved { style::BLUE } else { style::ORANGE },
                         points: cns
                             .iter()
-                            .filter_map(|&cn| runs.iter().find(|r| &r.cell.dataset == d && r.cell.cn == cn && r.cell.param == p && r.cell.approach == a))
+                            .filter_map(|&cn| {
+                                runs.iter().find(|r| {
+                                    &r.cell.dataset == d
+                                        && r.cell.cn == cn
+                                        && r.cell.param == p
+                                        && r.cell.approach == a
+                                })
+                            })
                             .map(|r| ((r.cell.cn.nx * r.cell.cn.ny) as f64, r.row.surface_error))
                             .collect(),
                         band: None,
@@ -80,7 +104,15 @@ pub fn write(runs: &[FitRun], grid: GridSize, out: &Path) -> Result<Vec<String>>
             })
             .collect();
         let chart = format!("png/error_vs_cn_{grid}_{d}.png");
-        match plots::small_multiples_png(&out.join(&chart), &format!("{d}, grid {grid}: surface error (Eq. 5.13) against control-net size"), "control points per view (CNx x CNy)", "surface error", &panels, 2, true) {
+        match plots::small_multiples_png(
+            &out.join(&chart),
+            &format!("{d}, grid {grid}: surface error (Eq. 5.13) against control-net size"),
+            "control points per view (CNx x CNy)",
+            "surface error",
+            &panels,
+            2,
+            true,
+        ) {
             Ok(()) => written.push(chart),
             Err(e) => eprintln!("somnurbs: warning: picture skipped: {e}"),
         }
@@ -92,25 +124,61 @@ pub fn write(runs: &[FitRun], grid: GridSize, out: &Path) -> Result<Vec<String>>
 /// along the grid rows and columns) and, per approach, the fitted surfaces evaluated densely of
 /// the cell whose surfaces go furthest from the data (largest `excursion`), so a blow-up between
 /// the data points shows.
-pub fn views(runs: &[FitRun], maps: &[(String, &crate::double_net::TwoViewGrid)]) -> Vec<crate::report::views3d::View> {
+pub fn views(
+    runs: &[FitRun],
+    maps: &[(String, &crate::double_net::TwoViewGrid)],
+) -> Vec<crate::report::views3d::View> {
     use crate::report::views3d::{hex, Trace, View};
     let mut views = Vec::new();
     for (d, grid) in maps {
         let (nx, ny) = (grid.nx, grid.ny);
-        let mut lines: Vec<Vec<usize>> = (0..nx).map(|i| (0..ny).map(|j| i * ny + j).collect()).collect();
+        let mut lines: Vec<Vec<usize>> =
+            (0..nx).map(|i| (0..ny).map(|j| i * ny + j).collect()).collect();
         lines.extend((0..ny).map(|j| (0..nx).map(|i| i * ny + j).collect()));
-        let traces = [("bottom view", &grid.bottom, style::DNSOM_BOTTOM), ("top view", &grid.top, style::DNSOM_TOP)]
-            .map(|(label, pts, c)| Trace::Points { label: label.into(), colour: hex(c), points: pts.clone(), lines: lines.clone() });
+        let traces = [
+            ("bottom view", &grid.bottom, style::DNSOM_BOTTOM),
+            ("top view", &grid.top, style::DNSOM_TOP),
+        ]
+        .map(|(label, pts, c)| Trace::Points {
+            label: label.into(),
+            colour: hex(c),
+            points: pts.clone(),
+            lines: lines.clone(),
+        });
         views.push(View { title: format!("{d}: DNSOM map {nx}x{ny}"), traces: traces.to_vec() });
         for a in [Approach::Conventional, Approach::Improved] {
-            let worst = runs.iter().filter(|r| &r.cell.dataset == d && r.cell.approach == a).max_by(|x, y| x.row.excursion.total_cmp(&y.row.excursion));
+            let worst = runs
+                .iter()
+                .filter(|r| &r.cell.dataset == d && r.cell.approach == a)
+                .max_by(|x, y| x.row.excursion.total_cmp(&y.row.excursion));
             let Some(r) = worst else { continue };
             let f = &r.fit;
-            let traces = [("bottom surface", &f.bottom, 0, style::DNSOM_BOTTOM), ("top surface", &f.top, 1, style::DNSOM_TOP)].map(|(label, s, k, c)| {
-                let (points, du, dv) = crate::spline::geometry::dense_grid(s, &f.params_u[k], &f.params_v[k], crate::spline::DENSE_FACTOR);
-                Trace::Surface { label: label.into(), colour: hex(c), rows: du.len(), cols: dv.len(), points }
+            let traces = [
+                ("bottom surface", &f.bottom, 0, style::DNSOM_BOTTOM),
+                ("top surface", &f.top, 1, style::DNSOM_TOP),
+            ]
+            .map(|(label, s, k, c)| {
+                let (points, du, dv) = crate::spline::geometry::dense_grid(
+                    s,
+                    &f.params_u[k],
+                    &f.params_v[k],
+                    crate::spline::DENSE_FACTOR,
+                );
+                Trace::Surface {
+                    label: label.into(),
+                    colour: hex(c),
+                    rows: du.len(),
+                    cols: dv.len(),
+                    points,
+                }
             });
-            let title = format!("{d}: {} surfaces furthest from the data (CN {}, {}, excursion {:.3e})", a.letter(), r.cell.cn, r.cell.param.name(), r.row.excursion);
+            let title = format!(
+                "{d}: {} surfaces furthest from the data (CN {}, {}, excursion {:.3e})",
+                a.letter(),
+                r.cell.cn,
+                r.cell.param.name(),
+                r.row.excursion
+            );
             views.push(View { title, traces: traces.to_vec() });
         }
     }

@@ -1,13 +1,13 @@
 //! Chapter 5 outputs: runs.csv, Appendix E/F (surface error of A and B per parameterisation), the
 //! win-count tables 5.4-5.9, the gap table, the charts and pictures and the REPORT.md section.
 
-use crate::report::claims::Claim;
-use crate::report::ordered;
-use crate::io::{csv_records, csv_text, write_atomic};
-use crate::report::markdown::{beside, num, table};
-use crate::report::reference::{self, RefTable};
-use crate::families::fit::FitRun;
 use crate::experiment::spec::GridSize;
+use crate::families::fit::FitRun;
+use crate::io::{csv_records, csv_text, write_atomic};
+use crate::report::claims::Claim;
+use crate::report::markdown::{beside, num, table};
+use crate::report::ordered;
+use crate::report::reference::{self, RefTable};
 use crate::spline::{Approach, Parameterisation};
 use anyhow::Result;
 use std::fmt::Write;
@@ -16,25 +16,56 @@ use std::path::Path;
 /// Names of a grid's tables: (appendix, param wins for A, param wins for B, A vs B).
 fn table_names(grid: GridSize) -> (String, String, String, String) {
     match (grid.nx, grid.ny) {
-        (20, 20) => ("appendix_e".into(), "table_5_4".into(), "table_5_5".into(), "table_5_6".into()),
-        (18, 30) => ("appendix_f".into(), "table_5_7".into(), "table_5_8".into(), "table_5_9".into()),
-        _ => (format!("surface_error_{grid}"), format!("param_wins_A_{grid}"), format!("param_wins_B_{grid}"), format!("approach_wins_{grid}")),
+        (20, 20) => {
+            ("appendix_e".into(), "table_5_4".into(), "table_5_5".into(), "table_5_6".into())
+        }
+        (18, 30) => {
+            ("appendix_f".into(), "table_5_7".into(), "table_5_8".into(), "table_5_9".into())
+        }
+        _ => (
+            format!("surface_error_{grid}"),
+            format!("param_wins_A_{grid}"),
+            format!("param_wins_B_{grid}"),
+            format!("approach_wins_{grid}"),
+        ),
     }
 }
 
 /// Surface error of a (data, cn, param, approach) cell, from the runs or from a published table.
 type ErrorOf<'a> = dyn Fn(&str, GridSize, Parameterisation, Approach) -> Option<f64> + 'a;
 
-fn runs_error(runs: &[FitRun]) -> impl Fn(&str, GridSize, Parameterisation, Approach) -> Option<f64> + '_ {
-    move |d, cn, p, a| runs.iter().find(|r| r.cell.dataset == d && r.cell.cn == cn && r.cell.param == p && r.cell.approach == a).map(|r| r.row.surface_error)
+fn runs_error(
+    runs: &[FitRun],
+) -> impl Fn(&str, GridSize, Parameterisation, Approach) -> Option<f64> + '_ {
+    move |d, cn, p, a| {
+        runs.iter()
+            .find(|r| {
+                r.cell.dataset == d && r.cell.cn == cn && r.cell.param == p && r.cell.approach == a
+            })
+            .map(|r| r.row.surface_error)
+    }
 }
 
-fn thesis_error(t: &RefTable) -> impl Fn(&str, GridSize, Parameterisation, Approach) -> Option<f64> + '_ {
-    move |d, cn, p, a| t.value(&["data", "cn_x", "cn_y"], &[d.to_string(), cn.nx.to_string(), cn.ny.to_string()], &format!("{}_{}", p.name(), a.letter()))
+fn thesis_error(
+    t: &RefTable,
+) -> impl Fn(&str, GridSize, Parameterisation, Approach) -> Option<f64> + '_ {
+    move |d, cn, p, a| {
+        t.value(
+            &["data", "cn_x", "cn_y"],
+            &[d.to_string(), cn.nx.to_string(), cn.ny.to_string()],
+            &format!("{}_{}", p.name(), a.letter()),
+        )
+    }
 }
 
 /// Per data set: how many control nets each parameterisation had the least error for approach `a`.
-fn param_wins(err: &ErrorOf, data: &[String], cns: &[GridSize], params: &[Parameterisation], a: Approach) -> Vec<(String, Vec<usize>, usize)> {
+fn param_wins(
+    err: &ErrorOf,
+    data: &[String],
+    cns: &[GridSize],
+    params: &[Parameterisation],
+    a: Approach,
+) -> Vec<(String, Vec<usize>, usize)> {
     data.iter()
         .map(|d| {
             let mut wins = vec![0; params.len()];
@@ -55,13 +86,20 @@ fn param_wins(err: &ErrorOf, data: &[String], cns: &[GridSize], params: &[Parame
 }
 
 /// Per (data, param): control nets where A had less error than B, and where B had less (ties to neither).
-fn approach_wins(err: &ErrorOf, data: &[String], cns: &[GridSize], params: &[Parameterisation]) -> Vec<(String, Parameterisation, usize, usize, usize)> {
+fn approach_wins(
+    err: &ErrorOf,
+    data: &[String],
+    cns: &[GridSize],
+    params: &[Parameterisation],
+) -> Vec<(String, Parameterisation, usize, usize, usize)> {
     let mut out = Vec::new();
     for d in data {
         for &p in params {
             let (mut a_w, mut b_w, mut cells) = (0, 0, 0);
             for &cn in cns {
-                if let (Some(a), Some(b)) = (err(d, cn, p, Approach::Conventional), err(d, cn, p, Approach::Improved)) {
+                if let (Some(a), Some(b)) =
+                    (err(d, cn, p, Approach::Conventional), err(d, cn, p, Approach::Improved))
+                {
                     cells += 1;
                     a_w += (a < b) as usize;
                     b_w += (b < a) as usize;
@@ -74,11 +112,23 @@ fn approach_wins(err: &ErrorOf, data: &[String], cns: &[GridSize], params: &[Par
 }
 
 /// Write every Chapter 5 file; returns the REPORT.md section.
-pub fn write(runs: &[FitRun], out: &Path, maps_origin: &[(String, String)], pictures: bool) -> Result<String> {
+pub fn write(
+    runs: &[FitRun],
+    out: &Path,
+    maps_origin: &[(String, String)],
+    pictures: bool,
+) -> Result<String> {
     let rows: Vec<_> = runs.iter().map(|r| r.row.clone()).collect();
     write_atomic(&out.join("runs.csv"), csv_text(&rows)?.as_bytes())?;
-    let mut s = String::from("## Chapter 5: cubic B-spline approximation, conventional (A) vs improved (B)\n\n");
-    let _ = writeln!(s, "{} fits. Maps: {}.\n", runs.len(), maps_origin.iter().map(|(d, o)| format!("{d} from {o}")).collect::<Vec<_>>().join("; "));
+    let mut s = String::from(
+        "## Chapter 5: cubic B-spline approximation, conventional (A) vs improved (B)\n\n",
+    );
+    let _ = writeln!(
+        s,
+        "{} fits. Maps: {}.\n",
+        runs.len(),
+        maps_origin.iter().map(|(d, o)| format!("{d} from {o}")).collect::<Vec<_>>().join("; ")
+    );
     s.push_str(&method(runs));
     let mut claims = Vec::new();
     for grid in ordered(runs.iter().map(|r| r.cell.grid)) {
@@ -109,13 +159,22 @@ pub fn write(runs: &[FitRun], out: &Path, maps_origin: &[(String, String)], pict
             for &cn in &cns {
                 let mut row = vec![d.clone(), cn.nx.to_string(), cn.ny.to_string()];
                 for col in &header[3..] {
-                    let v = Parameterisation::ALL.iter().flat_map(|&p| [Approach::Conventional, Approach::Improved].map(move |a| (p, a))).find(|(p, a)| format!("{}_{}", p.name(), a.letter()) == *col).and_then(|(p, a)| ours(d, cn, p, a));
+                    let v = Parameterisation::ALL
+                        .iter()
+                        .flat_map(|&p| {
+                            [Approach::Conventional, Approach::Improved].map(move |a| (p, a))
+                        })
+                        .find(|(p, a)| format!("{}_{}", p.name(), a.letter()) == *col)
+                        .and_then(|(p, a)| ours(d, cn, p, a));
                     row.push(v.map(|x| format!("{x:.6}")).unwrap_or_default());
                 }
                 app_rows.push(row);
             }
         }
-        write_atomic(&out.join(format!("{app_name}.csv")), csv_records(&header, &app_rows)?.as_bytes())?;
+        write_atomic(
+            &out.join(format!("{app_name}.csv")),
+            csv_records(&header, &app_rows)?.as_bytes(),
+        )?;
 
         // Win counts.
         let mut wins_md = String::new();
@@ -127,67 +186,154 @@ pub fn write(runs: &[FitRun], out: &Path, maps_origin: &[(String, String)], pict
             let mut h = vec!["data".to_string()];
             h.extend(params.iter().map(|p| p.name().to_string()));
             h.push("cells".into());
-            let mut rows: Vec<Vec<String>> = w.iter().map(|(d, v, c)| std::iter::once(d.clone()).chain(v.iter().map(|x| x.to_string())).chain(std::iter::once(c.to_string())).collect()).collect();
-            let totals: Vec<usize> = (0..params.len()).map(|k| w.iter().map(|x| x.1[k]).sum()).collect();
+            let mut rows: Vec<Vec<String>> = w
+                .iter()
+                .map(|(d, v, c)| {
+                    std::iter::once(d.clone())
+                        .chain(v.iter().map(|x| x.to_string()))
+                        .chain(std::iter::once(c.to_string()))
+                        .collect()
+                })
+                .collect();
+            let totals: Vec<usize> =
+                (0..params.len()).map(|k| w.iter().map(|x| x.1[k]).sum()).collect();
             let cells: usize = w.iter().map(|x| x.2).sum();
-            rows.push(std::iter::once("total".to_string()).chain(totals.iter().map(|x| x.to_string())).chain(std::iter::once(cells.to_string())).collect());
+            rows.push(
+                std::iter::once("total".to_string())
+                    .chain(totals.iter().map(|x| x.to_string()))
+                    .chain(std::iter::once(cells.to_string()))
+                    .collect(),
+            );
             write_atomic(&out.join(format!("{name}.csv")), csv_records(&h, &rows)?.as_bytes())?;
             let _ = write!(wins_md, "\n**`{name}.csv`**: control nets where each parameterisation gives approach {} the least surface error\n\n{}", a.letter(), table(&h, &rows));
             // Claim: the thesis' best parameterisation per approach.
-            let thesis_best = if a == Approach::Conventional { Parameterisation::Exponential } else { Parameterisation::ChordLength };
+            let thesis_best = if a == Approach::Conventional {
+                Parameterisation::Exponential
+            } else {
+                Parameterisation::ChordLength
+            };
             if let Some(k) = params.iter().position(|&p| p == thesis_best) {
                 let t_counts = thesis.as_ref().map(|t| {
                     let te = thesis_error(t);
                     let tw = param_wins(&te, &data, &cns, &params, a);
-                    let tt: Vec<usize> = (0..params.len()).map(|k| tw.iter().map(|x| x.1[k]).sum()).collect();
+                    let tt: Vec<usize> =
+                        (0..params.len()).map(|k| tw.iter().map(|x| x.1[k]).sum()).collect();
                     (tt[k], tw.iter().map(|x| x.2).sum::<usize>())
                 });
                 // Counted in cells, as the thesis counts them: X wins `totals[k]` of `cells` and
                 // holds when no other parameterisation wins as many.
-                let rival = totals.iter().enumerate().filter(|&(j, _)| j != k).map(|(_, &t)| t).max().unwrap_or(0);
+                let rival = totals
+                    .iter()
+                    .enumerate()
+                    .filter(|&(j, _)| j != k)
+                    .map(|(_, &t)| t)
+                    .max()
+                    .unwrap_or(0);
                 claims.push(Claim {
                     chapter: "5".into(),
                     rival: Some(rival),
-                    statement: format!("{} is the best parameterisation for approach {} (grid {grid})", thesis_best.name(), a.letter()),
+                    statement: format!(
+                        "{} is the best parameterisation for approach {} (grid {grid})",
+                        thesis_best.name(),
+                        a.letter()
+                    ),
                     ours: (totals[k], cells),
                     thesis: t_counts.map(|(w, c)| (w, c)),
-                    note: format!("wins here: {}", params.iter().zip(&totals).map(|(p, t)| format!("{} {t}", p.name())).collect::<Vec<_>>().join(", ")),
+                    note: format!(
+                        "wins here: {}",
+                        params
+                            .iter()
+                            .zip(&totals)
+                            .map(|(p, t)| format!("{} {t}", p.name()))
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    ),
                 });
             }
         }
-        if approaches.contains(&Approach::Conventional) && approaches.contains(&Approach::Improved) {
+        if approaches.contains(&Approach::Conventional) && approaches.contains(&Approach::Improved)
+        {
             let ab = approach_wins(&ours, &data, &cns, &params);
-            let h: Vec<String> = ["data", "parameterisation", "a_wins", "b_wins", "cells"].iter().map(|s| s.to_string()).collect();
-            let mut rows: Vec<Vec<String>> = ab.iter().map(|(d, p, a, b, c)| vec![d.clone(), p.name().into(), a.to_string(), b.to_string(), c.to_string()]).collect();
-            let (ta, tb, tc) = ab.iter().fold((0, 0, 0), |acc, x| (acc.0 + x.2, acc.1 + x.3, acc.2 + x.4));
-            rows.push(vec!["total".into(), String::new(), ta.to_string(), tb.to_string(), tc.to_string()]);
+            let h: Vec<String> = ["data", "parameterisation", "a_wins", "b_wins", "cells"]
+                .iter()
+                .map(|s| s.to_string())
+                .collect();
+            let mut rows: Vec<Vec<String>> = ab
+                .iter()
+                .map(|(d, p, a, b, c)| {
+                    vec![d.clone(), p.name().into(), a.to_string(), b.to_string(), c.to_string()]
+                })
+                .collect();
+            let (ta, tb, tc) =
+                ab.iter().fold((0, 0, 0), |acc, x| (acc.0 + x.2, acc.1 + x.3, acc.2 + x.4));
+            rows.push(vec![
+                "total".into(),
+                String::new(),
+                ta.to_string(),
+                tb.to_string(),
+                tc.to_string(),
+            ]);
             write_atomic(&out.join(format!("{ab_name}.csv")), csv_records(&h, &rows)?.as_bytes())?;
             let _ = write!(wins_md, "\n**`{ab_name}.csv`**: control nets where A or B has the smaller surface error\n\n{}", table(&h, &rows));
             let thesis_ab = thesis.as_ref().map(|t| {
                 let te = thesis_error(t);
-                approach_wins(&te, &data, &cns, &params).iter().fold((0, 0), |acc, x| (acc.0 + x.3, acc.1 + x.4))
+                approach_wins(&te, &data, &cns, &params)
+                    .iter()
+                    .fold((0, 0), |acc, x| (acc.0 + x.3, acc.1 + x.4))
             });
             claims.push(Claim { rival: None, chapter: "5".into(), statement: format!("B beats A in most cells (grid {grid})"), ours: (tb, tc), thesis: thesis_ab, note: "cells where B has the smaller surface error; verdict 'mostly holds' when more than half".into() });
             // Gaps.
-            let gh: Vec<String> = ["data", "cn_x", "cn_y", "parameterisation", "gap_A", "gap_B"].iter().map(|s| s.to_string()).collect();
+            let gh: Vec<String> = ["data", "cn_x", "cn_y", "parameterisation", "gap_A", "gap_B"]
+                .iter()
+                .map(|s| s.to_string())
+                .collect();
             let mut gap_rows = Vec::new();
             let (mut b_zero, mut b_all, mut a_pos) = (0, 0, 0);
             for d in &data {
                 for &cn in &cns {
                     for &p in &params {
-                        let find = |a: Approach| g_runs.iter().find(|r| &r.cell.dataset == d && r.cell.cn == cn && r.cell.param == p && r.cell.approach == a).map(|r| r.row.gap);
+                        let find = |a: Approach| {
+                            g_runs
+                                .iter()
+                                .find(|r| {
+                                    &r.cell.dataset == d
+                                        && r.cell.cn == cn
+                                        && r.cell.param == p
+                                        && r.cell.approach == a
+                                })
+                                .map(|r| r.row.gap)
+                        };
                         let (ga, gb) = (find(Approach::Conventional), find(Approach::Improved));
                         if let Some(gb) = gb {
                             b_all += 1;
                             b_zero += (gb == 0.0) as usize;
                         }
                         a_pos += ga.map(|g| (g > 0.0) as usize).unwrap_or(0);
-                        gap_rows.push(vec![d.clone(), cn.nx.to_string(), cn.ny.to_string(), p.name().into(), num(ga, 9), num(gb, 9)]);
+                        gap_rows.push(vec![
+                            d.clone(),
+                            cn.nx.to_string(),
+                            cn.ny.to_string(),
+                            p.name().into(),
+                            num(ga, 9),
+                            num(gb, 9),
+                        ]);
                     }
                 }
             }
-            write_atomic(&out.join(format!("gaps_{grid}.csv")), csv_records(&gh, &gap_rows)?.as_bytes())?;
-            claims.push(Claim { rival: None, chapter: "5".into(), statement: format!("The improved approach B leaves no gap (grid {grid})"), ours: (b_zero, b_all), thesis: None, note: format!("gap exactly 0; A has a positive gap in {a_pos} cells (`gaps_{grid}.csv`)") });
+            write_atomic(
+                &out.join(format!("gaps_{grid}.csv")),
+                csv_records(&gh, &gap_rows)?.as_bytes(),
+            )?;
+            claims.push(Claim {
+                rival: None,
+                chapter: "5".into(),
+                statement: format!("The improved approach B leaves no gap (grid {grid})"),
+                ours: (b_zero, b_all),
+                thesis: None,
+                note: format!(
+                    "gap exactly 0; A has a positive gap in {a_pos} cells (`gaps_{grid}.csv`)"
+                ),
+            });
         }
         // Error falls as the control net grows.
         let mut sorted = cns.clone();
@@ -197,7 +343,8 @@ pub fn write(runs: &[FitRun], out: &Path, maps_origin: &[(String, String)], pict
             for d in &data {
                 for &p in &params {
                     for &a in &approaches {
-                        let v: Option<Vec<f64>> = sorted.iter().map(|&cn| err(d, cn, p, a)).collect();
+                        let v: Option<Vec<f64>> =
+                            sorted.iter().map(|&cn| err(d, cn, p, a)).collect();
                         if let Some(v) = v.filter(|v| v.len() > 1) {
                             all += 1;
                             yes += v.windows(2).all(|w| w[1] < w[0]) as usize;
@@ -208,7 +355,14 @@ pub fn write(runs: &[FitRun], out: &Path, maps_origin: &[(String, String)], pict
             (yes, all)
         };
         let t_series = thesis.as_ref().map(|t| series(&thesis_error(t)));
-        claims.push(Claim { rival: None, chapter: "5".into(), statement: format!("Surface error falls as the control net grows (grid {grid})"), ours: series(&ours), thesis: t_series, note: "per (data, parameterisation, approach) series".into() });
+        claims.push(Claim {
+            rival: None,
+            chapter: "5".into(),
+            statement: format!("Surface error falls as the control net grows (grid {grid})"),
+            ours: series(&ours),
+            thesis: t_series,
+            note: "per (data, parameterisation, approach) series".into(),
+        });
         if let Some(t) = &thesis {
             let ratios = thesis_ratios(&ours, &thesis_error(t), &data, &cns, &params, &approaches);
             let (md, claim) = render_thesis_ratios(&ratios, grid, &app_name, out)?;
@@ -267,7 +421,14 @@ struct Ratio {
     cells: usize,
 }
 
-fn thesis_ratios(ours: &ErrorOf, thesis: &ErrorOf, data: &[String], cns: &[GridSize], params: &[Parameterisation], approaches: &[Approach]) -> Vec<Ratio> {
+fn thesis_ratios(
+    ours: &ErrorOf,
+    thesis: &ErrorOf,
+    data: &[String],
+    cns: &[GridSize],
+    params: &[Parameterisation],
+    approaches: &[Approach],
+) -> Vec<Ratio> {
     let mut out = Vec::new();
     for &cn in cns {
         let mut r = Vec::new();
@@ -294,20 +455,46 @@ fn thesis_ratios(ours: &ErrorOf, thesis: &ErrorOf, data: &[String], cns: &[GridS
 /// The band within which a median ratio counts as "the thesis' magnitude".
 const RATIO_BAND: (f64, f64) = (0.8, 1.25);
 
-fn render_thesis_ratios(ratios: &[Ratio], grid: GridSize, app_name: &str, out: &Path) -> Result<(String, Claim)> {
-    let h: Vec<String> = ["cn_x", "cn_y", "median_ratio", "min_ratio", "max_ratio", "cells"].iter().map(|s| s.to_string()).collect();
-    let rows: Vec<Vec<String>> = ratios.iter().map(|r| vec![r.cn.nx.to_string(), r.cn.ny.to_string(), format!("{:.4}", r.median), format!("{:.4}", r.min), format!("{:.4}", r.max), r.cells.to_string()]).collect();
+fn render_thesis_ratios(
+    ratios: &[Ratio],
+    grid: GridSize,
+    app_name: &str,
+    out: &Path,
+) -> Result<(String, Claim)> {
+    let h: Vec<String> = ["cn_x", "cn_y", "median_ratio", "min_ratio", "max_ratio", "cells"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    let rows: Vec<Vec<String>> = ratios
+        .iter()
+        .map(|r| {
+            vec![
+                r.cn.nx.to_string(),
+                r.cn.ny.to_string(),
+                format!("{:.4}", r.median),
+                format!("{:.4}", r.min),
+                format!("{:.4}", r.max),
+                r.cells.to_string(),
+            ]
+        })
+        .collect();
     let name = format!("{app_name}_vs_thesis");
     write_atomic(&out.join(format!("{name}.csv")), csv_records(&h, &rows)?.as_bytes())?;
     let md = format!("\n**`{name}.csv`**: our surface error divided by the thesis', per control net (over data sets, parameterisations and approaches)\n\n{}", table(&h, &rows));
-    let inside = ratios.iter().filter(|r| r.median >= RATIO_BAND.0 && r.median <= RATIO_BAND.1).count();
+    let inside =
+        ratios.iter().filter(|r| r.median >= RATIO_BAND.0 && r.median <= RATIO_BAND.1).count();
     let claim = Claim {
         chapter: "5".into(),
         rival: None,
         statement: format!("Surface errors are of the thesis' magnitude (grid {grid})"),
         ours: (inside, ratios.len()),
         thesis: None,
-        note: format!("control nets whose median ratio ours/thesis lies in [{}, {}]; medians {}", RATIO_BAND.0, RATIO_BAND.1, ratios.iter().map(|r| format!("{:.2}", r.median)).collect::<Vec<_>>().join(" ")),
+        note: format!(
+            "control nets whose median ratio ours/thesis lies in [{}, {}]; medians {}",
+            RATIO_BAND.0,
+            RATIO_BAND.1,
+            ratios.iter().map(|r| format!("{:.2}", r.median)).collect::<Vec<_>>().join(" ")
+        ),
     };
     Ok((md, claim))
 }
@@ -325,9 +512,16 @@ fn geometry_rows(runs: &[FitRun], cns: &[GridSize], approaches: &[Approach]) -> 
     let mut out = Vec::new();
     for &cn in cns {
         for &a in approaches {
-            let rs: Vec<&FitRun> = runs.iter().filter(|r| r.cell.cn == cn && r.cell.approach == a).collect();
+            let rs: Vec<&FitRun> =
+                runs.iter().filter(|r| r.cell.cn == cn && r.cell.approach == a).collect();
             let max = |f: &dyn Fn(&FitRun) -> f64| rs.iter().map(|r| f(r)).fold(0.0, f64::max);
-            out.push(GeometryRow { cn, approach: a, excursion: max(&|r| r.row.excursion), max_control: max(&|r| r.row.max_control), dense_gap: max(&|r| r.row.dense_gap) });
+            out.push(GeometryRow {
+                cn,
+                approach: a,
+                excursion: max(&|r| r.row.excursion),
+                max_control: max(&|r| r.row.max_control),
+                dense_gap: max(&|r| r.row.dense_gap),
+            });
         }
     }
     out
@@ -337,9 +531,30 @@ fn geometry_rows(runs: &[FitRun], cns: &[GridSize], approaches: &[Approach]) -> 
 /// excursion of a tenth of its side.
 pub const NEAR: f64 = 0.1;
 
-fn render_geometry(geo: &[GeometryRow], runs: &[FitRun], grid: GridSize, out: &Path) -> Result<(String, Claim)> {
-    let h: Vec<String> = ["cn_x", "cn_y", "approach", "max_excursion", "max_control", "max_dense_gap"].iter().map(|s| s.to_string()).collect();
-    let rows: Vec<Vec<String>> = geo.iter().map(|g| vec![g.cn.nx.to_string(), g.cn.ny.to_string(), g.approach.letter().into(), format!("{:.6e}", g.excursion), format!("{:.6e}", g.max_control), format!("{:.6e}", g.dense_gap)]).collect();
+fn render_geometry(
+    geo: &[GeometryRow],
+    runs: &[FitRun],
+    grid: GridSize,
+    out: &Path,
+) -> Result<(String, Claim)> {
+    let h: Vec<String> =
+        ["cn_x", "cn_y", "approach", "max_excursion", "max_control", "max_dense_gap"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+    let rows: Vec<Vec<String>> = geo
+        .iter()
+        .map(|g| {
+            vec![
+                g.cn.nx.to_string(),
+                g.cn.ny.to_string(),
+                g.approach.letter().into(),
+                format!("{:.6e}", g.excursion),
+                format!("{:.6e}", g.max_control),
+                format!("{:.6e}", g.dense_gap),
+            ]
+        })
+        .collect();
     let name = format!("geometry_{grid}");
     write_atomic(&out.join(format!("{name}.csv")), csv_records(&h, &rows)?.as_bytes())?;
     let md = format!(

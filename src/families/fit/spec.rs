@@ -43,7 +43,11 @@ pub struct FitSpec {
 impl FitSpec {
     /// The readings and options every fit of this section uses.
     pub fn fit_options(&self) -> crate::spline::FitOptions {
-        crate::spline::FitOptions { knots: self.knots, error_a: self.error_a, fairness: self.fairness }
+        crate::spline::FitOptions {
+            knots: self.knots,
+            error_a: self.error_a,
+            fairness: self.fairness,
+        }
     }
 }
 
@@ -62,13 +66,22 @@ pub struct FitSom {
 
 /// The keys a `[fit]` and an `[optim]` section share (data sets, grid, control nets,
 /// parameterisations), each error naming `<section>.<key>`.
-pub(crate) fn validate_grid_keys(spec: &Spec, section: &str, datasets: &[String], grid: GridSize, control_nets: &[GridSize], parameterisations: &[String]) -> Result<(), SpecError> {
+pub(crate) fn validate_grid_keys(
+    spec: &Spec,
+    section: &str,
+    datasets: &[String],
+    grid: GridSize,
+    control_nets: &[GridSize],
+    parameterisations: &[String],
+) -> Result<(), SpecError> {
     let key = |k: &str| format!("{section}.{k}");
     if datasets.is_empty() {
         return Err(spec.err(&key("datasets"), "is empty"));
     }
     if grid.nx.min(grid.ny) < 3 {
-        return Err(spec.err(&key("grid"), format!("grid {grid} is too small (each side at least 3)")));
+        return Err(
+            spec.err(&key("grid"), format!("grid {grid} is too small (each side at least 3)"))
+        );
     }
     if control_nets.is_empty() {
         return Err(spec.err(&key("control_nets"), "is empty"));
@@ -78,33 +91,51 @@ pub(crate) fn validate_grid_keys(spec: &Spec, section: &str, datasets: &[String]
             return Err(spec.err(&key("control_nets"), format!("control net {cn} is smaller than 4 (cubic needs p + 1 = 4 control points a side)")));
         }
         if cn.nx > grid.nx || cn.ny > grid.ny {
-            return Err(spec.err(&key("control_nets"), format!("control net {cn} is larger than the grid {grid}")));
+            return Err(spec.err(
+                &key("control_nets"),
+                format!("control net {cn} is larger than the grid {grid}"),
+            ));
         }
     }
     if parameterisations.is_empty() {
         return Err(spec.err(&key("parameterisations"), "is empty"));
     }
     for p in parameterisations {
-        p.parse::<crate::spline::Parameterisation>().map_err(|e| spec.err(&key("parameterisations"), e))?;
+        p.parse::<crate::spline::Parameterisation>()
+            .map_err(|e| spec.err(&key("parameterisations"), e))?;
     }
     Ok(())
 }
 
 /// The settings of the map recomputation (`<section>.som`).
-pub(crate) fn validate_map_som(spec: &Spec, section: &str, som: Option<&FitSom>) -> Result<(), SpecError> {
+pub(crate) fn validate_map_som(
+    spec: &Spec,
+    section: &str,
+    som: Option<&FitSom>,
+) -> Result<(), SpecError> {
     let Some(som) = som else { return Ok(()) };
     if som.iterations == 0 {
         return Err(spec.err(&format!("{section}.som.iterations"), "must be at least 1"));
     }
     if !(som.alpha0 > 0.0 && som.alpha0 <= 1.0) {
-        return Err(spec.err(&format!("{section}.som.alpha0"), format!("must be in (0, 1], got {}", som.alpha0)));
+        return Err(spec.err(
+            &format!("{section}.som.alpha0"),
+            format!("must be in (0, 1], got {}", som.alpha0),
+        ));
     }
     Ok(())
 }
 
 /// Every value of the `[fit]` section (after the limits).
 pub(crate) fn validate(spec: &Spec, fit: &FitSpec) -> Result<(), SpecError> {
-    validate_grid_keys(spec, "fit", &fit.datasets, fit.grid, &fit.control_nets, &fit.parameterisations)?;
+    validate_grid_keys(
+        spec,
+        "fit",
+        &fit.datasets,
+        fit.grid,
+        &fit.control_nets,
+        &fit.parameterisations,
+    )?;
     if fit.approaches.is_empty() {
         return Err(spec.err("fit.approaches", "is empty"));
     }
@@ -124,7 +155,13 @@ pub fn cells(spec: &Spec) -> Vec<FitCell> {
                 let Ok(param) = p.parse() else { continue };
                 for a in &fit.approaches {
                     let Ok(approach) = a.parse() else { continue };
-                    cells.push(FitCell { dataset: crate::data::registry::name_of(dataset), grid: fit.grid, cn: *cn, param, approach });
+                    cells.push(FitCell {
+                        dataset: crate::data::registry::name_of(dataset),
+                        grid: fit.grid,
+                        cn: *cn,
+                        param,
+                        approach,
+                    });
                 }
             }
         }
@@ -150,7 +187,14 @@ impl crate::experiment::runner::Cell for FitCell {
 
 impl FitCell {
     pub fn key(&self) -> String {
-        format!("fit/{}/{}/{}/{}/{}", self.dataset, self.grid, self.cn, self.param.name(), self.approach.letter())
+        format!(
+            "fit/{}/{}/{}/{}/{}",
+            self.dataset,
+            self.grid,
+            self.cn,
+            self.param.name(),
+            self.approach.letter()
+        )
     }
 }
 
@@ -166,6 +210,9 @@ pub(crate) fn limits(c: &Check, s: &FitSpec) -> Result<(), SpecError> {
         c.int("fit.som.iterations", som.iterations, limits::MAX_ITERATIONS)?;
     }
     c.real("fit.fairness", s.fairness, 0.0, true, limits::MAX_FAIRNESS)?;
-    c.cells("fit", &[s.datasets.len(), s.control_nets.len(), s.parameterisations.len(), s.approaches.len()])?;
+    c.cells(
+        "fit",
+        &[s.datasets.len(), s.control_nets.len(), s.parameterisations.len(), s.approaches.len()],
+    )?;
     Ok(())
 }

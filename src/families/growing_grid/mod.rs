@@ -5,17 +5,17 @@
 pub mod report;
 pub mod spec;
 
-use crate::experiment::spec::{GridSize, Spec};
-use spec::GrowingGridSpec;
-use crate::experiment::{runner, seeds, RunContext};
 use crate::data::registry;
+use crate::experiment::spec::{GridSize, Spec};
+use crate::experiment::{runner, seeds, RunContext};
 use crate::geom::Point3;
-use crate::spline::open_surface::OpenSurfaceProblem;
 use crate::optim::{Budget, Optimiser, Problem};
 use crate::som::growing_grid::{grow, GrowingGrid};
+use crate::spline::open_surface::OpenSurfaceProblem;
 use crate::spline::Parameterisation;
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
+use spec::GrowingGridSpec;
 use std::collections::BTreeMap;
 
 /// One grown map.
@@ -41,7 +41,14 @@ pub struct Cell {
 
 impl Cell {
     pub fn key(&self) -> String {
-        format!("seed001/{}/{}/{}/{}/r{}", self.dataset, self.cn, self.param.name(), self.optimiser, self.repeat)
+        format!(
+            "seed001/{}/{}/{}/{}/r{}",
+            self.dataset,
+            self.cn,
+            self.param.name(),
+            self.optimiser,
+            self.repeat
+        )
     }
 }
 
@@ -107,7 +114,13 @@ pub fn cells(spec: &Spec) -> Vec<Cell> {
                 let Ok(param) = p.parse::<Parameterisation>() else { continue };
                 for o in &g.optimisers {
                     for repeat in 0..g.repeats {
-                        out.push(Cell { dataset: d.clone(), cn, param, optimiser: o.clone(), repeat });
+                        out.push(Cell {
+                            dataset: d.clone(),
+                            cn,
+                            param,
+                            optimiser: o.clone(),
+                            repeat,
+                        });
                     }
                 }
             }
@@ -123,16 +136,28 @@ pub fn maps(spec: &Spec, ctx: &RunContext) -> Result<Vec<MapRun>> {
     let data: Vec<(String, Vec<Point3>)> = g
         .datasets
         .iter()
-        .map(|d| ctx.loader(spec).load(d).map(|c| (c.name, c.points)).with_context(|| format!("growing_grid.datasets: `{d}`")))
+        .map(|d| {
+            ctx.loader(spec)
+                .load(d)
+                .map(|c| (c.name, c.points))
+                .with_context(|| format!("growing_grid.datasets: `{d}`"))
+        })
         .collect::<Result<_>>()?;
-    runner::run_cells(&data, ctx.jobs, "growing grids", |(d, points)| {
-        let mut rng = seeds::cell_rng(spec.file.master_seed, &format!("seed001/map/{d}"));
-        let t0 = runner::thread_cpu_seconds();
-        let map = grow(points, &params, &mut rng).map_err(|e| anyhow::anyhow!("growing grid on {d}: {e}"))?;
-        let cpu_s = runner::thread_cpu_seconds() - t0;
-        let m = map.metrics(points);
-        Ok(MapRun { dataset: d.clone(), points: points.len(), map, qe: m.qe, te: m.te, cpu_s })
-    }, |_, _| Ok(()))
+    runner::run_cells(
+        &data,
+        ctx.jobs,
+        "growing grids",
+        |(d, points)| {
+            let mut rng = seeds::cell_rng(spec.file.master_seed, &format!("seed001/map/{d}"));
+            let t0 = runner::thread_cpu_seconds();
+            let map = grow(points, &params, &mut rng)
+                .map_err(|e| anyhow::anyhow!("growing grid on {d}: {e}"))?;
+            let cpu_s = runner::thread_cpu_seconds() - t0;
+            let m = map.metrics(points);
+            Ok(MapRun { dataset: d.clone(), points: points.len(), map, qe: m.qe, te: m.te, cpu_s })
+        },
+        |_, _| Ok(()),
+    )
 }
 
 /// The problem of every (data, net, parameterisation).
@@ -143,7 +168,16 @@ pub fn problems(spec: &Spec, maps: &[MapRun]) -> Result<BTreeMap<ProblemKey, Ope
         for &cn in &g.control_nets {
             for p in &g.parameterisations {
                 let param: Parameterisation = p.parse().map_err(anyhow::Error::msg)?;
-                let pr = OpenSurfaceProblem::new(&m.map.weights, m.map.nx, m.map.ny, cn.nx, cn.ny, param, g.bounds_margin).map_err(|e| anyhow::anyhow!("{} {cn} {p}: {e}", m.dataset))?;
+                let pr = OpenSurfaceProblem::new(
+                    &m.map.weights,
+                    m.map.nx,
+                    m.map.ny,
+                    cn.nx,
+                    cn.ny,
+                    param,
+                    g.bounds_margin,
+                )
+                .map_err(|e| anyhow::anyhow!("{} {cn} {p}: {e}", m.dataset))?;
                 out.insert((m.dataset.clone(), cn, param), pr);
             }
         }
@@ -154,14 +188,21 @@ pub fn problems(spec: &Spec, maps: &[MapRun]) -> Result<BTreeMap<ProblemKey, Ope
 fn optimiser(g: &GrowingGridSpec, name: &str) -> Result<Box<dyn Optimiser>> {
     // This section offers ga, de and pso only.
     let (csa, icsa) = (crate::optim::Csa::default(), crate::optim::Icsa::default());
-    crate::optim::named(name, &g.ga, &g.de, &g.pso, &csa, &icsa).filter(|_| matches!(name, "ga" | "de" | "pso")).with_context(|| format!("unknown optimiser `{name}`"))
+    crate::optim::named(name, &g.ga, &g.de, &g.pso, &csa, &icsa)
+        .filter(|_| matches!(name, "ga" | "de" | "pso"))
+        .with_context(|| format!("unknown optimiser `{name}`"))
 }
 
 /// Run one cell (alone or inside the full run: the same numbers).
 pub fn run_cell(spec: &Spec, cell: &Cell, problem: &OpenSurfaceProblem) -> Result<Run> {
     let g = section(spec)?;
     let opt = optimiser(g, &cell.optimiser)?;
-    let budget = Budget { generations: g.generations as u64, population: g.population, init_range: g.init_range, trace_every_evals: g.trace_every_evals };
+    let budget = Budget {
+        generations: g.generations as u64,
+        population: g.population,
+        init_range: g.init_range,
+        trace_every_evals: g.trace_every_evals,
+    };
     let key = cell.key();
     let mut rng = seeds::cell_rng(spec.file.master_seed, &key);
     let t0 = runner::thread_cpu_seconds();
@@ -191,9 +232,19 @@ pub fn run_cell(spec: &Spec, cell: &Cell, problem: &OpenSurfaceProblem) -> Resul
 }
 
 /// Run every cell of the spec.
-pub fn run(spec: &Spec, ctx: &RunContext, problems: &BTreeMap<ProblemKey, OpenSurfaceProblem>) -> Result<Vec<Run>> {
+pub fn run(
+    spec: &Spec,
+    ctx: &RunContext,
+    problems: &BTreeMap<ProblemKey, OpenSurfaceProblem>,
+) -> Result<Vec<Run>> {
     let cells = cells(spec);
-    runner::run_logged(&cells, ctx, &spec.file.name, |c| run_cell(spec, c, &problems[&(c.dataset.clone(), c.cn, c.param)]), |c, (row, best_x)| Ok(Run { cell: c.clone(), row, best_x }))
+    runner::run_logged(
+        &cells,
+        ctx,
+        &spec.file.name,
+        |c| run_cell(spec, c, &problems[&(c.dataset.clone(), c.cn, c.param)]),
+        |c, (row, best_x)| Ok(Run { cell: c.clone(), row, best_x }),
+    )
 }
 
 /// Seed 001's family: the `[growing_grid]` section.
@@ -206,7 +257,10 @@ impl crate::experiment::family::Family for Seed001 {
     fn present(&self, spec: &Spec) -> bool {
         spec.file.growing_grid.is_some()
     }
-    fn check_limits(&self, c: &crate::experiment::limits::Check) -> Result<(), crate::experiment::spec::SpecError> {
+    fn check_limits(
+        &self,
+        c: &crate::experiment::limits::Check,
+    ) -> Result<(), crate::experiment::spec::SpecError> {
         match &c.spec.file.growing_grid {
             Some(s) => self::spec::limits(c, s),
             None => Ok(()),
@@ -224,12 +278,22 @@ impl crate::experiment::family::Family for Seed001 {
     fn logged_keys(&self, spec: &Spec) -> Vec<String> {
         cells(spec).iter().map(|c| c.key()).collect()
     }
-    fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<crate::experiment::family::Outcome> {
+    fn run(
+        &self,
+        spec: &Spec,
+        ctx: &RunContext,
+        tables: bool,
+    ) -> Result<crate::experiment::family::Outcome> {
         let maps = maps(spec, ctx)?;
         let problems = problems(spec, &maps)?;
         let runs = run(spec, ctx, &problems)?;
-        let section = if tables { Some(crate::families::growing_grid::report::write(&maps, &problems, &runs, &ctx.out)?) } else { None };
-        let cpu_s = maps.iter().map(|m| m.cpu_s).sum::<f64>() + runs.iter().map(|r| r.row.cpu_s).sum::<f64>();
+        let section = if tables {
+            Some(crate::families::growing_grid::report::write(&maps, &problems, &runs, &ctx.out)?)
+        } else {
+            None
+        };
+        let cpu_s = maps.iter().map(|m| m.cpu_s).sum::<f64>()
+            + runs.iter().map(|r| r.row.cpu_s).sum::<f64>();
         Ok(crate::experiment::family::Outcome { section, cpu_s, cells: runs.len() })
     }
 }

@@ -57,7 +57,15 @@ pub struct GrowthSpec {
 impl Default for GrowthSpec {
     fn default() -> Self {
         let p = crate::som::growing_grid::GrowingGridParams::default();
-        GrowthSpec { lambda_g: p.lambda_g, eps_g: p.eps_g, lambda_f: p.lambda_f, eps_f0: p.eps_f0, eps_f1: p.eps_f1, sigma: p.sigma, reach2: p.reach2 }
+        GrowthSpec {
+            lambda_g: p.lambda_g,
+            eps_g: p.eps_g,
+            lambda_f: p.lambda_f,
+            eps_f0: p.eps_f0,
+            eps_f1: p.eps_f1,
+            sigma: p.sigma,
+            reach2: p.reach2,
+        }
     }
 }
 
@@ -65,7 +73,17 @@ impl GrowingGridSpec {
     /// The growing grid's parameters for the target grid.
     pub fn params(&self) -> crate::som::growing_grid::GrowingGridParams {
         let g = &self.growth;
-        crate::som::growing_grid::GrowingGridParams { nx: self.grid.nx, ny: self.grid.ny, lambda_g: g.lambda_g, eps_g: g.eps_g, lambda_f: g.lambda_f, eps_f0: g.eps_f0, eps_f1: g.eps_f1, sigma: g.sigma, reach2: g.reach2 }
+        crate::som::growing_grid::GrowingGridParams {
+            nx: self.grid.nx,
+            ny: self.grid.ny,
+            lambda_g: g.lambda_g,
+            eps_g: g.eps_g,
+            lambda_f: g.lambda_f,
+            eps_f0: g.eps_f0,
+            eps_f1: g.eps_f1,
+            sigma: g.sigma,
+            reach2: g.reach2,
+        }
     }
 }
 
@@ -83,21 +101,38 @@ pub(crate) fn validate(spec: &Spec, g: &GrowingGridSpec) -> Result<(), SpecError
     }
     for cn in &g.control_nets {
         if cn.nx < 4 || cn.ny < 4 || cn.nx > g.grid.nx || cn.ny > g.grid.ny {
-            return Err(spec.err("growing_grid.control_nets", format!("net {cn} must be at least 4x4 (cubic) and at most the grid {}", g.grid)));
+            return Err(spec.err(
+                "growing_grid.control_nets",
+                format!("net {cn} must be at least 4x4 (cubic) and at most the grid {}", g.grid),
+            ));
         }
     }
     if g.parameterisations.is_empty() {
         return Err(spec.err("growing_grid.parameterisations", "is empty"));
     }
     for p in &g.parameterisations {
-        p.parse::<crate::spline::Parameterisation>().map_err(|e| spec.err("growing_grid.parameterisations", e))?;
+        p.parse::<crate::spline::Parameterisation>()
+            .map_err(|e| spec.err("growing_grid.parameterisations", e))?;
     }
-    spec.validate_runs("growing_grid", &g.optimisers, &["ga", "de", "pso"], g.repeats, g.generations as u64, g.population)?;
+    spec.validate_runs(
+        "growing_grid",
+        &g.optimisers,
+        &["ga", "de", "pso"],
+        g.repeats,
+        g.generations as u64,
+        g.population,
+    )?;
     if !(g.init_range >= 0.0 && g.init_range.is_finite()) {
-        return Err(spec.err("growing_grid.init_range", format!("must be a non-negative number, got {}", g.init_range)));
+        return Err(spec.err(
+            "growing_grid.init_range",
+            format!("must be a non-negative number, got {}", g.init_range),
+        ));
     }
     if !(g.bounds_margin >= 0.0 && g.bounds_margin.is_finite()) {
-        return Err(spec.err("growing_grid.bounds_margin", format!("must be a non-negative number, got {}", g.bounds_margin)));
+        return Err(spec.err(
+            "growing_grid.bounds_margin",
+            format!("must be a non-negative number, got {}", g.bounds_margin),
+        ));
     }
     if g.trace_every_evals == 0 {
         return Err(spec.err("growing_grid.trace_every_evals", "must be at least 1"));
@@ -119,6 +154,15 @@ pub(crate) fn limits(c: &Check, g: &GrowingGridSpec) -> Result<(), SpecError> {
     c.int("growing_grid.trace_every_evals", g.trace_every_evals, limits::MAX_TRACE_EVERY)?;
     c.int("growing_grid.growth.lambda_g", g.growth.lambda_g, limits::MAX_ITERATIONS)?;
     c.int("growing_grid.growth.lambda_f", g.growth.lambda_f, limits::MAX_ITERATIONS)?;
-    c.cells("growing_grid", &[g.datasets.len(), g.control_nets.len(), g.parameterisations.len(), g.optimisers.len(), g.repeats])?;
+    c.cells(
+        "growing_grid",
+        &[
+            g.datasets.len(),
+            g.control_nets.len(),
+            g.parameterisations.len(),
+            g.optimisers.len(),
+            g.repeats,
+        ],
+    )?;
     Ok(())
 }

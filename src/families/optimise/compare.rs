@@ -6,7 +6,9 @@ use crate::families::optimise::OptimRow;
 use crate::io::{csv_records, write_atomic};
 use crate::report::plots;
 use crate::stats;
-use crate::stats::{effect, friedman::friedman, rank_sum::rank_sum, wilcoxon::signed_rank, Alternative};
+use crate::stats::{
+    effect, friedman::friedman, rank_sum::rank_sum, wilcoxon::signed_rank, Alternative,
+};
 use anyhow::{Context, Result};
 use std::collections::BTreeMap;
 
@@ -22,29 +24,54 @@ pub fn friedman_table(rows: &[OptimRow]) -> (Vec<String>, Vec<Vec<f64>>) {
         if !opts.contains(&r.competitor()) {
             opts.push(r.competitor());
         }
-        let e = cells.entry((r.dataset.clone(), r.grid_x, r.grid_y, r.cn_x, r.cn_y, r.parameterisation.clone())).or_default().entry(r.competitor()).or_default();
+        let e = cells
+            .entry((
+                r.dataset.clone(),
+                r.grid_x,
+                r.grid_y,
+                r.cn_x,
+                r.cn_y,
+                r.parameterisation.clone(),
+            ))
+            .or_default()
+            .entry(r.competitor())
+            .or_default();
         e.0 += r.best;
         e.1 += 1;
     }
-    let table = cells.values().filter(|per| opts.iter().all(|o| per.contains_key(o))).map(|per| opts.iter().map(|o| per[o].0 / per[o].1 as f64).collect()).collect();
+    let table = cells
+        .values()
+        .filter(|per| opts.iter().all(|o| per.contains_key(o)))
+        .map(|per| opts.iter().map(|o| per[o].0 / per[o].1 as f64).collect())
+        .collect();
     (opts, table)
 }
 
 pub fn compare(args: &CompareArgs) -> Result<()> {
     if !(args.rope >= 0.0 && args.rope.is_finite()) || args.bayes_samples == 0 {
-        anyhow::bail!("--rope must be finite and >= 0 (got {}) and --bayes-samples at least 1 (got {})", args.rope, args.bayes_samples);
+        anyhow::bail!(
+            "--rope must be finite and >= 0 (got {}) and --bayes-samples at least 1 (got {})",
+            args.rope,
+            args.bayes_samples
+        );
     }
     if !args.results.is_dir() {
-        anyhow::bail!("{}: not found (no such results folder)", args.results.join("runs.csv").display());
+        anyhow::bail!(
+            "{}: not found (no such results folder)",
+            args.results.join("runs.csv").display()
+        );
     }
     // compare writes its tables into the folder: one writer at a time (a run still writing it
     // refuses this, naming itself).
     let _lock = crate::io::outdir::lock(&args.results, "compare")?;
     let path = args.results.join("runs.csv");
-    let mut reader = csv::Reader::from_path(&path).with_context(|| format!("cannot read {}", path.display()))?;
+    let mut reader =
+        csv::Reader::from_path(&path).with_context(|| format!("cannot read {}", path.display()))?;
     let mut rows: Vec<OptimRow> = Vec::new();
     for (n, r) in reader.deserialize().enumerate() {
-        rows.push(r.with_context(|| format!("{}: line {}: not a Chapter 6 runs.csv row", path.display(), n + 2))?);
+        rows.push(r.with_context(|| {
+            format!("{}: line {}: not a Chapter 6 runs.csv row", path.display(), n + 2)
+        })?);
     }
     if rows.is_empty() {
         anyhow::bail!("{}: no runs", path.display());
@@ -55,16 +82,40 @@ pub fn compare(args: &CompareArgs) -> Result<()> {
         if !opts.contains(&r.competitor()) {
             opts.push(r.competitor());
         }
-        let key = (r.dataset.clone(), r.grid_x, r.grid_y, r.cn_x, r.cn_y, r.parameterisation.clone());
+        let key =
+            (r.dataset.clone(), r.grid_x, r.grid_y, r.cn_x, r.cn_y, r.parameterisation.clone());
         cells.entry(key).or_default().entry(r.competitor()).or_default().push((r.repeat, r.best));
     }
     if opts.len() < 2 {
         anyhow::bail!("{}: only one optimiser ({}); nothing to compare", path.display(), opts[0]);
     }
     // The traces first, so that a folder whose ioh/ does not match runs.csv gets nothing written.
-    let probs = if args.results.join("ioh").is_dir() { Some(problems(&rows, &args.results)?) } else { None };
+    let probs = if args.results.join("ioh").is_dir() {
+        Some(problems(&rows, &args.results)?)
+    } else {
+        None
+    };
     // Per cell and pair.
-    let header: Vec<String> = ["data", "grid", "cn", "parameterisation", "x", "y", "n", "signed_rank_v", "signed_rank_p", "rank_sum_w", "rank_sum_p", "a12", "a12_magnitude", "h_signed_rank", "h_rank_sum"].iter().map(|s| s.to_string()).collect();
+    let header: Vec<String> = [
+        "data",
+        "grid",
+        "cn",
+        "parameterisation",
+        "x",
+        "y",
+        "n",
+        "signed_rank_v",
+        "signed_rank_p",
+        "rank_sum_w",
+        "rank_sum_p",
+        "a12",
+        "a12_magnitude",
+        "h_signed_rank",
+        "h_rank_sum",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
     let mut out = Vec::new();
     let mut wins: BTreeMap<(String, String), (usize, usize)> = BTreeMap::new();
     for (k, per) in &cells {
@@ -77,10 +128,16 @@ pub fn compare(args: &CompareArgs) -> Result<()> {
                 b.sort_by_key(|x| x.0);
                 let xa: Vec<f64> = a.iter().map(|x| x.1).collect();
                 let xb: Vec<f64> = b.iter().map(|x| x.1).collect();
-                let sr = if xa.len() == xb.len() { signed_rank(&xa, &xb, Alternative::TwoSided).ok() } else { None };
+                let sr = if xa.len() == xb.len() {
+                    signed_rank(&xa, &xb, Alternative::TwoSided).ok()
+                } else {
+                    None
+                };
                 let rs = rank_sum(&xa, &xb, Alternative::TwoSided).ok();
                 let a12 = effect::a12(&xa, &xb);
-                let h = |p: Option<f64>| p.map(|p| if p < args.alpha { "1" } else { "0" }).unwrap_or("").to_string();
+                let h = |p: Option<f64>| {
+                    p.map(|p| if p < args.alpha { "1" } else { "0" }).unwrap_or("").to_string()
+                };
                 if rs.as_ref().map(|r| r.p_value < args.alpha).unwrap_or(false) {
                     let e = wins.entry((opts[i].clone(), opts[j].clone())).or_default();
                     if a12 < 0.5 {
@@ -112,27 +169,60 @@ pub fn compare(args: &CompareArgs) -> Result<()> {
     write_atomic(&args.results.join("compare_cells.csv"), csv_records(&header, &out)?.as_bytes())?;
     // Overall: Friedman over cells on the mean best of each optimiser.
     let (_, table) = friedman_table(&rows);
-    let f = friedman(&table).map_err(|e| anyhow::anyhow!("{}: Friedman test: {e}", path.display()))?;
-    let oh: Vec<String> = ["x", "y", "mean_rank_x", "mean_rank_y", "z", "p", "p_holm", "cells_x_better", "cells_y_better"].iter().map(|s| s.to_string()).collect();
+    let f =
+        friedman(&table).map_err(|e| anyhow::anyhow!("{}: Friedman test: {e}", path.display()))?;
+    let oh: Vec<String> = [
+        "x",
+        "y",
+        "mean_rank_x",
+        "mean_rank_y",
+        "z",
+        "p",
+        "p_holm",
+        "cells_x_better",
+        "cells_y_better",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
     let orows: Vec<Vec<String>> = f
         .pairwise
         .iter()
         .map(|&(i, j, z, p, ph)| {
             let w = wins.get(&(opts[i].clone(), opts[j].clone())).copied().unwrap_or((0, 0));
-            vec![opts[i].clone(), opts[j].clone(), format!("{:.4}", f.mean_ranks[i]), format!("{:.4}", f.mean_ranks[j]), format!("{z:.4}"), format!("{p:.6}"), format!("{ph:.6}"), w.0.to_string(), w.1.to_string()]
+            vec![
+                opts[i].clone(),
+                opts[j].clone(),
+                format!("{:.4}", f.mean_ranks[i]),
+                format!("{:.4}", f.mean_ranks[j]),
+                format!("{z:.4}"),
+                format!("{p:.6}"),
+                format!("{ph:.6}"),
+                w.0.to_string(),
+                w.1.to_string(),
+            ]
         })
         .collect();
     write_atomic(&args.results.join("compare_overall.csv"), csv_records(&oh, &orows)?.as_bytes())?;
-    let ranks: Vec<(String, f64)> = opts.iter().cloned().zip(f.mean_ranks.iter().copied()).collect();
+    let ranks: Vec<(String, f64)> =
+        opts.iter().cloned().zip(f.mean_ranks.iter().copied()).collect();
     let mut cd_note = String::new();
     if let Some(cd) = f.critical_difference {
         let png = args.results.join("cd_diagram.png");
-        match plots::cd_diagram_png(&png, &format!("Mean ranks over {} cells (Nemenyi CD = {cd:.3}, alpha 0.05)", f.blocks), &ranks, cd) {
+        match plots::cd_diagram_png(
+            &png,
+            &format!("Mean ranks over {} cells (Nemenyi CD = {cd:.3}, alpha 0.05)", f.blocks),
+            &ranks,
+            cd,
+        ) {
             Ok(()) => cd_note = format!(", critical-difference diagram {}", png.display()),
             Err(e) => eprintln!("somnurbs: warning: picture skipped: {e}"),
         }
     }
-    println!("Friedman over {} cells x {} optimisers: chi-squared {:.3}, df {}, p = {:.3e}", f.blocks, f.treatments, f.chi_squared, f.df, f.p_value);
+    println!(
+        "Friedman over {} cells x {} optimisers: chi-squared {:.3}, df {}, p = {:.3e}",
+        f.blocks, f.treatments, f.chi_squared, f.df, f.p_value
+    );
     for (o, r) in &ranks {
         println!("  mean rank {o:<5} {r:.3}");
     }
@@ -141,7 +231,11 @@ pub fn compare(args: &CompareArgs) -> Result<()> {
     }
     // Bayesian signed-rank test of every pair over the cells.
     let brows = bayes_table(&rows, &opts, args)?;
-    let bh: Vec<String> = ["x", "y", "cells", "rope", "samples", "p_x_better", "p_rope", "p_y_better"].iter().map(|s| s.to_string()).collect();
+    let bh: Vec<String> =
+        ["x", "y", "cells", "rope", "samples", "p_x_better", "p_rope", "p_y_better"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
     write_atomic(&args.results.join("compare_bayes.csv"), csv_records(&bh, &brows)?.as_bytes())?;
     for r in &brows {
         println!("  Bayesian signed-rank {} vs {} over {} cells (rope {} of B's error): P({} better) {}, P(equivalent) {}, P({} better) {}", r[0], r[1], r[2], r[3], r[0], r[5], r[6], r[1], r[7]);
@@ -152,12 +246,29 @@ pub fn compare(args: &CompareArgs) -> Result<()> {
         let rt = runtime(&probs, &opts);
         write_runtime_tables(&rt, &probs, &args.results)?;
         written.push_str(", compare_ecdf.csv, compare_aocc.csv, compare_fixed_budget.csv, compare_ert.csv, compare_targets.csv");
-        let groups: Vec<String> = std::iter::once("all".to_string()).chain(probs.iter().map(|p| p.name.clone())).collect();
+        let groups: Vec<String> = std::iter::once("all".to_string())
+            .chain(probs.iter().map(|p| p.name.clone()))
+            .collect();
         let mut pngs = 0;
         crate::io::ensure_dir(&args.results.join("png").join("compare"))?;
         for g in &groups {
-            let dir = if g == "all" { args.results.clone() } else { args.results.join("png").join("compare") };
-            for (kind, res) in [("ecdf", render_ecdf(&rt, g, &opts, &dir.join(format!("compare_ecdf_{g}.png")))), ("fixed_budget", render_fixed_budget(&rt, g, &opts, &dir.join(format!("compare_fixed_budget_{g}.png"))))] {
+            let dir = if g == "all" {
+                args.results.clone()
+            } else {
+                args.results.join("png").join("compare")
+            };
+            for (kind, res) in [
+                ("ecdf", render_ecdf(&rt, g, &opts, &dir.join(format!("compare_ecdf_{g}.png")))),
+                (
+                    "fixed_budget",
+                    render_fixed_budget(
+                        &rt,
+                        g,
+                        &opts,
+                        &dir.join(format!("compare_fixed_budget_{g}.png")),
+                    ),
+                ),
+            ] {
                 match res {
                     Ok(()) => pngs += 1,
                     Err(e) => eprintln!("somnurbs: warning: {kind} picture of {g} skipped: {e}"),
@@ -165,7 +276,10 @@ pub fn compare(args: &CompareArgs) -> Result<()> {
             }
         }
         for (g, o, _, a, pairs) in rt.ecdf.iter().filter(|r| r.0 == "all") {
-            println!("  runtime ECDF {g} {o}: AOCC {a:.4} over {pairs} (run, target) pairs, budget {}", rt.budget);
+            println!(
+                "  runtime ECDF {g} {o}: AOCC {a:.4} over {pairs} (run, target) pairs, budget {}",
+                rt.budget
+            );
         }
         written.push_str(&format!(", {pngs} runtime charts (compare_ecdf_all.png, compare_fixed_budget_all.png, per problem in png/compare/)"));
     } else {
@@ -217,13 +331,26 @@ fn certified_optima(folder: &std::path::Path) -> Result<BTreeMap<String, f64>> {
     for e in entries.flatten() {
         let p = e.path();
         let name = p.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-        let Some(grid) = name.strip_prefix("exact_").and_then(|g| g.strip_suffix(".csv")) else { continue };
-        let mut r = csv::Reader::from_path(&p).with_context(|| format!("cannot read {}", p.display()))?;
+        let Some(grid) = name.strip_prefix("exact_").and_then(|g| g.strip_suffix(".csv")) else {
+            continue;
+        };
+        let mut r =
+            csv::Reader::from_path(&p).with_context(|| format!("cannot read {}", p.display()))?;
         for (n, rec) in r.deserialize::<BTreeMap<String, String>>().enumerate() {
             let rec = rec.with_context(|| format!("{}: line {}", p.display(), n + 2))?;
-            let get = |k: &str| rec.get(k).with_context(|| format!("{}: line {}: no column {k}", p.display(), n + 2));
-            let f: f64 = get("exact_f")?.parse().with_context(|| format!("{}: line {}: exact_f is not a number", p.display(), n + 2))?;
-            let key = crate::families::optimise::ioh::problem_name(get("data")?, grid, &format!("{}x{}", get("cn_x")?, get("cn_y")?), get("parameterisation")?);
+            let get = |k: &str| {
+                rec.get(k)
+                    .with_context(|| format!("{}: line {}: no column {k}", p.display(), n + 2))
+            };
+            let f: f64 = get("exact_f")?.parse().with_context(|| {
+                format!("{}: line {}: exact_f is not a number", p.display(), n + 2)
+            })?;
+            let key = crate::families::optimise::ioh::problem_name(
+                get("data")?,
+                grid,
+                &format!("{}x{}", get("cn_x")?, get("cn_y")?),
+                get("parameterisation")?,
+            );
             out.insert(key, f);
         }
     }
@@ -234,27 +361,55 @@ fn certified_optima(folder: &std::path::Path) -> Result<BTreeMap<String, f64>> {
 /// with the same evaluation counts and final values).
 fn problems(rows: &[OptimRow], folder: &std::path::Path) -> Result<Vec<Problem>> {
     let certified = certified_optima(folder)?;
-    let name = |r: &OptimRow| crate::families::optimise::ioh::problem_name(&r.dataset, &format!("{}x{}", r.grid_x, r.grid_y), &format!("{}x{}", r.cn_x, r.cn_y), &r.parameterisation);
+    let name = |r: &OptimRow| {
+        crate::families::optimise::ioh::problem_name(
+            &r.dataset,
+            &format!("{}x{}", r.grid_x, r.grid_y),
+            &format!("{}x{}", r.cn_x, r.cn_y),
+            &r.parameterisation,
+        )
+    };
     let mut expected: BTreeMap<(String, String), Vec<&OptimRow>> = BTreeMap::new();
     for r in rows {
         expected.entry((name(r), r.competitor())).or_default().push(r);
     }
     let mut out: BTreeMap<String, Problem> = BTreeMap::new();
     for lp in crate::families::optimise::ioh::read(folder)? {
-        let mut exp = expected.remove(&(lp.function_name.clone(), lp.optimiser.clone())).with_context(|| format!("{}: ioh/{} has problem {} that runs.csv does not", folder.display(), lp.optimiser, lp.function_name))?;
+        let mut exp = expected
+            .remove(&(lp.function_name.clone(), lp.optimiser.clone()))
+            .with_context(|| {
+                format!(
+                    "{}: ioh/{} has problem {} that runs.csv does not",
+                    folder.display(),
+                    lp.optimiser,
+                    lp.function_name
+                )
+            })?;
         exp.sort_by_key(|r| r.repeat);
-        let agree = exp.len() == lp.runs.len() && exp.iter().zip(&lp.runs).all(|(r, (e, imp))| *e == r.evaluations && imp.iter().map(|x| x.1).fold(f64::INFINITY, f64::min) == r.best);
+        let agree = exp.len() == lp.runs.len()
+            && exp.iter().zip(&lp.runs).all(|(r, (e, imp))| {
+                *e == r.evaluations
+                    && imp.iter().map(|x| x.1).fold(f64::INFINITY, f64::min) == r.best
+            });
         if !agree {
             anyhow::bail!("{}: ioh/{} problem {}: the traces do not match runs.csv (runs, evaluations or final values differ; written by another run?)", folder.display(), lp.optimiser, lp.function_name);
         }
-        let p = out.entry(lp.function_name.clone()).or_insert_with(|| Problem { name: lp.function_name.clone(), b: exp[0].b, best_known: f64::INFINITY, certified: false, targets: Vec::new(), runs: BTreeMap::new() });
+        let p = out.entry(lp.function_name.clone()).or_insert_with(|| Problem {
+            name: lp.function_name.clone(),
+            b: exp[0].b,
+            best_known: f64::INFINITY,
+            certified: false,
+            targets: Vec::new(),
+            runs: BTreeMap::new(),
+        });
         p.runs.insert(lp.optimiser, lp.runs);
     }
     if let Some(((p, o), _)) = expected.into_iter().next() {
         anyhow::bail!("{}: runs.csv has {o} on {p} but ioh/ has no trace of it", folder.display());
     }
     for (pn, p) in out.iter_mut() {
-        let found = rows.iter().filter(|r| &name(r) == pn).map(|r| r.best).fold(f64::INFINITY, f64::min);
+        let found =
+            rows.iter().filter(|r| &name(r) == pn).map(|r| r.best).fold(f64::INFINITY, f64::min);
         p.best_known = found;
         if let Some(&f) = certified.get(pn) {
             p.best_known = f.min(found);
@@ -268,20 +423,44 @@ fn problems(rows: &[OptimRow], folder: &std::path::Path) -> Result<Vec<Problem>>
 /// Compute every runtime table: per optimiser, over all problems ("all") and per problem.
 fn runtime(problems: &[Problem], opts: &[String]) -> Runtime {
     use stats::runtime::{aocc, ecdf, ert, hitting_times, log_budgets, Trace};
-    let budget = problems.iter().flat_map(|p| p.runs.values().flatten().map(|r| r.0)).max().unwrap_or(1);
+    let budget =
+        problems.iter().flat_map(|p| p.runs.values().flatten().map(|r| r.0)).max().unwrap_or(1);
     let budgets = log_budgets(budget, BUDGETS);
-    let mut rt = Runtime { budget, budgets: budgets.clone(), ecdf: Vec::new(), fixed_budget: Vec::new(), ert: Vec::new() };
+    let mut rt = Runtime {
+        budget,
+        budgets: budgets.clone(),
+        ecdf: Vec::new(),
+        fixed_budget: Vec::new(),
+        ert: Vec::new(),
+    };
     for o in opts {
         let mut all_times = Vec::new();
         let mut all_gaps = vec![0.0; budgets.len()];
         let mut all_runs = 0usize;
         for p in problems {
             let Some(runs) = p.runs.get(o) else { continue };
-            let ts: Vec<Trace> = runs.iter().map(|(e, imp)| Trace { improvements: imp, evaluations: *e }).collect();
+            let ts: Vec<Trace> =
+                runs.iter().map(|(e, imp)| Trace { improvements: imp, evaluations: *e }).collect();
             let times = hitting_times(&ts, &p.targets);
-            rt.ecdf.push((p.name.clone(), o.clone(), ecdf(&times, &budgets), aocc(&times, budget), times.len()));
+            rt.ecdf.push((
+                p.name.clone(),
+                o.clone(),
+                ecdf(&times, &budgets),
+                aocc(&times, budget),
+                times.len(),
+            ));
             let span = p.b - p.best_known;
-            let gaps: Vec<f64> = budgets.iter().map(|&e| ts.iter().map(|t| if span > 0.0 { (t.best_at(e) - p.best_known) / span } else { 0.0 }).sum::<f64>() / ts.len() as f64).collect();
+            let gaps: Vec<f64> = budgets
+                .iter()
+                .map(|&e| {
+                    ts.iter()
+                        .map(
+                            |t| if span > 0.0 { (t.best_at(e) - p.best_known) / span } else { 0.0 },
+                        )
+                        .sum::<f64>()
+                        / ts.len() as f64
+                })
+                .collect();
             for (a, g) in all_gaps.iter_mut().zip(&gaps) {
                 *a += g * ts.len() as f64;
             }
@@ -296,8 +475,19 @@ fn runtime(problems: &[Problem], opts: &[String]) -> Runtime {
         if all_runs == 0 {
             continue;
         }
-        rt.ecdf.push(("all".into(), o.clone(), ecdf(&all_times, &budgets), aocc(&all_times, budget), all_times.len()));
-        rt.fixed_budget.push(("all".into(), o.clone(), all_gaps.iter().map(|g| g / all_runs as f64).collect(), all_runs));
+        rt.ecdf.push((
+            "all".into(),
+            o.clone(),
+            ecdf(&all_times, &budgets),
+            aocc(&all_times, budget),
+            all_times.len(),
+        ));
+        rt.fixed_budget.push((
+            "all".into(),
+            o.clone(),
+            all_gaps.iter().map(|g| g / all_runs as f64).collect(),
+            all_runs,
+        ));
     }
     rt
 }
@@ -311,54 +501,156 @@ fn num(v: f64) -> String {
 }
 
 /// Write the runtime tables (CSV).
-fn write_runtime_tables(rt: &Runtime, problems: &[Problem], folder: &std::path::Path) -> Result<()> {
+fn write_runtime_tables(
+    rt: &Runtime,
+    problems: &[Problem],
+    folder: &std::path::Path,
+) -> Result<()> {
     let h = |v: &[&str]| -> Vec<String> { v.iter().map(|s| s.to_string()).collect() };
     let mut rows = Vec::new();
     for (g, o, e, _, pairs) in &rt.ecdf {
         for (b, v) in rt.budgets.iter().zip(e) {
-            rows.push(vec![g.clone(), o.clone(), b.to_string(), format!("{v:.6}"), pairs.to_string()]);
+            rows.push(vec![
+                g.clone(),
+                o.clone(),
+                b.to_string(),
+                format!("{v:.6}"),
+                pairs.to_string(),
+            ]);
         }
     }
-    write_atomic(&folder.join("compare_ecdf.csv"), csv_records(&h(&["group", "optimiser", "evaluations", "ecdf", "pairs"]), &rows)?.as_bytes())?;
-    let rows: Vec<Vec<String>> = rt.ecdf.iter().map(|(g, o, _, a, pairs)| vec![g.clone(), o.clone(), pairs.to_string(), rt.budget.to_string(), format!("{a:.6}")]).collect();
-    write_atomic(&folder.join("compare_aocc.csv"), csv_records(&h(&["group", "optimiser", "pairs", "budget", "aocc"]), &rows)?.as_bytes())?;
+    write_atomic(
+        &folder.join("compare_ecdf.csv"),
+        csv_records(&h(&["group", "optimiser", "evaluations", "ecdf", "pairs"]), &rows)?.as_bytes(),
+    )?;
+    let rows: Vec<Vec<String>> = rt
+        .ecdf
+        .iter()
+        .map(|(g, o, _, a, pairs)| {
+            vec![g.clone(), o.clone(), pairs.to_string(), rt.budget.to_string(), format!("{a:.6}")]
+        })
+        .collect();
+    write_atomic(
+        &folder.join("compare_aocc.csv"),
+        csv_records(&h(&["group", "optimiser", "pairs", "budget", "aocc"]), &rows)?.as_bytes(),
+    )?;
     let mut rows = Vec::new();
     for (g, o, gaps, n) in &rt.fixed_budget {
         for (b, v) in rt.budgets.iter().zip(gaps) {
             rows.push(vec![g.clone(), o.clone(), b.to_string(), num(*v), n.to_string()]);
         }
     }
-    write_atomic(&folder.join("compare_fixed_budget.csv"), csv_records(&h(&["group", "optimiser", "evaluations", "mean_normalised_gap", "runs"]), &rows)?.as_bytes())?;
-    let rows: Vec<Vec<String>> = rt.ert.iter().map(|(g, o, k, t, hits, n, e)| vec![g.clone(), o.clone(), k.to_string(), num(*t), hits.to_string(), n.to_string(), num(*e)]).collect();
-    write_atomic(&folder.join("compare_ert.csv"), csv_records(&h(&["problem", "optimiser", "target_index", "target", "hits", "runs", "ert"]), &rows)?.as_bytes())?;
-    let rows: Vec<Vec<String>> = problems.iter().map(|p| vec![p.name.clone(), num(p.b), num(p.best_known), if p.certified { "certified optimum" } else { "best run" }.to_string(), p.targets.iter().map(|t| num(*t)).collect::<Vec<_>>().join(" ")]).collect();
-    write_atomic(&folder.join("compare_targets.csv"), csv_records(&h(&["problem", "b", "best_known", "best_known_from", "targets"]), &rows)?.as_bytes())?;
+    write_atomic(
+        &folder.join("compare_fixed_budget.csv"),
+        csv_records(
+            &h(&["group", "optimiser", "evaluations", "mean_normalised_gap", "runs"]),
+            &rows,
+        )?
+        .as_bytes(),
+    )?;
+    let rows: Vec<Vec<String>> = rt
+        .ert
+        .iter()
+        .map(|(g, o, k, t, hits, n, e)| {
+            vec![
+                g.clone(),
+                o.clone(),
+                k.to_string(),
+                num(*t),
+                hits.to_string(),
+                n.to_string(),
+                num(*e),
+            ]
+        })
+        .collect();
+    write_atomic(
+        &folder.join("compare_ert.csv"),
+        csv_records(
+            &h(&["problem", "optimiser", "target_index", "target", "hits", "runs", "ert"]),
+            &rows,
+        )?
+        .as_bytes(),
+    )?;
+    let rows: Vec<Vec<String>> = problems
+        .iter()
+        .map(|p| {
+            vec![
+                p.name.clone(),
+                num(p.b),
+                num(p.best_known),
+                if p.certified { "certified optimum" } else { "best run" }.to_string(),
+                p.targets.iter().map(|t| num(*t)).collect::<Vec<_>>().join(" "),
+            ]
+        })
+        .collect();
+    write_atomic(
+        &folder.join("compare_targets.csv"),
+        csv_records(&h(&["problem", "b", "best_known", "best_known_from", "targets"]), &rows)?
+            .as_bytes(),
+    )?;
     Ok(())
 }
 
-fn series_of(rt_rows: &[(String, String, Vec<f64>)], group: &str, budgets: &[u64], opts: &[String]) -> Vec<plots::Series> {
+fn series_of(
+    rt_rows: &[(String, String, Vec<f64>)],
+    group: &str,
+    budgets: &[u64],
+    opts: &[String],
+) -> Vec<plots::Series> {
     use crate::report::plots::style;
     opts.iter()
         .enumerate()
         .filter_map(|(k, o)| {
             let (_, _, v) = rt_rows.iter().find(|r| r.0 == group && &r.1 == o)?;
-            Some(plots::Series { label: o.clone(), colour: style::optimiser_colour(o).unwrap_or_else(|| style::cycle_colour(k)), points: budgets.iter().zip(v).map(|(b, y)| ((*b as f64).log10(), *y)).collect(), band: None })
+            Some(plots::Series {
+                label: o.clone(),
+                colour: style::optimiser_colour(o).unwrap_or_else(|| style::cycle_colour(k)),
+                points: budgets.iter().zip(v).map(|(b, y)| ((*b as f64).log10(), *y)).collect(),
+                band: None,
+            })
         })
         .collect()
 }
 
 /// The ECDF chart of one group.
-fn render_ecdf(rt: &Runtime, group: &str, opts: &[String], path: &std::path::Path) -> Result<(), plots::PlotError> {
-    let rows: Vec<(String, String, Vec<f64>)> = rt.ecdf.iter().map(|r| (r.0.clone(), r.1.clone(), r.2.clone())).collect();
-    let title = format!("{group}: share of (run, target) pairs reached ({TARGETS} targets per problem)");
-    plots::line_chart_png(path, &title, "log10 evaluations", "fraction of (run, target) pairs", &series_of(&rows, group, &rt.budgets, opts), false)
+fn render_ecdf(
+    rt: &Runtime,
+    group: &str,
+    opts: &[String],
+    path: &std::path::Path,
+) -> Result<(), plots::PlotError> {
+    let rows: Vec<(String, String, Vec<f64>)> =
+        rt.ecdf.iter().map(|r| (r.0.clone(), r.1.clone(), r.2.clone())).collect();
+    let title =
+        format!("{group}: share of (run, target) pairs reached ({TARGETS} targets per problem)");
+    plots::line_chart_png(
+        path,
+        &title,
+        "log10 evaluations",
+        "fraction of (run, target) pairs",
+        &series_of(&rows, group, &rt.budgets, opts),
+        false,
+    )
 }
 
 /// The fixed-budget chart of one group.
-fn render_fixed_budget(rt: &Runtime, group: &str, opts: &[String], path: &std::path::Path) -> Result<(), plots::PlotError> {
-    let rows: Vec<(String, String, Vec<f64>)> = rt.fixed_budget.iter().map(|r| (r.0.clone(), r.1.clone(), r.2.clone())).collect();
+fn render_fixed_budget(
+    rt: &Runtime,
+    group: &str,
+    opts: &[String],
+    path: &std::path::Path,
+) -> Result<(), plots::PlotError> {
+    let rows: Vec<(String, String, Vec<f64>)> =
+        rt.fixed_budget.iter().map(|r| (r.0.clone(), r.1.clone(), r.2.clone())).collect();
     let title = format!("{group}: mean (best - best known) / (B - best known) after a budget");
-    plots::line_chart_png(path, &title, "log10 evaluations", "normalised gap (1 = approach B, 0 = best known)", &series_of(&rows, group, &rt.budgets, opts), true)
+    plots::line_chart_png(
+        path,
+        &title,
+        "log10 evaluations",
+        "normalised gap (1 = approach B, 0 = best known)",
+        &series_of(&rows, group, &rt.budgets, opts),
+        true,
+    )
 }
 
 /// The Bayesian signed-rank test of every pair over the cells every optimiser ran: each cell's
@@ -366,19 +658,51 @@ fn render_fixed_budget(rt: &Runtime, group: &str, opts: &[String], path: &std::p
 fn bayes_table(rows: &[OptimRow], opts: &[String], args: &CompareArgs) -> Result<Vec<Vec<String>>> {
     let mut cells: BTreeMap<CellKey, CellSums> = BTreeMap::new();
     for r in rows {
-        let e = cells.entry((r.dataset.clone(), r.grid_x, r.grid_y, r.cn_x, r.cn_y, r.parameterisation.clone())).or_insert((r.b, BTreeMap::new()));
+        let e = cells
+            .entry((
+                r.dataset.clone(),
+                r.grid_x,
+                r.grid_y,
+                r.cn_x,
+                r.cn_y,
+                r.parameterisation.clone(),
+            ))
+            .or_insert((r.b, BTreeMap::new()));
         let s = e.1.entry(r.competitor()).or_default();
         s.0 += r.best;
         s.1 += 1;
     }
-    let full: Vec<(f64, Vec<f64>)> = cells.values().filter(|(_, per)| opts.iter().all(|o| per.contains_key(o))).map(|(b, per)| (*b, opts.iter().map(|o| per[o].0 / per[o].1 as f64 / b).collect())).collect();
+    let full: Vec<(f64, Vec<f64>)> = cells
+        .values()
+        .filter(|(_, per)| opts.iter().all(|o| per.contains_key(o)))
+        .map(|(b, per)| (*b, opts.iter().map(|o| per[o].0 / per[o].1 as f64 / b).collect()))
+        .collect();
     let mut out = Vec::new();
     for i in 0..opts.len() {
         for j in i + 1..opts.len() {
             let a: Vec<f64> = full.iter().map(|c| c.1[i]).collect();
             let b: Vec<f64> = full.iter().map(|c| c.1[j]).collect();
-            let r = stats::bayes::signed_rank(&a, &b, args.rope, stats::bayes::PRIOR, args.bayes_samples, 0x5eed + (i * opts.len() + j) as u64).map_err(|e| anyhow::anyhow!("Bayesian signed-rank test {} vs {}: {e}", opts[i], opts[j]))?;
-            out.push(vec![opts[i].clone(), opts[j].clone(), r.n.to_string(), format!("{:e}", args.rope), r.samples.to_string(), format!("{:.4}", r.p_a_better), format!("{:.4}", r.p_rope), format!("{:.4}", r.p_b_better)]);
+            let r = stats::bayes::signed_rank(
+                &a,
+                &b,
+                args.rope,
+                stats::bayes::PRIOR,
+                args.bayes_samples,
+                0x5eed + (i * opts.len() + j) as u64,
+            )
+            .map_err(|e| {
+                anyhow::anyhow!("Bayesian signed-rank test {} vs {}: {e}", opts[i], opts[j])
+            })?;
+            out.push(vec![
+                opts[i].clone(),
+                opts[j].clone(),
+                r.n.to_string(),
+                format!("{:e}", args.rope),
+                r.samples.to_string(),
+                format!("{:.4}", r.p_a_better),
+                format!("{:.4}", r.p_rope),
+                format!("{:.4}", r.p_b_better),
+            ]);
         }
     }
     Ok(out)

@@ -8,17 +8,17 @@ pub mod pictures;
 pub mod report;
 pub mod spec;
 
+use crate::experiment::spec::GridSize;
 use crate::experiment::spec::Spec;
-use spec::OptimCell;
 use crate::experiment::{runner, seeds, RunContext};
 use crate::families::fit;
-use crate::experiment::spec::GridSize;
-use crate::spline::ControlNetProblem;
 use crate::optim::{Budget, ExactOptions, Optimiser, Problem, RunResult};
 use crate::spline::BoxSpec;
+use crate::spline::ControlNetProblem;
 use crate::spline::{fit_two_view, Approach, Parameterisation};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
+use spec::OptimCell;
 use std::collections::BTreeMap;
 
 /// One row of a Chapter 6 `runs.csv`.
@@ -88,23 +88,40 @@ pub type ProblemKey = (String, GridSize, Parameterisation);
 
 /// The certified exact optimum of every problem, when the spec asks for it (deterministic, so
 /// computed once per problem and in parallel).
-pub fn exact_optima(spec: &Spec, ctx: &RunContext, problems: &BTreeMap<ProblemKey, ControlNetProblem>) -> Result<BTreeMap<ProblemKey, crate::optim::exact::ExactResult>> {
+pub fn exact_optima(
+    spec: &Spec,
+    ctx: &RunContext,
+    problems: &BTreeMap<ProblemKey, ControlNetProblem>,
+) -> Result<BTreeMap<ProblemKey, crate::optim::exact::ExactResult>> {
     let o = spec.file.optim.as_ref().context("spec has no [optim] section")?;
     if !o.exact {
         return Ok(BTreeMap::new());
     }
     let keys: Vec<&ProblemKey> = problems.keys().collect();
-    let solved = runner::run_cells(&keys, ctx.jobs, "exact optima", |k| {
-        let opts = ExactOptions { tol_rel_gap: o.exact_tol, max_newton_steps: o.exact_newton_steps, ..ExactOptions::default() };
-        problems[*k].exact_optimum(&opts).map_err(|e| anyhow::anyhow!("exact optimum of {} {} {}: {e}", k.0, k.1, k.2.name()))
-    }, |_, _| Ok(()))?;
+    let solved = runner::run_cells(
+        &keys,
+        ctx.jobs,
+        "exact optima",
+        |k| {
+            let opts = ExactOptions {
+                tol_rel_gap: o.exact_tol,
+                max_newton_steps: o.exact_newton_steps,
+                ..ExactOptions::default()
+            };
+            problems[*k].exact_optimum(&opts).map_err(|e| {
+                anyhow::anyhow!("exact optimum of {} {} {}: {e}", k.0, k.1, k.2.name())
+            })
+        },
+        |_, _| Ok(()),
+    )?;
     Ok(keys.into_iter().cloned().zip(solved).collect())
 }
 
 /// Build the optimiser a cell names, with the spec's parameters.
 pub fn optimiser(spec: &Spec, name: &str) -> Result<Box<dyn Optimiser>> {
     let o = spec.file.optim.as_ref().context("spec has no [optim] section")?;
-    crate::optim::named(name, &o.ga, &o.de, &o.pso, &o.csa, &o.icsa).with_context(|| format!("unknown optimiser `{name}`"))
+    crate::optim::named(name, &o.ga, &o.de, &o.pso, &o.csa, &o.icsa)
+        .with_context(|| format!("unknown optimiser `{name}`"))
 }
 
 /// The control-net problems of every (data, net, parameterisation), from approach B's fit.
@@ -118,13 +135,16 @@ pub fn problems(spec: &Spec, ctx: &RunContext) -> Result<BTreeMap<ProblemKey, Co
             for p in &o.parameterisations {
                 let param: Parameterisation = p.parse().map_err(anyhow::Error::msg)?;
                 let grid = &maps[d].grid;
-                let fit = fit_two_view(grid, cn.nx, cn.ny, param, Approach::Improved, &o.fit_options()).map_err(|e| anyhow::anyhow!("{d} {cn} {p}: {e}"))?;
+                let fit =
+                    fit_two_view(grid, cn.nx, cn.ny, param, Approach::Improved, &o.fit_options())
+                        .map_err(|e| anyhow::anyhow!("{d} {cn} {p}: {e}"))?;
                 let parts = fit.control_net_parts(grid).map_err(|e| anyhow::anyhow!("{e}"))?;
                 let bounds = match o.search_range {
                     Some(half_width) => BoxSpec::AroundStart { half_width },
                     None => BoxSpec::Cover { fraction: o.bounds_margin },
                 };
-                let problem = ControlNetProblem::new(parts, bounds).map_err(|e| anyhow::anyhow!("{d} {cn} {p}: {e}"))?;
+                let problem = ControlNetProblem::new(parts, bounds)
+                    .map_err(|e| anyhow::anyhow!("{d} {cn} {p}: {e}"))?;
                 out.insert((d.clone(), cn, param), problem);
             }
         }
@@ -136,11 +156,17 @@ pub fn problems(spec: &Spec, ctx: &RunContext) -> Result<BTreeMap<ProblemKey, Co
 pub fn run_cell(spec: &Spec, cell: &OptimCell, problem: &ControlNetProblem) -> Result<OptimRun> {
     let o = spec.file.optim.as_ref().context("spec has no [optim] section")?;
     let opt = optimiser(spec, &cell.optimiser)?;
-    let budget = Budget { generations: o.generations as u64, population: o.population, init_range: o.init_range, trace_every_evals: o.trace_every_evals };
+    let budget = Budget {
+        generations: o.generations as u64,
+        population: o.population,
+        init_range: o.init_range,
+        trace_every_evals: o.trace_every_evals,
+    };
     let key = cell.key();
     let mut rng = seeds::cell_rng(spec.file.master_seed, &key);
     let t0 = runner::thread_cpu_seconds();
-    let r: RunResult = opt.run(problem, &budget, &mut rng).map_err(|e| anyhow::anyhow!("{key}: {e}"))?;
+    let r: RunResult =
+        opt.run(problem, &budget, &mut rng).map_err(|e| anyhow::anyhow!("{key}: {e}"))?;
     let cpu_s = runner::thread_cpu_seconds() - t0;
     if !r.best_fitness.is_finite() {
         anyhow::bail!("{key}: the best fitness is not finite ({})", r.best_fitness);
@@ -167,7 +193,13 @@ pub fn run_cell(spec: &Spec, cell: &OptimCell, problem: &ControlNetProblem) -> R
         max_control: dense.max_control,
         cpu_s,
     };
-    Ok(OptimRun { cell: cell.clone(), row, trace: r.trace, improvements: r.improvements, best_x: r.best_x })
+    Ok(OptimRun {
+        cell: cell.clone(),
+        row,
+        trace: r.trace,
+        improvements: r.improvements,
+        best_x: r.best_x,
+    })
 }
 
 impl runner::Logged for OptimRun {
@@ -175,7 +207,11 @@ impl runner::Logged for OptimRun {
     /// deterministic, so the few the pictures need are recomputed: see [`picture_points`]).
     type Record = OptimRecord;
     fn record(&self) -> Self::Record {
-        OptimRecord { row: self.row.clone(), trace: self.trace.clone(), improvements: self.improvements.clone() }
+        OptimRecord {
+            row: self.row.clone(),
+            trace: self.trace.clone(),
+            improvements: self.improvements.clone(),
+        }
     }
 }
 
@@ -186,7 +222,11 @@ fn pictured(cell: &OptimCell, largest: GridSize) -> bool {
 }
 
 /// Run every optimisation cell of a spec (its shard's, with `--shard`).
-pub fn run(spec: &Spec, ctx: &RunContext, problems: &BTreeMap<ProblemKey, ControlNetProblem>) -> Result<Vec<OptimRun>> {
+pub fn run(
+    spec: &Spec,
+    ctx: &RunContext,
+    problems: &BTreeMap<ProblemKey, ControlNetProblem>,
+) -> Result<Vec<OptimRun>> {
     let cells = spec::cells(spec);
     let largest = cells.iter().map(|c| c.cn).max().unwrap_or(GridSize { nx: 0, ny: 0 });
     let problem = |cell: &OptimCell| &problems[&(cell.dataset.clone(), cell.cn, cell.param)];
@@ -201,7 +241,15 @@ pub fn run(spec: &Spec, ctx: &RunContext, problems: &BTreeMap<ProblemKey, Contro
             }
             Ok(r)
         },
-        |cell, rec: OptimRecord| Ok(OptimRun { cell: cell.clone(), row: rec.row, trace: rec.trace, improvements: rec.improvements, best_x: Vec::new() }),
+        |cell, rec: OptimRecord| {
+            Ok(OptimRun {
+                cell: cell.clone(),
+                row: rec.row,
+                trace: rec.trace,
+                improvements: rec.improvements,
+                best_x: Vec::new(),
+            })
+        },
     )?;
     picture_points(spec, &mut runs, largest, problem)?;
     Ok(runs)
@@ -212,7 +260,12 @@ pub fn run(spec: &Spec, ctx: &RunContext, problems: &BTreeMap<ProblemKey, Contro
 /// (its 3-D view) their best control points when they are not at hand, by running that cell
 /// again; the re-run must reproduce the logged error exactly (a check of determinism across
 /// processes).
-fn picture_points<'a>(spec: &Spec, runs: &mut [OptimRun], largest: GridSize, problem: impl Fn(&OptimCell) -> &'a ControlNetProblem) -> Result<()> {
+fn picture_points<'a>(
+    spec: &Spec,
+    runs: &mut [OptimRun],
+    largest: GridSize,
+    problem: impl Fn(&OptimCell) -> &'a ControlNetProblem,
+) -> Result<()> {
     let mut best: BTreeMap<(String, Parameterisation, String), usize> = BTreeMap::new();
     let mut furthest: BTreeMap<String, usize> = BTreeMap::new();
     for (k, r) in runs.iter().enumerate() {
@@ -223,12 +276,15 @@ fn picture_points<'a>(spec: &Spec, runs: &mut [OptimRun], largest: GridSize, pro
         if !pictured(&r.cell, largest) {
             continue;
         }
-        let e = best.entry((r.cell.dataset.clone(), r.cell.param, r.cell.optimiser.clone())).or_insert(k);
+        let e = best
+            .entry((r.cell.dataset.clone(), r.cell.param, r.cell.optimiser.clone()))
+            .or_insert(k);
         if r.row.best < runs[*e].row.best {
             *e = k;
         }
     }
-    let wanted: std::collections::BTreeSet<usize> = best.into_values().chain(furthest.into_values()).collect();
+    let wanted: std::collections::BTreeSet<usize> =
+        best.into_values().chain(furthest.into_values()).collect();
     for k in wanted {
         if runs[k].best_x.is_empty() {
             let again = run_cell(spec, &runs[k].cell, problem(&runs[k].cell))?;
@@ -244,7 +300,8 @@ fn picture_points<'a>(spec: &Spec, runs: &mut [OptimRun], largest: GridSize, pro
 /// One sentence on the start and the search box of a spec's runs, for the report.
 pub fn setting(spec: &Spec) -> String {
     let Some(o) = spec.file.optim.as_ref() else { return String::new() };
-    let start = format!("Each individual starts at B + U[-{r:e}, {r:e}] per coordinate", r = o.init_range);
+    let start =
+        format!("Each individual starts at B + U[-{r:e}, {r:e}] per coordinate", r = o.init_range);
     match o.search_range {
         Some(r) => format!("{start}; the search box is B +- {r:e} per coordinate (Table 6.1's \"control point coordinate range [-5e-6, 5e-6]\" read as the search space, as the thesis' tiny improvements over B imply; PSO's maximum velocity is half that box)."),
         None if o.bounds_margin == 0.0 => format!("{start}; the search box is the smallest per-axis box holding the data and B's control points."),
@@ -262,7 +319,10 @@ impl crate::experiment::family::Family for Optim {
     fn present(&self, spec: &Spec) -> bool {
         spec.file.optim.is_some()
     }
-    fn check_limits(&self, c: &crate::experiment::limits::Check) -> Result<(), crate::experiment::spec::SpecError> {
+    fn check_limits(
+        &self,
+        c: &crate::experiment::limits::Check,
+    ) -> Result<(), crate::experiment::spec::SpecError> {
         match &c.spec.file.optim {
             Some(s) => self::spec::limits(c, s),
             None => Ok(()),
@@ -285,12 +345,22 @@ impl crate::experiment::family::Family for Optim {
     fn logged_keys(&self, spec: &Spec) -> Vec<String> {
         spec::cells(spec).iter().map(|c| c.key()).collect()
     }
-    fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<crate::experiment::family::Outcome> {
+    fn run(
+        &self,
+        spec: &Spec,
+        ctx: &RunContext,
+        tables: bool,
+    ) -> Result<crate::experiment::family::Outcome> {
         self.run_variants(std::slice::from_ref(spec), ctx, tables)
     }
     /// Every variant's cells on the first variant's problems (a sweep varies optimiser settings
     /// only), then one set of tables in which each `optimiser@variant` of a sweep is a column.
-    fn run_variants(&self, variants: &[Spec], ctx: &RunContext, tables: bool) -> Result<crate::experiment::family::Outcome> {
+    fn run_variants(
+        &self,
+        variants: &[Spec],
+        ctx: &RunContext,
+        tables: bool,
+    ) -> Result<crate::experiment::family::Outcome> {
         let [first, ..] = variants else { anyhow::bail!("no variant to run") };
         let problems = problems(first, ctx)?;
         let exact = if tables { exact_optima(first, ctx, &problems)? } else { BTreeMap::new() };
@@ -301,10 +371,24 @@ impl crate::experiment::family::Family for Optim {
                 r
             }));
         }
-        let section = if tables { Some(crate::families::optimise::report::write(&runs, &problems, &exact, &setting(first), &ctx.out)?) } else { None };
+        let section = if tables {
+            Some(crate::families::optimise::report::write(
+                &runs,
+                &problems,
+                &exact,
+                &setting(first),
+                &ctx.out,
+            )?)
+        } else {
+            None
+        };
         if tables {
             crate::report::views3d::write(&ctx.out, &pictures::views(&runs, &problems))?;
         }
-        Ok(crate::experiment::family::Outcome { section, cpu_s: runs.iter().map(|r| r.row.cpu_s).sum(), cells: runs.len() })
+        Ok(crate::experiment::family::Outcome {
+            section,
+            cpu_s: runs.iter().map(|r| r.row.cpu_s).sum(),
+            cells: runs.len(),
+        })
     }
 }

@@ -13,22 +13,51 @@ use std::collections::BTreeMap;
 pub fn views(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProblem>) -> Vec<View> {
     let mut views = Vec::new();
     for grid in crate::report::ordered(runs.iter().map(|r| r.cell.grid)) {
-        for d in crate::report::ordered(runs.iter().filter(|r| r.cell.grid == grid).map(|r| r.cell.dataset.clone())) {
+        for d in crate::report::ordered(
+            runs.iter().filter(|r| r.cell.grid == grid).map(|r| r.cell.dataset.clone()),
+        ) {
             // The first of equal excursions, as `picture_points` chose it.
-            let worst = runs.iter().filter(|r| r.cell.grid == grid && r.cell.dataset == d).fold(None::<&OptimRun>, |w, r| match w {
-                Some(w) if w.row.excursion >= r.row.excursion => Some(w),
-                _ => Some(r),
-            });
+            let worst = runs.iter().filter(|r| r.cell.grid == grid && r.cell.dataset == d).fold(
+                None::<&OptimRun>,
+                |w, r| match w {
+                    Some(w) if w.row.excursion >= r.row.excursion => Some(w),
+                    _ => Some(r),
+                },
+            );
             let Some(r) = worst.filter(|r| !r.best_x.is_empty()) else { continue };
-            let Some(problem) = problems.get(&(d.clone(), r.cell.cn, r.cell.param)) else { continue };
+            let Some(problem) = problems.get(&(d.clone(), r.cell.cn, r.cell.param)) else {
+                continue;
+            };
             let parts = problem.parts();
             let mut traces = vec![
-                Trace::Points { label: "data, bottom view".into(), colour: hex(style::DNSOM_BOTTOM), points: parts.data_bottom.clone(), lines: Vec::new() },
-                Trace::Points { label: "data, top view".into(), colour: hex(style::DNSOM_TOP), points: parts.data_top.clone(), lines: Vec::new() },
+                Trace::Points {
+                    label: "data, bottom view".into(),
+                    colour: hex(style::DNSOM_BOTTOM),
+                    points: parts.data_bottom.clone(),
+                    lines: Vec::new(),
+                },
+                Trace::Points {
+                    label: "data, top view".into(),
+                    colour: hex(style::DNSOM_TOP),
+                    points: parts.data_top.clone(),
+                    lines: Vec::new(),
+                },
             ];
             let [(bottom, bu, bv), (top, tu, tv)] = parts.dense_grids(&r.best_x);
-            traces.push(Trace::Surface { label: "bottom surface".into(), colour: hex(style::DNSOM_BOTTOM), rows: bu, cols: bv, points: bottom });
-            traces.push(Trace::Surface { label: "top surface".into(), colour: hex(style::DNSOM_TOP), rows: tu, cols: tv, points: top });
+            traces.push(Trace::Surface {
+                label: "bottom surface".into(),
+                colour: hex(style::DNSOM_BOTTOM),
+                rows: bu,
+                cols: bv,
+                points: bottom,
+            });
+            traces.push(Trace::Surface {
+                label: "top surface".into(),
+                colour: hex(style::DNSOM_TOP),
+                rows: tu,
+                cols: tv,
+                points: top,
+            });
             let title = format!(
                 "{d} on {grid}: the optimised surfaces furthest from the data ({} r{}, CN {}, {}, best {:.4e}, excursion {:.3e})",
                 r.cell.optimiser.to_uppercase(),

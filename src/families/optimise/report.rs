@@ -2,20 +2,20 @@
 //! beside B) and M/N (CPU seconds), the win-count tables 6.4-6.9, each optimiser's count of cells
 //! where it beats B, convergence curves and box plots, and the REPORT.md section.
 
-use crate::report::claims::Claim;
-use crate::report::ordered;
-use crate::io::{csv_records, csv_text, write_atomic};
-use crate::report::markdown::table;
-use crate::report::plots::{self, style, Series};
-use crate::report::reference;
+use crate::experiment::spec::GridSize;
 use crate::families::optimise::{OptimRun, ProblemKey};
-use crate::spline::ControlNetProblem;
+use crate::io::{csv_records, csv_text, write_atomic};
 use crate::optim::exact::ExactResult;
 use crate::optim::Problem;
-use std::collections::BTreeMap;
-use crate::experiment::spec::GridSize;
+use crate::report::claims::Claim;
+use crate::report::markdown::table;
+use crate::report::ordered;
+use crate::report::plots::{self, style, Series};
+use crate::report::reference;
+use crate::spline::ControlNetProblem;
 use crate::spline::Parameterisation;
 use anyhow::Result;
+use std::collections::BTreeMap;
 use std::fmt::Write;
 use std::path::Path;
 
@@ -24,7 +24,11 @@ fn stats(v: &[f64]) -> Option<(f64, f64, f64)> {
         return None;
     }
     let avg = v.iter().sum::<f64>() / v.len() as f64;
-    Some((avg, v.iter().cloned().fold(f64::INFINITY, f64::min), v.iter().cloned().fold(f64::NEG_INFINITY, f64::max)))
+    Some((
+        avg,
+        v.iter().cloned().fold(f64::INFINITY, f64::min),
+        v.iter().cloned().fold(f64::NEG_INFINITY, f64::max),
+    ))
 }
 
 type CellKey = (String, Parameterisation, GridSize);
@@ -39,7 +43,11 @@ struct Beside {
 }
 
 /// Every cell of our appendix table that the published one also has.
-fn side_by_side(header: &[String], rows: &[Vec<String>], thesis: &reference::RefTable) -> Vec<Beside> {
+fn side_by_side(
+    header: &[String],
+    rows: &[Vec<String>],
+    thesis: &reference::RefTable,
+) -> Vec<Beside> {
     let keys = ["data", "parameterisation", "cn_x", "cn_y"];
     let mut out = Vec::new();
     for row in rows {
@@ -59,27 +67,52 @@ fn render_side_by_side(pairs: &[Beside], name: &str, out: &Path) -> Result<Strin
     // CPU seconds are measured, never identical across runs: their columns end in `_s`, which
     // marks a timing column for `drift` (reported, not judged).
     let timing = pairs.iter().any(|b| b.measure.ends_with("_s"));
-    let values: [&str; 3] = if timing { ["ours_s", "thesis_s", "ratio_s"] } else { ["ours", "thesis", "ratio"] };
-    let h: Vec<String> = ["data", "parameterisation", "cn_x", "cn_y", "measure"].iter().chain(&values).map(|s| s.to_string()).collect();
+    let values: [&str; 3] =
+        if timing { ["ours_s", "thesis_s", "ratio_s"] } else { ["ours", "thesis", "ratio"] };
+    let h: Vec<String> = ["data", "parameterisation", "cn_x", "cn_y", "measure"]
+        .iter()
+        .chain(&values)
+        .map(|s| s.to_string())
+        .collect();
     let rows: Vec<Vec<String>> = pairs
         .iter()
         .map(|b| {
             let mut r = b.key.clone();
-            r.extend([b.measure.clone(), format!("{:.6}", b.ours), format!("{:.6}", b.thesis), if b.thesis != 0.0 { format!("{:.6}", b.ours / b.thesis) } else { String::new() }]);
+            r.extend([
+                b.measure.clone(),
+                format!("{:.6}", b.ours),
+                format!("{:.6}", b.thesis),
+                if b.thesis != 0.0 { format!("{:.6}", b.ours / b.thesis) } else { String::new() },
+            ]);
             r
         })
         .collect();
     write_atomic(&out.join(format!("{name}_vs_thesis.csv")), csv_records(&h, &rows)?.as_bytes())?;
     let measures = ordered(pairs.iter().map(|b| b.measure.clone()));
-    let shown: Vec<&String> = measures.iter().filter(|m| m.as_str() == "b" || m.ends_with("_avg") || m.ends_with("_avg_s")).collect();
-    let nets = ordered(pairs.iter().map(|b| (b.key[2].parse::<usize>().unwrap_or(0), b.key[3].parse::<usize>().unwrap_or(0))));
+    let shown: Vec<&String> = measures
+        .iter()
+        .filter(|m| m.as_str() == "b" || m.ends_with("_avg") || m.ends_with("_avg_s"))
+        .collect();
+    let nets =
+        ordered(pairs.iter().map(|b| {
+            (b.key[2].parse::<usize>().unwrap_or(0), b.key[3].parse::<usize>().unwrap_or(0))
+        }));
     let mut mh = vec!["CN".to_string()];
     mh.extend(shown.iter().map(|m| m.to_string()));
     let mut mrows = Vec::new();
     for (cx, cy) in nets {
         let mut r = vec![format!("{cx}x{cy}")];
         for m in &shown {
-            let v: Vec<f64> = pairs.iter().filter(|b| &&b.measure == m && b.key[2] == cx.to_string() && b.key[3] == cy.to_string() && b.thesis != 0.0).map(|b| b.ours / b.thesis).collect();
+            let v: Vec<f64> = pairs
+                .iter()
+                .filter(|b| {
+                    &&b.measure == m
+                        && b.key[2] == cx.to_string()
+                        && b.key[3] == cy.to_string()
+                        && b.thesis != 0.0
+                })
+                .map(|b| b.ours / b.thesis)
+                .collect();
             r.push(crate::report::markdown::num(crate::report::markdown::median(&v), 3));
         }
         mrows.push(r);
@@ -89,7 +122,13 @@ fn render_side_by_side(pairs: &[Beside], name: &str, out: &Path) -> Result<Strin
 }
 
 /// Write every Chapter 6 file; returns the REPORT.md section.
-pub fn write(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProblem>, exact: &BTreeMap<ProblemKey, ExactResult>, setting: &str, out: &Path) -> Result<String> {
+pub fn write(
+    runs: &[OptimRun],
+    problems: &BTreeMap<ProblemKey, ControlNetProblem>,
+    exact: &BTreeMap<ProblemKey, ExactResult>,
+    setting: &str,
+    out: &Path,
+) -> Result<String> {
     let rows: Vec<_> = runs.iter().map(|r| r.row.clone()).collect();
     write_atomic(&out.join("runs.csv"), csv_text(&rows)?.as_bytes())?;
     let mut s = String::from("## Chapter 6: optimisation of the control points\n\n");
@@ -99,9 +138,15 @@ pub fn write(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProble
     let budgets: Vec<String> = ordered(runs.iter().map(|r| r.cell.optimiser.clone()))
         .iter()
         .map(|o| {
-            let e: Vec<u64> = runs.iter().filter(|r| &r.cell.optimiser == o).map(|r| r.row.evaluations).collect();
-            let (lo, hi) = (e.iter().min().copied().unwrap_or(0), e.iter().max().copied().unwrap_or(0));
-            if lo == hi { format!("{o} {lo}") } else { format!("{o} {lo}-{hi}") }
+            let e: Vec<u64> =
+                runs.iter().filter(|r| &r.cell.optimiser == o).map(|r| r.row.evaluations).collect();
+            let (lo, hi) =
+                (e.iter().min().copied().unwrap_or(0), e.iter().max().copied().unwrap_or(0));
+            if lo == hi {
+                format!("{o} {lo}")
+            } else {
+                format!("{o} {lo}-{hi}")
+            }
         })
         .collect();
     let _ = writeln!(s, "Fitness evaluations per run: {}. GA is steady-state (thesis 6.2.4.1) and evaluates two offspring per generation, DE and PSO their whole population each generation; its lead in CPU time (Tables 6.6, 6.7) rests on that smaller budget.\n", budgets.join(", "));
@@ -109,16 +154,26 @@ pub fn write(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProble
     for grid in ordered(runs.iter().map(|r| r.cell.grid)) {
         let g: Vec<&OptimRun> = runs.iter().filter(|r| r.cell.grid == grid).collect();
         let opts = ordered(g.iter().map(|r| r.cell.optimiser.clone()));
-        let cells: Vec<CellKey> = ordered(g.iter().map(|r| (r.cell.dataset.clone(), r.cell.param, r.cell.cn)));
+        let cells: Vec<CellKey> =
+            ordered(g.iter().map(|r| (r.cell.dataset.clone(), r.cell.param, r.cell.cn)));
         let (err_name, time_name, t_err, t_time) = match (grid.nx, grid.ny) {
             (20, 20) => ("appendix_k", "appendix_m", "table_6_4", "table_6_6"),
             (18, 30) => ("appendix_l", "appendix_n", "table_6_5", "table_6_7"),
             _ => ("optimised_error", "optimiser_cpu", "wins_error", "wins_time"),
         };
         let of = |c: &CellKey, o: &str, f: &dyn Fn(&OptimRun) -> f64| -> Vec<f64> {
-            g.iter().filter(|r| r.cell.dataset == c.0 && r.cell.param == c.1 && r.cell.cn == c.2 && r.cell.optimiser == o).map(|r| f(r)).collect()
+            g.iter()
+                .filter(|r| {
+                    r.cell.dataset == c.0
+                        && r.cell.param == c.1
+                        && r.cell.cn == c.2
+                        && r.cell.optimiser == o
+                })
+                .map(|r| f(r))
+                .collect()
         };
-        let mut eh = vec!["data".to_string(), "parameterisation".into(), "cn_x".into(), "cn_y".into()];
+        let mut eh =
+            vec!["data".to_string(), "parameterisation".into(), "cn_x".into(), "cn_y".into()];
         let mut th = eh.clone();
         for o in &opts {
             for m in ["avg", "min", "max"] {
@@ -133,7 +188,8 @@ pub fn write(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProble
         let mut beats_b = vec![0usize; opts.len()];
         let mut per_dp: Vec<(String, Parameterisation, Vec<usize>, Vec<usize>)> = Vec::new();
         for c in &cells {
-            let key = vec![c.0.clone(), c.1.name().to_string(), c.2.nx.to_string(), c.2.ny.to_string()];
+            let key =
+                vec![c.0.clone(), c.1.name().to_string(), c.2.nx.to_string(), c.2.ny.to_string()];
             let (mut er, mut tr) = (key.clone(), key);
             let mut avgs = Vec::new();
             let mut tavgs = Vec::new();
@@ -143,7 +199,8 @@ pub fn write(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProble
                 b = of(c, o, &|r| r.row.b).first().copied().unwrap_or(b);
                 let (a, mn, mx) = stats(&best).unwrap_or((f64::NAN, f64::NAN, f64::NAN));
                 er.extend([a, mn, mx].iter().map(|v| format!("{v:.6}")));
-                let (ta, tmn, tmx) = stats(&of(c, o, &|r| r.row.cpu_s)).unwrap_or((f64::NAN, f64::NAN, f64::NAN));
+                let (ta, tmn, tmx) =
+                    stats(&of(c, o, &|r| r.row.cpu_s)).unwrap_or((f64::NAN, f64::NAN, f64::NAN));
                 tr.extend([ta, tmn, tmx].iter().map(|v| format!("{v:.6}")));
                 avgs.push(a);
                 tavgs.push(ta);
@@ -152,7 +209,8 @@ pub fn write(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProble
             er.push(format!("{b:.6}"));
             erows.push(er);
             trows.push(tr);
-            let argmin = |v: &[f64]| v.iter().enumerate().min_by(|x, y| x.1.total_cmp(y.1)).map(|(i, _)| i);
+            let argmin =
+                |v: &[f64]| v.iter().enumerate().min_by(|x, y| x.1.total_cmp(y.1)).map(|(i, _)| i);
             let dp = match per_dp.iter().position(|x| x.0 == c.0 && x.1 == c.1) {
                 Some(i) => i,
                 None => {
@@ -181,7 +239,8 @@ pub fn write(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProble
         let mut wh = vec!["data".to_string(), "parameterisation".into()];
         wh.extend(opts.iter().cloned());
         wh.push("cells".into());
-        let per_cells = |d: &str, p: Parameterisation| cells.iter().filter(|c| c.0 == d && c.1 == p).count();
+        let per_cells =
+            |d: &str, p: Parameterisation| cells.iter().filter(|c| c.0 == d && c.1 == p).count();
         for (name, idx) in [(t_err, 2usize), (t_time, 3usize)] {
             let mut rows: Vec<Vec<String>> = per_dp
                 .iter()
@@ -201,29 +260,55 @@ pub fn write(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProble
             write_atomic(&out.join(format!("{name}.csv")), csv_records(&wh, &rows)?.as_bytes())?;
         }
         let _ = writeln!(s, "\n### Grid {grid}: `{err_name}.csv`, `{time_name}.csv`, `{t_err}.csv`, `{t_time}.csv`\n");
-        let h: Vec<String> = ["optimiser", "least AVG error (cells)", "least AVG CPU time (cells)", "AVG below B (cells)", "CPU s, all runs"].iter().map(|x| x.to_string()).collect();
+        let h: Vec<String> = [
+            "optimiser",
+            "least AVG error (cells)",
+            "least AVG CPU time (cells)",
+            "AVG below B (cells)",
+            "CPU s, all runs",
+        ]
+        .iter()
+        .map(|x| x.to_string())
+        .collect();
         let mut sum_rows = Vec::new();
         for (k, o) in opts.iter().enumerate() {
             let cpu: f64 = g.iter().filter(|r| &r.cell.optimiser == o).map(|r| r.row.cpu_s).sum();
-            sum_rows.push(vec![o.clone(), format!("{}/{}", err_wins[k], cells.len()), format!("{}/{}", time_wins[k], cells.len()), format!("{}/{}", beats_b[k], cells.len()), format!("{cpu:.2}")]);
+            sum_rows.push(vec![
+                o.clone(),
+                format!("{}/{}", err_wins[k], cells.len()),
+                format!("{}/{}", time_wins[k], cells.len()),
+                format!("{}/{}", beats_b[k], cells.len()),
+                format!("{cpu:.2}"),
+            ]);
         }
         s.push_str(&table(&h, &sum_rows));
         // Claims against the thesis' own tables.
         let thesis = reference::table(err_name);
         let thesis_time = reference::table(time_name);
-        let thesis_wins = |t: Option<&reference::RefTable>, suffix: &str, o: &str| -> Option<(usize, usize)> {
-            let t = t?;
-            let names = ["ga", "de", "pso"];
-            let mut w = 0;
-            for row in &t.rows {
-                let v: Vec<f64> = names.iter().filter_map(|n| row.get(&format!("{n}_avg{suffix}")).and_then(|x| x.parse().ok())).collect();
-                if v.len() == 3 {
-                    let k = v.iter().enumerate().min_by(|a, b| a.1.total_cmp(b.1)).map(|x| x.0).unwrap_or(0);
-                    w += (names[k] == o) as usize;
+        let thesis_wins =
+            |t: Option<&reference::RefTable>, suffix: &str, o: &str| -> Option<(usize, usize)> {
+                let t = t?;
+                let names = ["ga", "de", "pso"];
+                let mut w = 0;
+                for row in &t.rows {
+                    let v: Vec<f64> = names
+                        .iter()
+                        .filter_map(|n| {
+                            row.get(&format!("{n}_avg{suffix}")).and_then(|x| x.parse().ok())
+                        })
+                        .collect();
+                    if v.len() == 3 {
+                        let k = v
+                            .iter()
+                            .enumerate()
+                            .min_by(|a, b| a.1.total_cmp(b.1))
+                            .map(|x| x.0)
+                            .unwrap_or(0);
+                        w += (names[k] == o) as usize;
+                    }
                 }
-            }
-            Some((w, t.rows.len()))
-        };
+                Some((w, t.rows.len()))
+            };
         if let Some(k) = opts.iter().position(|o| o == "de") {
             s.push_str(&beside_md);
             claims.push(Claim { rival: None, chapter: "6".into(), statement: format!("DE gives the least average error in most cells (grid {grid})"), ours: (err_wins[k], cells.len()), thesis: thesis_wins(thesis.as_ref(), "", "de"), note: "thesis: 126/140 and 117/140 (Tables 6.4, 6.5); verdict 'mostly holds' when more than half".into() });
@@ -235,15 +320,43 @@ pub fn write(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProble
             claims.push(Claim { rival: None, chapter: "6".into(), statement: format!("{o} lowers the surface error below B (grid {grid})"), ours: (beats_b[k], cells.len()), thesis: None, note: "AVG over repeats below B's error; the +-5e-6 start can leave an optimiser above B".into() });
         }
         // The certified exact optimum and each optimiser's distance to it.
-        let ex_cells: Vec<(&CellKey, &ExactResult)> = cells.iter().filter_map(|c| exact.get(&(c.0.clone(), c.2, c.1)).map(|e| (c, e))).collect();
+        let ex_cells: Vec<(&CellKey, &ExactResult)> = cells
+            .iter()
+            .filter_map(|c| exact.get(&(c.0.clone(), c.2, c.1)).map(|e| (c, e)))
+            .collect();
         if !ex_cells.is_empty() {
-            let mut h: Vec<String> = ["data", "parameterisation", "cn_x", "cn_y", "b", "exact_f", "lower_bound", "certified_gap"].iter().map(|x| x.to_string()).collect();
+            let mut h: Vec<String> = [
+                "data",
+                "parameterisation",
+                "cn_x",
+                "cn_y",
+                "b",
+                "exact_f",
+                "lower_bound",
+                "certified_gap",
+            ]
+            .iter()
+            .map(|x| x.to_string())
+            .collect();
             h.extend(opts.iter().map(|o| format!("{o}_min_minus_exact")));
             let mut rows = Vec::new();
             let (mut below, mut checked) = (0usize, 0usize);
             for (c, e) in &ex_cells {
-                let b = g.iter().find(|r| r.cell.dataset == c.0 && r.cell.param == c.1 && r.cell.cn == c.2).map(|r| r.row.b).unwrap_or(f64::NAN);
-                let mut row = vec![c.0.clone(), c.1.name().to_string(), c.2.nx.to_string(), c.2.ny.to_string(), format!("{b:.9}"), format!("{:.9}", e.f), format!("{:.9}", e.lower_bound), format!("{:.3e}", e.gap)];
+                let b = g
+                    .iter()
+                    .find(|r| r.cell.dataset == c.0 && r.cell.param == c.1 && r.cell.cn == c.2)
+                    .map(|r| r.row.b)
+                    .unwrap_or(f64::NAN);
+                let mut row = vec![
+                    c.0.clone(),
+                    c.1.name().to_string(),
+                    c.2.nx.to_string(),
+                    c.2.ny.to_string(),
+                    format!("{b:.9}"),
+                    format!("{:.9}", e.f),
+                    format!("{:.9}", e.lower_bound),
+                    format!("{:.3e}", e.gap),
+                ];
                 for o in &opts {
                     let best = of(c, o, &|r| r.row.best);
                     checked += best.len();
@@ -256,7 +369,14 @@ pub fn write(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProble
             let name = format!("exact_{grid}.csv");
             write_atomic(&out.join(&name), csv_records(&h, &rows)?.as_bytes())?;
             let _ = writeln!(s, "\n`{name}`: the convex problem solved in its box (projected Newton on the smoothed sum of norms) with a proven lower bound; each optimiser's best minus the exact value.\n\n{}", table(&h, &rows));
-            claims.push(Claim { rival: None, chapter: "6".into(), statement: format!("No optimiser beats the certified lower bound (grid {grid})"), ours: (checked - below, checked), thesis: None, note: "a sanity check of the bound and the fitness".into() });
+            claims.push(Claim {
+                rival: None,
+                chapter: "6".into(),
+                statement: format!("No optimiser beats the certified lower bound (grid {grid})"),
+                ours: (checked - below, checked),
+                thesis: None,
+                note: "a sanity check of the bound and the fitness".into(),
+            });
         }
         // Appendix I/J: B beside the MIN-error surface of each optimiser, largest net, per data set.
         if let Some(&cn) = cells.iter().map(|c| &c.2).max() {
@@ -275,22 +395,64 @@ pub fn write(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProble
                     let meshes = |x: &[f64]| {
                         let [(bottom, be), (top, te)] = problem.parts().dense_wireframes(x);
                         vec![
-                            plots::LineMesh { points: bottom, edges: be, colour: style::DNSOM_BOTTOM, label: "bottom surface".into() },
-                            plots::LineMesh { points: top, edges: te, colour: style::DNSOM_TOP, label: "top surface".into() },
+                            plots::LineMesh {
+                                points: bottom,
+                                edges: be,
+                                colour: style::DNSOM_BOTTOM,
+                                label: "bottom surface".into(),
+                            },
+                            plots::LineMesh {
+                                points: top,
+                                edges: te,
+                                colour: style::DNSOM_TOP,
+                                label: "top surface".into(),
+                            },
                         ]
                     };
                     let b = meshes(problem.initial_point());
-                    panels.push(plots::Panel { title: format!("{} {cn} B ({:.4})", p.name(), problem.fitness(problem.initial_point())), meshes: b.clone() });
+                    panels.push(plots::Panel {
+                        title: format!(
+                            "{} {cn} B ({:.4})",
+                            p.name(),
+                            problem.fitness(problem.initial_point())
+                        ),
+                        meshes: b.clone(),
+                    });
                     // The optimised surfaces differ from B by ~1e-4: each is drawn as its
                     // difference from B, magnified, over B in grey.
-                    let grey: Vec<plots::LineMesh> = b.iter().map(|m| plots::LineMesh { colour: plotters::style::RGBColor(190, 190, 190), label: "B, under each optimiser's magnified difference".into(), ..m.clone() }).collect();
+                    let grey: Vec<plots::LineMesh> = b
+                        .iter()
+                        .map(|m| plots::LineMesh {
+                            colour: plotters::style::RGBColor(190, 190, 190),
+                            label: "B, under each optimiser's magnified difference".into(),
+                            ..m.clone()
+                        })
+                        .collect();
                     for o in &opts {
-                        let min = g.iter().filter(|r| r.cell.dataset == d && r.cell.param == p && r.cell.cn == cn && &r.cell.optimiser == o).min_by(|a, b| a.row.best.total_cmp(&b.row.best));
+                        let min = g
+                            .iter()
+                            .filter(|r| {
+                                r.cell.dataset == d
+                                    && r.cell.param == p
+                                    && r.cell.cn == cn
+                                    && &r.cell.optimiser == o
+                            })
+                            .min_by(|a, b| a.row.best.total_cmp(&b.row.best));
                         if let Some(r) = min {
-                            let (title, shown) = match plots::magnified_difference(&b, &meshes(&r.best_x), 0.15) {
-                                Some((m, k, dmax)) => (format!("{}: (MIN - B) x{k:.0}, max {dmax:.0e}", o.to_uppercase()), grey.iter().cloned().chain(m).collect()),
-                                None => (format!("{} MIN ({:.4}) = B", o.to_uppercase(), r.row.best), b.clone()),
-                            };
+                            let (title, shown) =
+                                match plots::magnified_difference(&b, &meshes(&r.best_x), 0.15) {
+                                    Some((m, k, dmax)) => (
+                                        format!(
+                                            "{}: (MIN - B) x{k:.0}, max {dmax:.0e}",
+                                            o.to_uppercase()
+                                        ),
+                                        grey.iter().cloned().chain(m).collect(),
+                                    ),
+                                    None => (
+                                        format!("{} MIN ({:.4}) = B", o.to_uppercase(), r.row.best),
+                                        b.clone(),
+                                    ),
+                                };
                             panels.push(plots::Panel { title, meshes: shown });
                         }
                     }
@@ -316,13 +478,25 @@ pub fn write(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProble
                 let mut series = Vec::new();
                 let mut groups = Vec::new();
                 for (k, o) in opts.iter().enumerate() {
-                    let rs: Vec<&&OptimRun> = g.iter().filter(|r| r.cell.dataset == d && r.cell.param == p0 && r.cell.cn == cn && &r.cell.optimiser == o).collect();
+                    let rs: Vec<&&OptimRun> = g
+                        .iter()
+                        .filter(|r| {
+                            r.cell.dataset == d
+                                && r.cell.param == p0
+                                && r.cell.cn == cn
+                                && &r.cell.optimiser == o
+                        })
+                        .collect();
                     groups.push((o.clone(), rs.iter().map(|r| r.row.best).collect::<Vec<f64>>()));
-                    let marks: Vec<u64> = rs.first().map(|r| r.trace.iter().map(|t| t.0).collect()).unwrap_or_default();
+                    let marks: Vec<u64> = rs
+                        .first()
+                        .map(|r| r.trace.iter().map(|t| t.0).collect())
+                        .unwrap_or_default();
                     let mut pts = Vec::new();
                     let mut band = Vec::new();
                     for (m, &e) in marks.iter().enumerate() {
-                        let mut v: Vec<f64> = rs.iter().filter_map(|r| r.trace.get(m).map(|t| t.1)).collect();
+                        let mut v: Vec<f64> =
+                            rs.iter().filter_map(|r| r.trace.get(m).map(|t| t.1)).collect();
                         v.sort_by(|a, b| a.total_cmp(b));
                         if v.is_empty() {
                             continue;
@@ -331,11 +505,25 @@ pub fn write(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProble
                         pts.push((e as f64, q(0.5)));
                         band.push((e as f64, q(0.25), q(0.75)));
                     }
-                    series.push(Series { label: o.clone(), colour: style::optimiser_colour(o).unwrap_or_else(|| style::cycle_colour(k)), points: pts, band: Some(band) });
+                    series.push(Series {
+                        label: o.clone(),
+                        colour: style::optimiser_colour(o)
+                            .unwrap_or_else(|| style::cycle_colour(k)),
+                        points: pts,
+                        band: Some(band),
+                    });
                 }
                 // B (where every run starts) and, where the folder has it, the certified optimum.
-                let (x0, x1) = series.iter().flat_map(|s| s.points.iter().map(|p| p.0)).fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(x), b.max(x)));
-                let level = |label: String, name: &str, y: f64| Series { label, colour: style::optimiser_colour(name).unwrap_or(style::GREY), points: vec![(x0, y), (x1, y)], band: None };
+                let (x0, x1) = series
+                    .iter()
+                    .flat_map(|s| s.points.iter().map(|p| p.0))
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(x), b.max(x)));
+                let level = |label: String, name: &str, y: f64| Series {
+                    label,
+                    colour: style::optimiser_colour(name).unwrap_or(style::GREY),
+                    points: vec![(x0, y), (x1, y)],
+                    band: None,
+                };
                 if let Some(problem) = problems.get(&(d.clone(), cn, p0)) {
                     let b = problem.fitness(problem.initial_point());
                     series.push(level(format!("B {b:.6}"), "b", b));
@@ -345,13 +533,25 @@ pub fn write(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProble
                 }
                 let conv = format!("png/convergence_{grid}_{d}_{}_{cn}.png", p0.name());
                 crate::io::ensure_dir(&out.join("png"))?;
-                if let Err(e) = plots::line_chart_png(&out.join(&conv), &format!("{d}, {} {cn} on {grid}: best fitness (median, quartiles)", p0.name()), "evaluations", "surface error", &series, false) {
+                if let Err(e) = plots::line_chart_png(
+                    &out.join(&conv),
+                    &format!("{d}, {} {cn} on {grid}: best fitness (median, quartiles)", p0.name()),
+                    "evaluations",
+                    "surface error",
+                    &series,
+                    false,
+                ) {
                     eprintln!("somnurbs: warning: picture skipped: {e}");
                 } else {
                     let _ = writeln!(s, "\n![{conv}]({conv})");
                 }
                 let bx = format!("png/boxplot_{grid}_{d}_{}_{cn}.png", p0.name());
-                if let Err(e) = plots::box_plot_png(&out.join(&bx), &format!("{d}, {} {cn} on {grid}: best surface error per repeat", p0.name()), "surface error", &groups) {
+                if let Err(e) = plots::box_plot_png(
+                    &out.join(&bx),
+                    &format!("{d}, {} {cn} on {grid}: best surface error per repeat", p0.name()),
+                    "surface error",
+                    &groups,
+                ) {
                     eprintln!("somnurbs: warning: picture skipped: {e}");
                 } else {
                     let _ = writeln!(s, "\n![{bx}]({bx})");
@@ -359,20 +559,34 @@ pub fn write(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProble
             }
         }
     }
-    let all_rows: Vec<crate::families::optimise::OptimRow> = runs.iter().map(|r| r.row.clone()).collect();
+    let all_rows: Vec<crate::families::optimise::OptimRow> =
+        runs.iter().map(|r| r.row.clone()).collect();
     let (fopts, ftable) = crate::families::optimise::compare::friedman_table(&all_rows);
     if fopts.len() > 1 {
         if let Ok(f) = crate::stats::friedman::friedman(&ftable) {
             let _ = writeln!(s, "\n### Statistics over all cells\n\nFriedman test over {} cells (mean best per optimiser): chi-squared {:.3}, df {}, p = {:.3e}. Mean ranks (1 = least error): {}.{}\n", f.blocks, f.chi_squared, f.df, f.p_value, fopts.iter().zip(&f.mean_ranks).map(|(o, r)| format!("{o} {r:.2}")).collect::<Vec<_>>().join(", "), f.critical_difference.map(|cd| format!(" Nemenyi critical difference (alpha 0.05): {cd:.3}.")).unwrap_or_default());
-            let h: Vec<String> = ["pair", "z", "p", "p (Holm)"].iter().map(|x| x.to_string()).collect();
-            let rows: Vec<Vec<String>> = f.pairwise.iter().map(|&(i, j, z, p, ph)| vec![format!("{} vs {}", fopts[i], fopts[j]), format!("{z:.3}"), format!("{p:.3e}"), format!("{ph:.3e}")]).collect();
+            let h: Vec<String> =
+                ["pair", "z", "p", "p (Holm)"].iter().map(|x| x.to_string()).collect();
+            let rows: Vec<Vec<String>> = f
+                .pairwise
+                .iter()
+                .map(|&(i, j, z, p, ph)| {
+                    vec![
+                        format!("{} vs {}", fopts[i], fopts[j]),
+                        format!("{z:.3}"),
+                        format!("{p:.3e}"),
+                        format!("{ph:.3e}"),
+                    ]
+                })
+                .collect();
             s.push_str(&table(&h, &rows));
             s.push_str("\nPer-cell Wilcoxon signed-rank and rank-sum tests with A12 effect sizes and a critical-difference diagram: `somnurbs compare <this folder>`.\n");
         }
     }
     let n_ioh = super::ioh::write(runs, out)?;
     let _ = writeln!(s, "\nEvery run's improvements of the best so far in the IOHprofiler format (`ioh/<optimiser>/`: {n_ioh} JSON meta-data files, format version 0.3.3 or later, each with its improvement-based `.dat`), loadable by IOHanalyzer and iohinspector.");
-    let near = runs.iter().filter(|r| r.row.excursion <= crate::families::fit::report::NEAR).count();
+    let near =
+        runs.iter().filter(|r| r.row.excursion <= crate::families::fit::report::NEAR).count();
     let worst = runs.iter().max_by(|a, b| a.row.excursion.total_cmp(&b.row.excursion));
     claims.push(Claim {
         chapter: "6".into(),
@@ -383,7 +597,14 @@ pub fn write(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProble
         note: format!("runs whose best surfaces' dense excursion from the data's bounding box is at most {}{}", crate::families::fit::report::NEAR, worst.map(|w| format!("; largest {:.3e} at {}", w.row.excursion, w.row.cell)).unwrap_or_default()),
     });
     let kept = runs.iter().filter(|r| r.row.best <= r.row.initial_best).count();
-    claims.push(Claim { rival: None, chapter: "6".into(), statement: "Every run's best is no worse than its initial population's best".into(), ours: (kept, runs.len()), thesis: None, note: "elitism check over all runs".into() });
+    claims.push(Claim {
+        rival: None,
+        chapter: "6".into(),
+        statement: "Every run's best is no worse than its initial population's best".into(),
+        ours: (kept, runs.len()),
+        thesis: None,
+        note: "elitism check over all runs".into(),
+    });
     s.push_str("\n### Claims\n\n");
     s.push_str(&crate::report::claims::write(out, &claims)?);
     Ok(s)

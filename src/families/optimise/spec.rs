@@ -71,7 +71,11 @@ pub struct OptimSpec {
 impl OptimSpec {
     /// The readings and options of approach B's fit that every cell starts from.
     pub fn fit_options(&self) -> crate::spline::FitOptions {
-        crate::spline::FitOptions { knots: self.knots, fairness: self.fairness, ..Default::default() }
+        crate::spline::FitOptions {
+            knots: self.knots,
+            fairness: self.fairness,
+            ..Default::default()
+        }
     }
 }
 
@@ -97,25 +101,42 @@ pub(crate) fn default_init_range() -> f64 {
     5e-6
 }
 
-
 /// Every value of the `[optim]` section (after the limits).
 pub(crate) fn validate(spec: &Spec, o: &OptimSpec) -> Result<(), SpecError> {
     validate_grid_keys(spec, "optim", &o.datasets, o.grid, &o.control_nets, &o.parameterisations)?;
     validate_map_som(spec, "optim", o.som.as_ref())?;
-    spec.validate_runs("optim", &o.optimisers, &["ga", "de", "pso", "csa", "icsa"], o.repeats, o.generations as u64, o.population)?;
+    spec.validate_runs(
+        "optim",
+        &o.optimisers,
+        &["ga", "de", "pso", "csa", "icsa"],
+        o.repeats,
+        o.generations as u64,
+        o.population,
+    )?;
     if !(o.init_range >= 0.0 && o.init_range.is_finite()) {
-        return Err(spec.err("optim.init_range", format!("must be a non-negative number, got {}", o.init_range)));
+        return Err(spec.err(
+            "optim.init_range",
+            format!("must be a non-negative number, got {}", o.init_range),
+        ));
     }
     if let Some(r) = o.search_range {
         if !(r > 0.0 && r.is_finite()) {
-            return Err(spec.err("optim.search_range", format!("must be a positive number, got {r}")));
+            return Err(
+                spec.err("optim.search_range", format!("must be a positive number, got {r}"))
+            );
         }
         if o.init_range > r {
-            return Err(spec.err("optim.init_range", format!("{} is wider than optim.search_range {r}", o.init_range)));
+            return Err(spec.err(
+                "optim.init_range",
+                format!("{} is wider than optim.search_range {r}", o.init_range),
+            ));
         }
     }
     if !(o.bounds_margin >= 0.0 && o.bounds_margin.is_finite()) {
-        return Err(spec.err("optim.bounds_margin", format!("must be a non-negative number, got {}", o.bounds_margin)));
+        return Err(spec.err(
+            "optim.bounds_margin",
+            format!("must be a non-negative number, got {}", o.bounds_margin),
+        ));
     }
     if o.trace_every_evals == 0 {
         return Err(spec.err("optim.trace_every_evals", "must be at least 1"));
@@ -123,7 +144,10 @@ pub(crate) fn validate(spec: &Spec, o: &OptimSpec) -> Result<(), SpecError> {
     if !(o.exact_tol > 0.0 && o.exact_tol < 1.0) {
         return Err(spec.err("optim.exact_tol", format!("must be in (0,1), got {}", o.exact_tol)));
     }
-    spec.validate_optimiser_params("optim", [o.ga.validate(), o.de.validate(), o.pso.validate(), o.csa.validate(), o.icsa.validate()])?;
+    spec.validate_optimiser_params(
+        "optim",
+        [o.ga.validate(), o.de.validate(), o.pso.validate(), o.csa.validate(), o.icsa.validate()],
+    )?;
     Ok(())
 }
 
@@ -137,7 +161,15 @@ pub fn cells(spec: &Spec) -> Vec<OptimCell> {
                 let Ok(param) = p.parse() else { continue };
                 for opt in &o.optimisers {
                     for repeat in 0..o.repeats {
-                        cells.push(OptimCell { dataset: crate::data::registry::name_of(dataset), grid: o.grid, cn: *cn, param, optimiser: opt.clone(), repeat, variant: spec.variant.key() });
+                        cells.push(OptimCell {
+                            dataset: crate::data::registry::name_of(dataset),
+                            grid: o.grid,
+                            cn: *cn,
+                            param,
+                            optimiser: opt.clone(),
+                            repeat,
+                            variant: spec.variant.key(),
+                        });
                     }
                 }
             }
@@ -170,8 +202,20 @@ impl OptimCell {
     /// `optim/<data>/<grid>/<net>/<param>/<optimiser>/r<repeat>`; a variant's cells begin
     /// `optim[<changes>]/`, so their seeds differ from the plain run's and from each other's.
     pub fn key(&self) -> String {
-        let head = if self.variant.is_empty() { "optim".to_string() } else { format!("optim[{}]", self.variant) };
-        format!("{head}/{}/{}/{}/{}/{}/r{}", self.dataset, self.grid, self.cn, self.param.name(), self.optimiser, self.repeat)
+        let head = if self.variant.is_empty() {
+            "optim".to_string()
+        } else {
+            format!("optim[{}]", self.variant)
+        };
+        format!(
+            "{head}/{}/{}/{}/{}/{}/r{}",
+            self.dataset,
+            self.grid,
+            self.cn,
+            self.param.name(),
+            self.optimiser,
+            self.repeat
+        )
     }
 }
 
@@ -195,6 +239,15 @@ pub(crate) fn limits(c: &Check, o: &OptimSpec) -> Result<(), SpecError> {
     if let Some(som) = &o.som {
         c.int("optim.som.iterations", som.iterations, limits::MAX_ITERATIONS)?;
     }
-    c.cells("optim", &[o.datasets.len(), o.control_nets.len(), o.parameterisations.len(), o.optimisers.len(), o.repeats])?;
+    c.cells(
+        "optim",
+        &[
+            o.datasets.len(),
+            o.control_nets.len(),
+            o.parameterisations.len(),
+            o.optimisers.len(),
+            o.repeats,
+        ],
+    )?;
     Ok(())
 }

@@ -6,13 +6,13 @@ pub mod report;
 pub mod spec;
 
 use crate::experiment::spec::Spec;
-use spec::Seed002Spec;
 use crate::experiment::{runner, seeds, RunContext};
 use crate::optim::{Budget, Optimiser, Problem, RunResult};
 use crate::spline::conic::{self, ConicProblem, P2};
 use crate::spline::rational_bezier::{SurfaceSse, TestSurface};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
+use spec::Seed002Spec;
 
 /// One (surface, optimiser, repeat).
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -80,19 +80,26 @@ fn section(spec: &Spec) -> Result<&Seed002Spec> {
 /// The flat list of cells.
 pub fn cells(spec: &Spec) -> Vec<Cell> {
     let Some(s) = &spec.file.seed002 else { return Vec::new() };
-    runner::product_cells(&s.surfaces, &s.optimisers, s.repeats, |sf, o, repeat| Cell { surface: sf.clone(), optimiser: o.clone(), repeat })
+    runner::product_cells(&s.surfaces, &s.optimisers, s.repeats, |sf, o, repeat| Cell {
+        surface: sf.clone(),
+        optimiser: o.clone(),
+        repeat,
+    })
 }
 
 /// The SSE problem of a surface with the spec's grid and box.
 pub fn problem(s: &Seed002Spec, surface: &str) -> Result<SurfaceSse> {
-    let ts = TestSurface::by_name(surface).with_context(|| format!("seed002.surfaces: unknown surface `{surface}`"))?;
+    let ts = TestSurface::by_name(surface)
+        .with_context(|| format!("seed002.surfaces: unknown surface `{surface}`"))?;
     Ok(SurfaceSse::new(ts.grid(s.grid), s.bounds_margin, s.w_min))
 }
 
 fn optimiser(s: &Seed002Spec, name: &str) -> Result<Box<dyn Optimiser>> {
     // This section offers ga, de and pso only.
     let (csa, icsa) = (crate::optim::Csa::default(), crate::optim::Icsa::default());
-    crate::optim::named(name, &s.ga, &s.de, &s.pso, &csa, &icsa).filter(|_| matches!(name, "ga" | "de" | "pso")).with_context(|| format!("seed002.optimisers: unknown optimiser `{name}`"))
+    crate::optim::named(name, &s.ga, &s.de, &s.pso, &csa, &icsa)
+        .filter(|_| matches!(name, "ga" | "de" | "pso"))
+        .with_context(|| format!("seed002.optimisers: unknown optimiser `{name}`"))
 }
 
 /// Run one cell (alone it gives the same numbers as inside the full run).
@@ -103,15 +110,24 @@ pub fn run_cell(spec: &Spec, cell: &Cell) -> Result<Run> {
     // init_range is a share of the data's largest bounding-box extent (the domains differ in scale).
     let extent = (0..3)
         .map(|k| {
-            let (lo, hi) = problem.data.points.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| (a.min(p[k]), b.max(p[k])));
+            let (lo, hi) =
+                problem.data.points.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+                    (a.min(p[k]), b.max(p[k]))
+                });
             hi - lo
         })
         .fold(0.0, f64::max);
-    let budget = Budget { generations: s.generations as u64, population: s.population, init_range: s.init_range * extent, trace_every_evals: s.trace_every_evals };
+    let budget = Budget {
+        generations: s.generations as u64,
+        population: s.population,
+        init_range: s.init_range * extent,
+        trace_every_evals: s.trace_every_evals,
+    };
     let key = cell.key();
     let mut rng = seeds::cell_rng(spec.file.master_seed, &key);
     let t0 = runner::thread_cpu_seconds();
-    let r: RunResult = opt.run(&problem, &budget, &mut rng).map_err(|e| anyhow::anyhow!("{key}: {e}"))?;
+    let r: RunResult =
+        opt.run(&problem, &budget, &mut rng).map_err(|e| anyhow::anyhow!("{key}: {e}"))?;
     let cpu_s = runner::thread_cpu_seconds() - t0;
     let n = problem.n_points();
     let row = Row {
@@ -136,7 +152,13 @@ pub fn run_cell(spec: &Spec, cell: &Cell) -> Result<Run> {
 /// Run every cell of the spec.
 pub fn run(spec: &Spec, ctx: &RunContext) -> Result<Vec<Run>> {
     let cells = cells(spec);
-    runner::run_logged(&cells, ctx, &spec.file.name, |cell| run_cell(spec, cell), |cell, (row, trace)| Ok(Run { cell: cell.clone(), row, trace, best_x: Vec::new() }))
+    runner::run_logged(
+        &cells,
+        ctx,
+        &spec.file.name,
+        |cell| run_cell(spec, cell),
+        |cell, (row, trace)| Ok(Run { cell: cell.clone(), row, trace, best_x: Vec::new() }),
+    )
 }
 
 /// One conic curve fit: (outline, optimiser, repeat).
@@ -186,17 +208,30 @@ pub struct CurveRun {
 
 pub fn curve_cells(spec: &Spec) -> Vec<CurveCell> {
     let Some(s) = &spec.file.seed002 else { return Vec::new() };
-    runner::product_cells(&s.outlines, &s.optimisers, s.repeats, |ol, o, repeat| CurveCell { outline: ol.clone(), optimiser: o.clone(), repeat })
+    runner::product_cells(&s.outlines, &s.optimisers, s.repeats, |ol, o, repeat| CurveCell {
+        outline: ol.clone(),
+        optimiser: o.clone(),
+        repeat,
+    })
 }
 
 /// Sample the outline, detect its corners (SAM06), cut it into conic runs and fit each run's
 /// conic with the cell's optimiser, all on the cell's stream in run order.
 pub fn run_curve_cell(spec: &Spec, cell: &CurveCell) -> Result<CurveRun> {
     let s = section(spec)?;
-    let (pieces, truth) = conic::outline(&cell.outline).with_context(|| format!("seed002.outlines: unknown outline `{}`", cell.outline))?;
+    let (pieces, truth) = conic::outline(&cell.outline)
+        .with_context(|| format!("seed002.outlines: unknown outline `{}`", cell.outline))?;
     let points = conic::sample_closed(&pieces, s.outline_spacing);
     let corners = conic::sam06(&points, s.sam06_l, s.sam06_d, s.sam06_r.unwrap_or(s.sam06_l));
-    let matched = truth.iter().filter(|c| corners.iter().any(|&i| ((points[i][0] - c[0]).powi(2) + (points[i][1] - c[1]).powi(2)).sqrt() <= s.outline_spacing)).count();
+    let matched = truth
+        .iter()
+        .filter(|c| {
+            corners.iter().any(|&i| {
+                ((points[i][0] - c[0]).powi(2) + (points[i][1] - c[1]).powi(2)).sqrt()
+                    <= s.outline_spacing
+            })
+        })
+        .count();
     let opt = optimiser(s, &cell.optimiser)?;
     let key = cell.key();
     let mut rng = seeds::cell_rng(spec.file.master_seed, &key);
@@ -205,7 +240,12 @@ pub fn run_curve_cell(spec: &Spec, cell: &CurveCell) -> Result<CurveRun> {
     for run in conic::conic_runs(&points, &corners) {
         let problem = ConicProblem::new(run, s.bounds_margin, s.w_min, 10.0);
         let ext = problem.bounds().1[0] - problem.bounds().0[0];
-        let budget = Budget { generations: s.curve_generations as u64, population: s.population, init_range: s.init_range * ext, trace_every_evals: s.trace_every_evals };
+        let budget = Budget {
+            generations: s.curve_generations as u64,
+            population: s.population,
+            init_range: s.init_range * ext,
+            trace_every_evals: s.trace_every_evals,
+        };
         let r = opt.run(&problem, &budget, &mut rng).map_err(|e| anyhow::anyhow!("{key}: {e}"))?;
         start_sse += problem.fitness(problem.initial_point());
         sse += r.best_fitness;
@@ -236,7 +276,13 @@ pub fn run_curve_cell(spec: &Spec, cell: &CurveCell) -> Result<CurveRun> {
 /// them again, deterministically).
 pub fn run_curves(spec: &Spec, ctx: &RunContext) -> Result<Vec<CurveRun>> {
     let cells = curve_cells(spec);
-    runner::run_cells(&cells, ctx.jobs, "seed002 curves", |c| run_curve_cell(spec, c), |_, _| Ok(()))
+    runner::run_cells(
+        &cells,
+        ctx.jobs,
+        "seed002 curves",
+        |c| run_curve_cell(spec, c),
+        |_, _| Ok(()),
+    )
 }
 
 /// Seed 002's family: the `[seed002]` section (surface cells logged, curve cells not).
@@ -249,7 +295,10 @@ impl crate::experiment::family::Family for Seed002 {
     fn present(&self, spec: &Spec) -> bool {
         spec.file.seed002.is_some()
     }
-    fn check_limits(&self, c: &crate::experiment::limits::Check) -> Result<(), crate::experiment::spec::SpecError> {
+    fn check_limits(
+        &self,
+        c: &crate::experiment::limits::Check,
+    ) -> Result<(), crate::experiment::spec::SpecError> {
         match &c.spec.file.seed002 {
             Some(s) => self::spec::limits(c, s),
             None => Ok(()),
@@ -267,12 +316,27 @@ impl crate::experiment::family::Family for Seed002 {
     fn unlogged_keys(&self, spec: &Spec) -> Vec<String> {
         curve_cells(spec).iter().map(|c| c.key()).collect()
     }
-    fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<crate::experiment::family::Outcome> {
+    fn run(
+        &self,
+        spec: &Spec,
+        ctx: &RunContext,
+        tables: bool,
+    ) -> Result<crate::experiment::family::Outcome> {
         let s = section(spec)?;
         let runs = run(spec, ctx)?;
         let curves = run_curves(spec, ctx)?;
-        let section = if tables { Some(crate::families::rational_bezier::report::write(&runs, &curves, s.population, &ctx.out)?) } else { None };
-        let cpu_s = runs.iter().map(|r| r.row.cpu_s).chain(curves.iter().map(|c| c.row.cpu_s)).sum();
+        let section = if tables {
+            Some(crate::families::rational_bezier::report::write(
+                &runs,
+                &curves,
+                s.population,
+                &ctx.out,
+            )?)
+        } else {
+            None
+        };
+        let cpu_s =
+            runs.iter().map(|r| r.row.cpu_s).chain(curves.iter().map(|c| c.row.cpu_s)).sum();
         Ok(crate::experiment::family::Outcome { section, cpu_s, cells: runs.len() + curves.len() })
     }
 }

@@ -113,18 +113,36 @@ pub(crate) fn validate(spec: &Spec, s: &Seed002Spec) -> Result<(), SpecError> {
     }
     for name in &s.surfaces {
         if crate::spline::rational_bezier::TestSurface::by_name(name).is_none() {
-            return Err(spec.err("seed002.surfaces", format!("unknown surface `{name}` (expected surface1, surface2, surface3 or surface4)")));
+            return Err(spec.err(
+                "seed002.surfaces",
+                format!(
+                    "unknown surface `{name}` (expected surface1, surface2, surface3 or surface4)"
+                ),
+            ));
         }
     }
-    spec.validate_runs("seed002", &s.optimisers, &["ga", "de", "pso"], s.repeats, s.generations as u64, s.population)?;
+    spec.validate_runs(
+        "seed002",
+        &s.optimisers,
+        &["ga", "de", "pso"],
+        s.repeats,
+        s.generations as u64,
+        s.population,
+    )?;
     if s.grid < 5 || s.grid.is_multiple_of(2) {
         return Err(spec.err("seed002.grid", format!("must be odd and at least 5, got {}", s.grid)));
     }
     if !(s.init_range >= 0.0 && s.init_range.is_finite()) {
-        return Err(spec.err("seed002.init_range", format!("must be a non-negative number, got {}", s.init_range)));
+        return Err(spec.err(
+            "seed002.init_range",
+            format!("must be a non-negative number, got {}", s.init_range),
+        ));
     }
     if !(s.bounds_margin >= 0.0 && s.bounds_margin.is_finite()) {
-        return Err(spec.err("seed002.bounds_margin", format!("must be a non-negative number, got {}", s.bounds_margin)));
+        return Err(spec.err(
+            "seed002.bounds_margin",
+            format!("must be a non-negative number, got {}", s.bounds_margin),
+        ));
     }
     if !(s.w_min > 0.0 && s.w_min < 1.0) {
         return Err(spec.err("seed002.w_min", format!("must be in (0, 1), got {}", s.w_min)));
@@ -134,22 +152,33 @@ pub(crate) fn validate(spec: &Spec, s: &Seed002Spec) -> Result<(), SpecError> {
     }
     for name in &s.outlines {
         if crate::spline::conic::outline(name).is_none() {
-            return Err(spec.err("seed002.outlines", format!("unknown outline `{name}` (expected square, letter_d or letter_p)")));
+            return Err(spec.err(
+                "seed002.outlines",
+                format!("unknown outline `{name}` (expected square, letter_d or letter_p)"),
+            ));
         }
     }
     if !(s.outline_spacing > 0.0 && s.outline_spacing <= 10.0) {
-        return Err(spec.err("seed002.outline_spacing", format!("must be in (0, 10], got {}", s.outline_spacing)));
+        return Err(spec.err(
+            "seed002.outline_spacing",
+            format!("must be in (0, 10], got {}", s.outline_spacing),
+        ));
     }
     if s.sam06_l < 2 {
         return Err(spec.err("seed002.sam06_l", format!("must be at least 2, got {}", s.sam06_l)));
     }
     if !(s.sam06_d > 0.0 && s.sam06_d.is_finite()) {
-        return Err(spec.err("seed002.sam06_d", format!("must be a positive number, got {}", s.sam06_d)));
+        return Err(
+            spec.err("seed002.sam06_d", format!("must be a positive number, got {}", s.sam06_d))
+        );
     }
     if s.curve_generations == 0 {
         return Err(spec.err("seed002.curve_generations", "must be at least 1"));
     }
-    spec.validate_optimiser_params("seed002", [s.ga.validate(), s.de.validate(), s.pso.validate()])?;
+    spec.validate_optimiser_params(
+        "seed002",
+        [s.ga.validate(), s.de.validate(), s.pso.validate()],
+    )?;
     Ok(())
 }
 

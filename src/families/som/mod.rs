@@ -5,14 +5,14 @@ pub mod pictures;
 pub mod report;
 pub mod spec;
 
-use crate::experiment::spec::Spec;
-use spec::SomCell;
-use crate::experiment::{runner, seeds, RunContext};
 use crate::data::PointCloud;
+use crate::experiment::spec::Spec;
+use crate::experiment::{runner, seeds, RunContext};
 use crate::geom::Point3;
 use crate::som::{self, FinalMetrics, NeuronCounts, OnlineMetrics, SomParams};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
+use spec::SomCell;
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
@@ -59,7 +59,15 @@ pub struct SomRow {
 pub const TIMING_COLUMNS: &[&str] = &["cpu_s"];
 
 impl SomRow {
-    fn new(cell: &SomCell, seed: String, iterations: usize, c: NeuronCounts, o: OnlineMetrics, f: FinalMetrics, cpu_s: f64) -> SomRow {
+    fn new(
+        cell: &SomCell,
+        seed: String,
+        iterations: usize,
+        c: NeuronCounts,
+        o: OnlineMetrics,
+        f: FinalMetrics,
+        cpu_s: f64,
+    ) -> SomRow {
         SomRow {
             cell: cell.key(),
             dataset: cell.dataset.clone(),
@@ -84,7 +92,11 @@ impl SomRow {
 }
 
 /// Load every data set a spec names, once, by its name ([`crate::data::registry::dataset_name`]).
-pub fn load_datasets(spec: &Spec, names: &[String], ctx: &RunContext) -> Result<BTreeMap<String, Arc<PointCloud>>> {
+pub fn load_datasets(
+    spec: &Spec,
+    names: &[String],
+    ctx: &RunContext,
+) -> Result<BTreeMap<String, Arc<PointCloud>>> {
     let mut out = BTreeMap::new();
     for name in names {
         if !out.contains_key(&crate::data::registry::name_of(name)) {
@@ -103,20 +115,40 @@ pub fn require_points(entry: &str, points: usize, cell: &SomCell) -> Result<()> 
     if cell.model != crate::som::Model::Dnsom {
         return Ok(());
     }
-    let neurons = cell.model.topology(cell.grid.nx, cell.grid.ny).map_err(anyhow::Error::msg)?.counts().non;
-    Ok(crate::data::require_points(entry, points, neurons, &format!("{} {}", cell.model.key(), cell.grid))?)
+    let neurons =
+        cell.model.topology(cell.grid.nx, cell.grid.ny).map_err(anyhow::Error::msg)?.counts().non;
+    Ok(crate::data::require_points(
+        entry,
+        points,
+        neurons,
+        &format!("{} {}", cell.model.key(), cell.grid),
+    )?)
 }
 
 /// Train one cell (pure apart from the CPU clock).
-pub fn run_cell(cell: &SomCell, data: &[Point3], params: &SomParams, master_seed: u64) -> Result<SomRun> {
+pub fn run_cell(
+    cell: &SomCell,
+    data: &[Point3],
+    params: &SomParams,
+    master_seed: u64,
+) -> Result<SomRun> {
     let key = cell.key();
     let topo = cell.model.topology(cell.grid.nx, cell.grid.ny).map_err(anyhow::Error::msg)?;
     let mut rng = seeds::cell_rng(master_seed, &key);
     let t0 = runner::thread_cpu_seconds();
-    let trained = som::train(topo.as_ref(), data, params, &mut rng).map_err(|e| anyhow::anyhow!("{key}: {e}"))?;
+    let trained = som::train(topo.as_ref(), data, params, &mut rng)
+        .map_err(|e| anyhow::anyhow!("{key}: {e}"))?;
     let cpu_s = runner::thread_cpu_seconds() - t0;
     let fin = som::final_map_metrics(topo.as_ref(), &trained.weights, data);
-    let row = SomRow::new(cell, seeds::seed_hex(master_seed, &key), params.iterations, topo.counts(), trained.online, fin, cpu_s);
+    let row = SomRow::new(
+        cell,
+        seeds::seed_hex(master_seed, &key),
+        params.iterations,
+        topo.counts(),
+        trained.online,
+        fin,
+        cpu_s,
+    );
     Ok(SomRun { cell: cell.clone(), row, weights: trained.weights })
 }
 
@@ -124,7 +156,11 @@ pub fn run_cell(cell: &SomCell, data: &[Point3], params: &SomParams, master_seed
 pub fn run(spec: &Spec, ctx: &RunContext) -> Result<Vec<SomRun>> {
     let som_spec = spec.file.som.as_ref().context("spec has no [som] section")?;
     let data = load_datasets(spec, &som_spec.datasets, ctx)?;
-    let params = SomParams { iterations: som_spec.iterations, alpha0: som_spec.alpha0, sigma0: som_spec.sigma0 };
+    let params = SomParams {
+        iterations: som_spec.iterations,
+        alpha0: som_spec.alpha0,
+        sigma0: som_spec.sigma0,
+    };
     let cells = spec::cells(spec);
     for entry in &som_spec.datasets {
         let name = crate::data::registry::name_of(entry);
@@ -132,9 +168,14 @@ pub fn run(spec: &Spec, ctx: &RunContext) -> Result<Vec<SomRun>> {
             require_points(entry, data[&name].points.len(), c)?;
         }
     }
-    runner::run_logged(&cells, ctx, &spec.file.name, |cell| run_cell(cell, &data[&cell.dataset].points, &params, spec.file.master_seed), |cell, (row, weights)| Ok(SomRun { cell: cell.clone(), row, weights }))
+    runner::run_logged(
+        &cells,
+        ctx,
+        &spec.file.name,
+        |cell| run_cell(cell, &data[&cell.dataset].points, &params, spec.file.master_seed),
+        |cell, (row, weights)| Ok(SomRun { cell: cell.clone(), row, weights }),
+    )
 }
-
 
 /// Chapter 4's family: the `[som]` section.
 pub struct Som;
@@ -146,7 +187,10 @@ impl crate::experiment::family::Family for Som {
     fn present(&self, spec: &Spec) -> bool {
         spec.file.som.is_some()
     }
-    fn check_limits(&self, c: &crate::experiment::limits::Check) -> Result<(), crate::experiment::spec::SpecError> {
+    fn check_limits(
+        &self,
+        c: &crate::experiment::limits::Check,
+    ) -> Result<(), crate::experiment::spec::SpecError> {
         match &c.spec.file.som {
             Some(s) => self::spec::limits(c, s),
             None => Ok(()),
@@ -164,9 +208,22 @@ impl crate::experiment::family::Family for Som {
     fn logged_keys(&self, spec: &Spec) -> Vec<String> {
         spec::cells(spec).iter().map(|c| c.key()).collect()
     }
-    fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<crate::experiment::family::Outcome> {
+    fn run(
+        &self,
+        spec: &Spec,
+        ctx: &RunContext,
+        tables: bool,
+    ) -> Result<crate::experiment::family::Outcome> {
         let runs = run(spec, ctx)?;
-        let section = if tables { Some(crate::families::som::report::write(spec, &runs, &ctx.out)?) } else { None };
-        Ok(crate::experiment::family::Outcome { section, cpu_s: runs.iter().map(|r| r.row.cpu_s).sum(), cells: runs.len() })
+        let section = if tables {
+            Some(crate::families::som::report::write(spec, &runs, &ctx.out)?)
+        } else {
+            None
+        };
+        Ok(crate::experiment::family::Outcome {
+            section,
+            cpu_s: runs.iter().map(|r| r.row.cpu_s).sum(),
+            cells: runs.len(),
+        })
     }
 }

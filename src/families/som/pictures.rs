@@ -2,8 +2,8 @@
 //! two colours) and overview pages laid out like the thesis' Appendix A (rows data x n, columns the
 //! four models) and Appendix D (rows data x grid, columns CKSOM and DNSOM).
 
-use crate::report::plots::{self, style, LineMesh, Panel};
 use crate::families::som::SomRun;
+use crate::report::plots::{self, style, LineMesh, Panel};
 use crate::som::Model;
 use anyhow::Result;
 use rayon::prelude::*;
@@ -46,7 +46,8 @@ pub fn write(runs: &[SomRun], out: &Path) -> Result<Vec<String>> {
         .par_iter()
         .filter_map(|run| {
             let name = cell_picture_name(run);
-            let title = format!("{} {} {}", run.cell.dataset, run.cell.model.label(), run.cell.grid);
+            let title =
+                format!("{} {} {}", run.cell.dataset, run.cell.model.label(), run.cell.grid);
             match plots::mesh_png(&out.join(&name), &title, &meshes(run), style::MESH_SIZE) {
                 Ok(()) => Some(name),
                 Err(e) => {

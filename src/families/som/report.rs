@@ -1,21 +1,26 @@
 //! Chapter 4 outputs: runs.csv, the Appendix B/C tables, the neuron-count tables 4.9/4.13/4.14, the
 //! saved DNSOM maps, the pictures and the Chapter 4 section of REPORT.md. Reads only the runs.
 
-use crate::report::claims::Claim;
+use crate::double_net::View;
+use crate::experiment::spec::{GridSize, Spec};
+use crate::families::som::SomRun;
 use crate::io::{csv_records, csv_text, write_atomic};
+use crate::report::claims::Claim;
 use crate::report::markdown::{beside, geometric_mean, num, table};
 use crate::report::reference::{self, RefTable};
-use crate::double_net::View;
-use crate::families::som::SomRun;
-use crate::experiment::spec::{GridSize, Spec};
 use crate::som::Model;
 use anyhow::Result;
 use std::fmt::Write;
 use std::path::Path;
 
 /// Metrics of Appendix B/C, as (column stem, label, runs.csv field).
-const METRICS: [(&str, &str); 5] =
-    [("min_error", "Min error"), ("max_error", "Max error"), ("qe", "QE"), ("te", "TE"), ("cpu_s", "CPU time (s)")];
+const METRICS: [(&str, &str); 5] = [
+    ("min_error", "Min error"),
+    ("max_error", "Max error"),
+    ("qe", "QE"),
+    ("te", "TE"),
+    ("cpu_s", "CPU time (s)"),
+];
 
 fn metric(run: &SomRun, stem: &str) -> f64 {
     let r = &run.row;
@@ -64,7 +69,8 @@ fn grids(runs: &[SomRun], square: bool) -> Vec<GridSize> {
 pub fn appendix_table(runs: &[SomRun], square: bool) -> Option<(Vec<String>, Vec<Vec<String>>)> {
     let name = if square { "appendix_b" } else { "appendix_c" };
     let header = reference::table(name)?.header;
-    let models: Vec<Model> = if square { Model::ALL.to_vec() } else { vec![Model::Cksom, Model::Dnsom] };
+    let models: Vec<Model> =
+        if square { Model::ALL.to_vec() } else { vec![Model::Cksom, Model::Dnsom] };
     let mut rows = Vec::new();
     for data in datasets(runs) {
         for grid in grids(runs, square) {
@@ -95,7 +101,17 @@ fn counts(model: Model, g: GridSize) -> Option<crate::som::NeuronCounts> {
 
 /// Table 4.9 for the square grids given.
 pub fn table_4_9(grids: &[GridSize]) -> (Vec<String>, Vec<Vec<String>>) {
-    let header = ["n", "som2d", "som3d", "cksom_non", "cksom_nor", "cksom_nov", "dnsom_non", "dnsom_nor", "dnsom_nov"];
+    let header = [
+        "n",
+        "som2d",
+        "som3d",
+        "cksom_non",
+        "cksom_nor",
+        "cksom_nov",
+        "dnsom_non",
+        "dnsom_nor",
+        "dnsom_nov",
+    ];
     let rows = grids
         .iter()
         .filter(|g| g.nx == g.ny)
@@ -113,13 +129,25 @@ pub fn table_4_9(grids: &[GridSize]) -> (Vec<String>, Vec<Vec<String>>) {
 
 /// Table 4.13 (CKSOM and DNSOM counts at nx x ny).
 pub fn table_4_13(grids: &[GridSize]) -> (Vec<String>, Vec<Vec<String>>) {
-    let header = ["n_x", "n_y", "cksom_non", "cksom_nov", "cksom_nor", "dnsom_non", "dnsom_nov", "dnsom_nor"];
+    let header = [
+        "n_x",
+        "n_y",
+        "cksom_non",
+        "cksom_nov",
+        "cksom_nor",
+        "dnsom_non",
+        "dnsom_nov",
+        "dnsom_nor",
+    ];
     let rows = grids
         .iter()
         .map(|&g| {
             let ck = counts(Model::Cksom, g).unwrap();
             let dn = counts(Model::Dnsom, g).unwrap();
-            vec![g.nx, g.ny, ck.non, ck.nov, ck.nor, dn.non, dn.nov, dn.nor].into_iter().map(|v| v.to_string()).collect()
+            vec![g.nx, g.ny, ck.non, ck.nov, ck.nor, dn.non, dn.nov, dn.nor]
+                .into_iter()
+                .map(|v| v.to_string())
+                .collect()
         })
         .collect();
     (header.iter().map(|s| s.to_string()).collect(), rows)
@@ -131,7 +159,10 @@ pub fn table_4_14() -> (Vec<String>, Vec<Vec<String>>) {
         .iter()
         .map(|&(nx, ny)| {
             let net = crate::double_net::DoubleNet::new(nx, ny).unwrap();
-            vec![nx, ny, net.non(), net.nov(), net.nor()].into_iter().map(|v| v.to_string()).collect()
+            vec![nx, ny, net.non(), net.nov(), net.nor()]
+                .into_iter()
+                .map(|v| v.to_string())
+                .collect()
         })
         .collect();
     (["n_x", "n_y", "non", "nov", "nor"].iter().map(|s| s.to_string()).collect(), rows)
@@ -140,7 +171,8 @@ pub fn table_4_14() -> (Vec<String>, Vec<Vec<String>>) {
 /// A two-view grid as CSV: i, j, view, class (1-based class number), x, y, z; one row per
 /// position of both views (NON rows), bottom view first. Chapter 5 and `somnurbs fit` read it back.
 pub fn two_view_grid_csv(grid: &crate::spline::TwoViewGrid) -> Result<String> {
-    let net = crate::double_net::DoubleNet::new(grid.nx, grid.ny).ok_or_else(|| anyhow::anyhow!("grid {}x{} is too small", grid.nx, grid.ny))?;
+    let net = crate::double_net::DoubleNet::new(grid.nx, grid.ny)
+        .ok_or_else(|| anyhow::anyhow!("grid {}x{} is too small", grid.nx, grid.ny))?;
     let mut rows = Vec::with_capacity(net.non());
     for view in View::BOTH {
         let points = match view {
@@ -162,7 +194,8 @@ pub fn two_view_grid_csv(grid: &crate::spline::TwoViewGrid) -> Result<String> {
             }
         }
     }
-    let header: Vec<String> = ["i", "j", "view", "class", "x", "y", "z"].iter().map(|s| s.to_string()).collect();
+    let header: Vec<String> =
+        ["i", "j", "view", "class", "x", "y", "z"].iter().map(|s| s.to_string()).collect();
     csv_records(&header, &rows)
 }
 
@@ -202,7 +235,9 @@ pub fn write(spec: &Spec, runs: &[SomRun], out: &Path) -> Result<String> {
 
     let save = &spec.file.som.as_ref().map(|s| s.save_maps.clone()).unwrap_or_default();
     let mut maps = Vec::new();
-    for run in runs.iter().filter(|r| r.cell.model == Model::Dnsom && r.cell.repeat == 0 && save.contains(&r.cell.grid)) {
+    for run in runs.iter().filter(|r| {
+        r.cell.model == Model::Dnsom && r.cell.repeat == 0 && save.contains(&r.cell.grid)
+    }) {
         let name = format!("maps/dnsom_{}_{}.csv", run.cell.dataset, run.cell.grid);
         write_atomic(&out.join(&name), dnsom_map_csv(run)?.as_bytes())?;
         maps.push(name);
@@ -223,9 +258,17 @@ pub fn claims(runs: &[SomRun]) -> Vec<Claim> {
     let ours = |d: &str, m: Model, g: GridSize, s: &str| mean_of(runs, d, m, g, s);
     let theirs = |d: &str, m: Model, g: GridSize, s: &str| -> Option<f64> {
         if g.nx == g.ny {
-            thesis_b.as_ref()?.value(&["data", "n"], &[d.to_string(), g.nx.to_string()], &format!("{s}_{}", m.key()))
+            thesis_b.as_ref()?.value(
+                &["data", "n"],
+                &[d.to_string(), g.nx.to_string()],
+                &format!("{s}_{}", m.key()),
+            )
         } else {
-            thesis_c.as_ref()?.value(&["data", "n_x", "n_y"], &[d.to_string(), g.nx.to_string(), g.ny.to_string()], &format!("{s}_{}", m.key()))
+            thesis_c.as_ref()?.value(
+                &["data", "n_x", "n_y"],
+                &[d.to_string(), g.nx.to_string(), g.ny.to_string()],
+                &format!("{s}_{}", m.key()),
+            )
         }
     };
     let data = datasets(runs);
@@ -234,7 +277,10 @@ pub fn claims(runs: &[SomRun]) -> Vec<Claim> {
 
     // Count (data, grid) cases where `pred` holds, over a value source.
     type Src<'a> = &'a dyn Fn(&str, Model, GridSize, &str) -> Option<f64>;
-    let count = |src: Src, gs: &[GridSize], pred: &dyn Fn(&dyn Fn(Model, &str) -> Option<f64>) -> Option<bool>| -> (usize, usize) {
+    let count = |src: Src,
+                 gs: &[GridSize],
+                 pred: &dyn Fn(&dyn Fn(Model, &str) -> Option<f64>) -> Option<bool>|
+     -> (usize, usize) {
         let (mut yes, mut all) = (0, 0);
         for d in &data {
             for &g in gs {
@@ -257,7 +303,10 @@ pub fn claims(runs: &[SomRun]) -> Vec<Claim> {
         }
     };
     let mut claims = Vec::new();
-    let mut add = |statement: &str, gs: &[GridSize], pred: &dyn Fn(&dyn Fn(Model, &str) -> Option<f64>) -> Option<bool>, note: &str| {
+    let mut add = |statement: &str,
+                   gs: &[GridSize],
+                   pred: &dyn Fn(&dyn Fn(Model, &str) -> Option<f64>) -> Option<bool>,
+                   note: &str| {
         let o = count(&ours, gs, pred);
         let t = count(&theirs, gs, pred);
         claims.push(Claim {
@@ -270,19 +319,49 @@ pub fn claims(runs: &[SomRun]) -> Vec<Claim> {
         });
     };
     let all = Model::ALL;
-    add("3-D SOM has the highest TE", &sq, &extreme(&all, "te", Model::Som3d, true), "per (data, n)");
+    add(
+        "3-D SOM has the highest TE",
+        &sq,
+        &extreme(&all, "te", Model::Som3d, true),
+        "per (data, n)",
+    );
     add("DNSOM has the lowest TE", &sq, &extreme(&all, "te", Model::Dnsom, false), "per (data, n)");
-    add("2-D SOM has the highest QE", &sq, &extreme(&all, "qe", Model::Som2d, true), "per (data, n)");
-    add("3-D SOM has the lowest QE", &sq, &extreme(&all, "qe", Model::Som3d, false), "per (data, n)");
-    add("2-D SOM is the fastest", &sq, &extreme(&all, "cpu_s", Model::Som2d, false), "CPU time per (data, n)");
+    add(
+        "2-D SOM has the highest QE",
+        &sq,
+        &extreme(&all, "qe", Model::Som2d, true),
+        "per (data, n)",
+    );
+    add(
+        "3-D SOM has the lowest QE",
+        &sq,
+        &extreme(&all, "qe", Model::Som3d, false),
+        "per (data, n)",
+    );
+    add(
+        "2-D SOM is the fastest",
+        &sq,
+        &extreme(&all, "cpu_s", Model::Som2d, false),
+        "CPU time per (data, n)",
+    );
     add(
         "DNSOM is faster than 3-D SOM and CKSOM",
         &sq,
         &extreme(&[Model::Som3d, Model::Cksom, Model::Dnsom], "cpu_s", Model::Dnsom, false),
         "CPU time per (data, n)",
     );
-    add("DNSOM has a lower TE than CKSOM at nx != ny", &nsq, &extreme(&[Model::Cksom, Model::Dnsom], "te", Model::Dnsom, false), "Appendix C, per (data, grid)");
-    add("CKSOM has a lower QE than DNSOM at nx != ny", &nsq, &extreme(&[Model::Cksom, Model::Dnsom], "qe", Model::Cksom, false), "Appendix C, per (data, grid)");
+    add(
+        "DNSOM has a lower TE than CKSOM at nx != ny",
+        &nsq,
+        &extreme(&[Model::Cksom, Model::Dnsom], "te", Model::Dnsom, false),
+        "Appendix C, per (data, grid)",
+    );
+    add(
+        "CKSOM has a lower QE than DNSOM at nx != ny",
+        &nsq,
+        &extreme(&[Model::Cksom, Model::Dnsom], "qe", Model::Cksom, false),
+        "Appendix C, per (data, grid)",
+    );
     // QE falls as n grows: per (data, model) series over the square grids.
     let falls = |src: Src| -> (usize, usize) {
         let (mut yes, mut all_) = (0, 0);
@@ -301,7 +380,17 @@ pub fn claims(runs: &[SomRun]) -> Vec<Claim> {
     };
     let o = falls(&ours);
     let t = falls(&theirs);
-    claims.insert(0, Claim { rival: None, chapter: "4".into(), statement: "QE falls as n grows, for every model".into(), ours: o, thesis: (t.1 > 0).then_some(t), note: "per (data, model) series".into() });
+    claims.insert(
+        0,
+        Claim {
+            rival: None,
+            chapter: "4".into(),
+            statement: "QE falls as n grows, for every model".into(),
+            ours: o,
+            thesis: (t.1 > 0).then_some(t),
+            note: "per (data, model) series".into(),
+        },
+    );
     claims
 }
 
@@ -309,7 +398,8 @@ pub fn claims(runs: &[SomRun]) -> Vec<Claim> {
 const THESIS_SQUARE: [&str; 2] = ["appendix_b", "section_4_bunny"];
 
 fn side_by_side(runs: &[SomRun], square: bool, thesis: Option<&RefTable>) -> String {
-    let models: Vec<Model> = if square { Model::ALL.to_vec() } else { vec![Model::Cksom, Model::Dnsom] };
+    let models: Vec<Model> =
+        if square { Model::ALL.to_vec() } else { vec![Model::Cksom, Model::Dnsom] };
     let mut s = String::new();
     for (stem, label) in METRICS {
         let mut header = vec!["data".to_string(), "grid".to_string()];
@@ -319,10 +409,20 @@ fn side_by_side(runs: &[SomRun], square: bool, thesis: Option<&RefTable>) -> Str
             for g in grids(runs, square) {
                 let mut row = vec![d.clone(), g.to_string()];
                 for &m in &models {
-                    let key: Vec<String> = if square { vec![d.clone(), g.nx.to_string()] } else { vec![d.clone(), g.nx.to_string(), g.ny.to_string()] };
-                    let cols: Vec<&str> = if square { vec!["data", "n"] } else { vec!["data", "n_x", "n_y"] };
-                    let t = thesis.and_then(|t| t.value(&cols, &key, &format!("{stem}_{}", m.key())));
-                    row.push(beside(mean_of(runs, &d, m, g, stem), t, if stem == "cpu_s" { 3 } else { 4 }));
+                    let key: Vec<String> = if square {
+                        vec![d.clone(), g.nx.to_string()]
+                    } else {
+                        vec![d.clone(), g.nx.to_string(), g.ny.to_string()]
+                    };
+                    let cols: Vec<&str> =
+                        if square { vec!["data", "n"] } else { vec!["data", "n_x", "n_y"] };
+                    let t =
+                        thesis.and_then(|t| t.value(&cols, &key, &format!("{stem}_{}", m.key())));
+                    row.push(beside(
+                        mean_of(runs, &d, m, g, stem),
+                        t,
+                        if stem == "cpu_s" { 3 } else { 4 },
+                    ));
                 }
                 rows.push(row);
             }
@@ -342,9 +442,21 @@ fn speed_section(runs: &[SomRun]) -> String {
         for r in runs.iter().filter(|r| r.cell.model == m) {
             let g = r.cell.grid;
             let t = if g.nx == g.ny {
-                tb.as_ref().and_then(|t| t.value(&["data", "n"], &[r.cell.dataset.clone(), g.nx.to_string()], &format!("cpu_s_{}", m.key())))
+                tb.as_ref().and_then(|t| {
+                    t.value(
+                        &["data", "n"],
+                        &[r.cell.dataset.clone(), g.nx.to_string()],
+                        &format!("cpu_s_{}", m.key()),
+                    )
+                })
             } else {
-                tc.as_ref().and_then(|t| t.value(&["data", "n_x", "n_y"], &[r.cell.dataset.clone(), g.nx.to_string(), g.ny.to_string()], &format!("cpu_s_{}", m.key())))
+                tc.as_ref().and_then(|t| {
+                    t.value(
+                        &["data", "n_x", "n_y"],
+                        &[r.cell.dataset.clone(), g.nx.to_string(), g.ny.to_string()],
+                        &format!("cpu_s_{}", m.key()),
+                    )
+                })
             };
             if let Some(t) = t {
                 // Scale the thesis' time to this run's iteration count (the thesis used T = 30000).
@@ -369,14 +481,24 @@ fn speed_section(runs: &[SomRun]) -> String {
     if rows.is_empty() {
         return String::new();
     }
-    let header: Vec<String> = ["model", "cells", "thesis CPU s (scaled to T)", "ours CPU s", "speed-up (geometric mean)"].iter().map(|s| s.to_string()).collect();
+    let header: Vec<String> =
+        ["model", "cells", "thesis CPU s (scaled to T)", "ours CPU s", "speed-up (geometric mean)"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
     format!(
         "\n### Speed against the thesis' CPU times\n\nCPU seconds of the training loop on one core (thread CPU clock), against Appendix B/C; the thesis' times are scaled to this run's iteration count when it is not 30000.\n\n{}",
         table(&header, &rows)
     )
 }
 
-fn section(runs: &[SomRun], written: &[String], maps: &[String], pictures: &[String], claims_md: &str) -> String {
+fn section(
+    runs: &[SomRun],
+    written: &[String],
+    maps: &[String],
+    pictures: &[String],
+    claims_md: &str,
+) -> String {
     let mut s = String::from("## Chapter 4: SOM models (Appendices A-D)\n\n");
     let iters: Vec<usize> = runs.iter().map(|r| r.row.iterations).collect();
     let _ = writeln!(
@@ -415,7 +537,11 @@ fn section(runs: &[SomRun], written: &[String], maps: &[String], pictures: &[Str
     let (h, r) = table_4_14();
     let _ = write!(s, "\n### Table 4.14: DNSOM neuron counts\n\n{}", table(&h, &r));
     if !maps.is_empty() {
-        let _ = writeln!(s, "\nDNSOM maps saved for Chapter 5: {}.", maps.iter().map(|m| format!("`{m}`")).collect::<Vec<_>>().join(", "));
+        let _ = writeln!(
+            s,
+            "\nDNSOM maps saved for Chapter 5: {}.",
+            maps.iter().map(|m| format!("`{m}`")).collect::<Vec<_>>().join(", ")
+        );
     }
     if !pictures.is_empty() {
         s.push_str("\n### Pictures\n\n");

@@ -66,7 +66,9 @@ pub(crate) fn validate(spec: &Spec, som: &SomSpec) -> Result<(), SpecError> {
     }
     if let Some(s) = som.sigma0 {
         if !(s > 1.0) {
-            return Err(spec.err("som.sigma0", format!("must exceed 1 (tau = T / ln sigma0), got {s}")));
+            return Err(
+                spec.err("som.sigma0", format!("must exceed 1 (tau = T / ln sigma0), got {s}"))
+            );
         }
     }
     if som.repeats == 0 {
@@ -84,7 +86,8 @@ pub(crate) fn validate(spec: &Spec, som: &SomSpec) -> Result<(), SpecError> {
             return Err(spec.err(&format!("{key}.grids"), "is empty"));
         }
         for m in &group.models {
-            let model: crate::som::Model = m.parse().map_err(|e| spec.err(&format!("{key}.models"), e))?;
+            let model: crate::som::Model =
+                m.parse().map_err(|e| spec.err(&format!("{key}.models"), e))?;
             for grid in &group.grids {
                 if som.sigma0.is_none() && grid.nx.min(grid.ny) < 3 {
                     return Err(spec.err(
@@ -92,12 +95,15 @@ pub(crate) fn validate(spec: &Spec, som: &SomSpec) -> Result<(), SpecError> {
                         format!("grid {grid} is too small: sigma0 = min(nx,ny)/2 must exceed 1"),
                     ));
                 }
-                model.topology(grid.nx, grid.ny).map_err(|e| spec.err(&format!("{key}.grids"), e))?;
+                model
+                    .topology(grid.nx, grid.ny)
+                    .map_err(|e| spec.err(&format!("{key}.grids"), e))?;
             }
         }
     }
     for grid in &som.save_maps {
-        let has = cells(spec).iter().any(|c| c.model == crate::som::Model::Dnsom && c.grid == *grid);
+        let has =
+            cells(spec).iter().any(|c| c.model == crate::som::Model::Dnsom && c.grid == *grid);
         if !has {
             return Err(spec.err("som.save_maps", format!("no DNSOM cell at grid {grid} to save")));
         }
@@ -117,7 +123,12 @@ pub fn cells(spec: &Spec) -> Vec<SomCell> {
                 for m in &group.models {
                     let Ok(model) = m.parse() else { continue };
                     for repeat in 0..som.repeats {
-                        let cell = SomCell { dataset: crate::data::registry::name_of(dataset), model, grid: *grid, repeat };
+                        let cell = SomCell {
+                            dataset: crate::data::registry::name_of(dataset),
+                            model,
+                            grid: *grid,
+                            repeat,
+                        };
                         if seen.insert(cell.key()) {
                             cells.push(cell);
                         }

@@ -10,8 +10,8 @@
 //! The 3-D views use plotly.js (gl3d partial bundle), vendored in `vendor/` and copied once into
 //! the results folder's `vendor/`; the page names it by a relative path and fetches nothing.
 
-use crate::io::{read_text, write_atomic};
 use super::views3d;
+use crate::io::{read_text, write_atomic};
 use anyhow::{Context, Result};
 use std::collections::BTreeSet;
 use std::fmt::Write;
@@ -22,8 +22,10 @@ pub const FILE: &str = "report.html";
 
 /// The vendored plotting library: its path inside a results folder, and its bytes.
 pub const PLOTLY_PATH: &str = "vendor/plotly-gl3d-4.1.1.min.js";
-pub const PLOTLY_JS: &[u8] = include_bytes!("../../../vendor/plotly.js-gl3d-dist-min-4.1.1/plotly-gl3d.min.js");
-const PLOTLY_LICENSE: &[u8] = include_bytes!("../../../vendor/plotly.js-gl3d-dist-min-4.1.1/LICENSE");
+pub const PLOTLY_JS: &[u8] =
+    include_bytes!("../../../vendor/plotly.js-gl3d-dist-min-4.1.1/plotly-gl3d.min.js");
+const PLOTLY_LICENSE: &[u8] =
+    include_bytes!("../../../vendor/plotly.js-gl3d-dist-min-4.1.1/LICENSE");
 /// sha256 of [`PLOTLY_JS`] (the npm package plotly.js-gl3d-dist-min 4.1.1).
 pub const PLOTLY_SHA256: &str = "aab04dcd9c103a92b18723f8c837712fe820f325d0bcd2421e415e8124a75b9f";
 
@@ -72,7 +74,8 @@ fn report_folders(root: &Path) -> Result<Vec<String>> {
         if depth == 3 {
             continue;
         }
-        let entries = std::fs::read_dir(&dir).with_context(|| format!("cannot read folder {}", dir.display()))?;
+        let entries = std::fs::read_dir(&dir)
+            .with_context(|| format!("cannot read folder {}", dir.display()))?;
         for e in entries {
             let e = e.with_context(|| format!("cannot read folder {}", dir.display()))?;
             let name = e.file_name().to_string_lossy().into_owned();
@@ -102,7 +105,9 @@ fn pictures(root: &Path, folder: &str) -> Result<Vec<String>> {
         if !dir.is_dir() {
             continue;
         }
-        for e in std::fs::read_dir(&dir).with_context(|| format!("cannot read folder {}", dir.display()))? {
+        for e in std::fs::read_dir(&dir)
+            .with_context(|| format!("cannot read folder {}", dir.display()))?
+        {
             let e = e.with_context(|| format!("cannot read folder {}", dir.display()))?;
             let name = e.file_name().to_string_lossy().into_owned();
             if name.ends_with(".png") && e.path().is_file() {
@@ -130,12 +135,27 @@ fn build(root: &Path) -> Result<Page> {
             None => parts.last_mut().expect("a part").1.push(line),
         }
     }
-    let title = parts.first().map(|p| p.0.clone()).filter(|t| !t.is_empty()).unwrap_or_else(|| "somnurbs report".into());
+    let title = parts
+        .first()
+        .map(|p| p.0.clone())
+        .filter(|t| !t.is_empty())
+        .unwrap_or_else(|| "somnurbs report".into());
     let mut covered: Vec<String> = Vec::new();
     let mut chapters = Vec::new();
     for (k, (heading, lines)) in parts.iter().enumerate() {
-        let folder = if k == 0 { Some(String::new()) } else { folders.iter().find(|f| *f == heading && !f.is_empty()).cloned() };
-        let mut ch = render_chapter(if heading.is_empty() { &title } else { heading }, &lines.join("\n"), "", 0, &mut ids, &mut shown);
+        let folder = if k == 0 {
+            Some(String::new())
+        } else {
+            folders.iter().find(|f| *f == heading && !f.is_empty()).cloned()
+        };
+        let mut ch = render_chapter(
+            if heading.is_empty() { &title } else { heading },
+            &lines.join("\n"),
+            "",
+            0,
+            &mut ids,
+            &mut shown,
+        );
         if let Some(f) = folder.filter(|f| !f.is_empty()) {
             covered.push(f);
         }
@@ -145,7 +165,8 @@ fn build(root: &Path) -> Result<Page> {
         chapters.push(ch_take(&mut ch));
     }
     // The other report folders (the readings' runs), each a chapter of its own.
-    let mut uncovered: Vec<String> = folders.iter().filter(|f| !f.is_empty() && !covered.contains(f)).cloned().collect();
+    let mut uncovered: Vec<String> =
+        folders.iter().filter(|f| !f.is_empty() && !covered.contains(f)).cloned().collect();
     // In the order the root REPORT.md names them (its table of specs), the rest after.
     uncovered.sort_by_key(|f| text.find(&format!("{f}/")).unwrap_or(usize::MAX));
     for f in &uncovered {
@@ -158,7 +179,11 @@ fn build(root: &Path) -> Result<Page> {
     // Each covered folder's remaining pictures and its 3-D views go at the end of its chapter
     // (the root's at the end of the first chapter).
     for (k, f) in covered.iter().enumerate() {
-        let idx = if f.is_empty() { 0 } else { chapters.iter().position(|c| &c.title == f).unwrap_or(k.min(chapters.len() - 1)) };
+        let idx = if f.is_empty() {
+            0
+        } else {
+            chapters.iter().position(|c| &c.title == f).unwrap_or(k.min(chapters.len() - 1))
+        };
         let mut extra = String::new();
         if root.join(f).join(views3d::FILE).is_file() {
             let _ = write!(
@@ -170,7 +195,8 @@ fn build(root: &Path) -> Result<Page> {
             view_folders.push(f.clone());
             chapters[idx].toc.push((4, "3-D views".into(), extra_id(&extra)));
         }
-        let rest: Vec<String> = pictures(root, f)?.into_iter().filter(|p| !shown.contains(p)).collect();
+        let rest: Vec<String> =
+            pictures(root, f)?.into_iter().filter(|p| !shown.contains(p)).collect();
         if !rest.is_empty() {
             let _ = writeln!(extra, "<details class=\"gallery\"><summary>All pictures of <code>{}</code> ({})</summary><div class=\"grid\">", esc(if f.is_empty() { "." } else { f }), rest.len());
             for p in &rest {
@@ -195,7 +221,11 @@ fn build(root: &Path) -> Result<Page> {
         if !c.toc.is_empty() {
             html.push_str("<details><summary>sections</summary><ul>");
             for (level, t, id) in &c.toc {
-                let _ = write!(html, "<li class=\"l{level}\"><a href=\"#{id}\">{}</a></li>", inline(t, ""));
+                let _ = write!(
+                    html,
+                    "<li class=\"l{level}\"><a href=\"#{id}\">{}</a></li>",
+                    inline(t, "")
+                );
             }
             html.push_str("</ul></details>");
         }
@@ -203,13 +233,24 @@ fn build(root: &Path) -> Result<Page> {
     }
     html.push_str("</ol>\n<p class=\"navnote\">Built from this folder's files; opens offline. Click a table heading to sort.</p></nav>\n<main>\n");
     for c in &chapters {
-        let _ = write!(html, "<section class=\"chapter\">\n<h1 id=\"{}\">{}</h1>\n{}</section>\n", c.id, esc(&c.title), c.body);
+        let _ = write!(
+            html,
+            "<section class=\"chapter\">\n<h1 id=\"{}\">{}</h1>\n{}</section>\n",
+            c.id,
+            esc(&c.title),
+            c.body
+        );
     }
     html.push_str("<pre id=\"script-errors\" hidden></pre>\n</main>\n");
     if !view_folders.is_empty() {
         let _ = writeln!(html, "<script src=\"{PLOTLY_PATH}\"></script>");
         for f in &view_folders {
-            let _ = writeln!(html, "<script src=\"{}\" data-folder=\"{}\"></script>", esc(&join(f, views3d::FILE)), esc(f));
+            let _ = writeln!(
+                html,
+                "<script src=\"{}\" data-folder=\"{}\"></script>",
+                esc(&join(f, views3d::FILE)),
+                esc(f)
+            );
         }
     }
     let _ = write!(html, "<script>\n{PAGE_JS}</script>\n</body>\n</html>\n");
@@ -217,7 +258,12 @@ fn build(root: &Path) -> Result<Page> {
 }
 
 fn ch_take(c: &mut Chapter) -> Chapter {
-    Chapter { title: std::mem::take(&mut c.title), id: std::mem::take(&mut c.id), toc: std::mem::take(&mut c.toc), body: std::mem::take(&mut c.body) }
+    Chapter {
+        title: std::mem::take(&mut c.title),
+        id: std::mem::take(&mut c.id),
+        toc: std::mem::take(&mut c.toc),
+        body: std::mem::take(&mut c.body),
+    }
 }
 
 fn extra_id(s: &str) -> String {
@@ -240,7 +286,11 @@ fn esc(s: &str) -> String {
 }
 
 fn unique_id(ids: &mut BTreeSet<String>, text: &str) -> String {
-    let mut base: String = text.to_lowercase().chars().map(|c| if c.is_ascii_alphanumeric() { c } else { '-' }).collect();
+    let mut base: String = text
+        .to_lowercase()
+        .chars()
+        .map(|c| if c.is_ascii_alphanumeric() { c } else { '-' })
+        .collect();
     base = base.split('-').filter(|s| !s.is_empty()).collect::<Vec<_>>().join("-");
     if base.is_empty() {
         base = "s".into();
@@ -292,7 +342,8 @@ fn inline(s: &str, prefix: &str) -> String {
                     if image {
                         let _ = write!(o, "<img src=\"{}\" alt=\"{}\">", esc(&url), esc(label));
                     } else {
-                        let _ = write!(o, "<a href=\"{}\">{}</a>", esc(&url), inline(label, prefix));
+                        let _ =
+                            write!(o, "<a href=\"{}\">{}</a>", esc(&url), inline(label, prefix));
                     }
                     rest = &rest[close + 3 + end..];
                     continue;
@@ -330,8 +381,11 @@ fn table(lines: &[&str], prefix: &str, reference: &str) -> String {
     // Columns whose every cell is "ours (reference)" or a plain number, at least one a pair.
     let split: Vec<bool> = (0..header.len())
         .map(|c| {
-            let col: Vec<&str> = body.iter().map(|r| r.get(c).map(String::as_str).unwrap_or("")).collect();
-            c > 0 && col.iter().all(|x| split_pair(x).is_some()) && col.iter().any(|x| x.ends_with(')'))
+            let col: Vec<&str> =
+                body.iter().map(|r| r.get(c).map(String::as_str).unwrap_or("")).collect();
+            c > 0
+                && col.iter().all(|x| split_pair(x).is_some())
+                && col.iter().any(|x| x.ends_with(')'))
         })
         .collect();
     let class = if body.len() >= 6 { "sortable filterable" } else { "sortable" };
@@ -350,7 +404,12 @@ fn table(lines: &[&str], prefix: &str, reference: &str) -> String {
             let cell = r.get(c).map(String::as_str).unwrap_or("");
             if split[c] {
                 let (a, b) = split_pair(cell).unwrap_or_default();
-                let _ = write!(o, "<td>{}</td><td class=\"ref\">{}</td>", inline(&a, prefix), inline(&b, prefix));
+                let _ = write!(
+                    o,
+                    "<td>{}</td><td class=\"ref\">{}</td>",
+                    inline(&a, prefix),
+                    inline(&b, prefix)
+                );
             } else {
                 let _ = write!(o, "<td>{}</td>", inline(cell, prefix));
             }
@@ -362,7 +421,14 @@ fn table(lines: &[&str], prefix: &str, reference: &str) -> String {
 }
 
 /// Render one chapter's Markdown. `demote` lowers its headings (a sub-folder's REPORT.md).
-fn render_chapter(title: &str, md: &str, prefix: &str, demote: usize, ids: &mut BTreeSet<String>, shown: &mut BTreeSet<String>) -> Chapter {
+fn render_chapter(
+    title: &str,
+    md: &str,
+    prefix: &str,
+    demote: usize,
+    ids: &mut BTreeSet<String>,
+    shown: &mut BTreeSet<String>,
+) -> Chapter {
     let id = unique_id(ids, title);
     let mut toc = Vec::new();
     let mut o = String::new();
@@ -413,7 +479,12 @@ fn render_chapter(title: &str, md: &str, prefix: &str, demote: usize, ids: &mut 
             loop {
                 let next = lines.get(i).map(|l| l.trim());
                 match next {
-                    Some(n) if n.starts_with("- ") || n.is_empty() || n.starts_with('#') || n.starts_with('|') => {
+                    Some(n)
+                        if n.starts_with("- ")
+                            || n.is_empty()
+                            || n.starts_with('#')
+                            || n.starts_with('|') =>
+                    {
                         let _ = writeln!(o, "<li>{}</li>", inline(&item, prefix));
                         match n.strip_prefix("- ") {
                             Some(rest) => {
@@ -472,7 +543,11 @@ mod tests {
 
     #[test]
     fn pairs_split_into_ours_and_reference() {
-        let t = table(&["| data | QE |", "|---|---|", "| cube | 0.0085 (0.0023) |", "| sphere | 0.5 |"], "", "thesis");
+        let t = table(
+            &["| data | QE |", "|---|---|", "| cube | 0.0085 (0.0023) |", "| sphere | 0.5 |"],
+            "",
+            "thesis",
+        );
         assert!(t.contains("<td>0.0085</td><td class=\"ref\">0.0023</td>"), "{t}");
         assert!(t.contains("<td>0.5</td><td class=\"ref\"></td>"), "{t}");
         assert!(t.contains("QE <span class=\"who\">thesis</span>"), "{t}");
@@ -497,7 +572,11 @@ mod tests {
         std::fs::write(root.join("spec1/p.png"), b"x").unwrap();
         std::fs::write(root.join("spec1/png/q.png"), b"x").unwrap();
         std::fs::create_dir_all(root.join("readings/r/spec1")).unwrap();
-        std::fs::write(root.join("readings/r/spec1/REPORT.md"), "# somnurbs report: spec1\n\n### Chapter\n\n![z](z.png)\n").unwrap();
+        std::fs::write(
+            root.join("readings/r/spec1/REPORT.md"),
+            "# somnurbs report: spec1\n\n### Chapter\n\n![z](z.png)\n",
+        )
+        .unwrap();
         std::fs::write(root.join("readings/r/spec1").join(views3d::FILE), "").unwrap();
         let path = write(root).unwrap();
         let html = std::fs::read_to_string(path).unwrap();
@@ -510,6 +589,9 @@ mod tests {
         assert!(html.contains("<script src=\"readings/r/spec1/views3d.js\" data-folder=\"readings/r/spec1\"></script>"), "{html}");
         assert!(html.contains("<li>one</li>\n<li>two</li>"), "{html}");
         assert_eq!(std::fs::read(root.join(PLOTLY_PATH)).unwrap(), PLOTLY_JS);
-        assert!(!html.contains("http://") && !html.contains("https://"), "the page fetches nothing");
+        assert!(
+            !html.contains("http://") && !html.contains("https://"),
+            "the page fetches nothing"
+        );
     }
 }

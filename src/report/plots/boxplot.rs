@@ -45,11 +45,8 @@ impl BoxStats {
             return None;
         }
         v.sort_by(f64::total_cmp);
-        let (q1, median, q3) = (
-            quantile_type7(&v, 0.25),
-            quantile_type7(&v, 0.5),
-            quantile_type7(&v, 0.75),
-        );
+        let (q1, median, q3) =
+            (quantile_type7(&v, 0.25), quantile_type7(&v, 0.5), quantile_type7(&v, 0.75));
         let iqr = q3 - q1;
         let (lf, uf) = (q1 - 1.5 * iqr, q3 + 1.5 * iqr);
         let inside = |x: &&f64| **x >= lf && **x <= uf;
@@ -57,15 +54,7 @@ impl BoxStats {
         let lower_whisker = v.iter().find(inside).copied().unwrap_or(q1);
         let upper_whisker = v.iter().rev().find(inside).copied().unwrap_or(q3);
         let outliers = v.iter().copied().filter(|x| *x < lf || *x > uf).collect();
-        Some(BoxStats {
-            n: v.len(),
-            q1,
-            median,
-            q3,
-            lower_whisker,
-            upper_whisker,
-            outliers,
-        })
+        Some(BoxStats { n: v.len(), q1, median, q3, lower_whisker, upper_whisker, outliers })
     }
 }
 
@@ -84,20 +73,13 @@ pub fn box_plot_png(
     y_label: &str,
     groups: &[(String, Vec<f64>)],
 ) -> Result<(), PlotError> {
-    let stats: Vec<Option<BoxStats>> = groups
-        .iter()
-        .map(|(_, v)| BoxStats::from_values(v))
-        .collect();
+    let stats: Vec<Option<BoxStats>> =
+        groups.iter().map(|(_, v)| BoxStats::from_values(v)).collect();
     let (lo, hi) = extent(stats.iter().flatten().flat_map(|s| {
-        [s.lower_whisker, s.upper_whisker]
-            .into_iter()
-            .chain(s.outliers.iter().copied())
+        [s.lower_whisker, s.upper_whisker].into_iter().chain(s.outliers.iter().copied())
     }))
     .ok_or_else(|| {
-        PlotError::input(
-            path,
-            format!("none of the {} groups has a finite value", groups.len()),
-        )
+        PlotError::input(path, format!("none of the {} groups has a finite value", groups.len()))
     })?;
     let y_axis = Axis::linear(lo, hi, 7);
     render_png(path, box_plot_size(groups.len()), |root| {
@@ -149,14 +131,8 @@ fn draw_box_plot(
                 Rectangle::new([(l, s.q3), (r, s.q1)], colour.stroke_width(2)),
             ])?;
             chart.draw_series([
-                PathElement::new(
-                    vec![(x, s.q3), (x, s.upper_whisker)],
-                    colour.stroke_width(2),
-                ),
-                PathElement::new(
-                    vec![(x, s.q1), (x, s.lower_whisker)],
-                    colour.stroke_width(2),
-                ),
+                PathElement::new(vec![(x, s.q3), (x, s.upper_whisker)], colour.stroke_width(2)),
+                PathElement::new(vec![(x, s.q1), (x, s.lower_whisker)], colour.stroke_width(2)),
                 PathElement::new(
                     vec![(x - 0.12, s.upper_whisker), (x + 0.12, s.upper_whisker)],
                     colour.stroke_width(2),
@@ -165,15 +141,10 @@ fn draw_box_plot(
                     vec![(x - 0.12, s.lower_whisker), (x + 0.12, s.lower_whisker)],
                     colour.stroke_width(2),
                 ),
-                PathElement::new(
-                    vec![(l, s.median), (r, s.median)],
-                    style::BLACK.stroke_width(3),
-                ),
+                PathElement::new(vec![(l, s.median), (r, s.median)], style::BLACK.stroke_width(3)),
             ])?;
             chart.draw_series(
-                s.outliers
-                    .iter()
-                    .map(|&o| Circle::new((x, o), 4, colour.stroke_width(2))),
+                s.outliers.iter().map(|&o| Circle::new((x, o), 4, colour.stroke_width(2))),
             )?;
         }
         // Group name and count under the axis, cut to the slot width.
@@ -224,13 +195,7 @@ mod tests {
         assert_eq!(s.outliers, vec![50.0]);
         let one = BoxStats::from_values(&[2.0]).unwrap();
         assert_eq!(
-            (
-                one.q1,
-                one.median,
-                one.q3,
-                one.lower_whisker,
-                one.upper_whisker
-            ),
+            (one.q1, one.median, one.q3, one.lower_whisker, one.upper_whisker),
             (2.0, 2.0, 2.0, 2.0, 2.0)
         );
     }
@@ -249,14 +214,8 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("box.png");
         let g = vec![
-            (
-                "ga".to_string(),
-                vec![14.742470, 14.742475, 14.742481, 14.742466, 14.742488],
-            ),
-            (
-                "de".to_string(),
-                vec![14.742461, 14.742462, 14.742461, 14.742463, f64::NAN],
-            ),
+            ("ga".to_string(), vec![14.742470, 14.742475, 14.742481, 14.742466, 14.742488]),
+            ("de".to_string(), vec![14.742461, 14.742462, 14.742461, 14.742463, f64::NAN]),
             ("empty".to_string(), vec![f64::NAN]),
         ];
         box_plot_png(&p, "Final fitness", "fitness", &g).unwrap();
@@ -269,14 +228,12 @@ mod tests {
     fn box_plot_errors_name_the_path() {
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("nobox.png");
-        let e = box_plot_png(&p, "t", "y", &[("a".into(), vec![f64::NAN])])
-            .unwrap_err()
-            .to_string();
+        let e =
+            box_plot_png(&p, "t", "y", &[("a".into(), vec![f64::NAN])]).unwrap_err().to_string();
         assert!(e.contains("nobox.png"), "{e}");
         let q = missing_folder_path(dir.path());
-        let e = box_plot_png(&q, "t", "y", &[("a".into(), vec![1.0, 2.0])])
-            .unwrap_err()
-            .to_string();
+        let e =
+            box_plot_png(&q, "t", "y", &[("a".into(), vec![1.0, 2.0])]).unwrap_err().to_string();
         assert!(e.contains(&q.display().to_string()), "{e}");
         assert!(listing(dir.path()).is_empty());
     }

@@ -52,12 +52,7 @@ pub fn cd_cliques(mean_ranks: &[(String, f64)], cd: f64) -> Vec<Vec<String>> {
     let (order, groups) = cliques_sorted(mean_ranks, cd);
     groups
         .iter()
-        .map(|&(a, b)| {
-            order[a..=b]
-                .iter()
-                .map(|&i| mean_ranks[i].0.clone())
-                .collect()
-        })
+        .map(|&(a, b)| order[a..=b].iter().map(|&i| mean_ranks[i].0.clone()).collect())
         .collect()
 }
 
@@ -67,9 +62,7 @@ fn validate(mean_ranks: &[(String, f64)], cd: f64) -> Result<(), String> {
         return Err(format!("a CD diagram needs at least 2 methods, got {k}"));
     }
     if !(cd.is_finite() && cd > 0.0) {
-        return Err(format!(
-            "critical difference must be finite and positive, got {cd}"
-        ));
+        return Err(format!("critical difference must be finite and positive, got {cd}"));
     }
     for (name, r) in mean_ranks {
         if !(r.is_finite() && *r >= 1.0 - 1e-9 && *r <= k as f64 + 1e-9) {
@@ -167,11 +160,7 @@ fn draw_cd(
     for (pos, &i) in order.iter().enumerate() {
         let (name, r) = &mean_ranks[i];
         let x = px(*r);
-        let (row, left) = if pos < n_left {
-            (pos, true)
-        } else {
-            (k - 1 - pos, false)
-        };
+        let (row, left) = if pos < n_left { (pos, true) } else { (k - 1 - pos, false) };
         let y = first_row + row as i32 * ROW_H;
         let text = format!("{} ({r:.2})", style::truncate(name, NAME_CHARS));
         if left {
@@ -206,26 +195,16 @@ mod tests {
     fn cliques_of_demsar_example() {
         // Demsar (2006) Section 3.2.2: C4.5 variants with mean ranks 3.143, 2.000, 2.893, 1.964
         // over 14 data sets, CD = 1.25 at alpha 0.05 (q = 2.569, k = 4, N = 14).
-        let m = ranks(&[
-            ("C4.5", 3.143),
-            ("C4.5+m", 2.000),
-            ("C4.5+cf", 2.893),
-            ("C4.5+m+cf", 1.964),
-        ]);
+        let m =
+            ranks(&[("C4.5", 3.143), ("C4.5+m", 2.000), ("C4.5+cf", 2.893), ("C4.5+m+cf", 1.964)]);
         let cd = 2.569 * (4.0f64 * 5.0 / (6.0 * 14.0)).sqrt();
         assert!((cd - 1.25).abs() < 0.01, "{cd}");
         // Differences to C4.5: 1.143 and 1.179, both < CD: all four in one group.
-        assert_eq!(
-            cd_cliques(&m, cd),
-            vec![vec!["C4.5+m+cf", "C4.5+m", "C4.5+cf", "C4.5"]]
-        );
+        assert_eq!(cd_cliques(&m, cd), vec![vec!["C4.5+m+cf", "C4.5+m", "C4.5+cf", "C4.5"]]);
         // With a CD of 1.0 the two with +m separate from plain C4.5.
         assert_eq!(
             cd_cliques(&m, 1.0),
-            vec![
-                vec!["C4.5+m+cf", "C4.5+m", "C4.5+cf"],
-                vec!["C4.5+cf", "C4.5"]
-            ]
+            vec![vec!["C4.5+m+cf", "C4.5+m", "C4.5+cf"], vec!["C4.5+cf", "C4.5"]]
         );
     }
 
@@ -243,13 +222,7 @@ mod tests {
     fn cd_diagram_writes_png_of_computed_size() {
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("cd.png");
-        let m = ranks(&[
-            ("DE", 1.6),
-            ("GA", 2.9),
-            ("PSO", 3.1),
-            ("CSA", 3.4),
-            ("ICSA", 4.0),
-        ]);
+        let m = ranks(&[("DE", 1.6), ("GA", 2.9), ("PSO", 3.1), ("CSA", 3.4), ("ICSA", 4.0)]);
         cd_diagram_png(&p, "Friedman / Nemenyi", &m, 1.36).unwrap();
         assert_eq!(png_size(&p), cd_diagram_size(&m, 1.36).unwrap());
         cd_diagram_png(&p, "huge CD", &m, 9.0).unwrap();
@@ -263,16 +236,8 @@ mod tests {
         type Case = (Vec<(String, f64)>, f64, &'static str);
         let cases: Vec<Case> = vec![
             (ranks(&[("a", 1.0)]), 1.0, "at least 2"),
-            (
-                ranks(&[("a", 1.0), ("b", 2.0)]),
-                f64::NAN,
-                "critical difference",
-            ),
-            (
-                ranks(&[("a", 1.0), ("b", 2.0)]),
-                -1.0,
-                "critical difference",
-            ),
+            (ranks(&[("a", 1.0), ("b", 2.0)]), f64::NAN, "critical difference"),
+            (ranks(&[("a", 1.0), ("b", 2.0)]), -1.0, "critical difference"),
             (ranks(&[("a", f64::NAN), ("b", 2.0)]), 1.0, "'a'"),
             (ranks(&[("a", 1.0), ("b", 3.5)]), 1.0, "'b'"),
         ];

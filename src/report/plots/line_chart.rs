@@ -107,24 +107,15 @@ pub fn small_multiples_png(
 /// The x extent and the y axis that show every drawable point of `series`.
 fn axes(path: &Path, series: &[Series], log_y: bool) -> Result<((f64, f64), Axis), PlotError> {
     let ok_y = |y: f64| if log_y { y > 0.0 } else { true };
-    let xs = series.iter().flat_map(|s| {
-        s.points
-            .iter()
-            .map(|p| p.0)
-            .chain(s.band.iter().flatten().map(|b| b.0))
-    });
+    let xs = series
+        .iter()
+        .flat_map(|s| s.points.iter().map(|p| p.0).chain(s.band.iter().flatten().map(|b| b.0)));
     let ys = series.iter().flat_map(|s| {
         s.points
             .iter()
             .filter(|p| p.0.is_finite())
             .map(|p| p.1)
-            .chain(
-                s.band
-                    .iter()
-                    .flatten()
-                    .filter(|b| b.0.is_finite())
-                    .flat_map(|b| [b.1, b.2]),
-            )
+            .chain(s.band.iter().flatten().filter(|b| b.0.is_finite()).flat_map(|b| [b.1, b.2]))
     });
     let (x_ext, y_ext) = match (extent(xs), extent(ys.filter(|y| ok_y(*y)))) {
         (Some(x), Some(y)) => (x, y),
@@ -134,11 +125,7 @@ fn axes(path: &Path, series: &[Series], log_y: bool) -> Result<((f64, f64), Axis
                 format!(
                     "no drawable point in {} series (all values non-finite{})",
                     series.len(),
-                    if log_y {
-                        " or not positive on the log axis"
-                    } else {
-                        ""
-                    }
+                    if log_y { " or not positive on the log axis" } else { "" }
                 ),
             ))
         }
@@ -165,10 +152,8 @@ fn draw_line_chart(
     let names: Vec<String> = series
         .iter()
         .map(|s| {
-            let drawable = s
-                .points
-                .iter()
-                .any(|p| y_axis.to_plot(p.1).is_some() && p.0.is_finite());
+            let drawable =
+                s.points.iter().any(|p| y_axis.to_plot(p.1).is_some() && p.0.is_finite());
             let name = style::truncate(&s.label, LEGEND_CHARS);
             if drawable {
                 name
@@ -205,11 +190,7 @@ fn draw_line_chart(
         .build_cartesian_2d(x_axis.clone(), y_axis.clone())?;
     let xf = |v: &f64| x_axis.label_at(*v);
     let yf = |v: &f64| y_axis.label_at(*v);
-    let y_desc = if y_axis.log {
-        format!("{y_label} (log scale)")
-    } else {
-        y_label.to_string()
-    };
+    let y_desc = if y_axis.log { format!("{y_label} (log scale)") } else { y_label.to_string() };
     chart
         .configure_mesh()
         .x_desc(x_label)
@@ -260,11 +241,8 @@ fn draw_line_chart(
         }
         let n: usize = pts.iter().map(|r| r.len()).sum();
         if n <= MARKER_LIMIT {
-            chart.draw_series(
-                pts.iter()
-                    .flatten()
-                    .map(|&p| Circle::new(p, 3, s.colour.filled())),
-            )?;
+            chart
+                .draw_series(pts.iter().flatten().map(|&p| Circle::new(p, 3, s.colour.filled())))?;
         }
     }
 
@@ -280,10 +258,7 @@ fn draw_line_chart(
                 s.colour.mix(0.18).filled(),
             ))?;
         }
-        legend_area.draw(&PathElement::new(
-            vec![(x, y), (x + 26, y)],
-            s.colour.stroke_width(2),
-        ))?;
+        legend_area.draw(&PathElement::new(vec![(x, y), (x + 26, y)], s.colour.stroke_width(2)))?;
         legend_area.draw(&Text::new(
             name.clone(),
             (x + 34, y),
@@ -300,20 +275,10 @@ mod tests {
 
     fn conv(label: &str, colour: RGBColor, scale: f64) -> Series {
         let pts: Vec<(f64, f64)> = (0..50)
-            .map(|i| {
-                (
-                    i as f64 * 40.0,
-                    14.742461 + scale * 1e-6 * (-(i as f64) / 10.0).exp(),
-                )
-            })
+            .map(|i| (i as f64 * 40.0, 14.742461 + scale * 1e-6 * (-(i as f64) / 10.0).exp()))
             .collect();
         let band = pts.iter().map(|&(x, y)| (x, y - 2e-7, y + 3e-7)).collect();
-        Series {
-            label: label.into(),
-            colour,
-            points: pts,
-            band: Some(band),
-        }
+        Series { label: label.into(), colour, points: pts, band: Some(band) }
     }
 
     #[test]
@@ -327,10 +292,7 @@ mod tests {
     fn line_chart_writes_png_of_chart_size() {
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("conv.png");
-        let s = [
-            conv("DE", style::BLUE, 27.0),
-            conv("GA", style::ORANGE, 20.0),
-        ];
+        let s = [conv("DE", style::BLUE, 27.0), conv("GA", style::ORANGE, 20.0)];
         line_chart_png(&p, "Convergence", "evaluations", "best fitness", &s, false).unwrap();
         assert_eq!(png_size(&p), style::CHART_SIZE);
         line_chart_png(&p, "Convergence", "evaluations", "best fitness", &s, true).unwrap();
@@ -374,9 +336,7 @@ mod tests {
             points: vec![(0.0, f64::NAN)],
             band: None,
         };
-        let e = line_chart_png(&p, "t", "x", "y", &[s], false)
-            .unwrap_err()
-            .to_string();
+        let e = line_chart_png(&p, "t", "x", "y", &[s], false).unwrap_err().to_string();
         assert!(e.contains("empty.png"), "{e}");
         let z = Series {
             label: "a".into(),
@@ -384,13 +344,9 @@ mod tests {
             points: vec![(0.0, 0.0), (1.0, -2.0)],
             band: None,
         };
-        let e = line_chart_png(&p, "t", "x", "y", &[z], true)
-            .unwrap_err()
-            .to_string();
+        let e = line_chart_png(&p, "t", "x", "y", &[z], true).unwrap_err().to_string();
         assert!(e.contains("empty.png") && e.contains("log"), "{e}");
-        let e = line_chart_png(&p, "t", "x", "y", &[], false)
-            .unwrap_err()
-            .to_string();
+        let e = line_chart_png(&p, "t", "x", "y", &[], false).unwrap_err().to_string();
         assert!(e.contains("empty.png"), "{e}");
         assert!(listing(dir.path()).is_empty());
     }

@@ -31,13 +31,32 @@ pub struct LineMesh {
 /// surfaces that differ by too little to see). Meshes pair up in order and must have as many
 /// points; returns the magnified meshes, `k` and the largest difference (None when nothing differs
 /// or the meshes do not pair up).
-pub fn magnified_difference(base: &[LineMesh], other: &[LineMesh], frac: f64) -> Option<(Vec<LineMesh>, f64, f64)> {
-    if base.len() != other.len() || base.iter().zip(other).any(|(b, o)| b.points.len() != o.points.len()) {
+pub fn magnified_difference(
+    base: &[LineMesh],
+    other: &[LineMesh],
+    frac: f64,
+) -> Option<(Vec<LineMesh>, f64, f64)> {
+    if base.len() != other.len()
+        || base.iter().zip(other).any(|(b, o)| b.points.len() != o.points.len())
+    {
         return None;
     }
-    let dist = |a: &Point3, b: &Point3| ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
-    let max_diff = base.iter().zip(other).flat_map(|(b, o)| b.points.iter().zip(&o.points).map(|(p, q)| dist(p, q))).filter(|d| d.is_finite()).fold(0.0f64, f64::max);
-    let (lo, hi) = base.iter().flat_map(|m| m.points.iter()).filter(|p| p.iter().all(|c| c.is_finite())).fold(([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]), |(lo, hi), p| ([0, 1, 2].map(|a| lo[a].min(p[a])), [0, 1, 2].map(|a| hi[a].max(p[a]))));
+    let dist = |a: &Point3, b: &Point3| {
+        ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+    };
+    let max_diff = base
+        .iter()
+        .zip(other)
+        .flat_map(|(b, o)| b.points.iter().zip(&o.points).map(|(p, q)| dist(p, q)))
+        .filter(|d| d.is_finite())
+        .fold(0.0f64, f64::max);
+    let (lo, hi) = base
+        .iter()
+        .flat_map(|m| m.points.iter())
+        .filter(|p| p.iter().all(|c| c.is_finite()))
+        .fold(([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]), |(lo, hi), p| {
+            ([0, 1, 2].map(|a| lo[a].min(p[a])), [0, 1, 2].map(|a| hi[a].max(p[a])))
+        });
     let side = (0..3).map(|a| hi[a] - lo[a]).fold(0.0f64, f64::max);
     if max_diff <= 0.0 || side.is_nan() || side <= 0.0 {
         return None;
@@ -46,7 +65,15 @@ pub fn magnified_difference(base: &[LineMesh], other: &[LineMesh], frac: f64) ->
     let meshes = base
         .iter()
         .zip(other)
-        .map(|(b, o)| LineMesh { points: b.points.iter().zip(&o.points).map(|(p, q)| [0, 1, 2].map(|a| p[a] + k * (q[a] - p[a]))).collect(), ..o.clone() })
+        .map(|(b, o)| LineMesh {
+            points: b
+                .points
+                .iter()
+                .zip(&o.points)
+                .map(|(p, q)| [0, 1, 2].map(|a| p[a] + k * (q[a] - p[a])))
+                .collect(),
+            ..o.clone()
+        })
         .collect();
     Some((meshes, k, max_diff))
 }
@@ -65,12 +92,7 @@ pub struct View3d {
 impl Default for View3d {
     /// A three-quarter view from slightly above, similar to GNUPlot's default `splot` view.
     fn default() -> Self {
-        View3d {
-            yaw: 0.65,
-            pitch: 0.35,
-            scale: 0.78,
-            tick_labels: true,
-        }
+        View3d { yaw: 0.65, pitch: 0.35, scale: 0.78, tick_labels: true }
     }
 }
 
@@ -131,9 +153,7 @@ fn view_cube(meshes: &[LineMesh]) -> ([f64; 3], f64) {
         return ([0.5; 3], 0.5);
     }
     let centre = [0, 1, 2].map(|a| lo[a] / 2.0 + hi[a] / 2.0);
-    let half = (0..3)
-        .map(|a| hi[a] / 2.0 - lo[a] / 2.0)
-        .fold(0.0f64, f64::max);
+    let half = (0..3).map(|a| hi[a] / 2.0 - lo[a] / 2.0).fold(0.0f64, f64::max);
     let half = if half > 0.0 {
         half * 1.08
     } else {
@@ -147,11 +167,7 @@ type Segment = (i32, u32, (i32, i32), (i32, i32));
 
 /// Checks every edge index and the view; the message names the mesh and the edge.
 fn validate(meshes: &[LineMesh], view: &View3d) -> Result<(), DrawError> {
-    if ![view.yaw, view.pitch, view.scale]
-        .iter()
-        .all(|v| v.is_finite())
-        || view.scale <= 0.0
-    {
+    if ![view.yaw, view.pitch, view.scale].iter().all(|v| v.is_finite()) || view.scale <= 0.0 {
         return Err(DrawError::Input(format!(
             "view needs finite yaw/pitch and a positive scale, got yaw {} pitch {} scale {}",
             view.yaw, view.pitch, view.scale
@@ -159,11 +175,8 @@ fn validate(meshes: &[LineMesh], view: &View3d) -> Result<(), DrawError> {
     }
     for (mi, m) in meshes.iter().enumerate() {
         let n = m.points.len();
-        if let Some((ei, &(a, b))) = m
-            .edges
-            .iter()
-            .enumerate()
-            .find(|(_, &(a, b))| a as usize >= n || b as usize >= n)
+        if let Some((ei, &(a, b))) =
+            m.edges.iter().enumerate().find(|(_, &(a, b))| a as usize >= n || b as usize >= n)
         {
             return Err(DrawError::Input(format!(
                 "mesh {mi} ('{}'): edge {ei} = ({a}, {b}) refers past its {n} points",
@@ -203,14 +216,8 @@ pub(crate) fn draw_meshes_with(
     let mut builder = ChartBuilder::on(area);
     builder.margin(if small { 2 } else { 10 });
     if !title.is_empty() {
-        builder.caption(
-            title,
-            style::bold(if small {
-                style::CAPTION_PX
-            } else {
-                style::TITLE_PX
-            }),
-        );
+        builder
+            .caption(title, style::bold(if small { style::CAPTION_PX } else { style::TITLE_PX }));
     }
     // plotters' Y axis is the vertical one: (data x, data z, data y).
     let mut chart = builder.build_cartesian_3d(r(0), r(2), r(1))?;
@@ -221,18 +228,15 @@ pub(crate) fn draw_meshes_with(
         pb.into_matrix()
     });
     let fmt = |v: &f64| {
-        let d = if half >= 0.5 {
-            1
-        } else {
-            ((-(half.log10())).ceil() as usize + 1).min(12)
-        };
+        let d = if half >= 0.5 { 1 } else { ((-(half.log10())).ceil() as usize + 1).min(12) };
         format!("{:.*}", d, v)
     };
     let blank = |_: &f64| String::new();
     // Two axes meet at each corner of the box: end labels there print on top of each other
     // ("1.01.0"). The vertical axis and the depth axis leave out labels near their ends (the
     // data's ends sit 7 % of a half side inside the box); the first axis keeps all of its labels.
-    let inside = |a: usize, v: f64| (v - (centre[a] - half)).min(centre[a] + half - v) >= 0.2 * half;
+    let inside =
+        |a: usize, v: f64| (v - (centre[a] - half)).min(centre[a] + half - v) >= 0.2 * half;
     let fmt_vertical = |v: &f64| if inside(2, *v) { fmt(v) } else { String::new() };
     let fmt_depth = |v: &f64| if inside(1, *v) { fmt(v) } else { String::new() };
     {
@@ -247,9 +251,7 @@ pub(crate) fn draw_meshes_with(
             axes.x_formatter(&fmt).y_formatter(&fmt_vertical).z_formatter(&fmt_depth);
         } else {
             axes.x_labels(3).y_labels(3).z_labels(3).tick_size(0);
-            axes.x_formatter(&blank)
-                .y_formatter(&blank)
-                .z_formatter(&blank);
+            axes.x_formatter(&blank).y_formatter(&blank).z_formatter(&blank);
         }
         axes.draw()?;
     }
@@ -265,10 +267,7 @@ pub(crate) fn draw_meshes_with(
             .map(|p| {
                 p.iter().all(|c| plottable(*c)).then(|| {
                     let q = (p[0], p[2], p[1]);
-                    (
-                        plot.map_coordinate(&q),
-                        coord.projected_depth(&q.0, &q.1, &q.2),
-                    )
+                    (plot.map_coordinate(&q), coord.projected_depth(&q.0, &q.1, &q.2))
                 })
             })
             .collect();
@@ -281,9 +280,8 @@ pub(crate) fn draw_meshes_with(
     }
     // Back to front; stable, so equal depths keep mesh order.
     segs.sort_by_key(|s| std::cmp::Reverse(s.0));
-    let (dmin, dmax) = segs.iter().fold((i32::MAX, i32::MIN), |(lo, hi), s| {
-        (lo.min(s.0), hi.max(s.0))
-    });
+    let (dmin, dmax) =
+        segs.iter().fold((i32::MAX, i32::MIN), |(lo, hi), s| (lo.min(s.0), hi.max(s.0)));
     let span = (dmax as f64 - dmin as f64).max(1.0);
     let screen = plot.use_screen_coord();
     let dense = segs.len() > 20_000;
@@ -292,11 +290,7 @@ pub(crate) fn draw_meshes_with(
         let far = (d as f64 - dmin as f64) / span;
         let c = meshes[mi as usize].colour;
         let fade = 0.6 * far + if dense { 0.15 } else { 0.0 };
-        let mixc = |v: u8| {
-            (v as f64 + (255.0 - v as f64) * fade)
-                .round()
-                .clamp(0.0, 255.0) as u8
-        };
+        let mixc = |v: u8| (v as f64 + (255.0 - v as f64) * fade).round().clamp(0.0, 255.0) as u8;
         let colour = RGBColor(mixc(c.0), mixc(c.1), mixc(c.2));
         screen.draw(&PathElement::new(vec![pa, pb], colour.stroke_width(1)))?;
     }
@@ -310,10 +304,8 @@ pub(crate) fn draw_meshes_with(
         for (i, m) in labelled.iter().enumerate() {
             let y = y0 + 6 + i as i32 * line_h + line_h / 2;
             let x = x0 + 6;
-            area.use_screen_coord().draw(&PathElement::new(
-                vec![(x, y), (x + 18, y)],
-                m.colour.stroke_width(3),
-            ))?;
+            area.use_screen_coord()
+                .draw(&PathElement::new(vec![(x, y), (x + 18, y)], m.colour.stroke_width(3)))?;
             area.use_screen_coord().draw(&Text::new(
                 m.label.clone(),
                 (x + 24, y),
@@ -334,13 +326,9 @@ pub fn mesh_png(
     meshes: &[LineMesh],
     size: (u32, u32),
 ) -> Result<(), PlotError> {
-    validate(meshes, &View3d::default()).map_err(|source| PlotError::Draw {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    render_png(path, size, |root| {
-        draw_meshes(root, title, meshes, View3d::default())
-    })
+    validate(meshes, &View3d::default())
+        .map_err(|source| PlotError::Draw { path: path.to_path_buf(), source })?;
+    render_png(path, size, |root| draw_meshes(root, title, meshes, View3d::default()))
 }
 
 #[cfg(test)]
@@ -357,10 +345,7 @@ mod tests {
                     // Map the square to a hemisphere (a disc lifted onto the sphere).
                     let u = 2.0 * i as f64 / (n - 1) as f64 - 1.0;
                     let v = 2.0 * j as f64 / (n - 1) as f64 - 1.0;
-                    let (x, y) = (
-                        u * (1.0 - v * v / 2.0).sqrt(),
-                        v * (1.0 - u * u / 2.0).sqrt(),
-                    );
+                    let (x, y) = (u * (1.0 - v * v / 2.0).sqrt(), v * (1.0 - u * u / 2.0).sqrt());
                     let z = (1.0 - x * x - y * y).max(0.0).sqrt();
                     let z = if top { z } else { -z };
                     pts.push([0.5 + 0.5 * x, 0.5 + 0.5 * y, 0.5 + 0.5 * z]);
@@ -369,16 +354,8 @@ mod tests {
             LineMesh {
                 points: pts,
                 edges: grid_edges(n, n),
-                colour: if top {
-                    style::DNSOM_TOP
-                } else {
-                    style::DNSOM_BOTTOM
-                },
-                label: if top {
-                    "top view".into()
-                } else {
-                    "bottom view".into()
-                },
+                colour: if top { style::DNSOM_TOP } else { style::DNSOM_BOTTOM },
+                label: if top { "top view".into() } else { "bottom view".into() },
             }
         };
         vec![view(false), view(true)]
@@ -411,13 +388,7 @@ mod tests {
     fn mesh_png_writes_png_of_requested_size() {
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("sphere.png");
-        mesh_png(
-            &p,
-            "Sphere, DNSOM 20 x 20",
-            &two_view_sphere(20),
-            (640, 480),
-        )
-        .unwrap();
+        mesh_png(&p, "Sphere, DNSOM 20 x 20", &two_view_sphere(20), (640, 480)).unwrap();
         assert_eq!(png_size(&p), (640, 480));
         assert_eq!(listing(dir.path()), vec!["sphere.png".to_string()]);
     }
@@ -451,10 +422,7 @@ mod tests {
             label: "net".into(),
         }];
         let e = mesh_png(&p, "bad", &m, (200, 200)).unwrap_err().to_string();
-        assert!(
-            e.contains("bad.png") && e.contains("edge 0") && e.contains("net"),
-            "{e}"
-        );
+        assert!(e.contains("bad.png") && e.contains("edge 0") && e.contains("net"), "{e}");
         assert!(listing(dir.path()).is_empty());
     }
 
@@ -462,9 +430,7 @@ mod tests {
     fn mesh_png_missing_folder_names_path() {
         let dir = tempfile::tempdir().unwrap();
         let p = missing_folder_path(dir.path());
-        let e = mesh_png(&p, "t", &two_view_sphere(4), (200, 200))
-            .unwrap_err()
-            .to_string();
+        let e = mesh_png(&p, "t", &two_view_sphere(4), (200, 200)).unwrap_err().to_string();
         assert!(e.contains(&p.display().to_string()), "{e}");
         assert!(listing(dir.path()).is_empty());
     }

@@ -22,7 +22,9 @@ pub mod style;
 pub use boxplot::{box_plot_png, box_plot_size, BoxStats};
 pub use cd_diagram::{cd_cliques, cd_diagram_png, cd_diagram_size};
 pub use line_chart::{line_chart_png, small_multiples_png, Series};
-pub use mesh3d::{draw_meshes, grid_edges, lattice_edges, magnified_difference, mesh_png, LineMesh, View3d};
+pub use mesh3d::{
+    draw_meshes, grid_edges, lattice_edges, magnified_difference, mesh_png, LineMesh, View3d,
+};
 pub use overview::{overview_png, overview_size, Panel};
 
 use plotters::coord::Shift;
@@ -79,10 +81,7 @@ pub enum PlotError {
 
 impl PlotError {
     pub(crate) fn input(path: &Path, reason: impl Into<String>) -> Self {
-        PlotError::Input {
-            path: path.to_path_buf(),
-            reason: reason.into(),
-        }
+        PlotError::Input { path: path.to_path_buf(), reason: reason.into() }
     }
 }
 
@@ -106,10 +105,8 @@ where
             format!("picture size {w}x{h} is outside 1..={MAX_SIDE} pixels per side"),
         ));
     }
-    let is_png = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    let is_png =
+        path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("png"));
     if !is_png {
         return Err(PlotError::input(path, "the file name must end in .png"));
     }
@@ -138,10 +135,7 @@ where
             })
         }
     }
-    style::ensure_fonts().map_err(|source| PlotError::Draw {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    style::ensure_fonts().map_err(|source| PlotError::Draw { path: path.to_path_buf(), source })?;
 
     // The backend writes the file when presented (or, on an early error, when dropped), so the
     // clean-up below runs only after the backend is gone.
@@ -165,10 +159,7 @@ where
     };
     if let Err(source) = drawn {
         let _ = std::fs::remove_file(&tmp);
-        return Err(PlotError::Draw {
-            path: path.to_path_buf(),
-            source,
-        });
+        return Err(PlotError::Draw { path: path.to_path_buf(), source });
     }
     if let Err(source) = std::fs::rename(&tmp, path) {
         let _ = std::fs::remove_file(&tmp);
@@ -234,10 +225,7 @@ mod tests {
         assert!(e.to_string().contains("x.png"), "{e}");
         let q = dir.path().join("x.jpg");
         let e = render_png(&q, (10, 10), |_| Ok(())).unwrap_err();
-        assert!(
-            e.to_string().contains("x.jpg") && e.to_string().contains(".png"),
-            "{e}"
-        );
+        assert!(e.to_string().contains("x.jpg") && e.to_string().contains(".png"), "{e}");
         assert!(listing(dir.path()).is_empty());
     }
 
@@ -246,10 +234,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("fail.png");
         let e = render_png(&p, (20, 20), |_| Err(DrawError::Input("boom".into()))).unwrap_err();
-        assert!(
-            e.to_string().contains("fail.png") && e.to_string().contains("boom"),
-            "{e}"
-        );
+        assert!(e.to_string().contains("fail.png") && e.to_string().contains("boom"), "{e}");
         assert!(listing(dir.path()).is_empty(), "{:?}", listing(dir.path()));
     }
 
@@ -258,10 +243,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("panic.png");
         let e = render_png(&p, (20, 20), |_| panic!("deliberate")).unwrap_err();
-        assert!(
-            e.to_string().contains("panic.png") && e.to_string().contains("deliberate"),
-            "{e}"
-        );
+        assert!(e.to_string().contains("panic.png") && e.to_string().contains("deliberate"), "{e}");
         assert!(listing(dir.path()).is_empty(), "{:?}", listing(dir.path()));
     }
 

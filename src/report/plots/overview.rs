@@ -30,10 +30,7 @@ pub fn overview_size(n_panels: usize, cols: usize) -> Option<(u32, u32)> {
     let cols = cols.min(n_panels);
     let rows = n_panels.div_ceil(cols);
     let w = u32::try_from(cols).ok()?.checked_mul(style::PANEL_PX)?;
-    let h = u32::try_from(rows)
-        .ok()?
-        .checked_mul(style::PANEL_PX)?
-        .checked_add(HEADER_PX)?;
+    let h = u32::try_from(rows).ok()?.checked_mul(style::PANEL_PX)?.checked_add(HEADER_PX)?;
     Some((w, h))
 }
 
@@ -68,11 +65,7 @@ pub fn overview_png(
         draw_legend(&header, &legend, size.0)?;
         let rows = panels.len().div_ceil(cols);
         let cells = body.split_evenly((rows, cols));
-        let view = View3d {
-            tick_labels: false,
-            scale: 0.8,
-            ..View3d::default()
-        };
+        let view = View3d { tick_labels: false, scale: 0.8, ..View3d::default() };
         for (cell, panel) in cells.iter().zip(panels) {
             let (w, h) = cell.dim_in_pixel();
             cell.draw(&Rectangle::new(
@@ -116,7 +109,9 @@ fn fit_title(
         None => vec![title.to_string()],
     };
     let mut px = style::LABEL_PX + 2.0;
-    while px > 8.0 && !lines.iter().map(|l| fits(l, px)).collect::<Result<Vec<_>, _>>()?.iter().all(|&f| f) {
+    while px > 8.0
+        && !lines.iter().map(|l| fits(l, px)).collect::<Result<Vec<_>, _>>()?.iter().all(|&f| f)
+    {
         px -= 1.0;
     }
     Ok((lines, px))
@@ -134,20 +129,13 @@ fn draw_legend(
     let ts = style::text(style::LABEL_PX);
     let widths: Vec<i32> = legend
         .iter()
-        .map(|(l, _)| {
-            header
-                .estimate_text_size(l, &ts)
-                .map(|(w, _)| w as i32 + 24 + 22)
-        })
+        .map(|(l, _)| header.estimate_text_size(l, &ts).map(|(w, _)| w as i32 + 24 + 22))
         .collect::<Result<_, _>>()?;
     let total: i32 = widths.iter().sum();
     let mut x = (width as i32 - total).max(0) / 2;
     let y = HEADER_PX as i32 - 16;
     for ((label, colour), w) in legend.iter().zip(widths) {
-        header.draw(&PathElement::new(
-            vec![(x, y), (x + 18, y)],
-            colour.stroke_width(3),
-        ))?;
+        header.draw(&PathElement::new(vec![(x, y), (x + 18, y)], colour.stroke_width(3)))?;
         header.draw(&Text::new(
             label.clone(),
             (x + 24, y),
@@ -172,12 +160,7 @@ mod tests {
                 points.push([x, y, tilt * x * y]);
             }
         }
-        LineMesh {
-            points,
-            edges: grid_edges(n, n),
-            colour,
-            label: label.into(),
-        }
+        LineMesh { points, edges: grid_edges(n, n), colour, label: label.into() }
     }
 
     #[test]
@@ -226,10 +209,7 @@ mod tests {
         let e = overview_png(&p, "t", &[bad], 1).unwrap_err().to_string();
         assert!(e.contains("empty.png") && e.contains("broken"), "{e}");
         let q = missing_folder_path(dir.path());
-        let ok = Panel {
-            title: "ok".into(),
-            meshes: vec![plane(3, 0.0, style::BLUE, "")],
-        };
+        let ok = Panel { title: "ok".into(), meshes: vec![plane(3, 0.0, style::BLUE, "")] };
         let e = overview_png(&q, "t", &[ok], 1).unwrap_err().to_string();
         assert!(e.contains(&q.display().to_string()), "{e}");
         assert!(listing(dir.path()).is_empty(), "{:?}", listing(dir.path()));
@@ -244,7 +224,10 @@ mod tests {
         render_png(&p, (600, 100), |root| {
             let (l, px) = fit_title(root, title, 584)?;
             for line in &l {
-                assert!(root.estimate_text_size(line, &style::bold(px))?.0 <= 584, "{line} at {px}");
+                assert!(
+                    root.estimate_text_size(line, &style::bold(px))?.0 <= 584,
+                    "{line} at {px}"
+                );
             }
             lines = l;
             Ok(())
@@ -260,16 +243,7 @@ mod tests {
         let p = dir.path().join("nan.png");
         let mut m = plane(4, 1.0, style::VERMILLION, "net");
         m.points[5] = [f64::NAN, 1.0, 1.0];
-        overview_png(
-            &p,
-            "NaN",
-            &[Panel {
-                title: "nan".into(),
-                meshes: vec![m],
-            }],
-            2,
-        )
-        .unwrap();
+        overview_png(&p, "NaN", &[Panel { title: "nan".into(), meshes: vec![m] }], 2).unwrap();
         assert_eq!(png_size(&p), overview_size(1, 2).unwrap());
     }
 }

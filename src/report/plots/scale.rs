@@ -19,13 +19,10 @@ pub fn plottable(v: f64) -> bool {
 
 /// Minimum and maximum of the plottable values (None when there are none).
 pub fn extent<I: IntoIterator<Item = f64>>(values: I) -> Option<(f64, f64)> {
-    values
-        .into_iter()
-        .filter(|v| plottable(*v))
-        .fold(None, |acc, v| match acc {
-            None => Some((v, v)),
-            Some((lo, hi)) => Some((lo.min(v), hi.max(v))),
-        })
+    values.into_iter().filter(|v| plottable(*v)).fold(None, |acc, v| match acc {
+        None => Some((v, v)),
+        Some((lo, hi)) => Some((lo.min(v), hi.max(v))),
+    })
 }
 
 /// One chart axis in plot space (log10 of the values for a log axis) with its ticks and labels.
@@ -50,11 +47,7 @@ pub struct Axis {
 fn nice_step(raw: f64) -> (f64, i32, usize) {
     let e = raw.log10().floor() as i32;
     let f = raw / 10f64.powi(e);
-    let cands: &[f64] = if e == 0 {
-        &[1.0, 2.0, 5.0, 10.0]
-    } else {
-        &[1.0, 2.0, 2.5, 5.0, 10.0]
-    };
+    let cands: &[f64] = if e == 0 { &[1.0, 2.0, 5.0, 10.0] } else { &[1.0, 2.0, 2.5, 5.0, 10.0] };
     let nf = cands
         .iter()
         .copied()
@@ -125,13 +118,7 @@ impl Axis {
         let lo = (mid - half).max(-f64::MAX);
         let hi = (mid + half).min(f64::MAX);
         let (ticks, labels) = linear_ticks(lo, hi, target);
-        Axis {
-            lo,
-            hi,
-            ticks,
-            labels,
-            log: false,
-        }
+        Axis { lo, hi, ticks, labels, log: false }
     }
 
     /// A log10 axis over [min, max] (0 < min <= max): powers of ten (with 2x and 5x when fewer
@@ -184,13 +171,7 @@ impl Axis {
                 keep.iter().map(|&i| labels[i].clone()).collect(),
             )
         };
-        Some(Axis {
-            lo,
-            hi,
-            ticks,
-            labels,
-            log: true,
-        })
+        Some(Axis { lo, hi, ticks, labels, log: true })
     }
 
     /// A value in plot space, or None when it cannot be drawn (non-finite, or not positive on a
@@ -218,11 +199,7 @@ impl Axis {
 
     /// The longest label (for sizing the label area).
     pub fn widest_label(&self) -> &str {
-        self.labels
-            .iter()
-            .max_by_key(|l| l.chars().count())
-            .map(|s| s.as_str())
-            .unwrap_or("0")
+        self.labels.iter().max_by_key(|l| l.chars().count()).map(|s| s.as_str()).unwrap_or("0")
     }
 }
 
@@ -270,18 +247,11 @@ mod tests {
     fn narrow_range_gets_distinct_labels_inside_padded_range() {
         let a = Axis::linear(14.742461, 14.742488, 6);
         assert!(a.lo < 14.742461 && a.hi > 14.742488);
-        assert!(
-            a.hi - a.lo < 1e-4,
-            "padding relative to width, got {} .. {}",
-            a.lo,
-            a.hi
-        );
+        assert!(a.hi - a.lo < 1e-4, "padding relative to width, got {} .. {}", a.lo, a.hi);
         assert!(a.ticks.len() >= 3, "{a:?}");
         assert_distinct(&a.labels);
         assert!(
-            a.labels
-                .iter()
-                .all(|l| l.starts_with("14.7424") || l.starts_with("14.7425")),
+            a.labels.iter().all(|l| l.starts_with("14.7424") || l.starts_with("14.7425")),
             "{a:?}"
         );
         for (t, l) in a.ticks.iter().zip(&a.labels) {
@@ -293,10 +263,7 @@ mod tests {
     #[test]
     fn equal_values_are_padded_by_magnitude() {
         let a = Axis::linear(5.0, 5.0, 5);
-        assert!(
-            (a.lo - 4.995).abs() < 1e-12 && (a.hi - 5.005).abs() < 1e-12,
-            "{a:?}"
-        );
+        assert!((a.lo - 4.995).abs() < 1e-12 && (a.hi - 5.005).abs() < 1e-12, "{a:?}");
         assert_distinct(&a.labels);
         let z = Axis::linear(0.0, 0.0, 5);
         assert_eq!((z.lo, z.hi), (-1.0, 1.0));
@@ -326,10 +293,7 @@ mod tests {
     #[test]
     fn tiny_and_huge_magnitudes_use_scientific_labels() {
         let a = Axis::linear(1e-7, 5e-7, 4);
-        assert!(
-            a.labels.iter().all(|l| l == "0" || l.contains('e')),
-            "{a:?}"
-        );
+        assert!(a.labels.iter().all(|l| l == "0" || l.contains('e')), "{a:?}");
         assert_distinct(&a.labels);
         let b = Axis::linear(2.0e7, 2.0e7 + 3.0, 5);
         assert!(b.labels.iter().all(|l| l.contains('e')), "{b:?}");
@@ -344,10 +308,7 @@ mod tests {
             "{a:?}"
         );
         for t in &a.ticks {
-            assert!(
-                (t - t.round()).abs() < 1e-12,
-                "power-of-ten ticks only: {a:?}"
-            );
+            assert!((t - t.round()).abs() < 1e-12, "power-of-ten ticks only: {a:?}");
         }
         let w = Axis::log10(1e-12, 1e3, 6).unwrap();
         assert!(w.labels.iter().any(|l| l.contains("e-")), "{w:?}");

@@ -73,9 +73,7 @@ pub const DNSOM_BOTTOM: RGBColor = BLUE;
 pub const DNSOM_TOP: RGBColor = VERMILLION;
 
 /// Series colours in the order they are handed out for unnamed series.
-pub const CYCLE: [RGBColor; 8] = [
-    BLUE, VERMILLION, GREEN, ORANGE, PURPLE, SKY_BLUE, BLACK, GREY,
-];
+pub const CYCLE: [RGBColor; 8] = [BLUE, VERMILLION, GREEN, ORANGE, PURPLE, SKY_BLUE, BLACK, GREY];
 
 /// The `i`-th colour of [`CYCLE`] (wrapping).
 pub fn cycle_colour(i: usize) -> RGBColor {
