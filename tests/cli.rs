@@ -322,7 +322,7 @@ fn fit_writes_nets_iges_and_obj_and_refuses_bad_grids() {
     c.write("short.csv", &lines[..lines.len() - 1].join("\n"));
     c.fails(&["fit", "--grid", "short.csv", "--cn", "8x8"], &["short.csv", "needs 800 rows"]);
     let mut nan = lines.clone();
-    let bad_line = nan[5].rsplitn(2, ',').nth(1).unwrap().to_string() + ",NaN";
+    let bad_line = nan[5].rsplit_once(',').unwrap().0.to_string() + ",NaN";
     nan[5] = &bad_line;
     c.write("nan.csv", &nan.join("\n"));
     c.fails(&["fit", "--grid", "nan.csv", "--cn", "8x8"], &["nan.csv", "line 6"]);

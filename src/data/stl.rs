@@ -84,7 +84,7 @@ pub fn sample_surface(
         total += if a.is_finite() { a } else { 0.0 };
         cum.push(total);
     }
-    if !(total > 0.0) {
+    if total.is_nan() || total <= 0.0 {
         return Err(DataError::Invalid(
             "the mesh has no triangle of positive area to sample".into(),
         ));

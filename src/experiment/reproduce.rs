@@ -14,6 +14,10 @@ use std::fmt::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+/// A table's header and rows, as `csv_records` takes them.
+type Header = Vec<String>;
+type Rows = Vec<Vec<String>>;
+
 /// A plan: `experiments/thesis.toml` (Chapters 4-6), `seeds.toml`, `all.toml`.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -495,7 +499,7 @@ fn overall(
     out: &Path,
     sources: &[(&str, &str)],
     name: &str,
-) -> Result<Option<(String, Vec<String>, Vec<Vec<String>>)>> {
+) -> Result<Option<(String, Header, Rows)>> {
     let mut rows = Vec::new();
     let mut opts: Vec<String> = Vec::new();
     let mut total: Vec<usize> = Vec::new();

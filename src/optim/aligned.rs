@@ -81,7 +81,7 @@ mod tests {
             }
             assert_eq!(Vec::from(b), v);
             let c: Aligned = v.iter().copied().collect();
-            assert!(c.as_ptr() as usize % 64 == 0 && c[..] == v[..]);
+            assert!((c.as_ptr() as usize).is_multiple_of(64) && c[..] == v[..]);
             let z = Aligned::zeros(len);
             assert!(z.len() == len && z.iter().all(|&x| x == 0.0));
         }

@@ -117,7 +117,7 @@ pub fn train(
         return Err("a map needs at least two units".into());
     }
     let sigma0 = params.sigma0.unwrap_or_else(|| topology.sigma0());
-    if !(sigma0 > 1.0) {
+    if sigma0.is_nan() || sigma0 <= 1.0 {
         return Err(format!(
             "initial radius sigma0 = {sigma0} must exceed 1 (tau = T / ln sigma0)"
         ));

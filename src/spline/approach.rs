@@ -381,7 +381,7 @@ impl TwoSurfaceFit {
     }
 
     /// Dense wireframes (bottom, top) of the fitted surfaces, for pictures.
-    pub fn dense_wireframes(&self) -> [(Vec<Point3>, Vec<(u32, u32)>); 2] {
+    pub fn dense_wireframes(&self) -> [super::geometry::Wireframe; 2] {
         [(&self.bottom, 0), (&self.top, 1)].map(|(s, k)| {
             super::geometry::dense_wireframe(
                 s,
@@ -430,7 +430,7 @@ impl TwoSurfaceFit {
 
 impl ControlNetParts {
     /// Dense wireframes (bottom, top) of a decision vector's surfaces, for pictures.
-    pub fn dense_wireframes(&self, x: &[f64]) -> [(Vec<Point3>, Vec<(u32, u32)>); 2] {
+    pub fn dense_wireframes(&self, x: &[f64]) -> [super::geometry::Wireframe; 2] {
         self.surfaces(x).map(|s| {
             super::geometry::dense_wireframe(
                 &s,

@@ -81,19 +81,22 @@ pub fn dense_grid(
     (fitted_grid(&surf.control, &nu, &nv), du, dv)
 }
 
+/// A wireframe for pictures: points and the edges (index pairs) between them.
+pub type Wireframe = (Vec<Point3>, Vec<(u32, u32)>);
+
 /// A wireframe of `surf` for pictures: the iso-parameter lines through the data parameters, each
 /// drawn through the dense parameters of the other direction, so whatever the surface does between
-/// the data points shows. Returns the points and the edges (index pairs) between them.
+/// the data points shows.
 pub fn dense_wireframe(
     surf: &BSplineSurface,
     params_u: &[f64],
     params_v: &[f64],
     factor: usize,
-) -> (Vec<Point3>, Vec<(u32, u32)>) {
+) -> Wireframe {
     let (points, du, dv) = dense_grid(surf, params_u, params_v, factor);
     let (mu, mv) = (du.len(), dv.len());
     let id = |i: usize, j: usize| (i * mv + j) as u32;
-    let is_data = |d: &[f64], x: f64| d.iter().any(|&t| t == x);
+    let is_data = |d: &[f64], x: f64| d.contains(&x);
     let mut edges = Vec::new();
     for i in (0..mu).filter(|&i| is_data(params_u, du[i])) {
         edges.extend((0..mv - 1).map(|j| (id(i, j), id(i, j + 1))));

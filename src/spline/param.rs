@@ -68,7 +68,7 @@ pub fn polyline_params(points: &[Point3], method: Parameterisation) -> Vec<f64> 
     let Some(alpha) = method.alpha() else { return uniform() };
     let steps: Vec<f64> = points.windows(2).map(|w| geom::dist(w[0], w[1]).powf(alpha)).collect();
     let total: f64 = steps.iter().sum();
-    if !(total > 0.0) {
+    if total.is_nan() || total <= 0.0 {
         return uniform();
     }
     let mut t = Vec::with_capacity(n);

@@ -238,7 +238,7 @@ pub fn write(
                         a.letter()
                     ),
                     ours: (totals[k], cells),
-                    thesis: t_counts.map(|(w, c)| (w, c)),
+                    thesis: t_counts,
                     note: format!(
                         "wins here: {}",
                         params

@@ -277,10 +277,9 @@ pub fn claims(runs: &[SomRun]) -> Vec<Claim> {
 
     // Count (data, grid) cases where `pred` holds, over a value source.
     type Src<'a> = &'a dyn Fn(&str, Model, GridSize, &str) -> Option<f64>;
-    let count = |src: Src,
-                 gs: &[GridSize],
-                 pred: &dyn Fn(&dyn Fn(Model, &str) -> Option<f64>) -> Option<bool>|
-     -> (usize, usize) {
+    // A claim's test on one (data, grid) case, given the case's value of (model, metric).
+    type Pred<'a> = &'a dyn Fn(&dyn Fn(Model, &str) -> Option<f64>) -> Option<bool>;
+    let count = |src: Src, gs: &[GridSize], pred: Pred| -> (usize, usize) {
         let (mut yes, mut all) = (0, 0);
         for d in &data {
             for &g in gs {
@@ -303,10 +302,7 @@ pub fn claims(runs: &[SomRun]) -> Vec<Claim> {
         }
     };
     let mut claims = Vec::new();
-    let mut add = |statement: &str,
-                   gs: &[GridSize],
-                   pred: &dyn Fn(&dyn Fn(Model, &str) -> Option<f64>) -> Option<bool>,
-                   note: &str| {
+    let mut add = |statement: &str, gs: &[GridSize], pred: Pred, note: &str| {
         let o = count(&ours, gs, pred);
         let t = count(&theirs, gs, pred);
         claims.push(Claim {

@@ -65,7 +65,7 @@ pub(crate) fn validate(spec: &Spec, som: &SomSpec) -> Result<(), SpecError> {
         return Err(spec.err("som.alpha0", format!("must be in (0, 1], got {}", som.alpha0)));
     }
     if let Some(s) = som.sigma0 {
-        if !(s > 1.0) {
+        if s.is_nan() || s <= 1.0 {
             return Err(
                 spec.err("som.sigma0", format!("must exceed 1 (tau = T / ln sigma0), got {s}"))
             );
