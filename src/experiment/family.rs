@@ -4,7 +4,7 @@
 //! seed's problem) plugs in as one folder under `src/families/` implementing it plus one line in
 //! the registry, [`crate::families::FAMILIES`]; nothing in the engine changes for it.
 
-use super::spec::{Spec, SpecError};
+use super::spec::{Spec, SpecError, SpecFile};
 use super::RunContext;
 use anyhow::Result;
 
@@ -18,7 +18,8 @@ pub struct Outcome {
     pub cells: usize,
 }
 
-/// One experiment family: which spec section selects it, its cells' keys, and how it runs.
+/// One experiment family as the engine sees it: which spec section selects it, its cells' keys,
+/// and how it runs. Implemented for every [`Experiment`] by the blanket impl below.
 pub trait Family: Sync {
     /// The spec section (`som`, `fit`, `optim`, `seed002`, ...), for messages.
     fn section(&self) -> &'static str;
@@ -27,12 +28,10 @@ pub trait Family: Sync {
     /// Check the bounds of the section's sizes and counts (before anything is allocated from them).
     fn check_limits(&self, c: &super::limits::Check) -> Result<(), SpecError>;
     /// The data-set entries of the section, as written (names or paths).
-    fn datasets<'a>(&self, _spec: &'a Spec) -> Vec<&'a String> {
-        Vec::new()
-    }
+    fn datasets<'a>(&self, spec: &'a Spec) -> Vec<&'a String>;
     /// Read the SOM maps from the folder `maps` (a plan whose earlier spec saved them); families
     /// that read no maps ignore it.
-    fn use_maps(&self, _spec: &mut Spec, _maps: &str) {}
+    fn use_maps(&self, spec: &mut Spec, maps: &str);
     /// Check every value of the family's section (called once the limits have passed and the
     /// spec has been found to hold this family's section only).
     fn validate(&self, spec: &Spec) -> Result<(), SpecError>;
@@ -41,22 +40,99 @@ pub trait Family: Sync {
     fn logged_keys(&self, spec: &Spec) -> Vec<String>;
     /// Keys of cells that run (on their own streams) but are not logged: a resumed run or a merge
     /// runs them again. Listed by `--dry-run` only.
-    fn unlogged_keys(&self, _spec: &Spec) -> Vec<String> {
-        Vec::new()
-    }
+    fn unlogged_keys(&self, spec: &Spec) -> Vec<String>;
     /// Run the cells of `ctx`'s slice; with `tables`, write the tables and pictures into
     /// `ctx.out` and return the REPORT.md section.
     fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<Outcome>;
     /// Run the variants of a spec (`--sweep`) into one folder, their tables together. A family
     /// whose tables cannot tell variants apart runs one variant only.
+    fn run_variants(&self, variants: &[Spec], ctx: &RunContext, tables: bool) -> Result<Outcome>;
+}
+
+/// Where a section type sits in the spec file: written for every family by the `families!`
+/// macro of the registry, from the section's field name.
+pub trait Placed: Sized + 'static {
+    /// The section's name in the spec file (also used in messages).
+    const NAME: &'static str;
+    /// The section in a spec file, if the file has it.
+    fn of(file: &SpecFile) -> Option<&Self>;
+    /// The same, to change (see [`Section::use_maps`]).
+    fn of_mut(file: &mut SpecFile) -> Option<&mut Self>;
+}
+
+/// A family's spec section (`[som]`, `[optim]`, `[seed004]`, ...): how it is checked. The
+/// section type lives in its family's folder.
+pub trait Section: Placed {
+    /// Check the bounds of the section's sizes and counts (before anything is allocated from
+    /// them).
+    fn limits(&self, c: &super::limits::Check) -> Result<(), SpecError>;
+    /// Check every value of the section (once the limits have passed).
+    fn validate(&self, spec: &Spec) -> Result<(), SpecError>;
+    /// The data-set entries of the section, as written (names or paths).
+    fn datasets(&self) -> &[String] {
+        &[]
+    }
+    /// Read the SOM maps from the folder `maps` (a plan whose earlier spec saved them).
+    fn use_maps(&mut self, _maps: &str) {}
+}
+
+/// A family as it is written: its section type, its cells and its run. Every `Experiment` is a
+/// [`Family`] (the engine's object-safe view) through the blanket impl below, so a family writes
+/// none of the section plumbing itself.
+pub trait Experiment: Sync {
+    type Section: Section;
+    /// See [`Family::logged_keys`].
+    fn logged_keys(&self, spec: &Spec) -> Vec<String>;
+    /// See [`Family::unlogged_keys`].
+    fn unlogged_keys(&self, _spec: &Spec) -> Vec<String> {
+        Vec::new()
+    }
+    /// See [`Family::run`].
+    fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<Outcome>;
+    /// See [`Family::run_variants`]; by default a sweep is refused.
     fn run_variants(&self, variants: &[Spec], ctx: &RunContext, tables: bool) -> Result<Outcome> {
         match variants {
             [one] => self.run(one, ctx, tables),
             _ => anyhow::bail!(
                 "--sweep: [{}] specs run one variant at a time (sweeps work on [optim] specs)",
-                self.section()
+                Self::Section::NAME
             ),
         }
+    }
+}
+
+impl<E: Experiment> Family for E {
+    fn section(&self) -> &'static str {
+        E::Section::NAME
+    }
+    fn present(&self, spec: &Spec) -> bool {
+        E::Section::of(&spec.file).is_some()
+    }
+    fn check_limits(&self, c: &super::limits::Check) -> Result<(), SpecError> {
+        E::Section::of(&c.spec.file).map_or(Ok(()), |s| s.limits(c))
+    }
+    fn datasets<'a>(&self, spec: &'a Spec) -> Vec<&'a String> {
+        E::Section::of(&spec.file).map(|s| s.datasets().iter().collect()).unwrap_or_default()
+    }
+    fn use_maps(&self, spec: &mut Spec, maps: &str) {
+        if let Some(s) = E::Section::of_mut(&mut spec.file) {
+            s.use_maps(maps);
+        }
+    }
+    fn validate(&self, spec: &Spec) -> Result<(), SpecError> {
+        E::Section::of(&spec.file).map_or(Ok(()), |s| s.validate(spec))
+    }
+    fn logged_keys(&self, spec: &Spec) -> Vec<String> {
+        Experiment::logged_keys(self, spec)
+    }
+    fn unlogged_keys(&self, spec: &Spec) -> Vec<String> {
+        Experiment::unlogged_keys(self, spec)
+    }
+    fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<Outcome> {
+        Experiment::run(self, spec, ctx, tables)
+    }
+    fn run_variants(&self, variants: &[Spec], ctx: &RunContext, tables: bool) -> Result<Outcome> {
+        Experiment::run_variants(self, variants, ctx, tables)
     }
 }
 

@@ -9,13 +9,13 @@ use crate::spline::{
 use anyhow::{Context, Result};
 
 pub fn fit(args: &FitArgs) -> Result<()> {
-    let cn: GridSize = args.cn.parse().map_err(|e| anyhow::anyhow!("--cn: {e}"))?;
+    let cn: GridSize = args.cn.parse().map_err(anyhow::Error::msg).context("--cn")?;
     let param: Parameterisation =
-        args.param.parse().map_err(|e| anyhow::anyhow!("--param: {e}"))?;
+        args.param.parse().map_err(anyhow::Error::msg).context("--param")?;
     let approach: Approach =
-        args.approach.parse().map_err(|e| anyhow::anyhow!("--approach: {e}"))?;
-    let knots: KnotRule = args.knots.parse().map_err(|e| anyhow::anyhow!("--knots: {e}"))?;
-    let error_a: ErrorA = args.error_a.parse().map_err(|e| anyhow::anyhow!("--error-a: {e}"))?;
+        args.approach.parse().map_err(anyhow::Error::msg).context("--approach")?;
+    let knots: KnotRule = args.knots.parse().map_err(anyhow::Error::msg).context("--knots")?;
+    let error_a: ErrorA = args.error_a.parse().map_err(anyhow::Error::msg).context("--error-a")?;
     if !(0.0..=1e6).contains(&args.fairness) {
         anyhow::bail!("--fairness: must be in [0, 1e6], got {}", args.fairness);
     }

@@ -104,10 +104,7 @@ impl Fingerprint {
         if !path.exists() {
             return Ok(None);
         }
-        let text = std::fs::read_to_string(&path)
-            .with_context(|| format!("cannot read {}", path.display()))?;
-        let fp = toml::from_str(&text)
-            .map_err(|e| anyhow::anyhow!("{}: {}", path.display(), e.message()))?;
+        let fp = crate::io::read_toml(&path)?;
         Ok(Some(fp))
     }
 

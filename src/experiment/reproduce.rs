@@ -74,10 +74,7 @@ fn default_title() -> String {
 
 impl Plan {
     pub fn load(path: &Path) -> Result<Plan> {
-        let text = std::fs::read_to_string(path)
-            .with_context(|| format!("cannot read {}", path.display()))?;
-        let plan: Plan = toml::from_str(&text)
-            .map_err(|e| anyhow::anyhow!("{}: {}", path.display(), e.message()))?;
+        let plan: Plan = crate::io::read_toml(path)?;
         if plan.specs.is_empty() {
             anyhow::bail!("{}: specs: is empty", path.display());
         }
@@ -464,11 +461,10 @@ fn win_table(path: &Path) -> Result<Option<(Vec<String>, Vec<usize>)>> {
     if !path.exists() {
         return Ok(None);
     }
-    let mut rd =
-        csv::Reader::from_path(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let mut rd = csv::Reader::from_path(path).with_context(|| format!("{}", path.display()))?;
     let header: Vec<String> = rd
         .headers()
-        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?
+        .with_context(|| format!("{}", path.display()))?
         .iter()
         .map(String::from)
         .collect();
@@ -479,7 +475,7 @@ fn win_table(path: &Path) -> Result<Option<(Vec<String>, Vec<usize>)>> {
         .collect();
     let mut sums = vec![0usize; opts.len() + 1];
     for (n, rec) in rd.records().enumerate() {
-        let rec = rec.map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        let rec = rec.with_context(|| format!("{}", path.display()))?;
         if rec.get(0) == Some("total") {
             continue;
         }

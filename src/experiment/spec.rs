@@ -5,8 +5,6 @@
 //! Errors are one line and name the file, the line and column, and the key at fault.
 
 pub use super::grid_size::GridSize;
-use serde::Deserialize;
-use std::collections::BTreeMap;
 use std::fmt;
 use std::path::Path;
 
@@ -22,47 +20,53 @@ impl fmt::Display for SpecError {
 
 impl std::error::Error for SpecError {}
 
-/// The whole spec file as written.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct SpecFile {
-    /// Experiment name; the default output folder is `results/<name>`.
-    pub name: String,
-    #[serde(default)]
-    pub description: String,
-    /// Master seed every (cell, repeat) stream is derived from.
-    pub master_seed: u64,
-    /// Output folder (overridden by `--out`).
-    #[serde(default)]
-    pub output: Option<String>,
-    /// How the data sets are scaled: per_axis (the thesis), uniform (aspect ratios kept) or none.
-    #[serde(default)]
-    pub normalise: crate::data::Normalise,
-    /// Chapter 4: SOM models.
-    #[serde(default)]
-    pub som: Option<crate::families::som::spec::SomSpec>,
-    /// Chapter 5: cubic B-spline fits of saved DNSOM maps.
-    #[serde(default)]
-    pub fit: Option<crate::families::fit::spec::FitSpec>,
-    /// Chapter 6: optimisation of approach B's control points.
-    #[serde(default)]
-    pub optim: Option<crate::families::optimise::spec::OptimSpec>,
-    /// Seed 002 (Yahya): four-patch G1 rational bi-quadratic Bezier surfaces by GA/DE/PSO.
-    #[serde(default)]
-    pub seed002: Option<crate::families::rational_bezier::spec::Seed002Spec>,
-    /// Seed 003 (Iglesias et al.): Bezier surfaces with CSA/ICSA-searched data parameters.
-    #[serde(default)]
-    pub seed003: Option<crate::families::cuckoo_bezier::Seed003Spec>,
-    /// Seed 001: growing grid on open surfaces, one B-spline surface, GA/DE/PSO.
-    #[serde(default)]
-    pub growing_grid: Option<crate::families::growing_grid::spec::GrowingGridSpec>,
-    /// Seed 004: closed B-spline surface of a cylinder by a binary-coded GA.
-    #[serde(default)]
-    pub seed004: Option<crate::families::closed_cylinder::spec::Seed004Spec>,
-    /// Named overrides, merged over the spec by `--profile NAME`.
-    #[serde(default)]
-    pub profiles: BTreeMap<String, toml::Table>,
+/// Declares the experiment families, once (invoked in `families/mod.rs`, the only list of
+/// families): the [`SpecFile`] struct (this header plus one optional section per family, in the
+/// given order, parsed with `deny_unknown_fields` so serde names the file, line and column of a
+/// bad key), where each section type sits in it ([`Placed`](super::family::Placed)), and the
+/// registry `FAMILIES` that the engine reaches the families through.
+macro_rules! families {
+    ($($(#[$doc:meta])* $field:ident: $section:ty => $family:expr),* $(,)?) => {
+        /// The whole spec file as written: the header and one optional section per family.
+        #[derive(Debug, Clone, serde::Deserialize)]
+        #[serde(deny_unknown_fields)]
+        pub struct SpecFile {
+            /// Experiment name; the default output folder is `results/<name>`.
+            pub name: String,
+            #[serde(default)]
+            pub description: String,
+            /// Master seed every (cell, repeat) stream is derived from.
+            pub master_seed: u64,
+            /// Output folder (overridden by `--out`).
+            #[serde(default)]
+            pub output: Option<String>,
+            /// How the data sets are scaled: per_axis (the thesis), uniform (aspect ratios kept)
+            /// or none.
+            #[serde(default)]
+            pub normalise: $crate::data::Normalise,
+            $($(#[$doc])* #[serde(default)] pub $field: Option<$section>,)*
+            /// Named overrides, merged over the spec by `--profile NAME`.
+            #[serde(default)]
+            pub profiles: std::collections::BTreeMap<String, toml::Table>,
+        }
+
+        /// Every family the harness knows, in the order their sections are named in messages.
+        pub static FAMILIES: &[&dyn $crate::experiment::family::Family] = &[$(&$family),*];
+
+        $(impl $crate::experiment::family::Placed for $section {
+            const NAME: &'static str = stringify!($field);
+            fn of(file: &SpecFile) -> Option<&Self> {
+                file.$field.as_ref()
+            }
+            fn of_mut(file: &mut SpecFile) -> Option<&mut Self> {
+                file.$field.as_mut()
+            }
+        })*
+    };
 }
+pub(crate) use families;
+
+pub use crate::families::SpecFile;
 
 /// A spec read from a file, with the profile applied.
 #[derive(Debug, Clone)]
@@ -227,22 +231,8 @@ impl CliOverrides {
     }
 }
 
-fn line_col(text: &str, offset: usize) -> (usize, usize) {
-    let before = &text[..offset.min(text.len())];
-    let line = before.matches('\n').count() + 1;
-    let col = before.len() - before.rfind('\n').map(|p| p + 1).unwrap_or(0) + 1;
-    (line, col)
-}
-
 fn toml_error(path: &str, text: &str, e: &toml::de::Error) -> SpecError {
-    let msg = e.message().replace('\n', " ");
-    match e.span() {
-        Some(span) => {
-            let (l, c) = line_col(text, span.start);
-            SpecError(format!("{path}:{l}:{c}: {msg}"))
-        }
-        None => SpecError(format!("{path}: {msg}")),
-    }
+    SpecError(crate::io::toml_message(path, text, e))
 }
 
 /// Deep-merge `over` into `base` (tables merge, everything else replaces).
@@ -295,6 +285,17 @@ fn apply_override(table: &mut toml::Table, over: &Override) -> Result<bool, Stri
 }
 
 impl Spec {
+    /// This spec's section of type `S` (a family's), if it has one.
+    pub fn section<S: super::family::Placed>(&self) -> Option<&S> {
+        S::of(&self.file)
+    }
+
+    /// The same, or an error naming the missing section.
+    pub fn require<S: super::family::Placed>(&self) -> anyhow::Result<&S> {
+        use anyhow::Context;
+        self.section().with_context(|| format!("spec has no [{}] section", S::NAME))
+    }
+
     /// Parse spec text with a reading set's overrides applied after the profile (each validated
     /// as if written in the file); `path` is used in messages only.
     pub fn parse_with(

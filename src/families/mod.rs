@@ -10,15 +10,19 @@ pub mod optimise;
 pub mod rational_bezier;
 pub mod som;
 
-use crate::experiment::family::Family;
-
-/// Every family the harness knows, in the order their sections are named in messages.
-pub static FAMILIES: &[&dyn Family] = &[
-    &som::Som,
-    &fit::Fit,
-    &optimise::Optim,
-    &growing_grid::Seed001,
-    &rational_bezier::Seed002,
-    &cuckoo_bezier::Seed003,
-    &closed_cylinder::Seed004,
-];
+crate::experiment::spec::families! {
+    /// Chapter 4: SOM models.
+    som: som::spec::SomSpec => som::Som,
+    /// Chapter 5: cubic B-spline fits of saved DNSOM maps.
+    fit: fit::spec::FitSpec => fit::Fit,
+    /// Chapter 6: optimisation of approach B's control points.
+    optim: optimise::spec::OptimSpec => optimise::Optim,
+    /// Seed 001: growing grid on open surfaces, one B-spline surface, GA/DE/PSO.
+    growing_grid: growing_grid::spec::GrowingGridSpec => growing_grid::Seed001,
+    /// Seed 002 (Yahya): four-patch G1 rational bi-quadratic Bezier surfaces by GA/DE/PSO.
+    seed002: rational_bezier::spec::Seed002Spec => rational_bezier::Seed002,
+    /// Seed 003 (Iglesias et al.): Bezier surfaces with CSA/ICSA-searched data parameters.
+    seed003: cuckoo_bezier::Seed003Spec => cuckoo_bezier::Seed003,
+    /// Seed 004: closed B-spline surface of a cylinder by a binary-coded GA.
+    seed004: closed_cylinder::spec::Seed004Spec => closed_cylinder::Seed004,
+}

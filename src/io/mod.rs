@@ -39,6 +39,28 @@ pub fn read_text(path: &Path) -> Result<String> {
     fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))
 }
 
+/// A TOML parse error on one line, `path:line:col: message` (toml's own Display spans several
+/// lines with a snippet of the file).
+pub fn toml_message(path: &str, text: &str, e: &toml::de::Error) -> String {
+    let msg = e.message().trim().replace('\n', " ");
+    match e.span() {
+        Some(span) => {
+            let before = &text[..span.start.min(text.len())];
+            let line = before.matches('\n').count() + 1;
+            let col = before.len() - before.rfind('\n').map(|p| p + 1).unwrap_or(0) + 1;
+            format!("{path}:{line}:{col}: {msg}")
+        }
+        None => format!("{path}: {msg}"),
+    }
+}
+
+/// Read and parse a TOML file; an error names the file, and the line and column where it can.
+pub fn read_toml<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T> {
+    let text = read_text(path)?;
+    toml::from_str(&text)
+        .map_err(|e| anyhow::Error::msg(toml_message(&path.display().to_string(), &text, &e)))
+}
+
 /// Typed rows of a CSV file (extra columns ignored); errors name the file and line.
 pub fn read_rows<T: serde::de::DeserializeOwned>(path: &Path) -> Result<Vec<T>> {
     let text = read_text(path)?;
@@ -68,13 +90,13 @@ pub fn csv_text<T: serde::Serialize>(rows: &[T]) -> Result<String> {
     for r in rows {
         w.serialize(r)?;
     }
-    let raw = w.into_inner().map_err(|e| anyhow::anyhow!("{e}"))?;
+    let raw = w.into_inner().map_err(|e| e.into_error())?;
     let mut reader = csv::ReaderBuilder::new().has_headers(false).from_reader(raw.as_slice());
     let mut out = csv::Writer::from_writer(Vec::new());
     for record in reader.records() {
         out.write_record(record?.iter().map(no_negative_zero))?;
     }
-    Ok(String::from_utf8(out.into_inner().map_err(|e| anyhow::anyhow!("{e}"))?)?)
+    Ok(String::from_utf8(out.into_inner().map_err(|e| e.into_error())?)?)
 }
 
 /// CSV text from a header and string records, with no negative zero.
@@ -84,7 +106,7 @@ pub fn csv_records(header: &[String], rows: &[Vec<String>]) -> Result<String> {
     for r in rows {
         w.write_record(r.iter().map(|f| no_negative_zero(f)))?;
     }
-    Ok(String::from_utf8(w.into_inner().map_err(|e| anyhow::anyhow!("{e}"))?)?)
+    Ok(String::from_utf8(w.into_inner().map_err(|e| e.into_error())?)?)
 }
 
 #[cfg(test)]

@@ -366,10 +366,7 @@ pub fn require_finished(dir: &Path, role: &str) -> Result<()> {
             continue;
         }
         let p = shown.join(MANIFEST);
-        let text =
-            fs::read_to_string(&p).with_context(|| format!("cannot read {}", p.display()))?;
-        let m: ManifestShard = toml::from_str(&text)
-            .map_err(|e| anyhow::anyhow!("{}: {}", p.display(), e.message()))?;
+        let m: ManifestShard = crate::io::read_toml(&p)?;
         if let Some(s) = m.shard {
             bail!("{role} {} holds shard {s} of a run only (no tables); combine the shards with `somnurbs merge` first", shown.display());
         }

@@ -55,28 +55,31 @@ pub(crate) fn check_range(key: &str, value: f64, lo: f64, hi: f64) -> Result<(),
     }
 }
 
-/// The optimiser named `name` ("ga", "de", "pso", "csa", "icsa") with the given parameters.
-pub fn named(
-    name: &str,
-    ga: &Ga,
-    de: &De,
-    pso: &Pso,
-    csa: &Csa,
-    icsa: &Icsa,
-) -> Option<Box<dyn Optimiser>> {
-    Some(match name {
-        "ga" => Box::new(ga.clone()),
-        "de" => Box::new(de.clone()),
-        "pso" => Box::new(pso.clone()),
-        "csa" => Box::new(csa.clone()),
-        "icsa" => Box::new(icsa.clone()),
-        _ => return None,
-    })
+/// Every optimiser the harness knows, with its default parameters (thesis Table 6.1, seed 003):
+/// a new optimiser is its own file implementing [`Optimiser`] plus one line here (and a parameter
+/// table in each spec section that offers it, listed by the section's `offered`).
+pub static REGISTRY: &[fn() -> Box<dyn Optimiser>] = &[
+    || Box::new(Ga::default()),
+    || Box::new(De::default()),
+    || Box::new(Pso::default()),
+    || Box::new(Csa::default()),
+    || Box::new(Icsa::default()),
+];
+
+/// The optimisers by name with their default parameters.
+pub fn default_optimiser(name: &str) -> Option<Box<dyn Optimiser>> {
+    REGISTRY.iter().map(|make| make()).find(|o| o.name() == name)
 }
 
-/// The optimisers by name with their default (Table 6.1 / seed 003) parameters.
-pub fn default_optimiser(name: &str) -> Option<Box<dyn Optimiser>> {
-    named(name, &Ga::default(), &De::default(), &Pso::default(), &Csa::default(), &Icsa::default())
+/// The optimiser named `name` among those a spec section offers (each with the section's
+/// parameters, e.g. `[optim.de]`).
+pub fn pick<'a>(offered: &[&'a dyn Optimiser], name: &str) -> Option<&'a dyn Optimiser> {
+    offered.iter().copied().find(|o| o.name() == name)
+}
+
+/// The names of the optimisers a section offers, for its checks and messages.
+pub fn names(offered: &[&dyn Optimiser]) -> Vec<&'static str> {
+    offered.iter().map(|o| o.name()).collect()
 }
 
 /// Shared checks every optimiser must pass.
@@ -145,9 +148,13 @@ pub(crate) mod optimiser_tests {
 
     #[test]
     fn registry_knows_the_five() {
+        let all: Vec<Box<dyn Optimiser>> = REGISTRY.iter().map(|make| make()).collect();
+        let offered: Vec<&dyn Optimiser> = all.iter().map(|o| o.as_ref()).collect();
+        assert_eq!(names(&offered), ["ga", "de", "pso", "csa", "icsa"]);
         for name in ["ga", "de", "pso", "csa", "icsa"] {
             assert_eq!(default_optimiser(name).unwrap().name(), name);
+            assert_eq!(pick(&offered, name).unwrap().name(), name);
         }
-        assert!(default_optimiser("sa").is_none());
+        assert!(default_optimiser("sa").is_none() && pick(&offered, "sa").is_none());
     }
 }

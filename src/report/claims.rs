@@ -1,6 +1,7 @@
 //! Qualitative claims of the thesis, each checked on the thesis' own published numbers and on a
 //! reproduction's, with the counts behind the verdict.
 
+use anyhow::Context;
 use std::fmt::Write;
 
 #[derive(Debug, Clone)]
@@ -86,11 +87,10 @@ pub fn write(out: &std::path::Path, claims: &[Claim]) -> anyhow::Result<String> 
 
 /// Claims read back from a `claims.csv` (for the combined report of `reproduce`).
 pub fn read(path: &std::path::Path) -> anyhow::Result<Vec<Claim>> {
-    let mut rd =
-        csv::Reader::from_path(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let mut rd = csv::Reader::from_path(path).with_context(|| format!("{}", path.display()))?;
     let mut out = Vec::new();
     for (n, rec) in rd.records().enumerate() {
-        let rec = rec.map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+        let rec = rec.with_context(|| format!("{}", path.display()))?;
         let num = |k: usize| -> anyhow::Result<usize> {
             rec.get(k).unwrap_or("").parse().map_err(|_| {
                 anyhow::anyhow!(

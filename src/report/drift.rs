@@ -373,7 +373,7 @@ impl Table {
         let mut rd = csv::ReaderBuilder::new().has_headers(true).from_reader(text.as_bytes());
         let header: Vec<String> = rd
             .headers()
-            .map_err(|e| anyhow::anyhow!("{name}: malformed CSV header: {e}"))?
+            .with_context(|| format!("{name}: malformed CSV header"))?
             .iter()
             .map(String::from)
             .collect();
@@ -547,10 +547,7 @@ fn identities(dir: &Path) -> Result<BTreeMap<PathBuf, (String, String, String)>>
         .filter(|f| f.file_name().is_some_and(|n| n == crate::io::outdir::MANIFEST))
     {
         let m = dir.join(&f);
-        let text =
-            std::fs::read_to_string(&m).with_context(|| format!("cannot read {}", m.display()))?;
-        let id: Id = toml::from_str(&text)
-            .map_err(|e| anyhow::anyhow!("{}: {}", m.display(), e.message()))?;
+        let id: Id = crate::io::read_toml(&m)?;
         out.insert(
             f.parent().unwrap_or(Path::new("")).to_path_buf(),
             (id.spec_sha256, id.profile, id.master_seed.to_string()),
@@ -565,9 +562,7 @@ pub fn read_config(baseline: &Path) -> Result<DriftConfig> {
     if !p.exists() {
         return Ok(DriftConfig::default());
     }
-    let text =
-        std::fs::read_to_string(&p).with_context(|| format!("cannot read {}", p.display()))?;
-    toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {}", p.display(), e.message().trim()))
+    crate::io::read_toml(&p)
 }
 
 /// Compare two folders. `allow_spec_change`: runs of other specs are compared anyway.

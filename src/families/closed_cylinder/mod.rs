@@ -7,7 +7,7 @@ pub mod report;
 pub mod spec;
 
 use crate::data::cylinder::{lattice_cylinder, sort_into_rings};
-use crate::experiment::spec::Spec;
+use crate::experiment::spec::{Spec, SpecError};
 use crate::experiment::{runner, seeds, RunContext};
 use crate::optim::{Budget, Problem};
 use crate::spline::closed::{fit_closed, ClosedNetShape, RingData, RingNetProblem};
@@ -87,12 +87,12 @@ impl runner::Logged for Run {
 }
 
 fn section(spec: &Spec) -> Result<&Seed004Spec> {
-    spec.file.seed004.as_ref().context("spec has no [seed004] section")
+    spec.require::<spec::Seed004Spec>()
 }
 
 /// The flat list of cells.
 pub fn cells(spec: &Spec) -> Vec<Cell> {
-    let Some(s) = &spec.file.seed004 else { return Vec::new() };
+    let Some(s) = spec.section::<spec::Seed004Spec>() else { return Vec::new() };
     s.control_points
         .iter()
         .flat_map(|&control_points| {
@@ -121,7 +121,7 @@ pub fn shape(s: &Seed004Spec, control_points: usize) -> ClosedNetShape {
 /// The GA problem (and analytical fit) for a number of control points.
 pub fn problem(s: &Seed004Spec, data: &RingData, control_points: usize) -> Result<RingNetProblem> {
     let fit = fit_closed(data, shape(s, control_points))
-        .map_err(|e| anyhow::anyhow!("seed004, {control_points} control points: {e}"))?;
+        .with_context(|| format!("seed004, {control_points} control points"))?;
     Ok(RingNetProblem::new(data, fit, s.search_range))
 }
 
@@ -142,9 +142,7 @@ fn run_cell_on(spec: &Spec, problem: &RingNetProblem, cell: &Cell) -> Result<Run
     let key = cell.key();
     let mut rng = seeds::cell_rng(spec.file.master_seed, &key);
     let t0 = runner::thread_cpu_seconds();
-    let r =
-        s.ga.run_with_history(problem, &budget, &mut rng)
-            .map_err(|e| anyhow::anyhow!("{key}: {e}"))?;
+    let r = s.ga.run_with_history(problem, &budget, &mut rng).with_context(|| key.clone())?;
     let cpu_s = runner::thread_cpu_seconds() - t0;
     let analytical = problem.analytical().rms;
     let row = Row {
@@ -223,7 +221,7 @@ pub fn analytical_sweep(spec: &Spec, data: &RingData) -> Result<Vec<(usize, f64)
             Ok((
                 n,
                 fit_closed(data, shape(s, n))
-                    .map_err(|e| anyhow::anyhow!("seed004, {n} control points: {e}"))?
+                    .with_context(|| format!("seed004, {n} control points"))?
                     .rms,
             ))
         })
@@ -298,28 +296,17 @@ pub fn top_view(
 /// Seed 004's family: the `[seed004]` section.
 pub struct Seed004;
 
-impl crate::experiment::family::Family for Seed004 {
-    fn section(&self) -> &'static str {
-        "seed004"
+impl crate::experiment::family::Section for self::spec::Seed004Spec {
+    fn limits(&self, c: &crate::experiment::limits::Check) -> Result<(), SpecError> {
+        self::spec::limits(c, self)
     }
-    fn present(&self, spec: &Spec) -> bool {
-        spec.file.seed004.is_some()
+    fn validate(&self, spec: &Spec) -> Result<(), SpecError> {
+        self::spec::validate(spec, self)
     }
-    fn check_limits(
-        &self,
-        c: &crate::experiment::limits::Check,
-    ) -> Result<(), crate::experiment::spec::SpecError> {
-        match &c.spec.file.seed004 {
-            Some(s) => self::spec::limits(c, s),
-            None => Ok(()),
-        }
-    }
-    fn validate(&self, spec: &Spec) -> Result<(), crate::experiment::spec::SpecError> {
-        match &spec.file.seed004 {
-            Some(s) => self::spec::validate(spec, s),
-            None => Ok(()),
-        }
-    }
+}
+
+impl crate::experiment::family::Experiment for Seed004 {
+    type Section = self::spec::Seed004Spec;
     fn logged_keys(&self, spec: &Spec) -> Vec<String> {
         cells(spec).iter().map(|c| c.key()).collect()
     }
@@ -336,7 +323,7 @@ impl crate::experiment::family::Family for Seed004 {
         let section = if tables {
             let sweep = analytical_sweep(spec, &data)?;
             let top = top_view(spec, &data, &runs, 7)?;
-            Some(crate::families::closed_cylinder::report::write(
+            Some(self::report::write(
                 s4,
                 &runs,
                 &sweep,

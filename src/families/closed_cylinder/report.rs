@@ -4,7 +4,7 @@
 //! claims checked on the runs (verdicts computed), and the Fig. 2(a), 3 and 5 analogues.
 
 use super::spec::Seed004Spec;
-use crate::families::closed_cylinder::{Run, TopView};
+use super::{Run, TopView};
 use crate::report::markdown::{num, table};
 use crate::report::plots::boxplot::quantile_type7;
 use crate::report::plots::{self, style, Series};

@@ -11,10 +11,10 @@
 pub mod report;
 pub mod spec;
 
-use crate::experiment::spec::Spec;
+use crate::experiment::spec::{Spec, SpecError};
 use crate::experiment::{runner, seeds, RunContext};
 use crate::geom::Point3;
-use crate::optim::{Budget, Csa, Icsa, Optimiser, Problem};
+use crate::optim::{Budget, Csa, Icsa, Problem};
 use crate::spline::bezier::{self, BezierParamProblem, Layout};
 use crate::spline::Parameterisation;
 use anyhow::{Context, Result};
@@ -203,12 +203,12 @@ impl runner::Logged for Run {
 }
 
 fn section(spec: &Spec) -> Result<&Seed003Spec> {
-    spec.file.seed003.as_ref().context("spec has no [seed003] section")
+    spec.require::<Seed003Spec>()
 }
 
 /// The flat list of cells: examples x methods x runs.
 pub fn cells(spec: &Spec) -> Vec<Cell> {
-    let Some(s) = &spec.file.seed003 else { return Vec::new() };
+    let Some(s) = spec.section::<Seed003Spec>() else { return Vec::new() };
     runner::product_cells(&s.examples, &s.methods, s.runs, |e, m, run| Cell {
         example: e.clone(),
         method: m.clone(),
@@ -311,10 +311,8 @@ pub fn run_cell(spec: &Spec, cell: &Cell) -> Result<Run> {
         ];
         let prob = BezierParamProblem::new(e.degree, e.degree, d.layout, d.points, centre)
             .map_err(|err| anyhow::anyhow!("{key}: {err}"))?;
-        let opt: Box<dyn Optimiser> = match cell.method.as_str() {
-            "csa" => Box::new(s.csa.clone()),
-            "icsa" => Box::new(s.icsa.clone()),
-            other => anyhow::bail!("seed003.methods: unknown method `{other}`"),
+        let Some(opt) = crate::optim::pick(&s.offered(), &cell.method) else {
+            anyhow::bail!("seed003.methods: unknown method `{}`", cell.method)
         };
         let mut rng = seeds::cell_rng(master, &key);
         let r = opt
@@ -360,27 +358,18 @@ pub fn run(spec: &Spec, ctx: &RunContext) -> Result<Vec<Run>> {
 /// Seed 003's family: the `[seed003]` section.
 pub struct Seed003;
 
-impl crate::experiment::family::Family for Seed003 {
-    fn section(&self) -> &'static str {
-        "seed003"
+impl crate::experiment::family::Section for Seed003Spec {
+    fn limits(&self, c: &crate::experiment::limits::Check) -> Result<(), SpecError> {
+        self::spec::limits(c, self)
     }
-    fn present(&self, spec: &Spec) -> bool {
-        spec.file.seed003.is_some()
+    fn validate(&self, spec: &Spec) -> Result<(), SpecError> {
+        self.validate().map_err(|(key, msg)| spec.err(&key, msg))?;
+        spec.validate_optimiser_params("seed003", [self.csa.validate(), self.icsa.validate()])
     }
-    fn check_limits(
-        &self,
-        c: &crate::experiment::limits::Check,
-    ) -> Result<(), crate::experiment::spec::SpecError> {
-        match &c.spec.file.seed003 {
-            Some(s) => self::spec::limits(c, s),
-            None => Ok(()),
-        }
-    }
-    fn validate(&self, spec: &Spec) -> Result<(), crate::experiment::spec::SpecError> {
-        let Some(s) = &spec.file.seed003 else { return Ok(()) };
-        s.validate().map_err(|(key, msg)| spec.err(&key, msg))?;
-        spec.validate_optimiser_params("seed003", [s.csa.validate(), s.icsa.validate()])
-    }
+}
+
+impl crate::experiment::family::Experiment for Seed003 {
+    type Section = Seed003Spec;
     fn logged_keys(&self, spec: &Spec) -> Vec<String> {
         cells(spec).iter().map(|c| c.key()).collect()
     }
@@ -392,15 +381,18 @@ impl crate::experiment::family::Family for Seed003 {
     ) -> Result<crate::experiment::family::Outcome> {
         let s3 = section(spec)?;
         let runs = run(spec, ctx)?;
-        let section = if tables {
-            Some(crate::families::cuckoo_bezier::report::write(s3, &runs, &ctx.out)?)
-        } else {
-            None
-        };
+        let section = if tables { Some(self::report::write(s3, &runs, &ctx.out)?) } else { None };
         Ok(crate::experiment::family::Outcome {
             section,
             cpu_s: runs.iter().map(|r| r.row.cpu_s).sum(),
             cells: runs.len(),
         })
+    }
+}
+
+impl Seed003Spec {
+    /// The optimisers this section offers, each with its parameter table (`csa`, ...).
+    pub fn offered(&self) -> Vec<&dyn crate::optim::Optimiser> {
+        vec![&self.csa, &self.icsa]
     }
 }

@@ -5,7 +5,7 @@
 //! both tables), and the convergence diagrams (best Y against iterations, median and quartiles
 //! over the runs).
 
-use crate::families::cuckoo_bezier::{Run, Seed003Spec, EXAMPLES, METHODS};
+use super::{Run, Seed003Spec, EXAMPLES, METHODS};
 use crate::report::plots::{self, boxplot::quantile_type7, style, Series};
 use crate::report::reference::{table, RefTable};
 use crate::stats::{rank_sum::rank_sum, wilcoxon::signed_rank, Alternative};

@@ -5,7 +5,7 @@ pub mod report;
 pub mod spec;
 
 use crate::double_net::{DoubleNet, View};
-use crate::experiment::spec::{GridSize, Spec};
+use crate::experiment::spec::{GridSize, Spec, SpecError};
 use crate::experiment::{runner, RunContext};
 use crate::families::som;
 use crate::families::som::spec::SomCell;
@@ -86,7 +86,7 @@ pub fn grid_from_weights(nx: usize, ny: usize, weights: &[crate::geom::Point3]) 
 /// Read each data set's map from the maps folder, or recompute it exactly as Chapter 4 does (same
 /// cell key, seed and settings); every map used is copied into `<out>/maps/`.
 pub fn maps(spec: &Spec, ctx: &RunContext) -> Result<BTreeMap<String, MapSource>> {
-    let fit = spec.file.fit.as_ref().context("spec has no [fit] section")?;
+    let fit = spec.require::<spec::FitSpec>()?;
     maps_for(spec, ctx, &fit.datasets, fit.grid, fit.maps.as_deref(), fit.som.as_ref())
 }
 
@@ -205,7 +205,7 @@ pub fn run(
     maps: &BTreeMap<String, MapSource>,
 ) -> Result<Vec<FitRun>> {
     let cells = spec::cells(spec);
-    let opts = spec.file.fit.as_ref().context("spec has no [fit] section")?.fit_options();
+    let opts = spec.require::<spec::FitSpec>()?.fit_options();
     // A logged cell's fit is rebuilt from its map (deterministic, a fraction of a millisecond);
     // the logged row, with its CPU time, is kept.
     runner::run_logged(
@@ -220,36 +220,23 @@ pub fn run(
 /// Chapter 5's family: the `[fit]` section.
 pub struct Fit;
 
-impl crate::experiment::family::Family for Fit {
-    fn section(&self) -> &'static str {
-        "fit"
+impl crate::experiment::family::Section for self::spec::FitSpec {
+    fn limits(&self, c: &crate::experiment::limits::Check) -> Result<(), SpecError> {
+        self::spec::limits(c, self)
     }
-    fn present(&self, spec: &Spec) -> bool {
-        spec.file.fit.is_some()
+    fn validate(&self, spec: &Spec) -> Result<(), SpecError> {
+        self::spec::validate(spec, self)
     }
-    fn check_limits(
-        &self,
-        c: &crate::experiment::limits::Check,
-    ) -> Result<(), crate::experiment::spec::SpecError> {
-        match &c.spec.file.fit {
-            Some(s) => self::spec::limits(c, s),
-            None => Ok(()),
-        }
+    fn datasets(&self) -> &[String] {
+        &self.datasets
     }
-    fn datasets<'a>(&self, spec: &'a Spec) -> Vec<&'a String> {
-        spec.file.fit.iter().flat_map(|s| &s.datasets).collect()
+    fn use_maps(&mut self, maps: &str) {
+        self.maps = Some(maps.to_string());
     }
-    fn use_maps(&self, spec: &mut Spec, maps: &str) {
-        if let Some(s) = spec.file.fit.as_mut() {
-            s.maps = Some(maps.to_string());
-        }
-    }
-    fn validate(&self, spec: &Spec) -> Result<(), crate::experiment::spec::SpecError> {
-        match &spec.file.fit {
-            Some(s) => self::spec::validate(spec, s),
-            None => Ok(()),
-        }
-    }
+}
+
+impl crate::experiment::family::Experiment for Fit {
+    type Section = self::spec::FitSpec;
     fn logged_keys(&self, spec: &Spec) -> Vec<String> {
         spec::cells(spec).iter().map(|c| c.key()).collect()
     }
@@ -263,18 +250,15 @@ impl crate::experiment::family::Family for Fit {
         let runs = run(spec, ctx, &maps)?;
         let origins: Vec<(String, String)> =
             maps.iter().map(|(d, m)| (d.clone(), m.origin.clone())).collect();
-        let pictures = spec.file.fit.as_ref().map(|f| f.pictures).unwrap_or(false);
+        let pictures = spec.section::<spec::FitSpec>().map(|f| f.pictures).unwrap_or(false);
         let section = if tables {
-            Some(crate::families::fit::report::write(&runs, &ctx.out, &origins, pictures)?)
+            Some(self::report::write(&runs, &ctx.out, &origins, pictures)?)
         } else {
             None
         };
         if tables && pictures {
             let grids: Vec<_> = maps.iter().map(|(d, m)| (d.clone(), &m.grid)).collect();
-            crate::report::views3d::write(
-                &ctx.out,
-                &crate::families::fit::pictures::views(&runs, &grids),
-            )?;
+            crate::report::views3d::write(&ctx.out, &self::pictures::views(&runs, &grids))?;
         }
         Ok(crate::experiment::family::Outcome {
             section,

@@ -2,8 +2,8 @@
 //! columns: each parameterisation's A beside B; the fitted surfaces as two-colour wireframes
 //! evaluated densely between the data parameters), and a chart of surface error against control-net size.
 
+use super::FitRun;
 use crate::experiment::spec::GridSize;
-use crate::families::fit::FitRun;
 use crate::report::plots::{self, style, LineMesh, Panel, Series};
 use crate::spline::Approach;
 use anyhow::Result;

@@ -1,8 +1,8 @@
 //! Chapter 5 outputs: runs.csv, Appendix E/F (surface error of A and B per parameterisation), the
 //! win-count tables 5.4-5.9, the gap table, the charts and pictures and the REPORT.md section.
 
+use super::FitRun;
 use crate::experiment::spec::GridSize;
-use crate::families::fit::FitRun;
 use crate::io::{csv_records, csv_text, write_atomic};
 use crate::report::claims::Claim;
 use crate::report::markdown::{beside, num, table};

@@ -147,7 +147,7 @@ pub(crate) fn validate(spec: &Spec, fit: &FitSpec) -> Result<(), SpecError> {
 
 /// The flat list of fit cells (data set x control net x parameterisation x approach).
 pub fn cells(spec: &Spec) -> Vec<FitCell> {
-    let Some(fit) = &spec.file.fit else { return Vec::new() };
+    let Some(fit) = spec.section::<FitSpec>() else { return Vec::new() };
     let mut cells = Vec::new();
     for dataset in &fit.datasets {
         for cn in &fit.control_nets {

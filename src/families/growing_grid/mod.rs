@@ -6,7 +6,7 @@ pub mod report;
 pub mod spec;
 
 use crate::data::registry;
-use crate::experiment::spec::{GridSize, Spec};
+use crate::experiment::spec::{GridSize, Spec, SpecError};
 use crate::experiment::{runner, seeds, RunContext};
 use crate::geom::Point3;
 use crate::optim::{Budget, Optimiser, Problem};
@@ -101,12 +101,12 @@ impl runner::Logged for Run {
 pub type ProblemKey = (String, GridSize, Parameterisation);
 
 fn section(spec: &Spec) -> Result<&GrowingGridSpec> {
-    spec.file.growing_grid.as_ref().context("spec has no [growing_grid] section")
+    spec.require::<spec::GrowingGridSpec>()
 }
 
 /// Every cell in a fixed order: data, net, parameterisation, optimiser, repeat.
 pub fn cells(spec: &Spec) -> Vec<Cell> {
-    let Some(g) = &spec.file.growing_grid else { return Vec::new() };
+    let Some(g) = spec.section::<spec::GrowingGridSpec>() else { return Vec::new() };
     let mut out = Vec::new();
     for d in g.datasets.iter().map(|d| registry::name_of(d)) {
         for &cn in &g.control_nets {
@@ -151,7 +151,8 @@ pub fn maps(spec: &Spec, ctx: &RunContext) -> Result<Vec<MapRun>> {
             let mut rng = seeds::cell_rng(spec.file.master_seed, &format!("seed001/map/{d}"));
             let t0 = runner::thread_cpu_seconds();
             let map = grow(points, &params, &mut rng)
-                .map_err(|e| anyhow::anyhow!("growing grid on {d}: {e}"))?;
+                .map_err(anyhow::Error::msg)
+                .with_context(|| format!("growing grid on {d}"))?;
             let cpu_s = runner::thread_cpu_seconds() - t0;
             let m = map.metrics(points);
             Ok(MapRun { dataset: d.clone(), points: points.len(), map, qe: m.qe, te: m.te, cpu_s })
@@ -177,7 +178,8 @@ pub fn problems(spec: &Spec, maps: &[MapRun]) -> Result<BTreeMap<ProblemKey, Ope
                     param,
                     g.bounds_margin,
                 )
-                .map_err(|e| anyhow::anyhow!("{} {cn} {p}: {e}", m.dataset))?;
+                .map_err(anyhow::Error::msg)
+                .with_context(|| format!("{} {cn} {p}", m.dataset))?;
                 out.insert((m.dataset.clone(), cn, param), pr);
             }
         }
@@ -185,12 +187,8 @@ pub fn problems(spec: &Spec, maps: &[MapRun]) -> Result<BTreeMap<ProblemKey, Ope
     Ok(out)
 }
 
-fn optimiser(g: &GrowingGridSpec, name: &str) -> Result<Box<dyn Optimiser>> {
-    // This section offers ga, de and pso only.
-    let (csa, icsa) = (crate::optim::Csa::default(), crate::optim::Icsa::default());
-    crate::optim::named(name, &g.ga, &g.de, &g.pso, &csa, &icsa)
-        .filter(|_| matches!(name, "ga" | "de" | "pso"))
-        .with_context(|| format!("unknown optimiser `{name}`"))
+fn optimiser<'a>(g: &'a GrowingGridSpec, name: &str) -> Result<&'a dyn Optimiser> {
+    crate::optim::pick(&g.offered(), name).with_context(|| format!("unknown optimiser `{name}`"))
 }
 
 /// Run one cell (alone or inside the full run: the same numbers).
@@ -206,7 +204,7 @@ pub fn run_cell(spec: &Spec, cell: &Cell, problem: &OpenSurfaceProblem) -> Resul
     let key = cell.key();
     let mut rng = seeds::cell_rng(spec.file.master_seed, &key);
     let t0 = runner::thread_cpu_seconds();
-    let r = opt.run(problem, &budget, &mut rng).map_err(|e| anyhow::anyhow!("{key}: {e}"))?;
+    let r = opt.run(problem, &budget, &mut rng).with_context(|| key.clone())?;
     let cpu_s = runner::thread_cpu_seconds() - t0;
     let n = (problem.nx * problem.ny) as f64;
     let row = Row {
@@ -250,31 +248,20 @@ pub fn run(
 /// Seed 001's family: the `[growing_grid]` section.
 pub struct Seed001;
 
-impl crate::experiment::family::Family for Seed001 {
-    fn section(&self) -> &'static str {
-        "growing_grid"
+impl crate::experiment::family::Section for self::spec::GrowingGridSpec {
+    fn limits(&self, c: &crate::experiment::limits::Check) -> Result<(), SpecError> {
+        self::spec::limits(c, self)
     }
-    fn present(&self, spec: &Spec) -> bool {
-        spec.file.growing_grid.is_some()
+    fn validate(&self, spec: &Spec) -> Result<(), SpecError> {
+        self::spec::validate(spec, self)
     }
-    fn check_limits(
-        &self,
-        c: &crate::experiment::limits::Check,
-    ) -> Result<(), crate::experiment::spec::SpecError> {
-        match &c.spec.file.growing_grid {
-            Some(s) => self::spec::limits(c, s),
-            None => Ok(()),
-        }
+    fn datasets(&self) -> &[String] {
+        &self.datasets
     }
-    fn datasets<'a>(&self, spec: &'a Spec) -> Vec<&'a String> {
-        spec.file.growing_grid.iter().flat_map(|s| &s.datasets).collect()
-    }
-    fn validate(&self, spec: &Spec) -> Result<(), crate::experiment::spec::SpecError> {
-        match &spec.file.growing_grid {
-            Some(s) => self::spec::validate(spec, s),
-            None => Ok(()),
-        }
-    }
+}
+
+impl crate::experiment::family::Experiment for Seed001 {
+    type Section = self::spec::GrowingGridSpec;
     fn logged_keys(&self, spec: &Spec) -> Vec<String> {
         cells(spec).iter().map(|c| c.key()).collect()
     }
@@ -288,7 +275,7 @@ impl crate::experiment::family::Family for Seed001 {
         let problems = problems(spec, &maps)?;
         let runs = run(spec, ctx, &problems)?;
         let section = if tables {
-            Some(crate::families::growing_grid::report::write(&maps, &problems, &runs, &ctx.out)?)
+            Some(self::report::write(&maps, &problems, &runs, &ctx.out)?)
         } else {
             None
         };

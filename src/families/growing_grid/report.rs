@@ -5,7 +5,7 @@
 //! The seed's tables did not survive (only its front matter), so there are no published numbers
 //! to print beside ours; the verdicts compare each optimiser with its least-squares start.
 
-use crate::families::growing_grid::{MapRun, ProblemKey, Run};
+use super::{MapRun, ProblemKey, Run};
 use crate::io::{csv_records, ensure_dir, write_atomic};
 use crate::optim::Problem;
 use crate::report::markdown::{num, table};

@@ -117,7 +117,7 @@ pub(crate) fn validate(spec: &Spec, g: &GrowingGridSpec) -> Result<(), SpecError
     spec.validate_runs(
         "growing_grid",
         &g.optimisers,
-        &["ga", "de", "pso"],
+        &crate::optim::names(&g.offered()),
         g.repeats,
         g.generations as u64,
         g.population,
@@ -165,4 +165,11 @@ pub(crate) fn limits(c: &Check, g: &GrowingGridSpec) -> Result<(), SpecError> {
         ],
     )?;
     Ok(())
+}
+
+impl GrowingGridSpec {
+    /// The optimisers this section offers, each with its parameter table (`ga`, ...).
+    pub fn offered(&self) -> Vec<&dyn crate::optim::Optimiser> {
+        vec![&self.ga, &self.de, &self.pso]
+    }
 }

@@ -1,8 +1,8 @@
 //! `somnurbs compare RESULTS_DIR`: statistics over the optimiser runs of a Chapter 6 folder, read
 //! from its runs.csv only (so a folder from another machine or an older run compares the same).
 
+use super::OptimRow;
 use crate::cli::CompareArgs;
-use crate::families::optimise::OptimRow;
 use crate::io::{csv_records, write_atomic};
 use crate::report::plots;
 use crate::stats;
@@ -169,8 +169,7 @@ pub fn compare(args: &CompareArgs) -> Result<()> {
     write_atomic(&args.results.join("compare_cells.csv"), csv_records(&header, &out)?.as_bytes())?;
     // Overall: Friedman over cells on the mean best of each optimiser.
     let (_, table) = friedman_table(&rows);
-    let f =
-        friedman(&table).map_err(|e| anyhow::anyhow!("{}: Friedman test: {e}", path.display()))?;
+    let f = friedman(&table).with_context(|| format!("{}: Friedman test", path.display()))?;
     let oh: Vec<String> = [
         "x",
         "y",
@@ -345,7 +344,7 @@ fn certified_optima(folder: &std::path::Path) -> Result<BTreeMap<String, f64>> {
             let f: f64 = get("exact_f")?.parse().with_context(|| {
                 format!("{}: line {}: exact_f is not a number", p.display(), n + 2)
             })?;
-            let key = crate::families::optimise::ioh::problem_name(
+            let key = super::ioh::problem_name(
                 get("data")?,
                 grid,
                 &format!("{}x{}", get("cn_x")?, get("cn_y")?),
@@ -362,7 +361,7 @@ fn certified_optima(folder: &std::path::Path) -> Result<BTreeMap<String, f64>> {
 fn problems(rows: &[OptimRow], folder: &std::path::Path) -> Result<Vec<Problem>> {
     let certified = certified_optima(folder)?;
     let name = |r: &OptimRow| {
-        crate::families::optimise::ioh::problem_name(
+        super::ioh::problem_name(
             &r.dataset,
             &format!("{}x{}", r.grid_x, r.grid_y),
             &format!("{}x{}", r.cn_x, r.cn_y),
@@ -374,7 +373,7 @@ fn problems(rows: &[OptimRow], folder: &std::path::Path) -> Result<Vec<Problem>>
         expected.entry((name(r), r.competitor())).or_default().push(r);
     }
     let mut out: BTreeMap<String, Problem> = BTreeMap::new();
-    for lp in crate::families::optimise::ioh::read(folder)? {
+    for lp in super::ioh::read(folder)? {
         let mut exp = expected
             .remove(&(lp.function_name.clone(), lp.optimiser.clone()))
             .with_context(|| {

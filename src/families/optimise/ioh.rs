@@ -4,7 +4,7 @@
 //! improvement-based raw data `data_f<id>_<name>/IOHprofiler_f<id>_DIM<d>.dat` (layout:
 //! [`crate::optim::ioh`]). Runs are listed in repeat order.
 
-use crate::families::optimise::OptimRun;
+use super::OptimRun;
 use crate::io::{read_text, write_atomic};
 use crate::optim::ioh::{dat_text, json_text, parse_dat, IohMeta, IohRun};
 use anyhow::{Context, Result};
@@ -137,7 +137,8 @@ pub fn read(folder: &Path) -> Result<Vec<LoadedProblem>> {
                     .with_context(|| format!("{}: a scenario has no path", f.display()))?;
                 let dat = dir.join(path);
                 let rows = parse_dat(&read_text(&dat)?)
-                    .map_err(|e| anyhow::anyhow!("{}: {e}", dat.display()))?;
+                    .map_err(anyhow::Error::msg)
+                    .with_context(|| format!("{}", dat.display()))?;
                 let listed = s
                     .get("runs")
                     .and_then(|r| r.as_array())

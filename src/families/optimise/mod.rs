@@ -9,7 +9,7 @@ pub mod report;
 pub mod spec;
 
 use crate::experiment::spec::GridSize;
-use crate::experiment::spec::Spec;
+use crate::experiment::spec::{Spec, SpecError};
 use crate::experiment::{runner, seeds, RunContext};
 use crate::families::fit;
 use crate::optim::{Budget, ExactOptions, Optimiser, Problem, RunResult};
@@ -93,7 +93,7 @@ pub fn exact_optima(
     ctx: &RunContext,
     problems: &BTreeMap<ProblemKey, ControlNetProblem>,
 ) -> Result<BTreeMap<ProblemKey, crate::optim::exact::ExactResult>> {
-    let o = spec.file.optim.as_ref().context("spec has no [optim] section")?;
+    let o = spec.require::<spec::OptimSpec>()?;
     if !o.exact {
         return Ok(BTreeMap::new());
     }
@@ -118,15 +118,14 @@ pub fn exact_optima(
 }
 
 /// Build the optimiser a cell names, with the spec's parameters.
-pub fn optimiser(spec: &Spec, name: &str) -> Result<Box<dyn Optimiser>> {
-    let o = spec.file.optim.as_ref().context("spec has no [optim] section")?;
-    crate::optim::named(name, &o.ga, &o.de, &o.pso, &o.csa, &o.icsa)
-        .with_context(|| format!("unknown optimiser `{name}`"))
+pub fn optimiser<'a>(spec: &'a Spec, name: &str) -> Result<&'a dyn Optimiser> {
+    let o = spec.require::<spec::OptimSpec>()?;
+    crate::optim::pick(&o.offered(), name).with_context(|| format!("unknown optimiser `{name}`"))
 }
 
 /// The control-net problems of every (data, net, parameterisation), from approach B's fit.
 pub fn problems(spec: &Spec, ctx: &RunContext) -> Result<BTreeMap<ProblemKey, ControlNetProblem>> {
-    let o = spec.file.optim.as_ref().context("spec has no [optim] section")?;
+    let o = spec.require::<spec::OptimSpec>()?;
     let maps = fit::maps_for(spec, ctx, &o.datasets, o.grid, o.maps.as_deref(), o.som.as_ref())?;
     let mut out = BTreeMap::new();
     for entry in &o.datasets {
@@ -137,14 +136,14 @@ pub fn problems(spec: &Spec, ctx: &RunContext) -> Result<BTreeMap<ProblemKey, Co
                 let grid = &maps[d].grid;
                 let fit =
                     fit_two_view(grid, cn.nx, cn.ny, param, Approach::Improved, &o.fit_options())
-                        .map_err(|e| anyhow::anyhow!("{d} {cn} {p}: {e}"))?;
-                let parts = fit.control_net_parts(grid).map_err(|e| anyhow::anyhow!("{e}"))?;
+                        .with_context(|| format!("{d} {cn} {p}"))?;
+                let parts = fit.control_net_parts(grid)?;
                 let bounds = match o.search_range {
                     Some(half_width) => BoxSpec::AroundStart { half_width },
                     None => BoxSpec::Cover { fraction: o.bounds_margin },
                 };
                 let problem = ControlNetProblem::new(parts, bounds)
-                    .map_err(|e| anyhow::anyhow!("{d} {cn} {p}: {e}"))?;
+                    .with_context(|| format!("{d} {cn} {p}"))?;
                 out.insert((d.clone(), cn, param), problem);
             }
         }
@@ -154,7 +153,7 @@ pub fn problems(spec: &Spec, ctx: &RunContext) -> Result<BTreeMap<ProblemKey, Co
 
 /// Run one cell (also alone: the same numbers as inside the full run).
 pub fn run_cell(spec: &Spec, cell: &OptimCell, problem: &ControlNetProblem) -> Result<OptimRun> {
-    let o = spec.file.optim.as_ref().context("spec has no [optim] section")?;
+    let o = spec.require::<spec::OptimSpec>()?;
     let opt = optimiser(spec, &cell.optimiser)?;
     let budget = Budget {
         generations: o.generations as u64,
@@ -165,8 +164,7 @@ pub fn run_cell(spec: &Spec, cell: &OptimCell, problem: &ControlNetProblem) -> R
     let key = cell.key();
     let mut rng = seeds::cell_rng(spec.file.master_seed, &key);
     let t0 = runner::thread_cpu_seconds();
-    let r: RunResult =
-        opt.run(problem, &budget, &mut rng).map_err(|e| anyhow::anyhow!("{key}: {e}"))?;
+    let r: RunResult = opt.run(problem, &budget, &mut rng).with_context(|| key.clone())?;
     let cpu_s = runner::thread_cpu_seconds() - t0;
     if !r.best_fitness.is_finite() {
         anyhow::bail!("{key}: the best fitness is not finite ({})", r.best_fitness);
@@ -299,7 +297,7 @@ fn picture_points<'a>(
 
 /// One sentence on the start and the search box of a spec's runs, for the report.
 pub fn setting(spec: &Spec) -> String {
-    let Some(o) = spec.file.optim.as_ref() else { return String::new() };
+    let Some(o) = spec.section::<spec::OptimSpec>() else { return String::new() };
     let start =
         format!("Each individual starts at B + U[-{r:e}, {r:e}] per coordinate", r = o.init_range);
     match o.search_range {
@@ -312,36 +310,23 @@ pub fn setting(spec: &Spec) -> String {
 /// Chapter 6's family: the `[optim]` section.
 pub struct Optim;
 
-impl crate::experiment::family::Family for Optim {
-    fn section(&self) -> &'static str {
-        "optim"
+impl crate::experiment::family::Section for self::spec::OptimSpec {
+    fn limits(&self, c: &crate::experiment::limits::Check) -> Result<(), SpecError> {
+        self::spec::limits(c, self)
     }
-    fn present(&self, spec: &Spec) -> bool {
-        spec.file.optim.is_some()
+    fn validate(&self, spec: &Spec) -> Result<(), SpecError> {
+        self::spec::validate(spec, self)
     }
-    fn check_limits(
-        &self,
-        c: &crate::experiment::limits::Check,
-    ) -> Result<(), crate::experiment::spec::SpecError> {
-        match &c.spec.file.optim {
-            Some(s) => self::spec::limits(c, s),
-            None => Ok(()),
-        }
+    fn datasets(&self) -> &[String] {
+        &self.datasets
     }
-    fn datasets<'a>(&self, spec: &'a Spec) -> Vec<&'a String> {
-        spec.file.optim.iter().flat_map(|s| &s.datasets).collect()
+    fn use_maps(&mut self, maps: &str) {
+        self.maps = Some(maps.to_string());
     }
-    fn use_maps(&self, spec: &mut Spec, maps: &str) {
-        if let Some(s) = spec.file.optim.as_mut() {
-            s.maps = Some(maps.to_string());
-        }
-    }
-    fn validate(&self, spec: &Spec) -> Result<(), crate::experiment::spec::SpecError> {
-        match &spec.file.optim {
-            Some(s) => self::spec::validate(spec, s),
-            None => Ok(()),
-        }
-    }
+}
+
+impl crate::experiment::family::Experiment for Optim {
+    type Section = self::spec::OptimSpec;
     fn logged_keys(&self, spec: &Spec) -> Vec<String> {
         spec::cells(spec).iter().map(|c| c.key()).collect()
     }
@@ -372,13 +357,7 @@ impl crate::experiment::family::Family for Optim {
             }));
         }
         let section = if tables {
-            Some(crate::families::optimise::report::write(
-                &runs,
-                &problems,
-                &exact,
-                &setting(first),
-                &ctx.out,
-            )?)
+            Some(self::report::write(&runs, &problems, &exact, &setting(first), &ctx.out)?)
         } else {
             None
         };

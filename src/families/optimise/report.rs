@@ -2,8 +2,8 @@
 //! beside B) and M/N (CPU seconds), the win-count tables 6.4-6.9, each optimiser's count of cells
 //! where it beats B, convergence curves and box plots, and the REPORT.md section.
 
+use super::{OptimRun, ProblemKey};
 use crate::experiment::spec::GridSize;
-use crate::families::optimise::{OptimRun, ProblemKey};
 use crate::io::{csv_records, csv_text, write_atomic};
 use crate::optim::exact::ExactResult;
 use crate::optim::Problem;
@@ -559,9 +559,8 @@ pub fn write(
             }
         }
     }
-    let all_rows: Vec<crate::families::optimise::OptimRow> =
-        runs.iter().map(|r| r.row.clone()).collect();
-    let (fopts, ftable) = crate::families::optimise::compare::friedman_table(&all_rows);
+    let all_rows: Vec<super::OptimRow> = runs.iter().map(|r| r.row.clone()).collect();
+    let (fopts, ftable) = super::compare::friedman_table(&all_rows);
     if fopts.len() > 1 {
         if let Ok(f) = crate::stats::friedman::friedman(&ftable) {
             let _ = writeln!(s, "\n### Statistics over all cells\n\nFriedman test over {} cells (mean best per optimiser): chi-squared {:.3}, df {}, p = {:.3e}. Mean ranks (1 = least error): {}.{}\n", f.blocks, f.chi_squared, f.df, f.p_value, fopts.iter().zip(&f.mean_ranks).map(|(o, r)| format!("{o} {r:.2}")).collect::<Vec<_>>().join(", "), f.critical_difference.map(|cd| format!(" Nemenyi critical difference (alpha 0.05): {cd:.3}.")).unwrap_or_default());

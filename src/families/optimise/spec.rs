@@ -108,7 +108,7 @@ pub(crate) fn validate(spec: &Spec, o: &OptimSpec) -> Result<(), SpecError> {
     spec.validate_runs(
         "optim",
         &o.optimisers,
-        &["ga", "de", "pso", "csa", "icsa"],
+        &crate::optim::names(&o.offered()),
         o.repeats,
         o.generations as u64,
         o.population,
@@ -153,7 +153,7 @@ pub(crate) fn validate(spec: &Spec, o: &OptimSpec) -> Result<(), SpecError> {
 
 /// The flat list of optimisation cells (data x net x parameterisation x optimiser x repeat).
 pub fn cells(spec: &Spec) -> Vec<OptimCell> {
-    let Some(o) = &spec.file.optim else { return Vec::new() };
+    let Some(o) = spec.section::<OptimSpec>() else { return Vec::new() };
     let mut cells = Vec::new();
     for dataset in &o.datasets {
         for cn in &o.control_nets {
@@ -250,4 +250,11 @@ pub(crate) fn limits(c: &Check, o: &OptimSpec) -> Result<(), SpecError> {
         ],
     )?;
     Ok(())
+}
+
+impl OptimSpec {
+    /// The optimisers this section offers, each with its parameter table (`ga`, ...).
+    pub fn offered(&self) -> Vec<&dyn crate::optim::Optimiser> {
+        vec![&self.ga, &self.de, &self.pso, &self.csa, &self.icsa]
+    }
 }

@@ -5,7 +5,7 @@
 pub mod report;
 pub mod spec;
 
-use crate::experiment::spec::Spec;
+use crate::experiment::spec::{Spec, SpecError};
 use crate::experiment::{runner, seeds, RunContext};
 use crate::optim::{Budget, Optimiser, Problem, RunResult};
 use crate::spline::conic::{self, ConicProblem, P2};
@@ -74,12 +74,12 @@ impl runner::Logged for Run {
 }
 
 fn section(spec: &Spec) -> Result<&Seed002Spec> {
-    spec.file.seed002.as_ref().context("spec has no [seed002] section")
+    spec.require::<spec::Seed002Spec>()
 }
 
 /// The flat list of cells.
 pub fn cells(spec: &Spec) -> Vec<Cell> {
-    let Some(s) = &spec.file.seed002 else { return Vec::new() };
+    let Some(s) = spec.section::<spec::Seed002Spec>() else { return Vec::new() };
     runner::product_cells(&s.surfaces, &s.optimisers, s.repeats, |sf, o, repeat| Cell {
         surface: sf.clone(),
         optimiser: o.clone(),
@@ -94,11 +94,8 @@ pub fn problem(s: &Seed002Spec, surface: &str) -> Result<SurfaceSse> {
     Ok(SurfaceSse::new(ts.grid(s.grid), s.bounds_margin, s.w_min))
 }
 
-fn optimiser(s: &Seed002Spec, name: &str) -> Result<Box<dyn Optimiser>> {
-    // This section offers ga, de and pso only.
-    let (csa, icsa) = (crate::optim::Csa::default(), crate::optim::Icsa::default());
-    crate::optim::named(name, &s.ga, &s.de, &s.pso, &csa, &icsa)
-        .filter(|_| matches!(name, "ga" | "de" | "pso"))
+fn optimiser<'a>(s: &'a Seed002Spec, name: &str) -> Result<&'a dyn Optimiser> {
+    crate::optim::pick(&s.offered(), name)
         .with_context(|| format!("seed002.optimisers: unknown optimiser `{name}`"))
 }
 
@@ -126,8 +123,7 @@ pub fn run_cell(spec: &Spec, cell: &Cell) -> Result<Run> {
     let key = cell.key();
     let mut rng = seeds::cell_rng(spec.file.master_seed, &key);
     let t0 = runner::thread_cpu_seconds();
-    let r: RunResult =
-        opt.run(&problem, &budget, &mut rng).map_err(|e| anyhow::anyhow!("{key}: {e}"))?;
+    let r: RunResult = opt.run(&problem, &budget, &mut rng).with_context(|| key.clone())?;
     let cpu_s = runner::thread_cpu_seconds() - t0;
     let n = problem.n_points();
     let row = Row {
@@ -207,7 +203,7 @@ pub struct CurveRun {
 }
 
 pub fn curve_cells(spec: &Spec) -> Vec<CurveCell> {
-    let Some(s) = &spec.file.seed002 else { return Vec::new() };
+    let Some(s) = spec.section::<spec::Seed002Spec>() else { return Vec::new() };
     runner::product_cells(&s.outlines, &s.optimisers, s.repeats, |ol, o, repeat| CurveCell {
         outline: ol.clone(),
         optimiser: o.clone(),
@@ -246,7 +242,7 @@ pub fn run_curve_cell(spec: &Spec, cell: &CurveCell) -> Result<CurveRun> {
             init_range: s.init_range * ext,
             trace_every_evals: s.trace_every_evals,
         };
-        let r = opt.run(&problem, &budget, &mut rng).map_err(|e| anyhow::anyhow!("{key}: {e}"))?;
+        let r = opt.run(&problem, &budget, &mut rng).with_context(|| key.clone())?;
         start_sse += problem.fitness(problem.initial_point());
         sse += r.best_fitness;
         evals += r.evaluations;
@@ -288,28 +284,17 @@ pub fn run_curves(spec: &Spec, ctx: &RunContext) -> Result<Vec<CurveRun>> {
 /// Seed 002's family: the `[seed002]` section (surface cells logged, curve cells not).
 pub struct Seed002;
 
-impl crate::experiment::family::Family for Seed002 {
-    fn section(&self) -> &'static str {
-        "seed002"
+impl crate::experiment::family::Section for self::spec::Seed002Spec {
+    fn limits(&self, c: &crate::experiment::limits::Check) -> Result<(), SpecError> {
+        self::spec::limits(c, self)
     }
-    fn present(&self, spec: &Spec) -> bool {
-        spec.file.seed002.is_some()
+    fn validate(&self, spec: &Spec) -> Result<(), SpecError> {
+        self::spec::validate(spec, self)
     }
-    fn check_limits(
-        &self,
-        c: &crate::experiment::limits::Check,
-    ) -> Result<(), crate::experiment::spec::SpecError> {
-        match &c.spec.file.seed002 {
-            Some(s) => self::spec::limits(c, s),
-            None => Ok(()),
-        }
-    }
-    fn validate(&self, spec: &Spec) -> Result<(), crate::experiment::spec::SpecError> {
-        match &spec.file.seed002 {
-            Some(s) => self::spec::validate(spec, s),
-            None => Ok(()),
-        }
-    }
+}
+
+impl crate::experiment::family::Experiment for Seed002 {
+    type Section = self::spec::Seed002Spec;
     fn logged_keys(&self, spec: &Spec) -> Vec<String> {
         cells(spec).iter().map(|c| c.key()).collect()
     }
@@ -326,12 +311,7 @@ impl crate::experiment::family::Family for Seed002 {
         let runs = run(spec, ctx)?;
         let curves = run_curves(spec, ctx)?;
         let section = if tables {
-            Some(crate::families::rational_bezier::report::write(
-                &runs,
-                &curves,
-                s.population,
-                &ctx.out,
-            )?)
+            Some(self::report::write(&runs, &curves, s.population, &ctx.out)?)
         } else {
             None
         };

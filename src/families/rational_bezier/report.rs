@@ -4,7 +4,7 @@
 //! The paper's published numbers are not in the surviving seed text (it stops in section 3.1),
 //! so no reference column can be typed in; the section says so.
 
-use crate::families::rational_bezier::{CurveRun, Run};
+use super::{CurveRun, Run};
 use crate::report::plots::{self, style, Series};
 use crate::spline::rational_bezier::conic_point;
 use crate::spline::rational_bezier::TestSurface;

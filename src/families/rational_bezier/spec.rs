@@ -124,7 +124,7 @@ pub(crate) fn validate(spec: &Spec, s: &Seed002Spec) -> Result<(), SpecError> {
     spec.validate_runs(
         "seed002",
         &s.optimisers,
-        &["ga", "de", "pso"],
+        &crate::optim::names(&s.offered()),
         s.repeats,
         s.generations as u64,
         s.population,
@@ -200,4 +200,11 @@ pub(crate) fn limits(c: &Check, s: &Seed002Spec) -> Result<(), SpecError> {
     c.real("seed002.sam06_d", s.sam06_d, 0.0, false, limits::MAX_LENGTH)?;
     c.cells("seed002", &[s.surfaces.len().max(s.outlines.len()), s.optimisers.len(), s.repeats])?;
     Ok(())
+}
+
+impl Seed002Spec {
+    /// The optimisers this section offers, each with its parameter table (`ga`, ...).
+    pub fn offered(&self) -> Vec<&dyn crate::optim::Optimiser> {
+        vec![&self.ga, &self.de, &self.pso]
+    }
 }

@@ -6,7 +6,7 @@ pub mod report;
 pub mod spec;
 
 use crate::data::PointCloud;
-use crate::experiment::spec::Spec;
+use crate::experiment::spec::{Spec, SpecError};
 use crate::experiment::{runner, seeds, RunContext};
 use crate::geom::Point3;
 use crate::som::{self, FinalMetrics, NeuronCounts, OnlineMetrics, SomParams};
@@ -137,7 +137,8 @@ pub fn run_cell(
     let mut rng = seeds::cell_rng(master_seed, &key);
     let t0 = runner::thread_cpu_seconds();
     let trained = som::train(topo.as_ref(), data, params, &mut rng)
-        .map_err(|e| anyhow::anyhow!("{key}: {e}"))?;
+        .map_err(anyhow::Error::msg)
+        .with_context(|| key.clone())?;
     let cpu_s = runner::thread_cpu_seconds() - t0;
     let fin = som::final_map_metrics(topo.as_ref(), &trained.weights, data);
     let row = SomRow::new(
@@ -154,7 +155,7 @@ pub fn run_cell(
 
 /// Run every SOM cell of a spec, logging each finished cell to the folder's cell log.
 pub fn run(spec: &Spec, ctx: &RunContext) -> Result<Vec<SomRun>> {
-    let som_spec = spec.file.som.as_ref().context("spec has no [som] section")?;
+    let som_spec = spec.require::<spec::SomSpec>()?;
     let data = load_datasets(spec, &som_spec.datasets, ctx)?;
     let params = SomParams {
         iterations: som_spec.iterations,
@@ -180,31 +181,20 @@ pub fn run(spec: &Spec, ctx: &RunContext) -> Result<Vec<SomRun>> {
 /// Chapter 4's family: the `[som]` section.
 pub struct Som;
 
-impl crate::experiment::family::Family for Som {
-    fn section(&self) -> &'static str {
-        "som"
+impl crate::experiment::family::Section for self::spec::SomSpec {
+    fn limits(&self, c: &crate::experiment::limits::Check) -> Result<(), SpecError> {
+        self::spec::limits(c, self)
     }
-    fn present(&self, spec: &Spec) -> bool {
-        spec.file.som.is_some()
+    fn validate(&self, spec: &Spec) -> Result<(), SpecError> {
+        self::spec::validate(spec, self)
     }
-    fn check_limits(
-        &self,
-        c: &crate::experiment::limits::Check,
-    ) -> Result<(), crate::experiment::spec::SpecError> {
-        match &c.spec.file.som {
-            Some(s) => self::spec::limits(c, s),
-            None => Ok(()),
-        }
+    fn datasets(&self) -> &[String] {
+        &self.datasets
     }
-    fn datasets<'a>(&self, spec: &'a Spec) -> Vec<&'a String> {
-        spec.file.som.iter().flat_map(|s| &s.datasets).collect()
-    }
-    fn validate(&self, spec: &Spec) -> Result<(), crate::experiment::spec::SpecError> {
-        match &spec.file.som {
-            Some(s) => self::spec::validate(spec, s),
-            None => Ok(()),
-        }
-    }
+}
+
+impl crate::experiment::family::Experiment for Som {
+    type Section = self::spec::SomSpec;
     fn logged_keys(&self, spec: &Spec) -> Vec<String> {
         spec::cells(spec).iter().map(|c| c.key()).collect()
     }
@@ -215,11 +205,7 @@ impl crate::experiment::family::Family for Som {
         tables: bool,
     ) -> Result<crate::experiment::family::Outcome> {
         let runs = run(spec, ctx)?;
-        let section = if tables {
-            Some(crate::families::som::report::write(spec, &runs, &ctx.out)?)
-        } else {
-            None
-        };
+        let section = if tables { Some(self::report::write(spec, &runs, &ctx.out)?) } else { None };
         Ok(crate::experiment::family::Outcome {
             section,
             cpu_s: runs.iter().map(|r| r.row.cpu_s).sum(),

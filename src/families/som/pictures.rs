@@ -2,7 +2,7 @@
 //! two colours) and overview pages laid out like the thesis' Appendix A (rows data x n, columns the
 //! four models) and Appendix D (rows data x grid, columns CKSOM and DNSOM).
 
-use crate::families::som::SomRun;
+use super::SomRun;
 use crate::report::plots::{self, style, LineMesh, Panel};
 use crate::som::Model;
 use anyhow::Result;

@@ -1,9 +1,9 @@
 //! Chapter 4 outputs: runs.csv, the Appendix B/C tables, the neuron-count tables 4.9/4.13/4.14, the
 //! saved DNSOM maps, the pictures and the Chapter 4 section of REPORT.md. Reads only the runs.
 
+use super::SomRun;
 use crate::double_net::View;
 use crate::experiment::spec::{GridSize, Spec};
-use crate::families::som::SomRun;
 use crate::io::{csv_records, csv_text, write_atomic};
 use crate::report::claims::Claim;
 use crate::report::markdown::{beside, geometric_mean, num, table};
@@ -233,7 +233,8 @@ pub fn write(spec: &Spec, runs: &[SomRun], out: &Path) -> Result<String> {
     write_atomic(&out.join("table_4_14.csv"), csv_records(&h, &r)?.as_bytes())?;
     written.push("table_4_14.csv".into());
 
-    let save = &spec.file.som.as_ref().map(|s| s.save_maps.clone()).unwrap_or_default();
+    let save =
+        &spec.section::<super::spec::SomSpec>().map(|s| s.save_maps.clone()).unwrap_or_default();
     let mut maps = Vec::new();
     for run in runs.iter().filter(|r| {
         r.cell.model == Model::Dnsom && r.cell.repeat == 0 && save.contains(&r.cell.grid)
@@ -242,7 +243,7 @@ pub fn write(spec: &Spec, runs: &[SomRun], out: &Path) -> Result<String> {
         write_atomic(&out.join(&name), dnsom_map_csv(run)?.as_bytes())?;
         maps.push(name);
     }
-    let pictures = if spec.file.som.as_ref().map(|s| s.pictures).unwrap_or(false) {
+    let pictures = if spec.section::<super::spec::SomSpec>().map(|s| s.pictures).unwrap_or(false) {
         super::pictures::write(runs, out)?
     } else {
         Vec::new()

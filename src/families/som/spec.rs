@@ -113,7 +113,7 @@ pub(crate) fn validate(spec: &Spec, som: &SomSpec) -> Result<(), SpecError> {
 
 /// The flat list of SOM cells (data set x group x grid x model x repeat), in report order.
 pub fn cells(spec: &Spec) -> Vec<SomCell> {
-    let Some(som) = &spec.file.som else { return Vec::new() };
+    let Some(som) = spec.section::<SomSpec>() else { return Vec::new() };
     let mut cells = Vec::new();
     // Groups may share a (model, grid): each cell once, in first-seen order.
     let mut seen = std::collections::HashSet::new();

@@ -1,7 +1,6 @@
 //! Resume after SIGKILL, shards merged back into one run, refusals, and `reproduce`.
 
-mod common;
-use common::*;
+use crate::common::*;
 use std::collections::BTreeSet;
 use std::time::{Duration, Instant};
 

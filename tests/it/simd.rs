@@ -3,8 +3,7 @@
 //! scalar one; a copy this CPU lacks is refused with a one-line error (exit 2); a malformed value
 //! likewise.
 
-mod common;
-use common::*;
+use crate::common::*;
 use somnurbs::spline::control_net::Isa;
 
 /// Every optimiser (so every kernel) on two nets, one of them with padded lanes.
@@ -28,7 +27,7 @@ iterations = 300
 
 /// Run the spec with SOMNURBS_SIMD = `simd` into `out`; the output.
 fn run_with(case: &Case, spec: &str, simd: &str, out: &str) -> std::process::Output {
-    common::bin()
+    crate::common::bin()
         .args(["run", spec, "--out", out, "--jobs", "2"])
         .current_dir(case.dir.path())
         .env("SOMNURBS_DATA", shared_data())

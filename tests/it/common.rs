@@ -179,3 +179,17 @@ maps = "nowhere"
 [optim.som]
 iterations = 500
 "#;
+
+/// A Chapter 4 spec that saves one small DNSOM map (sphere, 20x20) for Chapter 5 and 6 tests.
+pub const CH4_FOR_FIT: &str = r#"
+name = "maps"
+master_seed = 11
+[som]
+datasets = ["sphere"]
+iterations = 500
+save_maps = ["20x20"]
+pictures = false
+[[som.group]]
+models = ["dnsom"]
+grids = ["20x20"]
+"#;

@@ -1,8 +1,7 @@
 //! Integration tests: run the real binary on tiny specs in temporary folders and read what it
 //! writes. On failure each helper prints the command, the folder listing, stdout and stderr.
 
-mod common;
-use common::*;
+use crate::common::*;
 use std::path::Path;
 
 const TINY: &str = r#"
@@ -175,19 +174,6 @@ fn datasets_list_show_export() {
     assert!(!c.path(".somnurbs.lock").exists(), "datasets export left a lock file behind");
     c.fails(&["datasets", "show", "teapot"], &["teapot"]);
 }
-
-const CH4_FOR_FIT: &str = r#"
-name = "maps"
-master_seed = 11
-[som]
-datasets = ["sphere"]
-iterations = 500
-save_maps = ["20x20"]
-pictures = false
-[[som.group]]
-models = ["dnsom"]
-grids = ["20x20"]
-"#;
 
 const CH5_TINY: &str = r#"
 name = "fits"

@@ -1,8 +1,7 @@
 //! `somnurbs drift` on folders written by real runs: exit 0 / 1 / 2, the moved cell named, and
 //! `--accept`.
 
-mod common;
-use common::*;
+use crate::common::*;
 
 fn status(out: &std::process::Output) -> i32 {
     out.status.code().unwrap_or(-1)

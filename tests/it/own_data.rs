@@ -2,8 +2,7 @@
 //! anywhere), its results are named by the file's stem, `normalise` chooses the scaling, and a
 //! missing file is refused before anything is written.
 
-mod common;
-use common::*;
+use crate::common::*;
 
 /// Points on an ellipsoid with semi-axes 40, 25 and 15.
 fn ellipsoid() -> String {

@@ -1,8 +1,7 @@
 //! Seed 002 integration test: the quick profile of experiments/seed002_rational.toml through the
 //! real binary, then the CSVs it wrote are read back and checked.
 
-mod common;
-use common::{col, read_csv};
+use crate::common::{col, read_csv};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 

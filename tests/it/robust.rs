@@ -1,8 +1,7 @@
 //! Issue 17: never lose, mix or misjudge a result; refuse every bad input cleanly. One test per
 //! class of the issue, each with the issue's reproduction commands and more.
 
-mod common;
-use common::*;
+use crate::common::*;
 use std::path::Path;
 use std::process::Stdio;
 use std::time::{Duration, Instant};

@@ -2,8 +2,7 @@
 //! CPUs; sbatch runs the array's tasks and then the merge at once, in order, as the dependency
 //! would). The real scheduler is exercised by .ci/slurm on a one-node cluster.
 
-mod common;
-use common::*;
+use crate::common::*;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 

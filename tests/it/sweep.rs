@@ -2,8 +2,7 @@
 //! the seeds, a sweep writes one folder with a `variant` column that `compare` ranks, resume and
 //! shards of a sweep give the plain sweep's tables, and a run without either keeps its seeds.
 
-mod common;
-use common::*;
+use crate::common::*;
 use std::collections::{BTreeMap, BTreeSet};
 
 /// One optimiser, so that a sweep over its F is the whole comparison (two cells: Friedman needs two).

@@ -1,8 +1,7 @@
 //! Seed 004 integration test: the quick profile of experiments/seed004_cylinder.toml through the
 //! real binary, then the tables it wrote are read back and checked.
 
-mod common;
-use common::{col, read_csv, same_tables, Case};
+use crate::common::{col, read_csv, same_tables, Case};
 use std::path::{Path, PathBuf};
 
 fn spec() -> PathBuf {

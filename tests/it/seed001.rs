@@ -1,8 +1,7 @@
 //! Seed 001 end to end: the quick profile of experiments/seed001_growing_grid.toml in a temp dir,
 //! then real properties of the CSVs it wrote.
 
-mod common;
-use common::{bin, col, read_csv, shared_data};
+use crate::common::{bin, col, read_csv, shared_data};
 use std::path::Path;
 use std::process::Output;
 

@@ -2,8 +2,7 @@
 //! the real binary, the CSVs read back and checked; thread count does not change a number; a bad
 //! key is refused by name; --dry-run lists the cells.
 
-mod common;
-use common::{col, read_csv, same_tables, Case};
+use crate::common::{col, read_csv, same_tables, Case};
 use std::path::{Path, PathBuf};
 
 fn spec() -> PathBuf {

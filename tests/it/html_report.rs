@@ -3,22 +3,8 @@
 //! `scripts/check_report_html.sh` (CI installs chromium and runs the same check on the quick
 //! reproduction; without chromium this part is skipped with a printed reason).
 
-mod common;
-use common::*;
+use crate::common::*;
 use std::path::Path;
-
-const MAPS: &str = r#"
-name = "maps"
-master_seed = 11
-[som]
-datasets = ["sphere"]
-iterations = 500
-save_maps = ["20x20"]
-pictures = false
-[[som.group]]
-models = ["dnsom"]
-grids = ["20x20"]
-"#;
 
 const FITS: &str = r#"
 name = "fits"
@@ -36,7 +22,7 @@ pictures = true
 #[test]
 fn a_chapter_5_run_writes_a_self_contained_report_html() {
     let c = Case::new();
-    c.write("maps.toml", MAPS);
+    c.write("maps.toml", CH4_FOR_FIT);
     c.ok(&["run", "maps.toml", "--out", "ch4"]);
     c.write("fits.toml", FITS);
     c.ok(&["run", "fits.toml", "--out", "out"]);

@@ -1,0 +1,20 @@
+//! The integration tests, one binary with a module per topic: each runs the real `somnurbs`
+//! binary in temporary folders (`common::Case`), on the generated data sets and, where a test
+//! needs them, the third-party scans of `SOMNURBS_DATA`.
+
+mod common;
+
+mod cli;
+mod drift;
+mod fuzz;
+mod html_report;
+mod own_data;
+mod resume;
+mod robust;
+mod seed001;
+mod seed002;
+mod seed003;
+mod seed004;
+mod simd;
+mod slurm;
+mod sweep;
