@@ -49,6 +49,9 @@ fn e(v: f64) -> String {
     format!("{v:e}")
 }
 
+/// Rows of a table (CSV or markdown cells).
+type Rows = Vec<Vec<String>>;
+
 fn header(cols: &[&str]) -> Vec<String> {
     cols.iter().map(|c| c.to_string()).collect()
 }
@@ -65,8 +68,6 @@ pub fn write(
     let rows: Vec<_> = runs.iter().map(|r| r.row.clone()).collect();
     crate::io::write_atomic(&out.join("runs.csv"), crate::io::csv_text(&rows)?.as_bytes())?;
     let cps = crate::report::ordered(runs.iter().map(|r| r.cell.control_points));
-    let of =
-        |cp: usize| -> Vec<&Run> { runs.iter().filter(|r| r.cell.control_points == cp).collect() };
     let mut s = String::new();
     let _ =
         writeln!(s, "## Seed 004: closed B-spline surface of a cylinder by a binary-coded GA\n");
@@ -84,45 +85,22 @@ pub fn write(
         s4.grid_step, s4.radius, s4.accuracy, s4.height, s4.order_around, s4.order_vertical, s4.rows, s4.ga.bits, s4.search_range, s4.population, s4.generations, s4.ga.beta, s4.ga.pc, s4.ga.swap, s4.ga.pm, s4.ga.elitism, s4.repeats
     );
 
-    // Table II.
+    // Compute every table and the claims first, then render.
     let p2 = paper_table("seed004_table2");
-    let mut t2 = Vec::new();
-    let mut md2 = Vec::new();
-    for &cp in s4.table2_control_points.iter().filter(|cp| cps.contains(cp)) {
-        let sel = of(cp);
-        let analytical = sel[0].row.analytical_rms;
-        for &g in &s4.table2_generations {
-            let so_far: Vec<f64> =
-                sel.iter().filter_map(|r| r.best_so_far.get(g).copied()).collect();
-            let pop: Vec<f64> =
-                sel.iter().filter_map(|r| r.population_best.get(g).copied()).collect();
-            if so_far.is_empty() {
-                continue;
-            }
-            let (a, b) = (summary(&so_far), summary(&pop));
-            t2.push(vec![
-                cp.to_string(),
-                g.to_string(),
-                e(analytical),
-                e(a.min),
-                e(a.mean),
-                e(a.median),
-                e(b.min),
-                e(b.mean),
-                so_far.len().to_string(),
-            ]);
-            let paper = p2.value(&["generation"], &[g.to_string()], &format!("best_rms_{cp}cp"));
-            md2.push(vec![
-                cp.to_string(),
-                if g == 0 { "initial".into() } else { g.to_string() },
-                num(Some(a.min), 4),
-                num(Some(a.mean), 4),
-                num(Some(b.mean), 4),
-                num(Some(analytical), 4),
-                num(paper, 4),
-            ]);
-        }
-    }
+    let (t2, md2) = table_2(s4, runs, &cps, &p2);
+    let (t3, md3) = table_3(runs, &cps, &p3);
+    let ga_by_cp: Vec<(usize, f64)> =
+        t3.iter().map(|r| (r[0].parse().unwrap_or(0), r[2].parse().unwrap_or(f64::NAN))).collect();
+    let paper_by_cp: Vec<(usize, f64)> = p3
+        .rows
+        .iter()
+        .filter_map(|r| {
+            Some((r.get("control_points")?.parse().ok()?, r.get("best_fitness")?.parse().ok()?))
+        })
+        .collect();
+    let claims = claims(runs, &t3, &ga_by_cp, &paper_by_cp, sweep);
+
+    // Table II.
     crate::io::write_atomic(
         &out.join("seed004_table2.csv"),
         crate::io::csv_records(
@@ -157,44 +135,6 @@ pub fn write(
     ));
 
     // Table III.
-    let mut t3 = Vec::new();
-    let mut md3 = Vec::new();
-    for &cp in &cps {
-        let sel = of(cp);
-        let best: Vec<f64> = sel.iter().map(|r| r.row.best_rms).collect();
-        let sm = summary(&best);
-        let winner =
-            sel.iter().min_by(|a, b| a.row.best_rms.total_cmp(&b.row.best_rms)).expect("non-empty");
-        let mean_gen =
-            sel.iter().map(|r| r.row.best_generation as f64).sum::<f64>() / sel.len() as f64;
-        let an = winner.row.analytical_rms;
-        let impr = (an - sm.min) / an * 100.0;
-        t3.push(vec![
-            cp.to_string(),
-            e(an),
-            e(sm.min),
-            e(sm.mean),
-            e(sm.max),
-            e(sm.std),
-            winner.row.best_generation.to_string(),
-            format!("{mean_gen}"),
-            format!("{impr}"),
-            sel.len().to_string(),
-        ]);
-        let key = [cp.to_string()];
-        md3.push(vec![
-            cp.to_string(),
-            num(Some(an), 5),
-            num(Some(sm.min), 5),
-            num(Some(sm.mean), 5),
-            winner.row.best_generation.to_string(),
-            format!("{impr:.2}%"),
-            num(p3.value(&["control_points"], &key, "best_fitness"), 5),
-            p3.find(&["control_points"], &key)
-                .and_then(|r| r.get("generation").cloned())
-                .unwrap_or_else(|| "-".into()),
-        ]);
-    }
     crate::io::write_atomic(
         &out.join("seed004_table3.csv"),
         crate::io::csv_records(
@@ -236,7 +176,139 @@ pub fn write(
         &md3,
     ));
 
-    // Claims, each computed from the runs (and, where the transcribed tables allow, the paper's own numbers).
+    // Claims.
+    let _ = writeln!(s, "\n### The paper's claims, checked here\n");
+    s.push_str(&crate::report::claims::write(out, &claims)?);
+    let _ = writeln!(
+        s,
+        "\nThe GA's error against the number of control points has a minimum that moves with the search box (`search_range`; the spec's `narrow` profile uses 0.02 instead of 0.25). The box is centred on the least-squares minimiser, so a decoded point x0 + r d has SSE = SSE(x0) + r^2 q(d) with q independent of r: the GA's ranking, and so its whole run in bit space, is the same in every box (up to rounding), and its excess error over the analytical one scales with r^2. With 10 individuals and 500 generations that excess grows with the 2N dimensions while the analytical error falls, so a middle optimum such as the paper's 25-30 is a property of the GA's budget and box, not of the surface.");
+    let _ = writeln!(
+        s,
+        "\nWhy the GA cannot beat the analytical net on this cost: with the data parameters fixed, the RMS error is a convex quadratic in the control points and the SVD least squares is its exact minimiser; the GA searches a subset of the same control nets (a {}-bit lattice in the box), so its RMS is at best equal up to the lattice's resolution. A GA result below the analytical one would need other data parameters or another error measure.",
+        s4.ga.bits
+    );
+
+    // Pictures.
+    crate::io::ensure_dir(&out.join("png"))?;
+    let mut pictures = Vec::new();
+    if let Some(chart) = convergence_chart(s4, runs, &cps, &p2, out) {
+        pictures.push(chart);
+    }
+    pictures.push(fitness_chart(&t3, &ga_by_cp, &paper_by_cp, sweep, out));
+    if let Some(t) = top {
+        pictures.push(top_view_chart(t, out));
+    }
+    for (png, r) in pictures {
+        match r {
+            Ok(()) => {
+                let _ = writeln!(s, "\n![{png}]({png})");
+            }
+            Err(e) => eprintln!("somnurbs: warning: picture skipped: {e}"),
+        }
+    }
+    Ok(s)
+}
+
+/// The runs with `cp` control points around.
+fn of(runs: &[Run], cp: usize) -> Vec<&Run> {
+    runs.iter().filter(|r| r.cell.control_points == cp).collect()
+}
+
+/// Table II: per followed number of control points and generation, the CSV rows and the markdown
+/// rows beside the paper's best RMS.
+fn table_2(s4: &Seed004Spec, runs: &[Run], cps: &[usize], p2: &RefTable) -> (Rows, Rows) {
+    let mut t2 = Vec::new();
+    let mut md2 = Vec::new();
+    for &cp in s4.table2_control_points.iter().filter(|cp| cps.contains(cp)) {
+        let sel = of(runs, cp);
+        let analytical = sel[0].row.analytical_rms;
+        for &g in &s4.table2_generations {
+            let so_far: Vec<f64> =
+                sel.iter().filter_map(|r| r.best_so_far.get(g).copied()).collect();
+            let pop: Vec<f64> =
+                sel.iter().filter_map(|r| r.population_best.get(g).copied()).collect();
+            if so_far.is_empty() {
+                continue;
+            }
+            let (a, b) = (summary(&so_far), summary(&pop));
+            t2.push(vec![
+                cp.to_string(),
+                g.to_string(),
+                e(analytical),
+                e(a.min),
+                e(a.mean),
+                e(a.median),
+                e(b.min),
+                e(b.mean),
+                so_far.len().to_string(),
+            ]);
+            let paper = p2.value(&["generation"], &[g.to_string()], &format!("best_rms_{cp}cp"));
+            md2.push(vec![
+                cp.to_string(),
+                if g == 0 { "initial".into() } else { g.to_string() },
+                num(Some(a.min), 4),
+                num(Some(a.mean), 4),
+                num(Some(b.mean), 4),
+                num(Some(analytical), 4),
+                num(paper, 4),
+            ]);
+        }
+    }
+    (t2, md2)
+}
+
+/// Table III: per number of control points, the CSV rows and the markdown rows beside the paper's.
+fn table_3(runs: &[Run], cps: &[usize], p3: &RefTable) -> (Rows, Rows) {
+    let mut t3 = Vec::new();
+    let mut md3 = Vec::new();
+    for &cp in cps {
+        let sel = of(runs, cp);
+        let best: Vec<f64> = sel.iter().map(|r| r.row.best_rms).collect();
+        let sm = summary(&best);
+        let winner =
+            sel.iter().min_by(|a, b| a.row.best_rms.total_cmp(&b.row.best_rms)).expect("non-empty");
+        let mean_gen =
+            sel.iter().map(|r| r.row.best_generation as f64).sum::<f64>() / sel.len() as f64;
+        let an = winner.row.analytical_rms;
+        let impr = (an - sm.min) / an * 100.0;
+        t3.push(vec![
+            cp.to_string(),
+            e(an),
+            e(sm.min),
+            e(sm.mean),
+            e(sm.max),
+            e(sm.std),
+            winner.row.best_generation.to_string(),
+            format!("{mean_gen}"),
+            format!("{impr}"),
+            sel.len().to_string(),
+        ]);
+        let key = [cp.to_string()];
+        md3.push(vec![
+            cp.to_string(),
+            num(Some(an), 5),
+            num(Some(sm.min), 5),
+            num(Some(sm.mean), 5),
+            winner.row.best_generation.to_string(),
+            format!("{impr:.2}%"),
+            num(p3.value(&["control_points"], &key, "best_fitness"), 5),
+            p3.find(&["control_points"], &key)
+                .and_then(|r| r.get("generation").cloned())
+                .unwrap_or_else(|| "-".into()),
+        ]);
+    }
+    (t3, md3)
+}
+
+/// The paper's claims, each computed from the runs (and, where the transcribed tables allow, the
+/// paper's own numbers).
+fn claims(
+    runs: &[Run],
+    t3: &Rows,
+    ga_by_cp: &[(usize, f64)],
+    paper_by_cp: &[(usize, f64)],
+    sweep: &[(usize, f64)],
+) -> Vec<crate::report::claims::Claim> {
     let mut claims = Vec::new();
     let row3 = |cp: usize| {
         t3.iter().find(|r| r[0] == cp.to_string()).map(|r| {
@@ -254,16 +326,7 @@ pub fn write(
         });
     }
     let argmin = |v: &[(usize, f64)]| v.iter().copied().min_by(|a, b| a.1.total_cmp(&b.1));
-    let ga_by_cp: Vec<(usize, f64)> =
-        t3.iter().map(|r| (r[0].parse().unwrap_or(0), r[2].parse().unwrap_or(f64::NAN))).collect();
-    let paper_by_cp: Vec<(usize, f64)> = p3
-        .rows
-        .iter()
-        .filter_map(|r| {
-            Some((r.get("control_points")?.parse().ok()?, r.get("best_fitness")?.parse().ok()?))
-        })
-        .collect();
-    if let (Some((cp, v)), Some((pcp, _))) = (argmin(&ga_by_cp), argmin(&paper_by_cp)) {
+    if let (Some((cp, v)), Some((pcp, _))) = (argmin(ga_by_cp), argmin(paper_by_cp)) {
         claims.push(crate::report::claims::Claim {
             chapter: "seed004".into(),
             rival: None,
@@ -313,23 +376,21 @@ pub fn write(
         note: "runs whose last population's best RMS is below their initial population's best"
             .into(),
     });
-    let _ = writeln!(s, "\n### The paper's claims, checked here\n");
-    s.push_str(&crate::report::claims::write(out, &claims)?);
-    let _ = writeln!(
-        s,
-        "\nThe GA's error against the number of control points has a minimum that moves with the search box (`search_range`; the spec's `narrow` profile uses 0.02 instead of 0.25). The box is centred on the least-squares minimiser, so a decoded point x0 + r d has SSE = SSE(x0) + r^2 q(d) with q independent of r: the GA's ranking, and so its whole run in bit space, is the same in every box (up to rounding), and its excess error over the analytical one scales with r^2. With 10 individuals and 500 generations that excess grows with the 2N dimensions while the analytical error falls, so a middle optimum such as the paper's 25-30 is a property of the GA's budget and box, not of the surface.");
-    let _ = writeln!(
-        s,
-        "\nWhy the GA cannot beat the analytical net on this cost: with the data parameters fixed, the RMS error is a convex quadratic in the control points and the SVD least squares is its exact minimiser; the GA searches a subset of the same control nets (a {}-bit lattice in the box), so its RMS is at best equal up to the lattice's resolution. A GA result below the analytical one would need other data parameters or another error measure.",
-        s4.ga.bits
-    );
+    claims
+}
 
-    // Pictures.
-    crate::io::ensure_dir(&out.join("png"))?;
-    let mut pictures = Vec::new();
+/// Fig. 3 analogue: best RMS so far against generation (median and quartiles over the repeats)
+/// per followed number of control points, with the analytical RMS and the paper's Table II.
+fn convergence_chart(
+    s4: &Seed004Spec,
+    runs: &[Run],
+    cps: &[usize],
+    p2: &RefTable,
+    out: &Path,
+) -> Option<(&'static str, Result<(), plots::PlotError>)> {
     let mut conv = Vec::new();
     for (k, &cp) in s4.table2_control_points.iter().filter(|cp| cps.contains(cp)).enumerate() {
-        let sel = of(cp);
+        let sel = of(runs, cp);
         let len = sel.iter().map(|r| r.best_so_far.len()).min().unwrap_or(0);
         let sums: Vec<(f64, Summary)> = (0..len)
             .map(|g| (g as f64, summary(&sel.iter().map(|r| r.best_so_far[g]).collect::<Vec<_>>())))
@@ -369,19 +430,25 @@ pub fn write(
             });
         }
     }
-    if !conv.is_empty() {
-        pictures.push((
-            "png/seed004_convergence.png",
-            plots::line_chart_png(
-                &out.join("png/seed004_convergence.png"),
-                "Best RMS so far vs generation (Fig. 3 analogue)",
-                "generation",
-                "RMS error",
-                &conv,
-                true,
-            ),
-        ));
+    if conv.is_empty() {
+        return None;
     }
+    let name = "png/seed004_convergence.png";
+    let title = "Best RMS so far vs generation (Fig. 3 analogue)";
+    Some((
+        name,
+        plots::line_chart_png(&out.join(name), title, "generation", "RMS error", &conv, true),
+    ))
+}
+
+/// Fig. 5 analogue: best fitness (RMS) against the number of control points.
+fn fitness_chart(
+    t3: &Rows,
+    ga_by_cp: &[(usize, f64)],
+    paper_by_cp: &[(usize, f64)],
+    sweep: &[(usize, f64)],
+    out: &Path,
+) -> (&'static str, Result<(), plots::PlotError>) {
     let mut fit_series = vec![
         Series {
             label: "GA best over repeats".into(),
@@ -411,66 +478,43 @@ pub fn write(
         points: paper_by_cp.iter().map(|&(c, v)| (c as f64, v)).collect(),
         band: None,
     });
-    pictures.push((
-        "png/seed004_fitness_vs_control_points.png",
-        plots::line_chart_png(
-            &out.join("png/seed004_fitness_vs_control_points.png"),
-            "Best fitness (RMS) vs number of control points (Fig. 5 analogue)",
-            "control points around",
-            "RMS error",
-            &fit_series,
-            true,
-        ),
-    ));
-    if let Some(t) = top {
-        let series = vec![
-            Series {
-                label: "data (bottom ring)".into(),
-                colour: RGBColor(170, 170, 170),
-                points: t.data.iter().chain(t.data.first()).copied().collect(),
-                band: None,
-            },
-            Series {
-                label: format!("GA curve (RMS {:.5})", t.best_rms),
-                colour: style::cycle_colour(0),
-                points: t.ga_curve.clone(),
-                band: None,
-            },
-            Series {
-                label: "GA control polygon".into(),
-                colour: RGBColor(200, 0, 0),
-                points: t.ga_control.clone(),
-                band: None,
-            },
-            Series {
-                label: format!("analytical curve (RMS {:.5})", t.analytical_rms),
-                colour: style::cycle_colour(2),
-                points: t.analytical_curve.clone(),
-                band: None,
-            },
-        ];
-        pictures.push((
-            "png/seed004_top_view.png",
-            plots::line_chart_png(
-                &out.join("png/seed004_top_view.png"),
-                &format!(
-                    "Top view, {} control points, best GA run (Fig. 2a analogue)",
-                    t.control_points
-                ),
-                "x",
-                "y",
-                &series,
-                false,
-            ),
-        ));
-    }
-    for (png, r) in pictures {
-        match r {
-            Ok(()) => {
-                let _ = writeln!(s, "\n![{png}]({png})");
-            }
-            Err(e) => eprintln!("somnurbs: warning: picture skipped: {e}"),
-        }
-    }
-    Ok(s)
+    let name = "png/seed004_fitness_vs_control_points.png";
+    let title = "Best fitness (RMS) vs number of control points (Fig. 5 analogue)";
+    let x = "control points around";
+    (name, plots::line_chart_png(&out.join(name), title, x, "RMS error", &fit_series, true))
+}
+
+/// Fig. 2(a) analogue: the bottom ring seen from above with the best GA run's and the analytical
+/// curves.
+fn top_view_chart(t: &TopView, out: &Path) -> (&'static str, Result<(), plots::PlotError>) {
+    let series = vec![
+        Series {
+            label: "data (bottom ring)".into(),
+            colour: RGBColor(170, 170, 170),
+            points: t.data.iter().chain(t.data.first()).copied().collect(),
+            band: None,
+        },
+        Series {
+            label: format!("GA curve (RMS {:.5})", t.best_rms),
+            colour: style::cycle_colour(0),
+            points: t.ga_curve.clone(),
+            band: None,
+        },
+        Series {
+            label: "GA control polygon".into(),
+            colour: RGBColor(200, 0, 0),
+            points: t.ga_control.clone(),
+            band: None,
+        },
+        Series {
+            label: format!("analytical curve (RMS {:.5})", t.analytical_rms),
+            colour: style::cycle_colour(2),
+            points: t.analytical_curve.clone(),
+            band: None,
+        },
+    ];
+    let name = "png/seed004_top_view.png";
+    let title =
+        format!("Top view, {} control points, best GA run (Fig. 2a analogue)", t.control_points);
+    (name, plots::line_chart_png(&out.join(name), &title, "x", "y", &series, false))
 }
