@@ -32,6 +32,13 @@ fn table_names(grid: GridSize) -> (String, String, String, String) {
 }
 
 /// Surface error of a (data, cn, param, approach) cell, from the runs or from a published table.
+/// Rows of a table (CSV or markdown cells).
+type Rows = Vec<Vec<String>>;
+
+fn header(cols: &[&str]) -> Vec<String> {
+    cols.iter().map(|c| c.to_string()).collect()
+}
+
 type ErrorOf<'a> = dyn Fn(&str, GridSize, Parameterisation, Approach) -> Option<f64> + 'a;
 
 fn runs_error(
@@ -112,6 +119,270 @@ fn approach_wins(
 }
 
 /// Write every Chapter 5 file; returns the REPORT.md section.
+/// One grid's runs and what its tables are computed over.
+struct GridRuns {
+    grid: GridSize,
+    runs: Vec<FitRun>,
+    data: Vec<String>,
+    cns: Vec<GridSize>,
+    params: Vec<Parameterisation>,
+    approaches: Vec<Approach>,
+    /// The thesis' Appendix E/F, when this grid has one.
+    thesis: Option<RefTable>,
+    names: (String, String, String, String),
+}
+
+impl GridRuns {
+    fn new(runs: &[FitRun], grid: GridSize) -> GridRuns {
+        let runs: Vec<FitRun> = runs.iter().filter(|r| r.cell.grid == grid).cloned().collect();
+        let names = table_names(grid);
+        GridRuns {
+            grid,
+            data: ordered(runs.iter().map(|r| r.cell.dataset.clone())),
+            cns: ordered(runs.iter().map(|r| r.cell.cn)),
+            params: ordered(runs.iter().map(|r| r.cell.param)),
+            approaches: ordered(runs.iter().map(|r| r.cell.approach)),
+            thesis: reference::table(&names.0),
+            names,
+            runs,
+        }
+    }
+}
+
+/// Appendix E/F (ours), in the reference's column order where there is one.
+fn appendix(g: &GridRuns) -> (Vec<String>, Rows) {
+    let ours = runs_error(&g.runs);
+    let header: Vec<String> = match &g.thesis {
+        Some(t) => t.header.clone(),
+        None => {
+            let mut h = vec!["data".to_string(), "cn_x".into(), "cn_y".into()];
+            for p in Parameterisation::ALL {
+                for a in [Approach::Conventional, Approach::Improved] {
+                    h.push(format!("{}_{}", p.name(), a.letter()));
+                }
+            }
+            h
+        }
+    };
+    let mut rows = Vec::new();
+    for d in &g.data {
+        for &cn in &g.cns {
+            let mut row = vec![d.clone(), cn.nx.to_string(), cn.ny.to_string()];
+            for col in &header[3..] {
+                let v = Parameterisation::ALL
+                    .iter()
+                    .flat_map(|&p| {
+                        [Approach::Conventional, Approach::Improved].map(move |a| (p, a))
+                    })
+                    .find(|(p, a)| format!("{}_{}", p.name(), a.letter()) == *col)
+                    .and_then(|(p, a)| ours(d, cn, p, a));
+                row.push(v.map(|x| format!("{x:.6}")).unwrap_or_default());
+            }
+            rows.push(row);
+        }
+    }
+    (header, rows)
+}
+
+/// Control nets where each parameterisation gives approach `a` the least surface error, and the
+/// claim that the thesis' best parameterisation for `a` is the best here, counted in cells.
+fn param_win_table(g: &GridRuns, a: Approach) -> (Vec<String>, Rows, Option<Claim>) {
+    let (data, cns, params, grid) = (&g.data, &g.cns, &g.params, g.grid);
+    let w = param_wins(&runs_error(&g.runs), data, cns, params, a);
+    let mut h = vec!["data".to_string()];
+    h.extend(params.iter().map(|p| p.name().to_string()));
+    h.push("cells".into());
+    let mut rows: Rows = w
+        .iter()
+        .map(|(d, v, c)| {
+            std::iter::once(d.clone())
+                .chain(v.iter().map(|x| x.to_string()))
+                .chain(std::iter::once(c.to_string()))
+                .collect()
+        })
+        .collect();
+    let totals: Vec<usize> = (0..params.len()).map(|k| w.iter().map(|x| x.1[k]).sum()).collect();
+    let cells: usize = w.iter().map(|x| x.2).sum();
+    rows.push(
+        std::iter::once("total".to_string())
+            .chain(totals.iter().map(|x| x.to_string()))
+            .chain(std::iter::once(cells.to_string()))
+            .collect(),
+    );
+    let thesis_best = if a == Approach::Conventional {
+        Parameterisation::Exponential
+    } else {
+        Parameterisation::ChordLength
+    };
+    let claim = params.iter().position(|&p| p == thesis_best).map(|k| {
+        let t_counts = g.thesis.as_ref().map(|t| {
+            let tw = param_wins(&thesis_error(t), data, cns, params, a);
+            let tt: Vec<usize> =
+                (0..params.len()).map(|k| tw.iter().map(|x| x.1[k]).sum()).collect();
+            (tt[k], tw.iter().map(|x| x.2).sum::<usize>())
+        });
+        // Counted in cells, as the thesis counts them: X wins `totals[k]` of `cells` and holds
+        // when no other parameterisation wins as many.
+        let rival =
+            totals.iter().enumerate().filter(|&(j, _)| j != k).map(|(_, &t)| t).max().unwrap_or(0);
+        Claim {
+            chapter: "5".into(),
+            rival: Some(rival),
+            statement: format!(
+                "{} is the best parameterisation for approach {} (grid {grid})",
+                thesis_best.name(),
+                a.letter()
+            ),
+            ours: (totals[k], cells),
+            thesis: t_counts,
+            note: format!(
+                "wins here: {}",
+                params
+                    .iter()
+                    .zip(&totals)
+                    .map(|(p, t)| format!("{} {t}", p.name()))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        }
+    });
+    (h, rows, claim)
+}
+
+/// Control nets where A or B has the smaller surface error, and the claim that B beats A.
+fn approach_win_table(g: &GridRuns) -> (Vec<String>, Rows, Claim) {
+    let ab = approach_wins(&runs_error(&g.runs), &g.data, &g.cns, &g.params);
+    let h = header(&["data", "parameterisation", "a_wins", "b_wins", "cells"]);
+    let mut rows: Rows = ab
+        .iter()
+        .map(|(d, p, a, b, c)| {
+            vec![d.clone(), p.name().into(), a.to_string(), b.to_string(), c.to_string()]
+        })
+        .collect();
+    let (ta, tb, tc) = ab.iter().fold((0, 0, 0), |acc, x| (acc.0 + x.2, acc.1 + x.3, acc.2 + x.4));
+    rows.push(vec!["total".into(), String::new(), ta.to_string(), tb.to_string(), tc.to_string()]);
+    let thesis_ab = g.thesis.as_ref().map(|t| {
+        approach_wins(&thesis_error(t), &g.data, &g.cns, &g.params)
+            .iter()
+            .fold((0, 0), |acc, x| (acc.0 + x.3, acc.1 + x.4))
+    });
+    let claim = Claim {
+        rival: None,
+        chapter: "5".into(),
+        statement: format!("B beats A in most cells (grid {})", g.grid),
+        ours: (tb, tc),
+        thesis: thesis_ab,
+        note: "cells where B has the smaller surface error; verdict 'mostly holds' when more than half"
+            .into(),
+    };
+    (h, rows, claim)
+}
+
+/// The gap (`gaps_<grid>.csv`) of A and B per cell, and the claim that B leaves none.
+fn gap_table(g: &GridRuns) -> (Vec<String>, Rows, Claim) {
+    let h = header(&["data", "cn_x", "cn_y", "parameterisation", "gap_A", "gap_B"]);
+    let mut rows = Vec::new();
+    let (mut b_zero, mut b_all, mut a_pos) = (0, 0, 0);
+    for d in &g.data {
+        for &cn in &g.cns {
+            for &p in &g.params {
+                let find = |a: Approach| {
+                    g.runs
+                        .iter()
+                        .find(|r| {
+                            &r.cell.dataset == d
+                                && r.cell.cn == cn
+                                && r.cell.param == p
+                                && r.cell.approach == a
+                        })
+                        .map(|r| r.row.gap)
+                };
+                let (ga, gb) = (find(Approach::Conventional), find(Approach::Improved));
+                if let Some(gb) = gb {
+                    b_all += 1;
+                    b_zero += (gb == 0.0) as usize;
+                }
+                a_pos += ga.map(|g| (g > 0.0) as usize).unwrap_or(0);
+                rows.push(vec![
+                    d.clone(),
+                    cn.nx.to_string(),
+                    cn.ny.to_string(),
+                    p.name().into(),
+                    num(ga, 9),
+                    num(gb, 9),
+                ]);
+            }
+        }
+    }
+    let grid = g.grid;
+    let claim = Claim {
+        rival: None,
+        chapter: "5".into(),
+        statement: format!("The improved approach B leaves no gap (grid {grid})"),
+        ours: (b_zero, b_all),
+        thesis: None,
+        note: format!("gap exactly 0; A has a positive gap in {a_pos} cells (`gaps_{grid}.csv`)"),
+    };
+    (h, rows, claim)
+}
+
+/// The claim that the surface error falls as the control net grows, per (data,
+/// parameterisation, approach) series, here and on the thesis' figures.
+fn series_claim(g: &GridRuns) -> Claim {
+    let mut sorted = g.cns.clone();
+    sorted.sort();
+    let series = |err: &ErrorOf| -> (usize, usize) {
+        let (mut yes, mut all) = (0, 0);
+        for d in &g.data {
+            for &p in &g.params {
+                for &a in &g.approaches {
+                    let v: Option<Vec<f64>> = sorted.iter().map(|&cn| err(d, cn, p, a)).collect();
+                    if let Some(v) = v.filter(|v| v.len() > 1) {
+                        all += 1;
+                        yes += v.windows(2).all(|w| w[1] < w[0]) as usize;
+                    }
+                }
+            }
+        }
+        (yes, all)
+    };
+    Claim {
+        rival: None,
+        chapter: "5".into(),
+        statement: format!("Surface error falls as the control net grows (grid {})", g.grid),
+        ours: series(&runs_error(&g.runs)),
+        thesis: g.thesis.as_ref().map(|t| series(&thesis_error(t))),
+        note: "per (data, parameterisation, approach) series".into(),
+    }
+}
+
+/// Appendix E/F in REPORT.md: ours beside the thesis' value, per data set and control net.
+fn side_by_side_table(g: &GridRuns) -> (Vec<String>, Rows) {
+    let ours = runs_error(&g.runs);
+    let mut rows = Vec::new();
+    for d in &g.data {
+        for &cn in &g.cns {
+            let mut row = vec![d.clone(), cn.to_string()];
+            for &p in &g.params {
+                for &a in &g.approaches {
+                    let t = g.thesis.as_ref().and_then(|t| thesis_error(t)(d, cn, p, a));
+                    row.push(beside(ours(d, cn, p, a), t, 3));
+                }
+            }
+            rows.push(row);
+        }
+    }
+    let mut h = vec!["data".to_string(), "CN".into()];
+    for &p in &g.params {
+        for &a in &g.approaches {
+            h.push(format!("{} {}", p.name(), a.letter()));
+        }
+    }
+    (h, rows)
+}
+
+/// Write every Chapter 5 file (tables computed first, then rendered); returns the REPORT.md
+/// section.
 pub fn write(
     runs: &[FitRun],
     out: &Path,
@@ -120,6 +391,9 @@ pub fn write(
 ) -> Result<String> {
     let rows: Vec<_> = runs.iter().map(|r| r.row.clone()).collect();
     write_atomic(&out.join("runs.csv"), csv_text(&rows)?.as_bytes())?;
+    let csv = |name: &str, h: &[String], rows: &Rows| -> Result<()> {
+        write_atomic(&out.join(format!("{name}.csv")), csv_records(h, rows)?.as_bytes())
+    };
     let mut s = String::from(
         "## Chapter 5: cubic B-spline approximation, conventional (A) vs improved (B)\n\n",
     );
@@ -132,283 +406,63 @@ pub fn write(
     s.push_str(&method(runs));
     let mut claims = Vec::new();
     for grid in ordered(runs.iter().map(|r| r.cell.grid)) {
-        let g_runs: Vec<FitRun> = runs.iter().filter(|r| r.cell.grid == grid).cloned().collect();
-        let data = ordered(g_runs.iter().map(|r| r.cell.dataset.clone()));
-        let cns = ordered(g_runs.iter().map(|r| r.cell.cn));
-        let params = ordered(g_runs.iter().map(|r| r.cell.param));
-        let approaches = ordered(g_runs.iter().map(|r| r.cell.approach));
-        let (app_name, wa_name, wb_name, ab_name) = table_names(grid);
-        let thesis = reference::table(&app_name);
-        let ours = runs_error(&g_runs);
-
-        // Appendix E/F: the reference's column order where there is one.
-        let header: Vec<String> = match &thesis {
-            Some(t) => t.header.clone(),
-            None => {
-                let mut h = vec!["data".to_string(), "cn_x".into(), "cn_y".into()];
-                for p in Parameterisation::ALL {
-                    for a in [Approach::Conventional, Approach::Improved] {
-                        h.push(format!("{}_{}", p.name(), a.letter()));
-                    }
-                }
-                h
-            }
-        };
-        let mut app_rows = Vec::new();
-        for d in &data {
-            for &cn in &cns {
-                let mut row = vec![d.clone(), cn.nx.to_string(), cn.ny.to_string()];
-                for col in &header[3..] {
-                    let v = Parameterisation::ALL
-                        .iter()
-                        .flat_map(|&p| {
-                            [Approach::Conventional, Approach::Improved].map(move |a| (p, a))
-                        })
-                        .find(|(p, a)| format!("{}_{}", p.name(), a.letter()) == *col)
-                        .and_then(|(p, a)| ours(d, cn, p, a));
-                    row.push(v.map(|x| format!("{x:.6}")).unwrap_or_default());
-                }
-                app_rows.push(row);
-            }
-        }
-        write_atomic(
-            &out.join(format!("{app_name}.csv")),
-            csv_records(&header, &app_rows)?.as_bytes(),
-        )?;
+        let g = GridRuns::new(runs, grid);
+        let (app_name, wa_name, wb_name, ab_name) = g.names.clone();
+        let (h, rows) = appendix(&g);
+        csv(&app_name, &h, &rows)?;
 
         // Win counts.
         let mut wins_md = String::new();
         for (a, name) in [(Approach::Conventional, &wa_name), (Approach::Improved, &wb_name)] {
-            if !approaches.contains(&a) {
+            if !g.approaches.contains(&a) {
                 continue;
             }
-            let w = param_wins(&ours, &data, &cns, &params, a);
-            let mut h = vec!["data".to_string()];
-            h.extend(params.iter().map(|p| p.name().to_string()));
-            h.push("cells".into());
-            let mut rows: Vec<Vec<String>> = w
-                .iter()
-                .map(|(d, v, c)| {
-                    std::iter::once(d.clone())
-                        .chain(v.iter().map(|x| x.to_string()))
-                        .chain(std::iter::once(c.to_string()))
-                        .collect()
-                })
-                .collect();
-            let totals: Vec<usize> =
-                (0..params.len()).map(|k| w.iter().map(|x| x.1[k]).sum()).collect();
-            let cells: usize = w.iter().map(|x| x.2).sum();
-            rows.push(
-                std::iter::once("total".to_string())
-                    .chain(totals.iter().map(|x| x.to_string()))
-                    .chain(std::iter::once(cells.to_string()))
-                    .collect(),
-            );
-            write_atomic(&out.join(format!("{name}.csv")), csv_records(&h, &rows)?.as_bytes())?;
+            let (h, rows, claim) = param_win_table(&g, a);
+            csv(name, &h, &rows)?;
             let _ = write!(wins_md, "\n**`{name}.csv`**: control nets where each parameterisation gives approach {} the least surface error\n\n{}", a.letter(), table(&h, &rows));
-            // Claim: the thesis' best parameterisation per approach.
-            let thesis_best = if a == Approach::Conventional {
-                Parameterisation::Exponential
-            } else {
-                Parameterisation::ChordLength
-            };
-            if let Some(k) = params.iter().position(|&p| p == thesis_best) {
-                let t_counts = thesis.as_ref().map(|t| {
-                    let te = thesis_error(t);
-                    let tw = param_wins(&te, &data, &cns, &params, a);
-                    let tt: Vec<usize> =
-                        (0..params.len()).map(|k| tw.iter().map(|x| x.1[k]).sum()).collect();
-                    (tt[k], tw.iter().map(|x| x.2).sum::<usize>())
-                });
-                // Counted in cells, as the thesis counts them: X wins `totals[k]` of `cells` and
-                // holds when no other parameterisation wins as many.
-                let rival = totals
-                    .iter()
-                    .enumerate()
-                    .filter(|&(j, _)| j != k)
-                    .map(|(_, &t)| t)
-                    .max()
-                    .unwrap_or(0);
-                claims.push(Claim {
-                    chapter: "5".into(),
-                    rival: Some(rival),
-                    statement: format!(
-                        "{} is the best parameterisation for approach {} (grid {grid})",
-                        thesis_best.name(),
-                        a.letter()
-                    ),
-                    ours: (totals[k], cells),
-                    thesis: t_counts,
-                    note: format!(
-                        "wins here: {}",
-                        params
-                            .iter()
-                            .zip(&totals)
-                            .map(|(p, t)| format!("{} {t}", p.name()))
-                            .collect::<Vec<_>>()
-                            .join(", ")
-                    ),
-                });
-            }
+            claims.extend(claim);
         }
-        if approaches.contains(&Approach::Conventional) && approaches.contains(&Approach::Improved)
+        if g.approaches.contains(&Approach::Conventional)
+            && g.approaches.contains(&Approach::Improved)
         {
-            let ab = approach_wins(&ours, &data, &cns, &params);
-            let h: Vec<String> = ["data", "parameterisation", "a_wins", "b_wins", "cells"]
-                .iter()
-                .map(|s| s.to_string())
-                .collect();
-            let mut rows: Vec<Vec<String>> = ab
-                .iter()
-                .map(|(d, p, a, b, c)| {
-                    vec![d.clone(), p.name().into(), a.to_string(), b.to_string(), c.to_string()]
-                })
-                .collect();
-            let (ta, tb, tc) =
-                ab.iter().fold((0, 0, 0), |acc, x| (acc.0 + x.2, acc.1 + x.3, acc.2 + x.4));
-            rows.push(vec![
-                "total".into(),
-                String::new(),
-                ta.to_string(),
-                tb.to_string(),
-                tc.to_string(),
-            ]);
-            write_atomic(&out.join(format!("{ab_name}.csv")), csv_records(&h, &rows)?.as_bytes())?;
+            let (h, rows, claim) = approach_win_table(&g);
+            csv(&ab_name, &h, &rows)?;
             let _ = write!(wins_md, "\n**`{ab_name}.csv`**: control nets where A or B has the smaller surface error\n\n{}", table(&h, &rows));
-            let thesis_ab = thesis.as_ref().map(|t| {
-                let te = thesis_error(t);
-                approach_wins(&te, &data, &cns, &params)
-                    .iter()
-                    .fold((0, 0), |acc, x| (acc.0 + x.3, acc.1 + x.4))
-            });
-            claims.push(Claim { rival: None, chapter: "5".into(), statement: format!("B beats A in most cells (grid {grid})"), ours: (tb, tc), thesis: thesis_ab, note: "cells where B has the smaller surface error; verdict 'mostly holds' when more than half".into() });
-            // Gaps.
-            let gh: Vec<String> = ["data", "cn_x", "cn_y", "parameterisation", "gap_A", "gap_B"]
-                .iter()
-                .map(|s| s.to_string())
-                .collect();
-            let mut gap_rows = Vec::new();
-            let (mut b_zero, mut b_all, mut a_pos) = (0, 0, 0);
-            for d in &data {
-                for &cn in &cns {
-                    for &p in &params {
-                        let find = |a: Approach| {
-                            g_runs
-                                .iter()
-                                .find(|r| {
-                                    &r.cell.dataset == d
-                                        && r.cell.cn == cn
-                                        && r.cell.param == p
-                                        && r.cell.approach == a
-                                })
-                                .map(|r| r.row.gap)
-                        };
-                        let (ga, gb) = (find(Approach::Conventional), find(Approach::Improved));
-                        if let Some(gb) = gb {
-                            b_all += 1;
-                            b_zero += (gb == 0.0) as usize;
-                        }
-                        a_pos += ga.map(|g| (g > 0.0) as usize).unwrap_or(0);
-                        gap_rows.push(vec![
-                            d.clone(),
-                            cn.nx.to_string(),
-                            cn.ny.to_string(),
-                            p.name().into(),
-                            num(ga, 9),
-                            num(gb, 9),
-                        ]);
-                    }
-                }
-            }
-            write_atomic(
-                &out.join(format!("gaps_{grid}.csv")),
-                csv_records(&gh, &gap_rows)?.as_bytes(),
-            )?;
-            claims.push(Claim {
-                rival: None,
-                chapter: "5".into(),
-                statement: format!("The improved approach B leaves no gap (grid {grid})"),
-                ours: (b_zero, b_all),
-                thesis: None,
-                note: format!(
-                    "gap exactly 0; A has a positive gap in {a_pos} cells (`gaps_{grid}.csv`)"
-                ),
-            });
+            claims.push(claim);
+            let (h, rows, claim) = gap_table(&g);
+            csv(&format!("gaps_{grid}"), &h, &rows)?;
+            claims.push(claim);
         }
-        // Error falls as the control net grows.
-        let mut sorted = cns.clone();
-        sorted.sort();
-        let series = |err: &ErrorOf| -> (usize, usize) {
-            let (mut yes, mut all) = (0, 0);
-            for d in &data {
-                for &p in &params {
-                    for &a in &approaches {
-                        let v: Option<Vec<f64>> =
-                            sorted.iter().map(|&cn| err(d, cn, p, a)).collect();
-                        if let Some(v) = v.filter(|v| v.len() > 1) {
-                            all += 1;
-                            yes += v.windows(2).all(|w| w[1] < w[0]) as usize;
-                        }
-                    }
-                }
-            }
-            (yes, all)
-        };
-        let t_series = thesis.as_ref().map(|t| series(&thesis_error(t)));
-        claims.push(Claim {
-            rival: None,
-            chapter: "5".into(),
-            statement: format!("Surface error falls as the control net grows (grid {grid})"),
-            ours: series(&ours),
-            thesis: t_series,
-            note: "per (data, parameterisation, approach) series".into(),
-        });
-        if let Some(t) = &thesis {
-            let ratios = thesis_ratios(&ours, &thesis_error(t), &data, &cns, &params, &approaches);
+        claims.push(series_claim(&g));
+        if let Some(t) = &g.thesis {
+            let ours = runs_error(&g.runs);
+            let ratios =
+                thesis_ratios(&ours, &thesis_error(t), &g.data, &g.cns, &g.params, &g.approaches);
             let (md, claim) = render_thesis_ratios(&ratios, grid, &app_name, out)?;
             wins_md.push_str(&md);
             claims.push(claim);
         }
-        let geo = geometry_rows(&g_runs, &cns, &approaches);
-        let (md, claim) = render_geometry(&geo, &g_runs, grid, out)?;
+        let geo = geometry_rows(&g.runs, &g.cns, &g.approaches);
+        let (md, claim) = render_geometry(&geo, &g.runs, grid, out)?;
         wins_md.push_str(&md);
         claims.push(claim);
 
         let _ = write!(s, "\n### Grid {grid}: `{app_name}.csv`, ours (thesis)\n\n");
-        let mut md_rows = Vec::new();
-        for d in &data {
-            for &cn in &cns {
-                let mut row = vec![d.clone(), cn.to_string()];
-                for &p in &params {
-                    for &a in &approaches {
-                        let t = thesis.as_ref().and_then(|t| thesis_error(t)(d, cn, p, a));
-                        row.push(beside(ours(d, cn, p, a), t, 3));
-                    }
-                }
-                md_rows.push(row);
-            }
-        }
-        let mut mh = vec!["data".to_string(), "CN".into()];
-        for &p in &params {
-            for &a in &approaches {
-                mh.push(format!("{} {}", p.name(), a.letter()));
-            }
-        }
+        let (mh, md_rows) = side_by_side_table(&g);
         s.push_str(&table(&mh, &md_rows));
         s.push_str(&wins_md);
         if pictures {
-            for name in super::pictures::write(&g_runs, grid, out)? {
+            for name in super::pictures::write(&g.runs, grid, out)? {
                 let _ = writeln!(s, "\n![{name}]({name})");
             }
         }
     }
-    let mut out_s = String::from(&s[..]);
-    out_s.push_str("\n### Claims\n\n");
-    out_s.push_str(&crate::report::claims::write(out, &claims)?);
+    s.push_str("\n### Claims\n\n");
+    s.push_str(&crate::report::claims::write(out, &claims)?);
     if claims.iter().any(|c| c.statement.starts_with("B beats A") && 2 * c.ours.0 <= c.ours.1) {
-        out_s.push_str(DISAGREEMENT);
+        s.push_str(DISAGREEMENT);
     }
-    Ok(out_s)
+    Ok(s)
 }
 
 /// Per control-net size: the median, least and largest ratio of our surface error to the thesis'
