@@ -11,6 +11,13 @@ use somnurbs::experiment::{
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
+    // Output piped into a reader that stops early (`somnurbs drift ... | head`) ends the program
+    // quietly, as for other Unix tools, instead of a panic in println!.
+    #[cfg(unix)]
+    // SAFETY: restoring the default action of SIGPIPE before any thread starts.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     let cli = Cli::parse();
     match run(cli) {
         Ok(code) => code,

@@ -628,3 +628,22 @@ specs = ["fits"]
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("fit.knots") && err.contains("9.69"), "{err}");
 }
+
+/// Output piped into a reader that stops early ends the program quietly (SIGPIPE), not in a panic.
+#[test]
+fn a_closed_pipe_on_stdout_is_not_a_panic() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut child = crate::common::bin()
+        .args(["run", "--dry-run"])
+        .arg(root.join("experiments/ch6_same.toml"))
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    // 4,200 cell lines are more than a pipe holds: the reader goes away before they are written.
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!err.contains("panicked"), "{err}");
+    assert_ne!(out.status.code(), Some(101), "{err}");
+}

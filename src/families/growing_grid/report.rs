@@ -40,7 +40,15 @@ pub fn write(
     let rows: Vec<_> = runs.iter().map(|r| r.row.clone()).collect();
     write_atomic(&out.join("runs.csv"), crate::io::csv_text(&rows)?.as_bytes())?;
 
-    // Map quality.
+    map_quality(maps, out, &mut md)?;
+    least_squares(problems, out, &mut md)?;
+    optimisers(runs, out, &mut md)?;
+    pictures(maps, problems, runs, out, &mut md)?;
+    Ok(md)
+}
+
+/// Map quality per data set (maps.csv and its REPORT.md table).
+fn map_quality(maps: &[MapRun], out: &Path, md: &mut String) -> Result<()> {
     let map_rows: Vec<Vec<String>> = maps
         .iter()
         .map(|m| {
@@ -98,7 +106,15 @@ pub fn write(
     ));
     md.push('\n');
 
-    // Least-squares fit per net and parameterisation.
+    Ok(())
+}
+
+/// The least-squares fit per net and parameterisation (fit_error.csv).
+fn least_squares(
+    problems: &BTreeMap<ProblemKey, OpenSurfaceProblem>,
+    out: &Path,
+    md: &mut String,
+) -> Result<()> {
     let mut fit_rows = Vec::new();
     for ((d, cn, p), pr) in problems {
         let e = pr.fitness(pr.initial_point());
@@ -127,7 +143,12 @@ pub fn write(
     ));
     md.push('\n');
 
-    // Average error per optimiser.
+    Ok(())
+}
+
+/// The average error per optimiser and cell (avg_error.csv), the optimisers over all cells
+/// (optimiser_summary.csv) and each optimiser's verdict against its least-squares start.
+fn optimisers(runs: &[Run], out: &Path, md: &mut String) -> Result<()> {
     let mut groups: BTreeMap<(String, String, String, String), Vec<&Run>> = BTreeMap::new();
     for r in runs {
         groups
@@ -276,9 +297,21 @@ pub fn write(
     }
     md.push('\n');
 
-    // Pictures: per data set, the map and, per net, the surface of the lowest-error run.
+    Ok(())
+}
+
+/// Per data set the grown map and, per control net, the surface of the lowest-error run,
+/// evaluated densely between the data parameters (a near-square net is free to swing out between
+/// them, and the picture shows it).
+fn pictures(
+    maps: &[MapRun],
+    problems: &BTreeMap<ProblemKey, OpenSurfaceProblem>,
+    runs: &[Run],
+    out: &Path,
+    md: &mut String,
+) -> Result<()> {
     ensure_dir(&out.join("png"))?;
-    let _ = writeln!(md, "### Pictures\n\nPer data set: the grown map and, per control net, the surface of the lowest-error run evaluated at the data parameters.\n");
+    let _ = writeln!(md, "### Pictures\n\nPer data set: the grown map and, per control net, the surface of the lowest-error run evaluated densely between the data parameters.\n");
     for m in maps {
         let mut panels = vec![Panel {
             title: format!("growing grid {}x{}", m.map.nx, m.map.ny),
@@ -298,9 +331,14 @@ pub fn write(
                 .min_by(|a, b| a.row.best.total_cmp(&b.row.best));
             if let Some(r) = best {
                 let pr = &problems[&(r.cell.dataset.clone(), r.cell.cn, r.cell.param)];
-                // At the data parameters, as Chapter 5's pictures (between them a near-square net
-                // is free to oscillate: only the grid points are fitted).
-                let pts = pr.fitted(&r.best_x);
+                // Dense: between the data parameters a near-square net is free to swing out
+                // (only the grid points are fitted), and the picture must show it.
+                let (pts, edges) = crate::spline::geometry::dense_wireframe(
+                    &pr.surface(&r.best_x),
+                    &pr.us,
+                    &pr.vs,
+                    crate::spline::DENSE_FACTOR,
+                );
                 panels.push(Panel {
                     title: format!(
                         "{cn} {} {} ({:.4})",
@@ -310,9 +348,9 @@ pub fn write(
                     ),
                     meshes: vec![LineMesh {
                         points: pts,
-                        edges: grid_edges(pr.nx, pr.ny),
+                        edges,
                         colour: style::VERMILLION,
-                        label: "surface at the data parameters".into(),
+                        label: "surface, evaluated densely".into(),
                     }],
                 });
             }
@@ -331,5 +369,5 @@ pub fn write(
             Err(e) => eprintln!("somnurbs: warning: picture skipped: {e}"),
         }
     }
-    Ok(md)
+    Ok(())
 }
