@@ -438,7 +438,10 @@ fn check_inputs(
 }
 
 /// Minimise f over the box [lower, upper] from `x_start` (clamped into the box), returning the
-/// best point found and a certified lower bound.
+/// best point found and a certified lower bound. The start is one of the points compared, so the
+/// returned f is never above f(clamped start): when the start is in the box (approach B's net in
+/// Chapter 6's boxes) the exact optimum is never worse than B. `converged` is false when the
+/// certified relative gap did not reach `tol_rel_gap`; `gap` then says by how much.
 pub fn solve_exact(
     pb: &dyn SumOfNorms,
     lower: &[f64],
