@@ -6,6 +6,7 @@ mod common;
 
 mod cli;
 mod drift;
+mod exact_certificate;
 mod fuzz;
 mod html_report;
 mod own_data;

@@ -4,8 +4,6 @@
 //! never above approach B's error (B lies in the box), the lower bound is below it, and the
 //! relative gap is certified to the spec's `exact_tol` (1e-7), or at the very least to 1e-6.
 
-mod common;
-
 use somnurbs::experiment::spec::{Override, Spec};
 use somnurbs::experiment::RunContext;
 use somnurbs::families::optimise::{exact_optima, problems};
@@ -30,7 +28,7 @@ fn check_spec(name: &str, profile: Option<&str>, jobs: usize, check_pipeline: bo
     for knots in KnotRule::ALL {
         let spec = spec(name, profile, knots);
         let dir = tempfile::tempdir().unwrap();
-        let ctx = RunContext::new(dir.path().to_path_buf(), jobs, common::shared_data());
+        let ctx = RunContext::new(dir.path().to_path_buf(), jobs, crate::common::shared_data());
         let pbs = problems(&spec, &ctx).unwrap();
         let o = spec.file.optim.as_ref().unwrap();
         let tol = o.exact_tol;
@@ -94,7 +92,7 @@ fn exact_optimum_certifies_every_quick_cell() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
-/// The full profiles (50 problems per reading; minutes): `cargo test --release --test
+/// The full profiles (50 problems per reading; minutes): `cargo test --release --test it
 /// exact_certificate -- --ignored --nocapture`. EXACT_SPECS=ch6_exact limits the specs.
 #[test]
 #[ignore]
