@@ -391,210 +391,10 @@ pub fn write(
                 note: "a sanity check of the bound and the fitness".into(),
             });
         }
-        // Appendix I/J: B beside the MIN-error surface of each optimiser, largest net, per data set.
-        if let Some(&cn) = cells.iter().map(|c| &c.2).max() {
-            let appendix = match (grid.nx, grid.ny) {
-                (20, 20) => "appendix_i",
-                (18, 30) => "appendix_j",
-                _ => "optimised_surfaces",
-            };
-            let params: Vec<Parameterisation> = ordered(cells.iter().map(|c| c.1));
-            for d in ordered(cells.iter().map(|c| c.0.clone())) {
-                let mut panels = Vec::new();
-                for &p in &params {
-                    let Some(problem) = problems.get(&(d.clone(), cn, p)) else { continue };
-                    // Drawn from the dense evaluation, so a surface that swings out between the
-                    // data points shows.
-                    let meshes = |x: &[f64]| {
-                        let [(bottom, be), (top, te)] = problem.parts().dense_wireframes(x);
-                        vec![
-                            plots::LineMesh {
-                                points: bottom,
-                                edges: be,
-                                colour: style::DNSOM_BOTTOM,
-                                label: "bottom surface".into(),
-                            },
-                            plots::LineMesh {
-                                points: top,
-                                edges: te,
-                                colour: style::DNSOM_TOP,
-                                label: "top surface".into(),
-                            },
-                        ]
-                    };
-                    let b = meshes(problem.initial_point());
-                    panels.push(plots::Panel {
-                        title: format!(
-                            "{} {cn} B ({:.4})",
-                            p.name(),
-                            problem.fitness(problem.initial_point())
-                        ),
-                        meshes: b.clone(),
-                    });
-                    // The optimised surfaces differ from B by ~1e-4: each is drawn as its
-                    // difference from B, magnified, over B in grey.
-                    let grey: Vec<plots::LineMesh> = b
-                        .iter()
-                        .map(|m| plots::LineMesh {
-                            colour: plotters::style::RGBColor(190, 190, 190),
-                            label: "B, under each optimiser's magnified difference".into(),
-                            ..m.clone()
-                        })
-                        .collect();
-                    for o in &opts {
-                        let min = g
-                            .iter()
-                            .filter(|r| {
-                                r.cell.dataset == d
-                                    && r.cell.param == p
-                                    && r.cell.cn == cn
-                                    && &r.cell.optimiser == o
-                            })
-                            .min_by(|a, b| a.row.best.total_cmp(&b.row.best));
-                        if let Some(r) = min {
-                            let (title, shown) =
-                                match plots::magnified_difference(&b, &meshes(&r.best_x), 0.15) {
-                                    Some((m, k, dmax)) => (
-                                        format!(
-                                            "{}: (MIN - B) x{k:.0}, max {dmax:.0e}",
-                                            o.to_uppercase()
-                                        ),
-                                        grey.iter().cloned().chain(m).collect(),
-                                    ),
-                                    None => (
-                                        format!("{} MIN ({:.4}) = B", o.to_uppercase(), r.row.best),
-                                        b.clone(),
-                                    ),
-                                };
-                            panels.push(plots::Panel { title, meshes: shown });
-                        }
-                    }
-                }
-                if panels.is_empty() {
-                    continue;
-                }
-                crate::io::ensure_dir(&out.join("png"))?;
-                let name = format!("png/{appendix}_{d}.png");
-                match plots::overview_png(&out.join(&name), &format!("{d}, {cn} on {grid}: approach B and the MIN-error surface of each optimiser"), &panels, opts.len() + 1) {
-                    Ok(()) => {
-                        let _ = writeln!(s, "\n![{name}]({name})");
-                    }
-                    Err(e) => eprintln!("somnurbs: warning: picture skipped: {e}"),
-                }
-            }
-        }
-        // Pictures: convergence (median and quartiles over repeats) and box plots for the
-        // largest net with the first parameterisation, per data set.
-        if let Some(&cn) = cells.iter().map(|c| &c.2).max() {
-            let p0 = cells[0].1;
-            for d in ordered(cells.iter().map(|c| c.0.clone())) {
-                let mut series = Vec::new();
-                let mut groups = Vec::new();
-                for (k, o) in opts.iter().enumerate() {
-                    let rs: Vec<&&OptimRun> = g
-                        .iter()
-                        .filter(|r| {
-                            r.cell.dataset == d
-                                && r.cell.param == p0
-                                && r.cell.cn == cn
-                                && &r.cell.optimiser == o
-                        })
-                        .collect();
-                    groups.push((o.clone(), rs.iter().map(|r| r.row.best).collect::<Vec<f64>>()));
-                    let marks: Vec<u64> = rs
-                        .first()
-                        .map(|r| r.trace.iter().map(|t| t.0).collect())
-                        .unwrap_or_default();
-                    let mut pts = Vec::new();
-                    let mut band = Vec::new();
-                    for (m, &e) in marks.iter().enumerate() {
-                        let mut v: Vec<f64> =
-                            rs.iter().filter_map(|r| r.trace.get(m).map(|t| t.1)).collect();
-                        v.sort_by(|a, b| a.total_cmp(b));
-                        if v.is_empty() {
-                            continue;
-                        }
-                        let q = |p: f64| plots::boxplot::quantile_type7(&v, p);
-                        pts.push((e as f64, q(0.5)));
-                        band.push((e as f64, q(0.25), q(0.75)));
-                    }
-                    series.push(Series {
-                        label: o.clone(),
-                        colour: style::optimiser_colour(o)
-                            .unwrap_or_else(|| style::cycle_colour(k)),
-                        points: pts,
-                        band: Some(band),
-                    });
-                }
-                // B (where every run starts) and, where the folder has it, the certified optimum.
-                let (x0, x1) = series
-                    .iter()
-                    .flat_map(|s| s.points.iter().map(|p| p.0))
-                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(x), b.max(x)));
-                let level = |label: String, name: &str, y: f64| Series {
-                    label,
-                    colour: style::optimiser_colour(name).unwrap_or(style::GREY),
-                    points: vec![(x0, y), (x1, y)],
-                    band: None,
-                };
-                if let Some(problem) = problems.get(&(d.clone(), cn, p0)) {
-                    let b = problem.fitness(problem.initial_point());
-                    series.push(level(format!("B {b:.6}"), "b", b));
-                }
-                if let Some(e) = exact.get(&(d.clone(), cn, p0)) {
-                    series.push(level(format!("certified optimum {:.6}", e.f), "exact", e.f));
-                }
-                let conv = format!("png/convergence_{grid}_{d}_{}_{cn}.png", p0.name());
-                crate::io::ensure_dir(&out.join("png"))?;
-                if let Err(e) = plots::line_chart_png(
-                    &out.join(&conv),
-                    &format!("{d}, {} {cn} on {grid}: best fitness (median, quartiles)", p0.name()),
-                    "evaluations",
-                    "surface error",
-                    &series,
-                    false,
-                ) {
-                    eprintln!("somnurbs: warning: picture skipped: {e}");
-                } else {
-                    let _ = writeln!(s, "\n![{conv}]({conv})");
-                }
-                let bx = format!("png/boxplot_{grid}_{d}_{}_{cn}.png", p0.name());
-                if let Err(e) = plots::box_plot_png(
-                    &out.join(&bx),
-                    &format!("{d}, {} {cn} on {grid}: best surface error per repeat", p0.name()),
-                    "surface error",
-                    &groups,
-                ) {
-                    eprintln!("somnurbs: warning: picture skipped: {e}");
-                } else {
-                    let _ = writeln!(s, "\n![{bx}]({bx})");
-                }
-            }
-        }
+        appendix_ij(&g, &cells, &opts, problems, grid, out, &mut s)?;
+        convergence_charts(&g, &cells, &opts, problems, exact, grid, out, &mut s)?;
     }
-    let all_rows: Vec<super::OptimRow> = runs.iter().map(|r| r.row.clone()).collect();
-    let (fopts, ftable) = super::compare::friedman_table(&all_rows);
-    if fopts.len() > 1 {
-        if let Ok(f) = crate::stats::friedman::friedman(&ftable) {
-            let _ = writeln!(s, "\n### Statistics over all cells\n\nFriedman test over {} cells (mean best per optimiser): chi-squared {:.3}, df {}, p = {:.3e}. Mean ranks (1 = least error): {}.{}\n", f.blocks, f.chi_squared, f.df, f.p_value, fopts.iter().zip(&f.mean_ranks).map(|(o, r)| format!("{o} {r:.2}")).collect::<Vec<_>>().join(", "), f.critical_difference.map(|cd| format!(" Nemenyi critical difference (alpha 0.05): {cd:.3}.")).unwrap_or_default());
-            let h: Vec<String> =
-                ["pair", "z", "p", "p (Holm)"].iter().map(|x| x.to_string()).collect();
-            let rows: Vec<Vec<String>> = f
-                .pairwise
-                .iter()
-                .map(|&(i, j, z, p, ph)| {
-                    vec![
-                        format!("{} vs {}", fopts[i], fopts[j]),
-                        format!("{z:.3}"),
-                        format!("{p:.3e}"),
-                        format!("{ph:.3e}"),
-                    ]
-                })
-                .collect();
-            s.push_str(&table(&h, &rows));
-            s.push_str("\nPer-cell Wilcoxon signed-rank and rank-sum tests with A12 effect sizes and a critical-difference diagram: `somnurbs compare <this folder>`.\n");
-        }
-    }
+    s.push_str(&friedman_section(runs));
     let n_ioh = super::ioh::write(runs, out)?;
     let _ = writeln!(s, "\nEvery run's improvements of the best so far in the IOHprofiler format (`ioh/<optimiser>/`: {n_ioh} JSON meta-data files, format version 0.3.3 or later, each with its improvement-based `.dat`), loadable by IOHanalyzer and iohinspector.");
     let near =
@@ -620,4 +420,245 @@ pub fn write(
     s.push_str("\n### Claims\n\n");
     s.push_str(&crate::report::claims::write(out, &claims)?);
     Ok(s)
+}
+
+/// Appendix I/J: B beside the MIN-error surface of each optimiser (its difference from B,
+/// magnified), largest net, per data set, drawn from the dense evaluation.
+fn appendix_ij(
+    g: &[&OptimRun],
+    cells: &[CellKey],
+    opts: &[String],
+    problems: &BTreeMap<ProblemKey, ControlNetProblem>,
+    grid: GridSize,
+    out: &Path,
+    s: &mut String,
+) -> Result<()> {
+    if let Some(&cn) = cells.iter().map(|c| &c.2).max() {
+        let appendix = match (grid.nx, grid.ny) {
+            (20, 20) => "appendix_i",
+            (18, 30) => "appendix_j",
+            _ => "optimised_surfaces",
+        };
+        let params: Vec<Parameterisation> = ordered(cells.iter().map(|c| c.1));
+        for d in ordered(cells.iter().map(|c| c.0.clone())) {
+            let mut panels = Vec::new();
+            for &p in &params {
+                let Some(problem) = problems.get(&(d.clone(), cn, p)) else { continue };
+                // Drawn from the dense evaluation, so a surface that swings out between the
+                // data points shows.
+                let meshes = |x: &[f64]| {
+                    let [(bottom, be), (top, te)] = problem.parts().dense_wireframes(x);
+                    vec![
+                        plots::LineMesh {
+                            points: bottom,
+                            edges: be,
+                            colour: style::DNSOM_BOTTOM,
+                            label: "bottom surface".into(),
+                        },
+                        plots::LineMesh {
+                            points: top,
+                            edges: te,
+                            colour: style::DNSOM_TOP,
+                            label: "top surface".into(),
+                        },
+                    ]
+                };
+                let b = meshes(problem.initial_point());
+                panels.push(plots::Panel {
+                    title: format!(
+                        "{} {cn} B ({:.4})",
+                        p.name(),
+                        problem.fitness(problem.initial_point())
+                    ),
+                    meshes: b.clone(),
+                });
+                // The optimised surfaces differ from B by ~1e-4: each is drawn as its
+                // difference from B, magnified, over B in grey.
+                let grey: Vec<plots::LineMesh> = b
+                    .iter()
+                    .map(|m| plots::LineMesh {
+                        colour: plotters::style::RGBColor(190, 190, 190),
+                        label: "B, under each optimiser's magnified difference".into(),
+                        ..m.clone()
+                    })
+                    .collect();
+                for o in opts {
+                    let min = g
+                        .iter()
+                        .filter(|r| {
+                            r.cell.dataset == d
+                                && r.cell.param == p
+                                && r.cell.cn == cn
+                                && &r.cell.optimiser == o
+                        })
+                        .min_by(|a, b| a.row.best.total_cmp(&b.row.best));
+                    if let Some(r) = min {
+                        let (title, shown) =
+                            match plots::magnified_difference(&b, &meshes(&r.best_x), 0.15) {
+                                Some((m, k, dmax)) => (
+                                    format!(
+                                        "{}: (MIN - B) x{k:.0}, max {dmax:.0e}",
+                                        o.to_uppercase()
+                                    ),
+                                    grey.iter().cloned().chain(m).collect(),
+                                ),
+                                None => (
+                                    format!("{} MIN ({:.4}) = B", o.to_uppercase(), r.row.best),
+                                    b.clone(),
+                                ),
+                            };
+                        panels.push(plots::Panel { title, meshes: shown });
+                    }
+                }
+            }
+            if panels.is_empty() {
+                continue;
+            }
+            crate::io::ensure_dir(&out.join("png"))?;
+            let name = format!("png/{appendix}_{d}.png");
+            match plots::overview_png(
+                &out.join(&name),
+                &format!(
+                    "{d}, {cn} on {grid}: approach B and the MIN-error surface of each optimiser"
+                ),
+                &panels,
+                opts.len() + 1,
+            ) {
+                Ok(()) => {
+                    let _ = writeln!(s, "\n![{name}]({name})");
+                }
+                Err(e) => eprintln!("somnurbs: warning: picture skipped: {e}"),
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Convergence (median and quartiles over repeats, with B and the certified optimum) and box
+/// plots for the largest net with the first parameterisation, per data set.
+#[allow(clippy::too_many_arguments)]
+fn convergence_charts(
+    g: &[&OptimRun],
+    cells: &[CellKey],
+    opts: &[String],
+    problems: &BTreeMap<ProblemKey, ControlNetProblem>,
+    exact: &BTreeMap<ProblemKey, ExactResult>,
+    grid: GridSize,
+    out: &Path,
+    s: &mut String,
+) -> Result<()> {
+    if let Some(&cn) = cells.iter().map(|c| &c.2).max() {
+        let p0 = cells[0].1;
+        for d in ordered(cells.iter().map(|c| c.0.clone())) {
+            let mut series = Vec::new();
+            let mut groups = Vec::new();
+            for (k, o) in opts.iter().enumerate() {
+                let rs: Vec<&&OptimRun> = g
+                    .iter()
+                    .filter(|r| {
+                        r.cell.dataset == d
+                            && r.cell.param == p0
+                            && r.cell.cn == cn
+                            && &r.cell.optimiser == o
+                    })
+                    .collect();
+                groups.push((o.clone(), rs.iter().map(|r| r.row.best).collect::<Vec<f64>>()));
+                let marks: Vec<u64> =
+                    rs.first().map(|r| r.trace.iter().map(|t| t.0).collect()).unwrap_or_default();
+                let mut pts = Vec::new();
+                let mut band = Vec::new();
+                for (m, &e) in marks.iter().enumerate() {
+                    let mut v: Vec<f64> =
+                        rs.iter().filter_map(|r| r.trace.get(m).map(|t| t.1)).collect();
+                    v.sort_by(|a, b| a.total_cmp(b));
+                    if v.is_empty() {
+                        continue;
+                    }
+                    let q = |p: f64| plots::boxplot::quantile_type7(&v, p);
+                    pts.push((e as f64, q(0.5)));
+                    band.push((e as f64, q(0.25), q(0.75)));
+                }
+                series.push(Series {
+                    label: o.clone(),
+                    colour: style::optimiser_colour(o).unwrap_or_else(|| style::cycle_colour(k)),
+                    points: pts,
+                    band: Some(band),
+                });
+            }
+            // B (where every run starts) and, where the folder has it, the certified optimum.
+            let (x0, x1) = series
+                .iter()
+                .flat_map(|s| s.points.iter().map(|p| p.0))
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(x), b.max(x)));
+            let level = |label: String, name: &str, y: f64| Series {
+                label,
+                colour: style::optimiser_colour(name).unwrap_or(style::GREY),
+                points: vec![(x0, y), (x1, y)],
+                band: None,
+            };
+            if let Some(problem) = problems.get(&(d.clone(), cn, p0)) {
+                let b = problem.fitness(problem.initial_point());
+                series.push(level(format!("B {b:.6}"), "b", b));
+            }
+            if let Some(e) = exact.get(&(d.clone(), cn, p0)) {
+                series.push(level(format!("certified optimum {:.6}", e.f), "exact", e.f));
+            }
+            let conv = format!("png/convergence_{grid}_{d}_{}_{cn}.png", p0.name());
+            crate::io::ensure_dir(&out.join("png"))?;
+            if let Err(e) = plots::line_chart_png(
+                &out.join(&conv),
+                &format!("{d}, {} {cn} on {grid}: best fitness (median, quartiles)", p0.name()),
+                "evaluations",
+                "surface error",
+                &series,
+                false,
+            ) {
+                eprintln!("somnurbs: warning: picture skipped: {e}");
+            } else {
+                let _ = writeln!(s, "\n![{conv}]({conv})");
+            }
+            let bx = format!("png/boxplot_{grid}_{d}_{}_{cn}.png", p0.name());
+            if let Err(e) = plots::box_plot_png(
+                &out.join(&bx),
+                &format!("{d}, {} {cn} on {grid}: best surface error per repeat", p0.name()),
+                "surface error",
+                &groups,
+            ) {
+                eprintln!("somnurbs: warning: picture skipped: {e}");
+            } else {
+                let _ = writeln!(s, "\n![{bx}]({bx})");
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The Friedman test over all cells (mean best per optimiser) with its pairwise tests, for
+/// REPORT.md (empty with fewer than two optimisers).
+fn friedman_section(runs: &[OptimRun]) -> String {
+    let mut s = String::new();
+    let all_rows: Vec<super::OptimRow> = runs.iter().map(|r| r.row.clone()).collect();
+    let (fopts, ftable) = super::compare::friedman_table(&all_rows);
+    if fopts.len() > 1 {
+        if let Ok(f) = crate::stats::friedman::friedman(&ftable) {
+            let _ = writeln!(s, "\n### Statistics over all cells\n\nFriedman test over {} cells (mean best per optimiser): chi-squared {:.3}, df {}, p = {:.3e}. Mean ranks (1 = least error): {}.{}\n", f.blocks, f.chi_squared, f.df, f.p_value, fopts.iter().zip(&f.mean_ranks).map(|(o, r)| format!("{o} {r:.2}")).collect::<Vec<_>>().join(", "), f.critical_difference.map(|cd| format!(" Nemenyi critical difference (alpha 0.05): {cd:.3}.")).unwrap_or_default());
+            let h: Vec<String> =
+                ["pair", "z", "p", "p (Holm)"].iter().map(|x| x.to_string()).collect();
+            let rows: Vec<Vec<String>> = f
+                .pairwise
+                .iter()
+                .map(|&(i, j, z, p, ph)| {
+                    vec![
+                        format!("{} vs {}", fopts[i], fopts[j]),
+                        format!("{z:.3}"),
+                        format!("{p:.3e}"),
+                        format!("{ph:.3e}"),
+                    ]
+                })
+                .collect();
+            s.push_str(&table(&h, &rows));
+            s.push_str("\nPer-cell Wilcoxon signed-rank and rank-sum tests with A12 effect sizes and a critical-difference diagram: `somnurbs compare <this folder>`.\n");
+        }
+    }
+    s
 }
