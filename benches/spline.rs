@@ -1,12 +1,17 @@
 //! Chapter 5 speed (run: `cargo bench --bench spline`): all 280 fits of Appendices E + F (5 data
 //! x 4 parameterisations x 7 nets x A/B on grids 20x20 and 18x30) on one core, and one 18x18-net
 //! fit on the 20x20 grid. Target: the 280 fits in under 0.5 s (a numpy implementation: 1.2 ms per
-//! 18x18 fit; geomdl's approximate_surface: 27 ms).
+//! 18x18 fit; geomdl's approximate_surface: 27 ms). Then seed 003's Bezier fitness per example
+//! (evaluations per second, and the full-design SVD path of the grid examples).
 
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
 use somnurbs::experiment::{runner, seeds};
 use somnurbs::families;
 use somnurbs::families::som::spec::SomCell;
+use somnurbs::optim::Problem;
 use somnurbs::som::{Model, SomParams};
+use somnurbs::spline::bezier::{example3, franke, height_grid, peaks, BezierParamProblem, Layout};
 use somnurbs::spline::{fit_two_view, Approach, Parameterisation, TwoViewGrid};
 use std::time::Instant;
 
@@ -81,4 +86,60 @@ fn main() {
     }
     let per = t0.elapsed().as_secs_f64() / reps as f64;
     println!("one 18x18-net fit (both surfaces, approach B) on the 20x20 grid: {:.3} ms (numpy 1.2 ms: {:.1}x; geomdl 27 ms: {:.0}x)", per * 1e3, 1.2e-3 / per, 27e-3 / per);
+    bezier_fitness();
+}
+
+/// Seed 003: the Bezier parameter problem's fitness per example, one core.
+fn bezier_fitness() {
+    let mut rng = ChaCha8Rng::seed_from_u64(1);
+    let (_, ex3) = example3(628, &mut rng);
+    let cases = [
+        (
+            "example1 29x29 (5,5) grid",
+            5,
+            Layout::Grid { nu: 29, nv: 29 },
+            height_grid(franke, 29, 0.0, 1.0),
+        ),
+        (
+            "example2 41x41 (9,9) grid",
+            9,
+            Layout::Grid { nu: 41, nv: 41 },
+            height_grid(peaks, 41, -3.0, 3.0),
+        ),
+        ("example3 628 scattered (5,5)", 5, Layout::Scattered, ex3),
+    ];
+    for (name, d, layout, pts) in cases {
+        let dim = match layout {
+            Layout::Grid { nu, nv } => nu + nv,
+            Layout::Scattered => 2 * pts.len(),
+        };
+        let xs: Vec<Vec<f64>> =
+            (0..64).map(|_| (0..dim).map(|_| rng.gen_range(0.0..1.0)).collect()).collect();
+        let prob = BezierParamProblem::new(d, d, layout, pts, xs[0].clone()).unwrap();
+        let t = Instant::now();
+        let mut n = 0u64;
+        let mut acc = 0.0;
+        while t.elapsed().as_secs_f64() < 1.0 {
+            acc += prob.fitness(&xs[n as usize % xs.len()]);
+            n += 1;
+        }
+        let secs = t.elapsed().as_secs_f64();
+        println!(
+            "{name}: {:.0} evaluations/s ({:.1} us each; checksum {acc:.3e})",
+            n as f64 / secs,
+            1e6 * secs / n as f64
+        );
+        if let Layout::Grid { .. } = layout {
+            let t = Instant::now();
+            let mut m = 0u64;
+            while t.elapsed().as_secs_f64() < 1.0 {
+                let _ = prob.fit(&xs[m as usize % xs.len()]);
+                m += 1;
+            }
+            println!(
+                "  full-design SVD path: {:.0} evaluations/s",
+                m as f64 / t.elapsed().as_secs_f64()
+            );
+        }
+    }
 }

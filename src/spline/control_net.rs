@@ -1162,39 +1162,3 @@ mod tests {
         assert!(pb.fitness(&[0.0; 5]).is_nan());
     }
 }
-
-/// Measurements (run with `cargo test --release -- --ignored --nocapture fitness_timing`).
-#[cfg(test)]
-mod timing {
-    use super::test_support::sphere_problem;
-    use super::*;
-    use std::time::Instant;
-
-    #[test]
-    #[ignore]
-    fn fitness_timing() {
-        for (nx, ny, cx, cy) in [(20, 20, 18, 18), (18, 30, 16, 28), (20, 20, 6, 6)] {
-            let pb = sphere_problem(nx, ny, cx, cy, BoxSpec::DataRange);
-            let x = pb.initial_point().to_vec();
-            for isa in Isa::ALL {
-                let q = pb.clone().with_isa(isa);
-                if q.isa() != isa {
-                    continue;
-                }
-                let mut s = Scratch::default();
-                let mut acc = 0.0;
-                let n = 4_000;
-                // Best of 60 short batches (the machine is shared, and its speed drifts).
-                let mut per = f64::INFINITY;
-                for _ in 0..60 {
-                    let t = Instant::now();
-                    for k in 0..n {
-                        acc += q.fitness_with(&x, &mut s) * (k & 1) as f64;
-                    }
-                    per = per.min(t.elapsed().as_secs_f64() / n as f64);
-                }
-                println!("grid {nx}x{ny} cn {cx}x{cy} dim {} {isa:?}: {:.3} us per evaluation ({acc:.3e})", q.dim(), per * 1e6);
-            }
-        }
-    }
-}
