@@ -689,8 +689,9 @@ mod tests {
         let (mut x1, mut v1, mut g1) = (a.clone(), b.clone(), gen.clone());
         let (mut x2, mut v2, mut g2) = (a.clone(), b.clone(), gen.clone());
         for _ in 0..2 {
-            pso_move_generic(&mut x1, &x1.clone(), &mut v1, &c, &hi, &mut g1, co, bounds);
-            pso_move(&mut x2, &x2.clone(), &mut v2, &c, &hi, &mut g2, co, bounds);
+            let (from1, from2) = (x1.clone(), x2.clone());
+            pso_move_generic(&mut x1, &from1, &mut v1, &c, &hi, &mut g1, co, bounds);
+            pso_move(&mut x2, &from2, &mut v2, &c, &hi, &mut g2, co, bounds);
         }
         assert_eq!((&x1, &v1, &g1), (&x2, &v2, &g2));
         // Each compiled copy this CPU can run, not only the one `pso_move` picks.
@@ -712,7 +713,8 @@ mod tests {
                 let (mut x3, mut v3, mut g3) = (a.clone(), b.clone(), gen.clone());
                 for _ in 0..2 {
                     // SAFETY: the CPU reports the copy's features.
-                    unsafe { copy(&mut x3, &x3.clone(), &mut v3, &c, &hi, &mut g3, co, bounds) };
+                    let from = x3.clone();
+                    unsafe { copy(&mut x3, &from, &mut v3, &c, &hi, &mut g3, co, bounds) };
                 }
                 assert_eq!((&x1, &v1, &g1), (&x3, &v3, &g3), "n {n}");
             }
