@@ -41,6 +41,10 @@ fn main() {
     )
     .unwrap();
     let x0 = problem.initial_point().to_vec();
+    if let Ok(what) = std::env::var("BENCH_COUNT") {
+        count(&what, &problem);
+        return;
+    }
     println!(
         "control-net problem 18x18 on 20x20: {} variables, B = {:.6}",
         problem.dim(),
@@ -259,4 +263,40 @@ fn scaling(points: &[Point3], mhz: f64) {
             s / r.evaluations as f64 * 1e6
         );
     }
+}
+
+/// `BENCH_COUNT=fitness|ga|de|pso|csa|icsa` (BENCH_GENERATIONS, default 100, x 40): only the work
+/// inside [`counted`], for instruction counts by
+/// `valgrind --tool=callgrind --toggle-collect='*counted*'` (see `scripts/count_overhead.sh`,
+/// which turns them into each optimiser's overhead per evaluation in fitness units). `fitness`
+/// evaluates the fitness as many times as a DE run of the same budget does (40 (1 + G)) at
+/// points that differ from x0 in one coordinate each.
+fn count(what: &str, problem: &ControlNetProblem) {
+    let generations: u64 =
+        std::env::var("BENCH_GENERATIONS").ok().and_then(|v| v.parse().ok()).unwrap_or(100);
+    let budget = Budget { generations, population: 40, init_range: 5e-6, trace_every_evals: 400 };
+    let (evaluations, value) = counted(what, problem, &budget);
+    println!("BENCH_COUNT {what}: {evaluations} evaluations, {value:.9}");
+}
+
+/// The counted work of [`count`]: (evaluations, the best or summed fitness).
+#[inline(never)]
+fn counted(what: &str, problem: &ControlNetProblem, budget: &Budget) -> (u64, f64) {
+    if what == "fitness" {
+        let n = budget.population as u64 * (1 + budget.generations);
+        let x0 = problem.initial_point();
+        let mut x = x0.to_vec();
+        let mut acc = 0.0;
+        for k in 0..n as usize {
+            let j = k % x0.len();
+            x[j] += 1e-9;
+            acc += problem.fitness(std::hint::black_box(&x));
+            x[j] = x0[j];
+        }
+        return (n, acc);
+    }
+    let opt = default_optimiser(what).unwrap_or_else(|| panic!("BENCH_COUNT: unknown '{what}'"));
+    let mut rng = somnurbs::experiment::seeds::cell_rng(1, "bench");
+    let r = opt.run(problem, budget, &mut rng).unwrap();
+    (r.evaluations, r.best_fitness)
 }

@@ -32,8 +32,8 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::aligned::Aligned;
-use super::kernels::{clamp, de_trial, DeSources};
-use super::levy::{levy_fill, neg_ln};
+use super::kernels::{de_trial, DeSources};
+use super::levy::{flight_coordinate, levy_fill, levy_flight, neg_ln, FlightSources, LevyScratch};
 use super::problem::{check_problem, Budget, Evaluator, Optimiser, Population, Problem, RunResult};
 use super::sampling::{bernoulli_threshold_32, index, mantegna_sigma_u, unit, DeLanes};
 use super::{check_range, OptimError};
@@ -227,16 +227,22 @@ fn cuckoo_search(
     let mut cand = vec![Aligned::zeros(d); n];
     let mut cand_f = vec![0.0; n];
     let mut lanes = DeLanes::from_rng(rng);
+    let mut scratch = LevyScratch::default();
     for t in 0..budget.generations {
         let (pa, alpha) = schedule(t);
-        // 1. Levy flights around each nest, scaled by its distance to the best.
+        // 1. Levy flights around each nest, scaled by its distance to the best (beta = 3/2: the
+        // factors and the step in one vectorised pass).
         for i in 0..n {
-            levy_factors(&mut levy, &mut v_buf, sigma_u, beta, &mut lanes);
             let (x, c) = (&pop.x[i][..d], &mut cand[i][..d]);
-            let (b, l, lo, hi) = (&best[..d], &levy[..d], &lo[..d], &hi[..d]);
-            for j in 0..d {
-                let nj = x[j] + alpha * l[j] * (x[j] - b[j]);
-                c[j] = if nj.is_nan() { x[j] } else { clamp(nj, lo[j], hi[j]) };
+            let (b, lo, hi) = (&best[..d], &lo[..d], &hi[..d]);
+            if beta == 1.5 {
+                let src = FlightSources { x, b, lo, hi };
+                levy_flight(c, src, alpha, sigma_u, &mut lanes, &mut scratch);
+            } else {
+                levy_factors(&mut levy, &mut v_buf, sigma_u, beta, &mut lanes);
+                for j in 0..d {
+                    c[j] = flight_coordinate(x[j], b[j], lo[j], hi[j], alpha, levy[j]);
+                }
             }
             let f = eval.eval(c);
             if f <= pop.f[i] {

@@ -407,12 +407,14 @@ fn pso_coordinate(
     (clamp(x + vj, lo, hi), vj)
 }
 
-/// The move of coordinates `from..n`, coordinate j taking the next word of lane j % 8 (the
-/// baseline copy from 0; the vector copies for the coordinates after their last whole vector).
+/// The move of coordinates `from..n` of position `x` into `out`, coordinate j taking the next
+/// word of lane j % 8 (the baseline copy from 0; the vector copies for the coordinates after their
+/// last whole vector).
 #[allow(clippy::too_many_arguments)] // the vector copies' arguments and where they stopped
 #[inline(always)]
 fn pso_move_scalar(
-    x: &mut [f64],
+    out: &mut [f64],
+    x: &[f64],
     v: &mut [f64],
     p: &[f64],
     g: &[f64],
@@ -421,17 +423,19 @@ fn pso_move_scalar(
     co: PsoCoefficients,
     from: usize,
 ) {
-    let n = x.len();
-    let (v, p, g, lo, hi, vmax) =
-        (&mut v[..n], &p[..n], &g[..n], &b.lo[..n], &b.hi[..n], &b.vmax[..n]);
+    let n = out.len();
+    let (x, v, p, g, lo, hi, vmax) =
+        (&x[..n], &mut v[..n], &p[..n], &g[..n], &b.lo[..n], &b.hi[..n], &b.vmax[..n]);
     for j in from..n {
         let word = rng.next_word(j % PSO_LANES);
-        (x[j], v[j]) = pso_coordinate(x[j], v[j], p[j], g[j], lo[j], hi[j], vmax[j], word, co);
+        (out[j], v[j]) = pso_coordinate(x[j], v[j], p[j], g[j], lo[j], hi[j], vmax[j], word, co);
     }
 }
 
+#[allow(clippy::too_many_arguments)] // the move's vectors, generators, constants and box
 fn pso_move_generic(
-    x: &mut [f64],
+    out: &mut [f64],
+    x: &[f64],
     v: &mut [f64],
     p: &[f64],
     g: &[f64],
@@ -439,7 +443,7 @@ fn pso_move_generic(
     co: PsoCoefficients,
     b: PsoBounds,
 ) {
-    pso_move_scalar(x, v, p, g, b, rng, co, 0)
+    pso_move_scalar(out, x, v, p, g, b, rng, co, 0)
 }
 
 /// The PSO move in 256-bit instructions: the eight lanes' state in eight registers for the whole
@@ -448,12 +452,12 @@ fn pso_move_generic(
 /// not vectorised, and AVX-512 code uses 512-bit vectors, which this Zen 4 runs in two halves.)
 #[cfg(target_arch = "x86_64")]
 macro_rules! pso_move_simd {
-    ($isa:ident, $x:ident, $v:ident, $p:ident, $g:ident, $rng:ident, $co:ident, $b:ident) => {{
+    ($isa:ident, $out:ident, $x:ident, $v:ident, $p:ident, $g:ident, $rng:ident, $co:ident, $b:ident) => {{
         use std::arch::x86_64::*;
-        let (x, co) = ($x, $co);
-        let n = x.len();
-        let (v, p, g, lo, hi, vmax) =
-            (&mut $v[..n], &$p[..n], &$g[..n], &$b.lo[..n], &$b.hi[..n], &$b.vmax[..n]);
+        let (out, co) = ($out, $co);
+        let n = out.len();
+        let (x, v, p, g, lo, hi, vmax) =
+            (&$x[..n], &mut $v[..n], &$p[..n], &$g[..n], &$b.lo[..n], &$b.hi[..n], &$b.vmax[..n]);
         let mantissa_top32 = _mm256_set1_epi64x(0x000f_ffff_fff0_0000);
         let one = _mm256_set1_epi64x(0x3ff0_0000_0000_0000);
         let (c1, c2, k) = (_mm256_set1_pd(co.c1), _mm256_set1_pd(co.c2), _mm256_set1_pd(co.k));
@@ -504,7 +508,7 @@ macro_rules! pso_move_simd {
                     _mm256_loadu_pd(hi.as_ptr().add(j)),
                     _mm256_max_pd(_mm256_loadu_pd(lo.as_ptr().add(j)), xn),
                 );
-                _mm256_storeu_pd(x.as_mut_ptr().add(j), xn);
+                _mm256_storeu_pd(out.as_mut_ptr().add(j), xn);
             }};
         }
         let full = n - n % PSO_LANES;
@@ -525,14 +529,16 @@ macro_rules! pso_move_simd {
                 _mm256_storeu_si256(state[r].as_mut_ptr().add(4).cast(), *hg);
             }
         }
-        pso_move_scalar(x, v, p, g, PsoBounds { lo, hi, vmax }, $rng, co, done);
+        pso_move_scalar(out, x, v, p, g, PsoBounds { lo, hi, vmax }, $rng, co, done);
     }};
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
+#[allow(clippy::too_many_arguments)] // the move's vectors, generators, constants and box
 fn pso_move_avx2(
-    x: &mut [f64],
+    out: &mut [f64],
+    x: &[f64],
     v: &mut [f64],
     p: &[f64],
     g: &[f64],
@@ -540,13 +546,15 @@ fn pso_move_avx2(
     co: PsoCoefficients,
     b: PsoBounds,
 ) {
-    pso_move_simd!(avx2, x, v, p, g, rng, co, b)
+    pso_move_simd!(avx2, out, x, v, p, g, rng, co, b)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma,avx512f,avx512vl")]
+#[allow(clippy::too_many_arguments)] // the move's vectors, generators, constants and box
 fn pso_move_avx512vl(
-    x: &mut [f64],
+    out: &mut [f64],
+    x: &[f64],
     v: &mut [f64],
     p: &[f64],
     g: &[f64],
@@ -554,14 +562,18 @@ fn pso_move_avx512vl(
     co: PsoCoefficients,
     b: PsoBounds,
 ) {
-    pso_move_simd!(avx512vl, x, v, p, g, rng, co, b)
+    pso_move_simd!(avx512vl, out, x, v, p, g, rng, co, b)
 }
 
-/// One constricted PSO move of one particle. Coordinate j takes r1, r2 from the two 32-bit
-/// halves of the next word of lane j % 8 of `rng` (the generation and the move are one
-/// vectorised loop).
+/// One constricted PSO move of one particle from position `x` into `out` (of x's length; the
+/// velocity `v` in place). Coordinate j takes r1, r2 from the two 32-bit halves of the next word
+/// of lane j % 8 of `rng` (the generation and the move are one vectorised loop). Out of place,
+/// so that the caller can keep a particle's position and personal best in one buffer while they
+/// are equal, and swap buffers instead of copying when the personal best moves.
+#[allow(clippy::too_many_arguments)] // the move's vectors, generators, constants and box
 pub fn pso_move(
-    x: &mut [f64],
+    out: &mut [f64],
+    x: &[f64],
     v: &mut [f64],
     p: &[f64],
     g: &[f64],
@@ -573,14 +585,14 @@ pub fn pso_move(
     {
         if use_avx512() {
             // SAFETY: the CPU reports AVX2, FMA, AVX-512F and AVX-512VL.
-            return unsafe { pso_move_avx512vl(x, v, p, g, rng, co, bounds) };
+            return unsafe { pso_move_avx512vl(out, x, v, p, g, rng, co, bounds) };
         }
         if use_avx2() {
             // SAFETY: the CPU reports AVX2 and FMA.
-            return unsafe { pso_move_avx2(x, v, p, g, rng, co, bounds) };
+            return unsafe { pso_move_avx2(out, x, v, p, g, rng, co, bounds) };
         }
     }
-    pso_move_generic(x, v, p, g, rng, co, bounds)
+    pso_move_generic(out, x, v, p, g, rng, co, bounds)
 }
 
 #[cfg(test)]
@@ -677,8 +689,9 @@ mod tests {
         let (mut x1, mut v1, mut g1) = (a.clone(), b.clone(), gen.clone());
         let (mut x2, mut v2, mut g2) = (a.clone(), b.clone(), gen.clone());
         for _ in 0..2 {
-            pso_move_generic(&mut x1, &mut v1, &c, &hi, &mut g1, co, bounds);
-            pso_move(&mut x2, &mut v2, &c, &hi, &mut g2, co, bounds);
+            let (from1, from2) = (x1.clone(), x2.clone());
+            pso_move_generic(&mut x1, &from1, &mut v1, &c, &hi, &mut g1, co, bounds);
+            pso_move(&mut x2, &from2, &mut v2, &c, &hi, &mut g2, co, bounds);
         }
         assert_eq!((&x1, &v1, &g1), (&x2, &v2, &g2));
         // Each compiled copy this CPU can run, not only the one `pso_move` picks.
@@ -686,6 +699,7 @@ mod tests {
         {
             type Move = unsafe fn(
                 &mut [f64],
+                &[f64],
                 &mut [f64],
                 &[f64],
                 &[f64],
@@ -699,7 +713,8 @@ mod tests {
                 let (mut x3, mut v3, mut g3) = (a.clone(), b.clone(), gen.clone());
                 for _ in 0..2 {
                     // SAFETY: the CPU reports the copy's features.
-                    unsafe { copy(&mut x3, &mut v3, &c, &hi, &mut g3, co, bounds) };
+                    let from = x3.clone();
+                    unsafe { copy(&mut x3, &from, &mut v3, &c, &hi, &mut g3, co, bounds) };
                 }
                 assert_eq!((&x1, &v1, &g1), (&x3, &v3, &g3), "n {n}");
             }
@@ -813,9 +828,10 @@ mod timing {
         let bounds = PsoBounds { lo: &lo, hi: &hi, vmax: &vmax };
         let co = PsoCoefficients { k: 0.729, c1: 2.05, c2: 2.05 };
         let mut gen = PsoLanes::from_rng(&mut ChaCha8Rng::seed_from_u64(2));
-        let (mut x, mut vel) = (v.clone(), vec![0.0; n]);
+        let (mut x, mut vel, mut moved) = (v.clone(), vec![0.0; n], vec![0.0; n]);
         type Move = unsafe fn(
             &mut [f64],
+            &[f64],
             &mut [f64],
             &[f64],
             &[f64],
@@ -824,7 +840,7 @@ mod timing {
             PsoBounds,
         );
         let moves: [(&str, bool, Move); 3] = [
-            ("baseline", true, |x, v, p, g, r, c, b| pso_move_generic(x, v, p, g, r, c, b)),
+            ("baseline", true, |o, x, v, p, g, r, c, b| pso_move_generic(o, x, v, p, g, r, c, b)),
             ("avx2", avx2_fma(), pso_move_avx2),
             ("avx512vl", avx512vl(), pso_move_avx512vl),
         ];
@@ -832,7 +848,10 @@ mod timing {
             // SAFETY: the CPU reports the copy's features.
             println!(
                 "PSO move {name}: {:.3} ns per coordinate",
-                best_ns(n, || unsafe { copy(&mut x, &mut vel, &v, &hi, &mut gen, co, bounds) })
+                best_ns(n, || {
+                    unsafe { copy(&mut moved, &x, &mut vel, &v, &hi, &mut gen, co, bounds) };
+                    std::mem::swap(&mut x, &mut moved);
+                })
             );
         }
     }

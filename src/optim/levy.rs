@@ -190,6 +190,113 @@ fn fill_body(out: &mut [f64], sigma: f64, rng: &mut DeLanes) {
     }
 }
 
+/// The vectors of one Levy flight: the nest `x`, the best nest `b` and the box.
+#[derive(Debug, Clone, Copy)]
+pub struct FlightSources<'a> {
+    pub x: &'a [f64],
+    pub b: &'a [f64],
+    pub lo: &'a [f64],
+    pub hi: &'a [f64],
+}
+
+/// One flight's words and factors, chunk by chunk (kept by the caller across flights, so that
+/// nothing is allocated or cleared per flight).
+#[derive(Debug, Clone)]
+pub struct LevyScratch {
+    words: [u64; WORDS],
+    factors: [f64; CHUNK],
+}
+
+impl Default for LevyScratch {
+    fn default() -> LevyScratch {
+        LevyScratch { words: [0; WORDS], factors: [0.0; CHUNK] }
+    }
+}
+
+/// One coordinate of a Levy flight: x + alpha L (x - b) clamped to [lo, hi] (x itself if that
+/// is NaN, from 0 * inf).
+#[inline(always)]
+pub fn flight_coordinate(x: f64, b: f64, lo: f64, hi: f64, alpha: f64, l: f64) -> f64 {
+    let nj = x + alpha * l * (x - b);
+    if nj.is_nan() {
+        x
+    } else {
+        super::kernels::clamp(nj, lo, hi)
+    }
+}
+
+/// [`levy_flight`] in one pass: each chunk's factors go straight into its coordinates' flight,
+/// while they are in L1 (the same draws and operations as [`fill_body`] followed by
+/// [`flight_coordinate`] per coordinate, so the same bits).
+#[inline(always)]
+fn flight_body(
+    c: &mut [f64],
+    src: FlightSources,
+    alpha: f64,
+    sigma: f64,
+    rng: &mut DeLanes,
+    scratch: &mut LevyScratch,
+) {
+    let n = c.len();
+    let (x, b, lo, hi) = (&src.x[..n], &src.b[..n], &src.lo[..n], &src.hi[..n]);
+    for (k, piece) in c.chunks_mut(CHUNK).enumerate() {
+        super::kernels::lanes_fill(&mut scratch.words, rng);
+        chunk(&mut scratch.factors, &scratch.words, sigma);
+        let (from, m) = (k * CHUNK, piece.len());
+        let (x, b, lo, hi) = (&x[from..from + m], &b[from..from + m], &lo[from..], &hi[from..]);
+        let (lo, hi, l) = (&lo[..m], &hi[..m], &scratch.factors[..m]);
+        for j in 0..m {
+            piece[j] = flight_coordinate(x[j], b[j], lo[j], hi[j], alpha, l[j]);
+        }
+    }
+}
+
+fn flight_generic(
+    c: &mut [f64],
+    src: FlightSources,
+    alpha: f64,
+    sigma: f64,
+    rng: &mut DeLanes,
+    scratch: &mut LevyScratch,
+) {
+    flight_body(c, src, alpha, sigma, rng, scratch)
+}
+
+/// The same Rust compiled for AVX2 (vectorised by the compiler, no fused multiply-add).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+fn flight_avx2(
+    c: &mut [f64],
+    src: FlightSources,
+    alpha: f64,
+    sigma: f64,
+    rng: &mut DeLanes,
+    scratch: &mut LevyScratch,
+) {
+    flight_body(c, src, alpha, sigma, rng, scratch)
+}
+
+/// One Levy flight (beta = 3/2) of a nest into `c` (of the nest's length): coordinate j is
+/// [`flight_coordinate`] of the factor sigma_u u psi / |v|^(2/3) that [`levy_fill`] would draw
+/// for it from `rng` (the same words and the same bits), in the copy the run's SIMD choice names.
+pub fn levy_flight(
+    c: &mut [f64],
+    src: FlightSources,
+    alpha: f64,
+    sigma_u: f64,
+    rng: &mut DeLanes,
+    scratch: &mut LevyScratch,
+) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if super::kernels::use_avx2() {
+            // SAFETY: use_avx2 is true only when the CPU reports AVX2 and FMA.
+            return unsafe { flight_avx2(c, src, alpha, sigma_u, rng, scratch) };
+        }
+    }
+    flight_generic(c, src, alpha, sigma_u, rng, scratch)
+}
+
 fn fill_generic(out: &mut [f64], sigma: f64, rng: &mut DeLanes) {
     fill_body(out, sigma, rng)
 }
@@ -315,6 +422,38 @@ mod tests {
             }
             assert_eq!(a, b);
         }
+    }
+
+    /// A fused flight gives the bits of the factors from `levy_fill` followed by the flight's
+    /// formula, in the dispatched and the baseline copy, for lengths around the chunk size, with
+    /// coordinates at, inside and beyond the box; and the generators end in the same state.
+    #[test]
+    fn fused_flight_is_fill_then_step() {
+        let mut r = ChaCha8Rng::seed_from_u64(12);
+        for n in [1, 5, 127, 128, 129, 300, 1740] {
+            let x: Vec<f64> = (0..n).map(|_| symmetric(&mut r, 1.0)).collect();
+            let b: Vec<f64> = (0..n).map(|_| symmetric(&mut r, 1.0)).collect();
+            let lo: Vec<f64> = x.iter().map(|v| v - 0.05).collect();
+            let hi: Vec<f64> =
+                x.iter().enumerate().map(|(j, v)| v + 0.05 * (j % 3) as f64).collect();
+            let src = FlightSources { x: &x, b: &b, lo: &lo, hi: &hi };
+            let lanes = DeLanes::from_rng(&mut ChaCha8Rng::seed_from_u64(n as u64));
+            let (mut want_lanes, mut l) = (lanes.clone(), vec![0.0; n]);
+            levy_fill_baseline(&mut l, 0.7, &mut want_lanes);
+            let want: Vec<f64> =
+                (0..n).map(|j| flight_coordinate(x[j], b[j], lo[j], hi[j], 0.3, l[j])).collect();
+            assert!(want.iter().enumerate().any(|(j, w)| *w == hi[j]) || n < 100);
+            assert!(want.iter().enumerate().any(|(j, w)| *w == lo[j]) || n < 100);
+            assert!(want.iter().enumerate().any(|(j, w)| *w > lo[j] && *w < hi[j]) || n < 100);
+            let mut scratch = LevyScratch::default();
+            for fused in [levy_flight, flight_generic] {
+                let (mut got, mut got_lanes) = (vec![0.0; n], lanes.clone());
+                fused(&mut got, src, 0.3, 0.7, &mut got_lanes, &mut scratch);
+                assert!(got.iter().zip(&want).all(|(p, q)| p.to_bits() == q.to_bits()), "n {n}");
+                assert_eq!(got_lanes, want_lanes);
+            }
+        }
+        assert_eq!(flight_coordinate(1.0, 0.0, -2.0, 2.0, 0.0, f64::INFINITY), 1.0);
     }
 
     /// The law of L = sigma u psi / |v|^(2/3) against a direct simulation from independent

@@ -69,12 +69,17 @@ impl Optimiser for Pso {
         let d = problem.dim();
         let (lo, hi) = problem.bounds();
         let mut eval = Evaluator::new(problem, budget);
-        let Population { x: mut pos, f: mut fit } =
+        // A particle's position is its personal best's buffer while the two are equal
+        // (`at_best`, true after the initial population and after every improvement), else
+        // `pos`; each move writes into `spare`, which then swaps with the personal best (an
+        // improvement) or the position, so no vector is ever copied per evaluation.
+        let Population { x: mut pbest, f: mut pbest_f } =
             Population::initial(problem, budget, &mut eval, rng);
-        let n = pos.len();
+        let n = pbest.len();
         let mut vel = vec![Aligned::zeros(d); n];
-        let mut pbest = pos.clone();
-        let mut pbest_f = fit.clone();
+        let mut pos = vec![Aligned::zeros(d); n];
+        let mut at_best = vec![true; n];
+        let mut spare = Aligned::zeros(d);
         let mut g = argmin(&pbest_f);
         let initial_best = pbest_f[g];
         let mut gbest = pbest[g].clone();
@@ -86,11 +91,15 @@ impl Optimiser for Pso {
             // Each particle is evaluated right after its move, while its coordinates are in
             // cache; the global best it moved towards is the previous iteration's (a copy).
             for i in 0..n {
-                pso_move(&mut pos[i], &mut vel[i], &pbest[i], &gbest, &mut bulk, co, bounds);
-                fit[i] = eval.eval(&pos[i]);
-                if fit[i] < pbest_f[i] {
-                    pbest_f[i] = fit[i];
-                    pbest[i].copy_from_slice(&pos[i]);
+                let x = if at_best[i] { &pbest[i] } else { &pos[i] };
+                pso_move(&mut spare, x, &mut vel[i], &pbest[i], &gbest, &mut bulk, co, bounds);
+                let f = eval.eval(&spare);
+                at_best[i] = f < pbest_f[i];
+                if at_best[i] {
+                    pbest_f[i] = f;
+                    std::mem::swap(&mut pbest[i], &mut spare);
+                } else {
+                    std::mem::swap(&mut pos[i], &mut spare);
                 }
             }
             g = argmin(&pbest_f);
