@@ -47,6 +47,18 @@ pub trait Family: Sync {
     /// Run the variants of a spec (`--sweep`) into one folder, their tables together. A family
     /// whose tables cannot tell variants apart runs one variant only.
     fn run_variants(&self, variants: &[Spec], ctx: &RunContext, tables: bool) -> Result<Outcome>;
+    /// Which keys `--set` and `--sweep` may change in the section (None: none).
+    fn overrides(&self) -> Option<Overrides>;
+}
+
+/// Which keys of a section `--set` and `--sweep` may change (see [`Section::OVERRIDES`]).
+#[derive(Debug, Clone, Copy)]
+pub struct Overrides {
+    /// Whether `--sweep` may vary this key (a full dotted key, `optim.de.f`): settings that leave
+    /// every variant the same problems, so the variants can be ranked like optimisers.
+    pub sweepable: fn(&str) -> bool,
+    /// The sweepable keys, for messages.
+    pub describe: &'static str,
 }
 
 /// Where a section type sits in the spec file: written for every family by the `families!`
@@ -74,6 +86,9 @@ pub trait Section: Placed {
     }
     /// Read the SOM maps from the folder `maps` (a plan whose earlier spec saved them).
     fn use_maps(&mut self, _maps: &str) {}
+    /// Whether the section takes `--set`/`--sweep` (None: it does not), and which keys a sweep
+    /// may vary.
+    const OVERRIDES: Option<Overrides> = None;
 }
 
 /// A family as it is written: its section type, its cells and its run. Every `Experiment` is a
@@ -133,6 +148,9 @@ impl<E: Experiment> Family for E {
     }
     fn run_variants(&self, variants: &[Spec], ctx: &RunContext, tables: bool) -> Result<Outcome> {
         Experiment::run_variants(self, variants, ctx, tables)
+    }
+    fn overrides(&self) -> Option<Overrides> {
+        E::Section::OVERRIDES
     }
 }
 

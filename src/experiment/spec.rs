@@ -112,18 +112,6 @@ impl Variant {
     }
 }
 
-/// Keys a sweep may vary: optimiser settings only, so that every variant solves the same
-/// problems (same data, nets, search box) and the variants can be ranked like optimisers.
-const SWEEPABLE: &str = "optim.<ga|de|pso|csa|icsa>.*, optim.generations, optim.population, optim.init_range, optim.repeats";
-
-fn sweepable(key: &str) -> bool {
-    ["optim.ga.", "optim.de.", "optim.pso.", "optim.csa.", "optim.icsa."]
-        .iter()
-        .any(|p| key.starts_with(p))
-        || ["optim.generations", "optim.population", "optim.init_range", "optim.repeats"]
-            .contains(&key)
-}
-
 /// A command-line value as TOML (a number, a boolean, a quoted string, an array), else the text
 /// itself as a string (so `--set optim.knots=nurbs_book` needs no quotes).
 fn cli_value(raw: &str) -> toml::Value {
@@ -174,14 +162,30 @@ impl CliOverrides {
                 )));
             }
             seen.push(key.to_string());
-            if !key.starts_with("optim.") {
-                return Err(SpecError(format!("{flag} {key}: only keys of the [optim] section (optim.KEY) can be set or swept")));
+            // The sections that take --set/--sweep, as the families declare them.
+            let takers: Vec<_> = crate::families::FAMILIES
+                .iter()
+                .filter_map(|f| f.overrides().map(|o| (*f, o)))
+                .collect();
+            let list = takers
+                .iter()
+                .map(|(f, _)| format!("[{0}] section ({0}.KEY)", f.section()))
+                .collect::<Vec<_>>()
+                .join(", ");
+            let section = key.split('.').next().unwrap_or("");
+            let Some((family, ov)) = takers.iter().find(|(f, _)| f.section() == section) else {
+                return Err(SpecError(format!(
+                    "{flag} {key}: only keys of the {list} can be set or swept"
+                )));
+            };
+            if !family.present(&base) {
+                return Err(SpecError(format!(
+                    "{flag} {key}: {path} has no [{section}] section (--set and --sweep work on \
+                     specs with one)"
+                )));
             }
-            if base.file.optim.is_none() {
-                return Err(SpecError(format!("{flag} {key}: {path} has no [optim] section (--set and --sweep work on Chapter 6 specs)")));
-            }
-            if flag == "--sweep" && !sweepable(key) {
-                return Err(SpecError(format!("{flag} {key}: a sweep varies optimiser settings only ({SWEEPABLE}), so that every variant solves the same problems")));
+            if flag == "--sweep" && !(ov.sweepable)(key) {
+                return Err(SpecError(format!("{flag} {key}: a sweep varies optimiser settings only ({}), so that every variant solves the same problems", ov.describe)));
             }
         }
         let set: Vec<(String, String)> = self

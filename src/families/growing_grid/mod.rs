@@ -98,7 +98,8 @@ impl runner::Logged for Run {
     }
 }
 
-pub type ProblemKey = (String, GridSize, Parameterisation);
+/// (data set, control net, parameterisation), as in Chapter 6.
+pub use crate::families::optimise::ProblemKey;
 
 fn section(spec: &Spec) -> Result<&GrowingGridSpec> {
     spec.require::<spec::GrowingGridSpec>()

@@ -84,6 +84,7 @@ pub struct OptimRecord {
     pub improvements: Vec<(u64, f64)>,
 }
 
+/// A problem: (data set, control net, parameterisation); the grid is the spec's one.
 pub type ProblemKey = (String, GridSize, Parameterisation);
 
 /// The certified exact optimum of every problem, when the spec asks for it (deterministic, so
@@ -323,6 +324,19 @@ impl crate::experiment::family::Section for self::spec::OptimSpec {
     fn use_maps(&mut self, maps: &str) {
         self.maps = Some(maps.to_string());
     }
+    /// Optimiser settings only, so that every variant solves the same problems (same data,
+    /// nets, search box) and the variants can be ranked like optimisers.
+    const OVERRIDES: Option<crate::experiment::family::Overrides> =
+        Some(crate::experiment::family::Overrides {
+            sweepable: |key| {
+                ["optim.ga.", "optim.de.", "optim.pso.", "optim.csa.", "optim.icsa."]
+                    .iter()
+                    .any(|p| key.starts_with(p))
+                    || ["optim.generations", "optim.population", "optim.init_range", "optim.repeats"]
+                        .contains(&key)
+            },
+            describe: "optim.<ga|de|pso|csa|icsa>.*, optim.generations, optim.population, optim.init_range, optim.repeats",
+        });
 }
 
 impl crate::experiment::family::Experiment for Optim {
