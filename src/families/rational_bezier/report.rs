@@ -23,24 +23,7 @@ pub fn write(runs: &[Run], curves: &[CurveRun], population: usize, out: &Path) -
     let rows: Vec<_> = runs.iter().map(|r| r.row.clone()).collect();
     crate::io::write_atomic(&out.join("runs.csv"), crate::io::csv_text(&rows)?.as_bytes())?;
     // Error versus iteration, every trace point of every run.
-    let trace_header: Vec<String> =
-        ["cell", "surface", "optimiser", "repeat", "evaluations", "best_sse"]
-            .iter()
-            .map(|h| h.to_string())
-            .collect();
-    let mut trace_rows = Vec::new();
-    for r in runs {
-        for &(e, f) in &r.trace {
-            trace_rows.push(vec![
-                r.row.cell.clone(),
-                r.row.surface.clone(),
-                r.row.optimiser.clone(),
-                r.row.repeat.to_string(),
-                e.to_string(),
-                format!("{f:e}"),
-            ]);
-        }
-    }
+    let (trace_header, trace_rows) = traces(runs);
     crate::io::write_atomic(
         &out.join("seed002_traces.csv"),
         crate::io::csv_records(&trace_header, &trace_rows)?.as_bytes(),
@@ -59,6 +42,52 @@ pub fn write(runs: &[Run], curves: &[CurveRun], population: usize, out: &Path) -
         }
     }
     let _ = writeln!(s, "\nThe paper's published error/time tables (4.7, 5.7, 6.6, 7.3-7.7) and its GA/DE/PSO settings are not in the surviving seed text (it stops in section 3.1), so there is no side-by-side column; the settings are the project's Table 6.1 values (see the spec). Budgets are in evaluations: the project's GA is steady-state (two offspring per generation), so per iteration it spends far fewer evaluations than DE and PSO (column `evaluations` of seed002_errors.csv); the start (free points on the data, w11 = 1) is not itself a member of the initial population, so a run can end above the start's SSE.");
+    let (header, rows) = error_table(runs, &surfaces, &optimisers, &mut s);
+    crate::io::write_atomic(
+        &out.join("seed002_errors.csv"),
+        crate::io::csv_records(&header, &rows)?.as_bytes(),
+    )?;
+    // Which optimiser wins each surface (lowest mean SSE), computed from the runs.
+    let _ = writeln!(s);
+    s.push_str(&winners(runs, &surfaces, &optimisers));
+    // Error versus iteration.
+    crate::io::ensure_dir(&out.join("png"))?;
+    convergence_charts(runs, &surfaces, &optimisers, population, out, &mut s);
+    write_curves(curves, out, &mut s)?;
+    Ok(s)
+}
+
+/// Every trace point of every run (seed002_traces.csv).
+fn traces(runs: &[Run]) -> (Vec<String>, Vec<Vec<String>>) {
+    let trace_header: Vec<String> =
+        ["cell", "surface", "optimiser", "repeat", "evaluations", "best_sse"]
+            .iter()
+            .map(|h| h.to_string())
+            .collect();
+    let mut trace_rows = Vec::new();
+    for r in runs {
+        for &(e, f) in &r.trace {
+            trace_rows.push(vec![
+                r.row.cell.clone(),
+                r.row.surface.clone(),
+                r.row.optimiser.clone(),
+                r.row.repeat.to_string(),
+                e.to_string(),
+                format!("{f:e}"),
+            ]);
+        }
+    }
+    (trace_header, trace_rows)
+}
+
+/// Error and time per (surface, optimiser): the CSV rows of seed002_errors.csv, and the same in
+/// REPORT.md's table (written into `s`).
+fn error_table(
+    runs: &[Run],
+    surfaces: &[String],
+    optimisers: &[String],
+    s: &mut String,
+) -> (Vec<String>, Vec<Vec<String>>) {
     let header: Vec<String> = [
         "surface",
         "optimiser",
@@ -81,8 +110,8 @@ pub fn write(runs: &[Run], curves: &[CurveRun], population: usize, out: &Path) -
     let _ = writeln!(s, "\n### Error and time (our runs; the paper's Tables 4.7/5.7/6.6/7.6 are not in the surviving text)\n");
     let _ = writeln!(s, "| surface | optimiser | runs | best SSE | mean SSE | worst SSE | std SSE | best RMSE | start SSE | w11 (best run) | mean CPU s |");
     let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|");
-    for sf in &surfaces {
-        for o in &optimisers {
+    for sf in surfaces {
+        for o in optimisers {
             let sel: Vec<&Run> =
                 runs.iter().filter(|r| &r.row.surface == sf && &r.row.optimiser == o).collect();
             if sel.is_empty() {
@@ -116,13 +145,13 @@ pub fn write(runs: &[Run], curves: &[CurveRun], population: usize, out: &Path) -
             let _ = writeln!(s, "| {sf} | {o} | {} | {:.6e} | {m:.6e} | {worst:.6e} | {sd:.3e} | {:.4e} | {:.4e} | {:.4} | {cpu:.3} |", sel.len(), best.row.best_sse, best.row.rmse, best.row.start_sse, best.row.w11);
         }
     }
-    crate::io::write_atomic(
-        &out.join("seed002_errors.csv"),
-        crate::io::csv_records(&header, &rows)?.as_bytes(),
-    )?;
-    // Which optimiser wins each surface (lowest mean SSE), computed from the runs.
-    let _ = writeln!(s);
-    for sf in &surfaces {
+    (header, rows)
+}
+
+/// Per surface, the optimisers in order of mean SSE, best first.
+fn winners(runs: &[Run], surfaces: &[String], optimisers: &[String]) -> String {
+    let mut s = String::new();
+    for sf in surfaces {
         let mut means: Vec<(String, f64)> = optimisers
             .iter()
             .filter_map(|o| {
@@ -138,9 +167,19 @@ pub fn write(runs: &[Run], curves: &[CurveRun], population: usize, out: &Path) -
         let order: Vec<String> = means.iter().map(|(o, m)| format!("{o} ({m:.4e})")).collect();
         let _ = writeln!(s, "- {sf}: mean SSE order, best first: {}", order.join(" < "));
     }
-    // Error versus iteration.
-    crate::io::ensure_dir(&out.join("png"))?;
-    for sf in &surfaces {
+    s
+}
+
+/// Per surface, the best SSE (median over repeats) against evaluations, one line per optimiser.
+fn convergence_charts(
+    runs: &[Run],
+    surfaces: &[String],
+    optimisers: &[String],
+    population: usize,
+    out: &Path,
+    s: &mut String,
+) {
+    for sf in surfaces {
         let mut series = Vec::new();
         for (k, o) in optimisers.iter().enumerate() {
             let sel: Vec<&Run> =
@@ -168,8 +207,6 @@ pub fn write(runs: &[Run], curves: &[CurveRun], population: usize, out: &Path) -
             let _ = writeln!(s, "\n![{png}]({png})");
         }
     }
-    write_curves(curves, out, &mut s)?;
-    Ok(s)
 }
 
 /// The conic curve part: runs CSV, table per (outline, optimiser), and one picture per outline
