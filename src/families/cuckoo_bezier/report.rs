@@ -129,92 +129,11 @@ pub fn write(s: &Seed003Spec, runs: &[Run], out: &Path) -> Result<String> {
 
     // Table 3: CSA's statistics, examples in columns.
     if methods.contains(&"csa") {
-        let mut t3 = Vec::new();
-        let _ =
-            writeln!(md, "### Table 3: CSA fitting errors over {} runs (ours / paper)\n", s.runs);
-        let _ = writeln!(
-            md,
-            "| statistic | {} |",
-            examples
-                .iter()
-                .map(|e| format!("{e} ours | {e} paper"))
-                .collect::<Vec<_>>()
-                .join(" | ")
-        );
-        let _ = writeln!(md, "|---|{}", "---|---|".repeat(examples.len()));
-        for st in STATS {
-            let ours: Vec<f64> = examples
-                .iter()
-                .map(|e| stats(e, "csa").map(|x| x.get(st)).unwrap_or(f64::NAN))
-                .collect();
-            t3.push(std::iter::once(st.to_string()).chain(ours.iter().map(|v| num(*v))).collect());
-            let paper =
-                |e: &str| ref3.as_ref().and_then(|t| t.value(&["statistic"], &[st.to_string()], e));
-            let _ = writeln!(
-                md,
-                "| {st} | {} |",
-                examples
-                    .iter()
-                    .zip(&ours)
-                    .map(|(e, o)| format!("{} | {}", cell(Some(*o)), cell(paper(e))))
-                    .collect::<Vec<_>>()
-                    .join(" | ")
-            );
-        }
-        let mut header = vec!["statistic"];
-        header.extend(&examples);
-        write_csv(out, "seed003_table3.csv", &header, &t3)?;
+        table_3(s.runs, &examples, ref3.as_ref(), out, &mut md, &stats)?;
     }
 
     // Table 4: every method, with the error rate 100 * value / best value of the row.
-    let mut t4 = Vec::new();
-    let _ = writeln!(md, "\n### Table 4: the five methods (ours, paper below each row); E.R. = 100 x value / best value of the row, empty for the best\n");
-    let _ = writeln!(md, "| example | statistic | {} |", methods.join(" | "));
-    let _ = writeln!(md, "|---|---|{}", "---|".repeat(methods.len()));
-    for e in &examples {
-        for st in STATS {
-            let vals: Vec<Option<f64>> =
-                methods.iter().map(|m| stats(e, m).map(|x| x.get(st))).collect();
-            let mut lines = vec![(st.to_string(), vals.clone())];
-            if RATED.contains(&st) {
-                let best = vals.iter().flatten().copied().fold(f64::INFINITY, f64::min);
-                lines.push((
-                    format!("er_{st}"),
-                    vals.iter()
-                        .map(|v| v.filter(|x| *x != best).map(|x| 100.0 * x / best))
-                        .collect(),
-                ));
-            }
-            for (name, vals) in lines {
-                t4.push(
-                    [e.to_string(), name.clone()]
-                        .into_iter()
-                        .chain(vals.iter().map(|v| v.map(num).unwrap_or_default()))
-                        .collect(),
-                );
-                let paper: Vec<Option<f64>> = methods
-                    .iter()
-                    .map(|m| {
-                        ref4.as_ref().and_then(|t| {
-                            t.value(&["example", "statistic"], &[e.to_string(), name.clone()], m)
-                        })
-                    })
-                    .collect();
-                let _ = writeln!(
-                    md,
-                    "| {e} | {name} | {} |",
-                    vals.iter()
-                        .zip(&paper)
-                        .map(|(o, p)| format!("{} ({})", cell(*o), cell(*p)))
-                        .collect::<Vec<_>>()
-                        .join(" | ")
-                );
-            }
-        }
-    }
-    let mut header = vec!["example", "statistic"];
-    header.extend(&methods);
-    write_csv(out, "seed003_table4.csv", &header, &t4)?;
+    table_4(&examples, &methods, ref4.as_ref(), out, &mut md, &stats)?;
     if let Some(r4) = &ref4 {
         paper_consistency(r4, &examples, &methods, &mut md);
     }
@@ -238,30 +157,7 @@ pub fn write(s: &Seed003Spec, runs: &[Run], out: &Path) -> Result<String> {
         )?;
     }
 
-    // Speed: evaluations per CPU second of the searches.
-    let _ = writeln!(md, "\n### Speed\n");
-    let _ = writeln!(
-        md,
-        "| example | method | mean CPU s per run | evaluations per run | evaluations/s |"
-    );
-    let _ = writeln!(md, "|---|---|---|---|---|");
-    for e in &examples {
-        for m in ["csa", "icsa"].iter().filter(|m| methods.contains(m)) {
-            let v = sel(runs, e, m);
-            let (cpu, ev): (f64, f64) = v
-                .iter()
-                .fold((0.0, 0.0), |(c, n), r| (c + r.row.cpu_s, n + r.row.evaluations as f64));
-            if !v.is_empty() && cpu > 0.0 {
-                let _ = writeln!(
-                    md,
-                    "| {e} | {m} | {:.3} | {:.0} | {:.0} |",
-                    cpu / v.len() as f64,
-                    ev / v.len() as f64,
-                    ev / cpu
-                );
-            }
-        }
-    }
+    speed(runs, &examples, &methods, &mut md);
     convergence(s, runs, &examples, &methods, out, &mut md, &stats)?;
     Ok(md)
 }
@@ -569,4 +465,134 @@ fn convergence(
         }
     }
     Ok(())
+}
+
+/// Table 3: CSA's statistics over the runs, examples in columns, beside the paper's
+/// (seed003_table3.csv and its REPORT.md table).
+fn table_3(
+    runs: usize,
+    examples: &[&str],
+    ref3: Option<&RefTable>,
+    out: &Path,
+    md: &mut String,
+    stats: &dyn Fn(&str, &str) -> Option<Stats>,
+) -> Result<()> {
+    let mut t3 = Vec::new();
+    let _ = writeln!(md, "### Table 3: CSA fitting errors over {} runs (ours / paper)\n", runs);
+    let _ = writeln!(
+        md,
+        "| statistic | {} |",
+        examples.iter().map(|e| format!("{e} ours | {e} paper")).collect::<Vec<_>>().join(" | ")
+    );
+    let _ = writeln!(md, "|---|{}", "---|---|".repeat(examples.len()));
+    for st in STATS {
+        let ours: Vec<f64> = examples
+            .iter()
+            .map(|e| stats(e, "csa").map(|x| x.get(st)).unwrap_or(f64::NAN))
+            .collect();
+        t3.push(std::iter::once(st.to_string()).chain(ours.iter().map(|v| num(*v))).collect());
+        let paper = |e: &str| ref3.and_then(|t| t.value(&["statistic"], &[st.to_string()], e));
+        let _ = writeln!(
+            md,
+            "| {st} | {} |",
+            examples
+                .iter()
+                .zip(&ours)
+                .map(|(e, o)| format!("{} | {}", cell(Some(*o)), cell(paper(e))))
+                .collect::<Vec<_>>()
+                .join(" | ")
+        );
+    }
+    let mut header = vec!["statistic"];
+    header.extend(examples);
+    write_csv(out, "seed003_table3.csv", &header, &t3)?;
+    Ok(())
+}
+
+/// Table 4: every method, with the error rate 100 * value / best value of the row, beside the
+/// paper's (seed003_table4.csv and its REPORT.md table).
+fn table_4(
+    examples: &[&str],
+    methods: &[&str],
+    ref4: Option<&RefTable>,
+    out: &Path,
+    md: &mut String,
+    stats: &dyn Fn(&str, &str) -> Option<Stats>,
+) -> Result<()> {
+    let mut t4 = Vec::new();
+    let _ = writeln!(md, "\n### Table 4: the five methods (ours, paper below each row); E.R. = 100 x value / best value of the row, empty for the best\n");
+    let _ = writeln!(md, "| example | statistic | {} |", methods.join(" | "));
+    let _ = writeln!(md, "|---|---|{}", "---|".repeat(methods.len()));
+    for e in examples {
+        for st in STATS {
+            let vals: Vec<Option<f64>> =
+                methods.iter().map(|m| stats(e, m).map(|x| x.get(st))).collect();
+            let mut lines = vec![(st.to_string(), vals.clone())];
+            if RATED.contains(&st) {
+                let best = vals.iter().flatten().copied().fold(f64::INFINITY, f64::min);
+                lines.push((
+                    format!("er_{st}"),
+                    vals.iter()
+                        .map(|v| v.filter(|x| *x != best).map(|x| 100.0 * x / best))
+                        .collect(),
+                ));
+            }
+            for (name, vals) in lines {
+                t4.push(
+                    [e.to_string(), name.clone()]
+                        .into_iter()
+                        .chain(vals.iter().map(|v| v.map(num).unwrap_or_default()))
+                        .collect(),
+                );
+                let paper: Vec<Option<f64>> = methods
+                    .iter()
+                    .map(|m| {
+                        ref4.and_then(|t| {
+                            t.value(&["example", "statistic"], &[e.to_string(), name.clone()], m)
+                        })
+                    })
+                    .collect();
+                let _ = writeln!(
+                    md,
+                    "| {e} | {name} | {} |",
+                    vals.iter()
+                        .zip(&paper)
+                        .map(|(o, p)| format!("{} ({})", cell(*o), cell(*p)))
+                        .collect::<Vec<_>>()
+                        .join(" | ")
+                );
+            }
+        }
+    }
+    let mut header = vec!["example", "statistic"];
+    header.extend(methods);
+    write_csv(out, "seed003_table4.csv", &header, &t4)?;
+    Ok(())
+}
+
+/// Speed: evaluations per CPU second of the searches.
+fn speed(runs: &[Run], examples: &[&str], methods: &[&str], md: &mut String) {
+    let _ = writeln!(md, "\n### Speed\n");
+    let _ = writeln!(
+        md,
+        "| example | method | mean CPU s per run | evaluations per run | evaluations/s |"
+    );
+    let _ = writeln!(md, "|---|---|---|---|---|");
+    for e in examples {
+        for m in ["csa", "icsa"].iter().filter(|m| methods.contains(m)) {
+            let v = sel(runs, e, m);
+            let (cpu, ev): (f64, f64) = v
+                .iter()
+                .fold((0.0, 0.0), |(c, n), r| (c + r.row.cpu_s, n + r.row.evaluations as f64));
+            if !v.is_empty() && cpu > 0.0 {
+                let _ = writeln!(
+                    md,
+                    "| {e} | {m} | {:.3} | {:.0} | {:.0} |",
+                    cpu / v.len() as f64,
+                    ev / v.len() as f64,
+                    ev / cpu
+                );
+            }
+        }
+    }
 }
