@@ -254,6 +254,19 @@ pub fn run(
     Ok(runs)
 }
 
+/// The run of each (grid, data set) whose best surfaces go furthest from the data (largest dense
+/// excursion; the first of equal ones), by index into `runs`: its 3-D view in report.html.
+pub(crate) fn furthest(runs: &[OptimRun]) -> BTreeMap<(GridSize, String), usize> {
+    let mut out: BTreeMap<(GridSize, String), usize> = BTreeMap::new();
+    for (k, r) in runs.iter().enumerate() {
+        let f = out.entry((r.cell.grid, r.cell.dataset.clone())).or_insert(k);
+        if r.row.excursion > runs[*f].row.excursion {
+            *f = k;
+        }
+    }
+    out
+}
+
 /// Give the MIN run of every (data set, parameterisation, optimiser) at the largest net (the
 /// Appendix I/J pictures) and the run of each data set whose surfaces go furthest from the data
 /// (its 3-D view) their best control points when they are not at hand, by running that cell
@@ -266,12 +279,7 @@ fn picture_points<'a>(
     problem: impl Fn(&OptimCell) -> &'a ControlNetProblem,
 ) -> Result<()> {
     let mut best: BTreeMap<(String, Parameterisation, String), usize> = BTreeMap::new();
-    let mut furthest: BTreeMap<String, usize> = BTreeMap::new();
     for (k, r) in runs.iter().enumerate() {
-        let f = furthest.entry(r.cell.dataset.clone()).or_insert(k);
-        if r.row.excursion > runs[*f].row.excursion {
-            *f = k;
-        }
         if !pictured(&r.cell, largest) {
             continue;
         }
@@ -283,7 +291,7 @@ fn picture_points<'a>(
         }
     }
     let wanted: std::collections::BTreeSet<usize> =
-        best.into_values().chain(furthest.into_values()).collect();
+        best.into_values().chain(furthest(runs).into_values()).collect();
     for k in wanted {
         if runs[k].best_x.is_empty() {
             let again = run_cell(spec, &runs[k].cell, problem(&runs[k].cell))?;
