@@ -20,23 +20,20 @@ pub struct Claim {
 }
 
 impl Claim {
+    /// Whether the claim holds here without qualification (the verdict "holds").
     pub fn holds(&self) -> bool {
-        self.ours.1 > 0 && self.ours.0 == self.ours.1
+        self.verdict() == "holds"
     }
 
     pub fn verdict(&self) -> &'static str {
-        if let (Some(r), (a, b)) = (self.rival, self.ours) {
-            return match a.cmp(&r) {
-                _ if b == 0 => "not checked",
-                std::cmp::Ordering::Greater => "holds",
-                std::cmp::Ordering::Equal => "tied",
-                std::cmp::Ordering::Less => "does not hold",
-            };
-        }
-        match self.ours {
-            (_, 0) => "not checked",
-            (a, b) if a == b => "holds",
-            (a, b) if 2 * a > b => "mostly holds",
+        match (self.ours, self.rival) {
+            ((_, 0), _) => "not checked",
+            // Best of several: ahead of every other option.
+            ((a, _), Some(r)) if a > r => "holds",
+            ((a, _), Some(r)) if a == r => "tied",
+            (_, Some(_)) => "does not hold",
+            ((a, b), None) if a == b => "holds",
+            ((a, b), None) if 2 * a > b => "mostly holds",
             _ => "does not hold",
         }
     }
@@ -181,6 +178,9 @@ mod tests {
         );
         assert_eq!(Claim { rival: Some(11), ..back[2].clone() }.verdict(), "holds");
         assert_eq!(Claim { rival: Some(12), ..back[2].clone() }.verdict(), "tied");
+        // The count of claims that hold follows the verdict for both kinds.
+        assert!(Claim { rival: Some(11), ..back[2].clone() }.holds() && !back[2].holds());
+        assert!(back[1].holds() && !back[0].holds());
         assert_eq!(
             (back[0].statement.as_str(), back[0].ours, back[0].thesis),
             (claims[0].statement.as_str(), (10, 15), Some((15, 15)))
