@@ -719,6 +719,26 @@ mod tests {
     use super::*;
 
     #[test]
+    fn sub_reports_say_a_repeated_section_once_and_leave_claims_to_the_top() {
+        let a = "# report: a\n\n## Chapter\n\nintro ![p](png/p.png)\n### Metric definitions\n\n- QE\n### Claims\n\n| x |\n### Tables\n\nA\n";
+        let b = "# report: b\n\n## Chapter\n\n### Metric definitions\n\n- QE\n### Tables\n\nB\n";
+        let mut seen = Vec::new();
+        let ra = sub_report(a, "a", &mut seen);
+        let rb = sub_report(b, "b", &mut seen);
+        assert!(ra.contains("### Chapter") && ra.contains("![p](a/png/p.png)"), "{ra}");
+        assert!(ra.contains("#### Metric definitions\n\n- QE"), "{ra}");
+        assert!(
+            ra.contains("In the claims table at the top (`a/claims.csv`)") && !ra.contains("| x |")
+        );
+        assert!(
+            rb.contains("#### Metric definitions\n\nAs under [a](#a) above.")
+                && !rb.contains("- QE")
+        );
+        // Sections that differ are kept.
+        assert!(ra.contains("#### Tables\n\nA") && rb.contains("#### Tables\n\nB"), "{rb}");
+    }
+
+    #[test]
     fn links_point_into_the_sub_folder() {
         assert_eq!(
             relink("![a](png/a.png) and [b](https://x) [c](#c)", "ch4"),
