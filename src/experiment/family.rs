@@ -6,7 +6,9 @@
 
 use super::spec::{Spec, SpecError, SpecFile};
 use super::RunContext;
+use crate::report::claims::Claim;
 use anyhow::Result;
+use std::path::{Path, PathBuf};
 
 /// What a family's run hands back to `run_spec`.
 pub struct Outcome {
@@ -49,6 +51,44 @@ pub trait Family: Sync {
     fn run_variants(&self, variants: &[Spec], ctx: &RunContext, tables: bool) -> Result<Outcome>;
     /// Which keys `--set` and `--sweep` may change in the section (None: none).
     fn overrides(&self) -> Option<Overrides>;
+    /// The family's part of a plan's combined report, from its specs' finished folders.
+    fn combine(&self, view: &PlanView) -> Result<Combined>;
+}
+
+/// A finished plan as one family sees it, for the parts of the combined report that need more
+/// than one of its specs (the thesis' Tables 6.8 and 6.9 sum two specs' tables).
+pub struct PlanView<'a> {
+    /// The plan's output folder; spec `s` ran into `out/s`.
+    pub out: &'a Path,
+    /// The plan's specs of this family, in plan order.
+    pub specs: Vec<&'a Spec>,
+    /// The plan's own reading (`eq2_10`).
+    pub reading: &'a str,
+    /// The reading sets that ran some specs again.
+    pub readings: Vec<ReadingRun>,
+}
+
+/// One reading set of a plan: its name, the specs it ran again and the folder holding them
+/// (spec `s` ran into `root/s`).
+#[derive(Debug, Clone)]
+pub struct ReadingRun {
+    pub name: String,
+    pub specs: Vec<String>,
+    pub root: PathBuf,
+}
+
+/// What a family adds to a plan's combined report.
+#[derive(Default)]
+pub struct Combined {
+    /// Specs of the family that go beyond the source's protocol: their claims are labelled with
+    /// the spec's name (`6 (ch6_exact)`), so they are not read as the source's own.
+    pub beyond: Vec<String>,
+    /// Claims over several specs, added to the plan's claims table.
+    pub claims: Vec<Claim>,
+    /// Markdown sections after the claims table.
+    pub sections: Vec<String>,
+    /// Markdown appended to the readings matrix.
+    pub readings: Vec<String>,
 }
 
 /// Which keys of a section `--set` and `--sweep` may change (see [`Section::OVERRIDES`]).
@@ -114,6 +154,10 @@ pub trait Experiment: Sync {
             ),
         }
     }
+    /// See [`Family::combine`]; by default nothing.
+    fn combine(&self, _view: &PlanView) -> Result<Combined> {
+        Ok(Combined::default())
+    }
 }
 
 impl<E: Experiment> Family for E {
@@ -151,6 +195,9 @@ impl<E: Experiment> Family for E {
     }
     fn overrides(&self) -> Option<Overrides> {
         E::Section::OVERRIDES
+    }
+    fn combine(&self, view: &PlanView) -> Result<Combined> {
+        Experiment::combine(self, view)
     }
 }
 

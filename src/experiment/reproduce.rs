@@ -1,9 +1,12 @@
 //! `somnurbs reproduce`: the thesis' chapters in order, each spec in its own sub-folder, the maps
 //! of Chapter 4 feeding Chapters 5 and 6, then one REPORT.md that joins the chapters' reports
-//! and adds what needs more than one spec: Tables 6.8 and 6.9 (Tables 6.4 + 6.5 and 6.6 + 6.7)
-//! and one table of the thesis' claims with their verdicts. The list of specs is data
-//! (`experiments/thesis.toml`).
+//! and adds one table of the claims with their verdicts, the readings matrix, and what each
+//! family computes over several of its specs ([`Family::combine`]: Tables 6.8 and 6.9 sum
+//! Tables 6.4 + 6.5 and 6.6 + 6.7). The list of specs is data (`experiments/thesis.toml`).
+//!
+//! [`Family::combine`]: super::family::Family::combine
 
+use super::family::{Combined, PlanView, ReadingRun};
 use super::spec::{Override, Spec};
 use super::{run_spec, RunContext};
 use crate::io::{csv_records, write_atomic};
@@ -15,8 +18,6 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// A table's header and rows, as `csv_records` takes them.
-type Header = Vec<String>;
-type Rows = Vec<Vec<String>>;
 
 /// A plan: `experiments/thesis.toml` (Chapters 4-6), `seeds.toml`, `all.toml`.
 #[derive(Debug, Deserialize)]
@@ -217,18 +218,23 @@ pub fn reproduce(
             done.push((folder.to_string_lossy().into_owned(), t.elapsed().as_secs_f64()));
         }
     }
+    let combined = combine(&ctx.out, &plan, &specs)?;
     let mut report = combined_report(
         &ctx.out,
         &plan,
         plan_name,
         &specs,
         &done,
+        &combined,
         profile.unwrap_or("full"),
         started.elapsed().as_secs_f64(),
     )?;
     if !plan.readings.is_empty() {
         let matrix = readings_matrix(&ctx.out, &plan)?;
-        report.push_str(&render_readings(&ctx.out, &plan, &matrix)?);
+        report.push_str(&render_readings(&plan, &matrix, &ctx.out)?);
+        for part in &combined {
+            report.extend(part.readings.iter().map(String::as_str));
+        }
     }
     let path = ctx.out.join("REPORT.md");
     write_atomic(&path, report.as_bytes())?;
@@ -237,6 +243,35 @@ pub fn reproduce(
         .with_context(|| format!("cannot remove {}", incomplete.display()))?;
     crate::io::outdir::sync_dir(&ctx.out)?;
     Ok(path)
+}
+
+/// Each family's part of the combined report, from its specs' finished folders.
+fn combine(out: &Path, plan: &Plan, specs: &[Spec]) -> Result<Vec<Combined>> {
+    let readings: Vec<ReadingRun> = plan
+        .readings
+        .iter()
+        .map(|r| ReadingRun {
+            name: r.name.clone(),
+            specs: r.specs.clone(),
+            root: out.join(READINGS_DIR).join(&r.name),
+        })
+        .collect();
+    crate::families::FAMILIES
+        .iter()
+        .map(|f| {
+            let view = PlanView {
+                out,
+                specs: specs.iter().filter(|s| f.present(s)).collect(),
+                reading: &plan.reading,
+                readings: readings.clone(),
+            };
+            if view.specs.is_empty() {
+                Ok(Combined::default())
+            } else {
+                f.combine(&view).with_context(|| format!("[{}] over the plan", f.section()))
+            }
+        })
+        .collect()
 }
 
 /// Where the reading sets' runs go, inside the plan's output folder.
@@ -287,7 +322,7 @@ fn readings_matrix(out: &Path, plan: &Plan) -> Result<Vec<ReadingClaim>> {
 
 /// `readings.csv` and the REPORT.md section: one row per (spec, claim), one column per reading,
 /// and whether the verdict changes with the reading.
-fn render_readings(out: &Path, plan: &Plan, rows: &[ReadingClaim]) -> Result<String> {
+fn render_readings(plan: &Plan, rows: &[ReadingClaim], out: &Path) -> Result<String> {
     let header: Vec<String> =
         ["spec", "chapter", "claim", "reading", "verdict", "holds", "checked", "note"]
             .iter()
@@ -364,184 +399,8 @@ fn render_readings(out: &Path, plan: &Plan, rows: &[ReadingClaim]) -> Result<Str
         "\n{changing} of {} claims change their verdict with the reading.\n",
         keys.len()
     );
-    s.push_str(&markdown_table(&h, &md_rows));
-    if let Some(chart) = error_vs_excursion(out, plan)? {
-        let _ = writeln!(s, "\n![{chart}]({chart})\n\nSurface error against the largest distance of the fitted surfaces from the data's bounding box (log scale), one point per control net, for one data set under each reading: a reading can lower the error at the data points while its surfaces leave the data between them.");
-    }
+    s.push_str(&crate::report::markdown::table(&h, &md_rows));
     Ok(s)
-}
-
-/// One fitted cell as a readings chart needs it (from a Chapter 5 `runs.csv`).
-#[derive(Debug, Deserialize)]
-struct FitPoint {
-    dataset: String,
-    cn_x: usize,
-    parameterisation: String,
-    approach: String,
-    surface_error: f64,
-    excursion: f64,
-}
-
-/// The chart of surface error against excursion across readings: the first Chapter 5 spec every
-/// reading ran, its first data set, chord length, approach B. Returns its path in `out`.
-fn error_vs_excursion(out: &Path, plan: &Plan) -> Result<Option<String>> {
-    let Some(spec) = plan.specs.iter().find(|s| {
-        plan.readings.iter().all(|r| r.specs.contains(s))
-            && out.join(s).join("runs.csv").exists()
-            && is_fit_runs(&out.join(s).join("runs.csv"))
-    }) else {
-        return Ok(None);
-    };
-    let mut folders = vec![(plan.reading.clone(), out.join(spec))];
-    folders.extend(
-        plan.readings
-            .iter()
-            .map(|r| (r.name.clone(), out.join(READINGS_DIR).join(&r.name).join(spec))),
-    );
-    let mut series = Vec::new();
-    let mut data_set = None;
-    for (k, (name, folder)) in folders.iter().enumerate() {
-        let path = folder.join("runs.csv");
-        let points: Vec<FitPoint> = crate::io::read_rows(&path)?;
-        let d = data_set
-            .get_or_insert_with(|| points.first().map(|p| p.dataset.clone()).unwrap_or_default())
-            .clone();
-        let mut pts: Vec<(usize, f64, f64)> = points
-            .iter()
-            .filter(|p| {
-                p.dataset == d
-                    && p.parameterisation == "chord_length"
-                    && p.approach == "B"
-                    && p.excursion > 0.0
-            })
-            .map(|p| (p.cn_x, p.excursion.log10(), p.surface_error))
-            .collect();
-        pts.sort_by_key(|p| p.0);
-        series.push(crate::report::plots::Series {
-            label: name.clone(),
-            colour: crate::report::plots::style::cycle_colour(k),
-            points: pts.iter().map(|p| (p.1, p.2)).collect(),
-            band: None,
-        });
-    }
-    let name = format!("readings_error_vs_excursion_{spec}.png");
-    let title = format!(
-        "{spec}, {}, chord length, B: one point per control net",
-        data_set.unwrap_or_default()
-    );
-    match crate::report::plots::line_chart_png(
-        &out.join(&name),
-        &title,
-        "log10 excursion from the data's box",
-        "surface error (Eq. 5.13)",
-        &series,
-        false,
-    ) {
-        Ok(()) => Ok(Some(name)),
-        Err(e) => {
-            eprintln!("somnurbs: warning: picture skipped: {e}");
-            Ok(None)
-        }
-    }
-}
-
-fn is_fit_runs(path: &Path) -> bool {
-    std::fs::read_to_string(path)
-        .ok()
-        .and_then(|t| {
-            t.lines().next().map(|h| {
-                h.split(',').any(|c| c == "excursion") && h.split(',').any(|c| c == "approach")
-            })
-        })
-        .unwrap_or(false)
-}
-
-/// A win-count table (Tables 6.4-6.7: data, parameterisation, one column per optimiser, cells).
-fn win_table(path: &Path) -> Result<Option<(Vec<String>, Vec<usize>)>> {
-    if !path.exists() {
-        return Ok(None);
-    }
-    let mut rd = csv::Reader::from_path(path).with_context(|| format!("{}", path.display()))?;
-    let header: Vec<String> = rd
-        .headers()
-        .with_context(|| format!("{}", path.display()))?
-        .iter()
-        .map(String::from)
-        .collect();
-    let opts: Vec<String> = header
-        .iter()
-        .filter(|h| !["data", "parameterisation", "cells"].contains(&h.as_str()))
-        .cloned()
-        .collect();
-    let mut sums = vec![0usize; opts.len() + 1];
-    for (n, rec) in rd.records().enumerate() {
-        let rec = rec.with_context(|| format!("{}", path.display()))?;
-        if rec.get(0) == Some("total") {
-            continue;
-        }
-        for (k, name) in opts.iter().chain(std::iter::once(&"cells".to_string())).enumerate() {
-            let col = header.iter().position(|h| h == name).context("column")?;
-            sums[k] += rec.get(col).unwrap_or("").parse::<usize>().map_err(|_| {
-                anyhow::anyhow!("{}: line {}: {name} is not a count", path.display(), n + 2)
-            })?;
-        }
-    }
-    Ok(Some((opts, sums)))
-}
-
-/// Table 6.8 (errors) or 6.9 (CPU time): one row per source table, `wins/cells` per optimiser,
-/// and a total row; `None` if neither source table exists.
-fn overall(
-    out: &Path,
-    sources: &[(&str, &str)],
-    name: &str,
-) -> Result<Option<(String, Header, Rows)>> {
-    let mut rows = Vec::new();
-    let mut opts: Vec<String> = Vec::new();
-    let mut total: Vec<usize> = Vec::new();
-    for (spec, table) in sources {
-        if let Some((o, sums)) = win_table(&out.join(spec).join(format!("{table}.csv")))? {
-            if opts.is_empty() {
-                opts = o.clone();
-                total = vec![0; o.len() + 1];
-            }
-            if o != opts {
-                anyhow::bail!(
-                    "{spec}/{table}.csv has optimisers {o:?}, another table has {opts:?}"
-                );
-            }
-            let cells = sums[o.len()];
-            let mut row = vec![format!("Table {}", &table["table_".len()..].replace('_', "."))];
-            row.extend(sums[..o.len()].iter().map(|w| format!("{w}/{cells}")));
-            rows.push(row);
-            for (t, s) in total.iter_mut().zip(&sums) {
-                *t += s;
-            }
-        }
-    }
-    if rows.is_empty() {
-        return Ok(None);
-    }
-    let cells = total[opts.len()];
-    let mut row = vec!["overall".to_string()];
-    row.extend(total[..opts.len()].iter().map(|w| format!("{w}/{cells}")));
-    rows.push(row);
-    let mut header = vec!["table".to_string()];
-    header.extend(opts.iter().cloned());
-    write_atomic(&out.join(format!("{name}.csv")), csv_records(&header, &rows)?.as_bytes())?;
-    Ok(Some((name.to_string(), header, rows)))
-}
-
-fn markdown_table(header: &[String], rows: &[Vec<String>]) -> String {
-    let mut s = format!(
-        "| {} |\n|{}|\n",
-        header.join(" | "),
-        header.iter().map(|_| "---").collect::<Vec<_>>().join("|")
-    );
-    for r in rows {
-        let _ = writeln!(s, "| {} |", r.join(" | "));
-    }
-    s
 }
 
 /// The combined REPORT.md: header, claims, Tables 6.8/6.9, then each chapter's report with its
@@ -552,6 +411,7 @@ fn combined_report(
     plan_name: &str,
     specs: &[Spec],
     done: &[(String, f64)],
+    combined: &[Combined],
     profile: &str,
     wall: f64,
 ) -> Result<String> {
@@ -571,64 +431,37 @@ fn combined_report(
     for (name, secs) in done {
         let _ = writeln!(s, "| {name} | [`{name}/`]({name}/REPORT.md) | {secs:.1} |");
     }
-    let names: Vec<&str> = specs.iter().map(|sp| sp.file.name.as_str()).collect();
-    let find = |grid_same: bool| {
-        names
-            .iter()
-            .copied()
-            .find(|n| n.starts_with("ch6") && n.ends_with(if grid_same { "same" } else { "diff" }))
-    };
-    let (same, diff) = (find(true), find(false));
+    let mut beyond: Vec<String> = Vec::new();
+    let mut plan_claims: Vec<Claim> = Vec::new();
+    let mut sections = String::new();
+    for part in combined {
+        beyond.extend(part.beyond.iter().cloned());
+        plan_claims.extend(part.claims.iter().cloned());
+        sections.extend(part.sections.iter().map(String::as_str));
+    }
     let mut all: Vec<Claim> = Vec::new();
-    let mut thesis_ch6: Vec<Claim> = Vec::new();
     for spec in specs {
         let path = out.join(&spec.file.name).join("claims.csv");
         if path.exists() {
             let mut cs = claims::read(&path)?;
             cs.retain(|c| c.ours.1 > 0);
-            if Some(spec.file.name.as_str()) == same || Some(spec.file.name.as_str()) == diff {
-                thesis_ch6.extend(cs.iter().cloned());
-            } else {
-                // Claims of the specs beyond the thesis' protocol say so.
-                for c in cs.iter_mut().filter(|c| c.chapter == "6") {
-                    c.chapter = format!("6 ({})", spec.file.name);
+            if beyond.contains(&spec.file.name) {
+                // Claims of the specs beyond the source's protocol say so.
+                for c in cs.iter_mut() {
+                    c.chapter = format!("{} ({})", c.chapter, spec.file.name);
                 }
             }
             all.extend(cs);
         }
     }
-    all.extend(overall_claims(&thesis_ch6));
+    all.extend(plan_claims);
     let table = claims::write(out, &all)?;
     let holding = all.iter().filter(|c| c.holds()).count();
     if !all.is_empty() {
         let _ = writeln!(s, "\n## Claims\n\nEach claim of the thesis (or, for the other seeds, of the paper) is counted on this reproduction (`here`) and, where the published tables allow, on the source's own figures; {holding} of {} hold here without qualification (verdict **holds**: in every case checked, or, for a best-of-several claim, ahead of every rival). Also in `claims.csv`.\n", all.len());
         s.push_str(&table);
     }
-    let sources = |a: &'static str, b: &'static str| -> Vec<(&str, &str)> {
-        same.map(|n| (n, a)).into_iter().chain(diff.map(|n| (n, b))).collect()
-    };
-    for (name, title, thesis, src) in [
-        (
-            "table_6_8",
-            "Table 6.8: least average optimised surface error, overall",
-            "thesis: GA 0/280, DE 243/280, PSO 37/280",
-            sources("table_6_4", "table_6_5"),
-        ),
-        (
-            "table_6_9",
-            "Table 6.9: least average CPU time, overall",
-            "thesis: GA 280/280, DE 0/280, PSO 0/280",
-            sources("table_6_6", "table_6_7"),
-        ),
-    ] {
-        if let Some((file, h, r)) = overall(out, &src, name)? {
-            let _ = writeln!(
-                s,
-                "\n## {title}\n\n`{file}.csv` ({thesis}).\n\n{}",
-                markdown_table(&h, &r)
-            );
-        }
-    }
+    s.push_str(&sections);
     let mut seen: Vec<(String, String)> = Vec::new();
     for spec in specs {
         let name = &spec.file.name;
@@ -679,25 +512,6 @@ fn sub_report(text: &str, name: &str, seen: &mut Vec<(String, String)>) -> Strin
     s
 }
 
-/// Chapter 6's claims over both grids (Tables 6.8 and 6.9): the per-grid counts summed, here
-/// and on the thesis' own figures.
-fn overall_claims(per_grid: &[Claim]) -> Vec<Claim> {
-    let mut out = Vec::new();
-    for (stem, statement, note) in [
-        ("DE gives the least average error in most cells (grid", "DE gives the least average error in most cells, both grids (Table 6.8; thesis text: 243/280)", "sum of the two grids' counts"),
-        ("GA is the fastest (grid", "GA is the fastest in every cell, both grids (Table 6.9; thesis text: 280/280)", "sum of the two grids' counts"),
-    ] {
-        let parts: Vec<&Claim> = per_grid.iter().filter(|c| c.statement.starts_with(stem)).collect();
-        if parts.len() < 2 {
-            continue;
-        }
-        let ours = parts.iter().fold((0, 0), |a, c| (a.0 + c.ours.0, a.1 + c.ours.1));
-        let thesis = parts.iter().try_fold((0, 0), |a, c| c.thesis.map(|t| (a.0 + t.0, a.1 + t.1)));
-        out.push(Claim { rival: None, chapter: "6".into(), statement: statement.into(), ours, thesis, note: note.into() });
-    }
-    out
-}
-
 /// Point the relative links and images of a sub-report's line into its folder.
 fn relink(line: &str, folder: &str) -> String {
     let mut out = String::with_capacity(line.len());
@@ -744,44 +558,5 @@ mod tests {
             relink("![a](png/a.png) and [b](https://x) [c](#c)", "ch4"),
             "![a](ch4/png/a.png) and [b](https://x) [c](#c)"
         );
-    }
-
-    #[test]
-    fn overall_tables_sum_the_win_counts() {
-        let dir = tempfile::tempdir().unwrap();
-        for (spec, table, rows) in [
-            (
-                "ch6_same",
-                "table_6_4",
-                "cube,uniform,0,6,1,7\nsphere,uniform,1,5,1,7\ntotal,,1,11,2,14\n",
-            ),
-            ("ch6_diff", "table_6_5", "cube,uniform,0,7,0,7\n"),
-        ] {
-            std::fs::create_dir_all(dir.path().join(spec)).unwrap();
-            std::fs::write(
-                dir.path().join(spec).join(format!("{table}.csv")),
-                format!("data,parameterisation,ga,de,pso,cells\n{rows}"),
-            )
-            .unwrap();
-        }
-        let (_, h, r) = overall(
-            dir.path(),
-            &[("ch6_same", "table_6_4"), ("ch6_diff", "table_6_5")],
-            "table_6_8",
-        )
-        .unwrap()
-        .unwrap();
-        assert_eq!(h, vec!["table", "ga", "de", "pso"]);
-        assert_eq!(r[0], vec!["Table 6.4", "1/14", "11/14", "2/14"]);
-        assert_eq!(r[2], vec!["overall", "1/21", "18/21", "2/21"]);
-        std::fs::write(
-            dir.path().join("ch6_diff/table_6_5.csv"),
-            "data,parameterisation,ga,de,pso,cells\ncube,uniform,x,7,0,7\n",
-        )
-        .unwrap();
-        let e = overall(dir.path(), &[("ch6_same", "table_6_4"), ("ch6_diff", "table_6_5")], "t")
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("table_6_5.csv: line 2: ga"), "{e}");
     }
 }

@@ -1,6 +1,7 @@
 //! Chapter 5 wiring: read (or recompute) the DNSOM maps, fit every cell, log each at once.
 
 pub mod pictures;
+pub mod readings;
 pub mod report;
 pub mod spec;
 
@@ -237,6 +238,12 @@ impl crate::experiment::family::Section for self::spec::FitSpec {
 
 impl crate::experiment::family::Experiment for Fit {
     type Section = self::spec::FitSpec;
+    fn combine(
+        &self,
+        view: &crate::experiment::family::PlanView,
+    ) -> Result<crate::experiment::family::Combined> {
+        readings::combine(view)
+    }
     fn logged_keys(&self, spec: &Spec) -> Vec<String> {
         spec::cells(spec).iter().map(|c| c.key()).collect()
     }

@@ -4,6 +4,7 @@
 
 pub mod compare;
 pub mod ioh;
+pub mod overall;
 pub mod pictures;
 pub mod report;
 pub mod spec;
@@ -359,6 +360,12 @@ impl crate::experiment::family::Experiment for Optim {
         tables: bool,
     ) -> Result<crate::experiment::family::Outcome> {
         self.run_variants(std::slice::from_ref(spec), ctx, tables)
+    }
+    fn combine(
+        &self,
+        view: &crate::experiment::family::PlanView,
+    ) -> Result<crate::experiment::family::Combined> {
+        overall::combine(view)
     }
     /// Every variant's cells on the first variant's problems (a sweep varies optimiser settings
     /// only), then one set of tables in which each `optimiser@variant` of a sweep is a column.

@@ -156,11 +156,12 @@ pub fn write(
         let opts = ordered(g.iter().map(|r| r.cell.optimiser.clone()));
         let cells: Vec<CellKey> =
             ordered(g.iter().map(|r| (r.cell.dataset.clone(), r.cell.param, r.cell.cn)));
-        let (err_name, time_name, t_err, t_time) = match (grid.nx, grid.ny) {
-            (20, 20) => ("appendix_k", "appendix_m", "table_6_4", "table_6_6"),
-            (18, 30) => ("appendix_l", "appendix_n", "table_6_5", "table_6_7"),
-            _ => ("optimised_error", "optimiser_cpu", "wins_error", "wins_time"),
-        };
+        let (err_name, time_name, t_err, t_time) = table_names(grid.nx, grid.ny).unwrap_or((
+            "optimised_error",
+            "optimiser_cpu",
+            "wins_error",
+            "wins_time",
+        ));
         let of = |c: &CellKey, o: &str, f: &dyn Fn(&OptimRun) -> f64| -> Vec<f64> {
             g.iter()
                 .filter(|r| {
@@ -661,4 +662,17 @@ fn friedman_section(runs: &[OptimRun]) -> String {
         }
     }
     s
+}
+
+/// The thesis' names of a grid's tables: (errors appendix, CPU appendix, error wins, time wins);
+/// None for a grid the thesis did not use.
+pub fn table_names(
+    nx: usize,
+    ny: usize,
+) -> Option<(&'static str, &'static str, &'static str, &'static str)> {
+    match (nx, ny) {
+        (20, 20) => Some(("appendix_k", "appendix_m", "table_6_4", "table_6_6")),
+        (18, 30) => Some(("appendix_l", "appendix_n", "table_6_5", "table_6_7")),
+        _ => None,
+    }
 }

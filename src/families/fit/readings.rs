@@ -1,0 +1,86 @@
+//! Chapter 5 across the readings, for a plan's combined report: the surface error against the
+//! fitted surfaces' excursion between the data points, one series per reading.
+
+use crate::experiment::family::{Combined, PlanView};
+use anyhow::Result;
+use serde::Deserialize;
+
+/// One fitted cell as the chart needs it (from a Chapter 5 `runs.csv`).
+#[derive(Debug, Deserialize)]
+struct FitPoint {
+    dataset: String,
+    cn_x: usize,
+    parameterisation: String,
+    approach: String,
+    surface_error: f64,
+    excursion: f64,
+}
+
+/// The readings matrix's chart: the first fit spec every reading ran, its first data set, chord
+/// length, approach B; nothing when no reading ran a fit spec.
+pub fn combine(view: &PlanView) -> Result<Combined> {
+    let mut readings = Vec::new();
+    if let Some(chart) = error_vs_excursion(view)? {
+        readings.push(format!("\n![{chart}]({chart})\n\nSurface error against the largest distance of the fitted surfaces from the data's bounding box (log scale), one point per control net, for one data set under each reading: a reading can lower the error at the data points while its surfaces leave the data between them.\n"));
+    }
+    Ok(Combined { readings, ..Combined::default() })
+}
+
+/// Draws the chart into the plan's folder; returns its file name.
+fn error_vs_excursion(view: &PlanView) -> Result<Option<String>> {
+    if view.readings.is_empty() {
+        return Ok(None);
+    }
+    let Some(spec) = view.specs.iter().map(|s| s.file.name.as_str()).find(|s| {
+        view.readings.iter().all(|r| r.specs.iter().any(|x| x == s))
+            && view.out.join(s).join("runs.csv").exists()
+    }) else {
+        return Ok(None);
+    };
+    let mut folders = vec![(view.reading.to_string(), view.out.join(spec))];
+    folders.extend(view.readings.iter().map(|r| (r.name.clone(), r.root.join(spec))));
+    let mut series = Vec::new();
+    let mut data_set = None;
+    for (k, (name, folder)) in folders.iter().enumerate() {
+        let points: Vec<FitPoint> = crate::io::read_rows(&folder.join("runs.csv"))?;
+        let d = data_set
+            .get_or_insert_with(|| points.first().map(|p| p.dataset.clone()).unwrap_or_default())
+            .clone();
+        let mut pts: Vec<(usize, f64, f64)> = points
+            .iter()
+            .filter(|p| {
+                p.dataset == d
+                    && p.parameterisation == "chord_length"
+                    && p.approach == "B"
+                    && p.excursion > 0.0
+            })
+            .map(|p| (p.cn_x, p.excursion.log10(), p.surface_error))
+            .collect();
+        pts.sort_by_key(|p| p.0);
+        series.push(crate::report::plots::Series {
+            label: name.clone(),
+            colour: crate::report::plots::style::cycle_colour(k),
+            points: pts.iter().map(|p| (p.1, p.2)).collect(),
+            band: None,
+        });
+    }
+    let name = format!("readings_error_vs_excursion_{spec}.png");
+    let title = format!(
+        "{spec}, {}, chord length, B: one point per control net",
+        data_set.unwrap_or_default()
+    );
+    match crate::report::plots::line_chart_png(
+        &view.out.join(&name),
+        &title,
+        "log10 excursion from the data's box",
+        "surface error (Eq. 5.13)",
+        &series,
+        false,
+    ) {
+        Ok(()) => Ok(Some(name)),
+        Err(e) => {
+            eprintln!("somnurbs: warning: picture skipped: {e}");
+            Ok(None)
+        }
+    }
+}
