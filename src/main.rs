@@ -1,7 +1,7 @@
 //! somnurbs: parse the command line, run, print an error chain on one line, exit non-zero on error.
 
 use clap::Parser;
-use somnurbs::cli::{Cli, Command, DatasetsAction};
+use somnurbs::cli::{Cli, Command, DatasetsAction, DriftArgs, ReproduceArgs, RunArgs};
 use somnurbs::experiment::{
     self,
     log::Shard,
@@ -42,80 +42,8 @@ fn jobs(flag: Option<usize>) -> anyhow::Result<usize> {
 fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     somnurbs::optim::kernels::simd()?;
     match cli.command {
-        Command::Run(args) => {
-            let cli = CliOverrides { set: args.set.clone(), sweep: args.sweep.clone() };
-            let variants = Spec::load_variants(&args.spec, args.profile.as_deref(), &cli)?;
-            let spec = &variants[0];
-            if args.dry_run {
-                for (key, seed) in variants.iter().flat_map(experiment::dry_run_listing) {
-                    println!("{key}\tseed {seed}");
-                }
-                return Ok(ExitCode::SUCCESS);
-            }
-            let shard = args.shard.as_deref().map(Shard::parse).transpose()?;
-            let ctx = RunContext {
-                resume: args.resume,
-                shard,
-                ..RunContext::new(
-                    spec.output_dir(args.out.as_deref()),
-                    jobs(args.jobs)?,
-                    experiment::data_dir(args.data_dir.as_deref()),
-                )
-            };
-            let out = experiment::run_variants(&variants, &ctx)?;
-            match shard {
-                Some(s) => eprintln!(
-                    "somnurbs: wrote shard {s} to {} (combine the shards with `somnurbs merge`)",
-                    out.display()
-                ),
-                None => {
-                    let html = somnurbs::report::html::write(&out)?;
-                    eprintln!(
-                        "somnurbs: wrote {} and {}",
-                        out.join("REPORT.md").display(),
-                        html.display()
-                    )
-                }
-            }
-            Ok(ExitCode::SUCCESS)
-        }
-        Command::Drift(args) => {
-            use somnurbs::report::drift;
-            if args.accept {
-                let said = drift::accept(&args.baseline, &args.current)?;
-                for l in &said {
-                    println!("{l}");
-                }
-                println!(
-                    "baseline {} now holds the tables of {} ({} files changed)",
-                    args.baseline.display(),
-                    args.current.display(),
-                    said.len()
-                );
-                return Ok(ExitCode::SUCCESS);
-            }
-            let mut columns =
-                args.tol.iter().map(|t| drift::parse_tol(t)).collect::<anyhow::Result<Vec<_>>>()?;
-            let config = drift::read_config(&args.baseline)?;
-            columns.extend(
-                config
-                    .tolerance
-                    .iter()
-                    .map(|c| (c.column.clone(), drift::Tolerance { abs: c.abs, rel: c.rel })),
-            );
-            let opts = drift::DriftOptions { columns, config, ..Default::default() };
-            let report =
-                drift::compare_dirs(&args.baseline, &args.current, &opts, args.allow_spec_change)?;
-            let out = args.out.clone().unwrap_or_else(|| args.current.join("drift.csv"));
-            somnurbs::io::write_atomic(&out, report.csv()?.as_bytes())?;
-            println!(
-                "{}
-per-cell differences: {}",
-                report.summary(10),
-                out.display()
-            );
-            Ok(if report.drifted() { ExitCode::from(1) } else { ExitCode::SUCCESS })
-        }
+        Command::Run(args) => run_spec(&args),
+        Command::Drift(args) => drift(&args),
         Command::Merge(args) => {
             let ctx = RunContext::new(
                 args.out.clone(),
@@ -132,42 +60,105 @@ per-cell differences: {}",
             );
             Ok(ExitCode::SUCCESS)
         }
-        Command::Reproduce(args) => {
-            let out = args.out.clone().unwrap_or_else(|| {
-                if args.profile == "quick" {
-                    format!("results/{}_quick", args.plan).into()
-                } else {
-                    format!("results/{}", args.plan).into()
-                }
-            });
-            let ctx = RunContext {
-                resume: args.resume,
-                ..RunContext::new(
-                    out,
-                    jobs(args.jobs)?,
-                    experiment::data_dir(args.data_dir.as_deref()),
-                )
-            };
-            let report =
-                experiment::reproduce::reproduce(&args.specs, &args.plan, &args.profile, &ctx)?;
-            eprintln!("somnurbs: wrote {}", report.display());
-            Ok(ExitCode::SUCCESS)
-        }
+        Command::Reproduce(args) => reproduce(&args),
         Command::Compare(args) => {
             somnurbs::families::optimise::compare::compare(&args)?;
             Ok(ExitCode::SUCCESS)
         }
         Command::Fit(args) => {
-            experiment::fit_cmd::fit(&args)?;
+            somnurbs::families::fit::command::fit(&args)?;
             Ok(ExitCode::SUCCESS)
         }
         Command::Datasets(args) => {
             let dir = experiment::data_dir(args.data_dir.as_deref());
-            somnurbs::experiment::datasets::datasets(
-                args.action.unwrap_or(DatasetsAction::List),
-                &dir,
-            )?;
+            experiment::datasets::datasets(args.action.unwrap_or(DatasetsAction::List), &dir)?;
             Ok(ExitCode::SUCCESS)
         }
     }
+}
+
+/// `somnurbs run`: one spec (or its variants) into one folder, or one shard of it.
+fn run_spec(args: &RunArgs) -> anyhow::Result<ExitCode> {
+    let cli = CliOverrides { set: args.set.clone(), sweep: args.sweep.clone() };
+    let variants = Spec::load_variants(&args.spec, args.profile.as_deref(), &cli)?;
+    let spec = &variants[0];
+    if args.dry_run {
+        for (key, seed) in variants.iter().flat_map(experiment::dry_run_listing) {
+            println!("{key}\tseed {seed}");
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
+    let shard = args.shard.as_deref().map(Shard::parse).transpose()?;
+    let ctx = RunContext {
+        resume: args.resume,
+        shard,
+        ..RunContext::new(
+            spec.output_dir(args.out.as_deref()),
+            jobs(args.jobs)?,
+            experiment::data_dir(args.data_dir.as_deref()),
+        )
+    };
+    let out = experiment::run_variants(&variants, &ctx)?;
+    match shard {
+        Some(s) => eprintln!(
+            "somnurbs: wrote shard {s} to {} (combine the shards with `somnurbs merge`)",
+            out.display()
+        ),
+        None => {
+            let html = somnurbs::report::html::write(&out)?;
+            eprintln!("somnurbs: wrote {} and {}", out.join("REPORT.md").display(), html.display())
+        }
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `somnurbs drift`: compare two result folders (exit 1 on drift), or accept the current one.
+fn drift(args: &DriftArgs) -> anyhow::Result<ExitCode> {
+    use somnurbs::report::drift;
+    if args.accept {
+        let said = drift::accept(&args.baseline, &args.current)?;
+        for l in &said {
+            println!("{l}");
+        }
+        println!(
+            "baseline {} now holds the tables of {} ({} files changed)",
+            args.baseline.display(),
+            args.current.display(),
+            said.len()
+        );
+        return Ok(ExitCode::SUCCESS);
+    }
+    let mut columns =
+        args.tol.iter().map(|t| drift::parse_tol(t)).collect::<anyhow::Result<Vec<_>>>()?;
+    let config = drift::read_config(&args.baseline)?;
+    columns.extend(
+        config
+            .tolerance
+            .iter()
+            .map(|c| (c.column.clone(), drift::Tolerance { abs: c.abs, rel: c.rel })),
+    );
+    let opts = drift::DriftOptions { columns, config, ..Default::default() };
+    let report = drift::compare_dirs(&args.baseline, &args.current, &opts, args.allow_spec_change)?;
+    let out = args.out.clone().unwrap_or_else(|| args.current.join("drift.csv"));
+    somnurbs::io::write_atomic(&out, report.csv()?.as_bytes())?;
+    println!("{}\nper-cell differences: {}", report.summary(10), out.display());
+    Ok(if report.drifted() { ExitCode::from(1) } else { ExitCode::SUCCESS })
+}
+
+/// `somnurbs reproduce`: a plan's specs in order into one folder, then the combined report.
+fn reproduce(args: &ReproduceArgs) -> anyhow::Result<ExitCode> {
+    let out = args.out.clone().unwrap_or_else(|| {
+        if args.profile == "quick" {
+            format!("results/{}_quick", args.plan).into()
+        } else {
+            format!("results/{}", args.plan).into()
+        }
+    });
+    let ctx = RunContext {
+        resume: args.resume,
+        ..RunContext::new(out, jobs(args.jobs)?, experiment::data_dir(args.data_dir.as_deref()))
+    };
+    let report = experiment::reproduce::reproduce(&args.specs, &args.plan, &args.profile, &ctx)?;
+    eprintln!("somnurbs: wrote {}", report.display());
+    Ok(ExitCode::SUCCESS)
 }

@@ -86,10 +86,12 @@ struct Element {
     props: Vec<Property>,
 }
 
-/// Parse a PLY file's bytes into the vertex positions.
-pub fn parse_ply(bytes: &[u8]) -> Result<Vec<Point3>, DataError> {
-    let err = |ctx: String, msg: &str| DataError::parse(ctx, msg.to_string());
-    // Header: text lines up to end_header.
+fn err(ctx: String, msg: &str) -> DataError {
+    DataError::parse(ctx, msg.to_string())
+}
+
+/// The header's text lines up to `end_header`, and the offset of the first byte after it.
+fn header_lines(bytes: &[u8]) -> Result<(Vec<String>, usize), DataError> {
     let mut pos = 0;
     let mut lines = Vec::new();
     loop {
@@ -102,9 +104,40 @@ pub fn parse_ply(bytes: &[u8]) -> Result<Vec<Point3>, DataError> {
         let done = line == "end_header";
         lines.push(line);
         if done {
-            break;
+            return Ok((lines, pos));
         }
     }
+}
+
+/// One `property` line of the header.
+fn property(w: &[&str], ctx: String) -> Result<Property, DataError> {
+    if w.get(1) == Some(&"list") {
+        let count = w
+            .get(2)
+            .and_then(|t| Scalar::parse(t))
+            .ok_or_else(|| err(ctx.clone(), "bad list count type"))?;
+        if !count.is_integer() {
+            return Err(err(
+                ctx,
+                "a list's count type must be an integer type (uchar, ushort, uint, ...)",
+            ));
+        }
+        let item = w
+            .get(3)
+            .and_then(|t| Scalar::parse(t))
+            .ok_or_else(|| err(ctx, "bad list item type"))?;
+        Ok(Property::List { count, item })
+    } else {
+        let ty = w
+            .get(1)
+            .and_then(|t| Scalar::parse(t))
+            .ok_or_else(|| err(ctx, "unknown property type"))?;
+        Ok(Property::Scalar { name: w.get(2).unwrap_or(&"").to_string(), ty })
+    }
+}
+
+/// The header's format and elements.
+fn parse_header(lines: &[String]) -> Result<(Format, Vec<Element>), DataError> {
     if lines.first().map(|l| l.as_str()) != Some("ply") {
         return Err(err("line 1".into(), "not a PLY file (first line is not `ply`)"));
     }
@@ -140,53 +173,22 @@ pub fn parse_ply(bytes: &[u8]) -> Result<Vec<Point3>, DataError> {
                 let el = elements
                     .last_mut()
                     .ok_or_else(|| err(ctx.clone(), "property before any element"))?;
-                let prop = if w.get(1) == Some(&"list") {
-                    let count = w
-                        .get(2)
-                        .and_then(|t| Scalar::parse(t))
-                        .ok_or_else(|| err(ctx.clone(), "bad list count type"))?;
-                    if !count.is_integer() {
-                        return Err(err(ctx, "a list's count type must be an integer type (uchar, ushort, uint, ...)"));
-                    }
-                    let item = w
-                        .get(3)
-                        .and_then(|t| Scalar::parse(t))
-                        .ok_or_else(|| err(ctx.clone(), "bad list item type"))?;
-                    Property::List { count, item }
-                } else {
-                    let ty = w
-                        .get(1)
-                        .and_then(|t| Scalar::parse(t))
-                        .ok_or_else(|| err(ctx.clone(), "unknown property type"))?;
-                    Property::Scalar { name: w.get(2).unwrap_or(&"").to_string(), ty }
-                };
-                el.props.push(prop);
+                el.props.push(property(&w, ctx)?);
             }
             Some("comment") | Some("obj_info") | Some("end_header") | None => {}
             Some(other) => return Err(err(ctx, &format!("unknown header keyword `{other}`"))),
         }
     }
     let format = binary.ok_or_else(|| err("header".into(), "no format line"))?;
-    let vi = elements
-        .iter()
-        .position(|e| e.name == "vertex")
-        .ok_or_else(|| err("header".into(), "no vertex element"))?;
-    let axis = |name: &str| {
-        elements[vi]
-            .props
-            .iter()
-            .position(|p| matches!(p, Property::Scalar { name: n, .. } if n == name))
-            .ok_or_else(|| {
-                err("header".into(), &format!("vertex element has no `{name}` property"))
-            })
-    };
-    let (ix, iy, iz) = (axis("x")?, axis("y")?, axis("z")?);
-    // Every element up to the vertices must fit in what the file has left: at least its scalar
-    // bytes plus its list counts' bytes (binary), or one value and a separator per property
-    // (ascii), per item. Nothing is allocated or looped over before this holds.
-    let left = bytes.len() - pos;
+    Ok((format, elements))
+}
+
+/// Every element up to the vertices must fit in the `left` bytes after the header: at least its
+/// scalar bytes plus its list counts' bytes (binary), or one value and a separator per property
+/// (ascii), per item. Checked before anything is allocated or looped over.
+fn check_sizes(elements: &[Element], format: Format, left: usize) -> Result<(), DataError> {
     let mut need: usize = 0;
-    for el in &elements[..=vi] {
+    for el in elements {
         if el.props.is_empty() && el.count > 0 {
             return Err(err(format!("element {}", el.name), "has items but no properties"));
         }
@@ -205,81 +207,117 @@ pub fn parse_ply(bytes: &[u8]) -> Result<Vec<Point3>, DataError> {
             err(format!("element {}", el.name), &format!("the header says {} items, more than the {left} bytes after the header can hold", el.count))
         })?;
     }
+    Ok(())
+}
+
+/// The vertices of a binary body: the elements before them skipped, item by item. `axes` are
+/// the x, y, z properties' positions in the vertex element (the last of `elements`).
+fn read_binary(
+    bytes: &[u8],
+    mut at: usize,
+    elements: &[Element],
+    axes: [usize; 3],
+    big: bool,
+) -> Result<Vec<Point3>, DataError> {
+    let vi = elements.len() - 1;
     let mut points = Vec::with_capacity(elements[vi].count);
-    if let Format::Binary { big } = format {
-        let mut at = pos;
-        for (e, el) in elements.iter().enumerate() {
-            for k in 0..el.count {
-                let mut vals = [0.0f64; 3];
-                for (p, prop) in el.props.iter().enumerate() {
-                    let short =
-                        || err(format!("{} {}", el.name, k + 1), "file ends inside this element");
-                    match prop {
-                        Property::Scalar { ty, .. } => {
-                            let b = bytes.get(at..at + ty.size()).ok_or_else(short)?;
-                            if e == vi {
-                                let v = ty.read(b, big);
-                                if p == ix {
-                                    vals[0] = v;
-                                } else if p == iy {
-                                    vals[1] = v;
-                                } else if p == iz {
-                                    vals[2] = v;
-                                }
+    for (e, el) in elements.iter().enumerate() {
+        for k in 0..el.count {
+            let mut vals = [0.0f64; 3];
+            for (p, prop) in el.props.iter().enumerate() {
+                let short =
+                    || err(format!("{} {}", el.name, k + 1), "file ends inside this element");
+                match prop {
+                    Property::Scalar { ty, .. } => {
+                        let b = bytes.get(at..at + ty.size()).ok_or_else(short)?;
+                        if e == vi {
+                            if let Some(a) = axes.iter().position(|&i| i == p) {
+                                vals[a] = ty.read(b, big);
                             }
-                            at += ty.size();
                         }
-                        Property::List { count, item } => {
-                            let b = bytes.get(at..at + count.size()).ok_or_else(short)?;
-                            let n = count.read(b, big);
-                            if n < 0.0 {
-                                return Err(err(
-                                    format!("{} {}", el.name, k + 1),
-                                    &format!("negative list count {n}"),
-                                ));
-                            }
-                            at += count.size() + n as usize * item.size();
-                            if at > bytes.len() {
-                                return Err(short());
-                            }
+                        at += ty.size();
+                    }
+                    Property::List { count, item } => {
+                        let b = bytes.get(at..at + count.size()).ok_or_else(short)?;
+                        let n = count.read(b, big);
+                        if n < 0.0 {
+                            return Err(err(
+                                format!("{} {}", el.name, k + 1),
+                                &format!("negative list count {n}"),
+                            ));
+                        }
+                        at += count.size() + n as usize * item.size();
+                        if at > bytes.len() {
+                            return Err(short());
                         }
                     }
                 }
-                if e == vi {
-                    points.push(vals);
-                }
             }
             if e == vi {
-                break;
-            }
-        }
-    } else {
-        let text = String::from_utf8_lossy(&bytes[pos..]);
-        let mut rows = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty());
-        let header_lines = lines.len();
-        for (e, el) in elements.iter().enumerate() {
-            for k in 0..el.count {
-                let (n, line) = rows.next().ok_or_else(|| {
-                    err(format!("{} {}", el.name, k + 1), "file ends before this element")
-                })?;
-                if e == vi {
-                    let ctx = format!("line {}", header_lines + n + 1);
-                    let w: Vec<&str> = line.split_whitespace().collect();
-                    let get = |p: usize| -> Result<f64, DataError> {
-                        w.get(p)
-                            .ok_or_else(|| err(ctx.clone(), "too few values"))?
-                            .parse::<f64>()
-                            .map_err(|_| err(ctx.clone(), &format!("`{}` is not a number", w[p])))
-                    };
-                    points.push([get(ix)?, get(iy)?, get(iz)?]);
-                }
-            }
-            if e == vi {
-                break;
+                points.push(vals);
             }
         }
     }
     Ok(points)
+}
+
+/// The vertices of an ASCII body (one item per non-empty line; `header_lines` for the line
+/// numbers of messages).
+fn read_ascii(
+    body: &[u8],
+    header_lines: usize,
+    elements: &[Element],
+    axes: [usize; 3],
+) -> Result<Vec<Point3>, DataError> {
+    let vi = elements.len() - 1;
+    let mut points = Vec::with_capacity(elements[vi].count);
+    let text = String::from_utf8_lossy(body);
+    let mut rows = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty());
+    for (e, el) in elements.iter().enumerate() {
+        for k in 0..el.count {
+            let (n, line) = rows.next().ok_or_else(|| {
+                err(format!("{} {}", el.name, k + 1), "file ends before this element")
+            })?;
+            if e == vi {
+                let ctx = format!("line {}", header_lines + n + 1);
+                let w: Vec<&str> = line.split_whitespace().collect();
+                let get = |p: usize| -> Result<f64, DataError> {
+                    w.get(p)
+                        .ok_or_else(|| err(ctx.clone(), "too few values"))?
+                        .parse::<f64>()
+                        .map_err(|_| err(ctx.clone(), &format!("`{}` is not a number", w[p])))
+                };
+                points.push([get(axes[0])?, get(axes[1])?, get(axes[2])?]);
+            }
+        }
+    }
+    Ok(points)
+}
+
+/// Parse a PLY file's bytes into the vertex positions.
+pub fn parse_ply(bytes: &[u8]) -> Result<Vec<Point3>, DataError> {
+    let (lines, pos) = header_lines(bytes)?;
+    let (format, elements) = parse_header(&lines)?;
+    let vi = elements
+        .iter()
+        .position(|e| e.name == "vertex")
+        .ok_or_else(|| err("header".into(), "no vertex element"))?;
+    let axis = |name: &str| {
+        elements[vi]
+            .props
+            .iter()
+            .position(|p| matches!(p, Property::Scalar { name: n, .. } if n == name))
+            .ok_or_else(|| {
+                err("header".into(), &format!("vertex element has no `{name}` property"))
+            })
+    };
+    let axes = [axis("x")?, axis("y")?, axis("z")?];
+    let upto = &elements[..=vi];
+    check_sizes(upto, format, bytes.len() - pos)?;
+    match format {
+        Format::Binary { big } => read_binary(bytes, pos, upto, axes, big),
+        Format::Ascii => read_ascii(&bytes[pos..], lines.len(), upto, axes),
+    }
 }
 
 #[cfg(test)]

@@ -94,11 +94,32 @@ pub struct Combined {
 /// Which keys of a section `--set` and `--sweep` may change (see [`Section::OVERRIDES`]).
 #[derive(Debug, Clone, Copy)]
 pub struct Overrides {
-    /// Whether `--sweep` may vary this key (a full dotted key, `optim.de.f`): settings that leave
-    /// every variant the same problems, so the variants can be ranked like optimisers.
-    pub sweepable: fn(&str) -> bool,
-    /// The sweepable keys, for messages.
-    pub describe: &'static str,
+    /// What `--sweep` may vary: settings that leave every variant the same problems, so the
+    /// variants can be ranked like optimisers. Full dotted keys (`optim.generations`), or
+    /// prefixes ending in a dot (`optim.de.`: every key of that table).
+    pub sweepable: fn() -> Vec<String>,
+}
+
+impl Overrides {
+    /// Whether `--sweep` may vary `key` (a full dotted key, `optim.de.f`).
+    pub fn sweepable(&self, key: &str) -> bool {
+        (self.sweepable)().iter().any(|p| {
+            if p.ends_with('.') {
+                key.starts_with(p.as_str())
+            } else {
+                key == p
+            }
+        })
+    }
+
+    /// The sweepable keys, for messages (`optim.de.*, optim.generations`).
+    pub fn describe(&self) -> String {
+        let shown: Vec<String> = (self.sweepable)()
+            .iter()
+            .map(|p| if p.ends_with('.') { format!("{p}*") } else { p.to_string() })
+            .collect();
+        shown.join(", ")
+    }
 }
 
 /// Where a section type sits in the spec file: written for every family by the `families!`

@@ -3,10 +3,10 @@
 pub mod datasets;
 pub mod family;
 pub mod finite;
-pub mod fit_cmd;
 pub mod grid_size;
 pub mod limits;
 pub mod log;
+pub mod overrides;
 pub mod reproduce;
 pub mod runner;
 pub mod seeds;

@@ -1,14 +1,7 @@
 //! The experiment families, one folder each: `mod.rs` implements [`Family`] for the family's
 //! spec section, `report.rs` writes its tables, pictures and REPORT.md section. This file holds
-//! the only list of families: a new one is its folder plus one line here.
-
-pub mod closed_cylinder;
-pub mod cuckoo_bezier;
-pub mod fit;
-pub mod growing_grid;
-pub mod optimise;
-pub mod rational_bezier;
-pub mod som;
+//! the only list of families (the macro declares their modules too): a new one is its folder plus
+//! one line here.
 
 crate::experiment::spec::families! {
     /// Chapter 4: SOM models.

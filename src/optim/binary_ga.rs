@@ -111,6 +111,53 @@ impl BinaryGa {
         }
     }
 
+    /// Uniform crossover with probability `pc` (each bit swapped with probability `swap`), or
+    /// copies of the parents.
+    fn crossover(
+        &self,
+        pa: &[u64],
+        pb: &[u64],
+        c1: &mut [u64],
+        c2: &mut [u64],
+        rng: &mut ChaCha8Rng,
+    ) {
+        let cross = unit(rng) < self.pc;
+        for w in 0..pa.len() {
+            let m = if !cross {
+                0
+            } else if self.swap == 0.5 {
+                rng.next_u64()
+            } else {
+                (0..64).fold(0u64, |m, t| m | (((unit(rng) < self.swap) as u64) << t))
+            };
+            c1[w] = (pa[w] & !m) | (pb[w] & m);
+            c2[w] = (pb[w] & !m) | (pa[w] & m);
+        }
+    }
+
+    /// Elitism: the `elitism` best parents replace the worst children (`order` ranks the parents
+    /// worst first, so the best are at its end).
+    fn keep_elite(
+        &self,
+        pop: &[Vec<u64>],
+        f: &[f64],
+        order: &[usize],
+        children: &mut [Vec<u64>],
+        fc: &mut [f64],
+    ) {
+        if self.elitism == 0 {
+            return;
+        }
+        let mu = pop.len();
+        let mut child_order: Vec<usize> = (0..mu).collect();
+        child_order.sort_by(|&a, &b| fc[b].total_cmp(&fc[a]).then(a.cmp(&b)));
+        for e in 0..self.elitism {
+            let (dst, src) = (child_order[e], order[mu - 1 - e]);
+            children[dst].copy_from_slice(&pop[src]);
+            fc[dst] = f[src];
+        }
+    }
+
     /// One run with its per-generation history.
     pub fn run_with_history(
         &self,
@@ -198,20 +245,8 @@ impl BinaryGa {
                     continue;
                 }
                 let b = parents[2 * pair + 1];
-                let cross = unit(rng) < self.pc;
                 let (left, right) = children.split_at_mut(2 * pair + 1);
-                let (c1, c2) = (&mut left[2 * pair], &mut right[0]);
-                for w in 0..words {
-                    let m = if !cross {
-                        0
-                    } else if self.swap == 0.5 {
-                        rng.next_u64()
-                    } else {
-                        (0..64).fold(0u64, |m, t| m | (((unit(rng) < self.swap) as u64) << t))
-                    };
-                    c1[w] = (pop[a][w] & !m) | (pop[b][w] & m);
-                    c2[w] = (pop[b][w] & !m) | (pop[a][w] & m);
-                }
+                self.crossover(&pop[a], &pop[b], &mut left[2 * pair], &mut right[0], rng);
             }
             for c in children.iter_mut() {
                 mutation.for_each(nbits, &mut pool, rng, |t| c[t / 64] ^= 1u64 << (t % 64));
@@ -220,16 +255,7 @@ impl BinaryGa {
                 .iter()
                 .map(|c| evaluate(c, &mut eval, &mut x, &mut best_x, &mut best_f))
                 .collect();
-            if self.elitism > 0 {
-                // order is worst-first over the parents: the best are at its end.
-                let mut child_order: Vec<usize> = (0..mu).collect();
-                child_order.sort_by(|&a, &b| fc[b].total_cmp(&fc[a]).then(a.cmp(&b)));
-                for e in 0..self.elitism {
-                    let (dst, src) = (child_order[e], order[mu - 1 - e]);
-                    children[dst].copy_from_slice(&pop[src]);
-                    fc[dst] = f[src];
-                }
-            }
+            self.keep_elite(&pop, &f, &order, &mut children, &mut fc);
             std::mem::swap(&mut pop, &mut children);
             std::mem::swap(&mut f, &mut fc);
             population_best.push(pop_best(&f));

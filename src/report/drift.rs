@@ -462,53 +462,66 @@ pub fn compare_table(
                 b.get(i).map(String::as_str).unwrap_or(""),
                 c.get(j).map(String::as_str).unwrap_or(""),
             );
-            report.cells += 1;
-            if vb == vc {
-                if vb.parse::<f64>().is_ok_and(|x| !x.is_finite()) {
-                    report.findings.push(Finding::NonFinite {
-                        table: name.into(),
-                        row: key.clone(),
-                        column: col.clone(),
-                        value: vb.into(),
-                    });
-                }
-                continue;
-            }
             let judged = !(timing_table || timing_row || is_timing_column(col));
-            match (vb.parse::<f64>(), vc.parse::<f64>()) {
-                (Ok(x), Ok(y)) => {
-                    if judged && opts.tolerance(col).equal(x, y) {
-                        continue;
-                    }
-                    let abs = (x - y).abs();
-                    let rel = if x.is_finite() && y.is_finite() {
-                        abs / x.abs().max(y.abs()).max(f64::MIN_POSITIVE)
-                    } else {
-                        f64::INFINITY
-                    };
-                    report.findings.push(Finding::Cell {
-                        table: name.into(),
-                        row: key.clone(),
-                        column: col.clone(),
-                        baseline: vb.into(),
-                        current: vc.into(),
-                        abs,
-                        rel,
-                        judged,
-                    });
-                }
-                _ => report.findings.push(Finding::Cell {
-                    table: name.into(),
-                    row: key.clone(),
-                    column: col.clone(),
-                    baseline: vb.into(),
-                    current: vc.into(),
-                    abs: f64::NAN,
-                    rel: f64::INFINITY,
-                    judged,
-                }),
-            }
+            compare_cell(name, &key, col, (vb, vc), judged, opts, report);
         }
+    }
+}
+
+/// Compare one cell of a table (same column, same row key); findings go into `report`.
+fn compare_cell(
+    name: &str,
+    key: &str,
+    col: &str,
+    (vb, vc): (&str, &str),
+    judged: bool,
+    opts: &DriftOptions,
+    report: &mut DriftReport,
+) {
+    report.cells += 1;
+    if vb == vc {
+        if vb.parse::<f64>().is_ok_and(|x| !x.is_finite()) {
+            report.findings.push(Finding::NonFinite {
+                table: name.into(),
+                row: key.into(),
+                column: col.into(),
+                value: vb.into(),
+            });
+        }
+        return;
+    }
+    match (vb.parse::<f64>(), vc.parse::<f64>()) {
+        (Ok(x), Ok(y)) => {
+            if judged && opts.tolerance(col).equal(x, y) {
+                return;
+            }
+            let abs = (x - y).abs();
+            let rel = if x.is_finite() && y.is_finite() {
+                abs / x.abs().max(y.abs()).max(f64::MIN_POSITIVE)
+            } else {
+                f64::INFINITY
+            };
+            report.findings.push(Finding::Cell {
+                table: name.into(),
+                row: key.into(),
+                column: col.into(),
+                baseline: vb.into(),
+                current: vc.into(),
+                abs,
+                rel,
+                judged,
+            });
+        }
+        _ => report.findings.push(Finding::Cell {
+            table: name.into(),
+            row: key.into(),
+            column: col.into(),
+            baseline: vb.into(),
+            current: vc.into(),
+            abs: f64::NAN,
+            rel: f64::INFINITY,
+            judged,
+        }),
     }
 }
 

@@ -629,6 +629,65 @@ mod fused {
     }
 }
 
+/// The search box per axis (lower, upper) of `bounds`, from the data's box `data` and the start
+/// `x0` (xyz interleaved).
+fn box_axes(
+    bounds: BoxSpec,
+    data: ([f64; 3], [f64; 3]),
+    x0: &[f64],
+) -> Result<([f64; 3], [f64; 3]), OptimError> {
+    let (dlo, dhi) = data;
+    Ok(match bounds {
+        BoxSpec::DataRange => (dlo, dhi),
+        BoxSpec::Widened { fraction } | BoxSpec::Cover { fraction } => {
+            if !(fraction >= 0.0 && fraction.is_finite()) {
+                return Err(OptimError::param(
+                    "bounds.fraction",
+                    format!("must be finite and >= 0, got {fraction}"),
+                ));
+            }
+            let (mut lo, mut hi) = (dlo, dhi);
+            if matches!(bounds, BoxSpec::Cover { .. }) {
+                for (k, &v) in x0.iter().enumerate() {
+                    lo[k % 3] = lo[k % 3].min(v);
+                    hi[k % 3] = hi[k % 3].max(v);
+                }
+            }
+            for a in 0..3 {
+                let w = hi[a] - lo[a];
+                lo[a] -= fraction * w;
+                hi[a] += fraction * w;
+            }
+            (lo, hi)
+        }
+        BoxSpec::AroundStart { half_width } => {
+            if !(half_width > 0.0 && half_width.is_finite()) {
+                return Err(OptimError::param(
+                    "search_range",
+                    format!("must be finite and > 0, got {half_width}"),
+                ));
+            }
+            let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+            for (k, &v) in x0.iter().enumerate() {
+                lo[k % 3] = lo[k % 3].min(v - half_width);
+                hi[k % 3] = hi[k % 3].max(v + half_width);
+            }
+            (lo, hi)
+        }
+        BoxSpec::Axes { lower, upper } => {
+            if let Some(a) =
+                (0..3).find(|&a| lower[a].partial_cmp(&upper[a]).is_none_or(|o| o.is_gt()))
+            {
+                return Err(OptimError::param(
+                    "bounds",
+                    format!("axis {a}: lower {} is not <= upper {}", lower[a], upper[a]),
+                ));
+            }
+            (lower, upper)
+        }
+    })
+}
+
 impl ControlNetProblem {
     /// Check the parts, lay out the kernel's data and build the box.
     pub fn new(parts: ControlNetParts, bounds: BoxSpec) -> Result<ControlNetProblem, OptimError> {
@@ -638,55 +697,7 @@ impl ControlNetProblem {
         let (nx, ny) = (parts.nx, parts.ny);
         let all: Vec<Point3> = parts.data_bottom.iter().chain(&parts.data_top).copied().collect();
         let (dlo, dhi) = crate::geom::bounding_box(&all).expect("grid has points");
-        let box_axes = match bounds {
-            BoxSpec::DataRange => (dlo, dhi),
-            BoxSpec::Widened { fraction } | BoxSpec::Cover { fraction } => {
-                if !(fraction >= 0.0 && fraction.is_finite()) {
-                    return Err(OptimError::param(
-                        "bounds.fraction",
-                        format!("must be finite and >= 0, got {fraction}"),
-                    ));
-                }
-                let (mut lo, mut hi) = (dlo, dhi);
-                if matches!(bounds, BoxSpec::Cover { .. }) {
-                    for (k, &v) in parts.x0.iter().enumerate() {
-                        lo[k % 3] = lo[k % 3].min(v);
-                        hi[k % 3] = hi[k % 3].max(v);
-                    }
-                }
-                for a in 0..3 {
-                    let w = hi[a] - lo[a];
-                    lo[a] -= fraction * w;
-                    hi[a] += fraction * w;
-                }
-                (lo, hi)
-            }
-            BoxSpec::AroundStart { half_width } => {
-                if !(half_width > 0.0 && half_width.is_finite()) {
-                    return Err(OptimError::param(
-                        "search_range",
-                        format!("must be finite and > 0, got {half_width}"),
-                    ));
-                }
-                let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-                for (k, &v) in parts.x0.iter().enumerate() {
-                    lo[k % 3] = lo[k % 3].min(v - half_width);
-                    hi[k % 3] = hi[k % 3].max(v + half_width);
-                }
-                (lo, hi)
-            }
-            BoxSpec::Axes { lower, upper } => {
-                if let Some(a) =
-                    (0..3).find(|&a| lower[a].partial_cmp(&upper[a]).is_none_or(|o| o.is_gt()))
-                {
-                    return Err(OptimError::param(
-                        "bounds",
-                        format!("axis {a}: lower {} is not <= upper {}", lower[a], upper[a]),
-                    ));
-                }
-                (lower, upper)
-            }
-        };
+        let box_axes = box_axes(bounds.clone(), (dlo, dhi), &parts.x0)?;
         let nov = net.nov();
         let (lower, upper): (Vec<f64>, Vec<f64>) = match bounds {
             BoxSpec::AroundStart { half_width } => {

@@ -204,23 +204,21 @@ The transcribed Table 4 is not consistent with itself in these cells (garbled in
 Table 5's Example II cells for CSA vs centripetal are garbled: the sign test's h reads \"1 (alpha = 0.1)\", the sum test's \"1 (alpha = 0.15)\" (the text: h = 0 at 0.05), and its rank-sum p-value is printed \"0.148521 x 10^-1\" although the text says order 10^-1 (likely 1.48521e-1); the transcription keeps the printed number and h = 0.");
 }
 
-/// Table 5 (`seed003_table5.csv`), the agreement table (`seed003_agreement.csv`) and their
-/// Markdown. Direction: the method with the lower mean Y is better (Table 4's reading);
-/// significance: h of each test at the spec's alpha.
+/// One comparison of Table 5: (method, `csa_vs_<method>`, per example the six indices).
+type Comparison = (String, String, Vec<[f64; 6]>);
+
+/// Table 5 (`seed003_table5.csv`) and its Markdown: each method against CSA, paired by run.
 #[allow(clippy::too_many_arguments)]
-fn write_tests(
+fn table5(
     s: &Seed003Spec,
     runs: &[Run],
     examples: &[&str],
     others: &[&str],
-    ref4: Option<&RefTable>,
     ref5: Option<&RefTable>,
     out: &Path,
     md: &mut String,
-    stats: &dyn Fn(&str, &str) -> Option<Stats>,
-) -> Result<()> {
+) -> Result<Vec<Comparison>> {
     let mut t5 = Vec::new();
-    let mut agree = Vec::new();
     let _ = writeln!(md, "\n### Table 5: Wilcoxon signed-rank (sign) and rank-sum (sum) tests, alpha = {} (ours, paper in brackets)\n", s.alpha);
     let _ = writeln!(md, "x = the compared method, y = CSA, paired by run (same data). signed_rank = sum of the ranks of the positive x - y (MATLAB's `signrank` statistic); rank_sum = sum of x's ranks in the pooled sample (MATLAB's `ranksum`); 1275 and 3775 are their maxima for 50 runs (every x above every y). p-values: exact when there are no ties, else the normal approximation with tie and continuity corrections (the paper's MATLAB uses the normal approximation for 50 runs, so its p-values differ a little at the same statistic).\n");
     let _ = writeln!(md, "| comparison | index | {} |", examples.join(" | "));
@@ -263,11 +261,28 @@ fn write_tests(
                     .join(" | ")
             );
         }
-        results.push((o, comp, per));
+        results.push((o.to_string(), comp, per));
     }
     let mut header = vec!["comparison", "index"];
     header.extend(examples);
     write_csv(out, "seed003_table5.csv", &header, &t5)?;
+    Ok(results)
+}
+
+/// The agreement table (`seed003_agreement.csv`) and its Markdown: per comparison and example,
+/// the better method and the tests' h, ours beside the paper's. Returns its rows.
+#[allow(clippy::too_many_arguments)]
+fn agreement(
+    s: &Seed003Spec,
+    examples: &[&str],
+    results: &[Comparison],
+    ref4: Option<&RefTable>,
+    ref5: Option<&RefTable>,
+    out: &Path,
+    md: &mut String,
+    stats: &dyn Fn(&str, &str) -> Option<Stats>,
+) -> Result<Vec<Vec<String>>> {
+    let mut agree = Vec::new();
 
     let _ = writeln!(
         md,
@@ -287,7 +302,7 @@ fn write_tests(
             }
         }
     };
-    for (o, comp, per) in &results {
+    for (o, comp, per) in results {
         for (e, v) in examples.iter().zip(per) {
             let ours = better(e, o, &|m| stats(e, m).map(|x| x.y_mean));
             let paper = better(e, o, &|m| {
@@ -352,9 +367,16 @@ fn write_tests(
         ],
         &agree,
     )?;
-    // One claim per comparison for the combined report: the paper's verdict (direction and
-    // significance) checked on each example.
-    let claims: Vec<crate::report::claims::Claim> = results
+    Ok(agree)
+}
+
+/// One claim per comparison for the combined report: the paper's verdict (direction and
+/// significance) checked on each example.
+fn agreement_claims(
+    results: &[Comparison],
+    agree: &[Vec<String>],
+) -> Vec<crate::report::claims::Claim> {
+    results
         .iter()
         .map(|(o, comp, _)| {
             let rows: Vec<&Vec<String>> = agree.iter().filter(|r| &r[0] == comp).collect();
@@ -368,8 +390,27 @@ fn write_tests(
                 note: format!("examples where both agree (seed003_agreement.csv); paper: {}", paper.join(", ")),
             }
         })
-        .collect();
-    crate::report::claims::write(out, &claims).map(|_| ())
+        .collect()
+}
+
+/// Table 5 (`seed003_table5.csv`), the agreement table (`seed003_agreement.csv`) and their
+/// Markdown. Direction: the method with the lower mean Y is better (Table 4's reading);
+/// significance: h of each test at the spec's alpha.
+#[allow(clippy::too_many_arguments)]
+fn write_tests(
+    s: &Seed003Spec,
+    runs: &[Run],
+    examples: &[&str],
+    others: &[&str],
+    ref4: Option<&RefTable>,
+    ref5: Option<&RefTable>,
+    out: &Path,
+    md: &mut String,
+    stats: &dyn Fn(&str, &str) -> Option<Stats>,
+) -> Result<()> {
+    let results = table5(s, runs, examples, others, ref5, out, md)?;
+    let agree = agreement(s, examples, &results, ref4, ref5, out, md, stats)?;
+    crate::report::claims::write(out, &agreement_claims(&results, &agree)).map(|_| ())
 }
 
 /// Convergence diagrams: per example, the median and quartiles over the runs of CSA's and ICSA's

@@ -1,5 +1,6 @@
 //! Chapter 5 wiring: read (or recompute) the DNSOM maps, fit every cell, log each at once.
 
+pub mod command;
 pub mod pictures;
 pub mod readings;
 pub mod report;

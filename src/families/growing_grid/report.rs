@@ -146,9 +146,13 @@ fn least_squares(
     Ok(())
 }
 
-/// The average error per optimiser and cell (avg_error.csv), the optimisers over all cells
-/// (optimiser_summary.csv) and each optimiser's verdict against its least-squares start.
-fn optimisers(runs: &[Run], out: &Path, md: &mut String) -> Result<()> {
+/// Per optimiser: the improvements on the least-squares start (%, one per cell), the runs below
+/// it, the runs.
+type PerOpt = BTreeMap<String, (Vec<f64>, usize, usize)>;
+
+/// One `avg_error.csv` row per (data, net, parameterisation, optimiser), and the per-optimiser
+/// improvements.
+fn avg_error(runs: &[Run]) -> (Vec<Vec<String>>, PerOpt) {
     let mut groups: BTreeMap<(String, String, String, String), Vec<&Run>> = BTreeMap::new();
     for r in runs {
         groups
@@ -162,7 +166,7 @@ fn optimisers(runs: &[Run], out: &Path, md: &mut String) -> Result<()> {
             .push(r);
     }
     let mut avg_rows = Vec::new();
-    let mut per_opt: BTreeMap<String, (Vec<f64>, usize, usize)> = BTreeMap::new(); // improvement %, runs improved, runs
+    let mut per_opt: PerOpt = BTreeMap::new();
     for ((d, cn, p, o), rs) in &groups {
         let best: Vec<f64> = rs.iter().map(|r| r.row.best).collect();
         let (m, s) = mean_std(&best);
@@ -188,27 +192,17 @@ fn optimisers(runs: &[Run], out: &Path, md: &mut String) -> Result<()> {
             format!("{:?}", imp),
         ]);
     }
-    write_csv(
-        out,
-        "avg_error.csv",
-        &[
-            "dataset",
-            "control_net",
-            "parameterisation",
-            "optimiser",
-            "runs",
-            "lsq",
-            "mean_best",
-            "std_best",
-            "min_best",
-            "max_best",
-            "improvement_pct",
-        ],
-        &avg_rows,
-    )?;
-    let opts: Vec<String> = per_opt.keys().cloned().collect();
+    (avg_rows, per_opt)
+}
+
+/// The mean-error table shown in REPORT.md (one row per cell, least squares beside each
+/// optimiser's mean), the number of cells and each optimiser's cells with the lowest mean.
+fn mean_table(
+    avg_rows: &[Vec<String>],
+    opts: &[String],
+) -> (String, usize, BTreeMap<String, usize>) {
     let mut cells: BTreeMap<(String, String, String), BTreeMap<String, f64>> = BTreeMap::new();
-    for r in &avg_rows {
+    for r in avg_rows {
         cells
             .entry((r[0].clone(), r[1].clone(), r[2].clone()))
             .or_default()
@@ -231,37 +225,11 @@ fn optimisers(runs: &[Run], out: &Path, md: &mut String) -> Result<()> {
         row.extend(opts.iter().map(|o| num(by.get(o).copied(), 6)));
         shown.push(row);
     }
-    let _ = writeln!(md, "### Average error per optimiser (avg_error.csv)\n\nMean over the repeats of the best surface error each optimiser found, starting from the least-squares net.\n");
-    md.push_str(&table(&header, &shown));
-    md.push('\n');
-    let summary: Vec<Vec<String>> = opts
-        .iter()
-        .map(|o| {
-            let (imp, improved, n) = &per_opt[o];
-            let (mi, _) = mean_std(imp);
-            vec![
-                o.clone(),
-                cells.len().to_string(),
-                wins.get(o).copied().unwrap_or(0).to_string(),
-                format!("{:?}", mi),
-                improved.to_string(),
-                n.to_string(),
-            ]
-        })
-        .collect();
-    write_csv(
-        out,
-        "optimiser_summary.csv",
-        &[
-            "optimiser",
-            "cells",
-            "lowest_mean_cells",
-            "mean_improvement_pct",
-            "runs_below_lsq",
-            "runs",
-        ],
-        &summary,
-    )?;
+    (table(&header, &shown), cells.len(), wins)
+}
+
+/// The optimisers over all cells in REPORT.md, and each one's verdict against its start.
+fn render_summary(summary: &[Vec<String>], md: &mut String) {
     let _ = writeln!(md, "### Optimisers over all cells (optimiser_summary.csv)\n");
     let shown: Vec<Vec<String>> = summary
         .iter()
@@ -284,7 +252,7 @@ fn optimisers(runs: &[Run], out: &Path, md: &mut String) -> Result<()> {
         &shown,
     ));
     let _ = writeln!(md);
-    for r in &summary {
+    for r in summary {
         let (improved, n): (usize, usize) = (r[4].parse().unwrap_or(0), r[5].parse().unwrap_or(0));
         let verdict = if improved == n {
             "improves on the least-squares start in every run"
@@ -296,7 +264,64 @@ fn optimisers(runs: &[Run], out: &Path, md: &mut String) -> Result<()> {
         let _ = writeln!(md, "- {}: {verdict} ({improved} of {n}).", r[0].to_uppercase());
     }
     md.push('\n');
+}
 
+/// The average error per optimiser and cell (avg_error.csv), the optimisers over all cells
+/// (optimiser_summary.csv) and each optimiser's verdict against its least-squares start.
+fn optimisers(runs: &[Run], out: &Path, md: &mut String) -> Result<()> {
+    let (avg_rows, per_opt) = avg_error(runs);
+    write_csv(
+        out,
+        "avg_error.csv",
+        &[
+            "dataset",
+            "control_net",
+            "parameterisation",
+            "optimiser",
+            "runs",
+            "lsq",
+            "mean_best",
+            "std_best",
+            "min_best",
+            "max_best",
+            "improvement_pct",
+        ],
+        &avg_rows,
+    )?;
+    let opts: Vec<String> = per_opt.keys().cloned().collect();
+    let (means, n_cells, wins) = mean_table(&avg_rows, &opts);
+    let _ = writeln!(md, "### Average error per optimiser (avg_error.csv)\n\nMean over the repeats of the best surface error each optimiser found, starting from the least-squares net.\n");
+    md.push_str(&means);
+    md.push('\n');
+    let summary: Vec<Vec<String>> = opts
+        .iter()
+        .map(|o| {
+            let (imp, improved, n) = &per_opt[o];
+            let (mi, _) = mean_std(imp);
+            vec![
+                o.clone(),
+                n_cells.to_string(),
+                wins.get(o).copied().unwrap_or(0).to_string(),
+                format!("{:?}", mi),
+                improved.to_string(),
+                n.to_string(),
+            ]
+        })
+        .collect();
+    write_csv(
+        out,
+        "optimiser_summary.csv",
+        &[
+            "optimiser",
+            "cells",
+            "lowest_mean_cells",
+            "mean_improvement_pct",
+            "runs_below_lsq",
+            "runs",
+        ],
+        &summary,
+    )?;
+    render_summary(&summary, md);
     Ok(())
 }
 

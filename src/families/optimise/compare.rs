@@ -47,24 +47,14 @@ pub fn friedman_table(rows: &[OptimRow]) -> (Vec<String>, Vec<Vec<f64>>) {
     (opts, table)
 }
 
-pub fn compare(args: &CompareArgs) -> Result<()> {
-    if !(args.rope >= 0.0 && args.rope.is_finite()) || args.bayes_samples == 0 {
-        anyhow::bail!(
-            "--rope must be finite and >= 0 (got {}) and --bayes-samples at least 1 (got {})",
-            args.rope,
-            args.bayes_samples
-        );
-    }
-    if !args.results.is_dir() {
-        anyhow::bail!(
-            "{}: not found (no such results folder)",
-            args.results.join("runs.csv").display()
-        );
-    }
-    // compare writes its tables into the folder: one writer at a time (a run still writing it
-    // refuses this, naming itself).
-    let _lock = crate::io::outdir::lock(&args.results, "compare")?;
-    let path = args.results.join("runs.csv");
+/// Per cell, per competitor: its (repeat, best) pairs.
+type Cells = BTreeMap<CellKey, BTreeMap<String, Vec<(usize, f64)>>>;
+/// Per pair of competitors: cells where the rank-sum test favours the first, the second.
+type Wins = BTreeMap<(String, String), (usize, usize)>;
+
+/// The rows of `results/runs.csv`, every one checked.
+fn read_runs(results: &std::path::Path) -> Result<Vec<OptimRow>> {
+    let path = results.join("runs.csv");
     let mut reader =
         csv::Reader::from_path(&path).with_context(|| format!("cannot read {}", path.display()))?;
     let mut rows: Vec<OptimRow> = Vec::new();
@@ -76,49 +66,16 @@ pub fn compare(args: &CompareArgs) -> Result<()> {
     if rows.is_empty() {
         anyhow::bail!("{}: no runs", path.display());
     }
-    let mut opts: Vec<String> = Vec::new();
-    let mut cells: BTreeMap<CellKey, BTreeMap<String, Vec<(usize, f64)>>> = BTreeMap::new();
-    for r in &rows {
-        if !opts.contains(&r.competitor()) {
-            opts.push(r.competitor());
-        }
-        let key =
-            (r.dataset.clone(), r.grid_x, r.grid_y, r.cn_x, r.cn_y, r.parameterisation.clone());
-        cells.entry(key).or_default().entry(r.competitor()).or_default().push((r.repeat, r.best));
-    }
-    if opts.len() < 2 {
-        anyhow::bail!("{}: only one optimiser ({}); nothing to compare", path.display(), opts[0]);
-    }
-    // The traces first, so that a folder whose ioh/ does not match runs.csv gets nothing written.
-    let probs = if args.results.join("ioh").is_dir() {
-        Some(problems(&rows, &args.results)?)
-    } else {
-        None
-    };
-    // Per cell and pair.
-    let header: Vec<String> = [
-        "data",
-        "grid",
-        "cn",
-        "parameterisation",
-        "x",
-        "y",
-        "n",
-        "signed_rank_v",
-        "signed_rank_p",
-        "rank_sum_w",
-        "rank_sum_p",
-        "a12",
-        "a12_magnitude",
-        "h_signed_rank",
-        "h_rank_sum",
-    ]
-    .iter()
-    .map(|s| s.to_string())
-    .collect();
+    Ok(rows)
+}
+
+/// The signed-rank and rank-sum tests and A12 of every pair in every cell (`compare_cells.csv`
+/// rows), and the cells where the rank-sum test favours each side.
+fn pairwise_cells(cells: &Cells, opts: &[String], alpha: f64) -> (Vec<Vec<String>>, Wins) {
     let mut out = Vec::new();
-    let mut wins: BTreeMap<(String, String), (usize, usize)> = BTreeMap::new();
-    for (k, per) in &cells {
+    let mut wins: Wins = BTreeMap::new();
+    let h = |p: Option<f64>| p.map(|p| if p < alpha { "1" } else { "0" }).unwrap_or("").to_string();
+    for (k, per) in cells {
         for i in 0..opts.len() {
             for j in i + 1..opts.len() {
                 let (Some(a), Some(b)) = (per.get(&opts[i]), per.get(&opts[j])) else { continue };
@@ -135,10 +92,7 @@ pub fn compare(args: &CompareArgs) -> Result<()> {
                 };
                 let rs = rank_sum(&xa, &xb, Alternative::TwoSided).ok();
                 let a12 = effect::a12(&xa, &xb);
-                let h = |p: Option<f64>| {
-                    p.map(|p| if p < args.alpha { "1" } else { "0" }).unwrap_or("").to_string()
-                };
-                if rs.as_ref().map(|r| r.p_value < args.alpha).unwrap_or(false) {
+                if rs.as_ref().map(|r| r.p_value < alpha).unwrap_or(false) {
                     let e = wins.entry((opts[i].clone(), opts[j].clone())).or_default();
                     if a12 < 0.5 {
                         e.0 += 1;
@@ -166,10 +120,21 @@ pub fn compare(args: &CompareArgs) -> Result<()> {
             }
         }
     }
-    write_atomic(&args.results.join("compare_cells.csv"), csv_records(&header, &out)?.as_bytes())?;
-    // Overall: Friedman over cells on the mean best of each optimiser.
-    let (_, table) = friedman_table(&rows);
-    let f = friedman(&table).with_context(|| format!("{}: Friedman test", path.display()))?;
+    (out, wins)
+}
+
+/// Friedman over cells on the mean best of each optimiser, with Holm-adjusted pairwise tests:
+/// `compare_overall.csv`, the critical-difference diagram, and the summary on stdout. Returns the
+/// note naming the diagram (empty without one).
+fn friedman_overall(
+    rows: &[OptimRow],
+    opts: &[String],
+    wins: &Wins,
+    args: &CompareArgs,
+) -> Result<String> {
+    let (_, table) = friedman_table(rows);
+    let f = friedman(&table)
+        .with_context(|| format!("{}: Friedman test", args.results.join("runs.csv").display()))?;
     let oh: Vec<String> = [
         "x",
         "y",
@@ -228,6 +193,120 @@ pub fn compare(args: &CompareArgs) -> Result<()> {
     for row in &orows {
         println!("  {} vs {}: z {}, p {} (Holm {}); cells where the rank-sum test favours {}: {}, {}: {}", row[0], row[1], row[4], row[5], row[6], row[0], row[7], row[1], row[8]);
     }
+    Ok(cd_note)
+}
+
+/// Runtime distributions from the IOHprofiler traces: the tables and the charts, overall and per
+/// problem. Returns what it wrote, for the closing line.
+fn runtime_outputs(
+    probs: &[Problem],
+    opts: &[String],
+    results: &std::path::Path,
+) -> Result<String> {
+    let rt = runtime(probs, opts);
+    write_runtime_tables(&rt, probs, results)?;
+    let mut written = String::from(", compare_ecdf.csv, compare_aocc.csv, compare_fixed_budget.csv, compare_ert.csv, compare_targets.csv");
+    let groups: Vec<String> =
+        std::iter::once("all".to_string()).chain(probs.iter().map(|p| p.name.clone())).collect();
+    let mut pngs = 0;
+    crate::io::ensure_dir(&results.join("png").join("compare"))?;
+    for g in &groups {
+        let dir =
+            if g == "all" { results.to_path_buf() } else { results.join("png").join("compare") };
+        for (kind, res) in [
+            ("ecdf", render_ecdf(&rt, g, opts, &dir.join(format!("compare_ecdf_{g}.png")))),
+            (
+                "fixed_budget",
+                render_fixed_budget(
+                    &rt,
+                    g,
+                    opts,
+                    &dir.join(format!("compare_fixed_budget_{g}.png")),
+                ),
+            ),
+        ] {
+            match res {
+                Ok(()) => pngs += 1,
+                Err(e) => eprintln!("somnurbs: warning: {kind} picture of {g} skipped: {e}"),
+            }
+        }
+    }
+    for (g, o, _, a, pairs) in rt.ecdf.iter().filter(|r| r.0 == "all") {
+        println!(
+            "  runtime ECDF {g} {o}: AOCC {a:.4} over {pairs} (run, target) pairs, budget {}",
+            rt.budget
+        );
+    }
+    written.push_str(&format!(", {pngs} runtime charts (compare_ecdf_all.png, compare_fixed_budget_all.png, per problem in png/compare/)"));
+    Ok(written)
+}
+
+/// `somnurbs compare`: pairwise tests per cell, Friedman and Bayesian tests over cells, runtime
+/// distributions from the traces; tables into the folder, a summary on stdout.
+pub fn compare(args: &CompareArgs) -> Result<()> {
+    if !(args.rope >= 0.0 && args.rope.is_finite()) || args.bayes_samples == 0 {
+        anyhow::bail!(
+            "--rope must be finite and >= 0 (got {}) and --bayes-samples at least 1 (got {})",
+            args.rope,
+            args.bayes_samples
+        );
+    }
+    if !args.results.is_dir() {
+        anyhow::bail!(
+            "{}: not found (no such results folder)",
+            args.results.join("runs.csv").display()
+        );
+    }
+    // compare writes its tables into the folder: one writer at a time (a run still writing it
+    // refuses this, naming itself).
+    let _lock = crate::io::outdir::lock(&args.results, "compare")?;
+    let rows = read_runs(&args.results)?;
+    let mut opts: Vec<String> = Vec::new();
+    let mut cells: Cells = BTreeMap::new();
+    for r in &rows {
+        if !opts.contains(&r.competitor()) {
+            opts.push(r.competitor());
+        }
+        let key =
+            (r.dataset.clone(), r.grid_x, r.grid_y, r.cn_x, r.cn_y, r.parameterisation.clone());
+        cells.entry(key).or_default().entry(r.competitor()).or_default().push((r.repeat, r.best));
+    }
+    if opts.len() < 2 {
+        anyhow::bail!(
+            "{}: only one optimiser ({}); nothing to compare",
+            args.results.join("runs.csv").display(),
+            opts[0]
+        );
+    }
+    // The traces first, so that a folder whose ioh/ does not match runs.csv gets nothing written.
+    let probs = if args.results.join("ioh").is_dir() {
+        Some(problems(&rows, &args.results)?)
+    } else {
+        None
+    };
+    let header: Vec<String> = [
+        "data",
+        "grid",
+        "cn",
+        "parameterisation",
+        "x",
+        "y",
+        "n",
+        "signed_rank_v",
+        "signed_rank_p",
+        "rank_sum_w",
+        "rank_sum_p",
+        "a12",
+        "a12_magnitude",
+        "h_signed_rank",
+        "h_rank_sum",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    let (out, wins) = pairwise_cells(&cells, &opts, args.alpha);
+    write_atomic(&args.results.join("compare_cells.csv"), csv_records(&header, &out)?.as_bytes())?;
+    let cd_note = friedman_overall(&rows, &opts, &wins, args)?;
     // Bayesian signed-rank test of every pair over the cells.
     let brows = bayes_table(&rows, &opts, args)?;
     let bh: Vec<String> =
@@ -239,48 +318,9 @@ pub fn compare(args: &CompareArgs) -> Result<()> {
     for r in &brows {
         println!("  Bayesian signed-rank {} vs {} over {} cells (rope {} of B's error): P({} better) {}, P(equivalent) {}, P({} better) {}", r[0], r[1], r[2], r[3], r[0], r[5], r[6], r[1], r[7]);
     }
-    // Runtime distributions from the IOHprofiler traces.
     let mut written = String::from("compare_cells.csv, compare_overall.csv, compare_bayes.csv");
     if let Some(probs) = probs {
-        let rt = runtime(&probs, &opts);
-        write_runtime_tables(&rt, &probs, &args.results)?;
-        written.push_str(", compare_ecdf.csv, compare_aocc.csv, compare_fixed_budget.csv, compare_ert.csv, compare_targets.csv");
-        let groups: Vec<String> = std::iter::once("all".to_string())
-            .chain(probs.iter().map(|p| p.name.clone()))
-            .collect();
-        let mut pngs = 0;
-        crate::io::ensure_dir(&args.results.join("png").join("compare"))?;
-        for g in &groups {
-            let dir = if g == "all" {
-                args.results.clone()
-            } else {
-                args.results.join("png").join("compare")
-            };
-            for (kind, res) in [
-                ("ecdf", render_ecdf(&rt, g, &opts, &dir.join(format!("compare_ecdf_{g}.png")))),
-                (
-                    "fixed_budget",
-                    render_fixed_budget(
-                        &rt,
-                        g,
-                        &opts,
-                        &dir.join(format!("compare_fixed_budget_{g}.png")),
-                    ),
-                ),
-            ] {
-                match res {
-                    Ok(()) => pngs += 1,
-                    Err(e) => eprintln!("somnurbs: warning: {kind} picture of {g} skipped: {e}"),
-                }
-            }
-        }
-        for (g, o, _, a, pairs) in rt.ecdf.iter().filter(|r| r.0 == "all") {
-            println!(
-                "  runtime ECDF {g} {o}: AOCC {a:.4} over {pairs} (run, target) pairs, budget {}",
-                rt.budget
-            );
-        }
-        written.push_str(&format!(", {pngs} runtime charts (compare_ecdf_all.png, compare_fixed_budget_all.png, per problem in png/compare/)"));
+        written.push_str(&runtime_outputs(&probs, &opts, &args.results)?);
     } else {
         println!("  no ioh/ folder: runtime distributions skipped");
     }

@@ -320,6 +320,17 @@ pub fn setting(spec: &Spec) -> String {
 /// Chapter 6's family: the `[optim]` section.
 pub struct Optim;
 
+/// What `--sweep` may vary in `[optim]`: every registered optimiser's table and the run's
+/// budget and start range.
+fn sweepable_keys() -> Vec<String> {
+    let opts = crate::optim::REGISTRY.iter().map(|make| format!("optim.{}.", make().name()));
+    opts.chain(
+        ["optim.generations", "optim.population", "optim.init_range", "optim.repeats"]
+            .map(String::from),
+    )
+    .collect()
+}
+
 impl crate::experiment::family::Section for self::spec::OptimSpec {
     fn limits(&self, c: &crate::experiment::limits::Check) -> Result<(), SpecError> {
         self::spec::limits(c, self)
@@ -336,16 +347,7 @@ impl crate::experiment::family::Section for self::spec::OptimSpec {
     /// Optimiser settings only, so that every variant solves the same problems (same data,
     /// nets, search box) and the variants can be ranked like optimisers.
     const OVERRIDES: Option<crate::experiment::family::Overrides> =
-        Some(crate::experiment::family::Overrides {
-            sweepable: |key| {
-                ["optim.ga.", "optim.de.", "optim.pso.", "optim.csa.", "optim.icsa."]
-                    .iter()
-                    .any(|p| key.starts_with(p))
-                    || ["optim.generations", "optim.population", "optim.init_range", "optim.repeats"]
-                        .contains(&key)
-            },
-            describe: "optim.<ga|de|pso|csa|icsa>.*, optim.generations, optim.population, optim.init_range, optim.repeats",
-        });
+        Some(crate::experiment::family::Overrides { sweepable: sweepable_keys });
 }
 
 impl crate::experiment::family::Experiment for Optim {

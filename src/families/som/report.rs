@@ -252,6 +252,106 @@ pub fn write(spec: &Spec, runs: &[SomRun], out: &Path) -> Result<String> {
     Ok(section(runs, &written, &maps, &pictures, &claims_md))
 }
 
+/// One ranking claim of Chapter 4: among `models`, `target` has the highest (or lowest) `stem`
+/// on every (data, grid) case of the square grids (Appendix B) or the others (Appendix C).
+struct Ranking {
+    statement: &'static str,
+    square: bool,
+    models: &'static [Model],
+    stem: &'static str,
+    target: Model,
+    highest: bool,
+    note: &'static str,
+}
+
+/// The thesis' rankings of the four models (Sections 4.4-4.5).
+const RANKINGS: [Ranking; 8] = {
+    use Model::{Cksom, Dnsom, Som2d, Som3d};
+    const ALL: &[Model] = &Model::ALL;
+    const PER_N: &str = "per (data, n)";
+    const CPU: &str = "CPU time per (data, n)";
+    const APP_C: &str = "Appendix C, per (data, grid)";
+    const fn r(
+        statement: &'static str,
+        square: bool,
+        models: &'static [Model],
+        stem: &'static str,
+        target: Model,
+        highest: bool,
+        note: &'static str,
+    ) -> Ranking {
+        Ranking { statement, square, models, stem, target, highest, note }
+    }
+    [
+        r("3-D SOM has the highest TE", true, ALL, "te", Som3d, true, PER_N),
+        r("DNSOM has the lowest TE", true, ALL, "te", Dnsom, false, PER_N),
+        r("2-D SOM has the highest QE", true, ALL, "qe", Som2d, true, PER_N),
+        r("3-D SOM has the lowest QE", true, ALL, "qe", Som3d, false, PER_N),
+        r("2-D SOM is the fastest", true, ALL, "cpu_s", Som2d, false, CPU),
+        r(
+            "DNSOM is faster than 3-D SOM and CKSOM",
+            true,
+            &[Som3d, Cksom, Dnsom],
+            "cpu_s",
+            Dnsom,
+            false,
+            CPU,
+        ),
+        r(
+            "DNSOM has a lower TE than CKSOM at nx != ny",
+            false,
+            &[Cksom, Dnsom],
+            "te",
+            Dnsom,
+            false,
+            APP_C,
+        ),
+        r(
+            "CKSOM has a lower QE than DNSOM at nx != ny",
+            false,
+            &[Cksom, Dnsom],
+            "qe",
+            Cksom,
+            false,
+            APP_C,
+        ),
+    ]
+};
+
+/// A value source: (data, model, grid, metric stem) -> the mean over repeats.
+type Src<'a> = &'a dyn Fn(&str, Model, GridSize, &str) -> Option<f64>;
+
+/// (cases where the ranking holds, cases with every value) over the data sets and grids.
+fn ranking_count(rk: &Ranking, src: Src, data: &[String], gs: &[GridSize]) -> (usize, usize) {
+    let (mut yes, mut all) = (0, 0);
+    for d in data {
+        for &g in gs {
+            let vals: Option<Vec<f64>> = rk.models.iter().map(|&m| src(d, m, g, rk.stem)).collect();
+            let (Some(vals), Some(t)) = (vals, src(d, rk.target, g, rk.stem)) else { continue };
+            all += 1;
+            yes += vals.iter().all(|&v| if rk.highest { t >= v } else { t <= v }) as usize;
+        }
+    }
+    (yes, all)
+}
+
+/// QE falls as n grows: (per (data, model) series over the square grids that fall, series).
+fn qe_falls(src: Src, data: &[String], sq: &[GridSize]) -> (usize, usize) {
+    let (mut yes, mut all) = (0, 0);
+    let mut sorted = sq.to_vec();
+    sorted.sort();
+    for d in data {
+        for m in Model::ALL {
+            let v: Option<Vec<f64>> = sorted.iter().map(|&g| src(d, m, g, "qe")).collect();
+            if let Some(v) = v.filter(|v| v.len() >= 2) {
+                all += 1;
+                yes += v.windows(2).all(|w| w[1] < w[0]) as usize;
+            }
+        }
+    }
+    (yes, all)
+}
+
 /// Chapter 4 claims, checked on the runs and on the thesis' own Appendix B/C.
 pub fn claims(runs: &[SomRun]) -> Vec<Claim> {
     let thesis_b = reference::table("appendix_b");
@@ -275,119 +375,29 @@ pub fn claims(runs: &[SomRun]) -> Vec<Claim> {
     let data = datasets(runs);
     let sq = grids(runs, true);
     let nsq = grids(runs, false);
-
-    // Count (data, grid) cases where `pred` holds, over a value source.
-    type Src<'a> = &'a dyn Fn(&str, Model, GridSize, &str) -> Option<f64>;
-    // A claim's test on one (data, grid) case, given the case's value of (model, metric).
-    type Pred<'a> = &'a dyn Fn(&dyn Fn(Model, &str) -> Option<f64>) -> Option<bool>;
-    let count = |src: Src, gs: &[GridSize], pred: Pred| -> (usize, usize) {
-        let (mut yes, mut all) = (0, 0);
-        for d in &data {
-            for &g in gs {
-                let get = |m: Model, s: &str| src(d, m, g, s);
-                if let Some(h) = pred(&get) {
-                    all += 1;
-                    yes += h as usize;
-                }
-            }
-        }
-        (yes, all)
+    let claim = |statement: &str, o: (usize, usize), t: (usize, usize), note: &str| Claim {
+        chapter: "4".into(),
+        rival: None,
+        statement: statement.into(),
+        ours: o,
+        thesis: (t.1 > 0).then_some(t),
+        note: note.into(),
     };
-    let extreme = |models: &[Model], stem: &'static str, target: Model, highest: bool| {
-        let models = models.to_vec();
-        move |get: &dyn Fn(Model, &str) -> Option<f64>| -> Option<bool> {
-            let vals: Option<Vec<f64>> = models.iter().map(|&m| get(m, stem)).collect();
-            let vals = vals?;
-            let t = get(target, stem)?;
-            Some(vals.iter().all(|&v| if highest { t >= v } else { t <= v }))
-        }
-    };
-    let mut claims = Vec::new();
-    let mut add = |statement: &str, gs: &[GridSize], pred: Pred, note: &str| {
-        let o = count(&ours, gs, pred);
-        let t = count(&theirs, gs, pred);
-        claims.push(Claim {
-            chapter: "4".into(),
-            rival: None,
-            statement: statement.into(),
-            ours: o,
-            thesis: (t.1 > 0).then_some(t),
-            note: note.into(),
-        });
-    };
-    let all = Model::ALL;
-    add(
-        "3-D SOM has the highest TE",
-        &sq,
-        &extreme(&all, "te", Model::Som3d, true),
-        "per (data, n)",
-    );
-    add("DNSOM has the lowest TE", &sq, &extreme(&all, "te", Model::Dnsom, false), "per (data, n)");
-    add(
-        "2-D SOM has the highest QE",
-        &sq,
-        &extreme(&all, "qe", Model::Som2d, true),
-        "per (data, n)",
-    );
-    add(
-        "3-D SOM has the lowest QE",
-        &sq,
-        &extreme(&all, "qe", Model::Som3d, false),
-        "per (data, n)",
-    );
-    add(
-        "2-D SOM is the fastest",
-        &sq,
-        &extreme(&all, "cpu_s", Model::Som2d, false),
-        "CPU time per (data, n)",
-    );
-    add(
-        "DNSOM is faster than 3-D SOM and CKSOM",
-        &sq,
-        &extreme(&[Model::Som3d, Model::Cksom, Model::Dnsom], "cpu_s", Model::Dnsom, false),
-        "CPU time per (data, n)",
-    );
-    add(
-        "DNSOM has a lower TE than CKSOM at nx != ny",
-        &nsq,
-        &extreme(&[Model::Cksom, Model::Dnsom], "te", Model::Dnsom, false),
-        "Appendix C, per (data, grid)",
-    );
-    add(
-        "CKSOM has a lower QE than DNSOM at nx != ny",
-        &nsq,
-        &extreme(&[Model::Cksom, Model::Dnsom], "qe", Model::Cksom, false),
-        "Appendix C, per (data, grid)",
-    );
-    // QE falls as n grows: per (data, model) series over the square grids.
-    let falls = |src: Src| -> (usize, usize) {
-        let (mut yes, mut all_) = (0, 0);
-        let mut sorted = sq.clone();
-        sorted.sort();
-        for d in &data {
-            for m in Model::ALL {
-                let v: Option<Vec<f64>> = sorted.iter().map(|&g| src(d, m, g, "qe")).collect();
-                if let Some(v) = v.filter(|v| v.len() >= 2) {
-                    all_ += 1;
-                    yes += v.windows(2).all(|w| w[1] < w[0]) as usize;
-                }
-            }
-        }
-        (yes, all_)
-    };
-    let o = falls(&ours);
-    let t = falls(&theirs);
-    claims.insert(
-        0,
-        Claim {
-            rival: None,
-            chapter: "4".into(),
-            statement: "QE falls as n grows, for every model".into(),
-            ours: o,
-            thesis: (t.1 > 0).then_some(t),
-            note: "per (data, model) series".into(),
-        },
-    );
+    let mut claims = vec![claim(
+        "QE falls as n grows, for every model",
+        qe_falls(&ours, &data, &sq),
+        qe_falls(&theirs, &data, &sq),
+        "per (data, model) series",
+    )];
+    for rk in &RANKINGS {
+        let gs = if rk.square { &sq } else { &nsq };
+        claims.push(claim(
+            rk.statement,
+            ranking_count(rk, &ours, &data, gs),
+            ranking_count(rk, &theirs, &data, gs),
+            rk.note,
+        ));
+    }
     claims
 }
 

@@ -207,16 +207,23 @@ fn build(root: &Path) -> Result<Page> {
         }
         chapters[idx].body.push_str(&extra);
     }
+    let html = render_page(&title, &chapters, &view_folders);
+    Ok(Page { html, view_folders })
+}
+
+/// The whole page: the navigation from the chapters' tables of contents, the chapters, the 3-D
+/// views' scripts.
+fn render_page(title: &str, chapters: &[Chapter], view_folders: &[String]) -> String {
     let mut html = String::new();
     let _ = write!(
         html,
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n<title>{}</title>\n<script>{}</script>\n<style>\n{}</style>\n</head>\n<body>\n<nav id=\"nav\"><p class=\"navtitle\">{}</p>\n<ol>\n",
-        esc(&title),
+        esc(title),
         ERROR_HOOK,
         PAGE_CSS,
-        esc(&title)
+        esc(title)
     );
-    for c in &chapters {
+    for c in chapters {
         let _ = write!(html, "<li><a href=\"#{}\">{}</a>", c.id, esc(&c.title));
         if !c.toc.is_empty() {
             html.push_str("<details><summary>sections</summary><ul>");
@@ -232,7 +239,7 @@ fn build(root: &Path) -> Result<Page> {
         html.push_str("</li>\n");
     }
     html.push_str("</ol>\n<p class=\"navnote\">Built from this folder's files; opens offline. Click a table heading to sort.</p></nav>\n<main>\n");
-    for c in &chapters {
+    for c in chapters {
         let _ = write!(
             html,
             "<section class=\"chapter\">\n<h1 id=\"{}\">{}</h1>\n{}</section>\n",
@@ -244,7 +251,7 @@ fn build(root: &Path) -> Result<Page> {
     html.push_str("<pre id=\"script-errors\" hidden></pre>\n</main>\n");
     if !view_folders.is_empty() {
         let _ = writeln!(html, "<script src=\"{PLOTLY_PATH}\"></script>");
-        for f in &view_folders {
+        for f in view_folders {
             let _ = writeln!(
                 html,
                 "<script src=\"{}\" data-folder=\"{}\"></script>",
@@ -254,7 +261,7 @@ fn build(root: &Path) -> Result<Page> {
         }
     }
     let _ = write!(html, "<script>\n{PAGE_JS}</script>\n</body>\n</html>\n");
-    Ok(Page { html, view_folders })
+    html
 }
 
 fn ch_take(c: &mut Chapter) -> Chapter {

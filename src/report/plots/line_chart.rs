@@ -139,6 +139,24 @@ fn axes(path: &Path, series: &[Series], log_y: bool) -> Result<((f64, f64), Axis
     Ok((x_ext, y_axis))
 }
 
+/// A linear x axis with at most 8 ticks, fewer until their labels fit in 60 % of `plot_w`.
+fn fit_x_axis(
+    root: &DrawingArea<BitMapBackend<'_>, plotters::coord::Shift>,
+    x_ext: (f64, f64),
+    plot_w: i32,
+    label_font: &TextStyle<'static>,
+) -> Result<Axis, DrawError> {
+    let mut x_axis = Axis::linear(x_ext.0, x_ext.1, 8);
+    for target in (2..8).rev() {
+        let w = style::text_width(root, x_axis.widest_label(), label_font)? + 16;
+        if w * x_axis.ticks.len() as i32 <= plot_w * 6 / 10 {
+            break;
+        }
+        x_axis = Axis::linear(x_ext.0, x_ext.1, target);
+    }
+    Ok(x_axis)
+}
+
 fn draw_line_chart(
     root: &DrawingArea<BitMapBackend<'_>, plotters::coord::Shift>,
     title: &str,
@@ -173,14 +191,7 @@ fn draw_line_chart(
     let y_label_w = style::text_width(root, y_axis.widest_label(), &label_font)?;
     // Fewer x ticks until their labels fit in 60 % of the plot width.
     let plot_w = chart_area.dim_in_pixel().0 as i32 - y_label_w - 80;
-    let mut x_axis = Axis::linear(x_ext.0, x_ext.1, 8);
-    for target in (2..8).rev() {
-        let w = style::text_width(root, x_axis.widest_label(), &label_font)? + 16;
-        if w * x_axis.ticks.len() as i32 <= plot_w * 6 / 10 {
-            break;
-        }
-        x_axis = Axis::linear(x_ext.0, x_ext.1, target);
-    }
+    let x_axis = fit_x_axis(root, x_ext, plot_w, &label_font)?;
 
     let mut chart = ChartBuilder::on(&chart_area)
         .margin(12)
@@ -246,10 +257,21 @@ fn draw_line_chart(
         }
     }
 
-    // Legend: a swatch (band patch behind a line) and the label, top-aligned with the plot.
+    // Legend, top-aligned with the plot.
     let top = chart.plotting_area().get_base_pixel().1 - root.get_base_pixel().1;
+    draw_legend(&legend_area, series, &names, top, &label_font)
+}
+
+/// The legend: per series a swatch (band patch behind a line) and its label, from `top` down.
+fn draw_legend(
+    legend_area: &DrawingArea<BitMapBackend<'_>, plotters::coord::Shift>,
+    series: &[Series],
+    names: &[String],
+    top: i32,
+    label_font: &TextStyle<'static>,
+) -> Result<(), DrawError> {
     let row_h = 24;
-    for (i, (s, name)) in series.iter().zip(&names).enumerate() {
+    for (i, (s, name)) in series.iter().zip(names).enumerate() {
         let y = top + 8 + i as i32 * row_h;
         let x = 8;
         if s.band.is_some() {

@@ -1,0 +1,196 @@
+//! The command line's and the plans' changes to a spec: `--set KEY=VALUE`, `--sweep
+//! KEY=V1,V2,...` and a reading set's dotted keys, each applied to the spec's TOML table after
+//! its profile and validated exactly as the file's own value.
+
+use super::spec::{Spec, SpecError};
+use std::fmt;
+
+/// The command line's changes to a spec, as written: `--set KEY=VALUE` (one value) and
+/// `--sweep KEY=V1,V2,...` (every combination of the swept values is one variant, all run into
+/// one folder). Recorded in the fingerprint and the manifest, so `--resume` and `merge` rebuild
+/// the same variants.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct CliOverrides {
+    pub set: Vec<String>,
+    pub sweep: Vec<String>,
+}
+
+/// One variant of a spec: the `key=value` changes of `--set` and those of `--sweep`, as written.
+/// A plain run has none, and its cell keys and seeds are those of the spec alone.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Variant {
+    pub set: Vec<String>,
+    pub swept: Vec<String>,
+}
+
+impl Variant {
+    /// What the cell keys (so the seeds) carry: every change, `--set` first (empty: plain run).
+    pub fn key(&self) -> String {
+        self.set.iter().chain(&self.swept).cloned().collect::<Vec<_>>().join(",")
+    }
+
+    /// The `variant` column of a sweep's rows: the swept values (empty without `--sweep`).
+    pub fn label(&self) -> String {
+        self.swept.join(",")
+    }
+}
+
+/// A command-line value as TOML (a number, a boolean, a quoted string, an array), else the text
+/// itself as a string (so `--set optim.knots=nurbs_book` needs no quotes).
+fn cli_value(raw: &str) -> toml::Value {
+    match toml::from_str::<toml::Table>(&format!("v = {raw}")) {
+        Ok(mut t) => t.remove("v").unwrap_or_else(|| toml::Value::String(raw.to_string())),
+        Err(_) => toml::Value::String(raw.to_string()),
+    }
+}
+
+impl CliOverrides {
+    pub fn is_empty(&self) -> bool {
+        self.set.is_empty() && self.sweep.is_empty()
+    }
+
+    /// Split `KEY=VALUE` (or `KEY=V1,V2` for a sweep) of `flag`, naming the flag on error.
+    fn split<'a>(flag: &str, arg: &'a str) -> Result<(&'a str, &'a str), SpecError> {
+        match arg.split_once('=') {
+            Some((k, v)) if !k.trim().is_empty() && !v.trim().is_empty() => {
+                Ok((k.trim(), v.trim()))
+            }
+            _ => Err(SpecError(format!("{flag} `{arg}`: expected KEY=VALUE, e.g. optim.de.f=0.5"))),
+        }
+    }
+
+    /// The variants of the spec at `path` (its text and profile): one for a plain run or `--set`
+    /// only, else one per combination of the swept values (the first `--sweep` outermost). Each
+    /// is parsed and validated exactly as if its values were written in the file; an unknown key,
+    /// a bad value, a key given twice or a swept value given twice is a one-line error naming
+    /// the key.
+    pub fn variants(
+        &self,
+        path: &str,
+        text: &str,
+        profile: Option<&str>,
+    ) -> Result<Vec<Spec>, SpecError> {
+        let base = Spec::parse(path, text, profile)?;
+        if self.is_empty() {
+            return Ok(vec![base]);
+        }
+        let flags =
+            self.set.iter().map(|a| ("--set", a)).chain(self.sweep.iter().map(|a| ("--sweep", a)));
+        let mut seen: Vec<String> = Vec::new();
+        for (flag, arg) in flags {
+            let (key, _) = Self::split(flag, arg)?;
+            if seen.iter().any(|k| k == key) {
+                return Err(SpecError(format!(
+                    "{flag} {key}: the key is given twice (--set and --sweep take each key once)"
+                )));
+            }
+            seen.push(key.to_string());
+            // The sections that take --set/--sweep, as the families declare them.
+            let takers: Vec<_> = crate::families::FAMILIES
+                .iter()
+                .filter_map(|f| f.overrides().map(|o| (*f, o)))
+                .collect();
+            let list = takers
+                .iter()
+                .map(|(f, _)| format!("[{0}] section ({0}.KEY)", f.section()))
+                .collect::<Vec<_>>()
+                .join(", ");
+            let section = key.split('.').next().unwrap_or("");
+            let Some((family, ov)) = takers.iter().find(|(f, _)| f.section() == section) else {
+                return Err(SpecError(format!(
+                    "{flag} {key}: only keys of the {list} can be set or swept"
+                )));
+            };
+            if !family.present(&base) {
+                return Err(SpecError(format!(
+                    "{flag} {key}: {path} has no [{section}] section (--set and --sweep work on \
+                     specs with one)"
+                )));
+            }
+            if flag == "--sweep" && !ov.sweepable(key) {
+                return Err(SpecError(format!("{flag} {key}: a sweep varies optimiser settings only ({}), so that every variant solves the same problems", ov.describe())));
+            }
+        }
+        let set: Vec<(String, String)> = self
+            .set
+            .iter()
+            .map(|a| Self::split("--set", a).map(|(k, v)| (k.to_string(), v.to_string())))
+            .collect::<Result<_, _>>()?;
+        // Every combination of the swept values, the first sweep outermost.
+        let mut combos: Vec<Vec<(String, String)>> = vec![Vec::new()];
+        for arg in &self.sweep {
+            let (key, values) = Self::split("--sweep", arg)?;
+            let values: Vec<&str> = values.split(',').map(str::trim).collect();
+            if values.iter().any(|v| v.is_empty()) {
+                return Err(SpecError(format!("--sweep {key}: an empty value in `{arg}`")));
+            }
+            if let Some(v) =
+                values.iter().enumerate().find(|(k, v)| values[..*k].contains(v)).map(|(_, v)| v)
+            {
+                return Err(SpecError(format!("--sweep {key}: the value {v} is given twice")));
+            }
+            combos = combos
+                .into_iter()
+                .flat_map(|c| {
+                    values
+                        .iter()
+                        .map(move |v| [c.clone(), vec![(key.to_string(), v.to_string())]].concat())
+                })
+                .collect();
+        }
+        combos
+            .into_iter()
+            .map(|swept| {
+                let overrides: Vec<Override> = set
+                    .iter()
+                    .chain(&swept)
+                    .map(|(k, v)| Override { key: k.clone(), value: cli_value(v) })
+                    .collect();
+                let mut spec = Spec::parse_with(path, text, profile, &overrides)?;
+                spec.cli = self.clone();
+                let pairs = |l: &[(String, String)]| {
+                    l.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>()
+                };
+                spec.variant = Variant { set: pairs(&set), swept: pairs(&swept) };
+                Ok(spec)
+            })
+            .collect()
+    }
+}
+
+/// One change to a spec by a dotted key (`fit.knots`, `optim.de.f`), as a reading set of a plan
+/// makes it: applied after the profile and validated exactly as the file's own value.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Override {
+    pub key: String,
+    pub value: toml::Value,
+}
+
+impl fmt::Display for Override {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{} = {}", self.key, self.value)
+    }
+}
+
+/// Apply `over` to a spec table. A key whose section (first part) the spec does not have is
+/// skipped (a reading set names keys of several families) and reported as `false`.
+pub(crate) fn apply_override(table: &mut toml::Table, over: &Override) -> Result<bool, String> {
+    let parts: Vec<&str> = over.key.split('.').collect();
+    if parts.iter().any(|p| p.is_empty()) {
+        return Err(format!("`{}` is not a dotted key", over.key));
+    }
+    if parts.len() > 1 && !matches!(table.get(parts[0]), Some(toml::Value::Table(_))) {
+        return Ok(false);
+    }
+    let mut t = table;
+    for p in &parts[..parts.len() - 1] {
+        let entry =
+            t.entry(p.to_string()).or_insert_with(|| toml::Value::Table(toml::Table::new()));
+        t = match entry {
+            toml::Value::Table(inner) => inner,
+            _ => return Err(format!("`{}`: `{p}` is not a table", over.key)),
+        };
+    }
+    t.insert(parts[parts.len() - 1].to_string(), over.value.clone());
+    Ok(true)
+}
