@@ -12,7 +12,55 @@
 //! [0, 2 pi).
 
 use crate::geom::Point3;
-use crate::spline::closed::RingData;
+
+/// Ring-organised data: rings bottom to top, each in angular order (see [`sort_into_rings`]); the closed fit of `spline::closed` reads it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RingData {
+    pub rings: Vec<Vec<Point3>>,
+}
+
+impl RingData {
+    pub fn n_points(&self) -> usize {
+        self.rings.iter().map(|r| r.len()).sum()
+    }
+
+    pub fn points(&self) -> impl Iterator<Item = &Point3> {
+        self.rings.iter().flatten()
+    }
+
+    /// Eq. 8 on a closed ring: cumulative chord over the perimeter (closing chord included) times
+    /// `n_around`, so u runs over [0, n_around).
+    pub fn ring_parameters(ring: &[Point3], n_around: usize) -> Vec<f64> {
+        let m = ring.len();
+        let chord = |a: usize, b: usize| crate::geom::dist(ring[a], ring[b]);
+        let total: f64 = (0..m).map(|g| chord(g, (g + 1) % m)).sum();
+        let mut acc = 0.0;
+        let mut out = Vec::with_capacity(m);
+        for g in 0..m {
+            if g > 0 {
+                acc += chord(g - 1, g);
+            }
+            out.push(if total > 0.0 { acc / total * n_around as f64 } else { 0.0 });
+        }
+        out
+    }
+
+    /// Eq. 8 along the rings (chords between ring centroids), in [0, 1].
+    pub fn row_parameters(&self) -> Vec<f64> {
+        let centroid = |r: &[Point3]| {
+            let n = r.len().max(1) as f64;
+            let s = r.iter().fold([0.0; 3], |a, p| crate::geom::add(a, *p));
+            crate::geom::scale(s, 1.0 / n)
+        };
+        let c: Vec<Point3> = self.rings.iter().map(|r| centroid(r)).collect();
+        let mut acc = vec![0.0];
+        for k in 1..c.len() {
+            acc.push(acc[k - 1] + crate::geom::dist(c[k - 1], c[k]));
+        }
+        let total = *acc.last().unwrap_or(&0.0);
+        acc.iter().map(|a| if total > 0.0 { a / total } else { 0.0 }).collect()
+    }
+}
 
 /// Lattice points of step `step` with |x^2 + y^2 - radius^2| <= accuracy and 0 <= z <= height,
 /// level by level from z = 0, each level in lattice order (x, then y). Integer lattice indices
