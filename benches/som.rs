@@ -35,13 +35,18 @@ fn main() {
     // 2. The whole Appendix B grid on all cores.
     let spec_path =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/ch4_models.toml");
+    families::install();
     let spec = Spec::load(&spec_path, None).expect("spec");
     let cells: Vec<_> =
         families::som::spec::cells(&spec).into_iter().filter(|c| c.grid.nx == c.grid.ny).collect();
     let jobs = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
     let ctx = RunContext { jobs, ..ctx };
-    let data = families::som::load_datasets(&spec, &spec.file.som.as_ref().unwrap().datasets, &ctx)
-        .expect("data sets");
+    let data = families::som::load_datasets(
+        &spec,
+        &spec.section::<families::som::spec::SomSpec>().unwrap().datasets,
+        &ctx,
+    )
+    .expect("data sets");
     let t0 = Instant::now();
     let runs = runner::run_cells(
         &cells,

@@ -18,6 +18,7 @@ fn main() -> ExitCode {
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
+    somnurbs::families::install();
     let cli = Cli::parse();
     match run(cli) {
         Ok(code) => code,

@@ -2,7 +2,8 @@
 //! `[fit]`, Chapter 6's `[optim]`, and one per other seed). `run_spec`, `--dry-run`, the
 //! fingerprint and `merge` see a family only through [`Family`], so a new experiment (another
 //! seed's problem) plugs in as one folder under `src/families/` implementing it plus one line in
-//! the registry, [`crate::families::FAMILIES`]; nothing in the engine changes for it.
+//! the registry (`families/mod.rs`), which `install()` hands to the engine as a [`Registry`];
+//! nothing in the engine changes for it, and the engine imports no family.
 
 use super::spec::{Spec, SpecError, SpecFile};
 use super::RunContext;
@@ -122,15 +123,86 @@ impl Overrides {
     }
 }
 
-/// Where a section type sits in the spec file: written for every family by the `families!`
-/// macro of the registry, from the section's field name.
-pub trait Placed: Sized + 'static {
+/// Where a section type sits in the spec file: its name, written for every family by the
+/// `families!` macro of the registry from the section's field name.
+pub trait Placed: Sized + Clone + std::fmt::Debug + Send + Sync + 'static {
     /// The section's name in the spec file (also used in messages).
     const NAME: &'static str;
     /// The section in a spec file, if the file has it.
-    fn of(file: &SpecFile) -> Option<&Self>;
+    fn of(file: &SpecFile) -> Option<&Self> {
+        file.sections.get(Self::NAME)?.as_any().downcast_ref()
+    }
     /// The same, to change (see [`Section::use_maps`]).
-    fn of_mut(file: &mut SpecFile) -> Option<&mut Self>;
+    fn of_mut(file: &mut SpecFile) -> Option<&mut Self> {
+        file.sections.get_mut(Self::NAME)?.as_any_mut().downcast_mut()
+    }
+}
+
+/// A family's section as the engine holds it, whatever its type.
+pub trait AnySection: std::fmt::Debug + Send + Sync {
+    fn as_any(&self) -> &dyn std::any::Any;
+    fn as_any_mut(&mut self) -> &mut dyn std::any::Any;
+    fn clone_box(&self) -> Box<dyn AnySection>;
+}
+
+impl<T: Placed> AnySection for T {
+    fn as_any(&self) -> &dyn std::any::Any {
+        self
+    }
+    fn as_any_mut(&mut self) -> &mut dyn std::any::Any {
+        self
+    }
+    fn clone_box(&self) -> Box<dyn AnySection> {
+        Box::new(self.clone())
+    }
+}
+
+/// The family sections of a spec file, by section name, in the file's order of the registry.
+#[derive(Debug, Default)]
+pub struct Sections(Vec<(&'static str, Box<dyn AnySection>)>);
+
+impl Clone for Sections {
+    fn clone(&self) -> Sections {
+        Sections(self.0.iter().map(|(n, s)| (*n, s.as_ref().clone_box())).collect())
+    }
+}
+
+impl Sections {
+    pub fn insert(&mut self, name: &'static str, section: Box<dyn AnySection>) {
+        self.0.push((name, section));
+    }
+    pub fn get(&self, name: &str) -> Option<&dyn AnySection> {
+        self.0.iter().find(|(n, _)| *n == name).map(|(_, s)| s.as_ref())
+    }
+    pub fn get_mut(&mut self, name: &str) -> Option<&mut dyn AnySection> {
+        match self.0.iter_mut().find(|(n, _)| *n == name) {
+            Some((_, s)) => Some(s.as_mut()),
+            None => None,
+        }
+    }
+}
+
+/// The families as the engine reaches them: written by the `families!` macro in
+/// `families/mod.rs` and handed over by its `install()`, so the engine imports no family.
+pub struct Registry {
+    /// Every family, in the order their sections are named in messages.
+    pub families: &'static [&'static dyn Family],
+    /// Parse a spec file's text (the header and every family's optional section).
+    pub parse: fn(&str) -> Result<SpecFile, toml::de::Error>,
+}
+
+static INSTALLED: std::sync::OnceLock<&'static Registry> = std::sync::OnceLock::new();
+
+/// Hand the engine its families (the first call wins; `main` makes it before anything else).
+pub fn install(registry: &'static Registry) {
+    let _ = INSTALLED.set(registry);
+}
+
+/// The installed families. Unit tests install the crate's own on first use.
+pub fn registry() -> &'static Registry {
+    #[cfg(test)]
+    crate::families::install();
+    INSTALLED.get().expect("somnurbs::families::install() must run before a spec is read")
 }
 
 /// A family's spec section (`[som]`, `[optim]`, `[seed004]`, ...): how it is checked. The
@@ -223,16 +295,12 @@ impl<E: Experiment> Family for E {
 }
 
 /// The families whose sections the spec has (validation requires exactly one). The engine reaches
-/// the families only through the registry, [`crate::families::FAMILIES`].
+/// the families only through the installed [`Registry`].
 pub fn present(spec: &Spec) -> Vec<&'static dyn Family> {
-    crate::families::FAMILIES.iter().copied().filter(|f| f.present(spec)).collect()
+    registry().families.iter().copied().filter(|f| f.present(spec)).collect()
 }
 
 /// The section names, as `[som], [fit], ...`, for messages.
 pub fn section_list() -> String {
-    crate::families::FAMILIES
-        .iter()
-        .map(|f| format!("[{}]", f.section()))
-        .collect::<Vec<_>>()
-        .join(", ")
+    registry().families.iter().map(|f| format!("[{}]", f.section())).collect::<Vec<_>>().join(", ")
 }

@@ -86,7 +86,8 @@ impl CliOverrides {
             }
             seen.push(key.to_string());
             // The sections that take --set/--sweep, as the families declare them.
-            let takers: Vec<_> = crate::families::FAMILIES
+            let takers: Vec<_> = super::family::registry()
+                .families
                 .iter()
                 .filter_map(|f| f.overrides().map(|o| (*f, o)))
                 .collect();

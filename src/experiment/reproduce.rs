@@ -254,7 +254,8 @@ fn combine(out: &Path, plan: &Plan, specs: &[Spec]) -> Result<Vec<Combined>> {
             root: out.join(READINGS_DIR).join(&r.name),
         })
         .collect();
-    crate::families::FAMILIES
+    super::family::registry()
+        .families
         .iter()
         .map(|f| {
             let view = PlanView {

@@ -24,55 +24,93 @@ impl std::error::Error for SpecError {}
 
 /// Declares the experiment families, once (invoked in `families/mod.rs`, the only list of
 /// families): each family's module (the first part of its section's path: `som::spec::SomSpec`
-/// is in folder `som/`), the [`SpecFile`] struct (this header plus one optional section per
-/// family, in the given order, parsed with `deny_unknown_fields` so serde names the file, line
-/// and column of a bad key), where each section type sits in it
-/// ([`Placed`](super::family::Placed)), and the registry `FAMILIES` that the engine reaches the
-/// families through. A family is one folder plus one line here.
+/// is in folder `som/`), where each section type sits in the spec file
+/// ([`Placed`](super::family::Placed)), and the [`Registry`](super::family::Registry) the engine
+/// reaches the families through once `install()` has handed it over: the families in the order
+/// their sections are named in messages, and the parser of the whole file (the header plus one
+/// optional section per family, `deny_unknown_fields`, so serde names the file, line and column
+/// of a bad key). A family is one folder plus one line here.
 macro_rules! families {
     ($($(#[$doc:meta])* $field:ident: $module:ident :: $($section:ident)::+ => $($family:ident)::+),* $(,)?) => {
         $(pub mod $module;)*
 
         /// The whole spec file as written: the header and one optional section per family.
-        #[derive(Debug, Clone, serde::Deserialize)]
+        #[derive(serde::Deserialize)]
         #[serde(deny_unknown_fields)]
-        pub struct SpecFile {
-            /// Experiment name; the default output folder is `results/<name>`.
-            pub name: String,
+        struct Whole {
+            name: String,
             #[serde(default)]
-            pub description: String,
-            /// Master seed every (cell, repeat) stream is derived from.
-            pub master_seed: u64,
-            /// Output folder (overridden by `--out`).
+            description: String,
+            master_seed: u64,
             #[serde(default)]
-            pub output: Option<String>,
-            /// How the data sets are scaled: per_axis (the thesis), uniform (aspect ratios kept)
-            /// or none.
+            output: Option<String>,
             #[serde(default)]
-            pub normalise: $crate::data::Normalise,
-            $($(#[$doc])* #[serde(default)] pub $field: Option<$module::$($section)::+>,)*
-            /// Named overrides, merged over the spec by `--profile NAME`.
+            normalise: $crate::data::Normalise,
+            $($(#[$doc])* #[serde(default)] $field: Option<$module::$($section)::+>,)*
             #[serde(default)]
-            pub profiles: std::collections::BTreeMap<String, toml::Table>,
+            profiles: std::collections::BTreeMap<String, toml::Table>,
         }
 
-        /// Every family the harness knows, in the order their sections are named in messages.
-        pub static FAMILIES: &[&dyn $crate::experiment::family::Family] = &[$(&$($family)::+),*];
+        /// Parse a spec file's text: the header, and each section the file has.
+        fn parse(text: &str) -> Result<$crate::experiment::spec::SpecFile, toml::de::Error> {
+            let w: Whole = toml::from_str(text)?;
+            let mut sections = $crate::experiment::family::Sections::default();
+            $(if let Some(s) = w.$field {
+                sections.insert(stringify!($field), Box::new(s));
+            })*
+            Ok($crate::experiment::spec::SpecFile {
+                name: w.name,
+                description: w.description,
+                master_seed: w.master_seed,
+                output: w.output,
+                normalise: w.normalise,
+                profiles: w.profiles,
+                sections,
+            })
+        }
+
+        /// The registry of every family the harness knows.
+        pub static REGISTRY: $crate::experiment::family::Registry =
+            $crate::experiment::family::Registry {
+                families: &[$(&$($family)::+),*],
+                parse,
+            };
+
+        /// Hand the families to the engine (once per process, before any spec is read).
+        pub fn install() {
+            $crate::experiment::family::install(&REGISTRY);
+        }
 
         $(impl $crate::experiment::family::Placed for $module::$($section)::+ {
             const NAME: &'static str = stringify!($field);
-            fn of(file: &SpecFile) -> Option<&Self> {
-                file.$field.as_ref()
-            }
-            fn of_mut(file: &mut SpecFile) -> Option<&mut Self> {
-                file.$field.as_mut()
-            }
         })*
     };
 }
 pub(crate) use families;
 
-pub use crate::families::SpecFile;
+/// A spec file as read: the header every spec has, and the family sections it holds (one, once
+/// validated; reached through [`Spec::section`]).
+#[derive(Debug, Clone)]
+pub struct SpecFile {
+    /// Experiment name; the default output folder is `results/<name>`.
+    pub name: String,
+    pub description: String,
+    /// Master seed every (cell, repeat) stream is derived from.
+    pub master_seed: u64,
+    /// Output folder (overridden by `--out`).
+    pub output: Option<String>,
+    /// How the data sets are scaled: per_axis (the thesis), uniform (aspect ratios kept) or none.
+    pub normalise: crate::data::Normalise,
+    /// Named overrides, merged over the spec by `--profile NAME`.
+    pub profiles: std::collections::BTreeMap<String, toml::Table>,
+    /// The family sections the file has.
+    pub sections: super::family::Sections,
+}
+
+/// The spec text parsed by the installed families' parser.
+fn parse_file(text: &str) -> Result<SpecFile, toml::de::Error> {
+    (super::family::registry().parse)(text)
+}
 
 /// A spec read from a file, with the profile applied.
 #[derive(Debug, Clone)]
@@ -137,7 +175,7 @@ impl Spec {
             apply_override(&mut table, o).map_err(|e| SpecError(format!("{path}: {e}")))?;
         }
         let merged = toml::to_string(&table).map_err(|e| SpecError(format!("{path}: {e}")))?;
-        spec.file = toml::from_str(&merged).map_err(|e| {
+        spec.file = parse_file(&merged).map_err(|e| {
             SpecError(format!(
                 "{path}: with {}: {}",
                 overrides.iter().map(|o| o.to_string()).collect::<Vec<_>>().join(", "),
@@ -150,7 +188,7 @@ impl Spec {
 
     /// Parse spec text; `path` is used in messages only.
     pub fn parse(path: &str, text: &str, profile: Option<&str>) -> Result<Spec, SpecError> {
-        let file: SpecFile = toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
+        let file = parse_file(text).map_err(|e| toml_error(path, text, &e))?;
         let file = match profile {
             None => file,
             Some(name) => {
@@ -166,7 +204,7 @@ impl Spec {
                 merge(&mut table, over);
                 let merged =
                     toml::to_string(&table).map_err(|e| SpecError(format!("{path}: {e}")))?;
-                toml::from_str(&merged).map_err(|e| {
+                parse_file(&merged).map_err(|e| {
                     SpecError(format!(
                         "{path}: [profiles.{name}]: {}",
                         e.message().replace('\n', " ")
@@ -329,9 +367,9 @@ iterations = 7
     fn parses_expands_and_applies_profile() {
         let s = Spec::parse("t.toml", SPEC, None).unwrap();
         assert_eq!(crate::families::som::spec::cells(&s).len(), 4);
-        assert_eq!(s.file.som.as_ref().unwrap().iterations, 100);
+        assert_eq!(s.section::<crate::families::som::spec::SomSpec>().unwrap().iterations, 100);
         let q = Spec::parse("t.toml", SPEC, Some("quick")).unwrap();
-        assert_eq!(q.file.som.as_ref().unwrap().iterations, 7);
+        assert_eq!(q.section::<crate::families::som::spec::SomSpec>().unwrap().iterations, 7);
         assert_eq!(crate::families::som::spec::cells(&q)[3].key(), "som/cube/dnsom/18x30/r0");
     }
 
@@ -342,7 +380,7 @@ iterations = 7
         let text = "name = \"f\"\nmaster_seed = 1\n[fit]\ndatasets = [\"cube\"]\ngrid = \"20x20\"\ncontrol_nets = [\"6x6\"]\nparameterisations = [\"uniform\"]\napproaches = [\"A\"]\n[profiles.quick.fit]\nfairness = 0.5\n";
         let ov = |k: &str, v: toml::Value| Override { key: k.into(), value: v };
         let plain = Spec::parse("f.toml", text, Some("quick")).unwrap();
-        let fit = plain.file.fit.as_ref().unwrap();
+        let fit = plain.section::<crate::families::fit::spec::FitSpec>().unwrap();
         assert_eq!(
             (fit.knots, fit.error_a, fit.fairness),
             (crate::spline::KnotRule::Eq2_10, crate::spline::ErrorA::PerSurface, 0.5)
@@ -353,12 +391,15 @@ iterations = 7
             ov("optim.knots", "nurbs_book".into()),
         ];
         let s = Spec::parse_with("f.toml", text, Some("quick"), &set).unwrap();
-        let fit = s.file.fit.as_ref().unwrap();
+        let fit = s.section::<crate::families::fit::spec::FitSpec>().unwrap();
         assert_eq!(
             (fit.knots, fit.error_a, fit.fairness),
             (crate::spline::KnotRule::NurbsBook, crate::spline::ErrorA::NovBottom, 0.5)
         );
-        assert!(s.file.optim.is_none(), "a key of an absent section is skipped");
+        assert!(
+            s.section::<crate::families::optimise::spec::OptimSpec>().is_none(),
+            "a key of an absent section is skipped"
+        );
         let e = Spec::parse_with("f.toml", text, None, &[ov("fit.knots", "9.69".into())])
             .unwrap_err()
             .to_string();

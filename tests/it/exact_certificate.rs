@@ -19,6 +19,7 @@ fn spec(name: &str, profile: Option<&str>, knots: KnotRule) -> Spec {
     let text = std::fs::read_to_string(&path).unwrap();
     let over =
         Override { key: "optim.knots".into(), value: toml::Value::String(knots.name().into()) };
+    somnurbs::families::install();
     Spec::parse_with(&path.display().to_string(), &text, profile, &[over]).unwrap()
 }
 
@@ -30,7 +31,7 @@ fn check_spec(name: &str, profile: Option<&str>, jobs: usize, check_pipeline: bo
         let dir = tempfile::tempdir().unwrap();
         let ctx = RunContext::new(dir.path().to_path_buf(), jobs, crate::common::shared_data());
         let pbs = problems(&spec, &ctx).unwrap();
-        let o = spec.file.optim.as_ref().unwrap();
+        let o = spec.section::<somnurbs::families::optimise::spec::OptimSpec>().unwrap();
         let tol = o.exact_tol;
         let opts = ExactOptions {
             tol_rel_gap: o.exact_tol,

@@ -213,6 +213,7 @@ fn readers_and_spec_loader_survive_random_mutations() {
         fuzz("XYZ", &[xyz_seed], &mut rng, |b| xyz::parse_xyz(&String::from_utf8_lossy(b)).is_ok());
     let specs = fuzz("spec", &spec_seeds(), &mut rng, |b| {
         let text = String::from_utf8_lossy(b);
+        somnurbs::families::install();
         let plain = Spec::parse("fuzz.toml", &text, None);
         let quick = Spec::parse("fuzz.toml", &text, Some("quick"));
         // A spec that passes must also list its cells quickly.
