@@ -4,8 +4,9 @@
 //! the algorithms and the traces of repeats line up checkpoint by checkpoint.
 
 use super::aligned::Aligned;
-use super::sampling::symmetric;
+use super::sampling::symmetric_from;
 use super::OptimError;
+use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
@@ -259,9 +260,16 @@ impl Population {
         let (lo, hi) = problem.bounds();
         let mut x = Vec::with_capacity(budget.population);
         let mut f = Vec::with_capacity(budget.population);
+        // One individual's 64-bit draws in bulk (the words `symmetric` would take one by one, in
+        // the same order: ChaCha8's stream read as little-endian 64-bit words either way).
+        let mut words = vec![0u64; x0.len()];
+        let r = budget.init_range;
         for _ in 0..budget.population {
-            let mut v: Aligned =
-                x0.iter().map(|&c| c + symmetric(rng, budget.init_range)).collect();
+            rng.fill(&mut words[..]);
+            let mut v = Aligned::zeros(x0.len());
+            for ((vj, &c), &w) in v.iter_mut().zip(x0).zip(&words) {
+                *vj = c + symmetric_from(w, r);
+            }
             clamp_into(&mut v, lo, hi);
             f.push(eval.eval(&v));
             x.push(v);
@@ -403,5 +411,42 @@ pub(crate) mod tests {
         let b: Budget = toml::from_str("generations = 10").unwrap();
         assert_eq!(b, Budget { generations: 10, ..Budget::default() });
         assert!(toml::from_str::<Budget>("generation = 10").is_err());
+    }
+
+    /// The bulk initial population is the per-draw one: x0 + `symmetric` per coordinate in
+    /// order, clamped, for lengths whose words end inside and at a ChaCha8 block (16 words), and
+    /// the stream is left where the per-draw loop leaves it.
+    #[test]
+    fn initial_population_is_the_per_draw_one() {
+        use crate::optim::sampling::symmetric;
+        use rand::{RngCore, SeedableRng};
+        for n in [1, 3, 16, 17, 33, 1740] {
+            let mut p = Sphere::new(n);
+            p.lo = p.x0.iter().map(|c| c - 2e-6).collect();
+            let budget = Budget { population: 5, init_range: 5e-6, ..Budget::default() };
+            let mut rng = ChaCha8Rng::seed_from_u64(n as u64);
+            let mut want_rng = rng.clone();
+            let _ = want_rng.next_u32(); // start the blocks off an even word
+            let _ = rng.next_u32();
+            let mut e = Evaluator::new(&p, &budget);
+            let pop = Population::initial(&p, &budget, &mut e, &mut rng);
+            for (i, x) in pop.x.iter().enumerate() {
+                let want: Vec<f64> = (0..n)
+                    .map(|j| (p.x0[j] + symmetric(&mut want_rng, 5e-6)).max(p.lo[j]).min(p.hi[j]))
+                    .collect();
+                assert!(
+                    x.iter().zip(&want).all(|(a, b)| a.to_bits() == b.to_bits()),
+                    "n {n} i {i}"
+                );
+                assert_eq!(pop.f[i], p.fitness(x));
+            }
+            assert!(pop
+                .x
+                .iter()
+                .flat_map(|x| x.iter())
+                .zip(p.lo.iter().cycle())
+                .any(|(a, l)| a == l));
+            assert_eq!(rng.next_u64(), want_rng.next_u64());
+        }
     }
 }

@@ -31,13 +31,25 @@ const TWO_POW_M53: f64 = 1.0 / (1u64 << 53) as f64;
 /// A uniform in [0, 1) with 53 random bits.
 #[inline]
 pub fn unit(rng: &mut ChaCha8Rng) -> f64 {
-    (rng.next_u64() >> 11) as f64 * TWO_POW_M53
+    unit_from(rng.next_u64())
+}
+
+/// The uniform in [0, 1) of [`unit`] from its 64-bit draw `w`: (w >> 11) 2^-53.
+#[inline(always)]
+pub fn unit_from(w: u64) -> f64 {
+    (w >> 11) as f64 * TWO_POW_M53
 }
 
 /// A uniform in [-r, r) around 0 (53 random bits).
 #[inline]
 pub fn symmetric(rng: &mut ChaCha8Rng, r: f64) -> f64 {
-    r * (2.0 * unit(rng) - 1.0)
+    symmetric_from(rng.next_u64(), r)
+}
+
+/// The uniform of [`symmetric`] from its 64-bit draw `w`: r (2 u - 1), u = [`unit_from`] w.
+#[inline(always)]
+pub fn symmetric_from(w: u64, r: f64) -> f64 {
+    r * (2.0 * unit_from(w) - 1.0)
 }
 
 /// Two independent uniforms in [1, 2), 32 random bits each, from one 64-bit draw: 1 + h 2^-32 and
