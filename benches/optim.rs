@@ -90,6 +90,11 @@ fn main() {
         let cycles = ns * mhz / 1e3;
         println!("fitness, {isa:?} copy: {ns:.0} ns = {cycles:.0} cycles per evaluation; FMA lower bound {bound:.0} cycles (2 pipes x 4 lanes): {:.2}x the bound", cycles / bound);
     }
+    // The optimisers' own kernels, every compiled copy (all in L1: the floor of their overhead).
+    #[cfg(target_arch = "x86_64")]
+    for line in somnurbs::optim::kernels::timing::report() {
+        println!("{line}");
+    }
     if std::env::var("BENCH_SCALING").is_ok_and(|v| v != "0") {
         scaling(&spindle.points, mhz);
     }

@@ -778,11 +778,11 @@ mod tests {
     }
 }
 
-/// Measurements (run with `cargo test --release --lib kernel_timing -- --ignored --nocapture`):
-/// ns per coordinate of each compiled copy of the DE trial and the PSO move on a 12x12 net's 432
-/// coordinates (best of 30 batches).
-#[cfg(all(test, target_arch = "x86_64"))]
-mod timing {
+/// Measurements for `cargo bench --bench optim`: ns per coordinate of each compiled copy of the
+/// DE trial and the PSO move on a 12x12 net's 432 coordinates (best of 30 batches).
+#[cfg(target_arch = "x86_64")]
+#[doc(hidden)]
+pub mod timing {
     use super::*;
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
@@ -801,9 +801,10 @@ mod timing {
             .fold(f64::INFINITY, f64::min)
     }
 
-    #[test]
-    #[ignore]
-    fn kernel_timing() {
+    /// One line per compiled copy this CPU has: the DE trial's ns per gene, the PSO move's ns per
+    /// coordinate.
+    pub fn report() -> Vec<String> {
+        let mut out = Vec::new();
         let n = 432;
         let v: Vec<f64> = (0..n).map(|j| (j as f64 * 0.37).sin()).collect();
         let (lo, hi) = (vec![-1.0; n], vec![1.0; n]);
@@ -819,10 +820,10 @@ mod timing {
         ];
         for (name, _, copy) in trials.into_iter().filter(|c| c.1) {
             // SAFETY: the CPU reports the copy's features.
-            println!(
+            out.push(format!(
                 "DE trial {name}: {:.3} ns per gene",
                 best_ns(n, || unsafe { copy(&mut t, src, 0.3, &mut lanes, threshold) })
-            );
+            ));
         }
         let vmax = vec![0.5; n];
         let bounds = PsoBounds { lo: &lo, hi: &hi, vmax: &vmax };
@@ -846,13 +847,14 @@ mod timing {
         ];
         for (name, _, copy) in moves.into_iter().filter(|c| c.1) {
             // SAFETY: the CPU reports the copy's features.
-            println!(
+            out.push(format!(
                 "PSO move {name}: {:.3} ns per coordinate",
                 best_ns(n, || {
                     unsafe { copy(&mut moved, &x, &mut vel, &v, &hi, &mut gen, co, bounds) };
                     std::mem::swap(&mut x, &mut moved);
                 })
-            );
+            ));
         }
+        out
     }
 }
