@@ -54,6 +54,8 @@ pub trait Family: Sync {
     fn overrides(&self) -> Option<Overrides>;
     /// The family's part of a plan's combined report, from its specs' finished folders.
     fn combine(&self, view: &PlanView) -> Result<Combined>;
+    /// The exact definitions of the metrics the family reports (the manifest's `[definitions]`).
+    fn definitions(&self) -> super::Definitions;
 }
 
 /// A finished plan as one family sees it, for the parts of the combined report that need more
@@ -251,6 +253,10 @@ pub trait Experiment: Sync {
     fn combine(&self, _view: &PlanView) -> Result<Combined> {
         Ok(Combined::default())
     }
+    /// See [`Family::definitions`]; by default none.
+    fn definitions(&self) -> super::Definitions {
+        super::Definitions::default()
+    }
 }
 
 impl<E: Experiment> Family for E {
@@ -291,6 +297,9 @@ impl<E: Experiment> Family for E {
     }
     fn combine(&self, view: &PlanView) -> Result<Combined> {
         Experiment::combine(self, view)
+    }
+    fn definitions(&self) -> super::Definitions {
+        Experiment::definitions(self)
     }
 }
 

@@ -134,31 +134,26 @@ pub struct Manifest {
     pub started_unix: u64,
     pub wall_seconds: f64,
     pub cpu_seconds_cells: f64,
+    /// The family's metric definitions (none: no table).
+    #[serde(skip_serializing_if = "Definitions::is_empty")]
     pub definitions: Definitions,
     pub spec_text: String,
 }
 
-/// The exact metric definitions a run used (libraries disagree on them).
-#[derive(Debug, Serialize)]
-pub struct Definitions {
-    pub qe: String,
-    pub te: String,
-    pub te_adjacency: String,
-    pub qe_final: String,
-    pub te_final: String,
-    pub cpu_s: String,
+/// The exact definitions of the metrics a family reports (libraries disagree on them), in its
+/// order: (name, definition).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Definitions(pub &'static [(&'static str, &'static str)]);
+
+impl Definitions {
+    fn is_empty(&self) -> bool {
+        self.0.is_empty()
+    }
 }
 
-impl Default for Definitions {
-    fn default() -> Self {
-        Definitions {
-            qe: "mean over training iterations of |X(t) - W_c(t)| (Euclidean, before the update) (thesis Eq. 4.15)".into(),
-            te: "share of training iterations whose first and second winners are not adjacent (Eq. 4.16)".into(),
-            te_adjacency: "index distance 1: 4-neighbourhood on 2-D maps, 6-neighbourhood in the 3-D lattice and CKSOM surface, 4-neighbourhood on either DNSOM view over class numbers".into(),
-            qe_final: "mean Euclidean distance of every data point to its best-matching unit after training".into(),
-            te_final: "share of data points whose two best units are not adjacent (adjacency as above)".into(),
-            cpu_s: "thread CPU seconds of weight initialisation and the T training iterations".into(),
-        }
+impl Serialize for Definitions {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.collect_map(self.0.iter().copied())
     }
 }
 
@@ -262,7 +257,7 @@ fn run_spec_locked(variants: &[Spec], ctx: &RunContext) -> Result<PathBuf> {
         started_unix,
         wall_seconds: started.elapsed().as_secs_f64(),
         cpu_seconds_cells: cpu,
-        definitions: Definitions::default(),
+        definitions: family.definitions(),
         spec_text: spec.text.clone(),
     };
     if let Some(section) = section {

@@ -194,6 +194,17 @@ impl crate::experiment::family::Section for self::spec::SomSpec {
 }
 
 impl crate::experiment::family::Experiment for Som {
+    /// Chapter 4's metrics, exactly as computed (libraries disagree on them).
+    fn definitions(&self) -> crate::experiment::Definitions {
+        crate::experiment::Definitions(&[
+            ("qe", "mean over training iterations of |X(t) - W_c(t)| (Euclidean, before the update) (thesis Eq. 4.15)"),
+            ("te", "share of training iterations whose first and second winners are not adjacent (Eq. 4.16)"),
+            ("te_adjacency", "index distance 1: 4-neighbourhood on 2-D maps, 6-neighbourhood in the 3-D lattice and CKSOM surface, 4-neighbourhood on either DNSOM view over class numbers"),
+            ("qe_final", "mean Euclidean distance of every data point to its best-matching unit after training"),
+            ("te_final", "share of data points whose two best units are not adjacent (adjacency as above)"),
+            ("cpu_s", "thread CPU seconds of weight initialisation and the T training iterations"),
+        ])
+    }
     type Section = self::spec::SomSpec;
     fn logged_keys(&self, spec: &Spec) -> Vec<String> {
         spec::cells(spec).iter().map(|c| c.key()).collect()
