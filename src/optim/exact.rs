@@ -29,9 +29,15 @@
 //! y + B A d (B the 3x3 Hessian blocks, d the Newton direction), whose A^T-image is ~0 even when
 //! the primal step is below the resolution of f. The best point and the best bound are kept.
 //! Limit (f64): the residual of a term the optimum interpolates is known to ~1e-17 absolute, and
-//! its dual y = r / s divides that by mu, so the certified gap bottoms out near 1e-6 absolute
-//! (about 1e-7 relative for a 10x10 net on a 20x20 grid, 1e-4 for 18x18 and 16x28 nets whose
-//! optimum is ~1e-2; weak when the optimum itself is ~1e-5, i.e. near interpolation).
+//! its dual y = r / s divides that by mu, so the certified gap bottoms out near 1e-6 absolute.
+//! When the loop ends uncertified, a dual polish at the best point tries again: for a ladder of
+//! thresholds tau, terms with |r_k| <= tau are open (any y_k in the unit ball) and the others
+//! hold a unit y_k that may turn; Newton's method on the dual (weights I / tau and
+//! (I - u u^T) / |r_k|) drives g = A^T y to 0 off the bounds, and each round's y is certified.
+//! It lowers the data-box gaps of the near-square nets (ch6_beyond nurbs_book 18x18 sphere
+//! 2.0e-5 -> 6.4e-6) but does not reach 1e-6 there: the weighted system is too ill-conditioned
+//! for the shifted Cholesky (see docs/speed.md). The returned bound is LB of the returned dual
+//! point, which `certify_dual` re-evaluates independently of the solver.
 //! The primal value f is far more accurate than the certified gap in those cases.
 
 // Index loops over several parallel arrays read more plainly than zipped iterators here.
@@ -126,6 +132,8 @@ pub struct ExactResult {
     pub iterations: usize,
     /// Whether the requested relative gap was reached.
     pub converged: bool,
+    /// The dual point (|y_k| <= 1) whose bound LB(y) is `lower_bound`: `certify_dual` checks it.
+    pub dual: Vec<Point3>,
 }
 
 /// The certified lower bound LB(y) for a dual point y (rescaled into the unit balls if needed),
@@ -437,6 +445,603 @@ fn check_inputs(
     Ok(())
 }
 
+/// The point order of `pb`: its own (checked to be a permutation), else reverse Cuthill-McKee of
+/// the point graph.
+fn elimination_order(pb: &dyn SumOfNorms) -> Result<Vec<usize>, OptimError> {
+    let np = pb.n_points();
+    if let Some(o) = pb.point_order() {
+        let mut s = o.clone();
+        s.sort_unstable();
+        if s != (0..np).collect::<Vec<_>>() {
+            return Err(OptimError::Problem(
+                "point_order is not a permutation of the points".into(),
+            ));
+        }
+        return Ok(o);
+    }
+    let mut adj: Vec<Vec<usize>> = vec![Vec::new(); np];
+    for k in 0..pb.n_terms() {
+        let t = pb.term(k);
+        for &p in t.points {
+            for &q in t.points {
+                if p != q {
+                    adj[p].push(q);
+                }
+            }
+        }
+    }
+    for a in adj.iter_mut() {
+        a.sort_unstable();
+        a.dedup();
+    }
+    Ok(reverse_cuthill_mckee(&adj))
+}
+
+/// The Hessian of sqrt(|r|^2 + mu^2) in r: B = (I - r r^T / s^2) / s, s^2 = |r|^2 + mu^2.
+fn hessian_block(v: Point3, mu: f64) -> [[f64; 3]; 3] {
+    let s2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + mu * mu;
+    let s = s2.sqrt();
+    let mut b = [[0.0; 3]; 3];
+    for (i, row) in b.iter_mut().enumerate() {
+        for (c, e) in row.iter_mut().enumerate() {
+            *e = ((if i == c { 1.0 } else { 0.0 }) - v[i] * v[c] / s2) / s;
+        }
+    }
+    b
+}
+
+/// out_k = A_k v (no data term) for every term.
+fn apply_terms(pb: &dyn SumOfNorms, v: &[f64], out: &mut [Point3]) {
+    for (k, o) in out.iter_mut().enumerate().take(pb.n_terms()) {
+        let t = pb.term(k);
+        let mut s = [0.0; 3];
+        for (&p, &a) in t.points.iter().zip(t.coefs) {
+            for c in 0..3 {
+                s[c] += a * v[3 * p + c];
+            }
+        }
+        *o = s;
+    }
+}
+
+/// y_k = r_k / |r_k| (0 where r_k = 0): the subgradient of |r_k|.
+fn unit_duals(r: &[Point3], y: &mut [Point3]) {
+    for (yk, v) in y.iter_mut().zip(r) {
+        let nv = crate::geom::norm(*v);
+        *yk = if nv > 0.0 { [v[0] / nv, v[1] / nv, v[2] / nv] } else { [0.0; 3] };
+    }
+}
+
+/// The solver's fixed structure: the problem, its box, the elimination order of the points and
+/// an envelope matrix (the Newton Hessian or the polish's Gram matrix) in that order.
+struct Workspace<'a> {
+    pb: &'a dyn SumOfNorms,
+    lower: &'a [f64],
+    upper: &'a [f64],
+    /// pos[p]: the elimination position of point p.
+    pos: Vec<usize>,
+    env: Envelope,
+    /// skip[q]: row q (elimination order) is left out of the system (a unit row, solution 0).
+    skip: Vec<bool>,
+    /// The largest data norm or bound magnitude (for absolute tolerances).
+    scale: f64,
+}
+
+impl<'a> Workspace<'a> {
+    fn new(
+        pb: &'a dyn SumOfNorms,
+        lower: &'a [f64],
+        upper: &'a [f64],
+    ) -> Result<Workspace<'a>, OptimError> {
+        let np = pb.n_points();
+        let n = 3 * np;
+        let order = elimination_order(pb)?;
+        let mut pos = vec![0usize; np];
+        for (k, &p) in order.iter().enumerate() {
+            pos[p] = k;
+        }
+        // Row 3 pos[p] + c couples back to the earliest point p shares a term with.
+        let mut min_pos = pos.clone();
+        for k in 0..pb.n_terms() {
+            let t = pb.term(k);
+            let lo = t.points.iter().map(|&p| pos[p]).min().unwrap_or(0);
+            for &p in t.points {
+                min_pos[p] = min_pos[p].min(lo);
+            }
+        }
+        let mut first = vec![0usize; n];
+        for p in 0..np {
+            for c in 0..3 {
+                first[3 * pos[p] + c] = 3 * min_pos[p];
+            }
+        }
+        let mut scale: f64 = 0.0;
+        for k in 0..pb.n_terms() {
+            scale = scale.max(crate::geom::norm(pb.term(k).data));
+        }
+        for j in 0..n {
+            scale = scale.max(lower[j].abs()).max(upper[j].abs());
+        }
+        let env = Envelope::new(first);
+        Ok(Workspace { pb, lower, upper, pos, env, skip: vec![false; n], scale: scale.max(1e-300) })
+    }
+
+    /// Leave the coordinates with `out[j]` (coordinate order) out of the next system.
+    fn set_skip(&mut self, out: &[bool]) {
+        for (p, &q) in self.pos.iter().enumerate() {
+            for c in 0..3 {
+                self.skip[3 * q + c] = out[3 * p + c];
+            }
+        }
+    }
+
+    /// Assemble sum_k A_k^T W_k A_k on the kept rows (W_k = block(k); None leaves term k out).
+    fn assemble(&mut self, block: impl Fn(usize) -> Option<[[f64; 3]; 3]>) {
+        self.env.val.fill(0.0);
+        for k in 0..self.pb.n_terms() {
+            let Some(b) = block(k) else { continue };
+            let t = self.pb.term(k);
+            for (ia, &pa) in t.points.iter().enumerate() {
+                let ra = self.pos[pa];
+                for (ib, &pbb) in t.points.iter().enumerate() {
+                    let rb = self.pos[pbb];
+                    if rb > ra {
+                        continue;
+                    }
+                    let w = t.coefs[ia] * t.coefs[ib];
+                    for i in 0..3 {
+                        let row = 3 * ra + i;
+                        if self.skip[row] {
+                            continue;
+                        }
+                        for c in 0..3 {
+                            let col = 3 * rb + c;
+                            if col > row || self.skip[col] {
+                                continue;
+                            }
+                            let at = self.env.at(row, col);
+                            self.env.val[at] += w * b[i][c];
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Cholesky of the assembled matrix with the skipped rows set to the largest diagonal and
+    /// every diagonal shifted by `shift` times it (grown x100 on a failure, 12 tries).
+    fn factorise(&mut self, shift: f64) -> bool {
+        let n = self.skip.len();
+        let mut max_diag: f64 = 0.0;
+        for q in 0..n {
+            max_diag = max_diag.max(self.env.val[self.env.at(q, q)]);
+        }
+        for q in 0..n {
+            if self.skip[q] {
+                let at = self.env.at(q, q);
+                self.env.val[at] = max_diag.max(f64::MIN_POSITIVE);
+            }
+        }
+        let backup = self.env.val.clone();
+        let mut s = shift * max_diag.max(1e-300);
+        for _ in 0..12 {
+            self.env.val.copy_from_slice(&backup);
+            for q in 0..n {
+                let at = self.env.at(q, q);
+                self.env.val[at] += s;
+            }
+            if self.env.factorise().is_ok() {
+                return true;
+            }
+            s *= 100.0;
+        }
+        false
+    }
+
+    /// out = M^-1 b on the kept coordinates (coordinate order; 0 on the skipped ones).
+    fn solve(&self, b: &[f64], out: &mut [f64], buf: &mut [f64]) {
+        for (p, &q) in self.pos.iter().enumerate() {
+            for c in 0..3 {
+                let row = 3 * q + c;
+                buf[row] = if self.skip[row] { 0.0 } else { b[3 * p + c] };
+            }
+        }
+        self.env.solve(buf);
+        for (p, &q) in self.pos.iter().enumerate() {
+            for c in 0..3 {
+                let row = 3 * q + c;
+                out[3 * p + c] = if self.skip[row] { 0.0 } else { buf[row] };
+            }
+        }
+    }
+
+    /// Whether x_j sits on its lower (upper) bound, to 1e-13 of the box width.
+    fn at_bounds(&self, x: &[f64], j: usize) -> (bool, bool) {
+        let w = (self.upper[j] - self.lower[j]).max(self.scale * 1e-300);
+        (x[j] - self.lower[j] <= 1e-13 * w, self.upper[j] - x[j] <= 1e-13 * w)
+    }
+}
+
+/// Scratch vectors of the solver: n coordinates or m terms long.
+struct Scratch {
+    /// The smoothed dual point y_k = r_k / s_k and g = sum_k A_k^T y_k.
+    y: Vec<Point3>,
+    g: Vec<f64>,
+    d: Vec<f64>,
+    active: Vec<bool>,
+    vn: [Vec<f64>; 3],
+    vm: [Vec<Point3>; 2],
+}
+
+impl Scratch {
+    fn new(n: usize, m: usize) -> Scratch {
+        Scratch {
+            y: vec![[0.0; 3]; m],
+            g: vec![0.0; n],
+            d: vec![0.0; n],
+            active: vec![false; n],
+            vn: [vec![0.0; n], vec![0.0; n], vec![0.0; n]],
+            vm: [vec![[0.0; 3]; m], vec![[0.0; 3]; m]],
+        }
+    }
+}
+
+/// The current iterate: x, its residuals and f(x), and room for a trial point.
+struct Iterate {
+    x: Vec<f64>,
+    r: Vec<Point3>,
+    f: f64,
+    x_new: Vec<f64>,
+    r_new: Vec<Point3>,
+}
+
+/// sum_k |r_k|.
+fn norm_sum(r: &[Point3]) -> f64 {
+    r.iter().map(|v| crate::geom::norm(*v)).sum::<f64>()
+}
+
+/// F_mu = sum_k sqrt(|r_k|^2 + mu^2).
+fn smooth(r: &[Point3], mu: f64) -> f64 {
+    r.iter().map(|v| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + mu * mu).sqrt()).sum::<f64>()
+}
+
+/// The best point and the best certificate seen.
+struct Best {
+    x: Vec<f64>,
+    f: f64,
+    lb: f64,
+    y: Vec<Point3>,
+}
+
+impl Best {
+    /// Keep (lb, y) if lb is the best bound so far.
+    fn offer_dual(&mut self, lb: f64, y: &[Point3]) {
+        if lb > self.lb {
+            self.lb = lb;
+            self.y.copy_from_slice(y);
+        }
+    }
+
+    /// Keep x if f(x) is the best value so far.
+    fn offer_point(&mut self, it: &Iterate) {
+        if it.f < self.f {
+            self.f = it.f;
+            self.x.copy_from_slice(&it.x);
+        }
+    }
+}
+
+/// The smoothed dual y = r / s and g = A^T y at the iterate; certify it and y = r / |r|.
+/// Returns (box loss, smoothing gap) of the smoothed certificate: the stage test's figures.
+fn certificates(
+    ws: &Workspace,
+    it: &Iterate,
+    mu: f64,
+    best: &mut Best,
+    sc: &mut Scratch,
+) -> (f64, f64) {
+    let pb = ws.pb;
+    for (yk, v) in sc.y.iter_mut().zip(&it.r) {
+        let s = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + mu * mu).sqrt();
+        *yk = [v[0] / s, v[1] / s, v[2] / s];
+    }
+    pb.apply_transpose(&sc.y, &mut sc.g);
+    let [yc, _] = &mut sc.vm;
+    yc.copy_from_slice(&sc.y);
+    let lb_smooth = lower_bound_with(yc, &it.r, &it.x, ws.lower, ws.upper, pb, &mut sc.vn[0]);
+    best.offer_dual(lb_smooth, yc);
+    // The smoothed certificate's gap splits into the smoothing part f - sum y.r and the box
+    // part from the gradient left on the free variables; a stage ends when Newton has made
+    // the latter smaller than the former.
+    let y_dot_r: f64 =
+        sc.y.iter().zip(&it.r).map(|(a, b)| a[0] * b[0] + a[1] * b[1] + a[2] * b[2]).sum();
+    let box_loss = (y_dot_r - lb_smooth).max(0.0);
+    let smoothing_gap = (it.f - y_dot_r).max(0.0);
+    unit_duals(&it.r, yc);
+    let lb_unit = lower_bound_with(yc, &it.r, &it.x, ws.lower, ws.upper, pb, &mut sc.vn[0]);
+    best.offer_dual(lb_unit, yc);
+    (box_loss, smoothing_gap)
+}
+
+/// The projected Newton direction d = -H^-1 g on the free coordinates (0 on the active ones:
+/// at a bound with the gradient pushing out), H factorised in `ws`, with iterative refinement
+/// against the unshifted Hessian. Returns the decrement -g.d.
+fn newton_direction(ws: &Workspace, it: &Iterate, mu: f64, sc: &mut Scratch) -> f64 {
+    let n = sc.g.len();
+    let [rhs, sol, buf] = &mut sc.vn;
+    for j in 0..n {
+        rhs[j] = -sc.g[j];
+    }
+    ws.solve(rhs, &mut sc.d, buf);
+    // The factorisation carries a tiny shift and the rounding of an ill-conditioned system.
+    for _ in 0..REFINE_STEPS {
+        let [av, w] = &mut sc.vm;
+        hessian_apply(ws.pb, &it.r, mu, &sc.d, av, w, sol);
+        let mut worst: f64 = 0.0;
+        for j in 0..n {
+            let e = if sc.active[j] { 0.0 } else { -sc.g[j] - sol[j] };
+            worst = worst.max(e.abs());
+            rhs[j] = e;
+        }
+        if worst == 0.0 {
+            break;
+        }
+        ws.solve(rhs, sol, buf);
+        for j in 0..n {
+            if !sc.active[j] {
+                sc.d[j] += sol[j];
+            }
+        }
+    }
+    -(0..n).map(|j| sc.g[j] * sc.d[j]).sum::<f64>()
+}
+
+/// The dual Newton point y + B_k A_k d (linearising y(r) = r / s), whose A^T-image is
+/// g + H d ~ 0 on the free coordinates even when the primal step is below the resolution of f;
+/// certified.
+fn dual_newton_certificate(
+    ws: &Workspace,
+    it: &Iterate,
+    mu: f64,
+    best: &mut Best,
+    sc: &mut Scratch,
+) {
+    let [ad, yd] = &mut sc.vm;
+    // A d as (A d - data) + data: the rounding the certificates were tuned with.
+    ws.pb.residuals(&sc.d, ad);
+    for k in 0..yd.len() {
+        let data = ws.pb.term(k).data;
+        let u = [ad[k][0] + data[0], ad[k][1] + data[1], ad[k][2] + data[2]];
+        let v = it.r[k];
+        let s2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + mu * mu;
+        let s = s2.sqrt();
+        let vu = (v[0] * u[0] + v[1] * u[1] + v[2] * u[2]) / s2;
+        let y = sc.y[k];
+        yd[k] = [
+            y[0] + (u[0] - v[0] * vu) / s,
+            y[1] + (u[1] - v[1] * vu) / s,
+            y[2] + (u[2] - v[2] * vu) / s,
+        ];
+    }
+    let lb = lower_bound_with(yd, &it.r, &it.x, ws.lower, ws.upper, ws.pb, &mut sc.vn[0]);
+    best.offer_dual(lb, yd);
+}
+
+/// Armijo search on F_mu along the projection arc x(alpha) = P(x + alpha d); moves the iterate
+/// and returns true on success (a step that changes no coordinate counts as no step).
+fn line_search(ws: &Workspace, it: &mut Iterate, mu: f64, sc: &Scratch) -> bool {
+    let n = it.x.len();
+    let f_mu = smooth(&it.r, mu);
+    let mut alpha = 1.0;
+    for _ in 0..40 {
+        for j in 0..n {
+            it.x_new[j] = (it.x[j] + alpha * sc.d[j]).max(ws.lower[j]).min(ws.upper[j]);
+        }
+        ws.pb.residuals(&it.x_new, &mut it.r_new);
+        let f_new = smooth(&it.r_new, mu);
+        let lin: f64 = (0..n).map(|j| sc.g[j] * (it.x_new[j] - it.x[j])).sum();
+        if f_new <= f_mu + 1e-4 * lin && lin <= 0.0 {
+            if it.x_new == it.x {
+                return false;
+            }
+            std::mem::swap(&mut it.x, &mut it.x_new);
+            std::mem::swap(&mut it.r, &mut it.r_new);
+            it.f = norm_sum(&it.r);
+            return true;
+        }
+        alpha *= 0.5;
+    }
+    false
+}
+
+/// One projected Newton step at smoothing mu: active set, Hessian, direction, the dual Newton
+/// certificate, line search. None when the Hessian cannot be factorised; else (moved,
+/// decrement).
+fn newton_step(
+    ws: &mut Workspace,
+    it: &mut Iterate,
+    mu: f64,
+    best: &mut Best,
+    sc: &mut Scratch,
+) -> Option<(bool, f64)> {
+    for j in 0..it.x.len() {
+        let (at_lo, at_hi) = ws.at_bounds(&it.x, j);
+        sc.active[j] = (at_lo && sc.g[j] > 0.0) || (at_hi && sc.g[j] < 0.0);
+    }
+    ws.set_skip(&sc.active);
+    let r = &it.r;
+    ws.assemble(|k| Some(hessian_block(r[k], mu)));
+    if !ws.factorise(SHIFT) {
+        return None;
+    }
+    let decrement = newton_direction(ws, it, mu, sc);
+    dual_newton_certificate(ws, it, mu, best, sc);
+    Some((line_search(ws, it, mu, sc), decrement))
+}
+
+/// Predictor along the central path x(mu) with the current factorisation:
+/// H dx/dmu = sum_k A_k^T r_k mu / s_k^3 (from d/dmu of g(x(mu), mu) = 0); the predicted point
+/// (projected into the box) is kept if it lowers F at mu_next.
+fn predictor(ws: &Workspace, it: &mut Iterate, mu: f64, mu_next: f64, sc: &mut Scratch) {
+    let [c_r, _] = &mut sc.vm;
+    for (ck, v) in c_r.iter_mut().zip(&it.r) {
+        let s2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + mu * mu;
+        let c = mu / (s2 * s2.sqrt());
+        *ck = [v[0] * c, v[1] * c, v[2] * c];
+    }
+    let [rhs, sol, buf] = &mut sc.vn;
+    ws.pb.apply_transpose(c_r, rhs);
+    ws.solve(rhs, sol, buf);
+    for j in 0..it.x.len() {
+        let dx = if sc.active[j] { 0.0 } else { (mu_next - mu) * sol[j] };
+        it.x_new[j] = (it.x[j] + dx).max(ws.lower[j]).min(ws.upper[j]);
+    }
+    ws.pb.residuals(&it.x_new, &mut it.r_new);
+    if smooth(&it.r_new, mu_next) < smooth(&it.r, mu_next) {
+        std::mem::swap(&mut it.x, &mut it.x_new);
+        std::mem::swap(&mut it.r, &mut it.r_new);
+        it.f = norm_sum(&it.r);
+    }
+}
+
+/// Polish rounds (free terms whose y_k leaves the unit ball are fixed on its boundary).
+const POLISH_ROUNDS: usize = 4;
+
+/// Thresholds tau / (f / m) below which a term counts as near zero, tried in turn.
+const POLISH_LADDER: [f64; 7] = [1e-14, 1e-12, 1e-10, 1e-8, 1e-6, 1e-4, 1e-2];
+
+const IDENTITY: [[f64; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+
+/// Dual polish at x (residuals r): for each tau of the ladder, the terms with |r_k| <= tau are
+/// free and the others keep y_k = r_k / |r_k| (see `polish_with`); every polished y is offered
+/// to `best` (any y with |y_k| <= 1 certifies LB(y)). The fix for terms the optimum
+/// interpolates, whose y = r / s divides rounding noise by mu.
+fn polish(ws: &mut Workspace, x: &[f64], r: &[Point3], best: &mut Best, sc: &mut Scratch) {
+    let m = r.len();
+    let nr: Vec<f64> = r.iter().map(|v| crate::geom::norm(*v)).collect();
+    let unit = nr.iter().sum::<f64>() / m.max(1) as f64;
+    let mut last = vec![false; m];
+    for e in POLISH_LADDER {
+        let free: Vec<bool> = nr.iter().map(|&v| v <= e * unit).collect();
+        if free == last {
+            continue;
+        }
+        last.clone_from(&free);
+        polish_with(ws, x, r, e * unit, &free, best, sc);
+    }
+}
+
+/// out = sum_k A_k^T W_k A_k v for 3x3 blocks W_k (av, w: scratch).
+fn weighted_apply(
+    pb: &dyn SumOfNorms,
+    blocks: &[[[f64; 3]; 3]],
+    v: &[f64],
+    av: &mut [Point3],
+    w: &mut [Point3],
+    out: &mut [f64],
+) {
+    apply_terms(pb, v, av);
+    for ((wk, b), a) in w.iter_mut().zip(blocks).zip(av.iter()) {
+        for i in 0..3 {
+            wk[i] = b[i][0] * a[0] + b[i][1] * a[1] + b[i][2] * a[2];
+        }
+    }
+    pb.apply_transpose(w, out);
+}
+
+/// One polish at threshold tau, Newton's method on the dual: a fixed term holds a unit y_k = u_k
+/// (at first r_k / |r_k|) that may turn (weight W_k = (I - u u^T) / |r_k|), a free one an open
+/// y_k (W_k = I / tau). Each round solves (A^T W A) d = -A^T y on the coordinates off their bounds
+/// and sets y <- y + W A d, which makes g = A^T y vanish there to first order; turned y_k are
+/// put back on the unit sphere (y_k . r_k stays ~|r_k|: turning is second order) and free y_k
+/// that left the unit ball are fixed in their direction. Every round's y is certified.
+fn polish_with(
+    ws: &mut Workspace,
+    x: &[f64],
+    r: &[Point3],
+    tau: f64,
+    free: &[bool],
+    best: &mut Best,
+    sc: &mut Scratch,
+) {
+    let (pb, n, m) = (ws.pb, x.len(), r.len());
+    let mut fixed = vec![false; m];
+    let mut wt = vec![1.0 / tau; m];
+    let mut y = vec![[0.0; 3]; m];
+    for k in (0..m).filter(|&k| !free[k]) {
+        let nr = crate::geom::norm(r[k]);
+        y[k] = [r[k][0] / nr, r[k][1] / nr, r[k][2] / nr];
+        (fixed[k], wt[k]) = (true, 1.0 / nr);
+    }
+    let mut blocks = vec![[[0.0; 3]; 3]; m];
+    for _ in 0..POLISH_ROUNDS {
+        for k in 0..m {
+            let u = if fixed[k] { y[k] } else { [0.0; 3] };
+            for i in 0..3 {
+                for c in 0..3 {
+                    blocks[k][i][c] = (IDENTITY[i][c] - u[i] * u[c]) * wt[k];
+                }
+            }
+        }
+        pb.apply_transpose(&y, &mut sc.g);
+        for j in 0..n {
+            let (lo, hi) = ws.at_bounds(x, j);
+            sc.active[j] = (lo && sc.g[j] > 0.0) || (hi && sc.g[j] < 0.0);
+        }
+        ws.set_skip(&sc.active);
+        ws.assemble(|k| Some(blocks[k]));
+        if !ws.factorise(SHIFT) {
+            return;
+        }
+        let [rhs, sol, buf] = &mut sc.vn;
+        sc.d.fill(0.0);
+        for _ in 0..=REFINE_STEPS {
+            let [av, w] = &mut sc.vm;
+            weighted_apply(pb, &blocks, &sc.d, av, w, sol);
+            for j in 0..n {
+                rhs[j] = if sc.active[j] { 0.0 } else { -sc.g[j] - sol[j] };
+            }
+            ws.solve(rhs, sol, buf);
+            for j in 0..n {
+                sc.d[j] += sol[j];
+            }
+        }
+        let [ad, yc] = &mut sc.vm;
+        apply_terms(pb, &sc.d, ad);
+        for k in 0..m {
+            let (b, a) = (&blocks[k], ad[k]);
+            for i in 0..3 {
+                y[k][i] += b[i][0] * a[0] + b[i][1] * a[1] + b[i][2] * a[2];
+            }
+            let nk = crate::geom::norm(y[k]);
+            if fixed[k] || nk > 1.0 {
+                y[k] = [y[k][0] / nk, y[k][1] / nk, y[k][2] / nk];
+                fixed[k] = true;
+            }
+        }
+        yc.copy_from_slice(&y);
+        let lb = lower_bound_with(yc, r, x, ws.lower, ws.upper, pb, &mut sc.vn[0]);
+        best.offer_dual(lb, yc);
+    }
+}
+
+/// f(x) and the certified lower bound LB(y) of f over the box for a dual point y (each y_k
+/// rescaled into the unit ball if needed): the check of a solver's certificate, which trusts
+/// nothing but weak duality.
+pub fn certify_dual(
+    pb: &dyn SumOfNorms,
+    lower: &[f64],
+    upper: &[f64],
+    x: &[f64],
+    y: &[Point3],
+) -> (f64, f64) {
+    let mut r = vec![[0.0; 3]; pb.n_terms()];
+    pb.residuals(x, &mut r);
+    let mut y = y.to_vec();
+    let mut g = vec![0.0; x.len()];
+    (norm_sum(&r), lower_bound_with(&mut y, &r, x, lower, upper, pb, &mut g))
+}
+
 /// Minimise f over the box [lower, upper] from `x_start` (clamped into the box), returning the
 /// best point found and a certified lower bound. The start is one of the points compared, so the
 /// returned f is never above f(clamped start): when the start is in the box (approach B's net in
@@ -450,348 +1055,51 @@ pub fn solve_exact(
     opts: &ExactOptions,
 ) -> Result<ExactResult, OptimError> {
     check_inputs(pb, lower, upper, x_start)?;
-    let np = pb.n_points();
-    let n = 3 * np;
-    let m = pb.n_terms();
-    // Elimination order and the envelope of the Hessian in that order.
-    let order = match pb.point_order() {
-        Some(o) => {
-            let mut s = o.clone();
-            s.sort_unstable();
-            if s != (0..np).collect::<Vec<_>>() {
-                return Err(OptimError::Problem(
-                    "point_order is not a permutation of the points".into(),
-                ));
-            }
-            o
-        }
-        None => {
-            let mut adj: Vec<Vec<usize>> = vec![Vec::new(); np];
-            for k in 0..m {
-                let t = pb.term(k);
-                for &p in t.points {
-                    for &q in t.points {
-                        if p != q {
-                            adj[p].push(q);
-                        }
-                    }
-                }
-            }
-            for a in adj.iter_mut() {
-                a.sort_unstable();
-                a.dedup();
-            }
-            reverse_cuthill_mckee(&adj)
-        }
-    };
-    let mut pos = vec![0usize; np];
-    for (k, &p) in order.iter().enumerate() {
-        pos[p] = k;
-    }
-    let mut min_pos: Vec<usize> = (0..np).map(|p| pos[p]).collect();
-    for k in 0..m {
-        let t = pb.term(k);
-        let lo = t.points.iter().map(|&p| pos[p]).min().unwrap_or(0);
-        for &p in t.points {
-            min_pos[p] = min_pos[p].min(lo);
-        }
-    }
-    let mut first = vec![0usize; n];
-    for p in 0..np {
-        for c in 0..3 {
-            first[3 * pos[p] + c] = 3 * min_pos[p];
-        }
-    }
-    let mut env = Envelope::new(first);
-
-    let scale = {
-        let mut s: f64 = 0.0;
-        for k in 0..m {
-            s = s.max(crate::geom::norm(pb.term(k).data));
-        }
-        for j in 0..n {
-            s = s.max(lower[j].abs()).max(upper[j].abs());
-        }
-        s.max(1e-300)
-    };
-    let mut x: Vec<f64> = (0..n).map(|j| x_start[j].max(lower[j]).min(upper[j])).collect();
+    let mut ws = Workspace::new(pb, lower, upper)?;
+    let (n, m) = (3 * pb.n_points(), pb.n_terms());
+    let x: Vec<f64> = (0..n).map(|j| x_start[j].max(lower[j]).min(upper[j])).collect();
     let mut r = vec![[0.0; 3]; m];
-    let mut r_new = vec![[0.0; 3]; m];
-    let mut y = vec![[0.0; 3]; m];
-    let mut g = vec![0.0; n];
-    let mut g_scratch = vec![0.0; n];
-    let mut d = vec![0.0; n];
-    let mut x_new = vec![0.0; n];
-    let mut active = vec![false; n];
-    let mut active_pos = vec![false; n];
-    let mut y_dual = vec![[0.0; 3]; m];
-    let mut rhs = vec![0.0; n];
     pb.residuals(&x, &mut r);
-    let norm_sum = |r: &[Point3]| r.iter().map(|v| crate::geom::norm(*v)).sum::<f64>();
-    let smooth = |r: &[Point3], mu: f64| {
-        r.iter().map(|v| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + mu * mu).sqrt()).sum::<f64>()
-    };
-    let mut f = norm_sum(&r);
-    let mut best_x = x.clone();
-    let mut best_f = f;
-    let mut best_lb = f64::NEG_INFINITY;
+    let f = norm_sum(&r);
+    let mut it = Iterate { x_new: vec![0.0; n], r_new: vec![[0.0; 3]; m], x, r, f };
+    let mut best = Best { x: it.x.clone(), f, lb: f64::NEG_INFINITY, y: vec![[0.0; 3]; m] };
+    let mut sc = Scratch::new(n, m);
+    let scale = ws.scale;
+    let closed = |f: f64, lb: f64| f - lb <= opts.tol_rel_gap * f || f - lb <= 1e-15 * scale;
     let mut mu = (f / m.max(1) as f64).max(1e-12 * scale);
-    let mu_floor = 1e-15 * scale;
     let mut steps = 0;
-    let mut converged = false;
     loop {
-        // Gradient of F_mu, the smoothed dual point, and the certificates.
-        for k in 0..m {
-            let v = r[k];
-            let s = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + mu * mu).sqrt();
-            y[k] = [v[0] / s, v[1] / s, v[2] / s];
-        }
-        pb.apply_transpose(&y, &mut g);
-        let mut y_cert = y.clone();
-        let lb_smooth = lower_bound_with(&mut y_cert, &r, &x, lower, upper, pb, &mut g_scratch);
-        // The smoothed certificate's gap splits into the smoothing part f - sum y.r and the box
-        // part from the gradient left on the free variables; a stage ends when Newton has made
-        // the latter smaller than the former.
-        let y_dot_r: f64 =
-            y.iter().zip(&r).map(|(a, b)| a[0] * b[0] + a[1] * b[1] + a[2] * b[2]).sum();
-        let box_loss = (y_dot_r - lb_smooth).max(0.0);
-        let smoothing_gap = (f - y_dot_r).max(0.0);
-        let mut y_unit: Vec<Point3> = r
-            .iter()
-            .map(|v| {
-                let nv = crate::geom::norm(*v);
-                if nv > 0.0 {
-                    [v[0] / nv, v[1] / nv, v[2] / nv]
-                } else {
-                    [0.0; 3]
-                }
-            })
-            .collect();
-        let lb_unit = lower_bound_with(&mut y_unit, &r, &x, lower, upper, pb, &mut g_scratch);
-        best_lb = best_lb.max(lb_smooth).max(lb_unit);
-        if f < best_f {
-            best_f = f;
-            best_x.copy_from_slice(&x);
-        }
-        if best_f - best_lb <= opts.tol_rel_gap * best_f || best_f - best_lb <= 1e-15 * scale {
-            converged = true;
-            break;
-        }
-        if steps >= opts.max_newton_steps || mu < mu_floor {
+        let (box_loss, smoothing_gap) = certificates(&ws, &it, mu, &mut best, &mut sc);
+        best.offer_point(&it);
+        if closed(best.f, best.lb) || steps >= opts.max_newton_steps || mu < 1e-15 * scale {
             break;
         }
         steps += 1;
-        // Active set: at a bound, with the gradient pushing out of the box.
-        for j in 0..n {
-            let w = (upper[j] - lower[j]).max(scale * 1e-300);
-            let at_lo = x[j] - lower[j] <= 1e-13 * w;
-            let at_hi = upper[j] - x[j] <= 1e-13 * w;
-            active[j] = (at_lo && g[j] > 0.0) || (at_hi && g[j] < 0.0);
-        }
-        // Active variables by elimination position.
-        for p in 0..np {
-            for c in 0..3 {
-                active_pos[3 * pos[p] + c] = active[3 * p + c];
-            }
-        }
-        // Hessian of F_mu on the free variables: sum_k A_k^T B_k A_k, B_k = (I - r r^T / s^2) / s.
-        env.val.fill(0.0);
-        for k in 0..m {
-            let v = r[k];
-            let s2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + mu * mu;
-            let s = s2.sqrt();
-            let mut b = [[0.0; 3]; 3];
-            for (i, row) in b.iter_mut().enumerate() {
-                for (c, e) in row.iter_mut().enumerate() {
-                    *e = ((if i == c { 1.0 } else { 0.0 }) - v[i] * v[c] / s2) / s;
-                }
-            }
-            let t = pb.term(k);
-            for (ia, &pa) in t.points.iter().enumerate() {
-                let ra = pos[pa];
-                for (ib, &pbb) in t.points.iter().enumerate() {
-                    let rb = pos[pbb];
-                    if rb > ra {
-                        continue;
-                    }
-                    let w = t.coefs[ia] * t.coefs[ib];
-                    for i in 0..3 {
-                        let row = 3 * ra + i;
-                        if active_pos[row] {
-                            continue;
-                        }
-                        for c in 0..3 {
-                            let col = 3 * rb + c;
-                            if col > row || active_pos[col] {
-                                continue;
-                            }
-                            let at = env.at(row, col);
-                            env.val[at] += w * b[i][c];
-                        }
-                    }
-                }
-            }
-        }
-        // Active variables get unit rows; all diagonals a tiny relative shift.
-        let mut max_diag: f64 = 0.0;
-        for q in 0..n {
-            max_diag = max_diag.max(env.val[env.at(q, q)]);
-        }
-        for q in 0..n {
-            if active_pos[q] {
-                let at = env.at(q, q);
-                env.val[at] = max_diag.max(f64::MIN_POSITIVE);
-            }
-        }
-        let backup = env.val.clone();
-        let mut shift = SHIFT * max_diag.max(1e-300);
-        let mut factor_ok = false;
-        for _ in 0..12 {
-            env.val.copy_from_slice(&backup);
-            for q in 0..n {
-                let at = env.at(q, q);
-                env.val[at] += shift;
-            }
-            if env.factorise().is_ok() {
-                factor_ok = true;
-                break;
-            }
-            shift *= 100.0;
-        }
-        if !factor_ok {
+        let Some((moved, decrement)) = newton_step(&mut ws, &mut it, mu, &mut best, &mut sc) else {
             break;
-        }
-        // Newton direction on the free variables (in elimination order), 0 on the active ones.
-        for p in 0..np {
-            for c in 0..3 {
-                let j = 3 * p + c;
-                rhs[3 * pos[p] + c] = if active[j] { 0.0 } else { -g[j] };
-            }
-        }
-        env.solve(&mut rhs);
-        for p in 0..np {
-            for c in 0..3 {
-                let j = 3 * p + c;
-                d[j] = if active[j] { 0.0 } else { rhs[3 * pos[p] + c] };
-            }
-        }
-        // Iterative refinement against the unshifted Hessian (the factorisation carries a tiny
-        // shift and the rounding of an ill-conditioned system).
-        for _ in 0..REFINE_STEPS {
-            hessian_apply(pb, &r, mu, &d, &mut r_new, &mut y_dual, &mut g_scratch);
-            let mut worst: f64 = 0.0;
-            for p in 0..np {
-                for c in 0..3 {
-                    let j = 3 * p + c;
-                    let e = if active[j] { 0.0 } else { -g[j] - g_scratch[j] };
-                    worst = worst.max(e.abs());
-                    rhs[3 * pos[p] + c] = e;
-                }
-            }
-            if worst == 0.0 {
-                break;
-            }
-            env.solve(&mut rhs);
-            for p in 0..np {
-                for c in 0..3 {
-                    let j = 3 * p + c;
-                    if !active[j] {
-                        d[j] += rhs[3 * pos[p] + c];
-                    }
-                }
-            }
-        }
-        let decrement: f64 = -(0..n).map(|j| g[j] * d[j]).sum::<f64>();
-        // Dual Newton step: linearising y(r) = r / s gives y + B_k A_k d, whose A^T-image is
-        // g + H d ~ 0 on the free variables, even when the primal step is below the resolution
-        // of f. Certify it too.
-        pb.residuals(&d, &mut r_new);
-        for k in 0..m {
-            let data = pb.term(k).data;
-            let u = [r_new[k][0] + data[0], r_new[k][1] + data[1], r_new[k][2] + data[2]];
-            let v = r[k];
-            let s2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + mu * mu;
-            let s = s2.sqrt();
-            let vu = (v[0] * u[0] + v[1] * u[1] + v[2] * u[2]) / s2;
-            y_dual[k] = [
-                y[k][0] + (u[0] - v[0] * vu) / s,
-                y[k][1] + (u[1] - v[1] * vu) / s,
-                y[k][2] + (u[2] - v[2] * vu) / s,
-            ];
-        }
-        let lb_dual = lower_bound_with(&mut y_dual, &r, &x, lower, upper, pb, &mut g_scratch);
-        best_lb = best_lb.max(lb_dual);
-        // Armijo search along the projection arc.
-        let f_mu = smooth(&r, mu);
-        let mut alpha = 1.0;
-        let mut accepted = false;
-        for _ in 0..40 {
-            for j in 0..n {
-                x_new[j] = (x[j] + alpha * d[j]).max(lower[j]).min(upper[j]);
-            }
-            pb.residuals(&x_new, &mut r_new);
-            let f_new = smooth(&r_new, mu);
-            let lin: f64 = (0..n).map(|j| g[j] * (x_new[j] - x[j])).sum();
-            if f_new <= f_mu + 1e-4 * lin && lin <= 0.0 {
-                accepted = true;
-                break;
-            }
-            alpha *= 0.5;
-        }
-        // A step that changes nothing (below the resolution of x) counts as no step.
-        if accepted && x_new == x {
-            accepted = false;
-        }
-        if accepted {
-            std::mem::swap(&mut x, &mut x_new);
-            std::mem::swap(&mut r, &mut r_new);
-            f = norm_sum(&r);
-        }
+        };
         // Next stage once Newton has converged for this mu: the gradient left on the free
         // variables costs the certificate less than the smoothing does, or Newton makes no
         // more progress.
-        if !accepted || box_loss <= smoothing_gap || decrement <= STAGE_TOL * smoothing_gap {
-            let mu_next = mu * opts.mu_shrink;
-            // Predictor along the central path x(mu) with the current factorisation:
-            // H dx/dmu = sum_k A_k^T r_k mu / s_k^3 (from d/dmu of g(x(mu), mu) = 0).
-            for k in 0..m {
-                let v = r[k];
-                let s2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + mu * mu;
-                let c = mu / (s2 * s2.sqrt());
-                y_dual[k] = [v[0] * c, v[1] * c, v[2] * c];
-            }
-            pb.apply_transpose(&y_dual, &mut g_scratch);
-            for p in 0..np {
-                for c in 0..3 {
-                    let j = 3 * p + c;
-                    rhs[3 * pos[p] + c] = if active[j] { 0.0 } else { g_scratch[j] };
-                }
-            }
-            env.solve(&mut rhs);
-            for p in 0..np {
-                for c in 0..3 {
-                    let j = 3 * p + c;
-                    let dx = if active[j] { 0.0 } else { (mu_next - mu) * rhs[3 * pos[p] + c] };
-                    x_new[j] = (x[j] + dx).max(lower[j]).min(upper[j]);
-                }
-            }
-            pb.residuals(&x_new, &mut r_new);
-            if smooth(&r_new, mu_next) < smooth(&r, mu_next) {
-                std::mem::swap(&mut x, &mut x_new);
-                std::mem::swap(&mut r, &mut r_new);
-                f = norm_sum(&r);
-            }
-            mu = mu_next;
+        if !moved || box_loss <= smoothing_gap || decrement <= STAGE_TOL * smoothing_gap {
+            predictor(&ws, &mut it, mu, mu * opts.mu_shrink, &mut sc);
+            mu *= opts.mu_shrink;
         }
     }
-    let gap = (best_f - best_lb).max(0.0);
+    if !closed(best.f, best.lb) {
+        pb.residuals(&best.x, &mut it.r);
+        polish(&mut ws, &best.x.clone(), &it.r, &mut best, &mut sc);
+    }
+    // The bound returned is the one `certify_dual` gives for the returned (x, y).
+    let (f, lower_bound) = certify_dual(pb, lower, upper, &best.x, &best.y);
     Ok(ExactResult {
-        x: best_x,
-        f: best_f,
-        lower_bound: best_lb,
-        gap,
+        gap: (f - lower_bound).max(0.0),
+        converged: closed(f, lower_bound),
+        x: best.x,
+        dual: best.y,
+        f,
+        lower_bound,
         iterations: steps,
-        converged,
     })
 }
 
@@ -901,6 +1209,40 @@ mod tests {
         let lower = [-2.0, -2.0, -2.0];
         let res = solve_exact(&pb, &lower, &upper, &[0.0; 3], &ExactOptions::default()).unwrap();
         assert!(res.f < 1e-9 && res.lower_bound <= res.f && res.converged, "{res:?}");
+    }
+
+    /// Two weighted geometric medians whose optimum interpolates the heavy term exactly:
+    /// 3|x0| + |x0 - e1| + |x0 - e2| (min at x0 = 0, dual y0 = (e1 + e2) / 3) and
+    /// |2 x1 - d| + |x1 - d/2 - e3| (min at x1 = d/2, dual e3 / 2); f* = 3. At the optimum the
+    /// subgradient certificate is useless (y = 0 on the interpolated terms); the polish finds
+    /// the closed-form duals.
+    #[test]
+    fn polish_certifies_an_interpolating_optimum() {
+        let d = [0.4, -0.2, 0.6];
+        let pb = Plain {
+            n: 2,
+            points: vec![vec![0], vec![0], vec![0], vec![1], vec![1]],
+            coefs: vec![vec![3.0], vec![1.0], vec![1.0], vec![2.0], vec![1.0]],
+            data: vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], d, [0.2, -0.1, 1.3]],
+        };
+        let (lower, upper) = (vec![-5.0; 6], vec![5.0; 6]);
+        let x = [0.0, 0.0, 0.0, 0.2, -0.1, 0.3];
+        let (f, lb_unit) = certify(&pb, &lower, &upper, &x);
+        assert!((f - 3.0).abs() < 1e-15 && f - lb_unit > 1.0, "{f} {lb_unit}");
+        let mut ws = Workspace::new(&pb, &lower, &upper).unwrap();
+        let mut r = vec![[0.0; 3]; 5];
+        pb.residuals(&x, &mut r);
+        let mut best = Best { x: x.to_vec(), f, lb: f64::NEG_INFINITY, y: vec![[0.0; 3]; 5] };
+        let mut sc = Scratch::new(6, 5);
+        polish(&mut ws, &x, &r, &mut best, &mut sc);
+        let (f2, lb) = certify_dual(&pb, &lower, &upper, &x, &best.y);
+        assert!(f2 == f && lb <= f && f - lb <= 1e-9, "gap {} y {:?}", f - lb, best.y);
+        let want = [[1.0 / 3.0, 1.0 / 3.0, 0.0], [0.0, 0.0, 0.5]];
+        for (k, w) in [0, 3].iter().zip(want) {
+            for c in 0..3 {
+                assert!((best.y[*k][c] - w[c]).abs() < 1e-6, "{:?}", best.y);
+            }
+        }
     }
 
     #[test]
