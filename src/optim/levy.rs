@@ -59,35 +59,85 @@ const SIDE: usize = OCTAVES * SEGS;
 /// Table rows (both sides, padded to a power of two so that the index mask bounds it).
 const TABLE_LEN: usize = 2048;
 
-/// Trapezoid step in s of [`product_cdf`] and in y = ln|v| of the outer integral.
-const H_S: f64 = 0.25;
-const H_Y: f64 = 0.05;
-/// The y range of the outer integral (the density sqrt(2/pi) e^(y - e^(2y)/2) is below 1e-32
-/// relative beyond it on either side for the probabilities tabulated).
-const Y_MIN: f64 = -75.0;
+/// Trapezoid step in s of [`product_cdf`] and in y = ln|v| of the outer integral (both
+/// integrands are analytic in strips of half-width pi/2 and pi/4: errors near exp(-pi^2 / 0.3)
+/// = 5e-15 and exp(-2 pi (pi/4) / 0.1) = 4e-22 relative).
+const H_S: f64 = 0.3;
+const H_Y: f64 = 0.1;
+/// The top of the y range of the outer integral (the density of ln|v| is below 1e-300 above);
+/// the bottom is [`y_min`].
 const Y_MAX: f64 = 3.6;
 /// The ln t range of the grid: G(t) < 1e-12 below, 1 - G(t) < 2^-34 above (ln t > 30/beta + 3).
 const LN_T_MIN: f64 = -32.0;
 
-/// (P(|u psi| <= c), P(|u psi| > c)) for independent standard normals u, psi:
-/// P(|u psi| > c) = (1/pi) int exp(-c cosh s) sech s ds over the real line, and the complement
-/// with -expm1(-c cosh s), by the trapezoid rule of step 0.25 (errors near 1e-17 relative).
+/// The s nodes of [`product_cdf`]: cosh s_k, the trapezoid weights (1 or 2) sech s_k and the
+/// sums of the weights from k on (s_k = k H_S up to 700).
+#[derive(Debug, Clone)]
+pub struct SechNodes {
+    cosh: Vec<f64>,
+    weight: Vec<f64>,
+    suffix: Vec<f64>,
+}
+
+impl SechNodes {
+    /// The nodes up to s = 700.
+    pub fn new() -> SechNodes {
+        let n = (700.0 / H_S) as usize;
+        let cosh: Vec<f64> = (0..=n).map(|k| (k as f64 * H_S).cosh()).collect();
+        let weight: Vec<f64> =
+            cosh.iter().enumerate().map(|(k, c)| if k == 0 { 1.0 } else { 2.0 } / c).collect();
+        let mut suffix = vec![0.0; n + 2];
+        for k in (0..=n).rev() {
+            suffix[k] = suffix[k + 1] + weight[k];
+        }
+        SechNodes { cosh, weight, suffix }
+    }
+
+    /// (P(|u psi| <= c), P(|u psi| > c)) for independent standard normals u, psi:
+    /// P(|u psi| > c) = (1/pi) int exp(-c cosh s) sech s ds over the real line, and the
+    /// complement with 1 - exp(-c cosh s) (-expm1 below 1/4), by the trapezoid rule; once
+    /// c cosh s > c + 40 the upper terms are below 4e-18 of the first and the lower terms are
+    /// the weights, summed ahead.
+    pub fn product_cdf(&self, c: f64) -> (f64, f64) {
+        if c <= 0.0 {
+            return (0.0, 1.0);
+        }
+        let (mut lower, mut upper, mut k) = (0.0, 0.0, 0);
+        let stop = c + 40.0;
+        while k < self.cosh.len() {
+            let x = c * self.cosh[k];
+            if x > stop {
+                break;
+            }
+            let e = (-x).exp();
+            let l = if x < 0.25 { -(-x).exp_m1() } else { 1.0 - e };
+            lower += self.weight[k] * l;
+            upper += self.weight[k] * e;
+            k += 1;
+        }
+        lower += self.suffix[k];
+        let scale = H_S / std::f64::consts::PI;
+        (lower * scale, upper * scale)
+    }
+}
+
+impl Default for SechNodes {
+    fn default() -> SechNodes {
+        SechNodes::new()
+    }
+}
+
+/// (P(|u psi| <= c), P(|u psi| > c)) for independent standard normals ([`SechNodes::product_cdf`]
+/// on fresh nodes).
 pub fn product_cdf(c: f64) -> (f64, f64) {
-    if c <= 0.0 {
-        return (0.0, 1.0);
-    }
-    let s_max = (40.0 + (-c.ln()).max(0.0)).min(700.0);
-    let n = (s_max / H_S).ceil() as usize;
-    let (mut lower, mut upper) = (0.0, 0.0);
-    for k in 0..=n {
-        let s = k as f64 * H_S;
-        let ch = s.cosh();
-        let w = if k == 0 { 1.0 } else { 2.0 } / ch;
-        lower += w * -(-c * ch).exp_m1();
-        upper += w * (-c * ch).exp();
-    }
-    let scale = H_S / std::f64::consts::PI;
-    (lower * scale, upper * scale)
+    SechNodes::new().product_cdf(c)
+}
+
+/// The bottom of the y range for beta: the upper tail at the grid's largest t,
+/// about e^(-(30 + 3 beta)), takes its mass from y near -(30 + 3 beta); the density
+/// below y_min integrates to about e^(y_min) = 1e-9 of that.
+fn y_min(beta: f64) -> f64 {
+    -(51.0 + 3.0 * beta)
 }
 
 /// Density of y = ln|v| for v ~ N(0, 1): sqrt(2/pi) exp(y - e^(2y)/2).
@@ -96,18 +146,20 @@ pub fn ln_abs_normal_density(y: f64) -> f64 {
 }
 
 /// Nodes y_j of the outer integral.
-fn y_nodes() -> impl Iterator<Item = f64> {
-    let n = ((Y_MAX - Y_MIN) / H_Y).round() as usize;
-    (0..=n).map(|j| Y_MIN + j as f64 * H_Y)
+fn y_nodes(beta: f64) -> impl Iterator<Item = f64> {
+    let lo = y_min(beta);
+    let n = ((Y_MAX - lo) / H_Y).round() as usize;
+    (0..=n).map(move |j| lo + j as f64 * H_Y)
 }
 
 /// (G(t), 1 - G(t)) of |T| = |u psi| / |v|^(1/beta) computed directly:
 /// G(t) = int p(y) P(|u psi| <= t e^(y/beta)) dy (p the density of ln|v|), trapezoid in y.
 pub fn levy_cdf(t: f64, beta: f64) -> (f64, f64) {
     let (mut lower, mut upper) = (0.0, 0.0);
-    for y in y_nodes() {
+    let nodes = SechNodes::new();
+    for y in y_nodes(beta) {
         let p = ln_abs_normal_density(y);
-        let (l, u) = product_cdf(t * (y / beta).exp());
+        let (l, u) = nodes.product_cdf(t * (y / beta).exp());
         lower += p * l;
         upper += p * u;
     }
@@ -128,10 +180,11 @@ impl CdfGrid {
     pub fn new(beta: f64) -> CdfGrid {
         let step = H_Y / beta;
         let m = ((30.0 / beta + 3.0 - LN_T_MIN) / step).ceil() as usize + 1;
-        let dens: Vec<f64> = y_nodes().map(ln_abs_normal_density).collect();
-        let c0 = LN_T_MIN + Y_MIN / beta;
+        let dens: Vec<f64> = y_nodes(beta).map(ln_abs_normal_density).collect();
+        let c0 = LN_T_MIN + y_min(beta) / beta;
+        let nodes = SechNodes::new();
         let tails: Vec<(f64, f64)> =
-            (0..m + dens.len()).map(|k| product_cdf((c0 + k as f64 * step).exp())).collect();
+            (0..m + dens.len()).map(|k| nodes.product_cdf((c0 + k as f64 * step).exp())).collect();
         let (mut ln_lower, mut ln_upper) = (Vec::with_capacity(m), Vec::with_capacity(m));
         for i in 0..m {
             let (mut l, mut u) = (0.0, 0.0);
@@ -151,7 +204,16 @@ impl CdfGrid {
         let target = if upper { -r.ln() } else { r.ln() };
         let psi = |i: usize| if upper { -self.ln_upper[i] } else { self.ln_lower[i] };
         let n = self.ln_lower.len();
-        let first = (0..n).collect::<Vec<_>>().partition_point(|&i| psi(i) < target);
+        // The first node at or above the target (binary search; psi increases).
+        let (mut first, mut end) = (0, n);
+        while first < end {
+            let mid = (first + end) / 2;
+            if psi(mid) < target {
+                first = mid + 1;
+            } else {
+                end = mid;
+            }
+        }
         let start = first.saturating_sub(3).min(n - 6);
         let mut x = 0.0;
         for a in start..start + 6 {
@@ -505,7 +567,8 @@ mod tests {
         assert!((mean - 2.0 / std::f64::consts::PI).abs() < 1e-12, "{mean}");
         for c in [1e-14, 1e-5, 0.1, 1.0, 7.0, 30.0] {
             let (l, u) = product_cdf(c);
-            assert!((l + u - 1.0).abs() < 1e-14, "c {c}: {l} + {u}");
+            // The trapezoid sum of the weights sech s_k is 1 to about 4 exp(-pi^2 / H_S) = 2e-14.
+            assert!((l + u - 1.0).abs() < 5e-14, "c {c}: {l} + {u}");
         }
         let mut r = ChaCha8Rng::seed_from_u64(1);
         let n = 400_000;
