@@ -1,196 +1,422 @@
-//! Cuckoo search's Levy steps (Mantegna's method, beta = 3/2) drawn in bulk: one vectorised pass
-//! per nest instead of three library normal draws and a Newton cube root per coordinate.
+//! Cuckoo search's Levy factors by a quantile table: one 32-bit uniform, one table look-up and a
+//! cubic per coordinate, no transcendental call.
 //!
-//! Mantegna's step times the flight's own normal factor is L = u psi / |v|^(1/beta) with u, v, psi
-//! independent, u ~ N(0, sigma_u^2), v, psi ~ N(0, 1). The normals come from Box-Muller pairs
-//! (z1, z2) = r (cos theta, sin theta), r^2 = 2E, E ~ Exp(1), theta ~ U[0, 2 pi), drawn so that
-//! nothing is wasted:
-//! - u psi: the product of the two normals of one pair is r^2 cos theta sin theta = E sin 2 theta,
-//!   and 2 theta (mod 2 pi) is uniform, so u psi = sigma_u E sin theta' exactly in law: one
-//!   logarithm and one sine per coordinate for two normals.
-//! - v^2 of two coordinates: one pair gives v1^2 = 2E cos^2 theta and v2^2 = 2E sin^2 theta; then
-//!   |v|^(-2/3) = (v^2)^(-1/3) by Newton's iteration (no square root, no power function).
-//! - A uniform angle is reduced without multiplying by pi and folding: |sin| and |cos| of a
-//!   uniform angle are, with probability 1/2 each, sin t and cos t of t ~ U(0, pi/4) (the
-//!   circle's symmetries), so one random bit picks the function, one bit the sign, and the
-//!   remaining 31 bits give t; sin t and cos t are Taylor polynomials on (0, pi/4), exact to
-//!   about 1e-14 relative even for the tiny values that make the heavy tail.
+//! The flight's factor is L = sigma_u T with T = u psi / |v|^(1/beta), u, psi, v independent
+//! N(0, 1) (Mantegna's step u / |v|^(1/beta) times the flight's own normal psi). T is symmetric;
+//! its magnitude has the CDF G(t) = P(|T| <= t) = E_v[P(|u psi| <= t |v|^(1/beta))], where the
+//! product of two normals has |u psi| = E |sin theta| in law (Box-Muller), so
+//! P(|u psi| > c) = (2/pi) int_0^(pi/2) exp(-c / sin theta) d theta, which the substitution
+//! theta = 2 atan(e^s) (sin theta = sech s, d theta = sech s ds) makes a doubly decaying
+//! integral (1/pi) int exp(-c cosh s) sech s ds on the whole line, done by the trapezoid rule
+//! ([`product_cdf`]). The outer expectation is over y = ln|v| (density
+//! sqrt(2/pi) exp(y - e^(2y)/2)), again by the trapezoid rule, on a log-t grid whose step is the
+//! y step over beta, so every c = t |v|^(1/beta) lies on one log-c grid and G on the whole grid is
+//! a discrete convolution ([`CdfGrid`]). Both tails are kept apart (P(|T| <= t) and P(|T| > t)
+//! each summed from positive terms), so tiny probabilities keep their relative accuracy.
 //!
-//! Every uniform is (k + 1/2) 2^-32 from 32 random bits (or (k + 1/2) 2^-31 from 31 bits beside a
-//! sign or swap bit), in (0, 1): no logarithm of 0, no angle at 0, so every step is finite
-//! (E <= 22.9, |v|^2 >= 1e-29); a 32-bit uniform moves the law by at most 2^-32 in each
-//! probability. The functions are written in IEEE additions, multiplications, divisions and
-//! fused multiply-adds (`f64::mul_add`, one rounding: the AVX2 copy's `vfmadd`, the baseline
-//! copy's C library `fma`), so the baseline and AVX2 copies (the same Rust, compiled twice) give
-//! the same bits on every x86-64. Words come from four xoshiro256++ lanes ([`DeLanes`], seeded
-//! from the run's ChaCha8 stream), each 64-bit word giving two 32-bit fields: chunk after chunk of
-//! [`CHUNK`] coordinates, each consuming 3 CHUNK / 8 steps of the four lanes, word m of a chunk
-//! from lane m % 4 at step m / 4 (layout at [`chunk`]).
+//! Sampling ([`LevyTable`]): a 32-bit field is a sign bit (bit 31), a side bit (bit 30: the lower
+//! or the upper tail of |T|) and 30 bits k giving r' = (k + 1/2) 2^-30 in (0, 1); the tail
+//! probability is r'/2. The f64 r' itself is the per-octave grid: its exponent (31 octaves,
+//! 2^-31 .. 2^-1) and the top 5 mantissa bits pick one of 31 x 32 segments per side, the other
+//! mantissa bits are the fraction f in [0, 1), and the segment's cubic in f (fitted at four
+//! Chebyshev points to the exact quantiles) gives |T|. Every r' the 30 bits can give lies in the
+//! table, the deepest octave down to tail probability 2^-32, so no asymptotic formula is needed.
+//! Per side 992 segments of 4 coefficients: 63 KB for both. The cubic errs below about 1e-7
+//! relative, the quadrature far less.
+//!
+//! The baseline copy computes each factor in scalar IEEE operations and `f64::mul_add`; the AVX2
+//! copy does the same operations four lanes at a time (gathers for the coefficients, `vfmadd`), so
+//! the copies give the same bits. Words come from four xoshiro256++ lanes ([`DeLanes`], seeded from
+//! the run's ChaCha8 stream): chunk after chunk of [`CHUNK`] coordinates, each consuming HALF / 4
+//! steps of the four lanes; word k of a chunk (lane k % 4, step k / 4) holds the field of
+//! coordinate k (low 32 bits) and of coordinate k + HALF (high 32 bits).
 
 // Index loops over the chunk's parallel arrays read more plainly than zipped iterators here.
 #![allow(clippy::needless_range_loop)]
 
 use super::sampling::DeLanes;
-#[cfg(test)]
-use super::sampling::DE_LANES;
+use std::sync::{Arc, Mutex};
 
 /// Coordinates per chunk of words (a whole chunk of words is drawn even when fewer are needed).
 pub const CHUNK: usize = 128;
 const HALF: usize = CHUNK / 2;
-/// 64-bit words per chunk: 32-bit fields for E and the angle of each coordinate's u psi
-/// (2 CHUNK fields), E and the angle of each pair's v^2 (CHUNK fields).
-const WORDS: usize = 3 * HALF;
 
 const ONE: u64 = 0x3ff0_0000_0000_0000;
 const MANT: u64 = (1 << 52) - 1;
-/// 2^-33 and 2^-32: half the step of a 32-bit and of a 31-bit uniform.
-const HALF_STEP_32: f64 = 1.0 / (1u64 << 33) as f64;
-const HALF_STEP_31: f64 = 1.0 / (1u64 << 32) as f64;
-/// Bits of sqrt(1/2) (checked in the tests).
-const SQRT_HALF_BITS: u64 = 0x3fe6_a09e_667f_3bcd;
-const TWO52: f64 = (1u64 << 52) as f64;
-const FRAC_PI_4: f64 = std::f64::consts::FRAC_PI_4;
-const LN2: f64 = std::f64::consts::LN_2;
+/// The 30 bits k of a field.
+const K_MASK: u64 = (1 << 30) - 1;
+/// 2^-31: half the step of a 30-bit uniform.
+const HALF_STEP_30: f64 = 1.0 / (1u64 << 31) as f64;
+/// Segments per octave (the top 5 mantissa bits of r').
+const SEG_BITS: u32 = 5;
+const SEGS: usize = 1 << SEG_BITS;
+/// Octaves of r': exponents -31 ..= -1.
+const OCTAVES: usize = 31;
+/// Biased exponent of the first octave (2^-31).
+const FIRST_EXP: u64 = 1023 - 31;
+/// Segments per side.
+const SIDE: usize = OCTAVES * SEGS;
+/// Table rows (both sides, padded to a power of two so that the index mask bounds it).
+const TABLE_LEN: usize = 2048;
 
-/// 1/n! for n <= 20 (n! exact below 2^63, one rounding).
-const INV_FACT: [f64; 21] = {
-    let mut t = [1.0; 21];
-    let mut f = 1u64;
-    let mut n = 1;
-    while n < 21 {
-        f *= n as u64;
-        t[n] = 1.0 / f as f64;
-        n += 1;
+/// Trapezoid step in s of [`product_cdf`] and in y = ln|v| of the outer integral (both
+/// integrands are analytic in strips of half-width pi/2 and pi/4: errors near exp(-pi^2 / 0.3)
+/// = 5e-15 and exp(-2 pi (pi/4) / 0.1) = 4e-22 relative).
+const H_S: f64 = 0.3;
+const H_Y: f64 = 0.1;
+/// The top of the y range of the outer integral (the density of ln|v| is below 1e-300 above);
+/// the bottom is [`y_min`].
+const Y_MAX: f64 = 3.6;
+/// The ln t range of the grid: G(t) < 1e-12 below, 1 - G(t) < 2^-34 above (ln t > 30/beta + 3).
+const LN_T_MIN: f64 = -32.0;
+
+/// The s nodes of [`product_cdf`]: cosh s_k, the trapezoid weights (1 or 2) sech s_k and the
+/// sums of the weights from k on (s_k = k H_S up to 700).
+#[derive(Debug, Clone)]
+pub struct SechNodes {
+    cosh: Vec<f64>,
+    weight: Vec<f64>,
+    suffix: Vec<f64>,
+}
+
+impl SechNodes {
+    /// The nodes up to s = 700.
+    pub fn new() -> SechNodes {
+        let n = (700.0 / H_S) as usize;
+        let cosh: Vec<f64> = (0..=n).map(|k| (k as f64 * H_S).cosh()).collect();
+        let weight: Vec<f64> =
+            cosh.iter().enumerate().map(|(k, c)| if k == 0 { 1.0 } else { 2.0 } / c).collect();
+        let mut suffix = vec![0.0; n + 2];
+        for k in (0..=n).rev() {
+            suffix[k] = suffix[k + 1] + weight[k];
+        }
+        SechNodes { cosh, weight, suffix }
     }
-    t
-};
 
-/// The uniform (k + 1/2) 2^-32 in (0, 1) from the 32 bits k of `w` at bit `shift` upwards
-/// (`shift` 0 or 32), built from the bits (k at the top of the mantissa of 1 + k 2^-32).
-#[inline(always)]
-fn open_unit32(w: u64, shift: u32) -> f64 {
-    (f64::from_bits((((w >> shift) & 0xffff_ffff) << 20) | ONE) - 1.0) + HALF_STEP_32
-}
-
-/// The uniform (k + 1/2) 2^-31 in (0, 1) from the 31 bits k of `w` at bit `shift` upwards (bit
-/// `shift + 31` is left for a sign or a choice).
-#[inline(always)]
-fn open_unit31(w: u64, shift: u32) -> f64 {
-    (f64::from_bits((((w >> shift) & 0x7fff_ffff) << 21) | ONE) - 1.0) + HALF_STEP_31
-}
-
-/// Horner's rule with fused multiply-adds: c[0] + z (c[1] + z (c[2] + ...)).
-#[inline(always)]
-fn horner<const N: usize>(z: f64, c: [f64; N]) -> f64 {
-    let mut p = c[N - 1];
-    for k in (0..N - 1).rev() {
-        p = p.mul_add(z, c[k]);
+    /// (P(|u psi| <= c), P(|u psi| > c)) for independent standard normals u, psi:
+    /// P(|u psi| > c) = (1/pi) int exp(-c cosh s) sech s ds over the real line, and the
+    /// complement with 1 - exp(-c cosh s) (-expm1 below 1/4), by the trapezoid rule; once
+    /// c cosh s > c + 40 the upper terms are below 4e-18 of the first and the lower terms are
+    /// the weights, summed ahead.
+    pub fn product_cdf(&self, c: f64) -> (f64, f64) {
+        if c <= 0.0 {
+            return (0.0, 1.0);
+        }
+        let (mut lower, mut upper, mut k) = (0.0, 0.0, 0);
+        let stop = c + 40.0;
+        while k < self.cosh.len() {
+            let x = c * self.cosh[k];
+            if x > stop {
+                break;
+            }
+            let e = (-x).exp();
+            let l = if x < 0.25 { -(-x).exp_m1() } else { 1.0 - e };
+            lower += self.weight[k] * l;
+            upper += self.weight[k] * e;
+            k += 1;
+        }
+        lower += self.suffix[k];
+        let scale = H_S / std::f64::consts::PI;
+        (lower * scale, upper * scale)
     }
-    p
 }
 
-/// -ln u for u in (0, 1): u = m 2^e with m in [sqrt(1/2), sqrt 2) taken from the bits,
-/// ln m = 2 atanh s = 2 (s + s^3/3 + ... + s^15/15), s = (m - 1)/(m + 1), |s| <= 0.1716 (the
-/// series' remainder is below 4e-14 relative). Relative error below 1e-13.
-#[inline(always)]
-pub fn neg_ln(u: f64) -> f64 {
-    let bits = u.to_bits();
-    // e + 1023 of u's representation with the mantissa in [sqrt(1/2), sqrt 2).
-    let eb = (bits + (ONE - SQRT_HALF_BITS)) >> 52;
-    let m = f64::from_bits(bits.wrapping_sub((eb << 52).wrapping_sub(ONE)));
-    let e = f64::from_bits(0x4330_0000_0000_0000 | eb) - (TWO52 + 1023.0);
-    let s = (m - 1.0) / (m + 1.0);
-    let z = s * s;
-    let p =
-        horner(z, [1.0 / 3.0, 1.0 / 5.0, 1.0 / 7.0, 1.0 / 9.0, 1.0 / 11.0, 1.0 / 13.0, 1.0 / 15.0]);
-    let s2 = s + s;
-    -(e.mul_add(LN2, s2.mul_add(z * p, s2)))
-}
-
-/// (sin t, cos t) for t = h pi/4, h in (0, 1): Taylor polynomials to t^13 and t^14 (remainders
-/// below 3e-14 relative and 1e-15 on (0, pi/4)).
-#[inline(always)]
-pub fn sin_cos_octant(h: f64) -> (f64, f64) {
-    let f = |n: usize| INV_FACT[n];
-    let t = h * FRAC_PI_4;
-    let z = t * t;
-    let sp = horner(z, [-f(3), f(5), -f(7), f(9), -f(11), f(13)]);
-    let cp = horner(z, [-f(2), f(4), -f(6), f(8), -f(10), f(12), -f(14)]);
-    (t.mul_add(z * sp, t), z.mul_add(cp, 1.0))
-}
-
-/// a^(-1/3) for a normal positive a: a first guess from the exponent bits (bits / 3 by a
-/// floating-point multiply, within about 10%), then four Newton steps
-/// r <- r (4/3 - (a/3) r^3) (the error squares at each). Relative error below 5e-15 (2.9e-15 at
-/// worst in the test).
-#[inline(always)]
-pub fn inv_cbrt(a: f64) -> f64 {
-    let hi = a.to_bits() >> 12;
-    let third = (f64::from_bits(0x4330_0000_0000_0000 | hi) - TWO52) * (1.0 / 3.0);
-    let q = (third + TWO52).to_bits() & MANT;
-    let mut r = f64::from_bits(0x553e_f0ff_289d_d796u64.wrapping_sub(q << 12));
-    let neg_a3 = a * (-1.0 / 3.0);
-    for _ in 0..4 {
-        let r3 = r * r * r;
-        r *= neg_a3.mul_add(r3, 4.0 / 3.0);
+impl Default for SechNodes {
+    fn default() -> SechNodes {
+        SechNodes::new()
     }
-    r
 }
 
-/// sin t for t = h pi/2, h in (0, 1): the Taylor polynomial to t^17 (remainder below 5e-14 on
-/// (0, pi/2), where sin t >= 2t/pi).
-#[inline(always)]
-pub fn sin_quadrant(h: f64) -> f64 {
-    let f = |n: usize| INV_FACT[n];
-    let t = h * std::f64::consts::FRAC_PI_2;
-    let z = t * t;
-    let p = horner(z, [-f(3), f(5), -f(7), f(9), -f(11), f(13), -f(15), f(17)]);
-    t.mul_add(z * p, t)
+/// (P(|u psi| <= c), P(|u psi| > c)) for independent standard normals ([`SechNodes::product_cdf`]
+/// on fresh nodes).
+pub fn product_cdf(c: f64) -> (f64, f64) {
+    SechNodes::new().product_cdf(c)
 }
 
-/// sigma E sin(theta) for a uniform angle theta, from the 32-bit fields at bit `shift` of two
-/// words: |sin theta| is sin t for t ~ U(0, pi/2) (the circle's symmetries); the field's top bit
-/// of `angle` is the sign, its other 31 bits give t; E = -ln u from the field of `e_word`.
-#[inline(always)]
-fn product(e_word: u64, angle: u64, shift: u32, sigma: f64) -> f64 {
-    let trig = sin_quadrant(open_unit31(angle, shift));
-    let trig = f64::from_bits(trig.to_bits() ^ ((angle >> (shift + 31)) << 63));
-    sigma * neg_ln(open_unit32(e_word, shift)) * trig
+/// The bottom of the y range for beta: the upper tail at the grid's largest t,
+/// about e^(-(30 + 3 beta)), takes its mass from y near -(30 + 3 beta); the density
+/// below y_min integrates to about e^(y_min) = 1e-9 of that.
+fn y_min(beta: f64) -> f64 {
+    -(51.0 + 3.0 * beta)
 }
 
-/// One chunk of Levy factors: `out[j]` = sigma u_j psi_j / |v_j|^(2/3) for j < CHUNK, all from
-/// `words`: words k < HALF hold E of coordinates k (low 32 bits) and k + HALF (high), words
-/// HALF + k their angles likewise; word 2 HALF + k holds the pair of coordinates k and k + HALF:
-/// E (low 32 bits), the octant angle (bits 32..63) and which of the two takes the sine (bit 63).
+/// Density of y = ln|v| for v ~ N(0, 1): sqrt(2/pi) exp(y - e^(2y)/2).
+pub fn ln_abs_normal_density(y: f64) -> f64 {
+    (2.0 / std::f64::consts::PI).sqrt() * (y - 0.5 * (2.0 * y).exp()).exp()
+}
+
+/// Nodes y_j of the outer integral.
+fn y_nodes(beta: f64) -> impl Iterator<Item = f64> {
+    let lo = y_min(beta);
+    let n = ((Y_MAX - lo) / H_Y).round() as usize;
+    (0..=n).map(move |j| lo + j as f64 * H_Y)
+}
+
+/// (G(t), 1 - G(t)) of |T| = |u psi| / |v|^(1/beta) computed directly:
+/// G(t) = int p(y) P(|u psi| <= t e^(y/beta)) dy (p the density of ln|v|), trapezoid in y.
+pub fn levy_cdf(t: f64, beta: f64) -> (f64, f64) {
+    let (mut lower, mut upper) = (0.0, 0.0);
+    let nodes = SechNodes::new();
+    for y in y_nodes(beta) {
+        let p = ln_abs_normal_density(y);
+        let (l, u) = nodes.product_cdf(t * (y / beta).exp());
+        lower += p * l;
+        upper += p * u;
+    }
+    (lower * H_Y, upper * H_Y)
+}
+
+/// ln G(t_m) and ln(1 - G(t_m)) on the grid ln t_m = LN_T_MIN + m H_Y / beta (the convolution
+/// of [`levy_cdf`]'s sums, every c on one log grid).
+#[derive(Debug, Clone)]
+pub struct CdfGrid {
+    step: f64,
+    ln_lower: Vec<f64>,
+    ln_upper: Vec<f64>,
+}
+
+impl CdfGrid {
+    /// The grid for exponent beta.
+    pub fn new(beta: f64) -> CdfGrid {
+        let step = H_Y / beta;
+        let m = ((30.0 / beta + 3.0 - LN_T_MIN) / step).ceil() as usize + 1;
+        let dens: Vec<f64> = y_nodes(beta).map(ln_abs_normal_density).collect();
+        let c0 = LN_T_MIN + y_min(beta) / beta;
+        let nodes = SechNodes::new();
+        let tails: Vec<(f64, f64)> =
+            (0..m + dens.len()).map(|k| nodes.product_cdf((c0 + k as f64 * step).exp())).collect();
+        let (mut ln_lower, mut ln_upper) = (Vec::with_capacity(m), Vec::with_capacity(m));
+        for i in 0..m {
+            let (mut l, mut u) = (0.0, 0.0);
+            for (j, p) in dens.iter().enumerate() {
+                l += p * tails[i + j].0;
+                u += p * tails[i + j].1;
+            }
+            ln_lower.push((l * H_Y).ln());
+            ln_upper.push((u * H_Y).ln());
+        }
+        CdfGrid { step, ln_lower, ln_upper }
+    }
+
+    /// The t with P(|T| <= t) = r (`upper` false) or P(|T| > t) = r (`upper` true), r <= 1/2:
+    /// six-point Lagrange interpolation of ln t against ln r on the grid.
+    pub fn quantile(&self, upper: bool, r: f64) -> f64 {
+        let target = if upper { -r.ln() } else { r.ln() };
+        let psi = |i: usize| if upper { -self.ln_upper[i] } else { self.ln_lower[i] };
+        let n = self.ln_lower.len();
+        // The first node at or above the target (binary search; psi increases).
+        let (mut first, mut end) = (0, n);
+        while first < end {
+            let mid = (first + end) / 2;
+            if psi(mid) < target {
+                first = mid + 1;
+            } else {
+                end = mid;
+            }
+        }
+        let start = first.saturating_sub(3).min(n - 6);
+        let mut x = 0.0;
+        for a in start..start + 6 {
+            let mut w = 1.0;
+            for b in start..start + 6 {
+                if b != a {
+                    w *= (target - psi(b)) / (psi(a) - psi(b));
+                }
+            }
+            x += w * (LN_T_MIN + a as f64 * self.step);
+        }
+        x.exp()
+    }
+}
+
+/// Chebyshev points of [0, 1] for the segments' cubics.
+fn cheb_nodes() -> [f64; 4] {
+    std::array::from_fn(|i| 0.5 - 0.5 * ((2 * i + 1) as f64 * std::f64::consts::PI / 8.0).cos())
+}
+
+/// Monomial coefficients c with sum_k c_k f_i^k = v_i (the cubic through four points), by
+/// Gaussian elimination with partial pivoting on the Vandermonde system.
+fn cubic_through(f: [f64; 4], v: [f64; 4]) -> [f64; 4] {
+    let mut a: [[f64; 5]; 4] =
+        std::array::from_fn(|i| [1.0, f[i], f[i] * f[i], f[i].powi(3), v[i]]);
+    for col in 0..4 {
+        let p =
+            (col..4).max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs())).unwrap_or(col);
+        a.swap(col, p);
+        for row in col + 1..4 {
+            let m = a[row][col] / a[col][col];
+            for k in col..5 {
+                a[row][k] -= m * a[col][k];
+            }
+        }
+    }
+    let mut c = [0.0; 4];
+    for row in (0..4).rev() {
+        let s: f64 = (row + 1..4).map(|k| a[row][k] * c[k]).sum();
+        c[row] = (a[row][4] - s) / a[row][row];
+    }
+    c
+}
+
+/// The quantile table of |T| for one beta (see the module).
+#[derive(Debug, Clone)]
+pub struct LevyTable {
+    beta: f64,
+    coef: Box<[[f64; 4]; TABLE_LEN]>,
+}
+
+/// Tables built so far in this process, by beta (each built once).
+static TABLES: Mutex<Vec<Arc<LevyTable>>> = Mutex::new(Vec::new());
+
+impl LevyTable {
+    /// Build the table for exponent beta in (0, 2): the exact quantiles at each segment's four
+    /// Chebyshev points and the cubic through them.
+    pub fn new(beta: f64) -> LevyTable {
+        let grid = CdfGrid::new(beta);
+        let mut coef = Box::new([[0.0; 4]; TABLE_LEN]);
+        let nodes = cheb_nodes();
+        for side in 0..2 {
+            for o in 0..OCTAVES {
+                let base = (2.0f64).powi(o as i32 - 31);
+                for s in 0..SEGS {
+                    let v = nodes.map(|f| {
+                        let r = base * (1.0 + (s as f64 + f) / SEGS as f64);
+                        grid.quantile(side == 1, 0.5 * r)
+                    });
+                    coef[side * SIDE + o * SEGS + s] = cubic_through(nodes, v);
+                }
+            }
+        }
+        LevyTable { beta, coef }
+    }
+
+    /// The table for beta, built at the first call in the process and shared after.
+    pub fn shared(beta: f64) -> Arc<LevyTable> {
+        let mut tables = TABLES.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(t) = tables.iter().find(|t| t.beta.to_bits() == beta.to_bits()) {
+            return t.clone();
+        }
+        let t = Arc::new(LevyTable::new(beta));
+        tables.push(t.clone());
+        t
+    }
+
+    /// The exponent beta the table is for.
+    pub fn beta(&self) -> f64 {
+        self.beta
+    }
+
+    /// |T| at r' in (0, 1) (tail probability r'/2) of the lower (`upper` false) or upper side:
+    /// the segment's cubic c0 + f (c1 + f (c2 + f c3)) by fused multiply-adds.
+    #[inline(always)]
+    fn magnitude(&self, upper: bool, r: f64) -> f64 {
+        let bits = r.to_bits();
+        let i =
+            ((bits >> (52 - SEG_BITS)) - (FIRST_EXP << SEG_BITS)) as usize + upper as usize * SIDE;
+        let f = f64::from_bits(((bits << SEG_BITS) & MANT) | ONE) - 1.0;
+        let c = &self.coef[i & (TABLE_LEN - 1)];
+        c[3].mul_add(f, c[2]).mul_add(f, c[1]).mul_add(f, c[0])
+    }
+}
+
+/// The uniform r' = (k + 1/2) 2^-30 of a field's 30 bits k.
 #[inline(always)]
-fn chunk(out: &mut [f64; CHUNK], words: &[u64; WORDS], sigma: f64) {
-    let (e_words, rest) = words.split_at(HALF);
-    let (angles, pairs) = rest.split_at(HALF);
-    let (lo, hi) = out.split_at_mut(HALF);
+fn field_unit(field: u64) -> f64 {
+    (f64::from_bits(((field & K_MASK) << 22) | ONE) - 1.0) + HALF_STEP_30
+}
+
+/// One Levy factor sigma T from a 32-bit field (see the module): sign bit 31, side bit 30.
+#[inline(always)]
+fn factor(table: &LevyTable, field: u64, sigma: f64) -> f64 {
+    let t = table.magnitude((field >> 30) & 1 == 1, field_unit(field));
+    f64::from_bits((t * sigma).to_bits() ^ (((field >> 31) & 1) << 63))
+}
+
+/// One chunk of factors in scalar operations: `out[k]` from the low field of word k,
+/// `out[k + HALF]` from its high field.
+fn chunk_scalar(out: &mut [f64; CHUNK], words: &[u64; HALF], table: &LevyTable, sigma: f64) {
     for k in 0..HALF {
-        lo[k] = product(e_words[k], angles[k], 0, sigma);
-        hi[k] = product(e_words[k], angles[k], 32, sigma);
-    }
-    for k in 0..HALF {
-        let w = pairs[k];
-        let r2 = 2.0 * neg_ln(open_unit32(w, 0));
-        let (s, c) = sin_cos_octant(open_unit31(w, 32));
-        let swap = w & (1 << 63) != 0;
-        let (a, b) = if swap { (s, c) } else { (c, s) };
-        lo[k] *= inv_cbrt(r2 * (a * a));
-        hi[k] *= inv_cbrt(r2 * (b * b));
+        out[k] = factor(table, words[k] & 0xffff_ffff, sigma);
+        out[k + HALF] = factor(table, words[k] >> 32, sigma);
     }
 }
 
-/// `out[j]` = sigma_u u_j psi_j / |v_j|^(2/3) (Mantegna, beta = 3/2, times the flight's normal
-/// psi) for every j, chunk by chunk from `rng` (see the module).
+/// [`chunk_scalar`] four lanes at a time: the same operations (integer shifts and masks, IEEE
+/// subtract and add, gathers of the coefficients, `vfmadd`, multiply, sign xor), the same bits.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+fn chunk_avx2(out: &mut [f64; CHUNK], words: &[u64; HALF], table: &LevyTable, sigma: f64) {
+    use std::arch::x86_64::*;
+    let base: *const f64 = table.coef.as_ptr().cast();
+    // SAFETY: loads and stores of words[4 q..4 q + 4] and out[..] within bounds; every gathered
+    // index is row * 4 + 0..3 with row masked below TABLE_LEN, inside the coefficient array.
+    unsafe {
+        let one = _mm256_set1_epi64x(ONE as i64);
+        let onef = _mm256_set1_pd(1.0);
+        let half = _mm256_set1_pd(HALF_STEP_30);
+        let kmask = _mm256_set1_epi64x(K_MASK as i64);
+        let mant = _mm256_set1_epi64x(MANT as i64);
+        let low32 = _mm256_set1_epi64x(0xffff_ffff);
+        let first = _mm256_set1_epi64x((FIRST_EXP << SEG_BITS) as i64);
+        let side = _mm256_set1_epi64x(SIDE as i64);
+        let bit = _mm256_set1_epi64x(1);
+        let rows = _mm256_set1_epi64x(TABLE_LEN as i64 - 1);
+        let sig = _mm256_set1_pd(sigma);
+        for q in 0..HALF / 4 {
+            let w = _mm256_loadu_si256(words.as_ptr().add(4 * q).cast());
+            for (h, field) in
+                [_mm256_and_si256(w, low32), _mm256_srli_epi64::<32>(w)].into_iter().enumerate()
+            {
+                let k =
+                    _mm256_or_si256(_mm256_slli_epi64::<22>(_mm256_and_si256(field, kmask)), one);
+                let r = _mm256_add_pd(_mm256_sub_pd(_mm256_castsi256_pd(k), onef), half);
+                let bits = _mm256_castpd_si256(r);
+                let up = _mm256_and_si256(_mm256_srli_epi64::<30>(field), bit);
+                let off = _mm256_and_si256(_mm256_sub_epi64(_mm256_setzero_si256(), up), side);
+                let seg =
+                    _mm256_sub_epi64(_mm256_srli_epi64::<{ 52 - SEG_BITS as i32 }>(bits), first);
+                let row = _mm256_and_si256(_mm256_add_epi64(seg, off), rows);
+                let fb = _mm256_or_si256(
+                    _mm256_and_si256(_mm256_slli_epi64::<{ SEG_BITS as i32 }>(bits), mant),
+                    one,
+                );
+                let f = _mm256_sub_pd(_mm256_castsi256_pd(fb), onef);
+                let idx = _mm256_slli_epi64::<2>(row);
+                let c0 = _mm256_i64gather_pd::<8>(base, idx);
+                let c1 = _mm256_i64gather_pd::<8>(base.add(1), idx);
+                let c2 = _mm256_i64gather_pd::<8>(base.add(2), idx);
+                let c3 = _mm256_i64gather_pd::<8>(base.add(3), idx);
+                let t = _mm256_fmadd_pd(_mm256_fmadd_pd(_mm256_fmadd_pd(c3, f, c2), f, c1), f, c0);
+                let sign = _mm256_slli_epi64::<63>(_mm256_srli_epi64::<31>(field));
+                let l = _mm256_xor_pd(_mm256_mul_pd(t, sig), _mm256_castsi256_pd(sign));
+                _mm256_storeu_pd(out.as_mut_ptr().add(h * HALF + 4 * q), l);
+            }
+        }
+    }
+}
+
+/// One chunk of factors in the copy the run's SIMD choice names.
 #[inline(always)]
-fn fill_body(out: &mut [f64], sigma: f64, rng: &mut DeLanes) {
-    let mut words = [0u64; WORDS];
+fn chunk(out: &mut [f64; CHUNK], words: &[u64; HALF], table: &LevyTable, sigma: f64, avx2: bool) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if avx2 {
+            // SAFETY: avx2 is true only when the CPU reports AVX2 and FMA (use_avx2).
+            return unsafe { chunk_avx2(out, words, table, sigma) };
+        }
+    }
+    let _ = avx2;
+    chunk_scalar(out, words, table, sigma)
+}
+
+/// `out[j]` = sigma_u T_j for every j, chunk by chunk from `rng` (see the module), in the scalar
+/// (`avx2` false) or the AVX2 copy.
+fn fill_with(out: &mut [f64], sigma: f64, table: &LevyTable, rng: &mut DeLanes, avx2: bool) {
+    let mut words = [0u64; HALF];
     let mut buf = [0.0f64; CHUNK];
     for piece in out.chunks_mut(CHUNK) {
         super::kernels::lanes_fill(&mut words, rng);
-        chunk(&mut buf, &words, sigma);
+        chunk(&mut buf, &words, table, sigma, avx2);
         piece.copy_from_slice(&buf[..piece.len()]);
     }
 }
@@ -208,13 +434,13 @@ pub struct FlightSources<'a> {
 /// nothing is allocated or cleared per flight).
 #[derive(Debug, Clone)]
 pub struct LevyScratch {
-    words: [u64; WORDS],
+    words: [u64; HALF],
     factors: [f64; CHUNK],
 }
 
 impl Default for LevyScratch {
     fn default() -> LevyScratch {
-        LevyScratch { words: [0; WORDS], factors: [0.0; CHUNK] }
+        LevyScratch { words: [0; HALF], factors: [0.0; CHUNK] }
     }
 }
 
@@ -230,28 +456,36 @@ pub fn flight_coordinate(x: f64, b: f64, lo: f64, hi: f64, alpha: f64, l: f64) -
     }
 }
 
+/// The parameters of one flight's factors: the table, sigma_u and the step alpha.
+#[derive(Debug, Clone, Copy)]
+pub struct FlightLaw<'a> {
+    pub table: &'a LevyTable,
+    pub sigma_u: f64,
+    pub alpha: f64,
+}
+
 /// [`levy_flight`] in one pass: each chunk's factors go straight into its coordinates' flight,
-/// while they are in L1 (the same draws and operations as [`fill_body`] followed by
+/// while they are in L1 (the same draws and operations as [`levy_fill`] followed by
 /// [`flight_coordinate`] per coordinate, so the same bits).
 #[inline(always)]
 fn flight_body(
     c: &mut [f64],
     src: FlightSources,
-    alpha: f64,
-    sigma: f64,
+    law: FlightLaw,
     rng: &mut DeLanes,
     scratch: &mut LevyScratch,
+    avx2: bool,
 ) {
     let n = c.len();
     let (x, b, lo, hi) = (&src.x[..n], &src.b[..n], &src.lo[..n], &src.hi[..n]);
     for (k, piece) in c.chunks_mut(CHUNK).enumerate() {
         super::kernels::lanes_fill(&mut scratch.words, rng);
-        chunk(&mut scratch.factors, &scratch.words, sigma);
+        chunk(&mut scratch.factors, &scratch.words, law.table, law.sigma_u, avx2);
         let (from, m) = (k * CHUNK, piece.len());
         let (x, b, lo, hi) = (&x[from..from + m], &b[from..from + m], &lo[from..], &hi[from..]);
         let (lo, hi, l) = (&lo[..m], &hi[..m], &scratch.factors[..m]);
         for j in 0..m {
-            piece[j] = flight_coordinate(x[j], b[j], lo[j], hi[j], alpha, l[j]);
+            piece[j] = flight_coordinate(x[j], b[j], lo[j], hi[j], law.alpha, l[j]);
         }
     }
 }
@@ -259,36 +493,34 @@ fn flight_body(
 fn flight_generic(
     c: &mut [f64],
     src: FlightSources,
-    alpha: f64,
-    sigma: f64,
+    law: FlightLaw,
     rng: &mut DeLanes,
     scratch: &mut LevyScratch,
 ) {
-    flight_body(c, src, alpha, sigma, rng, scratch)
+    flight_body(c, src, law, rng, scratch, false)
 }
 
-/// The same Rust compiled for AVX2 (vectorised by the compiler, no fused multiply-add).
+/// The AVX2 copy: the factors by [`chunk_avx2`], the flight's loop vectorised by the compiler
+/// (no fused multiply-add there, so the same bits).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 fn flight_avx2(
     c: &mut [f64],
     src: FlightSources,
-    alpha: f64,
-    sigma: f64,
+    law: FlightLaw,
     rng: &mut DeLanes,
     scratch: &mut LevyScratch,
 ) {
-    flight_body(c, src, alpha, sigma, rng, scratch)
+    flight_body(c, src, law, rng, scratch, true)
 }
 
-/// One Levy flight (beta = 3/2) of a nest into `c` (of the nest's length): coordinate j is
-/// [`flight_coordinate`] of the factor sigma_u u psi / |v|^(2/3) that [`levy_fill`] would draw
-/// for it from `rng` (the same words and the same bits), in the copy the run's SIMD choice names.
+/// One Levy flight of a nest into `c` (of the nest's length): coordinate j is
+/// [`flight_coordinate`] of the factor sigma_u T that [`levy_fill`] would draw for it from `rng`
+/// (the same words and the same bits), in the copy the run's SIMD choice names.
 pub fn levy_flight(
     c: &mut [f64],
     src: FlightSources,
-    alpha: f64,
-    sigma_u: f64,
+    law: FlightLaw,
     rng: &mut DeLanes,
     scratch: &mut LevyScratch,
 ) {
@@ -296,154 +528,161 @@ pub fn levy_flight(
     {
         if super::kernels::use_avx2() {
             // SAFETY: use_avx2 is true only when the CPU reports AVX2 and FMA.
-            return unsafe { flight_avx2(c, src, alpha, sigma_u, rng, scratch) };
+            return unsafe { flight_avx2(c, src, law, rng, scratch) };
         }
     }
-    flight_generic(c, src, alpha, sigma_u, rng, scratch)
+    flight_generic(c, src, law, rng, scratch)
 }
 
-fn fill_generic(out: &mut [f64], sigma: f64, rng: &mut DeLanes) {
-    fill_body(out, sigma, rng)
-}
-
-/// The same Rust compiled for AVX2 (the compiler vectorises the chunk's loops; no fused
-/// multiply-add, so the same bits).
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-fn fill_avx2(out: &mut [f64], sigma: f64, rng: &mut DeLanes) {
-    fill_body(out, sigma, rng)
-}
-
-/// Fill `out` with Levy factors sigma_u u psi / |v|^(2/3) (beta = 3/2), in the copy the run's
-/// SIMD choice ([`super::kernels::simd`]) names; the same bits from every copy.
-pub fn levy_fill(out: &mut [f64], sigma_u: f64, rng: &mut DeLanes) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        if super::kernels::use_avx2() {
-            // SAFETY: use_avx2 is true only when the CPU reports AVX2 and FMA.
-            return unsafe { fill_avx2(out, sigma_u, rng) };
-        }
-    }
-    fill_generic(out, sigma_u, rng)
+/// Fill `out` with Levy factors sigma_u T (T = u psi / |v|^(1/beta), beta the table's), in the
+/// copy the run's SIMD choice ([`super::kernels::simd`]) names; the same bits from every copy.
+pub fn levy_fill(out: &mut [f64], sigma_u: f64, table: &LevyTable, rng: &mut DeLanes) {
+    fill_with(out, sigma_u, table, rng, super::kernels::use_avx2())
 }
 
 /// The baseline copy (the tests' reference for the dispatched one).
 #[cfg(test)]
-pub fn levy_fill_baseline(out: &mut [f64], sigma_u: f64, rng: &mut DeLanes) {
-    fill_generic(out, sigma_u, rng)
+pub fn levy_fill_baseline(out: &mut [f64], sigma_u: f64, table: &LevyTable, rng: &mut DeLanes) {
+    fill_with(out, sigma_u, table, rng, false)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::optim::sampling::{mantegna_sigma_u, symmetric};
-    use rand::{RngCore, SeedableRng};
+    use crate::optim::sampling::mantegna_sigma_u;
+    use rand::{Rng, RngCore, SeedableRng};
     use rand_chacha::ChaCha8Rng;
+    use rand_distr::StandardNormal;
 
-    const HALF_ULP: f64 = 1.0 / (1u64 << 53) as f64;
-
-    /// The uniform (k + 1/2) 2^-52 from the top 52 bits of `w` (the probes of the accuracy
-    /// tests, finer than the 32-bit uniforms the sampler uses).
-    fn open_unit52(w: u64) -> f64 {
-        ((w >> 12) as f64 + 0.5) * (1.0 / (1u64 << 52) as f64)
-    }
-
+    /// E|u psi| = (E|z|)^2 = 2/pi = int_0^inf P(|u psi| > c) dc, by the trapezoid rule in ln c;
+    /// the two tails add to 1; P(|u psi| > c) against a direct simulation at a few c.
     #[test]
-    fn constants_are_what_they_say() {
-        assert_eq!(SQRT_HALF_BITS, 0.5f64.sqrt().to_bits());
-        assert_eq!(open_unit32(0, 0), HALF_STEP_32);
-        assert_eq!(open_unit32(u64::MAX, 32), 1.0 - HALF_STEP_32);
-        assert_eq!(open_unit31(u64::MAX, 0), 1.0 - HALF_STEP_31);
-        let mut rng = ChaCha8Rng::seed_from_u64(13);
-        for _ in 0..1000 {
-            let w = rng.next_u64();
-            let (lo, hi) = (w & 0xffff_ffff, w >> 32);
-            assert_eq!(open_unit32(w, 0), (lo as f64 + 0.5) / 4_294_967_296.0);
-            assert_eq!(open_unit32(w, 32), (hi as f64 + 0.5) / 4_294_967_296.0);
-            assert_eq!(open_unit31(w, 0), ((lo & 0x7fff_ffff) as f64 + 0.5) / 2_147_483_648.0);
-            assert_eq!(open_unit31(w, 32), ((hi & 0x7fff_ffff) as f64 + 0.5) / 2_147_483_648.0);
+    fn product_tails_are_the_product_law() {
+        let h = 0.02;
+        let mean: f64 = (0..3000)
+            .map(|i| -45.0 + i as f64 * h)
+            .map(|x| product_cdf(x.exp()).1 * x.exp())
+            .sum::<f64>()
+            * h;
+        assert!((mean - 2.0 / std::f64::consts::PI).abs() < 1e-12, "{mean}");
+        for c in [1e-14, 1e-5, 0.1, 1.0, 7.0, 30.0] {
+            let (l, u) = product_cdf(c);
+            // The trapezoid sum of the weights sech s_k is 1 to about 4 exp(-pi^2 / H_S) = 2e-14.
+            assert!((l + u - 1.0).abs() < 5e-14, "c {c}: {l} + {u}");
+        }
+        let mut r = ChaCha8Rng::seed_from_u64(1);
+        let n = 400_000;
+        let sims: Vec<f64> = (0..n)
+            .map(|_| {
+                let (a, b): (f64, f64) = (r.sample(StandardNormal), r.sample(StandardNormal));
+                (a * b).abs()
+            })
+            .collect();
+        for c in [0.01, 0.3, 1.0, 4.0] {
+            let p = product_cdf(c).1;
+            let got = sims.iter().filter(|x| **x > c).count() as f64 / n as f64;
+            assert!(
+                (got - p).abs() < 5.0 * (p * (1.0 - p) / n as f64).sqrt(),
+                "c {c}: {got} vs {p}"
+            );
         }
     }
 
-    #[test]
-    fn neg_ln_matches_the_library() {
-        let mut rng = ChaCha8Rng::seed_from_u64(4);
-        let mut worst = 0.0f64;
-        let probes = [
-            HALF_ULP,
-            1.0 - HALF_ULP,
-            0.5,
-            0.5f64.sqrt(),
-            0.5f64.sqrt() * (1.0 + f64::EPSILON),
-            0.25,
-            0.999,
-            1e-10,
-        ];
-        for u in (0..200_000).map(|_| open_unit52(rng.next_u64())).chain(probes) {
-            let want = -u.ln();
-            let got = neg_ln(u);
-            worst = worst.max(((got - want) / want).abs());
-        }
-        println!("worst relative error {worst:e}");
-        assert!(worst < 1e-13, "worst relative error {worst:e}");
+    /// The table's |T| at r' (the same index and fraction as the sampler, any f64 r').
+    fn table_quantile(t: &LevyTable, upper: bool, r: f64) -> f64 {
+        t.magnitude(upper, r)
     }
 
+    /// The table's quantiles put the directly computed CDF at the asked probability, within 1e-6
+    /// relative, at random points of every octave of both sides, for several beta.
     #[test]
-    fn octant_sine_and_cosine_match_the_library() {
-        let mut rng = ChaCha8Rng::seed_from_u64(5);
-        let mut worst = 0.0f64;
-        for h in
-            (0..200_000).map(|_| open_unit52(rng.next_u64())).chain([HALF_ULP, 1.0 - HALF_ULP, 0.5])
-        {
-            let t = h * FRAC_PI_4;
-            let (s, c) = sin_cos_octant(h);
-            worst = worst.max(((s - t.sin()) / t.sin()).abs()).max(((c - t.cos()) / t.cos()).abs());
+    fn table_quantiles_match_the_quadrature() {
+        let mut rng = ChaCha8Rng::seed_from_u64(2);
+        for (beta, points) in [(1.5, 120), (1.0, 30), (1.9, 30), (0.7, 30)] {
+            let table = LevyTable::new(beta);
+            let mut worst = 0.0f64;
+            for i in 0..points {
+                let upper = i % 2 == 1;
+                // r' log-uniform over the 31 octaves, then the tail probability r'/2.
+                let r = (2.0f64).powf(-31.0 * rng.gen::<f64>()).min(1.0 - 1e-12);
+                let t = table_quantile(&table, upper, r);
+                let (lo, up) = levy_cdf(t, beta);
+                let got = if upper { up } else { lo };
+                worst = worst.max((got / (0.5 * r) - 1.0).abs());
+            }
+            println!("beta {beta}: worst relative CDF error {worst:e}");
+            assert!(worst < 1e-6, "beta {beta}: worst {worst:e}");
         }
-        println!("worst relative error {worst:e}");
-        assert!(worst < 1e-13, "worst relative error {worst:e}");
     }
 
+    /// Quantiles 0.5, 0.9, 0.99, 0.999 of |T| (beta = 3/2) from the table against the CDF; the
+    /// median from both sides agrees.
     #[test]
-    fn quadrant_sine_matches_the_library() {
-        let mut rng = ChaCha8Rng::seed_from_u64(7);
-        let mut worst = 0.0f64;
-        for h in
-            (0..200_000).map(|_| open_unit52(rng.next_u64())).chain([HALF_ULP, 1.0 - HALF_ULP, 0.5])
-        {
-            let want = (h * std::f64::consts::FRAC_PI_2).sin();
-            worst = worst.max(((sin_quadrant(h) - want) / want).abs());
+    fn table_quantiles_at_named_probabilities() {
+        let table = LevyTable::shared(1.5);
+        let top = 1.0 - HALF_STEP_30;
+        let (m_lo, m_up) = (table_quantile(&table, false, top), table_quantile(&table, true, top));
+        assert!((m_lo / m_up - 1.0).abs() < 1e-6, "{m_lo} {m_up}");
+        for p in [0.9, 0.99, 0.999] {
+            let t = table_quantile(&table, true, 2.0 * (1.0 - p));
+            let (g, _) = levy_cdf(t, 1.5);
+            assert!(((1.0 - g) / (1.0 - p) - 1.0).abs() < 1e-6, "p {p}: G = {g}");
         }
-        println!("worst relative error {worst:e}");
-        assert!(worst < 1e-13, "worst relative error {worst:e}");
+        let (g, _) = levy_cdf(m_lo, 1.5);
+        assert!((g - 0.5).abs() < 1e-6, "{g}");
     }
 
+    /// The sign bit flips the factor exactly; the index and fraction are the octave, segment and
+    /// position of r' = (k + 1/2) 2^-30.
     #[test]
-    fn inverse_cube_root_matches_powf() {
-        let mut rng = ChaCha8Rng::seed_from_u64(6);
-        let mut worst = 0.0f64;
-        for _ in 0..200_000 {
-            let a = 10f64.powf(symmetric(&mut rng, 60.0)) * (1.0 + open_unit52(rng.next_u64()));
-            let want = a.powf(-1.0 / 3.0);
-            worst = worst.max(((inv_cbrt(a) - want) / want).abs());
+    fn fields_map_to_the_grid() {
+        let table = LevyTable::shared(1.5);
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        for _ in 0..10_000 {
+            let field = rng.next_u64() & 0xffff_ffff;
+            let (a, b) = (factor(&table, field, 0.7), factor(&table, field ^ (1 << 31), 0.7));
+            assert_eq!(a.to_bits(), (-b).to_bits());
+            let r = field_unit(field);
+            assert_eq!(r, ((field & K_MASK) as f64 + 0.5) / (1u64 << 30) as f64);
+            let e = r.log2().floor();
+            let pos = (r / e.exp2() - 1.0) * SEGS as f64;
+            let bits = r.to_bits();
+            let i = ((bits >> (52 - SEG_BITS)) - (FIRST_EXP << SEG_BITS)) as usize;
+            assert_eq!(i, (e as i64 + 31) as usize * SEGS + pos.floor() as usize);
+            let f = f64::from_bits(((bits << SEG_BITS) & MANT) | ONE) - 1.0;
+            assert_eq!(f, pos - pos.floor());
         }
-        println!("worst relative error {worst:e}");
-        assert!(worst < 5e-15, "worst relative error {worst:e}");
+        assert_eq!(field_unit(0), HALF_STEP_30);
+        assert_eq!(field_unit(K_MASK), 1.0 - HALF_STEP_30);
     }
 
     /// The dispatched copy gives the baseline copy's bits, for lengths around the chunk size, and
     /// leaves the generators in the same state.
     #[test]
     fn copies_are_bit_identical() {
+        let table = LevyTable::shared(1.5);
         for n in [1, 3, 127, 128, 129, 1740] {
             let mut a = DeLanes::from_rng(&mut ChaCha8Rng::seed_from_u64(n as u64));
             let mut b = a.clone();
             let (mut x, mut y) = (vec![0.0; n], vec![0.0; n]);
             for _ in 0..3 {
-                levy_fill(&mut x, 0.7, &mut a);
-                levy_fill_baseline(&mut y, 0.7, &mut b);
+                levy_fill(&mut x, 0.7, &table, &mut a);
+                levy_fill_baseline(&mut y, 0.7, &table, &mut b);
                 assert!(x.iter().zip(&y).all(|(p, q)| p.to_bits() == q.to_bits()), "n {n}");
             }
             assert_eq!(a, b);
+        }
+        #[cfg(target_arch = "x86_64")]
+        if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
+            let mut rng = ChaCha8Rng::seed_from_u64(8);
+            for _ in 0..200 {
+                let words: [u64; HALF] = std::array::from_fn(|_| rng.next_u64());
+                let (mut p, mut q) = ([0.0; CHUNK], [0.0; CHUNK]);
+                chunk_scalar(&mut p, &words, &table, 0.7);
+                // SAFETY: the CPU reports AVX2 and FMA.
+                unsafe { chunk_avx2(&mut q, &words, &table, 0.7) };
+                assert!(p.iter().zip(&q).all(|(a, b)| a.to_bits() == b.to_bits()));
+            }
         }
     }
 
@@ -452,6 +691,8 @@ mod tests {
     /// coordinates at, inside and beyond the box; and the generators end in the same state.
     #[test]
     fn fused_flight_is_fill_then_step() {
+        use crate::optim::sampling::symmetric;
+        let table = LevyTable::shared(1.5);
         let mut r = ChaCha8Rng::seed_from_u64(12);
         for n in [1, 5, 127, 128, 129, 300, 1740] {
             let x: Vec<f64> = (0..n).map(|_| symmetric(&mut r, 1.0)).collect();
@@ -462,16 +703,17 @@ mod tests {
             let src = FlightSources { x: &x, b: &b, lo: &lo, hi: &hi };
             let lanes = DeLanes::from_rng(&mut ChaCha8Rng::seed_from_u64(n as u64));
             let (mut want_lanes, mut l) = (lanes.clone(), vec![0.0; n]);
-            levy_fill_baseline(&mut l, 0.7, &mut want_lanes);
+            levy_fill_baseline(&mut l, 0.7, &table, &mut want_lanes);
             let want: Vec<f64> =
                 (0..n).map(|j| flight_coordinate(x[j], b[j], lo[j], hi[j], 0.3, l[j])).collect();
             assert!(want.iter().enumerate().any(|(j, w)| *w == hi[j]) || n < 100);
             assert!(want.iter().enumerate().any(|(j, w)| *w == lo[j]) || n < 100);
             assert!(want.iter().enumerate().any(|(j, w)| *w > lo[j] && *w < hi[j]) || n < 100);
             let mut scratch = LevyScratch::default();
+            let law = FlightLaw { table: &table, sigma_u: 0.7, alpha: 0.3 };
             for fused in [levy_flight, flight_generic] {
                 let (mut got, mut got_lanes) = (vec![0.0; n], lanes.clone());
-                fused(&mut got, src, 0.3, 0.7, &mut got_lanes, &mut scratch);
+                fused(&mut got, src, law, &mut got_lanes, &mut scratch);
                 assert!(got.iter().zip(&want).all(|(p, q)| p.to_bits() == q.to_bits()), "n {n}");
                 assert_eq!(got_lanes, want_lanes);
             }
@@ -479,61 +721,55 @@ mod tests {
         assert_eq!(flight_coordinate(1.0, 0.0, -2.0, 2.0, 0.0, f64::INFINITY), 1.0);
     }
 
-    /// The law of L = sigma u psi / |v|^(2/3) against a direct simulation from independent
-    /// normals (rand_distr's ziggurat and powf: another code path): the fractions beyond
-    /// several thresholds, the sign, and the moments of the two halves.
+    /// The sampled law of L = sigma u psi / |v|^(1/beta) against a direct simulation from
+    /// independent normals (rand_distr's ziggurat and powf): two-sample Kolmogorov-Smirnov
+    /// statistic of |L| below its 0.1% critical value, the fractions beyond several thresholds
+    /// (deep into the tail), and the sign.
     #[test]
     fn levy_factors_have_mantegnas_law() {
-        use rand::Rng;
-        use rand_distr::StandardNormal;
-        let sigma = mantegna_sigma_u(1.5);
-        let n = 400_000;
-        let mut got = vec![0.0; n];
-        levy_fill(&mut got, sigma, &mut DeLanes::from_rng(&mut ChaCha8Rng::seed_from_u64(9)));
-        let mut r = ChaCha8Rng::seed_from_u64(10);
-        let want: Vec<f64> = (0..n)
-            .map(|_| {
-                let (u, v, p): (f64, f64, f64) =
-                    (r.sample(StandardNormal), r.sample(StandardNormal), r.sample(StandardNormal));
-                sigma * u * p * v.abs().powf(-2.0 / 3.0)
-            })
-            .collect();
-        let frac =
-            |s: &[f64], t: f64| s.iter().filter(|x| x.abs() > t).count() as f64 / s.len() as f64;
-        for t in [0.05, 0.3, 1.0, 3.0, 10.0, 100.0] {
-            let (a, b) = (frac(&got, t), frac(&want, t));
-            let sd = (b * (1.0 - b) / n as f64).sqrt() * 2f64.sqrt();
-            assert!((a - b).abs() < 5.0 * sd, "t {t}: {a} vs {b}");
-        }
-        let pos = got.iter().filter(|x| **x > 0.0).count() as f64 / n as f64;
-        assert!((pos - 0.5).abs() < 0.004, "{pos}");
-        // Each half of the product alone: E|u psi| = sigma 2/pi, E (v^2)^(-1/3) has no finite
-        // variance, so compare the median of |v|^(-2/3): (median |v| = 0.6745)^(-2/3) = 1.3006.
-        let mut words = [0u64; WORDS];
-        let mut lanes = DeLanes::from_rng(&mut ChaCha8Rng::seed_from_u64(11));
-        let (mut abs_prod, mut inv) = (0.0, Vec::new());
-        let rounds = 2000;
-        for _ in 0..rounds {
-            for w in words.chunks_mut(DE_LANES) {
-                w.copy_from_slice(&lanes.next_words());
+        for beta in [1.5, 1.1] {
+            let sigma = mantegna_sigma_u(beta);
+            let table = LevyTable::shared(beta);
+            let n = 400_000;
+            let mut got = vec![0.0; n];
+            let mut lanes = DeLanes::from_rng(&mut ChaCha8Rng::seed_from_u64(9));
+            levy_fill(&mut got, sigma, &table, &mut lanes);
+            let mut r = ChaCha8Rng::seed_from_u64(10);
+            let mut want: Vec<f64> = (0..n)
+                .map(|_| {
+                    let (u, v, p): (f64, f64, f64) = (
+                        r.sample(StandardNormal),
+                        r.sample(StandardNormal),
+                        r.sample(StandardNormal),
+                    );
+                    sigma * u * p * v.abs().powf(-1.0 / beta)
+                })
+                .collect();
+            let frac = |s: &[f64], t: f64| {
+                s.iter().filter(|x| x.abs() > t).count() as f64 / s.len() as f64
+            };
+            for t in [0.01, 0.3, 1.0, 3.0, 10.0, 100.0, 1000.0] {
+                let (a, b) = (frac(&got, t), frac(&want, t));
+                let sd = (b * (1.0 - b) / n as f64).sqrt() * 2f64.sqrt();
+                assert!((a - b).abs() < 5.0 * sd + 1e-5, "beta {beta} t {t}: {a} vs {b}");
             }
-            for k in 0..HALF {
-                for shift in [0, 32] {
-                    abs_prod += product(words[k], words[HALF + k], shift, 1.0).abs();
+            let pos = got.iter().filter(|x| **x > 0.0).count() as f64 / n as f64;
+            assert!((pos - 0.5).abs() < 0.004, "{pos}");
+            let mut a: Vec<f64> = got.iter().map(|x| x.abs()).collect();
+            a.sort_by(f64::total_cmp);
+            want.iter_mut().for_each(|x| *x = x.abs());
+            want.sort_by(f64::total_cmp);
+            let (mut i, mut j, mut d) = (0, 0, 0.0f64);
+            while i < n && j < n {
+                if a[i] <= want[j] {
+                    i += 1;
+                } else {
+                    j += 1;
                 }
+                d = d.max((i as f64 - j as f64).abs() / n as f64);
             }
-            for k in 0..HALF {
-                let w = words[2 * HALF + k];
-                let r2 = 2.0 * neg_ln(open_unit32(w, 0));
-                let (s, c) = sin_cos_octant(open_unit31(w, 32));
-                inv.push(inv_cbrt(r2 * s * s));
-                inv.push(inv_cbrt(r2 * c * c));
-            }
+            let crit = 1.95 * (2.0 / n as f64).sqrt();
+            assert!(d < crit, "beta {beta}: KS {d} >= {crit}");
         }
-        let m = abs_prod / (rounds * CHUNK) as f64;
-        assert!((m - 2.0 / std::f64::consts::PI).abs() < 0.004, "{m}");
-        inv.sort_by(f64::total_cmp);
-        let med = inv[inv.len() / 2];
-        assert!((med - 0.674_489_75f64.powf(-2.0 / 3.0)).abs() < 0.005, "{med}");
     }
 }
