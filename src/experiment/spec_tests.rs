@@ -1,0 +1,105 @@
+//! Unit tests of the spec parser (profiles, overrides, one section per spec), with real families.
+
+use super::*;
+
+const SPEC: &str = r#"
+name = "t"
+master_seed = 1
+[som]
+datasets = ["cube"]
+iterations = 100
+[[som.group]]
+models = ["som2d", "dnsom"]
+grids = ["10x10", "18x30"]
+[profiles.quick.som]
+iterations = 7
+"#;
+
+#[test]
+fn parses_expands_and_applies_profile() {
+    let s = Spec::parse("t.toml", SPEC, None).unwrap();
+    assert_eq!(crate::families::som::spec::cells(&s).len(), 4);
+    assert_eq!(s.section::<crate::families::som::spec::SomSpec>().unwrap().iterations, 100);
+    let q = Spec::parse("t.toml", SPEC, Some("quick")).unwrap();
+    assert_eq!(q.section::<crate::families::som::spec::SomSpec>().unwrap().iterations, 7);
+    assert_eq!(crate::families::som::spec::cells(&q)[3].key(), "som/cube/dnsom/18x30/r0");
+}
+
+/// A reading set's keys go through the same parsing and validation as the file's own values;
+/// a key of a section the spec does not have is skipped.
+#[test]
+fn overrides_apply_after_the_profile_and_are_validated() {
+    let text = "name = \"f\"\nmaster_seed = 1\n[fit]\ndatasets = [\"cube\"]\ngrid = \"20x20\"\ncontrol_nets = [\"6x6\"]\nparameterisations = [\"uniform\"]\napproaches = [\"A\"]\n[profiles.quick.fit]\nfairness = 0.5\n";
+    let ov = |k: &str, v: toml::Value| Override { key: k.into(), value: v };
+    let plain = Spec::parse("f.toml", text, Some("quick")).unwrap();
+    let fit = plain.section::<crate::families::fit::spec::FitSpec>().unwrap();
+    assert_eq!(
+        (fit.knots, fit.error_a, fit.fairness),
+        (crate::spline::KnotRule::Eq2_10, crate::spline::ErrorA::PerSurface, 0.5)
+    );
+    let set = [
+        ov("fit.knots", "nurbs_book".into()),
+        ov("fit.error_a", "nov_bottom".into()),
+        ov("optim.knots", "nurbs_book".into()),
+    ];
+    let s = Spec::parse_with("f.toml", text, Some("quick"), &set).unwrap();
+    let fit = s.section::<crate::families::fit::spec::FitSpec>().unwrap();
+    assert_eq!(
+        (fit.knots, fit.error_a, fit.fairness),
+        (crate::spline::KnotRule::NurbsBook, crate::spline::ErrorA::NovBottom, 0.5)
+    );
+    assert!(
+        s.section::<crate::families::optimise::spec::OptimSpec>().is_none(),
+        "a key of an absent section is skipped"
+    );
+    let e = Spec::parse_with("f.toml", text, None, &[ov("fit.knots", "9.69".into())])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("fit.knots") && e.contains("9.69"), "{e}");
+    let e = Spec::parse_with("f.toml", text, None, &[ov("fit.fairness", toml::Value::Float(-1.0))])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("fit.fairness"), "{e}");
+    let e = Spec::parse_with("f.toml", text, None, &[ov("fit.colour", "red".into())])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("colour"), "{e}");
+}
+
+#[test]
+fn exactly_one_experiment_section() {
+    let none = "name = \"t\"\nmaster_seed = 1\n";
+    let e = Spec::parse("t.toml", none, None).unwrap_err().0;
+    assert!(
+        e.contains("no experiment section") && e.contains("[som]") && e.contains("[seed002]"),
+        "{e}"
+    );
+    let two = format!("{SPEC}\n[seed002]\nsurfaces = [\"surface1\"]\n");
+    let e = Spec::parse("t.toml", &two, None).unwrap_err().0;
+    assert!(e.contains("[som] and [seed002]"), "{e}");
+}
+
+#[test]
+fn unknown_key_names_line_and_key() {
+    let bad = SPEC.replace("iterations = 100", "iteratons = 100");
+    let e = Spec::parse("t.toml", &bad, None).unwrap_err().0;
+    assert!(e.starts_with("t.toml:6:1:") && e.contains("iteratons"), "{e}");
+    assert!(!e.contains('\n'));
+}
+
+#[test]
+fn bad_values_name_their_key() {
+    for (from, to, key) in [
+        ("\"som2d\", \"dnsom\"", "\"som2d\", \"kohonen\"", "som.group[0].models"),
+        ("iterations = 100", "iterations = 0", "som.iterations"),
+        ("\"10x10\", \"18x30\"", "\"2x2\"", "som.group[0].grids"),
+        ("datasets = [\"cube\"]", "datasets = []", "som.datasets"),
+    ] {
+        let e = Spec::parse("t.toml", &SPEC.replace(from, to), None).unwrap_err().0;
+        assert!(e.contains(key), "{e}");
+    }
+    let e = Spec::parse("t.toml", "name = \"x\"\nmaster_seed = -1\n", None).unwrap_err().0;
+    assert!(e.starts_with("t.toml:2:"), "{e}");
+    let e = Spec::parse("t.toml", SPEC, Some("full")).unwrap_err().0;
+    assert!(e.contains("no profile `full`") && e.contains("quick"), "{e}");
+}
