@@ -229,7 +229,7 @@ pub fn reproduce(
     )?;
     if !plan.readings.is_empty() {
         let matrix = readings_matrix(&ctx.out, &plan)?;
-        report.push_str(&render_readings(&plan, &matrix, &ctx.out)?);
+        report.push_str(&render_readings(&ctx.out, &plan, &matrix)?);
         for part in &combined {
             report.extend(part.readings.iter().map(String::as_str));
         }
@@ -321,7 +321,7 @@ fn readings_matrix(out: &Path, plan: &Plan) -> Result<Vec<ReadingClaim>> {
 
 /// `readings.csv` and the REPORT.md section: one row per (spec, claim), one column per reading,
 /// and whether the verdict changes with the reading.
-fn render_readings(plan: &Plan, rows: &[ReadingClaim], out: &Path) -> Result<String> {
+fn render_readings(out: &Path, plan: &Plan, rows: &[ReadingClaim]) -> Result<String> {
     let header: Vec<String> =
         ["spec", "chapter", "claim", "reading", "verdict", "holds", "checked", "note"]
             .iter()

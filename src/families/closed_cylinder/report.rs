@@ -192,11 +192,14 @@ fn explanations(s4: &Seed004Spec) -> String {
 fn render_pictures(
     s4: &Seed004Spec,
     runs: &[Run],
-    (cps, p2, t3): (&[usize], &RefTable, &[Vec<String>]),
+    cps: &[usize],
+    p2: &RefTable,
+    t3: &[Vec<String>],
     ga_by_cp: &[(usize, f64)],
     paper_by_cp: &[(usize, f64)],
     sweep: &[(usize, f64)],
-    (top, out): (Option<&TopView>, &Path),
+    top: Option<&TopView>,
+    out: &Path,
     s: &mut String,
 ) -> Result<()> {
     crate::io::ensure_dir(&out.join("png"))?;
@@ -261,11 +264,14 @@ pub fn write(
     render_pictures(
         s4,
         runs,
-        (&cps, &p2, &t3),
+        &cps,
+        &p2,
+        &t3,
         &ga_by_cp,
         &paper_by_cp,
         sweep,
-        (top, out),
+        top,
+        out,
         &mut s,
     )?;
     Ok(s)

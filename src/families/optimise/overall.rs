@@ -39,24 +39,28 @@ pub fn combine(view: &PlanView) -> Result<Combined> {
         }
     }
     let mut sections = Vec::new();
-    for (name, title, thesis, win_of) in [
+    // Each overall table sums one win table per grid: the error wins or the time wins.
+    type Names = (&'static str, &'static str, &'static str, &'static str);
+    let error_wins: fn(Names) -> &'static str = |t| t.2;
+    let time_wins: fn(Names) -> &'static str = |t| t.3;
+    for (name, title, thesis, wins) in [
         (
             "table_6_8",
             "Table 6.8: least average optimised surface error, overall",
             "thesis: GA 0/280, DE 243/280, PSO 37/280",
-            2,
+            error_wins,
         ),
         (
             "table_6_9",
             "Table 6.9: least average CPU time, overall",
             "thesis: GA 280/280, DE 0/280, PSO 0/280",
-            3,
+            time_wins,
         ),
     ] {
         let sources: Vec<(&str, &str)> = protocol
             .iter()
             .filter_map(|(spec, g)| {
-                super::report::table_names(g.0, g.1).map(|t| (*spec, [t.0, t.1, t.2, t.3][win_of]))
+                super::report::table_names(g.0, g.1).map(|t| (*spec, wins(t)))
             })
             .collect();
         if let Some((file, h, r)) = overall(view.out, &sources, name)? {
