@@ -5,7 +5,7 @@
 //! SVD paths of the parent module, so rank deficiency behaves exactly as there (minimum norm).
 //!
 //! Determinism: every loop is plain IEEE multiplies and adds in a fixed order (no `mul_add`, no
-//! reassociation); the dot products over the points keep 16 fixed partial sums (lane k mod 16)
+//! reassociation); the dot products over the points keep 8 fixed partial sums (lane k mod 8)
 //! combined in a fixed tree. The AVX2 copy is the same Rust compiled with `target_feature(avx2)`
 //! (wider vectors only; rustc never fuses a multiply and an add on its own), so the copies give
 //! the same bits; `SOMNURBS_SIMD=scalar` forces the baseline copy.
@@ -18,7 +18,7 @@ use std::cell::RefCell;
 const MAXD: usize = 15;
 /// Length of the stack Bernstein buffers (degree 2 * MAXD).
 const MAXB: usize = 2 * MAXD + 1;
-/// Lanes of the fixed-order dot products.
+/// Padding of the per-point rows (a multiple of the dot products' 8 lanes).
 const LANES: usize = 16;
 /// Relative Cholesky pivot below which the normal equations are refused (SVD fallback): the
 /// squared pivot L_ii^2 must exceed `PIVOT_REL` times the largest diagonal entry of G, which
@@ -80,50 +80,78 @@ fn binom(n: usize, k: usize) -> f64 {
     (0..k).fold(1.0, |acc, j| acc * (n - j) as f64 / (j + 1) as f64)
 }
 
+/// w^n_ac = C(n,a) C(n,c) / C(2n,a+c) for a, c in 0..=n, row-major (n+1) x (n+1).
+fn product_weights(n: usize, w: &mut [f64; (MAXD + 1) * (MAXD + 1)]) {
+    let mut b = [0.0f64; MAXB];
+    let mut b2 = [0.0f64; MAXB];
+    for i in 0..=n {
+        b[i] = binom(n, i);
+    }
+    for i in 0..=2 * n {
+        b2[i] = binom(2 * n, i);
+    }
+    for a in 0..=n {
+        for c in 0..=n {
+            w[a * (n + 1) + c] = b[a] * b[c] / b2[a + c];
+        }
+    }
+}
+
 /// Bernstein polynomials B^n_i(t_k) = C(n,i) t^i (1-t)^(n-i) for every t_k, stored i-major
 /// (row i holds all k, `stride` apart); rows padded with zeros past `t.len()`.
 #[inline(always)]
 fn basis_rows(n: usize, t: &[f64], stride: usize, out: &mut [f64]) {
     let np = t.len();
-    out[..(n + 1) * stride].fill(0.0);
-    // out row i = t^i, then multiplied by s^(n-i) walking down, then by C(n, i)
-    out[..np].fill(1.0);
-    for i in 1..=n {
-        let (prev, cur) = out.split_at_mut(i * stride);
-        let prev = &prev[(i - 1) * stride..(i - 1) * stride + np];
-        for ((c, p), tk) in cur[..np].iter_mut().zip(prev).zip(t) {
-            *c = p * tk;
-        }
+    let mut binoms = [0.0f64; MAXB];
+    for (i, b) in binoms[..=n].iter_mut().enumerate() {
+        *b = binom(n, i);
     }
-    let mut spow = [0.0f64; LANES];
-    for (chunk_k, tc) in t.chunks(LANES).enumerate() {
-        let k0 = chunk_k * LANES;
-        spow[..tc.len()].fill(1.0);
+    // lane by lane over chunks of 8 points (t padded with zeros): t^i up, then (1-t)^(n-i) down
+    let mut tpad = [0.0f64; 8];
+    for k0 in (0..stride).step_by(8) {
+        let m = np.saturating_sub(k0).min(8);
+        tpad.fill(0.0);
+        if m > 0 {
+            tpad[..m].copy_from_slice(&t[k0..k0 + m]);
+        }
+        let mut tp = [1.0f64; 8];
+        for i in 0..=n {
+            out[i * stride + k0..i * stride + k0 + 8].copy_from_slice(&tp);
+            for l in 0..8 {
+                tp[l] *= tpad[l];
+            }
+        }
+        let mut sp = [1.0f64; 8];
         for i in (0..=n).rev() {
-            let w = binom(n, i);
-            let row = &mut out[i * stride + k0..i * stride + k0 + tc.len()];
-            for ((o, s), tk) in row.iter_mut().zip(spow.iter_mut()).zip(tc) {
-                *o = w * (*o * *s);
-                *s *= 1.0 - tk;
+            let w = binoms[i];
+            let row = &mut out[i * stride + k0..i * stride + k0 + 8];
+            for l in 0..8 {
+                row[l] = w * (row[l] * sp[l]);
+                sp[l] *= 1.0 - tpad[l];
             }
         }
     }
+    for i in 0..=n {
+        out[i * stride + np..(i + 1) * stride].fill(0.0);
+    }
 }
 
-/// sum_k a_k b_k over a multiple of [`LANES`] entries, in 16 fixed partial sums.
+/// The R dot products sum_k a_k b_rk over a multiple of 8 entries, each in 8 fixed partial sums
+/// (lane k mod 8) combined in a fixed tree; R rows at once share the loads of `a` (the value of
+/// each product does not depend on R).
 #[inline(always)]
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let mut acc = [0.0f64; LANES];
-    for (x, y) in a.chunks_exact(LANES).zip(b.chunks_exact(LANES)) {
-        for l in 0..LANES {
-            acc[l] += x[l] * y[l];
+fn dots<const R: usize>(a: &[f64], b: [&[f64]; R]) -> [f64; R] {
+    let b = b.map(|r| &r[..a.len()]);
+    let mut acc = [[0.0f64; 8]; R];
+    for (ch, x) in a.chunks_exact(8).enumerate() {
+        for r in 0..R {
+            let y = &b[r][ch * 8..ch * 8 + 8];
+            for l in 0..8 {
+                acc[r][l] += x[l] * y[l];
+            }
         }
     }
-    let mut h = [0.0f64; LANES / 2];
-    for l in 0..LANES / 2 {
-        h[l] = acc[l] + acc[l + LANES / 2];
-    }
-    ((h[0] + h[4]) + (h[2] + h[6])) + ((h[1] + h[5]) + (h[3] + h[7]))
+    acc.map(|h| ((h[0] + h[4]) + (h[2] + h[6])) + ((h[1] + h[5]) + (h[3] + h[7])))
 }
 
 /// Y of the least-squares degree-(du, dv) Bezier surface through scattered `pts` at the
@@ -184,17 +212,20 @@ fn scattered_sse_body(
     grow(&mut s.l, n * n);
     grow(&mut s.c, 3 * n);
     let m2 = 2 * dv + 1;
+    let (mut wus, mut wvs) = ([0.0; (MAXD + 1) * (MAXD + 1)], [0.0; (MAXD + 1) * (MAXD + 1)]);
+    product_weights(du, &mut wus);
+    product_weights(dv, &mut wvs);
     for a in 0..ku {
         for b in 0..kv {
             for c in 0..ku {
-                let wu = binom(du, a) * binom(du, c) / binom(2 * du, a + c);
+                let wu = wus[a * ku + c];
                 for d in 0..kv {
-                    let wv = binom(dv, b) * binom(dv, d) / binom(2 * dv, b + d);
+                    let wv = wvs[b * kv + d];
                     s.g[(a * kv + b) * n + c * kv + d] = (wu * wv) * s.m[(a + c) * m2 + b + d];
                 }
             }
             for co in 0..3 {
-                s.c[(a * kv + b) * 3 + co] = s.gq[(a * 3 + co) * kv + b];
+                s.c[co * n + a * kv + b] = s.gq[(a * 3 + co) * kv + b];
             }
         }
     }
@@ -205,17 +236,12 @@ fn scattered_sse_body(
     }
     chol_solve(&s.l[..n * n], n, &mut s.c[..3 * n]);
     // Y = |P|^2 - 2 g.c + c^T G c
-    let mut gc = 0.0;
+    let (c, g) = (&s.c[..3 * n], &s.g[..n * n]);
+    let gc = dots_any(&s.r[..3 * n], [c])[0];
     let mut cgc = 0.0;
     for i in 0..n {
-        for co in 0..3 {
-            gc += s.r[i * 3 + co] * s.c[i * 3 + co];
-            let mut row = 0.0;
-            for j in 0..n {
-                row += s.g[i * n + j] * s.c[j * 3 + co];
-            }
-            cgc += s.c[i * 3 + co] * row;
-        }
+        let h = dots_any(&g[i * n..(i + 1) * n], [&c[..n], &c[n..2 * n], &c[2 * n..]]);
+        cgc += (c[i] * h[0] + c[n + i] * h[1]) + c[2 * n + i] * h[2];
     }
     let y = p2 - 2.0 * gc + cgc;
     if y > CANCEL_REL * p2 {
@@ -250,10 +276,20 @@ fn moments(du: usize, dv: usize, x: &[f64], pts: &[Point3], stride: usize, s: &m
     basis_rows(dv, &s.q[stride..stride + np], stride, &mut s.bv);
     basis_rows(2 * dv, &s.q[stride..stride + np], stride, &mut s.bv2);
     grow(&mut s.m, ku2 * kv2);
+    fn row(m: &[f64], i: usize, stride: usize) -> &[f64] {
+        &m[i * stride..(i + 1) * stride]
+    }
     for a in 0..ku2 {
-        let ra = &s.bu2[a * stride..(a + 1) * stride];
-        for b in 0..kv2 {
-            s.m[a * kv2 + b] = dot(ra, &s.bv2[b * stride..(b + 1) * stride]);
+        let ra = row(&s.bu2, a, stride);
+        let mut b = 0;
+        while b + 4 <= kv2 {
+            let bv2 = &s.bv2;
+            let d = dots(ra, [row(bv2, b, stride), row(bv2, b + 1, stride), row(bv2, b + 2, stride), row(bv2, b + 3, stride)]);
+            s.m[a * kv2 + b..a * kv2 + b + 4].copy_from_slice(&d);
+            b += 4;
+        }
+        for b in b..kv2 {
+            s.m[a * kv2 + b] = dots(ra, [row(&s.bv2, b, stride)])[0];
         }
     }
     // gq[(a, c) * kv + b] = sum_k (bu_a(u_k) P_kc) bv_b(v_k); the product rows go to q[2..5]
@@ -267,10 +303,10 @@ fn moments(du: usize, dv: usize, x: &[f64], pts: &[Point3], stride: usize, s: &m
                 *o = ba * p[co];
             }
         }
-        for co in 0..3 {
-            let row = &prod[co * stride..(co + 1) * stride];
-            for b in 0..kv {
-                s.gq[(a * 3 + co) * kv + b] = dot(row, &s.bv[b * stride..(b + 1) * stride]);
+        for b in 0..kv {
+            let d = dots(row(&s.bv, b, stride), [row(prod, 0, stride), row(prod, 1, stride), row(prod, 2, stride)]);
+            for co in 0..3 {
+                s.gq[(a * 3 + co) * kv + b] = d[co];
             }
         }
     }
@@ -294,7 +330,7 @@ fn refined_residual(du: usize, dv: usize, x: &[f64], pts: &[Point3], s: &mut Scr
                 for b in 0..kv {
                     let w = bu[a] * bv[b];
                     for co in 0..3 {
-                        e[co] -= w * c[(a * kv + b) * 3 + co];
+                        e[co] -= w * c[co * n + a * kv + b];
                     }
                 }
             }
@@ -302,7 +338,7 @@ fn refined_residual(du: usize, dv: usize, x: &[f64], pts: &[Point3], s: &mut Scr
                 for b in 0..kv {
                     let w = bu[a] * bv[b];
                     for co in 0..3 {
-                        acc[(a * kv + b) * 3 + co] += w * e[co];
+                        acc[co * n + a * kv + b] += w * e[co];
                     }
                 }
             }
@@ -322,120 +358,149 @@ fn refined_residual(du: usize, dv: usize, x: &[f64], pts: &[Point3], s: &mut Scr
     y
 }
 
-/// Cholesky G = L L^T of the n x n row-major `g` into `l` (lower triangle); false if a squared
-/// pivot L_ii^2 is at most [`PIVOT_REL`] times max_i G_ii (or not finite).
-fn cholesky(g: &[f64], l: &mut [f64], n: usize) -> bool {
+/// Cholesky G = U^T U of the n x n row-major `g` into `u` (upper triangle, row j of U = column j
+/// of L), right-looking so that each step updates whole rows; false if a squared pivot U_jj^2 is
+/// at most [`PIVOT_REL`] times max_i G_ii (or not finite).
+fn cholesky(g: &[f64], u: &mut [f64], n: usize) -> bool {
     let dmax = (0..n).fold(0.0f64, |m, i| m.max(g[i * n + i]));
     if !(dmax > 0.0 && dmax.is_finite()) {
         return false;
     }
+    u[..n * n].copy_from_slice(&g[..n * n]);
     for j in 0..n {
-        let mut d = g[j * n + j];
-        for k in 0..j {
-            d -= l[j * n + k] * l[j * n + k];
-        }
+        let d = u[j * n + j];
         if !(d > PIVOT_REL * dmax) {
             return false;
         }
-        let ljj = d.sqrt();
-        l[j * n + j] = ljj;
-        for i in j + 1..n {
-            let mut v = g[i * n + j];
-            for k in 0..j {
-                v -= l[i * n + k] * l[j * n + k];
+        let r = d.sqrt();
+        let (top, rest) = u.split_at_mut((j + 1) * n);
+        let rowj = &mut top[j * n + j..];
+        for x in rowj.iter_mut() {
+            *x /= r;
+        }
+        for (i, rowi) in (j + 1..n).zip(rest.chunks_exact_mut(n)) {
+            let f = rowj[i - j];
+            for (x, y) in rowi[i..].iter_mut().zip(&rowj[i - j..]) {
+                *x -= f * y;
             }
-            l[i * n + j] = v / ljj;
         }
     }
     true
 }
 
-/// Solve L L^T c = b in place for the three right-hand sides of `c` (row i = (x, y, z)).
-fn chol_solve(l: &[f64], n: usize, c: &mut [f64]) {
-    for i in 0..n {
-        for co in 0..3 {
-            let mut v = c[i * 3 + co];
-            for k in 0..i {
-                v -= l[i * n + k] * c[k * 3 + co];
+/// Solve U^T U c = b in place for the three right-hand sides of `c` (three rows of n).
+fn chol_solve(u: &[f64], n: usize, c: &mut [f64]) {
+    for col in c.chunks_exact_mut(n).take(3) {
+        for j in 0..n {
+            let y = col[j] / u[j * n + j];
+            col[j] = y;
+            for (x, uj) in col[j + 1..].iter_mut().zip(&u[j * n + j + 1..(j + 1) * n]) {
+                *x -= uj * y;
             }
-            c[i * 3 + co] = v / l[i * n + i];
+        }
+        for j in (0..n).rev() {
+            let s = dots_any(&u[j * n + j + 1..(j + 1) * n], [&col[j + 1..]])[0];
+            col[j] = (col[j] - s) / u[j * n + j];
         }
     }
-    for i in (0..n).rev() {
-        for co in 0..3 {
-            let mut v = c[i * 3 + co];
-            for k in i + 1..n {
-                v -= l[k * n + i] * c[k * 3 + co];
+}
+
+/// The R dot products sum_k a_k b_rk of any length: 4 fixed partial sums (lane k mod 4) over the
+/// whole chunks, combined as (s0 + s2) + (s1 + s3), then the remainder in order.
+#[inline(always)]
+fn dots_any<const R: usize>(a: &[f64], b: [&[f64]; R]) -> [f64; R] {
+    let b = b.map(|r| &r[..a.len()]);
+    let mut acc = [[0.0f64; 4]; R];
+    let whole = a.len() / 4 * 4;
+    for (ch, x) in a[..whole].chunks_exact(4).enumerate() {
+        for r in 0..R {
+            let y = &b[r][ch * 4..ch * 4 + 4];
+            for l in 0..4 {
+                acc[r][l] += x[l] * y[l];
             }
-            c[i * 3 + co] = v / l[i * n + i];
         }
     }
+    let mut out = [0.0; R];
+    for r in 0..R {
+        let mut t = (acc[r][0] + acc[r][2]) + (acc[r][1] + acc[r][3]);
+        for (x, y) in a[whole..].iter().zip(&b[r][whole..]) {
+            t += x * y;
+        }
+        out[r] = t;
+    }
+    out
 }
 
 /// Thin Q (n x k, row-major) of the Householder QR of the n x (deg+1) Bernstein collocation
 /// matrix at the sorted parameters `t` (A = Q R); `None` unless n > deg and every |R_ii| exceeds
 /// 1e-8 max |R_jj| (the test of the parent module's `column_basis`, whose SVD then takes over).
-/// `work` holds the reflectors.
+/// Row-major throughout so that each reflector updates whole rows (vectorisable); `work` holds
+/// A (reduced in place) and then the reflectors.
+#[inline(always)]
 fn thin_q(deg: usize, t: &[f64], q: &mut Vec<f64>, work: &mut Vec<f64>) -> Option<()> {
     let (n, k) = (t.len(), deg + 1);
     if n <= deg || deg > MAXD {
         return None;
     }
-    // work: column-major A (k columns of n), then the reflectors overwrite it column by column
-    grow(work, n * k);
-    let mut b = [0.0; MAXB];
+    grow(work, n * k + n * k);
+    let (a, refl) = work.split_at_mut(n * k);
     for (i, &ti) in t.iter().enumerate() {
-        super::bernstein_into(deg, ti, &mut b[..k]);
-        for j in 0..k {
-            work[j * n + i] = b[j];
-        }
+        super::bernstein_into(deg, ti, &mut a[i * k..(i + 1) * k]);
     }
     let mut diag = [0.0f64; MAXB];
     let mut beta = [0.0f64; MAXB];
+    let mut f = [0.0f64; MAXB];
     for j in 0..k {
-        let (head, tail) = work.split_at_mut((j + 1) * n);
-        let v = &mut head[j * n + j..];
-        let norm = v.iter().fold(0.0, |acc, x| acc + x * x).sqrt();
-        let alpha = if v[0] > 0.0 { -norm } else { norm };
-        diag[j] = alpha;
-        v[0] -= alpha;
-        let vv = v.iter().fold(0.0, |acc, x| acc + x * x);
-        beta[j] = if vv > 0.0 { 2.0 / vv } else { 0.0 };
-        for col in tail.chunks_exact_mut(n).take(k - j - 1) {
-            let col = &mut col[j..];
-            let f = beta[j] * v.iter().zip(col.iter()).fold(0.0, |acc, (a, b)| acc + a * b);
-            for (c, a) in col.iter_mut().zip(v.iter()) {
-                *c -= f * a;
-            }
+        let v = &mut refl[j * n..(j + 1) * n];
+        for i in j..n {
+            v[i] = a[i * k + j];
         }
+        let norm = dots_any(&v[j..], [&v[j..]])[0].sqrt();
+        let alpha = if v[j] > 0.0 { -norm } else { norm };
+        diag[j] = alpha;
+        v[j] -= alpha;
+        let vv = dots_any(&v[j..], [&v[j..]])[0];
+        beta[j] = if vv > 0.0 { 2.0 / vv } else { 0.0 };
+        reflect(&v[j..n], beta[j], &mut a[j * k..], k, j + 1, &mut f);
     }
     let rmax = diag[..k].iter().fold(0.0f64, |m, d| m.max(d.abs()));
     if !diag[..k].iter().all(|d| d.abs() > 1e-8 * rmax) {
         return None;
     }
-    // Q = H_0 ... H_(k-1) [I; 0], applied column by column (row-major result)
+    // Q = H_0 ... H_(k-1) [I; 0]; H_j only touches rows j.. and columns j.. of the partial product
     grow(q, n * k);
-    let mut e = [0.0f64; 128];
-    if n > e.len() {
-        return None;
+    q[..n * k].fill(0.0);
+    for c in 0..k {
+        q[c * k + c] = 1.0;
     }
-    for col in 0..k {
-        let e = &mut e[..n];
-        e.fill(0.0);
-        e[col] = 1.0;
-        for j in (0..=col).rev() {
-            let v = &work[j * n + j..(j + 1) * n];
-            let seg = &mut e[j..];
-            let f = beta[j] * v.iter().zip(seg.iter()).fold(0.0, |acc, (a, b)| acc + a * b);
-            for (c, a) in seg.iter_mut().zip(v) {
-                *c -= f * a;
-            }
-        }
-        for i in 0..n {
-            q[i * k + col] = e[i];
-        }
+    for j in (0..k).rev() {
+        reflect(&refl[j * n + j..(j + 1) * n], beta[j], &mut q[j * k..n * k], k, j, &mut f);
     }
     Some(())
+}
+
+/// Apply H = I - beta v v^T to the rows of the row-major block `m` (row stride k), columns
+/// c0..k: f_c = sum_i v_i m_ic, then m_ic -= (beta f_c) v_i (whole-row updates).
+#[inline(always)]
+fn reflect(v: &[f64], beta: f64, m: &mut [f64], k: usize, c0: usize, f: &mut [f64; MAXB]) {
+    if c0 >= k {
+        return;
+    }
+    let f = &mut f[c0..k];
+    f.fill(0.0);
+    for (vi, row) in v.iter().zip(m.chunks_exact(k)) {
+        for (fc, x) in f.iter_mut().zip(&row[c0..]) {
+            *fc += vi * x;
+        }
+    }
+    for fc in f.iter_mut() {
+        *fc *= beta;
+    }
+    for (vi, row) in v.iter().zip(m.chunks_exact_mut(k)) {
+        for (x, fc) in row[c0..].iter_mut().zip(f.iter()) {
+            *x -= fc * vi;
+        }
+    }
 }
 
 /// Y of the grid fit by the separable projection Y = |D|^2 - sum_c |Qu^T D_c Qv|^2 (see
@@ -504,11 +569,12 @@ fn grid_sse_body(
     grow(&mut s.c, 3 * ku * kv);
     s.c[..3 * ku * kv].fill(0.0);
     for co in 0..3 {
-        for a in 0..ku {
-            let trow = &s.t[a * w + co * nv..a * w + (co + 1) * nv];
-            let crow = &mut s.c[(co * ku + a) * kv..(co * ku + a + 1) * kv];
-            for (j, &f) in trow.iter().enumerate() {
-                for (c, q) in crow.iter_mut().zip(&s.qb[j * kv..(j + 1) * kv]) {
+        for j in 0..nv {
+            let qrow = &s.qb[j * kv..(j + 1) * kv];
+            for a in 0..ku {
+                let f = s.t[a * w + co * nv + j];
+                let crow = &mut s.c[(co * ku + a) * kv..(co * ku + a + 1) * kv];
+                for (c, q) in crow.iter_mut().zip(qrow) {
                     *c += f * q;
                 }
             }
@@ -612,7 +678,7 @@ mod tests {
         assert!(y < 1e-24, "Y = {y}");
         for (k, p) in surf.poles.iter().enumerate() {
             for co in 0..3 {
-                assert!((s.c[k * 3 + co] - p[co]).abs() < 1e-9, "pole {k}");
+                assert!((s.c[co * 36 + k] - p[co]).abs() < 1e-9, "pole {k}");
             }
         }
         for p in pts.iter_mut() {
