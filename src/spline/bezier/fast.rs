@@ -284,7 +284,15 @@ fn moments(du: usize, dv: usize, x: &[f64], pts: &[Point3], stride: usize, s: &m
         let mut b = 0;
         while b + 4 <= kv2 {
             let bv2 = &s.bv2;
-            let d = dots(ra, [row(bv2, b, stride), row(bv2, b + 1, stride), row(bv2, b + 2, stride), row(bv2, b + 3, stride)]);
+            let d = dots(
+                ra,
+                [
+                    row(bv2, b, stride),
+                    row(bv2, b + 1, stride),
+                    row(bv2, b + 2, stride),
+                    row(bv2, b + 3, stride),
+                ],
+            );
             s.m[a * kv2 + b..a * kv2 + b + 4].copy_from_slice(&d);
             b += 4;
         }
@@ -304,7 +312,10 @@ fn moments(du: usize, dv: usize, x: &[f64], pts: &[Point3], stride: usize, s: &m
             }
         }
         for b in 0..kv {
-            let d = dots(row(&s.bv, b, stride), [row(prod, 0, stride), row(prod, 1, stride), row(prod, 2, stride)]);
+            let d = dots(
+                row(&s.bv, b, stride),
+                [row(prod, 0, stride), row(prod, 1, stride), row(prod, 2, stride)],
+            );
             for co in 0..3 {
                 s.gq[(a * 3 + co) * kv + b] = d[co];
             }
@@ -369,7 +380,7 @@ fn cholesky(g: &[f64], u: &mut [f64], n: usize) -> bool {
     u[..n * n].copy_from_slice(&g[..n * n]);
     for j in 0..n {
         let d = u[j * n + j];
-        if !(d > PIVOT_REL * dmax) {
+        if d.is_nan() || d <= PIVOT_REL * dmax {
             return false;
         }
         let r = d.sqrt();
@@ -615,8 +626,8 @@ fn grid_sse_body(
 #[cfg(test)]
 mod tests {
     use super::super::{add_noise, example3, fit_poles, grid_sse_qr, BezierSurface};
-    use crate::optim::Problem;
     use super::*;
+    use crate::optim::Problem;
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
