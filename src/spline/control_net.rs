@@ -522,74 +522,39 @@ mod fused {
         let mut ch = 0;
         while ch < chunks {
             let g = (chunks - ch).min(5);
-            let mut sums = [[0.0; CHUNK]; 5];
+            let (d, r) = (dp.add(ch * nc * 3 * CHUNK), rp.add(ch * k3p * CHUNK));
             match g {
-                5 => store(
-                    &pass2_group::<5>(
-                        cols.clone(),
-                        k3p,
-                        nv,
-                        dp.add(ch * nc * 3 * CHUNK),
-                        rp.add(ch * k3p * CHUNK),
-                    ),
-                    &mut sums,
-                ),
-                4 => store(
-                    &pass2_group::<4>(
-                        cols.clone(),
-                        k3p,
-                        nv,
-                        dp.add(ch * nc * 3 * CHUNK),
-                        rp.add(ch * k3p * CHUNK),
-                    ),
-                    &mut sums,
-                ),
-                3 => store(
-                    &pass2_group::<3>(
-                        cols.clone(),
-                        k3p,
-                        nv,
-                        dp.add(ch * nc * 3 * CHUNK),
-                        rp.add(ch * k3p * CHUNK),
-                    ),
-                    &mut sums,
-                ),
-                2 => store(
-                    &pass2_group::<2>(
-                        cols.clone(),
-                        k3p,
-                        nv,
-                        dp.add(ch * nc * 3 * CHUNK),
-                        rp.add(ch * k3p * CHUNK),
-                    ),
-                    &mut sums,
-                ),
-                _ => store(
-                    &pass2_group::<1>(
-                        cols.clone(),
-                        k3p,
-                        nv,
-                        dp.add(ch * nc * 3 * CHUNK),
-                        rp.add(ch * k3p * CHUNK),
-                    ),
-                    &mut sums,
-                ),
-            }
-            for lane_sums in &sums[..g] {
-                for v in lane_sums {
-                    total += v;
-                }
+                5 => add_group::<5>(&mut total, cols.clone(), k3p, nv, d, r),
+                4 => add_group::<4>(&mut total, cols.clone(), k3p, nv, d, r),
+                3 => add_group::<3>(&mut total, cols.clone(), k3p, nv, d, r),
+                2 => add_group::<2>(&mut total, cols.clone(), k3p, nv, d, r),
+                _ => add_group::<1>(&mut total, cols.clone(), k3p, nv, d, r),
             }
             ch += g;
         }
         total
     }
 
-    /// The `G` chunks' per-lane sums, for adding in chunk and lane order.
+    /// [`pass2_group`] of the `G` chunks from `data` and `rt`, its per-lane sums added to `total`
+    /// in chunk and lane order (one order for every schedule, so the same bits).
     #[inline(always)]
-    unsafe fn store<const G: usize>(acc: &[__m256d; G], out: &mut [[f64; CHUNK]; 5]) {
-        for (a, o) in acc.iter().zip(out.iter_mut()) {
-            _mm256_storeu_pd(o.as_mut_ptr(), *a);
+    unsafe fn add_group<const G: usize>(
+        total: &mut f64,
+        cols: std::ops::Range<usize>,
+        k3p: usize,
+        nv: &crate::spline::SparseBasis,
+        data: *const f64,
+        rt: *const f64,
+    ) {
+        let acc = pass2_group::<G>(cols, k3p, nv, data, rt);
+        let mut sums = [[0.0; CHUNK]; G];
+        for g in 0..G {
+            _mm256_storeu_pd(sums[g].as_mut_ptr(), acc[g]);
+        }
+        for lane_sums in &sums {
+            for v in lane_sums {
+                *total += v;
+            }
         }
     }
 
@@ -605,24 +570,6 @@ mod fused {
     #[target_feature(enable = "avx2,fma")]
     pub(super) unsafe fn kernel_avx2(pb: &ControlNetProblem, x: &[f64], s: &mut Scratch) -> f64 {
         body::<true>(pb, x, s)
-    }
-
-    /// One chunk's second pass right after its first (`CHUNKWISE`), its sums added to `total` in
-    /// lane order (the order of [`pass2_grouped`]).
-    #[inline(always)]
-    unsafe fn chunk_pass2(
-        total: &mut f64,
-        cols: std::ops::Range<usize>,
-        k3p: usize,
-        nv: &crate::spline::SparseBasis,
-        data: *const f64,
-        rt: *const f64,
-    ) {
-        let mut sums = [[0.0; CHUNK]; 5];
-        store(&pass2_group::<1>(cols, k3p, nv, data, rt), &mut sums);
-        for v in sums[0] {
-            *total += v;
-        }
     }
 
     #[inline(always)]
@@ -650,7 +597,7 @@ mod fused {
             by_lanes!(valid, segment(&src, k3, &w, k3, out));
             if CHUNKWISE {
                 let data = pb.data_b.as_ptr().add(ch * ny * 3 * CHUNK);
-                chunk_pass2(&mut bottom, 0..ny, k3p, &parts.nv, data, out);
+                add_group::<1>(&mut bottom, 0..ny, k3p, &parts.nv, data, out);
             }
         }
         if !CHUNKWISE {
@@ -714,7 +661,7 @@ mod fused {
             by_lanes!(valid, segment(&inner, ki, &w, ki, out.add(3 * CHUNK)));
             if CHUNKWISE {
                 let data = pb.data_t.as_ptr().add(ch * (ny - 2) * 3 * CHUNK);
-                chunk_pass2(&mut top, 1..ny - 1, k3p, &parts.nv, data, out);
+                add_group::<1>(&mut top, 1..ny - 1, k3p, &parts.nv, data, out);
             }
         }
         if !CHUNKWISE {
