@@ -25,8 +25,8 @@
 //! relative, the quadrature far less.
 //!
 //! The baseline copy computes each factor in scalar IEEE operations and `f64::mul_add`; the AVX2
-//! copy does the same operations four lanes at a time (gathers for the coefficients, `vfmadd`), so
-//! the copies give the same bits. Words come from four xoshiro256++ lanes ([`DeLanes`], seeded from
+//! copy does the same operations four lanes at a time (each lane's coefficient row loaded whole and
+//! transposed in registers, `vfmadd`), so the copies give the same bits. Words come from four xoshiro256++ lanes ([`DeLanes`], seeded from
 //! the run's ChaCha8 stream): chunk after chunk of [`CHUNK`] coordinates, each consuming HALF / 4
 //! steps of the four lanes; word k of a chunk (lane k % 4, step k / 4) holds the field of
 //! coordinate k (low 32 bits) and of coordinate k + HALF (high 32 bits).
@@ -342,14 +342,15 @@ fn chunk_scalar(out: &mut [f64; CHUNK], words: &[u64; HALF], table: &LevyTable, 
 }
 
 /// [`chunk_scalar`] four lanes at a time: the same operations (integer shifts and masks, IEEE
-/// subtract and add, gathers of the coefficients, `vfmadd`, multiply, sign xor), the same bits.
+/// subtract and add, the coefficient rows loaded and transposed, `vfmadd`, multiply, sign xor), the
+/// same bits.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 fn chunk_avx2(out: &mut [f64; CHUNK], words: &[u64; HALF], table: &LevyTable, sigma: f64) {
     use std::arch::x86_64::*;
     let base: *const f64 = table.coef.as_ptr().cast();
-    // SAFETY: loads and stores of words[4 q..4 q + 4] and out[..] within bounds; every gathered
-    // index is row * 4 + 0..3 with row masked below TABLE_LEN, inside the coefficient array.
+    // SAFETY: loads and stores of words[4 q..4 q + 4] and out[..] within bounds; every row loaded
+    // is row * 4 .. row * 4 + 4 with row masked below TABLE_LEN, inside the coefficient array.
     unsafe {
         let one = _mm256_set1_epi64x(ONE as i64);
         let onef = _mm256_set1_pd(1.0);
@@ -381,11 +382,22 @@ fn chunk_avx2(out: &mut [f64; CHUNK], words: &[u64; HALF], table: &LevyTable, si
                     one,
                 );
                 let f = _mm256_sub_pd(_mm256_castsi256_pd(fb), onef);
-                let idx = _mm256_slli_epi64::<2>(row);
-                let c0 = _mm256_i64gather_pd::<8>(base, idx);
-                let c1 = _mm256_i64gather_pd::<8>(base.add(1), idx);
-                let c2 = _mm256_i64gather_pd::<8>(base.add(2), idx);
-                let c3 = _mm256_i64gather_pd::<8>(base.add(3), idx);
+                // Each lane's four coefficients are one 32-byte row: four row loads and a 4 x 4
+                // transpose in registers (four gathers of one coefficient each cost more on Zen 3).
+                let mut at = [0u64; 4];
+                _mm256_storeu_si256(at.as_mut_ptr().cast(), _mm256_slli_epi64::<2>(row));
+                let r = [
+                    _mm256_loadu_pd(base.add(at[0] as usize)),
+                    _mm256_loadu_pd(base.add(at[1] as usize)),
+                    _mm256_loadu_pd(base.add(at[2] as usize)),
+                    _mm256_loadu_pd(base.add(at[3] as usize)),
+                ];
+                let (t0, t1) = (_mm256_unpacklo_pd(r[0], r[1]), _mm256_unpackhi_pd(r[0], r[1]));
+                let (t2, t3) = (_mm256_unpacklo_pd(r[2], r[3]), _mm256_unpackhi_pd(r[2], r[3]));
+                let c0 = _mm256_permute2f128_pd::<0x20>(t0, t2);
+                let c1 = _mm256_permute2f128_pd::<0x20>(t1, t3);
+                let c2 = _mm256_permute2f128_pd::<0x31>(t0, t2);
+                let c3 = _mm256_permute2f128_pd::<0x31>(t1, t3);
                 let t = _mm256_fmadd_pd(_mm256_fmadd_pd(_mm256_fmadd_pd(c3, f, c2), f, c1), f, c0);
                 let sign = _mm256_slli_epi64::<63>(_mm256_srli_epi64::<31>(field));
                 let l = _mm256_xor_pd(_mm256_mul_pd(t, sig), _mm256_castsi256_pd(sign));
