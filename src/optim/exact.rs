@@ -374,8 +374,8 @@ fn reverse_cuthill_mckee(adj: &[Vec<usize>]) -> Vec<usize> {
 /// A stage also ends when the Newton decrement falls below this fraction of the smoothing gap.
 const STAGE_TOL: f64 = 1e-6;
 
-/// Diagonal shift of the Hessian, relative to its largest diagonal entry (grown x100 on a
-/// failed factorisation).
+/// Diagonal shift of the Hessian, relative to each diagonal entry (grown x100 on a failed
+/// factorisation).
 const SHIFT: f64 = 1e-14;
 
 /// Iterative-refinement steps of each Newton solve.
@@ -525,6 +525,8 @@ struct Workspace<'a> {
     skip: Vec<bool>,
     /// The largest data norm or bound magnitude (for absolute tolerances).
     scale: f64,
+    /// The Jacobi scaling of each row (elimination order) of the last factorisation.
+    jac: Vec<f64>,
 }
 
 impl<'a> Workspace<'a> {
@@ -563,7 +565,16 @@ impl<'a> Workspace<'a> {
             scale = scale.max(lower[j].abs()).max(upper[j].abs());
         }
         let env = Envelope::new(first);
-        Ok(Workspace { pb, lower, upper, pos, env, skip: vec![false; n], scale: scale.max(1e-300) })
+        Ok(Workspace {
+            pb,
+            lower,
+            upper,
+            pos,
+            env,
+            skip: vec![false; n],
+            scale: scale.max(1e-300),
+            jac: vec![1.0; n],
+        })
     }
 
     /// Leave the coordinates with `out[j]` (coordinate order) out of the next system.
@@ -608,27 +619,39 @@ impl<'a> Workspace<'a> {
         }
     }
 
-    /// Cholesky of the assembled matrix with the skipped rows set to the largest diagonal and
-    /// every diagonal shifted by `shift` times it (grown x100 on a failure, 12 tries).
+    /// Cholesky of the assembled matrix M after Jacobi scaling by powers of two (rows and columns
+    /// times j_q ~ 1 / sqrt(M_qq), exact in f64), with the skipped rows set to 1 and every
+    /// diagonal shifted by `shift` (grown x100 on a failure, 12 tries). The shift is then relative
+    /// to each row's own diagonal: control points whose basis weights are tiny (the corners of
+    /// near-square nets, columns ~5e-4 of the largest) keep their own curvature.
     fn factorise(&mut self, shift: f64) -> bool {
         let n = self.skip.len();
-        let mut max_diag: f64 = 0.0;
         for q in 0..n {
-            max_diag = max_diag.max(self.env.val[self.env.at(q, q)]);
+            let d = self.env.val[self.env.at(q, q)];
+            // 2^round(-log2(d) / 2): scaling by it rounds nothing.
+            self.jac[q] =
+                if self.skip[q] || !(d > 0.0) { 1.0 } else { (-(d.log2() / 2.0).round()).exp2() };
+        }
+        for r in 0..n {
+            let (fr, jr) = (self.env.first[r], self.jac[r]);
+            let base = self.env.start[r] - fr;
+            for c in fr..=r {
+                self.env.val[base + c] *= jr * self.jac[c];
+            }
         }
         for q in 0..n {
-            if self.skip[q] {
-                let at = self.env.at(q, q);
-                self.env.val[at] = max_diag.max(f64::MIN_POSITIVE);
+            let at = self.env.at(q, q);
+            if self.skip[q] || !(self.env.val[at] > 0.0) {
+                self.env.val[at] = 1.0;
             }
         }
         let backup = self.env.val.clone();
-        let mut s = shift * max_diag.max(1e-300);
+        let mut s = shift;
         for _ in 0..12 {
             self.env.val.copy_from_slice(&backup);
             for q in 0..n {
                 let at = self.env.at(q, q);
-                self.env.val[at] += s;
+                self.env.val[at] *= 1.0 + s;
             }
             if self.env.factorise().is_ok() {
                 return true;
@@ -643,14 +666,14 @@ impl<'a> Workspace<'a> {
         for (p, &q) in self.pos.iter().enumerate() {
             for c in 0..3 {
                 let row = 3 * q + c;
-                buf[row] = if self.skip[row] { 0.0 } else { b[3 * p + c] };
+                buf[row] = if self.skip[row] { 0.0 } else { b[3 * p + c] * self.jac[row] };
             }
         }
         self.env.solve(buf);
         for (p, &q) in self.pos.iter().enumerate() {
             for c in 0..3 {
                 let row = 3 * q + c;
-                out[3 * p + c] = if self.skip[row] { 0.0 } else { buf[row] };
+                out[3 * p + c] = if self.skip[row] { 0.0 } else { buf[row] * self.jac[row] };
             }
         }
     }
@@ -904,8 +927,9 @@ fn predictor(ws: &Workspace, it: &mut Iterate, mu: f64, mu_next: f64, sc: &mut S
     }
 }
 
-/// Polish rounds (free terms whose y_k leaves the unit ball are fixed on its boundary).
-const POLISH_ROUNDS: usize = 4;
+/// At most this many polish rounds per threshold (free terms whose y_k leaves the unit ball are
+/// fixed on its boundary); they stop early when the bound stops rising.
+const POLISH_ROUNDS: usize = 12;
 
 /// Thresholds tau / (f / m) below which a term counts as near zero, tried in turn.
 const POLISH_LADDER: [f64; 7] = [1e-14, 1e-12, 1e-10, 1e-8, 1e-6, 1e-4, 1e-2];
@@ -954,7 +978,8 @@ fn weighted_apply(
 /// y_k (W_k = I / tau). Each round solves (A^T W A) d = -A^T y on the coordinates off their bounds
 /// and sets y <- y + W A d, which makes g = A^T y vanish there to first order; turned y_k are
 /// put back on the unit sphere (y_k . r_k stays ~|r_k|: turning is second order) and free y_k
-/// that left the unit ball are fixed in their direction. Every round's y is certified.
+/// that left the unit ball are fixed in their direction. Every round's y is certified; the
+/// rounds stop when two running have not raised the bound (each is a refinement of the last).
 fn polish_with(
     ws: &mut Workspace,
     x: &[f64],
@@ -974,6 +999,7 @@ fn polish_with(
         (fixed[k], wt[k]) = (true, 1.0 / nr);
     }
     let mut blocks = vec![[[0.0; 3]; 3]; m];
+    let (mut best_here, mut stale) = (f64::NEG_INFINITY, 0);
     for _ in 0..POLISH_ROUNDS {
         for k in 0..m {
             let u = if fixed[k] { y[k] } else { [0.0; 3] };
@@ -1022,6 +1048,15 @@ fn polish_with(
         yc.copy_from_slice(&y);
         let lb = lower_bound_with(yc, r, x, ws.lower, ws.upper, pb, &mut sc.vn[0]);
         best.offer_dual(lb, yc);
+        // Stop when two rounds running did not raise the bound.
+        if lb > best_here {
+            (best_here, stale) = (lb, 0);
+        } else {
+            stale += 1;
+            if stale >= 2 {
+                break;
+            }
+        }
     }
 }
 
