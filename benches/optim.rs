@@ -75,11 +75,34 @@ fn main() {
     let per =
         (0..rounds).map(|_| round(true) - round(false)).fold(f64::INFINITY, f64::min) / reps as f64;
     println!("fitness: {:.3} us per evaluation ({:.2} M evaluations/s; target 1.5 us, numpy 8.3 us: {:.1}x, thesis DE ~600 us: {:.0}x)", per * 1e6, 1e-6 / per, 8.3e-6 / per, 600e-6 / per);
-    let (model, mhz) = cpu_model();
-    println!("CPU: {model}, {mhz:.0} MHz (nominal, from /proc/cpuinfo); load {}", load());
+    let (model, nominal) = cpu_model();
+    // Cycles are counted at the clock the core runs at, measured with a loop of independent FMAs
+    // (two per cycle on every AVX2 core): /proc/cpuinfo gives the nominal clock, which a core
+    // that boosts exceeds (this Zen 3 ran its FMAs at 3.2 GHz with 2445 MHz nominal).
+    let peak = fma_peak();
+    let mhz = peak.map_or(nominal, |p| p.mhz);
+    println!("CPU: {model}, {nominal:.0} MHz nominal (/proc/cpuinfo); load {}", load());
+    if let Some(p) = peak {
+        println!(
+            "clock measured by an FMA loop: {:.0} MHz (0.5 / ns per 4-wide FMA); a 4-wide square root costs {:.2} ns = {:.1} cycles",
+            p.mhz,
+            p.sqrt_ns,
+            p.sqrt_ns * p.mhz / 1e3
+        );
+    }
     // Every compiled copy of the fitness on this problem, in cycles (ns x the nominal clock)
     // beside the floating-point lower bound (multiply(-add)s on two 4-wide FMA pipes).
     let bound = fma_lower_bound_cycles(20, 20, 18);
+    if let Some(p) = peak {
+        // The 190 4-wide square roots (one per chunk of 4 grid rows and grid column, both views)
+        // run on their own unit beside the FMAs: a second floor, not added to the first.
+        let roots = 5 * 20 + 5 * 18;
+        println!(
+            "square-root floor: {roots} x {:.1} cycles = {:.0} cycles (beside the FMA bound, not on top of it)",
+            p.sqrt_ns * mhz / 1e3,
+            roots as f64 * p.sqrt_ns * mhz / 1e3
+        );
+    }
     for isa in Isa::ALL {
         let q = problem.clone().with_isa(isa);
         if q.isa() != isa {
@@ -88,7 +111,7 @@ fn main() {
         }
         let ns = best_fitness_ns(&q, &x0, rounds);
         let cycles = ns * mhz / 1e3;
-        println!("fitness, {isa:?} copy: {ns:.0} ns = {cycles:.0} cycles per evaluation; FMA lower bound {bound:.0} cycles (2 pipes x 4 lanes): {:.2}x the bound", cycles / bound);
+        println!("fitness, {isa:?} copy: {ns:.0} ns = {cycles:.0} cycles per evaluation (at {mhz:.0} MHz); FMA lower bound {bound:.0} cycles (2 pipes x 4 lanes): {:.2}x the bound; {:.2}x at the nominal clock", cycles / bound, ns * nominal / 1e3 / bound);
     }
     // The optimisers' own kernels, every compiled copy (all in L1: the floor of their overhead).
     #[cfg(target_arch = "x86_64")]
@@ -185,6 +208,74 @@ fn load() -> String {
         .ok()
         .and_then(|l| l.split_whitespace().next().map(str::to_string))
         .unwrap_or_else(|| "unknown".into())
+}
+
+/// The core's clock as its FMA throughput shows it, and the cost of one 4-wide square root.
+#[derive(Clone, Copy)]
+struct Peak {
+    mhz: f64,
+    sqrt_ns: f64,
+}
+
+/// Time `f(n)` (thread CPU time, best of 5) in ns per unit of `n`.
+fn best_ns_per(n: usize, f: impl Fn(usize) -> f64) -> f64 {
+    (0..5)
+        .map(|_| {
+            let t = runner::thread_cpu_seconds();
+            std::hint::black_box(f(n));
+            (runner::thread_cpu_seconds() - t) / n as f64 * 1e9
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Measure [`Peak`] with ten independent chains of 4-wide FMAs (enough to cover their latency on
+/// two pipes) and a chain-free run of 4-wide square roots; None without AVX2 + FMA.
+fn fma_peak() -> Option<Peak> {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::*;
+        if !(is_x86_feature_detected!("avx2") && is_x86_feature_detected!("fma")) {
+            return None;
+        }
+        #[target_feature(enable = "avx2,fma")]
+        fn fmas(n: usize) -> f64 {
+            let mut acc = [_mm256_set1_pd(1.0); 10];
+            let (m, c) = (_mm256_set1_pd(0.999_999), _mm256_set1_pd(std::hint::black_box(1e-9)));
+            for _ in 0..n {
+                for a in acc.iter_mut() {
+                    *a = _mm256_fmadd_pd(*a, m, c);
+                }
+            }
+            let mut out = [0.0; 4];
+            let sum = acc.iter().fold(_mm256_setzero_pd(), |s, a| _mm256_add_pd(s, *a));
+            // SAFETY: `out` holds four f64.
+            unsafe { _mm256_storeu_pd(out.as_mut_ptr(), sum) };
+            out.iter().sum()
+        }
+        #[target_feature(enable = "avx2,fma")]
+        fn sqrts(n: usize) -> f64 {
+            let mut acc = [_mm256_setzero_pd(); 4];
+            let mut x = _mm256_set1_pd(std::hint::black_box(2.0));
+            let step = _mm256_set1_pd(1e-12);
+            for _ in 0..n {
+                for a in acc.iter_mut() {
+                    *a = _mm256_add_pd(*a, _mm256_sqrt_pd(x));
+                    x = _mm256_add_pd(x, step);
+                }
+            }
+            let mut out = [0.0; 4];
+            let sum = acc.iter().fold(_mm256_setzero_pd(), |s, a| _mm256_add_pd(s, *a));
+            // SAFETY: `out` holds four f64.
+            unsafe { _mm256_storeu_pd(out.as_mut_ptr(), sum) };
+            out.iter().sum()
+        }
+        // SAFETY (both): the CPU reports AVX2 and FMA (checked above).
+        let fma_ns = best_ns_per(2_000_000, |n| unsafe { fmas(n) }) / 10.0;
+        let sqrt_ns = best_ns_per(500_000, |n| unsafe { sqrts(n) }) / 4.0;
+        Some(Peak { mhz: 1e3 / (2.0 * fma_ns), sqrt_ns })
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    None
 }
 
 /// Floating-point lower bound of one fitness evaluation in cycles: pass 1 is 4 multiply(-add)s

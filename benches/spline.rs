@@ -43,6 +43,10 @@ fn maps(grid: (usize, usize)) -> Vec<TwoViewGrid> {
 
 fn main() {
     let _ = seeds::seed_hex(0, "");
+    if std::env::args().any(|a| a == "bezier") {
+        bezier_fitness(); // `cargo bench --bench spline -- bezier`: seed 003's part only
+        return;
+    }
     let same = maps((20, 20));
     let diff = maps((18, 30));
     let nets_same: Vec<(usize, usize)> = (3..=9).map(|k| (2 * k, 2 * k)).collect();

@@ -378,12 +378,14 @@ pub struct PsoCoefficients {
     pub c2: f64,
 }
 
-/// The box of a PSO run per coordinate: positions in [lo, hi], velocities in [-vmax, vmax].
+/// The box of a PSO run per coordinate: positions in [lo, hi], velocities in [-vmax, vmax] with
+/// vmax = vmax_fraction (hi - lo), computed in the move (one rounding each, the same bits as a
+/// stored vmax; the move reads seven slices instead of eight, and it is bound by their traffic).
 #[derive(Debug, Clone, Copy)]
 pub struct PsoBounds<'a> {
     pub lo: &'a [f64],
     pub hi: &'a [f64],
-    pub vmax: &'a [f64],
+    pub vmax_fraction: f64,
 }
 
 /// One coordinate's move from its 64-bit word: (new x, new v).
@@ -424,11 +426,11 @@ fn pso_move_scalar(
     from: usize,
 ) {
     let n = out.len();
-    let (x, v, p, g, lo, hi, vmax) =
-        (&x[..n], &mut v[..n], &p[..n], &g[..n], &b.lo[..n], &b.hi[..n], &b.vmax[..n]);
+    let (x, v, p, g, lo, hi) = (&x[..n], &mut v[..n], &p[..n], &g[..n], &b.lo[..n], &b.hi[..n]);
     for j in from..n {
         let word = rng.next_word(j % PSO_LANES);
-        (out[j], v[j]) = pso_coordinate(x[j], v[j], p[j], g[j], lo[j], hi[j], vmax[j], word, co);
+        let vmax = b.vmax_fraction * (hi[j] - lo[j]);
+        (out[j], v[j]) = pso_coordinate(x[j], v[j], p[j], g[j], lo[j], hi[j], vmax, word, co);
     }
 }
 
@@ -456,8 +458,9 @@ macro_rules! pso_move_simd {
         use std::arch::x86_64::*;
         let (out, co) = ($out, $co);
         let n = out.len();
-        let (x, v, p, g, lo, hi, vmax) =
-            (&$x[..n], &mut $v[..n], &$p[..n], &$g[..n], &$b.lo[..n], &$b.hi[..n], &$b.vmax[..n]);
+        let (x, v, p, g, lo, hi) =
+            (&$x[..n], &mut $v[..n], &$p[..n], &$g[..n], &$b.lo[..n], &$b.hi[..n]);
+        let fraction = _mm256_set1_pd($b.vmax_fraction);
         let mantissa_top32 = _mm256_set1_epi64x(0x000f_ffff_fff0_0000);
         let one = _mm256_set1_epi64x(0x3ff0_0000_0000_0000);
         let (c1, c2, k) = (_mm256_set1_pd(co.c1), _mm256_set1_pd(co.c2), _mm256_set1_pd(co.k));
@@ -500,14 +503,13 @@ macro_rules! pso_move_simd {
                 );
                 let vel = _mm256_mul_pd(k, vel);
                 // max(a, b) is a > b ? a : b, so max(lo, v) = v < lo ? lo : v, as `clamp`.
-                let vm = _mm256_loadu_pd(vmax.as_ptr().add(j));
+                let (hij, loj) =
+                    (_mm256_loadu_pd(hi.as_ptr().add(j)), _mm256_loadu_pd(lo.as_ptr().add(j)));
+                let vm = _mm256_mul_pd(fraction, _mm256_sub_pd(hij, loj));
                 let vel = _mm256_min_pd(vm, _mm256_max_pd(_mm256_xor_pd(vm, sign), vel));
                 _mm256_storeu_pd(v.as_mut_ptr().add(j), vel);
                 let xn = _mm256_add_pd(xj, vel);
-                let xn = _mm256_min_pd(
-                    _mm256_loadu_pd(hi.as_ptr().add(j)),
-                    _mm256_max_pd(_mm256_loadu_pd(lo.as_ptr().add(j)), xn),
-                );
+                let xn = _mm256_min_pd(hij, _mm256_max_pd(loj, xn));
                 _mm256_storeu_pd(out.as_mut_ptr().add(j), xn);
             }};
         }
@@ -529,7 +531,8 @@ macro_rules! pso_move_simd {
                 _mm256_storeu_si256(state[r].as_mut_ptr().add(4).cast(), *hg);
             }
         }
-        pso_move_scalar(out, x, v, p, g, PsoBounds { lo, hi, vmax }, $rng, co, done);
+        let bounds = PsoBounds { lo, hi, vmax_fraction: $b.vmax_fraction };
+        pso_move_scalar(out, x, v, p, g, bounds, $rng, co, done);
     }};
 }
 
@@ -683,8 +686,7 @@ mod tests {
             assert_eq!(single, generic.2);
         }
         let co = PsoCoefficients { k: 0.729, c1: 2.05, c2: 2.05 };
-        let vmax: Vec<f64> = lo.iter().zip(&hi).map(|(l, h)| 0.2 * (h - l)).collect();
-        let bounds = PsoBounds { lo: &lo, hi: &hi, vmax: &vmax };
+        let bounds = PsoBounds { lo: &lo, hi: &hi, vmax_fraction: 0.2 };
         let gen = PsoLanes::from_rng(&mut ChaCha8Rng::seed_from_u64(2));
         let (mut x1, mut v1, mut g1) = (a.clone(), b.clone(), gen.clone());
         let (mut x2, mut v2, mut g2) = (a.clone(), b.clone(), gen.clone());
@@ -825,8 +827,7 @@ pub mod timing {
                 best_ns(n, || unsafe { copy(&mut t, src, 0.3, &mut lanes, threshold) })
             ));
         }
-        let vmax = vec![0.5; n];
-        let bounds = PsoBounds { lo: &lo, hi: &hi, vmax: &vmax };
+        let bounds = PsoBounds { lo: &lo, hi: &hi, vmax_fraction: 0.5 };
         let co = PsoCoefficients { k: 0.729, c1: 2.05, c2: 2.05 };
         let mut gen = PsoLanes::from_rng(&mut ChaCha8Rng::seed_from_u64(2));
         let (mut x, mut vel, mut moved) = (v.clone(), vec![0.0; n], vec![0.0; n]);

@@ -85,8 +85,7 @@ impl Optimiser for Pso {
         let mut gbest = pbest[g].clone();
         let mut bulk = PsoLanes::from_rng(rng);
         let co = PsoCoefficients { k: self.k, c1: self.c1, c2: self.c2 };
-        let vmax: Aligned = lo.iter().zip(hi).map(|(l, h)| self.vmax_fraction * (h - l)).collect();
-        let bounds = PsoBounds { lo, hi, vmax: &vmax };
+        let bounds = PsoBounds { lo, hi, vmax_fraction: self.vmax_fraction };
         for _ in 0..budget.generations {
             // Each particle is evaluated right after its move, while its coordinates are in
             // cache; the global best it moved towards is the previous iteration's (a copy).

@@ -12,8 +12,8 @@
 //! x, y, z apart; chunks of 4 lanes, padded with zeros), accumulating per lane in registers. No
 //! allocation per call; the summation order is fixed, and every multiply-add is fused
 //! (`f64::mul_add`: one rounding, a hardware instruction in the AVX2 + FMA copy and the C
-//! library's `fma` in the baseline copy), so the two copies (picked at run time) give
-//! bit-identical results.
+//! library's `fma` in the baseline copy), so the copies (picked at run time: baseline, AVX2,
+//! AVX-512VL; `SOMNURBS_SIMD` forces one) give bit-identical results.
 //!
 //! A border grid class is scored once, on the bottom view (Eq. 5.13): the top view is evaluated
 //! at its interior grid points only. The top view's control points are read in place: its
@@ -80,7 +80,7 @@ pub struct Scratch {
     rt_b: Aligned,
     rt_t: Aligned,
     /// The top view's first and last four interior-run rows (stride 3 cn_y - 6), for the
-    /// fused AVX-512VL copy.
+    /// vector copies.
     edge: Vec<f64>,
 }
 
@@ -321,18 +321,18 @@ fn kernel(pb: &ControlNetProblem, x: &[f64], s: &mut Scratch) -> f64 {
     bottom + top
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-fn kernel_avx2(pb: &ControlNetProblem, x: &[f64], s: &mut Scratch) -> f64 {
-    kernel(pb, x, s)
-}
-
-/// The kernel in 256-bit AVX-512VL instructions (32 vector registers).
+/// The kernel in 256-bit vector instructions, compiled twice: for AVX2 + FMA (16 vector
+/// registers) and for AVX-512VL (32).
 ///
 /// - First pass fused with the transpose: four grid rows (one chunk of lanes) at a time, each
 ///   row's four-control-row sum over four consecutive k is one vector, and the four vectors are
 ///   transposed in registers and stored straight into RT (no R buffer, no second pass over it).
-///   Its sixteen broadcast weights take half of the 32 registers.
+///   Its sixteen broadcast weights take half of AVX-512VL's 32 registers; the AVX2 copy keeps
+///   them on the stack and reads them as memory operands. On the AVX2-only Zen 3 this copy
+///   took 1.60-1.68 us against 1.90-2.00 us for the compiler-vectorised [`kernel`]; a variant
+///   that kept two lanes' eight weights in registers (pairs of lanes, 128-bit stores) and one
+///   that also shared the rows of two lanes were no faster there (2026-12-03), so the one body
+///   serves both.
 /// - Second pass over up to five chunks at once, grid columns outside: the column's weights are
 ///   broadcast once for all of them.
 ///
@@ -460,7 +460,6 @@ mod fused {
     /// in a register. Per lane the same operations in the same order, so the same bits.
     #[inline(always)]
     unsafe fn pass2_group<const G: usize>(
-        ch0: usize,
         cols: std::ops::Range<usize>,
         k3p: usize,
         nv: &crate::spline::SparseBasis,
@@ -479,9 +478,8 @@ mod fused {
             );
             let base = nv.first[j] * 3 * CHUNK;
             for (g, a) in acc.iter_mut().enumerate() {
-                let ch = ch0 + g;
-                let q = rt.add(ch * k3p * CHUNK + base);
-                let d = data.add((ch * nc + lj) * 3 * CHUNK);
+                let q = rt.add(g * k3p * CHUNK + base);
+                let d = data.add((g * nc + lj) * 3 * CHUNK);
                 let mut e = [_mm256_setzero_pd(); 3];
                 for (c, ec) in e.iter_mut().enumerate() {
                     let v = _mm256_fmsub_pd(
@@ -524,40 +522,69 @@ mod fused {
         let mut ch = 0;
         while ch < chunks {
             let g = (chunks - ch).min(5);
-            let mut sums = [[0.0; CHUNK]; 5];
+            let (d, r) = (dp.add(ch * nc * 3 * CHUNK), rp.add(ch * k3p * CHUNK));
             match g {
-                5 => store(&pass2_group::<5>(ch, cols.clone(), k3p, nv, dp, rp), &mut sums),
-                4 => store(&pass2_group::<4>(ch, cols.clone(), k3p, nv, dp, rp), &mut sums),
-                3 => store(&pass2_group::<3>(ch, cols.clone(), k3p, nv, dp, rp), &mut sums),
-                2 => store(&pass2_group::<2>(ch, cols.clone(), k3p, nv, dp, rp), &mut sums),
-                _ => store(&pass2_group::<1>(ch, cols.clone(), k3p, nv, dp, rp), &mut sums),
-            }
-            for lane_sums in &sums[..g] {
-                for v in lane_sums {
-                    total += v;
-                }
+                5 => add_group::<5>(&mut total, cols.clone(), k3p, nv, d, r),
+                4 => add_group::<4>(&mut total, cols.clone(), k3p, nv, d, r),
+                3 => add_group::<3>(&mut total, cols.clone(), k3p, nv, d, r),
+                2 => add_group::<2>(&mut total, cols.clone(), k3p, nv, d, r),
+                _ => add_group::<1>(&mut total, cols.clone(), k3p, nv, d, r),
             }
             ch += g;
         }
         total
     }
 
-    /// The `G` chunks' per-lane sums, for adding in chunk and lane order.
+    /// [`pass2_group`] of the `G` chunks from `data` and `rt`, its per-lane sums added to `total`
+    /// in chunk and lane order (one order for every schedule, so the same bits).
     #[inline(always)]
-    unsafe fn store<const G: usize>(acc: &[__m256d; G], out: &mut [[f64; CHUNK]; 5]) {
-        for (a, o) in acc.iter().zip(out.iter_mut()) {
-            _mm256_storeu_pd(o.as_mut_ptr(), *a);
+    unsafe fn add_group<const G: usize>(
+        total: &mut f64,
+        cols: std::ops::Range<usize>,
+        k3p: usize,
+        nv: &crate::spline::SparseBasis,
+        data: *const f64,
+        rt: *const f64,
+    ) {
+        let acc = pass2_group::<G>(cols, k3p, nv, data, rt);
+        let mut sums = [[0.0; CHUNK]; G];
+        for g in 0..G {
+            _mm256_storeu_pd(sums[g].as_mut_ptr(), acc[g]);
+        }
+        for lane_sums in &sums {
+            for v in lane_sums {
+                *total += v;
+            }
         }
     }
 
     #[target_feature(enable = "avx2,fma,avx512f,avx512vl")]
-    pub(super) unsafe fn kernel(pb: &ControlNetProblem, x: &[f64], s: &mut Scratch) -> f64 {
+    pub(super) unsafe fn kernel_avx512vl(
+        pb: &ControlNetProblem,
+        x: &[f64],
+        s: &mut Scratch,
+    ) -> f64 {
+        body::<false>(pb, x, s)
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    pub(super) unsafe fn kernel_avx2(pb: &ControlNetProblem, x: &[f64], s: &mut Scratch) -> f64 {
+        body::<true>(pb, x, s)
+    }
+
+    #[inline(always)]
+    unsafe fn body<const CHUNKWISE: bool>(
+        pb: &ControlNetProblem,
+        x: &[f64],
+        s: &mut Scratch,
+    ) -> f64 {
         let parts = &pb.parts;
         let (nx, ny, cx, k3) = (parts.nx, parts.ny, parts.cn_x, 3 * parts.cn_y);
         let k3p = padded(k3);
         let nu = &parts.nu;
         let xp = x.as_ptr();
         // Bottom view: control row a starts at a * k3 in x.
+        let mut bottom = 0.0;
         for ch in 0..nx.div_ceil(CHUNK) {
             let i0 = ch * CHUNK;
             let valid = (nx - i0).min(CHUNK);
@@ -566,9 +593,16 @@ mod fused {
                 src[l] = xp.add(nu.first[i0 + l] * k3);
             }
             let w = weights(nu, i0, valid);
-            by_lanes!(valid, segment(&src, k3, &w, k3, s.rt_b.as_mut_ptr().add(ch * k3p * CHUNK)));
+            let out = s.rt_b.as_mut_ptr().add(if CHUNKWISE { 0 } else { ch * k3p * CHUNK });
+            by_lanes!(valid, segment(&src, k3, &w, k3, out));
+            if CHUNKWISE {
+                let data = pb.data_b.as_ptr().add(ch * ny * 3 * CHUNK);
+                add_group::<1>(&mut bottom, 0..ny, k3p, &parts.nv, data, out);
+            }
         }
-        let bottom = pass2_grouped(nx, 0..ny, k3p, &parts.nv, &pb.data_b, &s.rt_b);
+        if !CHUNKWISE {
+            bottom = pass2_grouped(nx, 0..ny, k3p, &parts.nv, &pb.data_b, &s.rt_b);
+        }
         // Top view, lanes li = grid rows li + 1. Its k < 3 and k >= k3 - 3 are bottom border
         // classes (the bottom's rows, read as such); its k in 3..k3 - 3 come from rows of ki
         // values: rows 1..cx - 1 are the top's interior classes, contiguous in x after the
@@ -602,11 +636,12 @@ mod fused {
             }
         }
         let edge = s.edge.as_ptr();
+        let mut top = 0.0;
         for ch in 0..lanes.div_ceil(CHUNK) {
             let li0 = ch * CHUNK;
             let valid = (lanes - li0).min(CHUNK);
             let w = weights(nu, li0 + 1, valid);
-            let out = s.rt_t.as_mut_ptr().add(ch * k3p * CHUNK);
+            let out = s.rt_t.as_mut_ptr().add(if CHUNKWISE { 0 } else { ch * k3p * CHUNK });
             let (mut border, mut inner) = ([xp; CHUNK], [xp; CHUNK]);
             for l in 0..valid {
                 let a = nu.first[li0 + l + 1];
@@ -624,8 +659,15 @@ mod fused {
             by_lanes!(valid, block(&border, k3, &w, 0, out));
             by_lanes!(valid, block(&border, k3, &w, k3 - 4, out.add((k3 - 4) * CHUNK)));
             by_lanes!(valid, segment(&inner, ki, &w, ki, out.add(3 * CHUNK)));
+            if CHUNKWISE {
+                let data = pb.data_t.as_ptr().add(ch * (ny - 2) * 3 * CHUNK);
+                add_group::<1>(&mut top, 1..ny - 1, k3p, &parts.nv, data, out);
+            }
         }
-        bottom + pass2_grouped(lanes, 1..ny - 1, k3p, &parts.nv, &pb.data_t, &s.rt_t)
+        if !CHUNKWISE {
+            top = pass2_grouped(lanes, 1..ny - 1, k3p, &parts.nv, &pb.data_t, &s.rt_t);
+        }
+        bottom + top
     }
 }
 
@@ -828,10 +870,10 @@ impl ControlNetProblem {
         match self.isa {
             // SAFETY: `with_isa` and `kernels::simd` only select AVX2 when this CPU reports it.
             #[cfg(target_arch = "x86_64")]
-            Isa::Avx2 => unsafe { kernel_avx2(self, x, scratch) },
+            Isa::Avx2 => unsafe { fused::kernel_avx2(self, x, scratch) },
             // SAFETY: as above, for AVX-512F and AVX-512VL.
             #[cfg(target_arch = "x86_64")]
-            Isa::Avx512Vl => unsafe { fused::kernel(self, x, scratch) },
+            Isa::Avx512Vl => unsafe { fused::kernel_avx512vl(self, x, scratch) },
             _ => kernel(self, x, scratch),
         }
     }

@@ -149,7 +149,11 @@ fn seed003_bad_keys_are_named() {
     for (from, to, needles) in [
         ("\nnests = 100", "\nnests = 100\nnestz = 3", &["nestz"][..]),
         ("\nruns = 50", "\nruns = 0", &["seed003.runs"][..]),
-        ("\ngenerations = 400", "\ngenerations = 0", &["seed003.example2.generations"][..]),
+        (
+            "snr_db = 12.5\ngenerations = 2000",
+            "snr_db = 12.5\ngenerations = 0",
+            &["seed003.example2.generations"][..],
+        ),
         ("\npa = 0.25", "\npa = 1.5", &["seed003.csa.pa"][..]),
         ("\"icsa\"]", "\"icsa\", \"pso\"]", &["seed003.methods", "pso"][..]),
     ] {

@@ -20,9 +20,18 @@ use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 
+mod fast;
+
 /// The n+1 Bernstein polynomials of degree n at t (de Casteljau-style recurrence).
 pub fn bernstein(n: usize, t: f64) -> Vec<f64> {
     let mut b = vec![0.0; n + 1];
+    bernstein_into(n, t, &mut b);
+    b
+}
+
+/// [`bernstein`] into `b` (length n + 1), no allocation.
+pub fn bernstein_into(n: usize, t: f64, b: &mut [f64]) {
+    b.fill(0.0);
     b[0] = 1.0;
     let s = 1.0 - t;
     for j in 1..=n {
@@ -34,7 +43,6 @@ pub fn bernstein(n: usize, t: f64) -> Vec<f64> {
         }
         b[j] = saved;
     }
-    b
 }
 
 /// Tensor-product Bezier surface of degrees (du, dv); pole (i, j) at `poles[i * (dv + 1) + j]`.
@@ -149,13 +157,21 @@ fn column_basis(deg: usize, t: &[f64]) -> DMatrix<f64> {
 pub struct GridData {
     coords: [DMatrix<f64>; 3],
     norm2: f64,
+    nu: usize,
+    nv: usize,
+    /// Row i = (x of points (i, 0..nv), y of them, z of them): the fast path's layout.
+    rows: Vec<f64>,
 }
 
 impl GridData {
     pub fn new(points: &[Point3], nu: usize, nv: usize) -> GridData {
         let coords = [0, 1, 2].map(|c| DMatrix::from_fn(nu, nv, |i, j| points[j * nu + i][c]));
         let norm2 = coords.iter().map(|m| m.norm_squared()).sum();
-        GridData { coords, norm2 }
+        let rows = (0..nu)
+            .flat_map(|i| (0..3).flat_map(move |c| (0..nv).map(move |j| (i, c, j))))
+            .map(|(i, c, j)| points[j * nu + i][c])
+            .collect();
+        GridData { coords, norm2, nu, nv, rows }
     }
 }
 
@@ -167,7 +183,15 @@ impl GridData {
 /// SVD of the (nu nv) x ((du+1)(dv+1)) design matrix. Equals [`fit_poles`]' Y (tested). When
 /// the difference cancels (Y below 1e-6 of sum ||D_c||^2) the residual D - Qu C Qv^T is formed
 /// and summed instead, so a near-exact fit keeps its small Y to full relative precision.
+/// Computed without allocation by the fast path (stack Householder QRs), falling back to
+/// [`grid_sse_qr`] when a collocation matrix is (nearly) rank deficient.
 pub fn grid_sse(du: usize, dv: usize, u: &[f64], v: &[f64], data: &GridData) -> f64 {
+    fast::with_scratch(|s| fast::grid_sse(du, dv, u, v, data, s))
+        .unwrap_or_else(|| grid_sse_qr(du, dv, u, v, data))
+}
+
+/// [`grid_sse`] by nalgebra's QRs (SVD bases when rank deficient): the reference and fallback.
+pub fn grid_sse_qr(du: usize, dv: usize, u: &[f64], v: &[f64], data: &GridData) -> f64 {
     let qu = column_basis(du, u);
     let qv = column_basis(dv, v);
     let cores: Vec<DMatrix<f64>> = data.coords.iter().map(|d| qu.tr_mul(d) * &qv).collect();
@@ -196,6 +220,8 @@ pub struct BezierParamProblem {
     pub dv: usize,
     pub layout: Layout,
     pub points: Vec<Point3>,
+    /// sum_k |P_k|^2.
+    norm2: f64,
     grid: Option<GridData>,
     start: Vec<f64>,
     lo: Vec<f64>,
@@ -237,6 +263,7 @@ impl BezierParamProblem {
             du,
             dv,
             layout,
+            norm2: points.iter().flat_map(|p| p.iter()).map(|c| c * c).sum(),
             points,
             grid,
             start,
@@ -275,17 +302,24 @@ impl Problem for BezierParamProblem {
         (&self.lo, &self.hi)
     }
     fn fitness(&self, x: &[f64]) -> f64 {
-        let clamped: Vec<f64> = x.iter().map(|t| t.clamp(0.0, 1.0)).collect();
-        let y = match (self.layout, &self.grid) {
-            (Layout::Grid { nu, nv }, Some(data)) => {
-                let mut u = clamped[..nu].to_vec();
-                let mut v = clamped[nu..nu + nv].to_vec();
-                u.sort_by(f64::total_cmp);
-                v.sort_by(f64::total_cmp);
-                grid_sse(self.du, self.dv, &u, &v, data)
-            }
-            _ => self.fit(&clamped).map(|(_, y)| y).unwrap_or(f64::INFINITY),
-        };
+        let y = fast::with_scratch(|s| {
+            let mut xs = std::mem::take(&mut s.x);
+            xs.clear();
+            xs.extend(x.iter().map(|t| t.clamp(0.0, 1.0)));
+            let y = match (self.layout, &self.grid) {
+                (Layout::Grid { nu, nv }, Some(data)) => {
+                    xs[..nu].sort_by(f64::total_cmp);
+                    xs[nu..nu + nv].sort_by(f64::total_cmp);
+                    let (u, v) = (&xs[..nu], &xs[nu..nu + nv]);
+                    fast::grid_sse(self.du, self.dv, u, v, data, s)
+                        .unwrap_or_else(|| grid_sse_qr(self.du, self.dv, u, v, data))
+                }
+                _ => fast::scattered_sse(self.du, self.dv, &xs, &self.points, self.norm2, s)
+                    .unwrap_or_else(|| self.fit(&xs).map(|(_, y)| y).unwrap_or(f64::INFINITY)),
+            };
+            s.x = xs;
+            y
+        });
         if y.is_finite() {
             y
         } else {
