@@ -47,6 +47,8 @@
 // Index loops over several parallel arrays read more plainly than zipped iterators here.
 #![allow(clippy::needless_range_loop)]
 
+mod refine;
+
 use super::OptimError;
 use crate::geom::Point3;
 
@@ -1129,6 +1131,9 @@ pub fn solve_exact(
         }
     }
     if !closed(best.f, best.lb) {
+        refine::refine(&mut ws, &best.x.clone(), &mut best, &mut sc, &closed);
+    }
+    if !closed(best.f, best.lb) {
         pb.residuals(&best.x, &mut it.r);
         polish(&mut ws, &best.x.clone(), &it.r, &mut best, &mut sc);
     }
@@ -1155,11 +1160,11 @@ mod tests {
     use rand_chacha::ChaCha8Rng;
 
     /// A plain sum of norms with explicit sparse rows.
-    struct Plain {
-        n: usize,
-        points: Vec<Vec<usize>>,
-        coefs: Vec<Vec<f64>>,
-        data: Vec<Point3>,
+    pub(super) struct Plain {
+        pub(super) n: usize,
+        pub(super) points: Vec<Vec<usize>>,
+        pub(super) coefs: Vec<Vec<f64>>,
+        pub(super) data: Vec<Point3>,
     }
 
     impl SumOfNorms for Plain {
