@@ -34,15 +34,18 @@
 //! the primal step is below the resolution of f. The best point and the best bound are kept.
 //! Limit (f64): the residual of a term the optimum interpolates is known to ~1e-17 absolute, and
 //! its dual y = r / s divides that by mu, so the certified gap bottoms out near 1e-6 absolute.
-//! When the loop ends uncertified, a dual polish at the best point tries again: for a ladder of
-//! thresholds tau, terms with |r_k| <= tau are open (any y_k in the unit ball) and the others
-//! hold a unit y_k that may turn; Newton's method on the dual (weights I / tau and
+//! When the loop ends uncertified, an active-set refinement (`refine`) runs at the best point:
+//! the terms with |r_k| near 0 are taken as interpolated (r_k = 0, open dual y_k), the others keep
+//! y_k = r_k / |r_k| exactly, and Newton's method on that square system moves x and y together,
+//! damped until the certified gap falls (ch6_beyond full: every `nurbs_book` 18x18 cell from
+//! 7e-6..3e-5 to 1.3e-8..7.6e-8). If that does not close the gap either, a dual polish at the best
+//! point tries again: for a ladder of thresholds tau, terms with |r_k| <= tau are open and the
+//! others hold a unit y_k that may turn; Newton's method on the dual (weights I / tau and
 //! (I - u u^T) / |r_k|) drives g = A^T y to 0 off the bounds, and each round's y is certified.
-//! With the Jacobi-scaled Cholesky it drives g off the bounds to ~1e-16 (ch6_beyond nurbs_book
-//! talus 18x18), but the data-box gaps of the near-square nets stay at 7e-6 to 3e-5: what is
-//! left is the cost of the turns of fixed terms with |r_k| ~ 1e-2 (see docs/speed.md). The returned bound is LB of the returned dual
-//! point, which `certify_dual` re-evaluates independently of the solver.
-//! The primal value f is far more accurate than the certified gap in those cases.
+//! What is left (docs/speed.md): in the optimisers' box B +- 5e-6 the `nurbs_book` 18x18 nets
+//! stop at the Newton step cap with most coordinates on a bound, too far from the optimum for
+//! the refinement's split, and certify only 9e-7 to 3e-6. The returned bound is LB of the
+//! returned dual point, which `certify_dual` re-evaluates independently of the solver.
 
 // Index loops over several parallel arrays read more plainly than zipped iterators here.
 #![allow(clippy::needless_range_loop)]
