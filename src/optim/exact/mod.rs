@@ -20,7 +20,11 @@
 //! back with an Armijo search along the projection arc. The Hessian
 //! sum_k A_k^T (I - r r^T / s^2) / s A_k (s the smoothed norm) is sparse; an envelope Cholesky
 //! factorises it in an order with a narrow profile (the problem may supply one, else reverse
-//! Cuthill-McKee), with two steps of iterative refinement. Newton copes with the conditioning of
+//! Cuthill-McKee), with two steps of iterative refinement. The matrix is Jacobi-scaled by powers
+//! of two before the factorisation (exact in f64) so that its small shift is relative to each
+//! row's own diagonal: the corner control points of near-square nets under the `nurbs_book`
+//! knots have basis columns ~5e-4 of the largest, and a shift relative to the largest diagonal
+//! flattened their curvature (ch6_beyond talus 18x18: 300 Newton steps before, 49 after). Newton copes with the conditioning of
 //! near-square control nets (~1e7 for an 18x18 net on a 20x20 grid) where first-order methods
 //! stall.
 //!
@@ -30,18 +34,23 @@
 //! the primal step is below the resolution of f. The best point and the best bound are kept.
 //! Limit (f64): the residual of a term the optimum interpolates is known to ~1e-17 absolute, and
 //! its dual y = r / s divides that by mu, so the certified gap bottoms out near 1e-6 absolute.
-//! When the loop ends uncertified, a dual polish at the best point tries again: for a ladder of
-//! thresholds tau, terms with |r_k| <= tau are open (any y_k in the unit ball) and the others
-//! hold a unit y_k that may turn; Newton's method on the dual (weights I / tau and
+//! When the loop ends uncertified, an active-set refinement (`refine`) runs at the best point:
+//! the terms with |r_k| near 0 are taken as interpolated (r_k = 0, open dual y_k), the others keep
+//! y_k = r_k / |r_k| exactly, and Newton's method on that square system moves x and y together,
+//! damped until the certified gap falls (ch6_beyond full: every `nurbs_book` 18x18 cell from
+//! 7e-6..3e-5 to 1.3e-8..7.6e-8). If that does not close the gap either, a dual polish at the best
+//! point tries again: for a ladder of thresholds tau, terms with |r_k| <= tau are open and the
+//! others hold a unit y_k that may turn; Newton's method on the dual (weights I / tau and
 //! (I - u u^T) / |r_k|) drives g = A^T y to 0 off the bounds, and each round's y is certified.
-//! It lowers the data-box gaps of the near-square nets (ch6_beyond nurbs_book 18x18 sphere
-//! 2.0e-5 -> 6.4e-6) but does not reach 1e-6 there: the weighted system is too ill-conditioned
-//! for the shifted Cholesky (see docs/speed.md). The returned bound is LB of the returned dual
-//! point, which `certify_dual` re-evaluates independently of the solver.
-//! The primal value f is far more accurate than the certified gap in those cases.
+//! What is left (docs/speed.md): in the optimisers' box B +- 5e-6 the `nurbs_book` 18x18 nets
+//! stop at the Newton step cap with most coordinates on a bound, too far from the optimum for
+//! the refinement's split, and certify only 9e-7 to 3e-6. The returned bound is LB of the
+//! returned dual point, which `certify_dual` re-evaluates independently of the solver.
 
 // Index loops over several parallel arrays read more plainly than zipped iterators here.
 #![allow(clippy::needless_range_loop)]
+
+mod refine;
 
 use super::OptimError;
 use crate::geom::Point3;
@@ -374,8 +383,8 @@ fn reverse_cuthill_mckee(adj: &[Vec<usize>]) -> Vec<usize> {
 /// A stage also ends when the Newton decrement falls below this fraction of the smoothing gap.
 const STAGE_TOL: f64 = 1e-6;
 
-/// Diagonal shift of the Hessian, relative to its largest diagonal entry (grown x100 on a
-/// failed factorisation).
+/// Diagonal shift of the Hessian, relative to each diagonal entry (grown x100 on a failed
+/// factorisation).
 const SHIFT: f64 = 1e-14;
 
 /// Iterative-refinement steps of each Newton solve.
@@ -525,6 +534,8 @@ struct Workspace<'a> {
     skip: Vec<bool>,
     /// The largest data norm or bound magnitude (for absolute tolerances).
     scale: f64,
+    /// The Jacobi scaling of each row (elimination order) of the last factorisation.
+    jac: Vec<f64>,
 }
 
 impl<'a> Workspace<'a> {
@@ -563,7 +574,16 @@ impl<'a> Workspace<'a> {
             scale = scale.max(lower[j].abs()).max(upper[j].abs());
         }
         let env = Envelope::new(first);
-        Ok(Workspace { pb, lower, upper, pos, env, skip: vec![false; n], scale: scale.max(1e-300) })
+        Ok(Workspace {
+            pb,
+            lower,
+            upper,
+            pos,
+            env,
+            skip: vec![false; n],
+            scale: scale.max(1e-300),
+            jac: vec![1.0; n],
+        })
     }
 
     /// Leave the coordinates with `out[j]` (coordinate order) out of the next system.
@@ -608,27 +628,42 @@ impl<'a> Workspace<'a> {
         }
     }
 
-    /// Cholesky of the assembled matrix with the skipped rows set to the largest diagonal and
-    /// every diagonal shifted by `shift` times it (grown x100 on a failure, 12 tries).
+    /// Cholesky of the assembled matrix M after Jacobi scaling by powers of two (rows and columns
+    /// times j_q ~ 1 / sqrt(M_qq), exact in f64), with the skipped rows set to 1 and every
+    /// diagonal shifted by `shift` (grown x100 on a failure, 12 tries). The shift is then relative
+    /// to each row's own diagonal: control points whose basis weights are tiny (the corners of
+    /// near-square nets, columns ~5e-4 of the largest) keep their own curvature.
     fn factorise(&mut self, shift: f64) -> bool {
         let n = self.skip.len();
-        let mut max_diag: f64 = 0.0;
         for q in 0..n {
-            max_diag = max_diag.max(self.env.val[self.env.at(q, q)]);
+            let d = self.env.val[self.env.at(q, q)];
+            // 2^round(-log2(d) / 2): scaling by it rounds nothing.
+            self.jac[q] = if self.skip[q] || d.is_nan() || d <= 0.0 {
+                1.0
+            } else {
+                (-(d.log2() / 2.0).round()).exp2()
+            };
+        }
+        for r in 0..n {
+            let (fr, jr) = (self.env.first[r], self.jac[r]);
+            let base = self.env.start[r] - fr;
+            for c in fr..=r {
+                self.env.val[base + c] *= jr * self.jac[c];
+            }
         }
         for q in 0..n {
-            if self.skip[q] {
-                let at = self.env.at(q, q);
-                self.env.val[at] = max_diag.max(f64::MIN_POSITIVE);
+            let at = self.env.at(q, q);
+            if self.skip[q] || self.env.val[at].is_nan() || self.env.val[at] <= 0.0 {
+                self.env.val[at] = 1.0;
             }
         }
         let backup = self.env.val.clone();
-        let mut s = shift * max_diag.max(1e-300);
+        let mut s = shift;
         for _ in 0..12 {
             self.env.val.copy_from_slice(&backup);
             for q in 0..n {
                 let at = self.env.at(q, q);
-                self.env.val[at] += s;
+                self.env.val[at] *= 1.0 + s;
             }
             if self.env.factorise().is_ok() {
                 return true;
@@ -643,14 +678,14 @@ impl<'a> Workspace<'a> {
         for (p, &q) in self.pos.iter().enumerate() {
             for c in 0..3 {
                 let row = 3 * q + c;
-                buf[row] = if self.skip[row] { 0.0 } else { b[3 * p + c] };
+                buf[row] = if self.skip[row] { 0.0 } else { b[3 * p + c] * self.jac[row] };
             }
         }
         self.env.solve(buf);
         for (p, &q) in self.pos.iter().enumerate() {
             for c in 0..3 {
                 let row = 3 * q + c;
-                out[3 * p + c] = if self.skip[row] { 0.0 } else { buf[row] };
+                out[3 * p + c] = if self.skip[row] { 0.0 } else { buf[row] * self.jac[row] };
             }
         }
     }
@@ -904,8 +939,9 @@ fn predictor(ws: &Workspace, it: &mut Iterate, mu: f64, mu_next: f64, sc: &mut S
     }
 }
 
-/// Polish rounds (free terms whose y_k leaves the unit ball are fixed on its boundary).
-const POLISH_ROUNDS: usize = 4;
+/// At most this many polish rounds per threshold (free terms whose y_k leaves the unit ball are
+/// fixed on its boundary); they stop early when the bound stops rising.
+const POLISH_ROUNDS: usize = 12;
 
 /// Thresholds tau / (f / m) below which a term counts as near zero, tried in turn.
 const POLISH_LADDER: [f64; 7] = [1e-14, 1e-12, 1e-10, 1e-8, 1e-6, 1e-4, 1e-2];
@@ -954,7 +990,8 @@ fn weighted_apply(
 /// y_k (W_k = I / tau). Each round solves (A^T W A) d = -A^T y on the coordinates off their bounds
 /// and sets y <- y + W A d, which makes g = A^T y vanish there to first order; turned y_k are
 /// put back on the unit sphere (y_k . r_k stays ~|r_k|: turning is second order) and free y_k
-/// that left the unit ball are fixed in their direction. Every round's y is certified.
+/// that left the unit ball are fixed in their direction. Every round's y is certified; the
+/// rounds stop when two running have not raised the bound (each is a refinement of the last).
 fn polish_with(
     ws: &mut Workspace,
     x: &[f64],
@@ -974,6 +1011,7 @@ fn polish_with(
         (fixed[k], wt[k]) = (true, 1.0 / nr);
     }
     let mut blocks = vec![[[0.0; 3]; 3]; m];
+    let (mut best_here, mut stale) = (f64::NEG_INFINITY, 0);
     for _ in 0..POLISH_ROUNDS {
         for k in 0..m {
             let u = if fixed[k] { y[k] } else { [0.0; 3] };
@@ -1022,6 +1060,15 @@ fn polish_with(
         yc.copy_from_slice(&y);
         let lb = lower_bound_with(yc, r, x, ws.lower, ws.upper, pb, &mut sc.vn[0]);
         best.offer_dual(lb, yc);
+        // Stop when two rounds running did not raise the bound.
+        if lb > best_here {
+            (best_here, stale) = (lb, 0);
+        } else {
+            stale += 1;
+            if stale >= 2 {
+                break;
+            }
+        }
     }
 }
 
@@ -1087,6 +1134,9 @@ pub fn solve_exact(
         }
     }
     if !closed(best.f, best.lb) {
+        refine::refine(&mut ws, &best.x.clone(), &mut best, &mut sc, &closed);
+    }
+    if !closed(best.f, best.lb) {
         pb.residuals(&best.x, &mut it.r);
         polish(&mut ws, &best.x.clone(), &it.r, &mut best, &mut sc);
     }
@@ -1113,11 +1163,11 @@ mod tests {
     use rand_chacha::ChaCha8Rng;
 
     /// A plain sum of norms with explicit sparse rows.
-    struct Plain {
-        n: usize,
-        points: Vec<Vec<usize>>,
-        coefs: Vec<Vec<f64>>,
-        data: Vec<Point3>,
+    pub(super) struct Plain {
+        pub(super) n: usize,
+        pub(super) points: Vec<Vec<usize>>,
+        pub(super) coefs: Vec<Vec<f64>>,
+        pub(super) data: Vec<Point3>,
     }
 
     impl SumOfNorms for Plain {
