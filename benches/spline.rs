@@ -121,6 +121,7 @@ fn bezier_fitness() {
             (0..64).map(|_| (0..dim).map(|_| rng.gen_range(0.0..1.0)).collect()).collect();
         let prob = BezierParamProblem::new(d, d, layout, pts, xs[0].clone()).unwrap();
         let t = Instant::now();
+        let c0 = runner::thread_cpu_seconds();
         let mut n = 0u64;
         let mut acc = 0.0;
         while t.elapsed().as_secs_f64() < 1.0 {
@@ -128,10 +129,12 @@ fn bezier_fitness() {
             n += 1;
         }
         let secs = t.elapsed().as_secs_f64();
+        let cpu = runner::thread_cpu_seconds() - c0;
         println!(
-            "{name}: {:.0} evaluations/s ({:.1} us each; checksum {acc:.3e})",
+            "{name}: {:.0} evaluations/s ({:.1} us each, {:.1} us CPU; checksum {acc:.3e})",
             n as f64 / secs,
-            1e6 * secs / n as f64
+            1e6 * secs / n as f64,
+            1e6 * cpu / n as f64
         );
         if let Layout::Grid { .. } = layout {
             let t = Instant::now();

@@ -1,14 +1,20 @@
 //! Allocation-free least-squares Y for the parameter search (seed 003's fitness): the grid layout
-//! by the separable projection with small stack-style Householder QRs, the scattered layout by the
-//! normal equations of the (du+1)(dv+1)-unknown Bernstein system built from the tensor structure.
+//! by the separable projection with small Householder QRs, the scattered layout by the normal
+//! equations of the (du+1)(dv+1)-unknown Bernstein system built from the tensor structure.
 //! Both return `None` when the system is (nearly) rank deficient, and the caller then takes the
 //! SVD paths of the parent module, so rank deficiency behaves exactly as there (minimum norm).
 //!
-//! Determinism: every loop is plain IEEE multiplies and adds in a fixed order (no `mul_add`, no
-//! reassociation); the dot products over the points keep 8 fixed partial sums (lane k mod 8)
-//! combined in a fixed tree. The AVX2 copy is the same Rust compiled with `target_feature(avx2)`
-//! (wider vectors only; rustc never fuses a multiply and an add on its own), so the copies give
-//! the same bits; `SOMNURBS_SIMD=scalar` forces the baseline copy.
+//! The bulk of the work is two products of matrices stored as rows of a common padded length
+//! ([`gemm_nt`]: the 11 x 11 moments and the right-hand sides of the scattered layout, Qu^T D and
+//! (Qu^T D) Qv of the grids), the grids' Householder QRs run column-major over the same padded
+//! columns, so every hot loop is 4 lanes over the points.
+//!
+//! Determinism: every sum has a fixed order written in the code: the long dot products keep 4
+//! partial sums (entry k into lane k mod 4, each a chain of fused multiply-adds `f64::mul_add`,
+//! one rounding in every copy) combined as (s0 + s2) + (s1 + s3). The AVX2 + FMA and AVX-512VL
+//! copies are the same Rust compiled with `target_feature` (wider vectors and hardware FMA only;
+//! rustc never reassociates), so all copies give the same bits; `SOMNURBS_SIMD=scalar` forces the
+//! baseline copy (whose `mul_add` is the C library's correctly rounded `fma`, slow but identical).
 
 use super::GridData;
 use crate::geom::Point3;
@@ -18,8 +24,11 @@ use std::cell::RefCell;
 const MAXD: usize = 15;
 /// Length of the stack Bernstein buffers (degree 2 * MAXD).
 const MAXB: usize = 2 * MAXD + 1;
-/// Padding of the per-point rows (a multiple of the dot products' 8 lanes).
-const LANES: usize = 16;
+/// Padding of the per-point rows and grid columns (a multiple of [`W`] and of the 8-point
+/// chunks of [`basis_rows`]).
+const LANES: usize = 8;
+/// Lanes of the long dot products: entry k adds into partial sum k mod W.
+const W: usize = 4;
 /// Relative Cholesky pivot below which the normal equations are refused (SVD fallback): the
 /// squared pivot L_ii^2 must exceed `PIVOT_REL` times the largest diagonal entry of G, which
 /// bounds cond(G) from below by 1 / PIVOT_REL before the factorisation is trusted.
@@ -46,6 +55,7 @@ pub(super) struct Scratch {
     qa: Vec<f64>,
     qb: Vec<f64>,
     t: Vec<f64>,
+    pv: Vec<f64>,
 }
 
 thread_local! {
@@ -63,33 +73,60 @@ fn grow(v: &mut Vec<f64>, n: usize) {
     }
 }
 
-/// Whether the AVX2 copies run (the optimisers' `SOMNURBS_SIMD` choice).
-fn avx2() -> bool {
+/// The length of a padded row or column of n entries (the next multiple of [`LANES`]).
+pub(super) fn padded(n: usize) -> usize {
+    n.div_ceil(LANES) * LANES
+}
+
+/// Which compiled copy runs (the optimisers' `SOMNURBS_SIMD` choice): 2 = AVX-512VL,
+/// 1 = AVX2 + FMA, 0 = baseline.
+fn copy() -> u8 {
     #[cfg(target_arch = "x86_64")]
     {
-        crate::optim::kernels::use_avx2()
+        if crate::optim::kernels::use_avx512() {
+            2
+        } else {
+            u8::from(crate::optim::kernels::use_avx2())
+        }
     }
     #[cfg(not(target_arch = "x86_64"))]
     {
-        false
+        0
     }
 }
 
-/// Binomial coefficient C(n, k) as f64 (exact for the degrees here).
-fn binom(n: usize, k: usize) -> f64 {
-    (0..k).fold(1.0, |acc, j| acc * (n - j) as f64 / (j + 1) as f64)
+/// Binomial coefficient C(n, k) = prod_j (n - j) / (j + 1) as f64 (exact for the degrees here).
+const fn binom(n: usize, k: usize) -> f64 {
+    let mut acc = 1.0;
+    let mut j = 0;
+    while j < k {
+        acc = acc * (n - j) as f64 / (j + 1) as f64;
+        j += 1;
+    }
+    acc
 }
+
+/// C(n, k) for n, k < [`MAXB`] (zero for k > n), evaluated at compile time.
+const BINOM: [[f64; MAXB]; MAXB] = {
+    let mut t = [[0.0; MAXB]; MAXB];
+    let mut n = 0;
+    while n < MAXB {
+        let mut k = 0;
+        while k <= n {
+            t[n][k] = binom(n, k);
+            k += 1;
+        }
+        n += 1;
+    }
+    t
+};
 
 /// w^n_ac = C(n,a) C(n,c) / C(2n,a+c) for a, c in 0..=n, row-major (n+1) x (n+1).
 fn product_weights(n: usize, w: &mut [f64; (MAXD + 1) * (MAXD + 1)]) {
     let mut b = [0.0f64; MAXB];
     let mut b2 = [0.0f64; MAXB];
-    for i in 0..=n {
-        b[i] = binom(n, i);
-    }
-    for i in 0..=2 * n {
-        b2[i] = binom(2 * n, i);
-    }
+    b[..=n].copy_from_slice(&BINOM[n][..=n]);
+    b2[..=2 * n].copy_from_slice(&BINOM[2 * n][..=2 * n]);
     for a in 0..=n {
         for c in 0..=n {
             w[a * (n + 1) + c] = b[a] * b[c] / b2[a + c];
@@ -97,61 +134,218 @@ fn product_weights(n: usize, w: &mut [f64; (MAXD + 1) * (MAXD + 1)]) {
     }
 }
 
-/// Bernstein polynomials B^n_i(t_k) = C(n,i) t^i (1-t)^(n-i) for every t_k, stored i-major
-/// (row i holds all k, `stride` apart); rows padded with zeros past `t.len()`.
+/// Bernstein polynomials B^n_i(t_k) = C(n,i) (t^i (1-t)^(n-i)) for every t_k, stored i-major
+/// (row i holds all k, `stride` apart, a multiple of 8); rows padded with zeros past `t.len()`.
+/// With `out2`, the degree-2n rows too, from the same powers (t^i and (1-t)^j by repeated
+/// multiplication, 8 points at a time).
 #[inline(always)]
-fn basis_rows(n: usize, t: &[f64], stride: usize, out: &mut [f64]) {
+fn basis_rows(n: usize, t: &[f64], stride: usize, out: &mut [f64], mut out2: Option<&mut [f64]>) {
     let np = t.len();
-    let mut binoms = [0.0f64; MAXB];
-    for (i, b) in binoms[..=n].iter_mut().enumerate() {
-        *b = binom(n, i);
-    }
-    // lane by lane over chunks of 8 points (t padded with zeros): t^i up, then (1-t)^(n-i) down
+    let top = if out2.is_some() { 2 * n } else { n };
     let mut tpad = [0.0f64; 8];
+    let mut pt = [[0.0f64; 8]; MAXB];
+    let mut ps = [[0.0f64; 8]; MAXB];
     for k0 in (0..stride).step_by(8) {
         let m = np.saturating_sub(k0).min(8);
         tpad.fill(0.0);
         if m > 0 {
             tpad[..m].copy_from_slice(&t[k0..k0 + m]);
         }
-        let mut tp = [1.0f64; 8];
-        for i in 0..=n {
-            out[i * stride + k0..i * stride + k0 + 8].copy_from_slice(&tp);
-            for l in 0..8 {
-                tp[l] *= tpad[l];
-            }
+        let mut s1 = [0.0f64; 8];
+        for l in 0..8 {
+            s1[l] = 1.0 - tpad[l];
         }
-        let mut sp = [1.0f64; 8];
-        for i in (0..=n).rev() {
-            let w = binoms[i];
+        let (mut a, mut b) = ([1.0f64; 8], [1.0f64; 8]);
+        pt[0] = a;
+        ps[0] = b;
+        for i in 1..=top {
+            for l in 0..8 {
+                a[l] *= tpad[l];
+                b[l] *= s1[l];
+            }
+            pt[i] = a;
+            ps[i] = b;
+        }
+        for i in 0..=n {
+            let w = BINOM[n][i];
             let row = &mut out[i * stride + k0..i * stride + k0 + 8];
             for l in 0..8 {
-                row[l] = w * (row[l] * sp[l]);
-                sp[l] *= 1.0 - tpad[l];
+                row[l] = w * (pt[i][l] * ps[n - i][l]);
+            }
+        }
+        if let Some(o2) = out2.as_deref_mut() {
+            for i in 0..=2 * n {
+                let w = BINOM[2 * n][i];
+                let row = &mut o2[i * stride + k0..i * stride + k0 + 8];
+                for l in 0..8 {
+                    row[l] = w * (pt[i][l] * ps[2 * n - i][l]);
+                }
             }
         }
     }
     for i in 0..=n {
         out[i * stride + np..(i + 1) * stride].fill(0.0);
     }
+    if let Some(o2) = out2 {
+        for i in 0..=2 * n {
+            o2[i * stride + np..(i + 1) * stride].fill(0.0);
+        }
+    }
 }
 
-/// The R dot products sum_k a_k b_rk over a multiple of 8 entries, each in 8 fixed partial sums
-/// (lane k mod 8) combined in a fixed tree; R rows at once share the loads of `a` (the value of
-/// each product does not depend on R).
+/// The dot product sum_k a_k b_k of two equally long slices in [`W`] partial sums (entry k into
+/// lane k mod W by fused multiply-adds, whole chunks only), (s0 + s2) + (s1 + s3), then the
+/// remainder in order.
 #[inline(always)]
-fn dots<const R: usize>(a: &[f64], b: [&[f64]; R]) -> [f64; R] {
-    let b = b.map(|r| &r[..a.len()]);
-    let mut acc = [[0.0f64; 8]; R];
-    for (ch, x) in a.chunks_exact(8).enumerate() {
-        for r in 0..R {
-            let y = &b[r][ch * 8..ch * 8 + 8];
-            for l in 0..8 {
-                acc[r][l] += x[l] * y[l];
+fn dot4(a: &[f64], b: &[f64]) -> f64 {
+    let b = &b[..a.len()];
+    let (ac, at) = a.as_chunks::<W>();
+    let (bc, bt) = b.as_chunks::<W>();
+    let mut h = [0.0f64; W];
+    for (x, y) in ac.iter().zip(bc) {
+        for l in 0..W {
+            h[l] = x[l].mul_add(y[l], h[l]);
+        }
+    }
+    let mut t = (h[0] + h[2]) + (h[1] + h[3]);
+    for (x, y) in at.iter().zip(bt) {
+        t = x.mul_add(*y, t);
+    }
+    t
+}
+
+/// out[i os + j] = sum_k a_ik b_jk for the `ra` rows of `a` and the `rb` rows of `b` (row-major,
+/// rows `len` long, len a multiple of [`W`]): each sum in W partial sums (entry k into lane
+/// k mod W, a chain of fused multiply-adds), combined as (s0 + s2) + (s1 + s3). Blocks of
+/// 2 x 4 rows share their loads in registers; the value of every sum is independent of the
+/// blocking (edge blocks repeat the last row and drop its results). `V` picks the explicit
+/// AVX2 + FMA kernel (the same lanes, the same bits) in the vector copies.
+#[inline(always)]
+fn gemm_nt<const V: bool>(
+    a: &[f64],
+    ra: usize,
+    b: &[f64],
+    rb: usize,
+    len: usize,
+    out: &mut [f64],
+    os: usize,
+) {
+    assert!(
+        len.is_multiple_of(W) && ra > 0 && rb > 0 && a.len() >= ra * len && b.len() >= rb * len
+    );
+    assert!(out.len() > (ra - 1) * os + rb - 1);
+    #[cfg(target_arch = "x86_64")]
+    if V {
+        // SAFETY: V is only set by the copies compiled with AVX2 + FMA; the sizes are checked.
+        unsafe { gemm_nt_avx2(a, ra, b, rb, len, out, os) };
+        return;
+    }
+    gemm_nt_scalar(a, ra, b, rb, len, out, os)
+}
+
+/// [`gemm_nt`]'s 2 x 4 register blocks in AVX2 + FMA registers: lane l of each accumulator is
+/// partial sum l; loads through raw pointers (the caller checked every row fits).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn gemm_nt_avx2(
+    a: &[f64],
+    ra: usize,
+    b: &[f64],
+    rb: usize,
+    len: usize,
+    out: &mut [f64],
+    os: usize,
+) {
+    use std::arch::x86_64::*;
+    let (pa, pb) = (a.as_ptr(), b.as_ptr());
+    for i0 in (0..ra).step_by(2) {
+        let a0 = pa.add(i0 * len);
+        let a1 = pa.add((i0 + 1).min(ra - 1) * len);
+        for j0 in (0..rb).step_by(4) {
+            let b0 = pb.add(j0 * len);
+            let b1 = pb.add((j0 + 1).min(rb - 1) * len);
+            let b2 = pb.add((j0 + 2).min(rb - 1) * len);
+            let b3 = pb.add((j0 + 3).min(rb - 1) * len);
+            let mut acc = [_mm256_setzero_pd(); 8];
+            for k in (0..len).step_by(W) {
+                let (x0, x1) = (_mm256_loadu_pd(a0.add(k)), _mm256_loadu_pd(a1.add(k)));
+                let y = _mm256_loadu_pd(b0.add(k));
+                acc[0] = _mm256_fmadd_pd(x0, y, acc[0]);
+                acc[4] = _mm256_fmadd_pd(x1, y, acc[4]);
+                let y = _mm256_loadu_pd(b1.add(k));
+                acc[1] = _mm256_fmadd_pd(x0, y, acc[1]);
+                acc[5] = _mm256_fmadd_pd(x1, y, acc[5]);
+                let y = _mm256_loadu_pd(b2.add(k));
+                acc[2] = _mm256_fmadd_pd(x0, y, acc[2]);
+                acc[6] = _mm256_fmadd_pd(x1, y, acc[6]);
+                let y = _mm256_loadu_pd(b3.add(k));
+                acc[3] = _mm256_fmadd_pd(x0, y, acc[3]);
+                acc[7] = _mm256_fmadd_pd(x1, y, acc[7]);
+            }
+            for (m, am) in acc.chunks_exact(4).enumerate().take(ra - i0) {
+                for (n, v) in am.iter().enumerate().take(rb - j0) {
+                    let mut h = [0.0f64; W];
+                    _mm256_storeu_pd(h.as_mut_ptr(), *v);
+                    out[(i0 + m) * os + j0 + n] = (h[0] + h[2]) + (h[1] + h[3]);
+                }
             }
         }
     }
-    acc.map(|h| ((h[0] + h[4]) + (h[2] + h[6])) + ((h[1] + h[5]) + (h[3] + h[7])))
+}
+
+/// [`gemm_nt`] in portable Rust (the baseline copy's kernel).
+#[inline(always)]
+fn gemm_nt_scalar(
+    a: &[f64],
+    ra: usize,
+    b: &[f64],
+    rb: usize,
+    len: usize,
+    out: &mut [f64],
+    os: usize,
+) {
+    const MR: usize = 2;
+    const NR: usize = 4;
+    let nc = len / W;
+    #[inline(always)]
+    fn row(m: &[f64], i: usize, len: usize, nc: usize) -> &[[f64; W]] {
+        &m[i * len..(i + 1) * len].as_chunks().0[..nc]
+    }
+    for i0 in (0..ra).step_by(MR) {
+        let mut ar: [&[[f64; W]]; MR] = [&[]; MR];
+        for (m, r) in ar.iter_mut().enumerate() {
+            *r = row(a, (i0 + m).min(ra - 1), len, nc);
+        }
+        for j0 in (0..rb).step_by(NR) {
+            let mut br: [&[[f64; W]]; NR] = [&[]; NR];
+            for (n, r) in br.iter_mut().enumerate() {
+                *r = row(b, (j0 + n).min(rb - 1), len, nc);
+            }
+            let mut acc = [[[0.0f64; W]; NR]; MR];
+            for c in 0..nc {
+                let mut xa = [[0.0f64; W]; MR];
+                let mut xb = [[0.0f64; W]; NR];
+                for m in 0..MR {
+                    xa[m] = ar[m][c];
+                }
+                for n in 0..NR {
+                    xb[n] = br[n][c];
+                }
+                for m in 0..MR {
+                    for n in 0..NR {
+                        for l in 0..W {
+                            acc[m][n][l] = xa[m][l].mul_add(xb[n][l], acc[m][n][l]);
+                        }
+                    }
+                }
+            }
+            for (m, am) in acc.iter().enumerate().take(ra - i0) {
+                for (n, h) in am.iter().enumerate().take(rb - j0) {
+                    out[(i0 + m) * os + j0 + n] = (h[0] + h[2]) + (h[1] + h[3]);
+                }
+            }
+        }
+    }
 }
 
 /// Y of the least-squares degree-(du, dv) Bezier surface through scattered `pts` at the
@@ -173,16 +367,19 @@ pub(super) fn scattered_sse(
         return None;
     }
     #[cfg(target_arch = "x86_64")]
-    if avx2() {
-        // SAFETY: AVX2 is present (checked by the dispatcher).
-        return unsafe { scattered_sse_avx2(du, dv, x, pts, p2, s) };
+    match copy() {
+        // SAFETY: the dispatcher checked that the CPU has the copy's features.
+        2 => return unsafe { scattered_sse_avx512(du, dv, x, pts, p2, s) },
+        1 => return unsafe { scattered_sse_avx2(du, dv, x, pts, p2, s) },
+        _ => {}
     }
-    scattered_sse_body(du, dv, x, pts, p2, s)
+    scattered_sse_body::<false>(du, dv, x, pts, p2, s)
 }
 
+/// [`scattered_sse_body`] compiled for AVX2 + FMA.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn scattered_sse_avx2(
+#[target_feature(enable = "avx2,fma")]
+fn scattered_sse_avx2(
     du: usize,
     dv: usize,
     x: &[f64],
@@ -190,11 +387,25 @@ unsafe fn scattered_sse_avx2(
     p2: f64,
     s: &mut Scratch,
 ) -> Option<f64> {
-    scattered_sse_body(du, dv, x, pts, p2, s)
+    scattered_sse_body::<true>(du, dv, x, pts, p2, s)
+}
+
+/// [`scattered_sse_body`] compiled for AVX-512VL (256-bit vectors, 32 registers).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma,avx512f,avx512vl")]
+fn scattered_sse_avx512(
+    du: usize,
+    dv: usize,
+    x: &[f64],
+    pts: &[Point3],
+    p2: f64,
+    s: &mut Scratch,
+) -> Option<f64> {
+    scattered_sse_body::<true>(du, dv, x, pts, p2, s)
 }
 
 #[inline(always)]
-fn scattered_sse_body(
+fn scattered_sse_body<const V: bool>(
     du: usize,
     dv: usize,
     x: &[f64],
@@ -206,7 +417,7 @@ fn scattered_sse_body(
     let stride = np.div_ceil(LANES) * LANES;
     let (ku, kv) = (du + 1, dv + 1);
     let n = ku * kv;
-    moments(du, dv, x, pts, stride, s);
+    moments::<V>(du, dv, x, pts, stride, s);
     // G from the moments, g from gq (gq[(a, c), b] = sum_k bu_a P_c bv_b)
     grow(&mut s.g, n * n);
     grow(&mut s.l, n * n);
@@ -253,7 +464,14 @@ fn scattered_sse_body(
 /// The moments M (i-major (2du+1) x (2dv+1)) and gq ((du+1) * 3 rows of dv+1) of
 /// [`scattered_sse`], from i-major basis rows of all points.
 #[inline(always)]
-fn moments(du: usize, dv: usize, x: &[f64], pts: &[Point3], stride: usize, s: &mut Scratch) {
+fn moments<const V: bool>(
+    du: usize,
+    dv: usize,
+    x: &[f64],
+    pts: &[Point3],
+    stride: usize,
+    s: &mut Scratch,
+) {
     let np = pts.len();
     let (ku, kv) = (du + 1, dv + 1);
     let (ku2, kv2) = (2 * du + 1, 2 * dv + 1);
@@ -271,56 +489,35 @@ fn moments(du: usize, dv: usize, x: &[f64], pts: &[Point3], stride: usize, s: &m
     grow(&mut s.bv, kv * stride);
     grow(&mut s.bu2, ku2 * stride);
     grow(&mut s.bv2, kv2 * stride);
-    basis_rows(du, &s.q[..np], stride, &mut s.bu);
-    basis_rows(2 * du, &s.q[..np], stride, &mut s.bu2);
-    basis_rows(dv, &s.q[stride..stride + np], stride, &mut s.bv);
-    basis_rows(2 * dv, &s.q[stride..stride + np], stride, &mut s.bv2);
+    basis_rows(du, &s.q[..np], stride, &mut s.bu, Some(&mut s.bu2));
+    basis_rows(dv, &s.q[stride..stride + np], stride, &mut s.bv, Some(&mut s.bv2));
     grow(&mut s.m, ku2 * kv2);
-    fn row(m: &[f64], i: usize, stride: usize) -> &[f64] {
-        &m[i * stride..(i + 1) * stride]
-    }
-    for a in 0..ku2 {
-        let ra = row(&s.bu2, a, stride);
-        let mut b = 0;
-        while b + 4 <= kv2 {
-            let bv2 = &s.bv2;
-            let d = dots(
-                ra,
-                [
-                    row(bv2, b, stride),
-                    row(bv2, b + 1, stride),
-                    row(bv2, b + 2, stride),
-                    row(bv2, b + 3, stride),
-                ],
-            );
-            s.m[a * kv2 + b..a * kv2 + b + 4].copy_from_slice(&d);
-            b += 4;
-        }
-        for b in b..kv2 {
-            s.m[a * kv2 + b] = dots(ra, [row(&s.bv2, b, stride)])[0];
-        }
-    }
-    // gq[(a, c) * kv + b] = sum_k (bu_a(u_k) P_kc) bv_b(v_k); the product rows go to q[2..5]
-    grow(&mut s.gq, ku * 3 * kv);
-    let (_, prod) = s.q.split_at_mut(2 * stride);
-    for a in 0..ku {
-        let ra = &s.bu[a * stride..a * stride + np];
-        for co in 0..3 {
-            let row = &mut prod[co * stride..co * stride + np];
-            for ((o, ba), p) in row.iter_mut().zip(ra).zip(pts) {
-                *o = ba * p[co];
-            }
-        }
-        for b in 0..kv {
-            let d = dots(
-                row(&s.bv, b, stride),
-                [row(prod, 0, stride), row(prod, 1, stride), row(prod, 2, stride)],
-            );
+    gemm_nt::<V>(&s.bu2, ku2, &s.bv2, kv2, stride, &mut s.m, kv2);
+    // the points' coordinates as rows (q[2..5]), the rows P_c bv_b (pv, (c, b)-major), then
+    // gq[a * 3kv + c kv + b] = sum_k bu_a(u_k) (P_kc bv_b(v_k))
+    {
+        let (_, prod) = s.q.split_at_mut(2 * stride);
+        for (k, p) in pts.iter().enumerate() {
             for co in 0..3 {
-                s.gq[(a * 3 + co) * kv + b] = d[co];
+                prod[co * stride + k] = p[co];
+            }
+        }
+        for co in 0..3 {
+            prod[co * stride + np..(co + 1) * stride].fill(0.0);
+        }
+    }
+    grow(&mut s.pv, 3 * kv * stride);
+    for co in 0..3 {
+        let pc = &s.q[(2 + co) * stride..(3 + co) * stride];
+        for b in 0..kv {
+            let out = &mut s.pv[(co * kv + b) * stride..(co * kv + b + 1) * stride];
+            for ((o, p), bv) in out.iter_mut().zip(pc).zip(&s.bv[b * stride..(b + 1) * stride]) {
+                *o = p * bv;
             }
         }
     }
+    grow(&mut s.gq, ku * 3 * kv);
+    gemm_nt::<V>(&s.bu, ku, &s.pv, 3 * kv, stride, &mut s.gq, 3 * kv);
 }
 
 /// Near-exact fit: one step of iterative refinement (c += G^-1 B^T (P - B c)) and Y summed from
@@ -372,6 +569,7 @@ fn refined_residual(du: usize, dv: usize, x: &[f64], pts: &[Point3], s: &mut Scr
 /// Cholesky G = U^T U of the n x n row-major `g` into `u` (upper triangle, row j of U = column j
 /// of L), right-looking so that each step updates whole rows; false if a squared pivot U_jj^2 is
 /// at most [`PIVOT_REL`] times max_i G_ii (or not finite).
+#[inline(always)]
 fn cholesky(g: &[f64], u: &mut [f64], n: usize) -> bool {
     let dmax = (0..n).fold(0.0f64, |m, i| m.max(g[i * n + i]));
     if !(dmax > 0.0 && dmax.is_finite()) {
@@ -392,7 +590,7 @@ fn cholesky(g: &[f64], u: &mut [f64], n: usize) -> bool {
         for (i, rowi) in (j + 1..n).zip(rest.chunks_exact_mut(n)) {
             let f = rowj[i - j];
             for (x, y) in rowi[i..].iter_mut().zip(&rowj[i - j..]) {
-                *x -= f * y;
+                *x = (-f).mul_add(*y, *x);
             }
         }
     }
@@ -400,13 +598,14 @@ fn cholesky(g: &[f64], u: &mut [f64], n: usize) -> bool {
 }
 
 /// Solve U^T U c = b in place for the three right-hand sides of `c` (three rows of n).
+#[inline(always)]
 fn chol_solve(u: &[f64], n: usize, c: &mut [f64]) {
     for col in c.chunks_exact_mut(n).take(3) {
         for j in 0..n {
             let y = col[j] / u[j * n + j];
             col[j] = y;
             for (x, uj) in col[j + 1..].iter_mut().zip(&u[j * n + j + 1..(j + 1) * n]) {
-                *x -= uj * y;
+                *x = (-y).mul_add(*uj, *x);
             }
         }
         for j in (0..n).rev() {
@@ -442,75 +641,62 @@ fn dots_any<const R: usize>(a: &[f64], b: [&[f64]; R]) -> [f64; R] {
     out
 }
 
-/// Thin Q (n x k, row-major) of the Householder QR of the n x (deg+1) Bernstein collocation
-/// matrix at the sorted parameters `t` (A = Q R); `None` unless n > deg and every |R_ii| exceeds
-/// 1e-8 max |R_jj| (the test of the parent module's `column_basis`, whose SVD then takes over).
-/// Row-major throughout so that each reflector updates whole rows (vectorisable); `work` holds
-/// A (reduced in place) and then the reflectors.
+/// Thin Q of the Householder QR of the n x (deg+1) Bernstein collocation matrix A at the sorted
+/// parameters `t` (A = Q R), column-major into `q` (deg+1 columns `lp` = [`padded`](n) long, zero
+/// past n); `None` unless n > deg and every |R_jj| exceeds 1e-8 max |R_ii| (the test of the
+/// parent module's `column_basis`, whose SVD then takes over). Reflector j is
+/// H_j = I - beta_j v_j v_j^T with v_j zero above row j, kept as full padded columns so that every
+/// update is 4 lanes over the rows; `work` holds A (reduced in place) and the reflectors.
 #[inline(always)]
 fn thin_q(deg: usize, t: &[f64], q: &mut Vec<f64>, work: &mut Vec<f64>) -> Option<()> {
-    let (n, k) = (t.len(), deg + 1);
+    let (n, k, lp) = (t.len(), deg + 1, padded(t.len()));
     if n <= deg || deg > MAXD {
         return None;
     }
-    grow(work, n * k + n * k);
-    let (a, refl) = work.split_at_mut(n * k);
-    for (i, &ti) in t.iter().enumerate() {
-        super::bernstein_into(deg, ti, &mut a[i * k..(i + 1) * k]);
-    }
+    grow(work, 2 * k * lp);
+    let (a, refl) = work.split_at_mut(k * lp);
+    basis_rows(deg, t, lp, a, None); // column j of A = row j here
     let mut diag = [0.0f64; MAXB];
     let mut beta = [0.0f64; MAXB];
-    let mut f = [0.0f64; MAXB];
     for j in 0..k {
-        let v = &mut refl[j * n..(j + 1) * n];
-        for i in j..n {
-            v[i] = a[i * k + j];
-        }
-        let norm = dots_any(&v[j..], [&v[j..]])[0].sqrt();
+        let v = &mut refl[j * lp..(j + 1) * lp];
+        v.copy_from_slice(&a[j * lp..(j + 1) * lp]);
+        v[..j].fill(0.0);
+        let norm = dot4(v, v).sqrt();
         let alpha = if v[j] > 0.0 { -norm } else { norm };
         diag[j] = alpha;
         v[j] -= alpha;
-        let vv = dots_any(&v[j..], [&v[j..]])[0];
+        let vv = dot4(v, v);
         beta[j] = if vv > 0.0 { 2.0 / vv } else { 0.0 };
-        reflect(&v[j..n], beta[j], &mut a[j * k..], k, j + 1, &mut f);
+        for c in j + 1..k {
+            reflect(v, beta[j], &mut a[c * lp..(c + 1) * lp]);
+        }
     }
     let rmax = diag[..k].iter().fold(0.0f64, |m, d| m.max(d.abs()));
     if !diag[..k].iter().all(|d| d.abs() > 1e-8 * rmax) {
         return None;
     }
-    // Q = H_0 ... H_(k-1) [I; 0]; H_j only touches rows j.. and columns j.. of the partial product
-    grow(q, n * k);
-    q[..n * k].fill(0.0);
+    // Q = H_0 ... H_(k-1) [I; 0]; H_j leaves columns c < j (= e_c) unchanged
+    grow(q, k * lp);
+    q[..k * lp].fill(0.0);
     for c in 0..k {
-        q[c * k + c] = 1.0;
+        q[c * lp + c] = 1.0;
     }
     for j in (0..k).rev() {
-        reflect(&refl[j * n + j..(j + 1) * n], beta[j], &mut q[j * k..n * k], k, j, &mut f);
+        let v = &refl[j * lp..(j + 1) * lp];
+        for c in j..k {
+            reflect(v, beta[j], &mut q[c * lp..(c + 1) * lp]);
+        }
     }
     Some(())
 }
 
-/// Apply H = I - beta v v^T to the rows of the row-major block `m` (row stride k), columns
-/// c0..k: f_c = sum_i v_i m_ic, then m_ic -= (beta f_c) v_i (whole-row updates).
+/// Apply H = I - beta v v^T to the column x: x -= (beta (v . x)) v, by fused multiply-adds.
 #[inline(always)]
-fn reflect(v: &[f64], beta: f64, m: &mut [f64], k: usize, c0: usize, f: &mut [f64; MAXB]) {
-    if c0 >= k {
-        return;
-    }
-    let f = &mut f[c0..k];
-    f.fill(0.0);
-    for (vi, row) in v.iter().zip(m.chunks_exact(k)) {
-        for (fc, x) in f.iter_mut().zip(&row[c0..]) {
-            *fc += vi * x;
-        }
-    }
-    for fc in f.iter_mut() {
-        *fc *= beta;
-    }
-    for (vi, row) in v.iter().zip(m.chunks_exact_mut(k)) {
-        for (x, fc) in row[c0..].iter_mut().zip(f.iter()) {
-            *x -= fc * vi;
-        }
+fn reflect(v: &[f64], beta: f64, x: &mut [f64]) {
+    let f = -(beta * dot4(v, x));
+    for (xi, vi) in x.iter_mut().zip(v) {
+        *xi = f.mul_add(*vi, *xi);
     }
 }
 
@@ -527,16 +713,19 @@ pub(super) fn grid_sse(
     s: &mut Scratch,
 ) -> Option<f64> {
     #[cfg(target_arch = "x86_64")]
-    if avx2() {
-        // SAFETY: AVX2 is present (checked by the dispatcher).
-        return unsafe { grid_sse_avx2(du, dv, u, v, data, s) };
+    match copy() {
+        // SAFETY: the dispatcher checked that the CPU has the copy's features.
+        2 => return unsafe { grid_sse_avx512(du, dv, u, v, data, s) },
+        1 => return unsafe { grid_sse_avx2(du, dv, u, v, data, s) },
+        _ => {}
     }
-    grid_sse_body(du, dv, u, v, data, s)
+    grid_sse_body::<false>(du, dv, u, v, data, s)
 }
 
+/// [`grid_sse_body`] compiled for AVX2 + FMA.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn grid_sse_avx2(
+#[target_feature(enable = "avx2,fma")]
+fn grid_sse_avx2(
     du: usize,
     dv: usize,
     u: &[f64],
@@ -544,11 +733,25 @@ unsafe fn grid_sse_avx2(
     data: &GridData,
     s: &mut Scratch,
 ) -> Option<f64> {
-    grid_sse_body(du, dv, u, v, data, s)
+    grid_sse_body::<true>(du, dv, u, v, data, s)
+}
+
+/// [`grid_sse_body`] compiled for AVX-512VL (256-bit vectors, 32 registers).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma,avx512f,avx512vl")]
+fn grid_sse_avx512(
+    du: usize,
+    dv: usize,
+    u: &[f64],
+    v: &[f64],
+    data: &GridData,
+    s: &mut Scratch,
+) -> Option<f64> {
+    grid_sse_body::<true>(du, dv, u, v, data, s)
 }
 
 #[inline(always)]
-fn grid_sse_body(
+fn grid_sse_body<const V: bool>(
     du: usize,
     dv: usize,
     u: &[f64],
@@ -561,50 +764,43 @@ fn grid_sse_body(
         return None;
     }
     let (ku, kv) = (du + 1, dv + 1);
+    let (lu, lv) = (padded(nu), padded(nv));
     thin_q(du, u, &mut s.qa, &mut s.l)?;
     thin_q(dv, v, &mut s.qb, &mut s.l)?;
-    // T = Qu^T [D_x D_y D_z] (ku x 3 nv), rows of `data.rows` are (x row, y row, z row) of i
-    let w = 3 * nv;
+    // T = Qu^T [D_x D_y D_z]: row a holds coordinate c's nv entries at c lv.. (zero padded)
+    let w = 3 * lv;
     grow(&mut s.t, ku * w);
     s.t[..ku * w].fill(0.0);
-    for i in 0..nu {
-        let drow = &data.rows[i * w..(i + 1) * w];
-        for a in 0..ku {
-            let f = s.qa[i * ku + a];
-            for (t, d) in s.t[a * w..(a + 1) * w].iter_mut().zip(drow) {
-                *t += f * d;
-            }
-        }
-    }
-    // C_c = T_c Qv (ku x kv per coordinate), in s.c as [c][a][b]
-    grow(&mut s.c, 3 * ku * kv);
-    s.c[..3 * ku * kv].fill(0.0);
     for co in 0..3 {
-        for j in 0..nv {
-            let qrow = &s.qb[j * kv..(j + 1) * kv];
-            for a in 0..ku {
-                let f = s.t[a * w + co * nv + j];
-                let crow = &mut s.c[(co * ku + a) * kv..(co * ku + a + 1) * kv];
-                for (c, q) in crow.iter_mut().zip(qrow) {
-                    *c += f * q;
-                }
-            }
-        }
+        let dc = &data.cols[co * nv * lu..(co + 1) * nv * lu];
+        gemm_nt::<V>(&s.qa, ku, dc, nv, lu, &mut s.t[co * lv..], w);
     }
-    let kept = s.c[..3 * ku * kv].iter().fold(0.0, |acc, c| acc + c * c);
+    // C = T_c Qv: row 3a + c of T (lv long) against column b of Qv, into s.c[(3a + c) kv + b]
+    let nc = 3 * ku * kv;
+    grow(&mut s.c, nc);
+    gemm_nt::<V>(&s.t, 3 * ku, &s.qb, kv, lv, &mut s.c, kv);
+    let kept = dot4(&s.c[..nc], &s.c[..nc]);
     let y = data.norm2 - kept;
     if y > CANCEL_REL * data.norm2 {
         return Some(y);
     }
-    // residual D_c - (Qu C_c) Qv^T, with Qu C_c (nu x kv) in s.t
+    Some(grid_residual(ku, kv, data, s))
+}
+
+/// The grid's residual sum_c |D_c - Qu C_c Qv^T|^2 from the Qs and C left in the scratch by
+/// [`grid_sse_body`] (the near-exact fit, where |D|^2 - |C|^2 cancels).
+fn grid_residual(ku: usize, kv: usize, data: &GridData, s: &mut Scratch) -> f64 {
+    let (nu, nv) = (data.nu, data.nv);
+    let (lu, lv) = (padded(nu), padded(nv));
     let mut sse = 0.0;
     grow(&mut s.t, nu * kv);
     for co in 0..3 {
+        // Qu C_c (nu x kv) into s.t
         for i in 0..nu {
             for b in 0..kv {
                 let mut acc = 0.0;
                 for a in 0..ku {
-                    acc += s.qa[i * ku + a] * s.c[(co * ku + a) * kv + b];
+                    acc += s.qa[a * lu + i] * s.c[(3 * a + co) * kv + b];
                 }
                 s.t[i * kv + b] = acc;
             }
@@ -613,14 +809,14 @@ fn grid_sse_body(
             for j in 0..nv {
                 let mut fit = 0.0;
                 for b in 0..kv {
-                    fit += s.t[i * kv + b] * s.qb[j * kv + b];
+                    fit += s.t[i * kv + b] * s.qb[b * lv + j];
                 }
-                let e = data.rows[i * w + co * nv + j] - fit;
+                let e = data.cols[(co * nv + j) * lu + i] - fit;
                 sse += e * e;
             }
         }
     }
-    Some(sse)
+    sse
 }
 
 #[cfg(test)]
@@ -647,6 +843,34 @@ mod tests {
         BezierSurface { du, dv, poles }
     }
 
+    /// The AVX2 + FMA product kernel equals the portable one bit for bit, edge blocks included,
+    /// and both equal the plain sums sum_k a_ik b_jk to rounding.
+    #[test]
+    fn gemm_kernels_agree_bit_for_bit() {
+        let mut rng = ChaCha8Rng::seed_from_u64(35);
+        for (ra, rb, len) in [(1, 1, 4), (3, 5, 8), (11, 11, 632), (10, 41, 48), (30, 10, 48)] {
+            let a: Vec<f64> = (0..ra * len).map(|_| rng.gen_range(-1.0..1.0)).collect();
+            let b: Vec<f64> = (0..rb * len).map(|_| rng.gen_range(-1.0..1.0)).collect();
+            let mut o1 = vec![f64::NAN; ra * rb];
+            gemm_nt_scalar(&a, ra, &b, rb, len, &mut o1, rb);
+            for i in 0..ra {
+                for j in 0..rb {
+                    let (x, y) = (&a[i * len..(i + 1) * len], &b[j * len..(j + 1) * len]);
+                    let exact: f64 = x.iter().zip(y).map(|(p, q)| p * q).sum();
+                    let scale: f64 = x.iter().zip(y).map(|(p, q)| (p * q).abs()).sum();
+                    assert!((o1[i * rb + j] - exact).abs() <= 1e-14 * scale, "({ra},{rb},{len})");
+                }
+            }
+            #[cfg(target_arch = "x86_64")]
+            if crate::optim::kernels::avx2_fma() {
+                let mut o2 = vec![f64::NAN; ra * rb];
+                unsafe { gemm_nt_avx2(&a, ra, &b, rb, len, &mut o2, rb) };
+                let bits = |o: &[f64]| o.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&o1), bits(&o2), "({ra},{rb},{len})");
+            }
+        }
+    }
+
     /// Normal-equation Y equals the QR + SVD Y (fit_poles) on noisy scattered data at random
     /// parameters, for Example III's layout and a mixed-degree one; both copies give the same bits.
     #[test]
@@ -663,13 +887,21 @@ mod tests {
             for _ in 0..5 {
                 let x: Vec<f64> = (0..2 * pts.len()).map(|_| rng.gen_range(0.0..1.0)).collect();
                 let mut s = Scratch::default();
-                let y = scattered_sse_body(du, dv, &x, &pts, p2, &mut s).expect("well posed");
+                let y =
+                    scattered_sse_body::<false>(du, dv, &x, &pts, p2, &mut s).expect("well posed");
                 let y_svd = svd_y(du, dv, &x, &pts);
                 assert!((y - y_svd).abs() <= 1e-10 * y_svd, "({du},{dv}): {y} vs {y_svd}");
                 #[cfg(target_arch = "x86_64")]
-                if std::arch::is_x86_feature_detected!("avx2") {
-                    let y2 = unsafe { scattered_sse_avx2(du, dv, &x, &pts, p2, &mut s) };
-                    assert_eq!(y2.map(f64::to_bits), Some(y.to_bits()));
+                {
+                    use crate::optim::kernels::{avx2_fma, avx512vl};
+                    if avx2_fma() {
+                        let y2 = unsafe { scattered_sse_avx2(du, dv, &x, &pts, p2, &mut s) };
+                        assert_eq!(y2.map(f64::to_bits), Some(y.to_bits()), "AVX2 ({du},{dv})");
+                    }
+                    if avx512vl() {
+                        let y3 = unsafe { scattered_sse_avx512(du, dv, &x, &pts, p2, &mut s) };
+                        assert_eq!(y3.map(f64::to_bits), Some(y.to_bits()), "AVX-512 ({du},{dv})");
+                    }
                 }
             }
         }
@@ -685,7 +917,7 @@ mod tests {
         let x: Vec<f64> = (0..2 * 300).map(|_| rng.gen_range(0.0..1.0)).collect();
         let mut pts: Vec<Point3> = x.chunks(2).map(|c| surf.eval(c[0], c[1])).collect();
         let mut s = Scratch::default();
-        let y = scattered_sse_body(5, 5, &x, &pts, norm2(&pts), &mut s).unwrap();
+        let y = scattered_sse_body::<false>(5, 5, &x, &pts, norm2(&pts), &mut s).unwrap();
         assert!(y < 1e-24, "Y = {y}");
         for (k, p) in surf.poles.iter().enumerate() {
             for co in 0..3 {
@@ -697,7 +929,7 @@ mod tests {
                 *c += 1e-7 * rng.gen_range(-1.0..1.0);
             }
         }
-        let y = scattered_sse_body(5, 5, &x, &pts, norm2(&pts), &mut s).unwrap();
+        let y = scattered_sse_body::<false>(5, 5, &x, &pts, norm2(&pts), &mut s).unwrap();
         let y_svd = svd_y(5, 5, &x, &pts);
         assert!(y < 1e-6 * norm2(&pts) && y > 0.0);
         assert!((y - y_svd).abs() <= 1e-8 * y_svd, "{y} vs {y_svd}");
@@ -714,7 +946,7 @@ mod tests {
             .map(|k| if k % 2 == 0 { (k / 2 % 4) as f64 / 3.0 } else { rng.gen_range(0.0..1.0) })
             .collect();
         let mut s = Scratch::default();
-        assert!(scattered_sse_body(5, 5, &x, &pts, norm2(&pts), &mut s).is_none());
+        assert!(scattered_sse_body::<false>(5, 5, &x, &pts, norm2(&pts), &mut s).is_none());
         let prob = super::super::BezierParamProblem::new(
             5,
             5,
@@ -741,20 +973,27 @@ mod tests {
                 u.sort_by(f64::total_cmp);
                 v.sort_by(f64::total_cmp);
                 let mut s = Scratch::default();
-                let y = grid_sse_body(d, d, &u, &v, &data, &mut s).expect("full rank");
+                let y = grid_sse_body::<false>(d, d, &u, &v, &data, &mut s).expect("full rank");
                 let y_qr = grid_sse_qr(d, d, &u, &v, &data);
                 assert!((y - y_qr).abs() <= 1e-10 * y_qr, "n={n}: {y} vs {y_qr}");
                 #[cfg(target_arch = "x86_64")]
-                if std::arch::is_x86_feature_detected!("avx2") {
-                    let y2 = unsafe { grid_sse_avx2(d, d, &u, &v, &data, &mut s) };
-                    assert_eq!(y2.map(f64::to_bits), Some(y.to_bits()));
+                {
+                    use crate::optim::kernels::{avx2_fma, avx512vl};
+                    if avx2_fma() {
+                        let y2 = unsafe { grid_sse_avx2(d, d, &u, &v, &data, &mut s) };
+                        assert_eq!(y2.map(f64::to_bits), Some(y.to_bits()), "AVX2 n={n}");
+                    }
+                    if avx512vl() {
+                        let y3 = unsafe { grid_sse_avx512(d, d, &u, &v, &data, &mut s) };
+                        assert_eq!(y3.map(f64::to_bits), Some(y.to_bits()), "AVX-512 n={n}");
+                    }
                 }
             }
             let u: Vec<f64> = (0..n).map(|i| (i % 3) as f64 / 2.0).collect();
             let v: Vec<f64> = (0..n).map(|j| j as f64 / (n - 1) as f64).collect();
             let mut u = u;
             u.sort_by(f64::total_cmp);
-            assert!(grid_sse_body(d, d, &u, &v, &data, &mut Scratch::default()).is_none());
+            assert!(grid_sse_body::<false>(d, d, &u, &v, &data, &mut Scratch::default()).is_none());
         }
     }
 }

@@ -159,19 +159,25 @@ pub struct GridData {
     norm2: f64,
     nu: usize,
     nv: usize,
-    /// Row i = (x of points (i, 0..nv), y of them, z of them): the fast path's layout.
-    rows: Vec<f64>,
+    /// Column (c, j) = coordinate c of points (0..nu, j), zero padded to `fast::padded(nu)`,
+    /// at (c nv + j) padded(nu): the fast path's layout.
+    cols: Vec<f64>,
 }
 
 impl GridData {
     pub fn new(points: &[Point3], nu: usize, nv: usize) -> GridData {
         let coords = [0, 1, 2].map(|c| DMatrix::from_fn(nu, nv, |i, j| points[j * nu + i][c]));
         let norm2 = coords.iter().map(|m| m.norm_squared()).sum();
-        let rows = (0..nu)
-            .flat_map(|i| (0..3).flat_map(move |c| (0..nv).map(move |j| (i, c, j))))
-            .map(|(i, c, j)| points[j * nu + i][c])
-            .collect();
-        GridData { coords, norm2, nu, nv, rows }
+        let lu = fast::padded(nu);
+        let mut cols = vec![0.0; 3 * nv * lu];
+        for c in 0..3 {
+            for j in 0..nv {
+                for i in 0..nu {
+                    cols[(c * nv + j) * lu + i] = points[j * nu + i][c];
+                }
+            }
+        }
+        GridData { coords, norm2, nu, nv, cols }
     }
 }
 
