@@ -114,7 +114,7 @@ pub fn simd() -> Result<Isa, OptimError> {
 
 /// The copy the dispatchers run ([`simd`]; the fastest copy if the variable is malformed, which
 /// the runs have already refused).
-fn chosen() -> Isa {
+pub(crate) fn chosen() -> Isa {
     simd().unwrap_or_else(|_| Isa::fastest())
 }
 

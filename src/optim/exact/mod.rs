@@ -757,11 +757,40 @@ impl Best {
         }
     }
 
-    /// Keep x if f(x) is the best value so far.
+    /// Keep the iterate's x if f(x) is the best value so far.
     fn offer_point(&mut self, it: &Iterate) {
-        if it.f < self.f {
-            self.f = it.f;
-            self.x.copy_from_slice(&it.x);
+        self.offer_x(it.f, &it.x);
+    }
+
+    /// Keep x if its value f is the best so far.
+    fn offer_x(&mut self, f: f64, x: &[f64]) {
+        if f < self.f {
+            self.f = f;
+            self.x.copy_from_slice(x);
+        }
+    }
+}
+
+/// The polish's and the refinement's stopping rule: stop once two rounds running did not raise
+/// the certified bound.
+struct Stall {
+    best: f64,
+    stale: u32,
+}
+
+impl Stall {
+    fn new() -> Stall {
+        Stall { best: f64::NEG_INFINITY, stale: 0 }
+    }
+
+    /// Record this round's bound; true when it is the second round running without a rise.
+    fn stalled(&mut self, lb: f64) -> bool {
+        if lb > self.best {
+            (self.best, self.stale) = (lb, 0);
+            false
+        } else {
+            self.stale += 1;
+            self.stale >= 2
         }
     }
 }
@@ -1011,7 +1040,7 @@ fn polish_with(
         (fixed[k], wt[k]) = (true, 1.0 / nr);
     }
     let mut blocks = vec![[[0.0; 3]; 3]; m];
-    let (mut best_here, mut stale) = (f64::NEG_INFINITY, 0);
+    let mut stall = Stall::new();
     for _ in 0..POLISH_ROUNDS {
         for k in 0..m {
             let u = if fixed[k] { y[k] } else { [0.0; 3] };
@@ -1060,14 +1089,8 @@ fn polish_with(
         yc.copy_from_slice(&y);
         let lb = lower_bound_with(yc, r, x, ws.lower, ws.upper, pb, &mut sc.vn[0]);
         best.offer_dual(lb, yc);
-        // Stop when two rounds running did not raise the bound.
-        if lb > best_here {
-            (best_here, stale) = (lb, 0);
-        } else {
-            stale += 1;
-            if stale >= 2 {
-                break;
-            }
+        if stall.stalled(lb) {
+            break;
         }
     }
 }

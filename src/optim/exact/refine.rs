@@ -22,8 +22,8 @@
 //! (x, y) is certified by weak duality and offered to the solver's best point and best bound.
 
 use super::{
-    apply_terms, lower_bound_with, norm_sum, weighted_apply, Best, Scratch, Workspace, IDENTITY,
-    REFINE_STEPS, SHIFT,
+    apply_terms, lower_bound_with, norm_sum, weighted_apply, Best, Scratch, Stall, Workspace,
+    IDENTITY, REFINE_STEPS, SHIFT,
 };
 use crate::geom::{norm, Point3};
 
@@ -118,7 +118,7 @@ fn refine_with(
     let mut y = vec![[0.0; 3]; m];
     let mut blocks = vec![[[0.0; 3]; 3]; m];
     let mut adx = vec![[0.0; 3]; m];
-    let (mut best_here, mut stale) = (f64::NEG_INFINITY, 0);
+    let mut stall = Stall::new();
     split_duals(&r, &interp, &y_open, &mut y);
     let mut gap =
         norm_sum(&r) - lower_bound_with(&mut y, &r, &x, ws.lower, ws.upper, pb, &mut sc.g);
@@ -171,23 +171,15 @@ fn refine_with(
         // The same LB, now with y rescaled into the balls as it was certified.
         let lb = lower_bound_with(&mut y, &r, &x, ws.lower, ws.upper, pb, &mut sc.vn[0]);
         best.offer_dual(lb, &y);
-        if f < best.f {
-            best.f = f;
-            best.x.copy_from_slice(&x);
-        }
+        best.offer_x(f, &x);
         // A y_k of I that left the unit ball: its term is not interpolated at the optimum.
         for k in 0..m {
             if interp[k] && norm(y_open[k]) > 1.0 {
                 interp[k] = false;
             }
         }
-        if lb > best_here {
-            (best_here, stale) = (lb, 0);
-        } else {
-            stale += 1;
-            if stale >= 2 {
-                break;
-            }
+        if stall.stalled(lb) {
+            break;
         }
     }
 }

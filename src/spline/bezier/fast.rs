@@ -18,6 +18,8 @@
 
 use super::GridData;
 use crate::geom::Point3;
+#[cfg(target_arch = "x86_64")]
+use crate::optim::kernels::Isa;
 use std::cell::RefCell;
 
 /// Highest degree of the fast paths (the doubled degree's basis must fit [`MAXB`]).
@@ -76,23 +78,6 @@ fn grow(v: &mut Vec<f64>, n: usize) {
 /// The length of a padded row or column of n entries (the next multiple of [`LANES`]).
 pub(super) fn padded(n: usize) -> usize {
     n.div_ceil(LANES) * LANES
-}
-
-/// Which compiled copy runs (the optimisers' `SOMNURBS_SIMD` choice): 2 = AVX-512VL,
-/// 1 = AVX2 + FMA, 0 = baseline.
-fn copy() -> u8 {
-    #[cfg(target_arch = "x86_64")]
-    {
-        if crate::optim::kernels::use_avx512() {
-            2
-        } else {
-            u8::from(crate::optim::kernels::use_avx2())
-        }
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        0
-    }
 }
 
 /// Binomial coefficient C(n, k) = prod_j (n - j) / (j + 1) as f64 (exact for the degrees here).
@@ -367,11 +352,11 @@ pub(super) fn scattered_sse(
         return None;
     }
     #[cfg(target_arch = "x86_64")]
-    match copy() {
+    match crate::optim::kernels::chosen() {
         // SAFETY: the dispatcher checked that the CPU has the copy's features.
-        2 => return unsafe { scattered_sse_avx512(du, dv, x, pts, p2, s) },
-        1 => return unsafe { scattered_sse_avx2(du, dv, x, pts, p2, s) },
-        _ => {}
+        Isa::Avx512Vl => return unsafe { scattered_sse_avx512(du, dv, x, pts, p2, s) },
+        Isa::Avx2 => return unsafe { scattered_sse_avx2(du, dv, x, pts, p2, s) },
+        Isa::Baseline => {}
     }
     scattered_sse_body::<false>(du, dv, x, pts, p2, s)
 }
@@ -713,11 +698,11 @@ pub(super) fn grid_sse(
     s: &mut Scratch,
 ) -> Option<f64> {
     #[cfg(target_arch = "x86_64")]
-    match copy() {
+    match crate::optim::kernels::chosen() {
         // SAFETY: the dispatcher checked that the CPU has the copy's features.
-        2 => return unsafe { grid_sse_avx512(du, dv, u, v, data, s) },
-        1 => return unsafe { grid_sse_avx2(du, dv, u, v, data, s) },
-        _ => {}
+        Isa::Avx512Vl => return unsafe { grid_sse_avx512(du, dv, u, v, data, s) },
+        Isa::Avx2 => return unsafe { grid_sse_avx2(du, dv, u, v, data, s) },
+        Isa::Baseline => {}
     }
     grid_sse_body::<false>(du, dv, u, v, data, s)
 }
