@@ -9,7 +9,10 @@
 #   scripts/bench_peers.sh [OUT_DIR]      (default: a temporary folder)
 #
 # Environment: PEERS_GENERATIONS (default 2000, the thesis' budget; CI uses a few), PEERS_VENV
-# (default target/peers-venv, made on first use), PYTHON (default python3), SOMNURBS_DATA.
+# (default target/peers-venv, made on first use), PYTHON (default python3), SOMNURBS_DATA;
+# PEERS_PROTOCOL=1 then also times the full Chapter 6 protocol (scripts/bench_ch6_protocol.sh,
+# about 12 minutes on 2 cores; PREV_BIN as there), so that every figure of issue 21 comes from
+# one run on one machine.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 NUMPY_VERSION=2.2.6
@@ -27,3 +30,6 @@ export OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 MKL_NUM_THREADS=1
 BENCH_EXPORT="$out/problem.json" cargo bench --quiet --bench optim > /dev/null
 BENCH_ONLY=de,pso,csa,icsa BENCH_GENERATIONS="$gens" cargo bench --quiet --bench optim | tee "$out/somnurbs.txt"
 "$venv/bin/python" scripts/peers/peers.py "$out/problem.json" "$out/somnurbs.txt" "$gens" | tee "$out/peers.md"
+if [ "${PEERS_PROTOCOL:-0}" = 1 ]; then
+    scripts/bench_ch6_protocol.sh "$out/protocol" | tee "$out/protocol.txt"
+fi
