@@ -9,11 +9,15 @@
 //!
 //!   Phi(x) = sum_k sqrt(|r_k|^2 + mu^2) - beta sum_j [ln(x_j - l_j) + ln(u_j - x_j)],
 //!
-//! whose Hessian is the smoothed one plus the diagonal beta / (x_j - l_j)^2 + beta / (u_j - x_j)^2
-//! (the Jacobi scaling of the factorisation makes its huge entries harmless). Newton's method on
-//! Phi with a fraction-to-boundary rule and an Armijo search follows the path x(mu, beta) as
-//! both shrink together (beta = mu m / n: the smoothing gap of the terms the optimum interpolates
-//! and the barrier's gap, ~beta per coordinate near a bound, shrink at one rate). Every iterate
+//! whose gradient is the smoothed one plus the barrier's -beta / (x_j - l_j) + beta / (u_j - x_j).
+//! Newton's method on Phi uses the primal-dual form of the barrier's Hessian, the diagonal
+//! z_l / (x_j - l_j) + z_u / (u_j - x_j) with multipliers z (z (x - l) = beta on the path; each
+//! moves by its own Newton step), which a primal barrier's beta / (x - l)^2 would understate right
+//! after beta shrinks; the Jacobi scaling of the factorisation makes its huge entries harmless.
+//! Steps go at most TO_BOUNDARY of the way to a bound, with an Armijo search on Phi, and mu and
+//! beta shrink together once the Newton decrement is below beta (beta = mu m / n: the smoothing
+//! gap of the terms the optimum interpolates and the barrier's gap, ~beta per coordinate near a
+//! bound, shrink at one rate). Every iterate
 //! is certified as in the main loop: at a point of the path, y = r / s leaves
 //! g_j = beta / (x_j - l_j) - beta / (u_j - x_j) on each coordinate, so LB(y) loses ~beta per
 //! coordinate near a bound and nothing on the free ones.
@@ -23,7 +27,7 @@ use super::{
     Iterate, Scratch, Workspace, REFINE_STEPS, SHIFT,
 };
 
-/// A stage ends when the Newton decrement of Phi is below this fraction of the gap it aims at.
+/// A stage ends when the Newton decrement of Phi is below this multiple of beta.
 const STAGE_TOL: f64 = 1.0;
 
 /// The fraction of the way to the nearest bound a step may go.
