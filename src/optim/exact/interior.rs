@@ -233,7 +233,7 @@ fn line_search(ws: &Workspace, it: &mut Iterate, bar: &Barrier, mu: f64, sc: &Sc
     }
     let phi = smooth(&it.r, mu) + bar.value(ws, &it.x);
     let slope: f64 = (0..n).map(|j| (sc.g[j] + bar.grad[j]) * sc.d[j]).sum();
-    if !(slope < 0.0) {
+    if slope.is_nan() || slope >= 0.0 {
         return false;
     }
     for _ in 0..40 {
