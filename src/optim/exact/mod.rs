@@ -1145,7 +1145,8 @@ fn on_bounds(ws: &Workspace, x: &[f64]) -> usize {
 }
 
 /// The projected Newton loop on F_mu from the iterate, mu shrinking by stages (see the module
-/// doc), until `done(best.f, best.lb)`, the step cap or mu ~ 0; returns the steps taken.
+/// doc), until `done(best.f, best.lb)`, the step cap or mu ~ 0; returns the steps taken and
+/// whether it stopped to hand over to the interior-point path (see SWITCH_STEPS).
 fn projected_newton(
     ws: &mut Workspace,
     it: &mut Iterate,
