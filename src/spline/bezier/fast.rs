@@ -50,7 +50,7 @@ pub(super) struct Scratch {
     q: Vec<f64>,
     m: Vec<f64>,
     gq: Vec<f64>,
-    g: Vec<f64>,
+    acc: Vec<f64>,
     l: Vec<f64>,
     c: Vec<f64>,
     r: Vec<f64>,
@@ -73,6 +73,13 @@ fn grow(v: &mut Vec<f64>, n: usize) {
     if v.len() < n {
         v.resize(n, 0.0);
     }
+}
+
+/// Grow `v` to hold `n` entries from its first 64-byte boundary and return that offset, so that
+/// the kernels' 4-lane loads and stores never straddle two cache lines.
+fn align64(v: &mut Vec<f64>, n: usize) -> usize {
+    grow(v, n + 8);
+    v.as_ptr().align_offset(64).min(8)
 }
 
 /// The length of a padded row or column of n entries (the next multiple of [`LANES`]).
@@ -120,27 +127,119 @@ fn product_weights(n: usize, w: &mut [f64; (MAXD + 1) * (MAXD + 1)]) {
 }
 
 /// Bernstein polynomials B^n_i(t_k) = C(n,i) (t^i (1-t)^(n-i)) for every t_k, stored i-major
-/// (row i holds all k, `stride` apart, a multiple of 8); rows padded with zeros past `t.len()`.
-/// With `out2`, the degree-2n rows too, from the same powers (t^i and (1-t)^j by repeated
-/// multiplication, 8 points at a time).
+/// (row i holds all k, `stride` apart, the multiple of 8 that [`padded`] gives for `t.len()`);
+/// rows zero past `t.len()`. With `out2`, the degree-2n rows too, from the same powers (t^i and
+/// (1-t)^j by repeated multiplication, 8 points at a time; the padding lanes' powers of t start
+/// from 0 instead of 1, so their rows are zero without a separate fill).
 #[inline(always)]
-fn basis_rows(n: usize, t: &[f64], stride: usize, out: &mut [f64], mut out2: Option<&mut [f64]>) {
+fn basis_rows<const V: bool>(
+    n: usize,
+    t: &[f64],
+    stride: usize,
+    out: &mut [f64],
+    out2: Option<&mut [f64]>,
+) {
+    let np = t.len();
+    assert!(np > 0 && stride == padded(np) && n <= MAXD && out.len() >= (n + 1) * stride);
+    assert!(out2.as_ref().is_none_or(|o| o.len() >= (2 * n + 1) * stride));
+    #[cfg(target_arch = "x86_64")]
+    if V {
+        // SAFETY: V is only set by the copies compiled with AVX2 + FMA; the sizes are checked.
+        unsafe { basis_rows_avx2(n, t, stride, out, out2) };
+        return;
+    }
+    basis_rows_scalar(n, t, stride, out, out2)
+}
+
+/// [`basis_rows`]' AVX2 copy: 8 points (two registers) at a time, four independent chains of
+/// powers, the same products in the same order.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn basis_rows_avx2(
+    n: usize,
+    t: &[f64],
+    stride: usize,
+    out: &mut [f64],
+    out2: Option<&mut [f64]>,
+) {
+    use std::arch::x86_64::*;
     let np = t.len();
     let top = if out2.is_some() { 2 * n } else { n };
-    let mut tpad = [0.0f64; 8];
+    let (po, po2) = (out.as_mut_ptr(), out2.map(|o| o.as_mut_ptr()));
+    let mut pt = [[_mm256_setzero_pd(); 2]; MAXB];
+    let mut ps = [[_mm256_setzero_pd(); 2]; MAXB];
+    let one = _mm256_set1_pd(1.0);
+    for k0 in (0..stride).step_by(2 * W) {
+        let m = np.saturating_sub(k0).min(2 * W);
+        let (mut tp, mut kp) = ([0.0f64; 2 * W], [1.0f64; 2 * W]);
+        if m == 2 * W {
+            tp.copy_from_slice(&t[k0..k0 + 2 * W]);
+        } else {
+            for l in 0..2 * W {
+                tp[l] = t.get(k0 + l).copied().unwrap_or(0.0);
+                kp[l] = if l < m { 1.0 } else { 0.0 };
+            }
+        }
+        let tv = [_mm256_loadu_pd(tp.as_ptr()), _mm256_loadu_pd(tp.as_ptr().add(W))];
+        let sv = [_mm256_sub_pd(one, tv[0]), _mm256_sub_pd(one, tv[1])];
+        let mut a = [_mm256_loadu_pd(kp.as_ptr()), _mm256_loadu_pd(kp.as_ptr().add(W))];
+        let mut b = [one, one];
+        pt[0] = a;
+        ps[0] = b;
+        for i in 1..=top {
+            a = [_mm256_mul_pd(a[0], tv[0]), _mm256_mul_pd(a[1], tv[1])];
+            b = [_mm256_mul_pd(b[0], sv[0]), _mm256_mul_pd(b[1], sv[1])];
+            pt[i] = a;
+            ps[i] = b;
+        }
+        for i in 0..=n {
+            let w = _mm256_set1_pd(BINOM[n][i]);
+            for h in 0..2 {
+                let r = _mm256_mul_pd(w, _mm256_mul_pd(pt[i][h], ps[n - i][h]));
+                _mm256_storeu_pd(po.add(i * stride + k0 + h * W), r);
+            }
+        }
+        if let Some(p2) = po2 {
+            for i in 0..=2 * n {
+                let w = _mm256_set1_pd(BINOM[2 * n][i]);
+                for h in 0..2 {
+                    let r = _mm256_mul_pd(w, _mm256_mul_pd(pt[i][h], ps[2 * n - i][h]));
+                    _mm256_storeu_pd(p2.add(i * stride + k0 + h * W), r);
+                }
+            }
+        }
+    }
+}
+
+/// [`basis_rows`] in portable Rust (the baseline copy), 8 points at a time.
+#[inline(always)]
+fn basis_rows_scalar(
+    n: usize,
+    t: &[f64],
+    stride: usize,
+    out: &mut [f64],
+    mut out2: Option<&mut [f64]>,
+) {
+    let np = t.len();
+    let top = if out2.is_some() { 2 * n } else { n };
     let mut pt = [[0.0f64; 8]; MAXB];
     let mut ps = [[0.0f64; 8]; MAXB];
     for k0 in (0..stride).step_by(8) {
-        let m = np.saturating_sub(k0).min(8);
-        tpad.fill(0.0);
-        if m > 0 {
-            tpad[..m].copy_from_slice(&t[k0..k0 + m]);
+        let m = (np - k0).min(8);
+        let (mut tpad, mut keep) = ([0.0f64; 8], [1.0f64; 8]);
+        if m == 8 {
+            tpad.copy_from_slice(&t[k0..k0 + 8]);
+        } else {
+            for l in 0..8 {
+                tpad[l] = t.get(k0 + l).copied().unwrap_or(0.0);
+                keep[l] = if l < m { 1.0 } else { 0.0 };
+            }
         }
         let mut s1 = [0.0f64; 8];
         for l in 0..8 {
             s1[l] = 1.0 - tpad[l];
         }
-        let (mut a, mut b) = ([1.0f64; 8], [1.0f64; 8]);
+        let (mut a, mut b) = (keep, [1.0f64; 8]);
         pt[0] = a;
         ps[0] = b;
         for i in 1..=top {
@@ -166,14 +265,6 @@ fn basis_rows(n: usize, t: &[f64], stride: usize, out: &mut [f64], mut out2: Opt
                     row[l] = w * (pt[i][l] * ps[2 * n - i][l]);
                 }
             }
-        }
-    }
-    for i in 0..=n {
-        out[i * stride + np..(i + 1) * stride].fill(0.0);
-    }
-    if let Some(o2) = out2 {
-        for i in 0..=2 * n {
-            o2[i * stride + np..(i + 1) * stride].fill(0.0);
         }
     }
 }
@@ -333,13 +424,155 @@ fn gemm_nt_scalar(
     }
 }
 
+/// acc[(i rb + j) W + l] += sum_(k = l mod W) a_ik b_jk for the `ra` rows of `a` and the `rb` rows
+/// of `b` (row-major, rows `len` long, len a multiple of [`W`]): [`gemm_nt`]'s partial sums
+/// (entry k into lane k mod W, a chain of fused multiply-adds) left open, so that a product
+/// over consecutive column blocks gives the same lanes as one product over all columns. Blocks
+/// of 2 x 4 rows in registers (edge blocks repeat the last row and drop its results); `V` picks
+/// the explicit AVX2 + FMA kernel (the same lanes, the same bits) in the vector copies.
+#[inline(always)]
+fn gemm_nt_acc<const V: bool>(
+    a: &[f64],
+    ra: usize,
+    b: &[f64],
+    rb: usize,
+    len: usize,
+    acc: &mut [f64],
+) {
+    assert!(
+        len.is_multiple_of(W) && ra > 0 && rb > 0 && a.len() >= ra * len && b.len() >= rb * len
+    );
+    assert!(acc.len() >= ra * rb * W);
+    #[cfg(target_arch = "x86_64")]
+    if V {
+        // SAFETY: V is only set by the copies compiled with AVX2 + FMA; the sizes are checked.
+        unsafe { gemm_nt_acc_avx2(a, ra, b, rb, len, acc) };
+        return;
+    }
+    gemm_nt_acc_scalar(a, ra, b, rb, len, acc)
+}
+
+/// [`gemm_nt_acc`]'s 2 x 4 register blocks in AVX2 + FMA registers (lane l of each register is
+/// partial sum l); loads through raw pointers (the caller checked every row fits).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn gemm_nt_acc_avx2(
+    a: &[f64],
+    ra: usize,
+    b: &[f64],
+    rb: usize,
+    len: usize,
+    acc: &mut [f64],
+) {
+    use std::arch::x86_64::*;
+    let (pa, pb, pc) = (a.as_ptr(), b.as_ptr(), acc.as_mut_ptr());
+    for i0 in (0..ra).step_by(2) {
+        let i1 = (i0 + 1).min(ra - 1);
+        let (a0, a1) = (pa.add(i0 * len), pa.add(i1 * len));
+        let (c0, c1) = (pc.add(i0 * rb * W), pc.add(i1 * rb * W));
+        for j0 in (0..rb).step_by(4) {
+            let (j1, j2, j3) = ((j0 + 1).min(rb - 1), (j0 + 2).min(rb - 1), (j0 + 3).min(rb - 1));
+            let (b0, b1, b2, b3) =
+                (pb.add(j0 * len), pb.add(j1 * len), pb.add(j2 * len), pb.add(j3 * len));
+            // a repeated edge row or column loads the same sums and computes the same values
+            // as its original, so storing all eight writes the same bits twice
+            let mut h0 = _mm256_loadu_pd(c0.add(j0 * W));
+            let mut h1 = _mm256_loadu_pd(c0.add(j1 * W));
+            let mut h2 = _mm256_loadu_pd(c0.add(j2 * W));
+            let mut h3 = _mm256_loadu_pd(c0.add(j3 * W));
+            let mut h4 = _mm256_loadu_pd(c1.add(j0 * W));
+            let mut h5 = _mm256_loadu_pd(c1.add(j1 * W));
+            let mut h6 = _mm256_loadu_pd(c1.add(j2 * W));
+            let mut h7 = _mm256_loadu_pd(c1.add(j3 * W));
+            for k in (0..len).step_by(W) {
+                let (x0, x1) = (_mm256_loadu_pd(a0.add(k)), _mm256_loadu_pd(a1.add(k)));
+                let y = _mm256_loadu_pd(b0.add(k));
+                h0 = _mm256_fmadd_pd(x0, y, h0);
+                h4 = _mm256_fmadd_pd(x1, y, h4);
+                let y = _mm256_loadu_pd(b1.add(k));
+                h1 = _mm256_fmadd_pd(x0, y, h1);
+                h5 = _mm256_fmadd_pd(x1, y, h5);
+                let y = _mm256_loadu_pd(b2.add(k));
+                h2 = _mm256_fmadd_pd(x0, y, h2);
+                h6 = _mm256_fmadd_pd(x1, y, h6);
+                let y = _mm256_loadu_pd(b3.add(k));
+                h3 = _mm256_fmadd_pd(x0, y, h3);
+                h7 = _mm256_fmadd_pd(x1, y, h7);
+            }
+            _mm256_storeu_pd(c0.add(j0 * W), h0);
+            _mm256_storeu_pd(c0.add(j1 * W), h1);
+            _mm256_storeu_pd(c0.add(j2 * W), h2);
+            _mm256_storeu_pd(c0.add(j3 * W), h3);
+            _mm256_storeu_pd(c1.add(j0 * W), h4);
+            _mm256_storeu_pd(c1.add(j1 * W), h5);
+            _mm256_storeu_pd(c1.add(j2 * W), h6);
+            _mm256_storeu_pd(c1.add(j3 * W), h7);
+        }
+    }
+}
+
+/// [`gemm_nt_acc`] in portable Rust (the baseline copy's kernel).
+#[inline(always)]
+fn gemm_nt_acc_scalar(a: &[f64], ra: usize, b: &[f64], rb: usize, len: usize, acc: &mut [f64]) {
+    const MR: usize = 2;
+    const NR: usize = 4;
+    let nc = len / W;
+    #[inline(always)]
+    fn row(m: &[f64], i: usize, len: usize, nc: usize) -> &[[f64; W]] {
+        &m[i * len..(i + 1) * len].as_chunks().0[..nc]
+    }
+    for i0 in (0..ra).step_by(MR) {
+        let mut ar: [&[[f64; W]]; MR] = [&[]; MR];
+        for (m, r) in ar.iter_mut().enumerate() {
+            *r = row(a, (i0 + m).min(ra - 1), len, nc);
+        }
+        for j0 in (0..rb).step_by(NR) {
+            let mut br: [&[[f64; W]]; NR] = [&[]; NR];
+            for (n, r) in br.iter_mut().enumerate() {
+                *r = row(b, (j0 + n).min(rb - 1), len, nc);
+            }
+            let mut h = [[[0.0f64; W]; NR]; MR];
+            for (m, hm) in h.iter_mut().enumerate() {
+                for (n, hmn) in hm.iter_mut().enumerate() {
+                    let at = ((i0 + m).min(ra - 1) * rb + (j0 + n).min(rb - 1)) * W;
+                    hmn.copy_from_slice(&acc[at..at + W]);
+                }
+            }
+            for c in 0..nc {
+                let mut xa = [[0.0f64; W]; MR];
+                let mut xb = [[0.0f64; W]; NR];
+                for m in 0..MR {
+                    xa[m] = ar[m][c];
+                }
+                for n in 0..NR {
+                    xb[n] = br[n][c];
+                }
+                for m in 0..MR {
+                    for n in 0..NR {
+                        for l in 0..W {
+                            h[m][n][l] = xa[m][l].mul_add(xb[n][l], h[m][n][l]);
+                        }
+                    }
+                }
+            }
+            for (m, hm) in h.iter().enumerate().take(ra - i0) {
+                for (n, hmn) in hm.iter().enumerate().take(rb - j0) {
+                    let at = ((i0 + m) * rb + j0 + n) * W;
+                    acc[at..at + W].copy_from_slice(hmn);
+                }
+            }
+        }
+    }
+}
+
 /// Y of the least-squares degree-(du, dv) Bezier surface through scattered `pts` at the
 /// parameters x = (u_0, v_0, u_1, v_1, ...), by the normal equations G c = g with G = B^T B,
 /// g = B^T P (B_k = kron(bu(u_k), bv(v_k))). The tensor structure gives
 /// G[(a,b),(c,d)] = w^du_ac w^dv_bd M[a+c][b+d] with M = sum_k B^2du(u_k) B^2dv(v_k)^T and
-/// w^n_ac = C(n,a) C(n,c) / C(2n,a+c) (B^n_a B^n_c = w^n_ac B^2n_(a+c)). Y = |P|^2 - 2 g.c + c^T G c
-/// (second order in the solution's error); below 1e-6 |P|^2 the solution is refined once and Y
-/// summed from the residuals. `None` if a Cholesky pivot is below [`PIVOT_REL`].
+/// w^n_ac = C(n,a) C(n,c) / C(2n,a+c) (B^n_a B^n_c = w^n_ac B^2n_(a+c)). With G = U^T U and
+/// z = U^-T g, Y = |P|^2 - 2 g.c + c^T G c = |P|^2 - |z|^2 (the back substitution for c is
+/// skipped); below 1e-6 |P|^2 c is solved for, refined once and Y summed from the residuals.
+/// `None` if a Cholesky pivot is below [`PIVOT_REL`].
 pub(super) fn scattered_sse(
     du: usize,
     dv: usize,
@@ -398,14 +631,12 @@ fn scattered_sse_body<const V: bool>(
     p2: f64,
     s: &mut Scratch,
 ) -> Option<f64> {
-    let np = pts.len();
-    let stride = np.div_ceil(LANES) * LANES;
     let (ku, kv) = (du + 1, dv + 1);
     let n = ku * kv;
-    moments::<V>(du, dv, x, pts, stride, s);
-    // G from the moments, g from gq (gq[(a, c), b] = sum_k bu_a P_c bv_b)
-    grow(&mut s.g, n * n);
-    grow(&mut s.l, n * n);
+    moments::<V>(du, dv, x, pts, s);
+    // the upper triangle of G from the moments straight into the factor's buffer, g from gq
+    // (gq[(a, c), b] = sum_k bu_a P_c bv_b)
+    let lo = align64(&mut s.l, n * n);
     grow(&mut s.c, 3 * n);
     let m2 = 2 * dv + 1;
     let (mut wus, mut wvs) = ([0.0; (MAXD + 1) * (MAXD + 1)], [0.0; (MAXD + 1) * (MAXD + 1)]);
@@ -413,11 +644,13 @@ fn scattered_sse_body<const V: bool>(
     product_weights(dv, &mut wvs);
     for a in 0..ku {
         for b in 0..kv {
-            for c in 0..ku {
+            let row = &mut s.l[lo + (a * kv + b) * n..lo + (a * kv + b + 1) * n];
+            for c in a..ku {
                 let wu = wus[a * ku + c];
-                for d in 0..kv {
-                    let wv = wvs[b * kv + d];
-                    s.g[(a * kv + b) * n + c * kv + d] = (wu * wv) * s.m[(a + c) * m2 + b + d];
+                let mrow = &s.m[(a + c) * m2 + b..];
+                let d0 = if c == a { b } else { 0 };
+                for d in d0..kv {
+                    row[c * kv + d] = (wu * wvs[b * kv + d]) * mrow[d];
                 }
             }
             for co in 0..3 {
@@ -425,90 +658,102 @@ fn scattered_sse_body<const V: bool>(
             }
         }
     }
-    s.r.clear();
-    s.r.extend_from_slice(&s.c[..3 * n]); // g, kept for Y
-    if !cholesky(&s.g[..n * n], &mut s.l[..n * n], n) {
+    if !cholesky::<V>(&mut s.l[lo..lo + n * n], n) {
         return None;
     }
-    chol_solve(&s.l[..n * n], n, &mut s.c[..3 * n]);
-    // Y = |P|^2 - 2 g.c + c^T G c
-    let (c, g) = (&s.c[..3 * n], &s.g[..n * n]);
-    let gc = dots_any(&s.r[..3 * n], [c])[0];
-    let mut cgc = 0.0;
-    for i in 0..n {
-        let h = dots_any(&g[i * n..(i + 1) * n], [&c[..n], &c[n..2 * n], &c[2 * n..]]);
-        cgc += (c[i] * h[0] + c[n + i] * h[1]) + c[2 * n + i] * h[2];
-    }
-    let y = p2 - 2.0 * gc + cgc;
+    // z = U^-T g: Y = |P|^2 - 2 g.c + c^T G c = |P|^2 - |z|^2 (c = U^-1 z, c^T G c = |U c|^2)
+    forward_solve(&s.l[lo..lo + n * n], n, &mut s.c[..3 * n]);
+    let y = p2 - dot4(&s.c[..3 * n], &s.c[..3 * n]);
     if y > CANCEL_REL * p2 {
         return Some(y);
     }
-    Some(refined_residual(du, dv, x, pts, s))
+    back_solve(&s.l[lo..lo + n * n], n, &mut s.c[..3 * n]);
+    Some(refined_residual(du, dv, x, pts, lo, s))
 }
 
+/// Points per block of [`moments`]' fused pass (the block's basis rows stay in L1).
+const BLK: usize = 64;
+
 /// The moments M (i-major (2du+1) x (2dv+1)) and gq ((du+1) * 3 rows of dv+1) of
-/// [`scattered_sse`], from i-major basis rows of all points.
+/// [`scattered_sse`], block by block of [`BLK`] points: the block's i-major basis rows, then
+/// both products accumulate into 4-lane partial sums ([`gemm_nt_acc`]) that run on across the
+/// blocks, so every sum has the order of one product over all points (lane k mod 4).
 #[inline(always)]
-fn moments<const V: bool>(
-    du: usize,
-    dv: usize,
-    x: &[f64],
-    pts: &[Point3],
-    stride: usize,
-    s: &mut Scratch,
-) {
+fn moments<const V: bool>(du: usize, dv: usize, x: &[f64], pts: &[Point3], s: &mut Scratch) {
     let np = pts.len();
     let (ku, kv) = (du + 1, dv + 1);
     let (ku2, kv2) = (2 * du + 1, 2 * dv + 1);
-    // parameters into the (padded) rows of bu / bv as scratch for the t values
-    grow(&mut s.q, 5 * stride);
-    {
-        let (tu, rest) = s.q.split_at_mut(stride);
-        let (tv, _) = rest.split_at_mut(stride);
-        for (k, uv) in x.chunks_exact(2).enumerate() {
-            tu[k] = uv[0];
-            tv[k] = uv[1];
+    // every buffer from a 64-byte boundary (rows BLK long stay aligned)
+    let nacc = W * (ku2 * kv2 + ku * 3 * kv);
+    let o = [
+        align64(&mut s.q, 5 * BLK),
+        align64(&mut s.bu, ku * BLK),
+        align64(&mut s.bv, kv * BLK),
+        align64(&mut s.bu2, ku2 * BLK),
+        align64(&mut s.bv2, kv2 * BLK),
+        align64(&mut s.pv, 3 * kv * BLK),
+        align64(&mut s.acc, nacc),
+    ];
+    let (bu, bv) = (&mut s.bu[o[1]..], &mut s.bv[o[2]..]);
+    let (bu2, bv2, pv) = (&mut s.bu2[o[3]..], &mut s.bv2[o[4]..], &mut s.pv[o[5]..]);
+    let (macc, gacc) = s.acc[o[6]..o[6] + nacc].split_at_mut(W * ku2 * kv2);
+    macc.fill(0.0);
+    gacc.fill(0.0);
+    for k0 in (0..np).step_by(BLK) {
+        let m = (np - k0).min(BLK);
+        let len = padded(m);
+        // the block's parameters (q[0..BLK], q[BLK..2 BLK]) and coordinates (q[2..5] BLK)
+        let (tq, pq) = s.q[o[0]..].split_at_mut(2 * BLK);
+        for (k, uv) in x[2 * k0..2 * (k0 + m)].chunks_exact(2).enumerate() {
+            tq[k] = uv[0];
+            tq[BLK + k] = uv[1];
         }
-    }
-    grow(&mut s.bu, ku * stride);
-    grow(&mut s.bv, kv * stride);
-    grow(&mut s.bu2, ku2 * stride);
-    grow(&mut s.bv2, kv2 * stride);
-    basis_rows(du, &s.q[..np], stride, &mut s.bu, Some(&mut s.bu2));
-    basis_rows(dv, &s.q[stride..stride + np], stride, &mut s.bv, Some(&mut s.bv2));
-    grow(&mut s.m, ku2 * kv2);
-    gemm_nt::<V>(&s.bu2, ku2, &s.bv2, kv2, stride, &mut s.m, kv2);
-    // the points' coordinates as rows (q[2..5]), the rows P_c bv_b (pv, (c, b)-major), then
-    // gq[a * 3kv + c kv + b] = sum_k bu_a(u_k) (P_kc bv_b(v_k))
-    {
-        let (_, prod) = s.q.split_at_mut(2 * stride);
-        for (k, p) in pts.iter().enumerate() {
+        for (k, p) in pts[k0..k0 + m].iter().enumerate() {
             for co in 0..3 {
-                prod[co * stride + k] = p[co];
+                pq[co * BLK + k] = p[co];
             }
         }
+        if m < len {
+            for co in 0..3 {
+                pq[co * BLK + m..co * BLK + len].fill(0.0);
+            }
+        }
+        basis_rows::<V>(du, &tq[..m], len, bu, Some(&mut *bu2));
+        basis_rows::<V>(dv, &tq[BLK..BLK + m], len, bv, Some(&mut *bv2));
+        // the rows P_c bv_b (pv, (c, b)-major; zero past m as bv is)
         for co in 0..3 {
-            prod[co * stride + np..(co + 1) * stride].fill(0.0);
-        }
-    }
-    grow(&mut s.pv, 3 * kv * stride);
-    for co in 0..3 {
-        let pc = &s.q[(2 + co) * stride..(3 + co) * stride];
-        for b in 0..kv {
-            let out = &mut s.pv[(co * kv + b) * stride..(co * kv + b + 1) * stride];
-            for ((o, p), bv) in out.iter_mut().zip(pc).zip(&s.bv[b * stride..(b + 1) * stride]) {
-                *o = p * bv;
+            let pc = &pq[co * BLK..co * BLK + len];
+            for b in 0..kv {
+                let out = &mut pv[(co * kv + b) * len..(co * kv + b + 1) * len];
+                for ((o, p), bv) in out.iter_mut().zip(pc).zip(&bv[b * len..(b + 1) * len]) {
+                    *o = p * bv;
+                }
             }
         }
+        gemm_nt_acc::<V>(bu2, ku2, bv2, kv2, len, macc);
+        gemm_nt_acc::<V>(bu, ku, pv, 3 * kv, len, gacc);
     }
+    grow(&mut s.m, ku2 * kv2);
     grow(&mut s.gq, ku * 3 * kv);
-    gemm_nt::<V>(&s.bu, ku, &s.pv, 3 * kv, stride, &mut s.gq, 3 * kv);
+    for (o, h) in s.m.iter_mut().zip(macc.as_chunks::<W>().0) {
+        *o = (h[0] + h[2]) + (h[1] + h[3]);
+    }
+    for (o, h) in s.gq.iter_mut().zip(gacc.as_chunks::<W>().0) {
+        *o = (h[0] + h[2]) + (h[1] + h[3]);
+    }
 }
 
 /// Near-exact fit: one step of iterative refinement (c += G^-1 B^T (P - B c)) and Y summed from
 /// the residuals sum_k |P_k - B_k c|^2, so a tiny Y keeps its relative precision. Uses the
 /// Cholesky factor and solution left in the scratch by [`scattered_sse`].
-fn refined_residual(du: usize, dv: usize, x: &[f64], pts: &[Point3], s: &mut Scratch) -> f64 {
+fn refined_residual(
+    du: usize,
+    dv: usize,
+    x: &[f64],
+    pts: &[Point3],
+    lo: usize,
+    s: &mut Scratch,
+) -> f64 {
     let (ku, kv) = (du + 1, dv + 1);
     let n = ku * kv;
     let residual = |c: &[f64], acc: &mut [f64]| -> f64 {
@@ -542,7 +787,7 @@ fn refined_residual(du: usize, dv: usize, x: &[f64], pts: &[Point3], s: &mut Scr
     let mut corr = std::mem::take(&mut s.r);
     corr.resize(3 * n, 0.0);
     residual(&s.c[..3 * n], &mut corr);
-    chol_solve(&s.l[..n * n], n, &mut corr);
+    chol_solve(&s.l[lo..lo + n * n], n, &mut corr);
     for (c, d) in s.c[..3 * n].iter_mut().zip(&corr) {
         *c += d;
     }
@@ -551,16 +796,17 @@ fn refined_residual(du: usize, dv: usize, x: &[f64], pts: &[Point3], s: &mut Scr
     y
 }
 
-/// Cholesky G = U^T U of the n x n row-major `g` into `u` (upper triangle, row j of U = column j
-/// of L), right-looking so that each step updates whole rows; false if a squared pivot U_jj^2 is
-/// at most [`PIVOT_REL`] times max_i G_ii (or not finite).
+/// Cholesky G = U^T U in place in the n x n row-major `u`, which holds G's upper triangle on
+/// entry (row j of U = column j of L), right-looking so that each step updates whole rows; false
+/// if a squared pivot U_jj^2 is at most [`PIVOT_REL`] times max_i G_ii (or not finite). The
+/// updates run over whole groups of [`W`] columns from the group holding the diagonal, so they
+/// also write a few entries below it: the strict lower triangle is scratch, never read.
 #[inline(always)]
-fn cholesky(g: &[f64], u: &mut [f64], n: usize) -> bool {
-    let dmax = (0..n).fold(0.0f64, |m, i| m.max(g[i * n + i]));
+fn cholesky<const V: bool>(u: &mut [f64], n: usize) -> bool {
+    let dmax = (0..n).fold(0.0f64, |m, i| m.max(u[i * n + i]));
     if !(dmax > 0.0 && dmax.is_finite()) {
         return false;
     }
-    u[..n * n].copy_from_slice(&g[..n * n]);
     for j in 0..n {
         let d = u[j * n + j];
         if d.is_nan() || d <= PIVOT_REL * dmax {
@@ -568,13 +814,27 @@ fn cholesky(g: &[f64], u: &mut [f64], n: usize) -> bool {
         }
         let r = d.sqrt();
         let (top, rest) = u.split_at_mut((j + 1) * n);
-        let rowj = &mut top[j * n + j..];
-        for x in rowj.iter_mut() {
+        let rowj = &mut top[j * n..];
+        for x in rowj[j..].iter_mut() {
             *x /= r;
         }
         for (i, rowi) in (j + 1..n).zip(rest.chunks_exact_mut(n)) {
-            let f = rowj[i - j];
-            for (x, y) in rowi[i..].iter_mut().zip(&rowj[i - j..]) {
+            let f = rowj[i];
+            let i0 = i / W * W;
+            let (xc, xt) = rowi[i0..].as_chunks_mut::<W>();
+            let (yc, yt) = rowj[i0..].as_chunks::<W>();
+            for (x, y) in xc.iter_mut().zip(yc) {
+                #[cfg(target_arch = "x86_64")]
+                if V {
+                    // SAFETY: V is only set by the copies compiled with AVX2 + FMA.
+                    unsafe { fnmadd4(x, y, f) };
+                    continue;
+                }
+                for l in 0..W {
+                    x[l] = (-f).mul_add(y[l], x[l]);
+                }
+            }
+            for (x, y) in xt.iter_mut().zip(yt) {
                 *x = (-f).mul_add(*y, *x);
             }
         }
@@ -582,9 +842,25 @@ fn cholesky(g: &[f64], u: &mut [f64], n: usize) -> bool {
     true
 }
 
-/// Solve U^T U c = b in place for the three right-hand sides of `c` (three rows of n).
+/// x_l = fma(-f, y_l, x_l) for the 4 lanes in one AVX2 + FMA instruction (-(f y) + x, one
+/// rounding: the same bits as `(-f).mul_add(y, x)`).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+unsafe fn fnmadd4(x: &mut [f64; W], y: &[f64; W], f: f64) {
+    use std::arch::x86_64::*;
+    let r = _mm256_fnmadd_pd(
+        _mm256_set1_pd(f),
+        _mm256_loadu_pd(y.as_ptr()),
+        _mm256_loadu_pd(x.as_ptr()),
+    );
+    _mm256_storeu_pd(x.as_mut_ptr(), r);
+}
+
+/// Forward substitution U^T z = b in place for the three right-hand sides of `c` (three rows of
+/// n): z_j = (b_j - sum_(i<j) U_ij z_i) / U_jj, by row-wise fused updates.
 #[inline(always)]
-fn chol_solve(u: &[f64], n: usize, c: &mut [f64]) {
+fn forward_solve(u: &[f64], n: usize, c: &mut [f64]) {
     for col in c.chunks_exact_mut(n).take(3) {
         for j in 0..n {
             let y = col[j] / u[j * n + j];
@@ -593,6 +869,14 @@ fn chol_solve(u: &[f64], n: usize, c: &mut [f64]) {
                 *x = (-y).mul_add(*uj, *x);
             }
         }
+    }
+}
+
+/// Back substitution U c = z in place for the three right-hand sides of `c`:
+/// c_j = (z_j - sum_(i>j) U_ji c_i) / U_jj.
+#[inline(always)]
+fn back_solve(u: &[f64], n: usize, c: &mut [f64]) {
+    for col in c.chunks_exact_mut(n).take(3) {
         for j in (0..n).rev() {
             let s = dots_any(&u[j * n + j + 1..(j + 1) * n], [&col[j + 1..]])[0];
             col[j] = (col[j] - s) / u[j * n + j];
@@ -600,6 +884,12 @@ fn chol_solve(u: &[f64], n: usize, c: &mut [f64]) {
     }
 }
 
+/// Solve U^T U c = b in place for the three right-hand sides of `c` (three rows of n).
+#[inline(always)]
+fn chol_solve(u: &[f64], n: usize, c: &mut [f64]) {
+    forward_solve(u, n, c);
+    back_solve(u, n, c);
+}
 /// The R dot products sum_k a_k b_rk of any length: 4 fixed partial sums (lane k mod 4) over the
 /// whole chunks, combined as (s0 + s2) + (s1 + s3), then the remainder in order.
 #[inline(always)]
@@ -633,14 +923,19 @@ fn dots_any<const R: usize>(a: &[f64], b: [&[f64]; R]) -> [f64; R] {
 /// H_j = I - beta_j v_j v_j^T with v_j zero above row j, kept as full padded columns so that every
 /// update is 4 lanes over the rows; `work` holds A (reduced in place) and the reflectors.
 #[inline(always)]
-fn thin_q(deg: usize, t: &[f64], q: &mut Vec<f64>, work: &mut Vec<f64>) -> Option<()> {
+fn thin_q<const V: bool>(
+    deg: usize,
+    t: &[f64],
+    q: &mut Vec<f64>,
+    work: &mut Vec<f64>,
+) -> Option<()> {
     let (n, k, lp) = (t.len(), deg + 1, padded(t.len()));
     if n <= deg || deg > MAXD {
         return None;
     }
     grow(work, 2 * k * lp);
     let (a, refl) = work.split_at_mut(k * lp);
-    basis_rows(deg, t, lp, a, None); // column j of A = row j here
+    basis_rows::<V>(deg, t, lp, a, None); // column j of A = row j here
     let mut diag = [0.0f64; MAXB];
     let mut beta = [0.0f64; MAXB];
     for j in 0..k {
@@ -750,8 +1045,8 @@ fn grid_sse_body<const V: bool>(
     }
     let (ku, kv) = (du + 1, dv + 1);
     let (lu, lv) = (padded(nu), padded(nv));
-    thin_q(du, u, &mut s.qa, &mut s.l)?;
-    thin_q(dv, v, &mut s.qb, &mut s.l)?;
+    thin_q::<V>(du, u, &mut s.qa, &mut s.l)?;
+    thin_q::<V>(dv, v, &mut s.qb, &mut s.l)?;
     // T = Qu^T [D_x D_y D_z]: row a holds coordinate c's nv entries at c lv.. (zero padded)
     let w = 3 * lv;
     grow(&mut s.t, ku * w);
@@ -852,6 +1147,90 @@ mod tests {
                 unsafe { gemm_nt_avx2(&a, ra, &b, rb, len, &mut o2, rb) };
                 let bits = |o: &[f64]| o.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
                 assert_eq!(bits(&o1), bits(&o2), "({ra},{rb},{len})");
+            }
+        }
+    }
+
+    /// The Bernstein rows of both copies are bit-identical, equal the recursive values of
+    /// `bernstein_into` to rounding and are zero in the padding, for every partial last chunk.
+    #[test]
+    fn basis_rows_copies_agree_and_pad_with_zeros() {
+        let mut rng = ChaCha8Rng::seed_from_u64(37);
+        for n in [1, 3, 5, 9] {
+            for np in [1, 3, 4, 5, 8, 9, 13, 17, 64] {
+                let t: Vec<f64> = (0..np).map(|_| rng.gen_range(0.0..1.0)).collect();
+                let stride = padded(np);
+                let run = |v: bool| {
+                    let mut o = vec![f64::NAN; (n + 1) * stride];
+                    let mut o2 = vec![f64::NAN; (2 * n + 1) * stride];
+                    if v {
+                        basis_rows::<true>(n, &t, stride, &mut o, Some(&mut o2));
+                    } else {
+                        basis_rows::<false>(n, &t, stride, &mut o, Some(&mut o2));
+                    }
+                    (o, o2)
+                };
+                let (o, o2) = run(false);
+                for (deg, rows) in [(n, &o), (2 * n, &o2)] {
+                    let mut b = [0.0; MAXB];
+                    for (k, &tk) in t.iter().enumerate() {
+                        super::super::bernstein_into(deg, tk, &mut b[..=deg]);
+                        for i in 0..=deg {
+                            assert!((rows[i * stride + k] - b[i]).abs() <= 1e-14, "n={n} k={k}");
+                        }
+                    }
+                    for i in 0..=deg {
+                        assert!(rows[i * stride + np..(i + 1) * stride].iter().all(|&x| x == 0.0));
+                    }
+                }
+                #[cfg(target_arch = "x86_64")]
+                if crate::optim::kernels::avx2_fma() {
+                    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                    let (p, p2) = run(true);
+                    assert_eq!((bits(&p), bits(&p2)), (bits(&o), bits(&o2)), "n={n} np={np}");
+                }
+            }
+        }
+    }
+
+    /// The accumulating product kernel run over consecutive column blocks leaves the same lanes
+    /// as [`gemm_nt`] over all columns (same bits after (s0 + s2) + (s1 + s3)), edge blocks
+    /// included, and its AVX2 + FMA copy equals the portable one bit for bit.
+    #[test]
+    fn blocked_accumulating_gemm_equals_whole_product_bit_for_bit() {
+        let mut rng = ChaCha8Rng::seed_from_u64(36);
+        for (ra, rb, len, blk) in [(1, 1, 8, 4), (11, 11, 632, 64), (6, 18, 56, 8), (3, 5, 48, 16)]
+        {
+            let a: Vec<f64> = (0..ra * len).map(|_| rng.gen_range(-1.0..1.0)).collect();
+            let b: Vec<f64> = (0..rb * len).map(|_| rng.gen_range(-1.0..1.0)).collect();
+            let mut whole = vec![f64::NAN; ra * rb];
+            gemm_nt_scalar(&a, ra, &b, rb, len, &mut whole, rb);
+            let blocked = |avx: bool| {
+                let mut acc = vec![0.0; W * ra * rb];
+                for k0 in (0..len).step_by(blk) {
+                    let l = blk.min(len - k0);
+                    let cut = |m: &[f64], r: usize| -> Vec<f64> {
+                        (0..r).flat_map(|i| m[i * len + k0..i * len + k0 + l].to_vec()).collect()
+                    };
+                    let (ab, bb) = (cut(&a, ra), cut(&b, rb));
+                    if avx {
+                        #[cfg(target_arch = "x86_64")]
+                        unsafe {
+                            gemm_nt_acc_avx2(&ab, ra, &bb, rb, l, &mut acc)
+                        };
+                    } else {
+                        gemm_nt_acc_scalar(&ab, ra, &bb, rb, l, &mut acc);
+                    }
+                }
+                acc.chunks_exact(W)
+                    .map(|h| ((h[0] + h[2]) + (h[1] + h[3])).to_bits())
+                    .collect::<Vec<_>>()
+            };
+            let bits: Vec<u64> = whole.iter().map(|x| x.to_bits()).collect();
+            assert_eq!(blocked(false), bits, "({ra},{rb},{len})");
+            #[cfg(target_arch = "x86_64")]
+            if crate::optim::kernels::avx2_fma() {
+                assert_eq!(blocked(true), bits, "AVX2 ({ra},{rb},{len})");
             }
         }
     }
