@@ -243,13 +243,7 @@ fn line_search(ws: &Workspace, it: &mut Iterate, bar: &Barrier, mu: f64, sc: &Sc
         ws.pb.residuals(&it.x_new, &mut it.r_new);
         let phi_new = smooth(&it.r_new, mu) + bar.value(ws, &it.x_new);
         if phi_new <= phi + 1e-4 * alpha * slope {
-            if it.x_new == it.x {
-                return false;
-            }
-            std::mem::swap(&mut it.x, &mut it.x_new);
-            std::mem::swap(&mut it.r, &mut it.r_new);
-            it.f = norm_sum(&it.r);
-            return true;
+            return it.accept_trial();
         }
         alpha *= 0.5;
     }

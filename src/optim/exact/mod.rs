@@ -752,6 +752,20 @@ struct Iterate {
     r_new: Vec<Point3>,
 }
 
+impl Iterate {
+    /// Make the trial point (x_new, r_new) the iterate; false, and nothing changes, when it is
+    /// the iterate itself (the step no longer moves x).
+    fn accept_trial(&mut self) -> bool {
+        if self.x_new == self.x {
+            return false;
+        }
+        std::mem::swap(&mut self.x, &mut self.x_new);
+        std::mem::swap(&mut self.r, &mut self.r_new);
+        self.f = norm_sum(&self.r);
+        true
+    }
+}
+
 /// sum_k |r_k|.
 fn norm_sum(r: &[Point3]) -> f64 {
     r.iter().map(|v| crate::geom::norm(*v)).sum::<f64>()
@@ -927,13 +941,7 @@ fn line_search(ws: &Workspace, it: &mut Iterate, mu: f64, sc: &Scratch) -> bool 
         let f_new = smooth(&it.r_new, mu);
         let lin: f64 = (0..n).map(|j| sc.g[j] * (it.x_new[j] - it.x[j])).sum();
         if f_new <= f_mu + 1e-4 * lin && lin <= 0.0 {
-            if it.x_new == it.x {
-                return false;
-            }
-            std::mem::swap(&mut it.x, &mut it.x_new);
-            std::mem::swap(&mut it.r, &mut it.r_new);
-            it.f = norm_sum(&it.r);
-            return true;
+            return it.accept_trial();
         }
         alpha *= 0.5;
     }
@@ -984,9 +992,7 @@ fn predictor(ws: &Workspace, it: &mut Iterate, mu: f64, mu_next: f64, sc: &mut S
     }
     ws.pb.residuals(&it.x_new, &mut it.r_new);
     if smooth(&it.r_new, mu_next) < smooth(&it.r, mu_next) {
-        std::mem::swap(&mut it.x, &mut it.x_new);
-        std::mem::swap(&mut it.r, &mut it.r_new);
-        it.f = norm_sum(&it.r);
+        it.accept_trial();
     }
 }
 

@@ -369,6 +369,38 @@ unsafe fn gemm_nt_avx2(
     }
 }
 
+/// Rows of `a` and of `b` per register block of the portable product kernels.
+const MR: usize = 2;
+const NR: usize = 4;
+
+/// The portable register block of the product kernels: acc[m][n][l] += a_m[c][l] b_n[c][l] over
+/// the columns c < nc, one fused multiply-add per lane in column order.
+#[inline(always)]
+fn block_fma(
+    ar: &[&[[f64; W]]; MR],
+    br: &[&[[f64; W]]; NR],
+    nc: usize,
+    acc: &mut [[[f64; W]; NR]; MR],
+) {
+    for c in 0..nc {
+        let mut xa = [[0.0f64; W]; MR];
+        let mut xb = [[0.0f64; W]; NR];
+        for m in 0..MR {
+            xa[m] = ar[m][c];
+        }
+        for n in 0..NR {
+            xb[n] = br[n][c];
+        }
+        for m in 0..MR {
+            for n in 0..NR {
+                for l in 0..W {
+                    acc[m][n][l] = xa[m][l].mul_add(xb[n][l], acc[m][n][l]);
+                }
+            }
+        }
+    }
+}
+
 /// [`gemm_nt`] in portable Rust (the baseline copy's kernel).
 #[inline(always)]
 fn gemm_nt_scalar(
@@ -380,8 +412,6 @@ fn gemm_nt_scalar(
     out: &mut [f64],
     os: usize,
 ) {
-    const MR: usize = 2;
-    const NR: usize = 4;
     let nc = len / W;
     #[inline(always)]
     fn row(m: &[f64], i: usize, len: usize, nc: usize) -> &[[f64; W]] {
@@ -398,23 +428,7 @@ fn gemm_nt_scalar(
                 *r = row(b, (j0 + n).min(rb - 1), len, nc);
             }
             let mut acc = [[[0.0f64; W]; NR]; MR];
-            for c in 0..nc {
-                let mut xa = [[0.0f64; W]; MR];
-                let mut xb = [[0.0f64; W]; NR];
-                for m in 0..MR {
-                    xa[m] = ar[m][c];
-                }
-                for n in 0..NR {
-                    xb[n] = br[n][c];
-                }
-                for m in 0..MR {
-                    for n in 0..NR {
-                        for l in 0..W {
-                            acc[m][n][l] = xa[m][l].mul_add(xb[n][l], acc[m][n][l]);
-                        }
-                    }
-                }
-            }
+            block_fma(&ar, &br, nc, &mut acc);
             for (m, am) in acc.iter().enumerate().take(ra - i0) {
                 for (n, h) in am.iter().enumerate().take(rb - j0) {
                     out[(i0 + m) * os + j0 + n] = (h[0] + h[2]) + (h[1] + h[3]);
@@ -514,8 +528,6 @@ unsafe fn gemm_nt_acc_avx2(
 /// [`gemm_nt_acc`] in portable Rust (the baseline copy's kernel).
 #[inline(always)]
 fn gemm_nt_acc_scalar(a: &[f64], ra: usize, b: &[f64], rb: usize, len: usize, acc: &mut [f64]) {
-    const MR: usize = 2;
-    const NR: usize = 4;
     let nc = len / W;
     #[inline(always)]
     fn row(m: &[f64], i: usize, len: usize, nc: usize) -> &[[f64; W]] {
@@ -538,23 +550,7 @@ fn gemm_nt_acc_scalar(a: &[f64], ra: usize, b: &[f64], rb: usize, len: usize, ac
                     hmn.copy_from_slice(&acc[at..at + W]);
                 }
             }
-            for c in 0..nc {
-                let mut xa = [[0.0f64; W]; MR];
-                let mut xb = [[0.0f64; W]; NR];
-                for m in 0..MR {
-                    xa[m] = ar[m][c];
-                }
-                for n in 0..NR {
-                    xb[n] = br[n][c];
-                }
-                for m in 0..MR {
-                    for n in 0..NR {
-                        for l in 0..W {
-                            h[m][n][l] = xa[m][l].mul_add(xb[n][l], h[m][n][l]);
-                        }
-                    }
-                }
-            }
+            block_fma(&ar, &br, nc, &mut h);
             for (m, hm) in h.iter().enumerate().take(ra - i0) {
                 for (n, hmn) in hm.iter().enumerate().take(rb - j0) {
                     let at = ((i0 + m) * rb + j0 + n) * W;
