@@ -369,6 +369,34 @@ unsafe fn gemm_nt_avx2(
     }
 }
 
+/// The register blocks of the portable product kernels: `f(i0, j0, a rows, b rows)` for every
+/// block of MR rows of `a` (from i0) and NR rows of `b` (from j0), each row as its `len / W`
+/// lane groups; edge blocks repeat the last row (the caller drops those results).
+#[inline(always)]
+fn for_blocks(
+    a: &[f64],
+    ra: usize,
+    b: &[f64],
+    rb: usize,
+    len: usize,
+    mut f: impl FnMut(usize, usize, &[&[[f64; W]]; MR], &[&[[f64; W]]; NR]),
+) {
+    let nc = len / W;
+    for i0 in (0..ra).step_by(MR) {
+        let ar: [&[[f64; W]]; MR] = std::array::from_fn(|m| {
+            let i = (i0 + m).min(ra - 1);
+            &a[i * len..(i + 1) * len].as_chunks().0[..nc]
+        });
+        for j0 in (0..rb).step_by(NR) {
+            let br: [&[[f64; W]]; NR] = std::array::from_fn(|n| {
+                let j = (j0 + n).min(rb - 1);
+                &b[j * len..(j + 1) * len].as_chunks().0[..nc]
+            });
+            f(i0, j0, &ar, &br);
+        }
+    }
+}
+
 /// Rows of `a` and of `b` per register block of the portable product kernels.
 const MR: usize = 2;
 const NR: usize = 4;
@@ -412,30 +440,15 @@ fn gemm_nt_scalar(
     out: &mut [f64],
     os: usize,
 ) {
-    let nc = len / W;
-    #[inline(always)]
-    fn row(m: &[f64], i: usize, len: usize, nc: usize) -> &[[f64; W]] {
-        &m[i * len..(i + 1) * len].as_chunks().0[..nc]
-    }
-    for i0 in (0..ra).step_by(MR) {
-        let mut ar: [&[[f64; W]]; MR] = [&[]; MR];
-        for (m, r) in ar.iter_mut().enumerate() {
-            *r = row(a, (i0 + m).min(ra - 1), len, nc);
-        }
-        for j0 in (0..rb).step_by(NR) {
-            let mut br: [&[[f64; W]]; NR] = [&[]; NR];
-            for (n, r) in br.iter_mut().enumerate() {
-                *r = row(b, (j0 + n).min(rb - 1), len, nc);
-            }
-            let mut acc = [[[0.0f64; W]; NR]; MR];
-            block_fma(&ar, &br, nc, &mut acc);
-            for (m, am) in acc.iter().enumerate().take(ra - i0) {
-                for (n, h) in am.iter().enumerate().take(rb - j0) {
-                    out[(i0 + m) * os + j0 + n] = (h[0] + h[2]) + (h[1] + h[3]);
-                }
+    for_blocks(a, ra, b, rb, len, |i0, j0, ar, br| {
+        let mut acc = [[[0.0f64; W]; NR]; MR];
+        block_fma(ar, br, len / W, &mut acc);
+        for (m, am) in acc.iter().enumerate().take(ra - i0) {
+            for (n, h) in am.iter().enumerate().take(rb - j0) {
+                out[(i0 + m) * os + j0 + n] = (h[0] + h[2]) + (h[1] + h[3]);
             }
         }
-    }
+    });
 }
 
 /// acc[(i rb + j) W + l] += sum_(k = l mod W) a_ik b_jk for the `ra` rows of `a` and the `rb` rows
@@ -528,37 +541,22 @@ unsafe fn gemm_nt_acc_avx2(
 /// [`gemm_nt_acc`] in portable Rust (the baseline copy's kernel).
 #[inline(always)]
 fn gemm_nt_acc_scalar(a: &[f64], ra: usize, b: &[f64], rb: usize, len: usize, acc: &mut [f64]) {
-    let nc = len / W;
-    #[inline(always)]
-    fn row(m: &[f64], i: usize, len: usize, nc: usize) -> &[[f64; W]] {
-        &m[i * len..(i + 1) * len].as_chunks().0[..nc]
-    }
-    for i0 in (0..ra).step_by(MR) {
-        let mut ar: [&[[f64; W]]; MR] = [&[]; MR];
-        for (m, r) in ar.iter_mut().enumerate() {
-            *r = row(a, (i0 + m).min(ra - 1), len, nc);
-        }
-        for j0 in (0..rb).step_by(NR) {
-            let mut br: [&[[f64; W]]; NR] = [&[]; NR];
-            for (n, r) in br.iter_mut().enumerate() {
-                *r = row(b, (j0 + n).min(rb - 1), len, nc);
-            }
-            let mut h = [[[0.0f64; W]; NR]; MR];
-            for (m, hm) in h.iter_mut().enumerate() {
-                for (n, hmn) in hm.iter_mut().enumerate() {
-                    let at = ((i0 + m).min(ra - 1) * rb + (j0 + n).min(rb - 1)) * W;
-                    hmn.copy_from_slice(&acc[at..at + W]);
-                }
-            }
-            block_fma(&ar, &br, nc, &mut h);
-            for (m, hm) in h.iter().enumerate().take(ra - i0) {
-                for (n, hmn) in hm.iter().enumerate().take(rb - j0) {
-                    let at = ((i0 + m) * rb + j0 + n) * W;
-                    acc[at..at + W].copy_from_slice(hmn);
-                }
+    for_blocks(a, ra, b, rb, len, |i0, j0, ar, br| {
+        let mut h = [[[0.0f64; W]; NR]; MR];
+        for (m, hm) in h.iter_mut().enumerate() {
+            for (n, hmn) in hm.iter_mut().enumerate() {
+                let at = ((i0 + m).min(ra - 1) * rb + (j0 + n).min(rb - 1)) * W;
+                hmn.copy_from_slice(&acc[at..at + W]);
             }
         }
-    }
+        block_fma(ar, br, len / W, &mut h);
+        for (m, hm) in h.iter().enumerate().take(ra - i0) {
+            for (n, hmn) in hm.iter().enumerate().take(rb - j0) {
+                let at = ((i0 + m) * rb + j0 + n) * W;
+                acc[at..at + W].copy_from_slice(hmn);
+            }
+        }
+    });
 }
 
 /// Y of the least-squares degree-(du, dv) Bezier surface through scattered `pts` at the
