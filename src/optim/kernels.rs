@@ -108,17 +108,24 @@ pub fn parse_simd(value: Option<&str>) -> Result<Isa, OptimError> {
 /// Every optimiser run and every control-net problem checks it first, so a bad value is an
 /// error before any work.
 pub fn simd() -> Result<Isa, OptimError> {
+    choice().clone()
+}
+
+/// [`SIMD_ENV`] parsed once for the process.
+fn choice() -> &'static Result<Isa, OptimError> {
     static CHOICE: std::sync::OnceLock<Result<Isa, OptimError>> = std::sync::OnceLock::new();
-    CHOICE.get_or_init(|| parse_simd(std::env::var(SIMD_ENV).ok().as_deref())).clone()
+    CHOICE.get_or_init(|| parse_simd(std::env::var(SIMD_ENV).ok().as_deref()))
 }
 
 /// The copy the dispatchers run ([`simd`]; the fastest copy if the variable is malformed, which
-/// the runs have already refused). Kept in its own cell: the dispatchers ask for every chunk of
-/// a move, and cloning [`simd`]'s result each time took about 1% of a cuckoo-search run.
+/// the runs have already refused). Read by reference: the dispatchers ask for every chunk of a
+/// move, and cloning [`simd`]'s result each time took about 1% of a cuckoo-search run.
 #[inline]
 pub(crate) fn chosen() -> Isa {
-    static ISA: std::sync::OnceLock<Isa> = std::sync::OnceLock::new();
-    *ISA.get_or_init(|| simd().unwrap_or_else(|_| Isa::fastest()))
+    match choice() {
+        Ok(isa) => *isa,
+        Err(_) => Isa::fastest(),
+    }
 }
 
 /// Whether the AVX2 (or AVX-512VL) copies run.
