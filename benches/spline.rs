@@ -112,7 +112,12 @@ fn bezier_fitness() {
         ),
         ("example3 628 scattered (5,5)", 5, Layout::Scattered, ex3),
     ];
+    // `-- bezier example3`: one example only (for profilers)
+    let only: Vec<String> = std::env::args().filter(|a| a.starts_with("example")).collect();
     for (name, d, layout, pts) in cases {
+        if !only.is_empty() && !only.iter().any(|o| name.starts_with(o.as_str())) {
+            continue;
+        }
         let dim = match layout {
             Layout::Grid { nu, nv } => nu + nv,
             Layout::Scattered => 2 * pts.len(),

@@ -21,6 +21,7 @@ use crate::geom::Point3;
 #[cfg(target_arch = "x86_64")]
 use crate::optim::kernels::Isa;
 use std::cell::RefCell;
+use std::mem::MaybeUninit;
 
 /// Highest degree of the fast paths (the doubled degree's basis must fit [`MAXB`]).
 const MAXD: usize = 15;
@@ -113,59 +114,149 @@ const BINOM: [[f64; MAXB]; MAXB] = {
     t
 };
 
-/// w^n_ac = C(n,a) C(n,c) / C(2n,a+c) for a, c in 0..=n, row-major (n+1) x (n+1).
-fn product_weights(n: usize, w: &mut [f64; (MAXD + 1) * (MAXD + 1)]) {
-    let mut b = [0.0f64; MAXB];
-    let mut b2 = [0.0f64; MAXB];
-    b[..=n].copy_from_slice(&BINOM[n][..=n]);
-    b2[..=2 * n].copy_from_slice(&BINOM[2 * n][..=2 * n]);
-    for a in 0..=n {
-        for c in 0..=n {
-            w[a * (n + 1) + c] = b[a] * b[c] / b2[a + c];
+/// The Bernstein polynomials (seed 003, Eq. 3) without their binomials at every t_k:
+/// m_a = t^a (1-t)^(n-a) for a in 0..=n into `out` and m2_i = t^i (1-t)^(2n-i) for i in 0..=2n
+/// into `out2`, the latter as the product m2_i = m_(i-c) m_c with c = min(i, n); i-major, rows
+/// `stride` apart (the multiple of 8 that [`padded`] gives for `t.len()`), 8 points at a time,
+/// zero past `t.len()` (the padding lanes' powers of t start from 0). `V` picks the explicit
+/// AVX2 copy (the same products in the same order, so the same bits).
+#[inline(always)]
+fn monomial_rows<const V: bool>(
+    n: usize,
+    t: &[f64],
+    stride: usize,
+    out: &mut [f64],
+    out2: &mut [f64],
+) {
+    assert!(!t.is_empty() && stride == padded(t.len()) && n <= MAXD);
+    assert!(out.len() >= (n + 1) * stride && out2.len() >= (2 * n + 1) * stride);
+    #[cfg(target_arch = "x86_64")]
+    if V {
+        // SAFETY: V is only set by the copies compiled with AVX2 + FMA; the sizes are checked.
+        unsafe { monomial_rows_avx2(n, t, stride, out, out2) };
+        return;
+    }
+    let mut pt = [[0.0f64; 8]; MAXD + 1];
+    let mut ps = [[0.0f64; 8]; MAXD + 1];
+    let mut mr = [[0.0f64; 8]; MAXD + 1];
+    for k0 in (0..stride).step_by(8) {
+        powers8(n, t, k0, &mut pt, &mut ps);
+        for a in 0..=n {
+            for l in 0..8 {
+                mr[a][l] = pt[a][l] * ps[n - a][l];
+            }
+            out[a * stride + k0..a * stride + k0 + 8].copy_from_slice(&mr[a]);
+        }
+        for i in 0..=2 * n {
+            let c = i.min(n);
+            let row = &mut out2[i * stride + k0..i * stride + k0 + 8];
+            for l in 0..8 {
+                row[l] = mr[i - c][l] * mr[c][l];
+            }
+        }
+    }
+}
+
+/// [`monomial_rows`]' AVX2 copy: the degree as a constant (so every loop unrolls and the
+/// powers stay at fixed places), 8 points (two registers) at a time.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn monomial_rows_avx2(
+    n: usize,
+    t: &[f64],
+    stride: usize,
+    out: &mut [f64],
+    out2: &mut [f64],
+) {
+    macro_rules! by_degree {
+        ($($d:literal)*) => {
+            match n {
+                $($d => monomial_rows_avx2_n::<$d>(t, stride, out, out2),)*
+                _ => unreachable!("degree {n} above MAXD"),
+            }
+        };
+    }
+    by_degree!(0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15)
+}
+
+/// [`monomial_rows_avx2`] for degree N (exclusive ranges, so that every loop unrolls).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn monomial_rows_avx2_n<const N: usize>(
+    t: &[f64],
+    stride: usize,
+    out: &mut [f64],
+    out2: &mut [f64],
+) {
+    use std::arch::x86_64::*;
+    assert!(N <= MAXD && out.len() >= (N + 1) * stride && out2.len() >= (2 * N + 1) * stride);
+    let (po, po2) = (out.as_mut_ptr(), out2.as_mut_ptr());
+    let one = _mm256_set1_pd(1.0);
+    for k0 in (0..stride).step_by(2 * W) {
+        let m = t.len().saturating_sub(k0).min(2 * W);
+        let (mut tp, mut kp) = ([0.0f64; 2 * W], [1.0f64; 2 * W]);
+        if m == 2 * W {
+            tp.copy_from_slice(&t[k0..k0 + 2 * W]);
+        } else {
+            tp[..m].copy_from_slice(&t[k0..k0 + m]);
+            kp[m..].fill(0.0);
+        }
+        for h in 0..2 {
+            let tv = _mm256_loadu_pd(tp.as_ptr().add(h * W));
+            let sv = _mm256_sub_pd(one, tv);
+            // only entries 0..=N are written and read: no fill of the unused ones
+            let mut pt = [MaybeUninit::<__m256d>::uninit(); MAXD + 1];
+            let mut ps = [MaybeUninit::<__m256d>::uninit(); MAXD + 1];
+            let mut mr = [MaybeUninit::<__m256d>::uninit(); MAXD + 1];
+            let (mut a, mut b) = (_mm256_loadu_pd(kp.as_ptr().add(h * W)), one);
+            pt[0].write(a);
+            ps[0].write(b);
+            for i in 1..N + 1 {
+                a = _mm256_mul_pd(a, tv);
+                b = _mm256_mul_pd(b, sv);
+                pt[i].write(a);
+                ps[i].write(b);
+            }
+            for i in 0..N + 1 {
+                let r = _mm256_mul_pd(pt[i].assume_init(), ps[N - i].assume_init());
+                mr[i].write(r);
+                _mm256_storeu_pd(po.add(i * stride + k0 + h * W), r);
+            }
+            for i in 0..2 * N + 1 {
+                let c = if i < N { i } else { N };
+                let r = _mm256_mul_pd(mr[i - c].assume_init(), mr[c].assume_init());
+                _mm256_storeu_pd(po2.add(i * stride + k0 + h * W), r);
+            }
         }
     }
 }
 
 /// Bernstein polynomials B^n_i(t_k) = C(n,i) (t^i (1-t)^(n-i)) for every t_k, stored i-major
 /// (row i holds all k, `stride` apart, the multiple of 8 that [`padded`] gives for `t.len()`);
-/// rows zero past `t.len()`. With `out2`, the degree-2n rows too, from the same powers (t^i and
-/// (1-t)^j by repeated multiplication, 8 points at a time; the padding lanes' powers of t start
-/// from 0 instead of 1, so their rows are zero without a separate fill).
+/// rows zero past `t.len()` (t^i and (1-t)^j by repeated multiplication, 8 points at a time; the
+/// padding lanes' powers of t start from 0 instead of 1, so their rows are zero without a
+/// separate fill).
 #[inline(always)]
-fn basis_rows<const V: bool>(
-    n: usize,
-    t: &[f64],
-    stride: usize,
-    out: &mut [f64],
-    out2: Option<&mut [f64]>,
-) {
+fn basis_rows<const V: bool>(n: usize, t: &[f64], stride: usize, out: &mut [f64]) {
     let np = t.len();
     assert!(np > 0 && stride == padded(np) && n <= MAXD && out.len() >= (n + 1) * stride);
-    assert!(out2.as_ref().is_none_or(|o| o.len() >= (2 * n + 1) * stride));
     #[cfg(target_arch = "x86_64")]
     if V {
         // SAFETY: V is only set by the copies compiled with AVX2 + FMA; the sizes are checked.
-        unsafe { basis_rows_avx2(n, t, stride, out, out2) };
+        unsafe { basis_rows_avx2(n, t, stride, out) };
         return;
     }
-    basis_rows_scalar(n, t, stride, out, out2)
+    basis_rows_scalar(n, t, stride, out)
 }
 
 /// [`basis_rows`]' AVX2 copy: 8 points (two registers) at a time, four independent chains of
 /// powers, the same products in the same order.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-unsafe fn basis_rows_avx2(
-    n: usize,
-    t: &[f64],
-    stride: usize,
-    out: &mut [f64],
-    out2: Option<&mut [f64]>,
-) {
+unsafe fn basis_rows_avx2(n: usize, t: &[f64], stride: usize, out: &mut [f64]) {
     use std::arch::x86_64::*;
     let np = t.len();
-    let top = if out2.is_some() { 2 * n } else { n };
-    let (po, po2) = (out.as_mut_ptr(), out2.map(|o| o.as_mut_ptr()));
+    let po = out.as_mut_ptr();
     let mut pt = [[_mm256_setzero_pd(); 2]; MAXB];
     let mut ps = [[_mm256_setzero_pd(); 2]; MAXB];
     let one = _mm256_set1_pd(1.0);
@@ -186,7 +277,7 @@ unsafe fn basis_rows_avx2(
         let mut b = [one, one];
         pt[0] = a;
         ps[0] = b;
-        for i in 1..=top {
+        for i in 1..=n {
             a = [_mm256_mul_pd(a[0], tv[0]), _mm256_mul_pd(a[1], tv[1])];
             b = [_mm256_mul_pd(b[0], sv[0]), _mm256_mul_pd(b[1], sv[1])];
             pt[i] = a;
@@ -199,57 +290,16 @@ unsafe fn basis_rows_avx2(
                 _mm256_storeu_pd(po.add(i * stride + k0 + h * W), r);
             }
         }
-        if let Some(p2) = po2 {
-            for i in 0..=2 * n {
-                let w = _mm256_set1_pd(BINOM[2 * n][i]);
-                for h in 0..2 {
-                    let r = _mm256_mul_pd(w, _mm256_mul_pd(pt[i][h], ps[2 * n - i][h]));
-                    _mm256_storeu_pd(p2.add(i * stride + k0 + h * W), r);
-                }
-            }
-        }
     }
 }
 
 /// [`basis_rows`] in portable Rust (the baseline copy), 8 points at a time.
 #[inline(always)]
-fn basis_rows_scalar(
-    n: usize,
-    t: &[f64],
-    stride: usize,
-    out: &mut [f64],
-    mut out2: Option<&mut [f64]>,
-) {
-    let np = t.len();
-    let top = if out2.is_some() { 2 * n } else { n };
-    let mut pt = [[0.0f64; 8]; MAXB];
-    let mut ps = [[0.0f64; 8]; MAXB];
+fn basis_rows_scalar(n: usize, t: &[f64], stride: usize, out: &mut [f64]) {
+    let mut pt = [[0.0f64; 8]; MAXD + 1];
+    let mut ps = [[0.0f64; 8]; MAXD + 1];
     for k0 in (0..stride).step_by(8) {
-        let m = (np - k0).min(8);
-        let (mut tpad, mut keep) = ([0.0f64; 8], [1.0f64; 8]);
-        if m == 8 {
-            tpad.copy_from_slice(&t[k0..k0 + 8]);
-        } else {
-            for l in 0..8 {
-                tpad[l] = t.get(k0 + l).copied().unwrap_or(0.0);
-                keep[l] = if l < m { 1.0 } else { 0.0 };
-            }
-        }
-        let mut s1 = [0.0f64; 8];
-        for l in 0..8 {
-            s1[l] = 1.0 - tpad[l];
-        }
-        let (mut a, mut b) = (keep, [1.0f64; 8]);
-        pt[0] = a;
-        ps[0] = b;
-        for i in 1..=top {
-            for l in 0..8 {
-                a[l] *= tpad[l];
-                b[l] *= s1[l];
-            }
-            pt[i] = a;
-            ps[i] = b;
-        }
+        powers8(n, t, k0, &mut pt, &mut ps);
         for i in 0..=n {
             let w = BINOM[n][i];
             let row = &mut out[i * stride + k0..i * stride + k0 + 8];
@@ -257,15 +307,42 @@ fn basis_rows_scalar(
                 row[l] = w * (pt[i][l] * ps[n - i][l]);
             }
         }
-        if let Some(o2) = out2.as_deref_mut() {
-            for i in 0..=2 * n {
-                let w = BINOM[2 * n][i];
-                let row = &mut o2[i * stride + k0..i * stride + k0 + 8];
-                for l in 0..8 {
-                    row[l] = w * (pt[i][l] * ps[2 * n - i][l]);
-                }
-            }
+    }
+}
+
+/// The powers t^i and (1-t)^i, i in 0..=n, of the 8 values of `t` from k0 (8 lanes, a chain of
+/// products each; past `t.len()` t is 0 and the powers of t start from 0 instead of 1, so every
+/// product with them is zero in the padding).
+#[inline(always)]
+fn powers8(
+    n: usize,
+    t: &[f64],
+    k0: usize,
+    pt: &mut [[f64; 8]; MAXD + 1],
+    ps: &mut [[f64; 8]; MAXD + 1],
+) {
+    let m = t.len().saturating_sub(k0).min(8);
+    let (mut tp, mut keep) = ([0.0f64; 8], [1.0f64; 8]);
+    if m == 8 {
+        tp.copy_from_slice(&t[k0..k0 + 8]);
+    } else {
+        tp[..m].copy_from_slice(&t[k0..k0 + m]);
+        keep[m..].fill(0.0);
+    }
+    let mut s1 = [0.0f64; 8];
+    for l in 0..8 {
+        s1[l] = 1.0 - tp[l];
+    }
+    let (mut a, mut b) = (keep, [1.0f64; 8]);
+    pt[0] = a;
+    ps[0] = b;
+    for i in 1..=n {
+        for l in 0..8 {
+            a[l] *= tp[l];
+            b[l] *= s1[l];
         }
+        pt[i] = a;
+        ps[i] = b;
     }
 }
 
@@ -343,7 +420,8 @@ unsafe fn gemm_nt_avx2(
             let b2 = pb.add((j0 + 2).min(rb - 1) * len);
             let b3 = pb.add((j0 + 3).min(rb - 1) * len);
             let mut acc = [_mm256_setzero_pd(); 8];
-            for k in (0..len).step_by(W) {
+            for q in 0..len / W {
+                let k = q * W;
                 let (x0, x1) = (_mm256_loadu_pd(a0.add(k)), _mm256_loadu_pd(a1.add(k)));
                 let y = _mm256_loadu_pd(b0.add(k));
                 acc[0] = _mm256_fmadd_pd(x0, y, acc[0]);
@@ -511,7 +589,8 @@ unsafe fn gemm_nt_acc_avx2(
             let mut h5 = _mm256_loadu_pd(c1.add(j1 * W));
             let mut h6 = _mm256_loadu_pd(c1.add(j2 * W));
             let mut h7 = _mm256_loadu_pd(c1.add(j3 * W));
-            for k in (0..len).step_by(W) {
+            for q in 0..len / W {
+                let k = q * W;
                 let (x0, x1) = (_mm256_loadu_pd(a0.add(k)), _mm256_loadu_pd(a1.add(k)));
                 let y = _mm256_loadu_pd(b0.add(k));
                 h0 = _mm256_fmadd_pd(x0, y, h0);
@@ -561,9 +640,10 @@ fn gemm_nt_acc_scalar(a: &[f64], ra: usize, b: &[f64], rb: usize, len: usize, ac
 
 /// Y of the least-squares degree-(du, dv) Bezier surface through scattered `pts` at the
 /// parameters x = (u_0, v_0, u_1, v_1, ...), by the normal equations G c = g with G = B^T B,
-/// g = B^T P (B_k = kron(bu(u_k), bv(v_k))). The tensor structure gives
-/// G[(a,b),(c,d)] = w^du_ac w^dv_bd M[a+c][b+d] with M = sum_k B^2du(u_k) B^2dv(v_k)^T and
-/// w^n_ac = C(n,a) C(n,c) / C(2n,a+c) (B^n_a B^n_c = w^n_ac B^2n_(a+c)). With G = U^T U and
+/// g = B^T P (B_k = kron(bu(u_k), bv(v_k))). The tensor structure gives, with the monomials
+/// m^n_a(t) = t^a (1-t)^(n-a) (B^n_a = C(n,a) m^n_a, m^n_a m^n_c = m^2n_(a+c)),
+/// G[(a,b),(c,d)] = C(du,a) C(du,c) C(dv,b) C(dv,d) M[a+c][b+d], M = sum_k m^2du(u_k) m^2dv(v_k)^T,
+/// and g_(a,b) = C(du,a) C(dv,b) sum_k m^du_a(u_k) m^dv_b(v_k) P_k. With G = U^T U and
 /// z = U^-T g, Y = |P|^2 - 2 g.c + c^T G c = |P|^2 - |z|^2 (the back substitution for c is
 /// skipped); below 1e-6 |P|^2 c is solved for, refined once and Y summed from the residuals.
 /// `None` if a Cholesky pivot is below [`PIVOT_REL`].
@@ -633,22 +713,22 @@ fn scattered_sse_body<const V: bool>(
     let lo = align64(&mut s.l, n * n);
     grow(&mut s.c, 3 * n);
     let m2 = 2 * dv + 1;
-    let (mut wus, mut wvs) = ([0.0; (MAXD + 1) * (MAXD + 1)], [0.0; (MAXD + 1) * (MAXD + 1)]);
-    product_weights(du, &mut wus);
-    product_weights(dv, &mut wvs);
+    // the binomials the monomial rows left out: C(du,a) C(du,c) C(dv,b) C(dv,d) is an integer
+    // below 2^53 for every degree up to MAXD (C(15,7)^4 < 1.8e15), so exact
+    let (cu, cv) = (&BINOM[du], &BINOM[dv]);
     for a in 0..ku {
         for b in 0..kv {
+            let wab = cu[a] * cv[b];
             let row = &mut s.l[lo + (a * kv + b) * n..lo + (a * kv + b + 1) * n];
             for c in a..ku {
-                let wu = wus[a * ku + c];
                 let mrow = &s.m[(a + c) * m2 + b..];
                 let d0 = if c == a { b } else { 0 };
                 for d in d0..kv {
-                    row[c * kv + d] = (wu * wvs[b * kv + d]) * mrow[d];
+                    row[c * kv + d] = (wab * (cu[c] * cv[d])) * mrow[d];
                 }
             }
             for co in 0..3 {
-                s.c[co * n + a * kv + b] = s.gq[(a * 3 + co) * kv + b];
+                s.c[co * n + a * kv + b] = wab * s.gq[(a * 3 + co) * kv + b];
             }
         }
     }
@@ -669,7 +749,8 @@ fn scattered_sse_body<const V: bool>(
 const BLK: usize = 64;
 
 /// The moments M (i-major (2du+1) x (2dv+1)) and gq ((du+1) * 3 rows of dv+1) of
-/// [`scattered_sse`], block by block of [`BLK`] points: the block's i-major basis rows, then
+/// [`scattered_sse`] (binomials left out), block by block of [`BLK`] points: the block's
+/// i-major monomial rows ([`monomial_rows`]), then
 /// both products accumulate into 4-lane partial sums ([`gemm_nt_acc`]) that run on across the
 /// blocks, so every sum has the order of one product over all points (lane k mod 4).
 #[inline(always)]
@@ -712,8 +793,8 @@ fn moments<const V: bool>(du: usize, dv: usize, x: &[f64], pts: &[Point3], s: &m
                 pq[co * BLK + m..co * BLK + len].fill(0.0);
             }
         }
-        basis_rows::<V>(du, &tq[..m], len, bu, Some(&mut *bu2));
-        basis_rows::<V>(dv, &tq[BLK..BLK + m], len, bv, Some(&mut *bv2));
+        monomial_rows::<V>(du, &tq[..m], len, bu, bu2);
+        monomial_rows::<V>(dv, &tq[BLK..BLK + m], len, bv, bv2);
         // the rows P_c bv_b (pv, (c, b)-major; zero past m as bv is)
         for co in 0..3 {
             let pc = &pq[co * BLK..co * BLK + len];
@@ -812,18 +893,19 @@ fn cholesky<const V: bool>(u: &mut [f64], n: usize) -> bool {
         for x in rowj[j..].iter_mut() {
             *x /= r;
         }
+        #[cfg(target_arch = "x86_64")]
+        if V {
+            // SAFETY: V is only set by the copies compiled with AVX2 + FMA; rows j + 1.. of n
+            // entries lie in `rest`.
+            unsafe { rank1_rows_avx2(rowj, rest, j, n) };
+            continue;
+        }
         for (i, rowi) in (j + 1..n).zip(rest.chunks_exact_mut(n)) {
             let f = rowj[i];
             let i0 = i / W * W;
             let (xc, xt) = rowi[i0..].as_chunks_mut::<W>();
             let (yc, yt) = rowj[i0..].as_chunks::<W>();
             for (x, y) in xc.iter_mut().zip(yc) {
-                #[cfg(target_arch = "x86_64")]
-                if V {
-                    // SAFETY: V is only set by the copies compiled with AVX2 + FMA.
-                    unsafe { fnmadd4(x, y, f) };
-                    continue;
-                }
                 for l in 0..W {
                     x[l] = (-f).mul_add(y[l], x[l]);
                 }
@@ -836,19 +918,33 @@ fn cholesky<const V: bool>(u: &mut [f64], n: usize) -> bool {
     true
 }
 
-/// x_l = fma(-f, y_l, x_l) for the 4 lanes in one AVX2 + FMA instruction (-(f y) + x, one
-/// rounding: the same bits as `(-f).mul_add(y, x)`).
+/// [`cholesky`]'s update of step j in AVX2 + FMA: row i > j (row i - j - 1 of `rest`) gets
+/// x_k = fma(-f, y_k, x_k) with f = U_ji and y = row j, over the whole groups of [`W`] columns
+/// from the one holding column i, then the remaining columns one by one: the same operations in
+/// the same order as the portable loop, one instruction per group.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-#[inline]
-unsafe fn fnmadd4(x: &mut [f64; W], y: &[f64; W], f: f64) {
+unsafe fn rank1_rows_avx2(rowj: &[f64], rest: &mut [f64], j: usize, n: usize) {
     use std::arch::x86_64::*;
-    let r = _mm256_fnmadd_pd(
-        _mm256_set1_pd(f),
-        _mm256_loadu_pd(y.as_ptr()),
-        _mm256_loadu_pd(x.as_ptr()),
-    );
-    _mm256_storeu_pd(x.as_mut_ptr(), r);
+    assert!(rowj.len() >= n && rest.len() >= (n - j - 1) * n);
+    let (py, px) = (rowj.as_ptr(), rest.as_mut_ptr());
+    for i in j + 1..n {
+        let f = *py.add(i);
+        let nf = _mm256_set1_pd(-f);
+        let row = px.add((i - j - 1) * n);
+        let i0 = i / W * W;
+        let whole = i0 + (n - i0) / W * W;
+        let mut k = i0;
+        while k < whole {
+            let r = _mm256_fmadd_pd(nf, _mm256_loadu_pd(py.add(k)), _mm256_loadu_pd(row.add(k)));
+            _mm256_storeu_pd(row.add(k), r);
+            k += W;
+        }
+        while k < n {
+            *row.add(k) = (-f).mul_add(*py.add(k), *row.add(k));
+            k += 1;
+        }
+    }
 }
 
 /// Forward substitution U^T z = b in place for the three right-hand sides of `c` (three rows of
@@ -929,7 +1025,7 @@ fn thin_q<const V: bool>(
     }
     grow(work, 2 * k * lp);
     let (a, refl) = work.split_at_mut(k * lp);
-    basis_rows::<V>(deg, t, lp, a, None); // column j of A = row j here
+    basis_rows::<V>(deg, t, lp, a); // column j of A = row j here
     let mut diag = [0.0f64; MAXB];
     let mut beta = [0.0f64; MAXB];
     for j in 0..k {
@@ -1150,41 +1246,120 @@ mod tests {
     #[test]
     fn basis_rows_copies_agree_and_pad_with_zeros() {
         let mut rng = ChaCha8Rng::seed_from_u64(37);
-        for n in [1, 3, 5, 9] {
+        for n in [1, 3, 5, 9, 15] {
             for np in [1, 3, 4, 5, 8, 9, 13, 17, 64] {
+                let t: Vec<f64> = (0..np).map(|_| rng.gen_range(0.0..1.0)).collect();
+                let stride = padded(np);
+                let run = |v: bool| {
+                    let mut o = vec![f64::NAN; (n + 1) * stride];
+                    if v {
+                        basis_rows::<true>(n, &t, stride, &mut o);
+                    } else {
+                        basis_rows::<false>(n, &t, stride, &mut o);
+                    }
+                    o
+                };
+                let o = run(false);
+                let mut b = [0.0; MAXB];
+                for (k, &tk) in t.iter().enumerate() {
+                    super::super::bernstein_into(n, tk, &mut b[..=n]);
+                    for i in 0..=n {
+                        assert!((o[i * stride + k] - b[i]).abs() <= 1e-14, "n={n} k={k}");
+                    }
+                }
+                for i in 0..=n {
+                    assert!(o[i * stride + np..(i + 1) * stride].iter().all(|&x| x == 0.0));
+                }
+                #[cfg(target_arch = "x86_64")]
+                if crate::optim::kernels::avx2_fma() {
+                    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                    assert_eq!(bits(&run(true)), bits(&o), "n={n} np={np}");
+                }
+            }
+        }
+    }
+
+    /// The monomial rows equal t^a (1-t)^(n-a) and t^i (1-t)^(2n-i) (powi, to a few roundings
+    /// relative) and are exactly zero in the padding, for every partial last chunk; the AVX2
+    /// copy gives the same bits.
+    #[test]
+    fn monomial_rows_equal_powers_and_pad_with_zeros() {
+        let mut rng = ChaCha8Rng::seed_from_u64(38);
+        for n in [1, 3, 5, 9, 15] {
+            for np in [1, 3, 8, 9, 13, 64] {
                 let t: Vec<f64> = (0..np).map(|_| rng.gen_range(0.0..1.0)).collect();
                 let stride = padded(np);
                 let run = |v: bool| {
                     let mut o = vec![f64::NAN; (n + 1) * stride];
                     let mut o2 = vec![f64::NAN; (2 * n + 1) * stride];
                     if v {
-                        basis_rows::<true>(n, &t, stride, &mut o, Some(&mut o2));
+                        monomial_rows::<true>(n, &t, stride, &mut o, &mut o2);
                     } else {
-                        basis_rows::<false>(n, &t, stride, &mut o, Some(&mut o2));
+                        monomial_rows::<false>(n, &t, stride, &mut o, &mut o2);
                     }
                     (o, o2)
                 };
                 let (o, o2) = run(false);
-                for (deg, rows) in [(n, &o), (2 * n, &o2)] {
-                    let mut b = [0.0; MAXB];
-                    for (k, &tk) in t.iter().enumerate() {
-                        super::super::bernstein_into(deg, tk, &mut b[..=deg]);
-                        for i in 0..=deg {
-                            assert!((rows[i * stride + k] - b[i]).abs() <= 1e-14, "n={n} k={k}");
-                        }
-                    }
-                    for i in 0..=deg {
-                        assert!(rows[i * stride + np..(i + 1) * stride].iter().all(|&x| x == 0.0));
-                    }
-                }
                 #[cfg(target_arch = "x86_64")]
                 if crate::optim::kernels::avx2_fma() {
                     let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
                     let (p, p2) = run(true);
                     assert_eq!((bits(&p), bits(&p2)), (bits(&o), bits(&o2)), "n={n} np={np}");
                 }
+                for (deg, rows) in [(n, &o), (2 * n, &o2)] {
+                    for (k, &tk) in t.iter().enumerate() {
+                        for i in 0..=deg {
+                            let want = tk.powi(i as i32) * (1.0 - tk).powi((deg - i) as i32);
+                            let got = rows[i * stride + k];
+                            assert!((got - want).abs() <= 1e-14 * want, "n={n} k={k} i={i}");
+                        }
+                    }
+                    for i in 0..=deg {
+                        assert!(rows[i * stride + np..(i + 1) * stride].iter().all(|&x| x == 0.0));
+                    }
+                }
             }
         }
+    }
+
+    /// The Cholesky factor of both copies is bit-identical (sizes with and without a partial
+    /// last group of columns) and reproduces G: U^T U = G to rounding.
+    #[test]
+    fn cholesky_copies_agree_bit_for_bit() {
+        let mut rng = ChaCha8Rng::seed_from_u64(39);
+        for n in [1, 3, 5, 9, 20, 36, 37] {
+            let a: Vec<f64> = (0..n * (n + 3)).map(|_| rng.gen_range(-1.0..1.0)).collect();
+            let g: Vec<f64> = (0..n * n)
+                .map(|ij| {
+                    (0..n + 3).map(|k| a[ij / n * (n + 3) + k] * a[ij % n * (n + 3) + k]).sum()
+                })
+                .collect();
+            let mut u1 = g.clone();
+            assert!(cholesky::<false>(&mut u1, n), "n={n}");
+            for i in 0..n {
+                for j in i..n {
+                    let v: f64 = (0..=i).map(|k| u1[k * n + i] * u1[k * n + j]).sum();
+                    assert!((v - g[i * n + j]).abs() <= 1e-12 * g[i * n + i].max(1.0), "n={n}");
+                }
+            }
+            #[cfg(target_arch = "x86_64")]
+            if crate::optim::kernels::avx2_fma() {
+                let mut u2 = g.clone();
+                assert!(unsafe { cholesky_avx2_for_test(&mut u2, n) });
+                let upper = |u: &[f64]| {
+                    (0..n)
+                        .flat_map(|i| (i..n).map(move |j| u[i * n + j].to_bits()))
+                        .collect::<Vec<_>>()
+                };
+                assert_eq!(upper(&u1), upper(&u2), "n={n}");
+            }
+        }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
+    unsafe fn cholesky_avx2_for_test(u: &mut [f64], n: usize) -> bool {
+        cholesky::<true>(u, n)
     }
 
     /// The accumulating product kernel run over consecutive column blocks leaves the same lanes
