@@ -396,6 +396,39 @@ fn gemm_nt<const V: bool>(
     gemm_nt_scalar(a, ra, b, rb, len, out, os)
 }
 
+/// The register block of [`gemm_nt_avx2`] and [`gemm_nt_acc_avx2`]: acc[4 m + n] += a_m b_n
+/// lane by lane over the `len / W` lane groups of rows a_0, a_1 and b_0..b_3 (one fused
+/// multiply-add per group and accumulator, groups in order; two groups per turn of the loop).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+#[inline]
+unsafe fn fma_2x4_avx2(
+    a: [*const f64; 2],
+    b: [*const f64; 4],
+    len: usize,
+    acc: &mut [std::arch::x86_64::__m256d; 8],
+) {
+    use std::arch::x86_64::*;
+    let step = |k: usize, acc: &mut [__m256d; 8]| {
+        let (x0, x1) = (_mm256_loadu_pd(a[0].add(k)), _mm256_loadu_pd(a[1].add(k)));
+        for n in 0..4 {
+            let y = _mm256_loadu_pd(b[n].add(k));
+            acc[n] = _mm256_fmadd_pd(x0, y, acc[n]);
+            acc[4 + n] = _mm256_fmadd_pd(x1, y, acc[4 + n]);
+        }
+    };
+    let groups = len / W;
+    let mut q = 0;
+    while q + 2 <= groups {
+        step(q * W, acc);
+        step((q + 1) * W, acc);
+        q += 2;
+    }
+    if q < groups {
+        step(q * W, acc);
+    }
+}
+
 /// [`gemm_nt`]'s 2 x 4 register blocks in AVX2 + FMA registers: lane l of each accumulator is
 /// partial sum l; loads through raw pointers (the caller checked every row fits).
 #[cfg(target_arch = "x86_64")]
@@ -420,22 +453,7 @@ unsafe fn gemm_nt_avx2(
             let b2 = pb.add((j0 + 2).min(rb - 1) * len);
             let b3 = pb.add((j0 + 3).min(rb - 1) * len);
             let mut acc = [_mm256_setzero_pd(); 8];
-            for q in 0..len / W {
-                let k = q * W;
-                let (x0, x1) = (_mm256_loadu_pd(a0.add(k)), _mm256_loadu_pd(a1.add(k)));
-                let y = _mm256_loadu_pd(b0.add(k));
-                acc[0] = _mm256_fmadd_pd(x0, y, acc[0]);
-                acc[4] = _mm256_fmadd_pd(x1, y, acc[4]);
-                let y = _mm256_loadu_pd(b1.add(k));
-                acc[1] = _mm256_fmadd_pd(x0, y, acc[1]);
-                acc[5] = _mm256_fmadd_pd(x1, y, acc[5]);
-                let y = _mm256_loadu_pd(b2.add(k));
-                acc[2] = _mm256_fmadd_pd(x0, y, acc[2]);
-                acc[6] = _mm256_fmadd_pd(x1, y, acc[6]);
-                let y = _mm256_loadu_pd(b3.add(k));
-                acc[3] = _mm256_fmadd_pd(x0, y, acc[3]);
-                acc[7] = _mm256_fmadd_pd(x1, y, acc[7]);
-            }
+            fma_2x4_avx2([a0, a1], [b0, b1, b2, b3], len, &mut acc);
             for (m, am) in acc.chunks_exact(4).enumerate().take(ra - i0) {
                 for (n, v) in am.iter().enumerate().take(rb - j0) {
                     let mut h = [0.0f64; W];
@@ -581,30 +599,18 @@ unsafe fn gemm_nt_acc_avx2(
                 (pb.add(j0 * len), pb.add(j1 * len), pb.add(j2 * len), pb.add(j3 * len));
             // a repeated edge row or column loads the same sums and computes the same values
             // as its original, so storing all eight writes the same bits twice
-            let mut h0 = _mm256_loadu_pd(c0.add(j0 * W));
-            let mut h1 = _mm256_loadu_pd(c0.add(j1 * W));
-            let mut h2 = _mm256_loadu_pd(c0.add(j2 * W));
-            let mut h3 = _mm256_loadu_pd(c0.add(j3 * W));
-            let mut h4 = _mm256_loadu_pd(c1.add(j0 * W));
-            let mut h5 = _mm256_loadu_pd(c1.add(j1 * W));
-            let mut h6 = _mm256_loadu_pd(c1.add(j2 * W));
-            let mut h7 = _mm256_loadu_pd(c1.add(j3 * W));
-            for q in 0..len / W {
-                let k = q * W;
-                let (x0, x1) = (_mm256_loadu_pd(a0.add(k)), _mm256_loadu_pd(a1.add(k)));
-                let y = _mm256_loadu_pd(b0.add(k));
-                h0 = _mm256_fmadd_pd(x0, y, h0);
-                h4 = _mm256_fmadd_pd(x1, y, h4);
-                let y = _mm256_loadu_pd(b1.add(k));
-                h1 = _mm256_fmadd_pd(x0, y, h1);
-                h5 = _mm256_fmadd_pd(x1, y, h5);
-                let y = _mm256_loadu_pd(b2.add(k));
-                h2 = _mm256_fmadd_pd(x0, y, h2);
-                h6 = _mm256_fmadd_pd(x1, y, h6);
-                let y = _mm256_loadu_pd(b3.add(k));
-                h3 = _mm256_fmadd_pd(x0, y, h3);
-                h7 = _mm256_fmadd_pd(x1, y, h7);
-            }
+            let mut acc = [
+                _mm256_loadu_pd(c0.add(j0 * W)),
+                _mm256_loadu_pd(c0.add(j1 * W)),
+                _mm256_loadu_pd(c0.add(j2 * W)),
+                _mm256_loadu_pd(c0.add(j3 * W)),
+                _mm256_loadu_pd(c1.add(j0 * W)),
+                _mm256_loadu_pd(c1.add(j1 * W)),
+                _mm256_loadu_pd(c1.add(j2 * W)),
+                _mm256_loadu_pd(c1.add(j3 * W)),
+            ];
+            fma_2x4_avx2([a0, a1], [b0, b1, b2, b3], len, &mut acc);
+            let [h0, h1, h2, h3, h4, h5, h6, h7] = acc;
             _mm256_storeu_pd(c0.add(j0 * W), h0);
             _mm256_storeu_pd(c0.add(j1 * W), h1);
             _mm256_storeu_pd(c0.add(j2 * W), h2);
