@@ -193,14 +193,7 @@ unsafe fn monomial_rows_avx2_n<const N: usize>(
     let (po, po2) = (out.as_mut_ptr(), out2.as_mut_ptr());
     let one = _mm256_set1_pd(1.0);
     for k0 in (0..stride).step_by(2 * W) {
-        let m = t.len().saturating_sub(k0).min(2 * W);
-        let (mut tp, mut kp) = ([0.0f64; 2 * W], [1.0f64; 2 * W]);
-        if m == 2 * W {
-            tp.copy_from_slice(&t[k0..k0 + 2 * W]);
-        } else {
-            tp[..m].copy_from_slice(&t[k0..k0 + m]);
-            kp[m..].fill(0.0);
-        }
+        let (tp, kp) = lanes8(t, k0);
         for h in 0..2 {
             let tv = _mm256_loadu_pd(tp.as_ptr().add(h * W));
             let sv = _mm256_sub_pd(one, tv);
@@ -255,22 +248,12 @@ fn basis_rows<const V: bool>(n: usize, t: &[f64], stride: usize, out: &mut [f64]
 #[target_feature(enable = "avx2,fma")]
 unsafe fn basis_rows_avx2(n: usize, t: &[f64], stride: usize, out: &mut [f64]) {
     use std::arch::x86_64::*;
-    let np = t.len();
     let po = out.as_mut_ptr();
-    let mut pt = [[_mm256_setzero_pd(); 2]; MAXB];
-    let mut ps = [[_mm256_setzero_pd(); 2]; MAXB];
+    let mut pt = [[_mm256_setzero_pd(); 2]; MAXD + 1];
+    let mut ps = [[_mm256_setzero_pd(); 2]; MAXD + 1];
     let one = _mm256_set1_pd(1.0);
     for k0 in (0..stride).step_by(2 * W) {
-        let m = np.saturating_sub(k0).min(2 * W);
-        let (mut tp, mut kp) = ([0.0f64; 2 * W], [1.0f64; 2 * W]);
-        if m == 2 * W {
-            tp.copy_from_slice(&t[k0..k0 + 2 * W]);
-        } else {
-            for l in 0..2 * W {
-                tp[l] = t.get(k0 + l).copied().unwrap_or(0.0);
-                kp[l] = if l < m { 1.0 } else { 0.0 };
-            }
-        }
+        let (tp, kp) = lanes8(t, k0);
         let tv = [_mm256_loadu_pd(tp.as_ptr()), _mm256_loadu_pd(tp.as_ptr().add(W))];
         let sv = [_mm256_sub_pd(one, tv[0]), _mm256_sub_pd(one, tv[1])];
         let mut a = [_mm256_loadu_pd(kp.as_ptr()), _mm256_loadu_pd(kp.as_ptr().add(W))];
@@ -310,6 +293,21 @@ fn basis_rows_scalar(n: usize, t: &[f64], stride: usize, out: &mut [f64]) {
     }
 }
 
+/// The 8 values of `t` from k0, zero past its end, and the mask that is 1 where a value exists
+/// and 0 in the padding (the start of the powers of t, so every row is zero there).
+#[inline(always)]
+fn lanes8(t: &[f64], k0: usize) -> ([f64; 8], [f64; 8]) {
+    let m = t.len().saturating_sub(k0).min(8);
+    let (mut tp, mut keep) = ([0.0f64; 8], [1.0f64; 8]);
+    if m == 8 {
+        tp.copy_from_slice(&t[k0..k0 + 8]);
+    } else {
+        tp[..m].copy_from_slice(&t[k0..k0 + m]);
+        keep[m..].fill(0.0);
+    }
+    (tp, keep)
+}
+
 /// The powers t^i and (1-t)^i, i in 0..=n, of the 8 values of `t` from k0 (8 lanes, a chain of
 /// products each; past `t.len()` t is 0 and the powers of t start from 0 instead of 1, so every
 /// product with them is zero in the padding).
@@ -321,14 +319,7 @@ fn powers8(
     pt: &mut [[f64; 8]; MAXD + 1],
     ps: &mut [[f64; 8]; MAXD + 1],
 ) {
-    let m = t.len().saturating_sub(k0).min(8);
-    let (mut tp, mut keep) = ([0.0f64; 8], [1.0f64; 8]);
-    if m == 8 {
-        tp.copy_from_slice(&t[k0..k0 + 8]);
-    } else {
-        tp[..m].copy_from_slice(&t[k0..k0 + m]);
-        keep[m..].fill(0.0);
-    }
+    let (tp, keep) = lanes8(t, k0);
     let mut s1 = [0.0f64; 8];
     for l in 0..8 {
         s1[l] = 1.0 - tp[l];
