@@ -129,7 +129,9 @@ fn bezier_fitness() {
         let c0 = runner::thread_cpu_seconds();
         let mut n = 0u64;
         let mut acc = 0.0;
-        while t.elapsed().as_secs_f64() < 1.0 {
+        // BENCH_EVALS=n: exactly n evaluations (for instruction counts under callgrind)
+        let fixed: Option<u64> = std::env::var("BENCH_EVALS").ok().and_then(|v| v.parse().ok());
+        while fixed.map_or(t.elapsed().as_secs_f64() < 1.0, |f| n < f) {
             acc += prob.fitness(&xs[n as usize % xs.len()]);
             n += 1;
         }
@@ -141,7 +143,7 @@ fn bezier_fitness() {
             1e6 * secs / n as f64,
             1e6 * cpu / n as f64
         );
-        if let Layout::Grid { .. } = layout {
+        if let (Layout::Grid { .. }, None) = (layout, fixed) {
             let t = Instant::now();
             let mut m = 0u64;
             while t.elapsed().as_secs_f64() < 1.0 {

@@ -160,8 +160,11 @@ pub struct GridData {
     nu: usize,
     nv: usize,
     /// Column (c, j) = coordinate c of points (0..nu, j), zero padded to `fast::padded(nu)`,
-    /// at (c nv + j) padded(nu): the fast path's layout.
+    /// at (c nv + j) padded(nu): the fast path's layout (its residual).
     cols: Vec<f64>,
+    /// Row i = coordinate c of points (i, 0..nv) at c lv + j, lv = `fast::padded(nv)`, zero
+    /// padded; rows 3 lv long: the fast path's layout (its first product).
+    rows: Vec<f64>,
 }
 
 impl GridData {
@@ -177,7 +180,16 @@ impl GridData {
                 }
             }
         }
-        GridData { coords, norm2, nu, nv, cols }
+        let lv = fast::padded(nv);
+        let mut rows = vec![0.0; nu * 3 * lv];
+        for i in 0..nu {
+            for c in 0..3 {
+                for j in 0..nv {
+                    rows[(3 * i + c) * lv + j] = points[j * nu + i][c];
+                }
+            }
+        }
+        GridData { coords, norm2, nu, nv, cols, rows }
     }
 }
 
