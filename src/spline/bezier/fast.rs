@@ -1612,7 +1612,8 @@ mod tests {
     #[test]
     fn blocked_accumulating_gemm_equals_whole_product_bit_for_bit() {
         let mut rng = ChaCha8Rng::seed_from_u64(36);
-        for (ra, rb, len, blk) in [(1, 1, 8, 4), (11, 11, 632, 64), (6, 18, 56, 8), (3, 5, 48, 16)]
+        for (ra, rb, len, blk) in
+            [(1, 1, 8, 4), (11, 11, 632, 64), (6, 18, 56, 8), (3, 5, 48, 16), (5, 6, 16, 8)]
         {
             let a: Vec<f64> = (0..ra * len).map(|_| rng.gen_range(-1.0..1.0)).collect();
             let b: Vec<f64> = (0..rb * len).map(|_| rng.gen_range(-1.0..1.0)).collect();
