@@ -439,7 +439,8 @@ unsafe fn gemm_tn_avx2(
     let blocks = k.div_ceil(5);
     let mut a0 = 0;
     for b in 0..blocks {
-        let m = (k - a0) / (blocks - b); // the rest, as even as possible
+        // the rest as even as possible: never more than 5, as k - a0 <= 5 (blocks - b)
+        let m = (k - a0) / (blocks - b);
         let (pq, po) = (q.as_ptr().add(a0 * lq), out.as_mut_ptr().add(a0 * w));
         match m {
             1 => tn_rows_avx2::<1, 3>(pq, lq, r.as_ptr(), n, w, po),
@@ -450,6 +451,7 @@ unsafe fn gemm_tn_avx2(
         }
         a0 += m;
     }
+    debug_assert_eq!(a0, k);
 }
 
 /// M output rows of [`gemm_tn_avx2`], NJ vectors of 4 columns at a time: per row i of `r`, NJ
@@ -1238,6 +1240,7 @@ unsafe fn reflect_cols_avx2(v: &[f64], beta: f64, cols: &mut [f64], lp: usize) {
 /// [`dot4`]'s.
 #[inline(always)]
 fn dot8(a: &[f64], b: &[f64]) -> f64 {
+    assert!(a.len().is_multiple_of(LANES));
     let (ac, _) = a.as_chunks::<LANES>();
     let (bc, _) = b[..a.len()].as_chunks::<LANES>();
     let mut h = [0.0f64; LANES];
