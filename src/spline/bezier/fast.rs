@@ -1229,9 +1229,7 @@ unsafe fn reflect_cols_avx2(v: &[f64], beta: f64, cols: &mut [f64], lp: usize) {
             }
         }
     }
-    for x in quads.into_remainder().chunks_exact_mut(lp) {
-        axpy(-(beta * dot8(v, x)), v, x);
-    }
+    reflect_cols::<false>(v, beta, quads.into_remainder(), lp);
 }
 
 /// The dot product of two equally long slices (a multiple of [`LANES`] long) in 8 partial sums
@@ -1369,7 +1367,7 @@ fn grid_residual(ku: usize, kv: usize, data: &GridData, s: &mut Scratch) -> f64 
                 for b in 0..kv {
                     fit += s.t[i * kv + b] * s.qb[b * lv + j];
                 }
-                let e = data.cols[(co * nv + j) * lu + i] - fit;
+                let e = data.rows[(3 * i + co) * lv + j] - fit;
                 sse += e * e;
             }
         }

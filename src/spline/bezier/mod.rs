@@ -159,11 +159,8 @@ pub struct GridData {
     norm2: f64,
     nu: usize,
     nv: usize,
-    /// Column (c, j) = coordinate c of points (0..nu, j), zero padded to `fast::padded(nu)`,
-    /// at (c nv + j) padded(nu): the fast path's layout (its residual).
-    cols: Vec<f64>,
     /// Row i = coordinate c of points (i, 0..nv) at c lv + j, lv = `fast::padded(nv)`, zero
-    /// padded; rows 3 lv long: the fast path's layout (its first product).
+    /// padded; rows 3 lv long: the fast path's layout.
     rows: Vec<f64>,
 }
 
@@ -171,15 +168,6 @@ impl GridData {
     pub fn new(points: &[Point3], nu: usize, nv: usize) -> GridData {
         let coords = [0, 1, 2].map(|c| DMatrix::from_fn(nu, nv, |i, j| points[j * nu + i][c]));
         let norm2 = coords.iter().map(|m| m.norm_squared()).sum();
-        let lu = fast::padded(nu);
-        let mut cols = vec![0.0; 3 * nv * lu];
-        for c in 0..3 {
-            for j in 0..nv {
-                for i in 0..nu {
-                    cols[(c * nv + j) * lu + i] = points[j * nu + i][c];
-                }
-            }
-        }
         let lv = fast::padded(nv);
         let mut rows = vec![0.0; nu * 3 * lv];
         for i in 0..nu {
@@ -189,7 +177,7 @@ impl GridData {
                 }
             }
         }
-        GridData { coords, norm2, nu, nv, cols, rows }
+        GridData { coords, norm2, nu, nv, rows }
     }
 }
 
