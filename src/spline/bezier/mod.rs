@@ -226,9 +226,8 @@ pub struct BezierParamProblem {
     pub dv: usize,
     pub layout: Layout,
     pub points: Vec<Point3>,
-    /// sum_k |P_k|^2.
-    norm2: f64,
     grid: Option<GridData>,
+    scattered: Option<fast::ScatteredData>,
     start: Vec<f64>,
     lo: Vec<f64>,
     hi: Vec<f64>,
@@ -261,17 +260,17 @@ impl BezierParamProblem {
                 start.len()
             )));
         }
-        let grid = match layout {
-            Layout::Grid { nu, nv } => Some(GridData::new(&points, nu, nv)),
-            Layout::Scattered => None,
+        let (grid, scattered) = match layout {
+            Layout::Grid { nu, nv } => (Some(GridData::new(&points, nu, nv)), None),
+            Layout::Scattered => (None, Some(fast::ScatteredData::new(&points))),
         };
         Ok(BezierParamProblem {
             du,
             dv,
             layout,
-            norm2: points.iter().flat_map(|p| p.iter()).map(|c| c * c).sum(),
             points,
             grid,
+            scattered,
             start,
             lo: vec![0.0; dim],
             hi: vec![1.0; dim],
@@ -312,16 +311,17 @@ impl Problem for BezierParamProblem {
             let mut xs = std::mem::take(&mut s.x);
             xs.clear();
             xs.extend(x.iter().map(|t| t.clamp(0.0, 1.0)));
-            let y = match (self.layout, &self.grid) {
-                (Layout::Grid { nu, nv }, Some(data)) => {
-                    xs[..nu].sort_by(f64::total_cmp);
-                    xs[nu..nu + nv].sort_by(f64::total_cmp);
+            let y = match (self.layout, &self.grid, &self.scattered) {
+                (Layout::Grid { nu, nv }, Some(data), _) => {
+                    fast::sort_params(&mut xs[..nu]);
+                    fast::sort_params(&mut xs[nu..nu + nv]);
                     let (u, v) = (&xs[..nu], &xs[nu..nu + nv]);
                     fast::grid_sse(self.du, self.dv, u, v, data, s)
                         .unwrap_or_else(|| grid_sse_qr(self.du, self.dv, u, v, data))
                 }
-                _ => fast::scattered_sse(self.du, self.dv, &xs, &self.points, self.norm2, s)
+                (_, _, Some(data)) => fast::scattered_sse(self.du, self.dv, &xs, data, s)
                     .unwrap_or_else(|| self.fit(&xs).map(|(_, y)| y).unwrap_or(f64::INFINITY)),
+                _ => unreachable!("the constructor builds the layout's data"),
             };
             s.x = xs;
             y
