@@ -60,6 +60,7 @@ pub(super) struct Scratch {
     qa: Vec<f64>,
     qb: Vec<f64>,
     t: Vec<f64>,
+    /// The rows P_c bv_b of the portable right-hand sides ([`rhs_acc`]).
     pv: Vec<f64>,
 }
 
@@ -887,9 +888,10 @@ const BLK: usize = 64;
 
 /// The moments M (i-major (2du+1) x (2dv+1)) and gq ((du+1) * 3 rows of dv+1) of
 /// [`scattered_sse`] (binomials left out), block by block of [`BLK`] points: the block's
-/// i-major monomial rows ([`monomial_rows`]), then
-/// both products accumulate into 4-lane partial sums ([`gemm_nt_acc`]) that run on across the
-/// blocks, so every sum has the order of one product over all points (lane k mod 4).
+/// i-major monomial rows ([`monomial_rows`]), then M's product ([`gemm_nt_acc`]) and the
+/// right-hand sides' ([`rhs_acc`], the coordinates from the `data`'s block rows) accumulate into
+/// 4-lane partial sums that run on across the blocks, so every sum has the order of one product
+/// over all points (lane k mod 4).
 #[inline(always)]
 fn moments<const V: bool>(du: usize, dv: usize, x: &[f64], data: &ScatteredData, s: &mut Scratch) {
     let np = data.pts.len();
@@ -914,7 +916,7 @@ fn moments<const V: bool>(du: usize, dv: usize, x: &[f64], data: &ScatteredData,
     for k0 in (0..np).step_by(BLK) {
         let m = (np - k0).min(BLK);
         let len = padded(m);
-        // the block's parameters (q[0..BLK], q[BLK..2 BLK]) and coordinates
+        // the block's parameters (q[0..BLK], q[BLK..2 BLK]) and coordinates (3 rows of BLK)
         let tq = &mut s.q[o[0]..o[0] + 2 * BLK];
         for (k, uv) in x[2 * k0..2 * (k0 + m)].chunks_exact(2).enumerate() {
             tq[k] = uv[0];
