@@ -1006,7 +1006,7 @@ unsafe fn rhs_acc_avx2(
     }
 }
 
-/// One register block of [`rhs_acc_avx2`]: acc[m][n] += a_m (P bv_n) over the `len` points,
+/// One register block of [`rhs_acc_avx2`]: `acc[m][n] += a_m (P bv_n)` over the `len` points,
 /// `MA` rows of a (`len` apart from `pa`), `NB` rows of bv (from `rows.1`) with the coordinate row
 /// `rows.0`; the sums at `pc + (m rb + n) W`.
 #[cfg(target_arch = "x86_64")]
@@ -1306,7 +1306,7 @@ pub(super) fn sort_params(t: &mut [f64]) {
 
 /// [`sort_params`] by ranks: with i64 keys ordered as `total_cmp` orders the values,
 /// rank_i = #{j < i: k_j <= k_i} + #{j > i: k_j < k_i} (distinct ranks 0..n, ties kept in
-/// order), four i per register against every j, then t[rank_i] = old t_i.
+/// order), four i per register against every j, then `t[rank_i] = old t_i`.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 unsafe fn rank_sort_avx2(t: &mut [f64]) {
