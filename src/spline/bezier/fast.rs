@@ -757,12 +757,12 @@ fn gemm_nt_acc_scalar(a: &[f64], ra: usize, b: &[f64], rb: usize, len: usize, ac
     });
 }
 
-/// Scattered points as [`scattered_sse`] reads them: the points, their coordinates in
+/// Scattered points as [`scattered_sse`] reads them: their number, their coordinates in
 /// [`moments`]' layout (per block of [`BLK`] points the x, y and z rows, [`BLK`] apart, zero past
 /// the last point; laid out once per problem instead of once per evaluation) and sum_k |P_k|^2.
 #[derive(Debug, Clone)]
 pub(super) struct ScatteredData {
-    pts: Vec<Point3>,
+    len: usize,
     blocks: Vec<f64>,
     norm2: f64,
 }
@@ -772,11 +772,21 @@ impl ScatteredData {
         let mut blocks = vec![0.0; pts.len().div_ceil(BLK) * 3 * BLK];
         for (k, p) in pts.iter().enumerate() {
             for co in 0..3 {
-                blocks[(3 * (k / BLK) + co) * BLK + k % BLK] = p[co];
+                blocks[Self::at(k, co)] = p[co];
             }
         }
         let norm2 = pts.iter().flat_map(|p| p.iter()).map(|c| c * c).sum();
-        ScatteredData { pts: pts.to_vec(), blocks, norm2 }
+        ScatteredData { len: pts.len(), blocks, norm2 }
+    }
+
+    /// Where coordinate `co` of point k lies in `blocks`.
+    fn at(k: usize, co: usize) -> usize {
+        (3 * (k / BLK) + co) * BLK + k % BLK
+    }
+
+    /// Point k, read back from its block rows.
+    fn point(&self, k: usize) -> Point3 {
+        std::array::from_fn(|co| self.blocks[Self::at(k, co)])
     }
 }
 
@@ -796,7 +806,7 @@ pub(super) fn scattered_sse(
     data: &ScatteredData,
     s: &mut Scratch,
 ) -> Option<f64> {
-    if du > MAXD || dv > MAXD || data.pts.is_empty() || x.len() != 2 * data.pts.len() {
+    if du > MAXD || dv > MAXD || data.len == 0 || x.len() != 2 * data.len {
         return None;
     }
     #[cfg(target_arch = "x86_64")]
@@ -880,7 +890,7 @@ fn scattered_sse_body<const V: bool>(
         return Some(y);
     }
     back_solve(&s.l[lo..lo + n * n], n, &mut s.c[..3 * n]);
-    Some(refined_residual(du, dv, x, &data.pts, lo, s))
+    Some(refined_residual(du, dv, x, data, lo, s))
 }
 
 /// Points per block of [`moments`]' fused pass (the block's basis rows stay in L1).
@@ -894,7 +904,7 @@ const BLK: usize = 64;
 /// over all points (lane k mod 4).
 #[inline(always)]
 fn moments<const V: bool>(du: usize, dv: usize, x: &[f64], data: &ScatteredData, s: &mut Scratch) {
-    let np = data.pts.len();
+    let np = data.len;
     let (ku, kv) = (du + 1, dv + 1);
     let (ku2, kv2) = (2 * du + 1, 2 * dv + 1);
     // every buffer from a 64-byte boundary (rows BLK long stay aligned)
@@ -1053,7 +1063,7 @@ fn refined_residual(
     du: usize,
     dv: usize,
     x: &[f64],
-    pts: &[Point3],
+    data: &ScatteredData,
     lo: usize,
     s: &mut Scratch,
 ) -> f64 {
@@ -1063,10 +1073,10 @@ fn refined_residual(
         acc.fill(0.0);
         let mut y = 0.0;
         let (mut bu, mut bv) = ([0.0; MAXB], [0.0; MAXB]);
-        for (uv, p) in x.chunks_exact(2).zip(pts) {
+        for (k, uv) in x.chunks_exact(2).enumerate() {
             super::bernstein_into(du, uv[0], &mut bu[..ku]);
             super::bernstein_into(dv, uv[1], &mut bv[..kv]);
-            let mut e = *p;
+            let mut e = data.point(k);
             for a in 0..ku {
                 for b in 0..kv {
                     let w = bu[a] * bv[b];

@@ -220,14 +220,20 @@ pub enum Layout {
     Scattered,
 }
 
+/// A problem's data laid out for its layout's fast path.
+enum FastData {
+    Grid(GridData),
+    Scattered(fast::ScatteredData),
+}
+
 /// The optimisation problem: decision vector = data parameters in [0, 1], fitness = Y.
 pub struct BezierParamProblem {
     pub du: usize,
     pub dv: usize,
     pub layout: Layout,
     pub points: Vec<Point3>,
-    grid: Option<GridData>,
-    scattered: Option<fast::ScatteredData>,
+    /// The data in the fast path's layout (grid or scattered, as `layout` says).
+    data: FastData,
     start: Vec<f64>,
     lo: Vec<f64>,
     hi: Vec<f64>,
@@ -260,17 +266,16 @@ impl BezierParamProblem {
                 start.len()
             )));
         }
-        let (grid, scattered) = match layout {
-            Layout::Grid { nu, nv } => (Some(GridData::new(&points, nu, nv)), None),
-            Layout::Scattered => (None, Some(fast::ScatteredData::new(&points))),
+        let data = match layout {
+            Layout::Grid { nu, nv } => FastData::Grid(GridData::new(&points, nu, nv)),
+            Layout::Scattered => FastData::Scattered(fast::ScatteredData::new(&points)),
         };
         Ok(BezierParamProblem {
             du,
             dv,
             layout,
             points,
-            grid,
-            scattered,
+            data,
             start,
             lo: vec![0.0; dim],
             hi: vec![1.0; dim],
@@ -311,17 +316,17 @@ impl Problem for BezierParamProblem {
             let mut xs = std::mem::take(&mut s.x);
             xs.clear();
             xs.extend(x.iter().map(|t| t.clamp(0.0, 1.0)));
-            let y = match (self.layout, &self.grid, &self.scattered) {
-                (Layout::Grid { nu, nv }, Some(data), _) => {
+            let y = match &self.data {
+                FastData::Grid(data) => {
+                    let (nu, nv) = (data.nu, data.nv);
                     fast::sort_params(&mut xs[..nu]);
                     fast::sort_params(&mut xs[nu..nu + nv]);
                     let (u, v) = (&xs[..nu], &xs[nu..nu + nv]);
                     fast::grid_sse(self.du, self.dv, u, v, data, s)
                         .unwrap_or_else(|| grid_sse_qr(self.du, self.dv, u, v, data))
                 }
-                (_, _, Some(data)) => fast::scattered_sse(self.du, self.dv, &xs, data, s)
+                FastData::Scattered(data) => fast::scattered_sse(self.du, self.dv, &xs, data, s)
                     .unwrap_or_else(|| self.fit(&xs).map(|(_, y)| y).unwrap_or(f64::INFINITY)),
-                _ => unreachable!("the constructor builds the layout's data"),
             };
             s.x = xs;
             y
