@@ -153,12 +153,12 @@ fn main() {
     // BENCH_INIT_RANGE sets the initial population's spread around x0 (the thesis' 5e-6 by default).
     let init_range: f64 =
         std::env::var("BENCH_INIT_RANGE").ok().and_then(|v| v.parse().ok()).unwrap_or(5e-6);
-    let budget = Budget {
-        generations: generations as u64,
-        population: 40,
-        init_range,
-        trace_every_evals: 400,
-    };
+    // BENCH_POPULATION sets the population (40 by default, Table 6.1): with fewer individuals
+    // the population's vectors stay in the L2 cache, which shows what memory traffic costs.
+    let population: usize =
+        std::env::var("BENCH_POPULATION").ok().and_then(|v| v.parse().ok()).unwrap_or(40);
+    let budget =
+        Budget { generations: generations as u64, population, init_range, trace_every_evals: 400 };
     // Per run: CPU seconds of this thread (the machine may be shared), per evaluation, and what
     // the optimiser itself costs per evaluation on top of the fitness (its per-coordinate work).
     for name in ["de", "ga", "pso", "csa", "icsa"]
@@ -177,7 +177,7 @@ fn main() {
             String::new()
         };
         println!(
-            "{name} {generations} x 40: {s:.3} s CPU, {} evaluations ({:.2} M/s), {:.3} us per evaluation = fitness + {:.3} us ({:.2}x the fitness alone), best {:.6}{target}",
+            "{name} {generations} x {population}: {s:.3} s CPU, {} evaluations ({:.2} M/s), {:.3} us per evaluation = fitness + {:.3} us ({:.2}x the fitness alone), best {:.6}{target}",
             r.evaluations,
             1e-6 / per_eval,
             per_eval * 1e6,
