@@ -15,6 +15,9 @@ use somnurbs::spline::{fit_two_view, Approach, Parameterisation};
 use somnurbs::spline::{BoxSpec, ControlNetProblem};
 use std::time::Instant;
 
+#[path = "optim/floor.rs"]
+mod floor;
+
 fn main() {
     let spindle =
         somnurbs::data::registry::load_dataset("spindle", &somnurbs::experiment::data_dir(None))
@@ -106,6 +109,17 @@ fn main() {
             "square-root floor: {roots} x {:.1} cycles = {:.0} cycles (beside the FMA bound, not on top of it)",
             p.sqrt_ns * mhz / 1e3,
             roots as f64 * p.sqrt_ns * mhz / 1e3
+        );
+    }
+    if let Some(b) = floor::measure(mhz, |n, f| best_ns_per(n, f)) {
+        let (blocks, columns) = kernel_blocks(20, 20, 18);
+        let sum = blocks as f64 * b.pass1_block + columns as f64 * b.pass2_column;
+        println!(
+            "AVX2 building blocks alone (data in L1, nothing around them): first-pass block {:.1} cycles (its 16 FMAs: 8), second-pass column {:.1} cycles (its 15 FMAs: 7.5; its root: {:.1}); {blocks} blocks + {columns} columns = {sum:.0} cycles = {:.2}x the FMA bound",
+            b.pass1_block,
+            b.pass2_column,
+            peak.map_or(f64::NAN, |p| p.sqrt_ns * mhz / 1e3),
+            sum / bound
         );
     }
     for isa in Isa::ALL {
@@ -330,6 +344,16 @@ fn fma_lower_bound_cycles(nx: usize, ny: usize, cn_y: usize) -> f64 {
     let pass1 = 4 * (nx * k3 + (nx - 2) * (k3 - 6));
     let pass2 = 15 * (pad(nx) * ny + pad(nx - 2) * (ny - 2));
     (pass1 + pass2) as f64 / 8.0
+}
+
+/// First-pass blocks and second-pass columns of the vector fitness on an nx x ny map with a
+/// cn_y-column net: per chunk of four grid rows, the bottom view's segment of 3 cn_y values in
+/// blocks of four (the last one overlapping), the top view's two border blocks and its segment
+/// of 3 cn_y - 6; per chunk, one column per grid column (ny bottom, ny - 2 top).
+fn kernel_blocks(nx: usize, ny: usize, cn_y: usize) -> (usize, usize) {
+    let k3 = 3 * cn_y;
+    let (bottom, top) = (nx.div_ceil(4), (nx - 2).div_ceil(4));
+    (bottom * k3.div_ceil(4) + top * (2 + (k3 - 6).div_ceil(4)), bottom * ny + top * (ny - 2))
 }
 
 /// Best of `rounds` batches of fitness evaluations at x0 (ns per evaluation, thread CPU time).

@@ -50,6 +50,9 @@ pub enum BoxSpec {
 }
 
 pub use crate::optim::kernels::Isa;
+#[cfg(target_arch = "x86_64")]
+#[doc(hidden)]
+pub use fused::building_blocks;
 
 /// The control-net problem: minimise Eq. 6.2 over the distinct control points inside a box.
 #[derive(Debug, Clone)]
@@ -555,6 +558,90 @@ mod fused {
             for v in lane_sums {
                 *total += v;
             }
+        }
+    }
+
+    /// The AVX2 copy's two building blocks run alone, over and over, for the optim bench's
+    /// floor (`benches/optim/floor.rs`); not part of the interface.
+    #[doc(hidden)]
+    pub mod building_blocks {
+        use super::{add_group, segment, CHUNK};
+        use crate::spline::SparseBasis;
+        use std::arch::x86_64::*;
+
+        /// `n` times [`segment`] of `k` values from the lanes' rows `src` into `out`.
+        #[target_feature(enable = "avx2,fma")]
+        unsafe fn segments(
+            n: usize,
+            src: &[*const f64; CHUNK],
+            s: usize,
+            w: &[[f64; 4]; CHUNK],
+            k: usize,
+            out: *mut f64,
+        ) {
+            let wv = w.map(|wl| wl.map(|v| _mm256_set1_pd(v)));
+            for _ in 0..n {
+                segment::<4>(src, s, &wv, k, std::hint::black_box(out));
+            }
+        }
+
+        /// `n` times the first pass of one chunk of four grid rows over `out.len() / 4` k (at
+        /// least 4): lanes 0, 1 from control row 0 and lanes 2, 3 from row 1 of `rows` (rows
+        /// `s` apart), weights `w` per lane, transposed into `out`. None without AVX2 and FMA.
+        pub fn first_pass(
+            n: usize,
+            rows: &[f64],
+            s: usize,
+            w: &[[f64; 4]; 4],
+            out: &mut [f64],
+        ) -> Option<()> {
+            let k = out.len() / CHUNK;
+            assert!(k >= 4 && k <= s && out.len().is_multiple_of(CHUNK) && rows.len() >= 4 * s + k);
+            if !crate::optim::kernels::avx2_fma() {
+                return None;
+            }
+            let src: [*const f64; CHUNK] = std::array::from_fn(|l| rows[(l / 2) * s..].as_ptr());
+            // SAFETY: the CPU has AVX2 and FMA; lane l reads rows l / 2 + t (t < 4, so below
+            // row 5) at k < out.len() / 4 <= s (asserted), and writes out whole.
+            unsafe { segments(n, &src, s, w, k, out.as_mut_ptr()) };
+            Some(())
+        }
+
+        #[target_feature(enable = "avx2,fma")]
+        unsafe fn second_pass_avx2(
+            n: usize,
+            nv: &SparseBasis,
+            k3p: usize,
+            data: &[f64],
+            rt: &[f64],
+        ) -> f64 {
+            let mut total = 0.0;
+            for _ in 0..n {
+                add_group::<1>(&mut total, 0..nv.first.len(), k3p, nv, data.as_ptr(), rt.as_ptr());
+                total = std::hint::black_box(total);
+            }
+            total
+        }
+
+        /// `n` times the second pass of one chunk over all of `nv`'s grid columns, from its
+        /// transposed rows `rt` (k3p rows of 4 lanes) and data (3 rows of 4 lanes per column).
+        /// None without AVX2 and FMA.
+        pub fn second_pass(
+            n: usize,
+            nv: &SparseBasis,
+            k3p: usize,
+            data: &[f64],
+            rt: &[f64],
+        ) -> Option<f64> {
+            let nc = nv.first.len();
+            assert!(nv.w.len() == nc && rt.len() >= k3p * CHUNK && data.len() >= nc * 3 * CHUNK);
+            assert!(nv.first.iter().all(|&f| (f + 4) * 3 <= k3p));
+            if !crate::optim::kernels::avx2_fma() {
+                return None;
+            }
+            // SAFETY: the CPU has AVX2 and FMA; every column reads RT rows below k3p and its
+            // own three data rows (asserted).
+            Some(unsafe { second_pass_avx2(n, nv, k3p, data, rt) })
         }
     }
 
@@ -1112,6 +1199,44 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// The bench's building blocks do the kernel's work: the first pass gives lin4's rows
+    /// transposed, the second pass pass2_error's sum, bit for bit.
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn building_blocks_compute_the_portable_passes() {
+        use super::building_blocks::{first_pass, second_pass};
+        let (s, k) = (30, 26);
+        let rows: Vec<f64> = (0..5 * s).map(|i| (i as f64 * 0.37).sin()).collect();
+        let w = [
+            [0.1, 0.6, 0.25, 0.05],
+            [0.05, 0.5, 0.4, 0.05],
+            [0.2, 0.6, 0.15, 0.05],
+            [0.3, 0.3, 0.3, 0.1],
+        ];
+        let mut out = vec![f64::NAN; CHUNK * k];
+        if first_pass(2, &rows, s, &w, &mut out).is_none() {
+            return; // no AVX2 here: the portable copy is the only one
+        }
+        let mut r = vec![0.0; CHUNK * k];
+        for l in 0..CHUNK {
+            let row = |t: usize| &rows[(l / 2 + t) * s..(l / 2 + t) * s + k];
+            lin4(&mut r[l * k..(l + 1) * k], row(0), row(1), row(2), row(3), &w[l]);
+        }
+        let mut rt = vec![0.0; CHUNK * k];
+        transpose_rows(CHUNK, k, &r, &mut rt);
+        assert!(out.iter().zip(&rt).all(|(a, b)| a.to_bits() == b.to_bits()));
+        let nv = SparseBasis {
+            first: vec![0, 1, 1, 2, 4],
+            w: w.iter().cycle().take(5).copied().collect(),
+        };
+        let data: Vec<f64> = (0..5 * 3 * CHUNK).map(|i| (i as f64 * 0.11).cos()).collect();
+        let (k3p, expected) = (24, pass2_error(CHUNK, 0..5, 24, &nv, &data, &rt));
+        assert_eq!(
+            second_pass(1, &nv, k3p, &data, &rt).map(f64::to_bits),
+            Some(expected.to_bits())
+        );
     }
 
     #[test]
