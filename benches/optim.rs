@@ -101,18 +101,19 @@ fn main() {
     // Every compiled copy of the fitness on this problem, in cycles (ns x the nominal clock)
     // beside the floating-point lower bound (multiply(-add)s on two 4-wide FMA pipes).
     let bound = fma_lower_bound_cycles(20, 20, 18);
+    // One second-pass column (and one 4-wide square root) per chunk of 4 grid rows and grid
+    // column, both views.
+    let (blocks, columns) = kernel_blocks(20, 20, 18);
     if let Some(p) = peak {
-        // The 190 4-wide square roots (one per chunk of 4 grid rows and grid column, both views)
-        // run on their own unit beside the FMAs: a second floor, not added to the first.
-        let roots = 5 * 20 + 5 * 18;
+        // The square roots run on their own unit beside the FMAs: a second floor, not added to
+        // the first.
         println!(
-            "square-root floor: {roots} x {:.1} cycles = {:.0} cycles (beside the FMA bound, not on top of it)",
+            "square-root floor: {columns} x {:.1} cycles = {:.0} cycles (beside the FMA bound, not on top of it)",
             p.sqrt_ns * mhz / 1e3,
-            roots as f64 * p.sqrt_ns * mhz / 1e3
+            columns as f64 * p.sqrt_ns * mhz / 1e3
         );
     }
-    if let Some(b) = floor::measure(mhz, |n, f| best_ns_per(n, f)) {
-        let (blocks, columns) = kernel_blocks(20, 20, 18);
+    if let Some(b) = floor::measure(mhz) {
         let sum = blocks as f64 * b.pass1_block + columns as f64 * b.pass2_column;
         println!(
             "AVX2 building blocks alone (data in L1, nothing around them): first-pass block {:.1} cycles (its 16 FMAs: 8), second-pass column {:.1} cycles (its 15 FMAs: 7.5; its root: {:.1}); {blocks} blocks + {columns} columns = {sum:.0} cycles = {:.2}x the FMA bound",

@@ -28,14 +28,12 @@ const K: usize = 200;
 const COLUMNS: usize = 80;
 const K3P: usize = 56;
 
-/// Time both blocks with `best_ns_per` (ns per batch) and convert to cycles at `mhz`; None
+/// Time both blocks with the bench's [`best_ns_per`] and convert to cycles at `mhz`; None
 /// without AVX2 and FMA.
-pub fn measure(
-    mhz: f64,
-    best_ns_per: impl Fn(usize, &dyn Fn(usize) -> f64) -> f64,
-) -> Option<Blocks> {
+pub fn measure(mhz: f64) -> Option<Blocks> {
     #[cfg(target_arch = "x86_64")]
     {
+        use crate::best_ns_per;
         use somnurbs::spline::control_net::building_blocks::{first_pass, second_pass};
         let rows: Vec<f64> = (0..5 * K).map(|k| 1.0 + k as f64 * 1e-3).collect();
         let w = [
@@ -46,7 +44,7 @@ pub fn measure(
         ];
         let out = std::cell::RefCell::new(vec![0.0; 4 * K]);
         first_pass(1, &rows, K, &w, &mut out.borrow_mut())?;
-        let p1 = best_ns_per(5_000, &|n| {
+        let p1 = best_ns_per(5_000, |n| {
             first_pass(n, &rows, K, &w, &mut out.borrow_mut());
             out.borrow()[0]
         });
@@ -57,7 +55,7 @@ pub fn measure(
         };
         let rt: Vec<f64> = (0..4 * K3P).map(|k| 1.0 + k as f64 * 1e-3).collect();
         let data: Vec<f64> = (0..12 * COLUMNS).map(|k| 0.5 + k as f64 * 1e-3).collect();
-        let p2 = best_ns_per(5_000, &|n| second_pass(n, &nv, K3P, &data, &rt).unwrap_or(0.0));
+        let p2 = best_ns_per(5_000, |n| second_pass(n, &nv, K3P, &data, &rt).unwrap_or(0.0));
         let cycles = |ns: f64| ns * mhz / 1e3;
         Some(Blocks {
             pass1_block: cycles(p1 / (K / 4) as f64),
@@ -66,7 +64,7 @@ pub fn measure(
     }
     #[cfg(not(target_arch = "x86_64"))]
     {
-        let _ = (mhz, best_ns_per);
+        let _ = mhz;
         None
     }
 }
