@@ -53,7 +53,7 @@ pub enum Command {
     Reproduce(ReproduceArgs),
     /// Compare every table of a results folder with a baseline folder: numbers to per-column
     /// tolerances, timing columns reported but not judged. Exit 0: no drift; 1: drift (the moved
-    /// cells are named, and all differences written to drift.csv); 2: bad input.
+    /// cells are named, and all differences written to drift.csv, or --out); 2: bad input.
     #[command(
         after_help = "Examples:\n  somnurbs drift results/baselines/quick results/thesis_quick\n  somnurbs drift results/baselines/quick results/thesis_quick --tol 'de_*=1e-6'\n  somnurbs drift --accept results/baselines/quick results/thesis_quick   # update the baseline on purpose"
     )]
@@ -80,6 +80,10 @@ pub struct CompareArgs {
     /// Monte Carlo samples of the Bayesian signed-rank test.
     #[arg(long, default_value_t = 50_000)]
     pub bayes_samples: usize,
+    /// Folder for the tables and charts (default RESULTS/compare). It must be missing, empty or
+    /// an earlier compare's, which is replaced whole; the run's own files are never changed.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
 }
 
 #[derive(Debug, Args)]
@@ -166,7 +170,8 @@ pub struct DriftArgs {
     /// Repeatable. Default 1e-9 absolute and 1e-9 relative.
     #[arg(long, value_name = "COLUMN=ABS[,REL]")]
     pub tol: Vec<String>,
-    /// Where to write the per-cell diff CSV (default CURRENT/drift.csv).
+    /// Where to write the per-cell diff CSV (default drift.csv in the working folder; never
+    /// inside a result folder).
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Compare even when the two folders were made by different specs, seeds or profiles.

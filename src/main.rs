@@ -46,18 +46,20 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Run(args) => run_spec(&args),
         Command::Drift(args) => drift(&args),
         Command::Merge(args) => {
-            let ctx = RunContext::new(
-                args.out.clone(),
-                jobs(args.jobs)?,
-                experiment::data_dir(args.data_dir.as_deref()),
-            );
+            let ctx = RunContext {
+                page: true,
+                ..RunContext::new(
+                    args.out.clone(),
+                    jobs(args.jobs)?,
+                    experiment::data_dir(args.data_dir.as_deref()),
+                )
+            };
             let out = experiment::merge(&args.shards, &ctx)?;
-            let html = somnurbs::report::html::write(&out)?;
             eprintln!(
                 "somnurbs: merged {} shards into {} and {}",
                 args.shards.len(),
                 out.join("REPORT.md").display(),
-                html.display()
+                out.join(somnurbs::report::html::FILE).display()
             );
             Ok(ExitCode::SUCCESS)
         }
@@ -93,6 +95,7 @@ fn run_spec(args: &RunArgs) -> anyhow::Result<ExitCode> {
     let ctx = RunContext {
         resume: args.resume,
         shard,
+        page: true,
         ..RunContext::new(
             spec.output_dir(args.out.as_deref()),
             jobs(args.jobs)?,
@@ -105,10 +108,11 @@ fn run_spec(args: &RunArgs) -> anyhow::Result<ExitCode> {
             "somnurbs: wrote shard {s} to {} (combine the shards with `somnurbs merge`)",
             out.display()
         ),
-        None => {
-            let html = somnurbs::report::html::write(&out)?;
-            eprintln!("somnurbs: wrote {} and {}", out.join("REPORT.md").display(), html.display())
-        }
+        None => eprintln!(
+            "somnurbs: {} and {} are in place",
+            out.join("REPORT.md").display(),
+            out.join(somnurbs::report::html::FILE).display()
+        ),
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -140,7 +144,8 @@ fn drift(args: &DriftArgs) -> anyhow::Result<ExitCode> {
     );
     let opts = drift::DriftOptions { columns, config, ..Default::default() };
     let report = drift::compare_dirs(&args.baseline, &args.current, &opts, args.allow_spec_change)?;
-    let out = args.out.clone().unwrap_or_else(|| args.current.join("drift.csv"));
+    let out = args.out.clone().unwrap_or_else(|| "drift.csv".into());
+    somnurbs::io::outdir::require_outside_results(&out, "--out FILE")?;
     somnurbs::io::write_atomic(&out, report.csv()?.as_bytes())?;
     println!("{}\nper-cell differences: {}", report.summary(10), out.display());
     Ok(if report.drifted() { ExitCode::from(1) } else { ExitCode::SUCCESS })

@@ -44,11 +44,9 @@ pub fn datasets(action: DatasetsAction, data_dir: &Path) -> Result<()> {
                     let _ = writeln!(text, "{:?} {:?} {:?}", p[0], p[1], p[2]);
                 }
             }
-            // A results folder has one writer at a time (a run writing there refuses this); the
-            // file itself is written atomically, so a plain folder gets no lock file.
-            let folder =
-                file.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-            let _lock = crate::io::outdir::lock_if_shared(folder, "datasets export")?;
+            // A result folder holds one run and nothing else; the file is written atomically,
+            // and only over a regular file.
+            crate::io::outdir::require_outside_results(&file, "datasets export NAME FILE")?;
             crate::io::write_atomic(&file, text.as_bytes())?;
             eprintln!("somnurbs: wrote {} points to {}", cloud.points.len(), file.display());
         }

@@ -31,31 +31,28 @@ pub struct RunContext {
     pub resume: bool,
     /// Run only this slice of the cells (no tables: `somnurbs merge` makes them).
     pub shard: Option<log::Shard>,
-    /// Set by `run_spec`: the folder's reset, done once the inputs have loaded.
+    /// Set by `run_spec`: the folder's start, done once the inputs have loaded.
     pub session: Option<Arc<Session>>,
+    /// Write `report.html` (and its `vendor/`) beside REPORT.md before the manifest: a folder
+    /// that is a result of its own (`run`, `merge`), not a chapter of a plan's page.
+    pub page: bool,
 }
 
 impl RunContext {
     /// A plain run: fresh folder, all cells.
     pub fn new(out: PathBuf, jobs: usize, data_dir: PathBuf) -> RunContext {
-        RunContext { out, jobs, data_dir, resume: false, shard: None, session: None }
+        RunContext { out, jobs, data_dir, resume: false, shard: None, session: None, page: false }
     }
 
     /// Make the folder this run's: called by the runner when the first cell is about to run,
     /// i.e. after every input (spec, data, maps) has loaded, and before anything is written. The
-    /// first call removes the old manifest (the folder is unfinished from here on), writes the
+    /// folder is empty or holds this run unfinished ([`claim`]); the first call writes the
     /// fingerprint and starts the cell log (kept when resuming); later calls do nothing.
     pub fn begin(&self) -> Result<()> {
         let Some(session) = &self.session else { return Ok(()) };
         let mut pending =
             session.pending.lock().map_err(|_| anyhow::anyhow!("run state lock poisoned"))?;
         if let Some(fp) = pending.take() {
-            let manifest = self.out.join(crate::io::outdir::MANIFEST);
-            if manifest.exists() {
-                std::fs::remove_file(&manifest)
-                    .with_context(|| format!("cannot remove {}", manifest.display()))?;
-                crate::io::outdir::sync_dir(&self.out)?;
-            }
             fp.write(&self.out)?;
             drop(log::CellLog::open(&self.out, self.resume, session.master_seed)?);
         }
@@ -175,13 +172,14 @@ pub fn fingerprint(variants: &[Spec], shard: Option<log::Shard>) -> log::Fingerp
     }
 }
 
-/// Run a whole spec: cells, tables, pictures, REPORT.md, and last the manifest (its presence marks
-/// a complete run). The folder is locked for the whole run (one writer), and nothing in it is
-/// removed or rewritten until every input (data, maps) has loaded: the old manifest goes, and the
-/// fingerprint and a fresh cell log come, only when the first cell is about to run
-/// ([`RunContext::begin`]). With a shard, only its cells run and no tables are written (`merge`
+/// Run a whole spec: cells, tables, pictures, REPORT.md, report.html, and last the manifest (its
+/// presence marks a complete run). The folder is locked for the whole run (one writer) and must
+/// be empty, or with `resume` hold this same run ([`claim`]); the fingerprint and the cell log
+/// come only when the first cell is about to run ([`RunContext::begin`]), after every input
+/// (data, maps) has loaded. With a shard, only its cells run and no tables are written (`merge`
 /// writes them). With `resume`, the cells in the folder's log are kept if the folder's
-/// fingerprint and every logged seed match, else the run is refused before anything is touched.
+/// fingerprint and every logged seed match, else the run is refused before anything is touched;
+/// a folder that already holds this run finished is left as it is.
 pub fn run_spec(spec: &Spec, ctx: &RunContext) -> Result<PathBuf> {
     run_variants(std::slice::from_ref(spec), ctx)
 }
@@ -197,28 +195,67 @@ pub fn run_variants(variants: &[Spec], ctx: &RunContext) -> Result<PathBuf> {
             .with_context(|| format!("{}: data set `{d}`", spec.path))?;
     }
     let _lock = crate::io::outdir::lock(&ctx.out, &format!("run {}", spec.path))?;
-    run_spec_locked(variants, ctx)
+    let fp = fingerprint(variants, ctx.shard);
+    match claim(&ctx.out, &fp, ctx.resume)? {
+        Claimed::Finished => {
+            eprintln!(
+                "somnurbs: {} already holds this run, finished; nothing to do",
+                ctx.out.display()
+            );
+            Ok(ctx.out.clone())
+        }
+        Claimed::Start => run_spec_locked(variants, ctx),
+    }
 }
 
-/// [`run_variants`] in a folder the caller has locked.
+/// What a writer may do with its (locked) output folder.
+#[derive(Debug, PartialEq)]
+enum Claimed {
+    /// Run: the folder is empty, or (resuming) holds this run unfinished.
+    Start,
+    /// The folder holds this run finished (resuming): leave it as it is.
+    Finished,
+}
+
+/// The folder contract for a run: a fresh run needs an empty folder; `--resume` needs an empty
+/// folder or one holding this same run (its fingerprint), whose leftover temporary files it
+/// removes. Anything else is refused, naming what the folder holds.
+fn claim(out: &Path, fp: &log::Fingerprint, resume: bool) -> Result<Claimed> {
+    if !resume {
+        crate::io::outdir::require_empty(out)?;
+        return Ok(Claimed::Start);
+    }
+    let Some(old) = log::Fingerprint::read(out)? else {
+        if out.join(log::LOG_FILE).exists() {
+            anyhow::bail!(
+                "cannot resume in {}: it has a cell log but no {}",
+                out.display(),
+                log::FINGERPRINT_FILE
+            );
+        }
+        crate::io::outdir::require_empty(out)?;
+        return Ok(Claimed::Start);
+    };
+    if let Some(diff) = old.difference(fp) {
+        anyhow::bail!("cannot resume in {}: it holds a different run ({diff}); use another --out or drop --resume", out.display());
+    }
+    if out.join(crate::io::outdir::MANIFEST).exists() {
+        return Ok(Claimed::Finished);
+    }
+    let removed = crate::io::outdir::remove_leftovers(out)?;
+    if removed > 0 {
+        eprintln!(
+            "somnurbs: removed {removed} temporary file(s) the interrupted run left in {}",
+            out.display()
+        );
+    }
+    Ok(Claimed::Start)
+}
+
+/// [`run_variants`] in a folder the caller has locked and claimed.
 fn run_spec_locked(variants: &[Spec], ctx: &RunContext) -> Result<PathBuf> {
     let spec = variants.first().context("no spec to run")?;
     let fp = fingerprint(variants, ctx.shard);
-    if ctx.resume {
-        match log::Fingerprint::read(&ctx.out)? {
-            Some(old) => {
-                if let Some(diff) = old.difference(&fp) {
-                    anyhow::bail!("cannot resume in {}: it holds a different run ({diff}); use another --out or drop --resume", ctx.out.display());
-                }
-            }
-            None if ctx.out.join(log::LOG_FILE).exists() => anyhow::bail!(
-                "cannot resume in {}: it has a cell log but no {}",
-                ctx.out.display(),
-                log::FINGERPRINT_FILE
-            ),
-            None => {}
-        }
-    }
     let manifest_path = ctx.out.join(crate::io::outdir::MANIFEST);
     let session = Arc::new(Session {
         master_seed: spec.file.master_seed,
@@ -263,7 +300,11 @@ fn run_spec_locked(variants: &[Spec], ctx: &RunContext) -> Result<PathBuf> {
     if let Some(section) = section {
         let report = report_md(spec, &manifest, &[section]);
         crate::io::write_atomic(&ctx.out.join("REPORT.md"), report.as_bytes())?;
+        if ctx.page {
+            crate::report::html::write(&ctx.out)?;
+        }
     }
+    // The manifest is the very last write: its presence says every file above is whole.
     let text = toml::to_string_pretty(&manifest).context("cannot serialise the manifest")?;
     crate::io::write_atomic(&manifest_path, text.as_bytes())?;
     Ok(ctx.out.clone())
@@ -317,13 +358,14 @@ pub fn report_md(spec: &Spec, m: &Manifest, sections: &[String]) -> String {
 /// Combine shard folders of one spec into `out` and write its tables: the shards' fingerprints
 /// must agree (apart from the shard) and cover 1..N once, each shard finished, its logged seeds
 /// the spec's, and their cell logs together hold exactly the spec's cells; the logs are joined and
-/// the spec is run in `out` (locked, and empty of any run) with every cell restored from the log,
-/// so the tables equal a one-machine run's.
+/// the spec is run in `out` (locked, and empty) with every cell restored from the log, so the
+/// tables equal a one-machine run's.
 pub fn merge(shards: &[PathBuf], ctx: &RunContext) -> Result<PathBuf> {
     if shards.is_empty() {
         anyhow::bail!("merge: no shard folders given");
     }
     let _lock = crate::io::outdir::lock(&ctx.out, "merge")?;
+    crate::io::outdir::require_empty(&ctx.out).context("merge")?;
     let mut first: Option<log::Fingerprint> = None;
     let mut seen: BTreeMap<usize, PathBuf> = BTreeMap::new();
     let mut count = 0;
@@ -401,12 +443,6 @@ pub fn merge(shards: &[PathBuf], ctx: &RunContext) -> Result<PathBuf> {
     }
     if let Some(k) = records.keys().find(|k| !expected.contains(*k)) {
         anyhow::bail!("merge: the shards log cell {k}, which the spec does not have");
-    }
-    if ctx.out.join(log::LOG_FILE).exists()
-        || ctx.out.join(crate::io::outdir::MANIFEST).exists()
-        || ctx.out.join(log::FINGERPRINT_FILE).exists()
-    {
-        anyhow::bail!("merge: {} already holds a run; choose an empty folder", ctx.out.display());
     }
     {
         let mut out_log = log::CellLog::open(&ctx.out, false, fp.master_seed)?;

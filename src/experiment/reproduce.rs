@@ -8,7 +8,8 @@
 
 use super::family::{Combined, PlanView, ReadingRun};
 use super::spec::{Override, Spec};
-use super::{run_spec, RunContext};
+use super::{run_spec, Claimed, RunContext};
+use crate::io::outdir::PLAN_FILE;
 use crate::io::{csv_records, write_atomic};
 use crate::report::claims::{self, Claim};
 use anyhow::{Context, Result};
@@ -182,6 +183,14 @@ pub fn reproduce(
         }
     }
     let _lock = crate::io::outdir::lock(&ctx.out, &format!("reproduce --plan {plan_name}"))?;
+    let record = PlanRecord::new(plan_name, &plan_path, profile.unwrap_or("full"))?;
+    if claim_plan(&ctx.out, &record, ctx.resume)? == Claimed::Finished {
+        eprintln!(
+            "somnurbs: {} already holds this reproduction, finished; nothing to do",
+            ctx.out.display()
+        );
+        return Ok(ctx.out.join("REPORT.md"));
+    }
     // Every spec has loaded: the folder is unfinished until the combined REPORT.md is written.
     let incomplete = ctx.out.join(crate::io::outdir::INCOMPLETE);
     write_atomic(
@@ -192,6 +201,7 @@ pub fn reproduce(
         )
         .as_bytes(),
     )?;
+    record.write(&ctx.out)?;
     let started = Instant::now();
     let mut done = Vec::new();
     for spec in &specs {
@@ -241,6 +251,83 @@ pub fn reproduce(
         .with_context(|| format!("cannot remove {}", incomplete.display()))?;
     crate::io::outdir::sync_dir(&ctx.out)?;
     Ok(path)
+}
+
+/// The record of the plan a `reproduce` folder holds ([`PLAN_FILE`]): which plan, in which
+/// version, under which profile. `--resume` continues only the same plan.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PlanRecord {
+    plan: String,
+    plan_path: String,
+    plan_sha256: String,
+    profile: String,
+    plan_text: String,
+}
+
+impl PlanRecord {
+    fn new(plan: &str, path: &Path, profile: &str) -> Result<PlanRecord> {
+        let text = crate::io::read_text(path)?;
+        Ok(PlanRecord {
+            plan: plan.to_string(),
+            plan_path: path.display().to_string(),
+            plan_sha256: hex::encode(<sha2::Sha256 as sha2::Digest>::digest(text.as_bytes())),
+            profile: profile.to_string(),
+            plan_text: text,
+        })
+    }
+
+    fn read(dir: &Path) -> Result<Option<PlanRecord>> {
+        let path = dir.join(PLAN_FILE);
+        if !path.exists() {
+            return Ok(None);
+        }
+        crate::io::read_toml(&path).map(Some)
+    }
+
+    fn write(&self, dir: &Path) -> Result<()> {
+        let text = toml::to_string(self).context("cannot serialise the plan record")?;
+        write_atomic(&dir.join(PLAN_FILE), text.as_bytes())
+    }
+
+    /// The first field in which `other` differs, as `name: ours vs theirs`.
+    fn difference(&self, other: &PlanRecord) -> Option<String> {
+        [
+            ("plan", &self.plan, &other.plan),
+            ("profile", &self.profile, &other.profile),
+            ("plan text (sha256)", &self.plan_sha256, &other.plan_sha256),
+        ]
+        .into_iter()
+        .find(|(_, a, b)| a != b)
+        .map(|(name, a, b)| format!("{name}: {a} vs {b}"))
+    }
+}
+
+/// The folder contract for a plan: a fresh reproduction needs an empty folder; `--resume` needs an
+/// empty folder or one holding the same plan and profile ([`PlanRecord`]), unfinished (a finished
+/// one is left as it is); its specs' folders are then claimed one by one as `run --resume` does.
+fn claim_plan(out: &Path, record: &PlanRecord, resume: bool) -> Result<Claimed> {
+    if !resume {
+        crate::io::outdir::require_empty(out)?;
+        return Ok(Claimed::Start);
+    }
+    let Some(old) = PlanRecord::read(out)? else {
+        // A kill between the unfinished marker and the record leaves the marker alone.
+        let found = crate::io::outdir::entries(out)?;
+        if found.iter().all(|e| e == crate::io::outdir::INCOMPLETE) {
+            return Ok(Claimed::Start);
+        }
+        crate::io::outdir::require_empty(out)?;
+        return Ok(Claimed::Start);
+    };
+    if let Some(diff) = old.difference(record) {
+        anyhow::bail!("cannot resume in {}: it holds another reproduction ({diff}); use another --out or drop --resume", out.display());
+    }
+    if !out.join(crate::io::outdir::INCOMPLETE).exists() {
+        return Ok(Claimed::Finished);
+    }
+    crate::io::outdir::remove_leftovers(out)?;
+    Ok(Claimed::Start)
 }
 
 /// Each family's part of the combined report, from its specs' finished folders.

@@ -92,11 +92,14 @@ where
             scope.spawn(move || {
                 let interval = progress_interval();
                 let mut stopped = stop.0.lock().unwrap_or_else(|e| e.into_inner());
-                loop {
-                    stopped =
-                        stop.1.wait_timeout(stopped, interval).unwrap_or_else(|e| e.into_inner()).0;
-                    if *stopped {
-                        break;
+                // The flag is read before every wait, under the lock the stop is set with, so a
+                // stop that comes before the first wait (a tiny run) is never missed.
+                while !*stopped {
+                    let (guard, timeout) =
+                        stop.1.wait_timeout(stopped, interval).unwrap_or_else(|e| e.into_inner());
+                    stopped = guard;
+                    if *stopped || !timeout.timed_out() {
+                        continue;
                     }
                     eprintln!(
                         "{}",

@@ -15,8 +15,40 @@ pub fn ensure_dir(dir: &Path) -> Result<()> {
     fs::create_dir_all(dir).with_context(|| format!("cannot create folder {}", dir.display()))
 }
 
-/// Write `bytes` to `path` atomically (temporary file + rename).
+/// Refuse to replace anything but a regular file: a rename would put a plain file in place of a
+/// device, a pipe, a socket, a folder or a link (a link's target would not be written).
+pub fn require_regular_or_absent(path: &Path) -> Result<()> {
+    let Ok(meta) = fs::symlink_metadata(path) else { return Ok(()) };
+    let ty = meta.file_type();
+    if ty.is_file() {
+        return Ok(());
+    }
+    let kind = {
+        use std::os::unix::fs::FileTypeExt;
+        if ty.is_dir() {
+            "a folder"
+        } else if ty.is_symlink() {
+            "a symbolic link"
+        } else if ty.is_char_device() || ty.is_block_device() {
+            "a device"
+        } else if ty.is_fifo() {
+            "a named pipe"
+        } else if ty.is_socket() {
+            "a socket"
+        } else {
+            "not a regular file"
+        }
+    };
+    anyhow::bail!(
+        "cannot write {}: it is {kind}, and somnurbs replaces only regular files; name a new file",
+        path.display()
+    )
+}
+
+/// Write `bytes` to `path` atomically (temporary file + rename); `path` must be a regular file or
+/// absent ([`require_regular_or_absent`]).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    require_regular_or_absent(path)?;
     if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
         ensure_dir(parent)?;
     }

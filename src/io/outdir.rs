@@ -11,8 +11,14 @@
 //!   heartbeat is younger than [`STALE_AFTER`] refuses the writer too, and a record of this host
 //!   whose process is alive does. (Two starts on two such hosts within the same instant can still
 //!   both pass; nothing portable closes that window.)
+//! - **An empty folder to start.** A result folder holds one run (or plan) and the files it wrote:
+//!   a new result starts only in a missing or empty folder ([`require_empty`], which names what a
+//!   refused folder holds); `--resume` continues only the same run and first removes the
+//!   temporary files an interrupted writer left ([`remove_leftovers`]); single files (`datasets
+//!   export`, `drift`'s CSV) are never written inside a result folder
+//!   ([`require_outside_results`]).
 //! - **Finished means a manifest.** A run folder (one holding `fingerprint.toml`, `cells.jsonl` or
-//!   `manifest.toml`) is finished when `manifest.toml`, written last, is there and it is not a
+//!   `manifest.toml`) is finished when `manifest.toml`, written after every other file, is there and it is not a
 //!   single shard; a `reproduce` folder is unfinished while it holds [`INCOMPLETE`].
 //!   [`require_finished`] refuses anything else, naming the missing piece.
 //! - **Whole-folder swaps.** [`replace_dir`] builds a new folder beside the old one and swaps
@@ -38,6 +44,10 @@ pub const LOG_FILE: &str = "cells.jsonl";
 pub const FINGERPRINT_FILE: &str = "fingerprint.toml";
 /// Present in a `reproduce` folder from the moment its inputs have loaded until its REPORT.md.
 pub const INCOMPLETE: &str = ".somnurbs-incomplete";
+/// The record of the plan a `reproduce` folder holds (what `reproduce --resume` compares).
+pub const PLAN_FILE: &str = "plan_fingerprint.toml";
+/// The files that make a folder a result folder (a run, a shard, a plan or a `fit`).
+const MARKERS: [&str; 6] = [MANIFEST, FINGERPRINT_FILE, LOG_FILE, INCOMPLETE, PLAN_FILE, LOCK_FILE];
 /// How often a lock holder refreshes its record.
 pub const HEARTBEAT: Duration = Duration::from_secs(20);
 /// A record of another host older than this is taken to be left by a dead writer.
@@ -49,6 +59,150 @@ pub fn temp_name(path: &Path, what: &str) -> PathBuf {
     let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
     let n = COUNTER.fetch_add(1, Ordering::Relaxed);
     path.with_file_name(format!(".{name}.{}.{n}.{what}", std::process::id()))
+}
+
+/// Whether a file name is one [`temp_name`] made: `.NAME.PID.N.WHAT` for a temporary file
+/// (`tmp`) or folder (`staged`, `old`).
+fn is_temp_name(name: &str) -> bool {
+    let Some(rest) = name.strip_prefix('.') else { return false };
+    let mut parts = rest.rsplitn(4, '.');
+    let (what, n, pid, stem) = (parts.next(), parts.next(), parts.next(), parts.next());
+    let digits =
+        |s: Option<&str>| s.is_some_and(|s| !s.is_empty() && s.bytes().all(|b| b.is_ascii_digit()));
+    matches!(what, Some("tmp" | "staged" | "old"))
+        && digits(n)
+        && digits(pid)
+        && stem.is_some_and(|s| !s.is_empty())
+}
+
+/// Remove the temporary files and folders that an interrupted writer left anywhere under `dir`
+/// (names made by [`temp_name`]); call it only while holding the folder's [`lock`]. Returns how
+/// many were removed.
+pub fn remove_leftovers(dir: &Path) -> Result<usize> {
+    let (files, dirs) = walk(dir)?;
+    let mut gone: Vec<PathBuf> = Vec::new();
+    for rel in dirs.iter().chain(&files) {
+        let temp = rel.file_name().is_some_and(|n| is_temp_name(&n.to_string_lossy()));
+        if !temp || gone.iter().any(|g| rel.starts_with(g)) {
+            continue;
+        }
+        let path = dir.join(rel);
+        let removed =
+            if path.is_dir() { fs::remove_dir_all(&path) } else { fs::remove_file(&path) };
+        removed.with_context(|| format!("cannot remove the leftover {}", path.display()))?;
+        gone.push(rel.clone());
+    }
+    if !gone.is_empty() {
+        sync_dir(dir)?;
+    }
+    Ok(gone.len())
+}
+
+/// The entries of `dir` other than its lock file, sorted, folders with a trailing `/` (none when
+/// `dir` does not exist).
+pub fn entries(dir: &Path) -> Result<Vec<String>> {
+    let rd = match fs::read_dir(dir) {
+        Ok(rd) => rd,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(e) => return Err(e).with_context(|| format!("cannot read folder {}", dir.display())),
+    };
+    let mut names = Vec::new();
+    for e in rd {
+        let e = e.with_context(|| format!("cannot read folder {}", dir.display()))?;
+        let name = e.file_name().to_string_lossy().into_owned();
+        if name == LOCK_FILE {
+            continue;
+        }
+        let folder = e.path().is_dir();
+        names.push(if folder { format!("{name}/") } else { name });
+    }
+    names.sort();
+    Ok(names)
+}
+
+/// What a non-empty folder holds, in words: a finished or unfinished run, a shard, a
+/// reproduction, or files that are no somnurbs result.
+fn describe(dir: &Path, entries: &[String]) -> String {
+    #[derive(serde::Deserialize)]
+    struct Named {
+        spec_name: Option<String>,
+        shard: Option<String>,
+    }
+    let named = |file: &str| -> Option<Named> {
+        let text = fs::read_to_string(dir.join(file)).ok()?;
+        toml::from_str(&text).ok()
+    };
+    let has = |f: &str| entries.iter().any(|e| e == f);
+    let spec = |n: &Option<Named>| {
+        n.as_ref()
+            .and_then(|n| n.spec_name.clone())
+            .map(|s| format!(" of spec `{s}`"))
+            .unwrap_or_default()
+    };
+    if has(PLAN_FILE) || has(INCOMPLETE) {
+        return if has(INCOMPLETE) {
+            "an unfinished reproduction (continue it with `somnurbs reproduce --resume` and the same --plan and --profile)".into()
+        } else {
+            "a finished reproduction".into()
+        };
+    }
+    if has(MANIFEST) {
+        let m = named(MANIFEST);
+        let shard = m.as_ref().and_then(|m| m.shard.clone());
+        return match shard {
+            Some(s) => format!("shard {s}{}, finished", spec(&m)),
+            None => format!("a finished run{}", spec(&m)),
+        };
+    }
+    if has(FINGERPRINT_FILE) || has(LOG_FILE) {
+        return format!(
+            "an unfinished run{} (continue it with --resume and the same spec, profile and options)",
+            spec(&named(FINGERPRINT_FILE))
+        );
+    }
+    let shown: Vec<&str> = entries.iter().take(5).map(String::as_str).collect();
+    let more = entries.len().saturating_sub(shown.len());
+    format!(
+        "files that are not a somnurbs result ({}{})",
+        shown.join(", "),
+        if more > 0 { format!(" and {more} more") } else { String::new() }
+    )
+}
+
+/// Refuse to start a new result in `dir` unless it is missing or empty (its lock file aside): a
+/// result folder holds one run and the files that run wrote, and a finished one is never changed.
+pub fn require_empty(dir: &Path) -> Result<()> {
+    let found = entries(dir)?;
+    if found.is_empty() {
+        return Ok(());
+    }
+    bail!(
+        "output folder {} already holds {}; a result folder holds one run and nothing else, so choose another --out (or remove that folder yourself)",
+        dir.display(),
+        describe(dir, &found)
+    )
+}
+
+/// The result folder (a run, shard, plan or `fit` folder: one holding a manifest, fingerprint,
+/// cell log, plan record or lock file) that `path` would be written into, if any: `path`'s
+/// folder or one of its parents.
+pub fn result_folder_of(path: &Path) -> Option<PathBuf> {
+    let parent = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let start = fs::canonicalize(parent).ok()?;
+    start.ancestors().find(|d| MARKERS.iter().any(|m| d.join(m).exists())).map(Path::to_path_buf)
+}
+
+/// Refuse to write the single file `path` (e.g. `datasets export`, `drift`'s CSV) inside a result
+/// folder: results are never changed after the fact.
+pub fn require_outside_results(path: &Path, option: &str) -> Result<()> {
+    if let Some(folder) = result_folder_of(path) {
+        bail!(
+            "{} is inside the result folder {}, which holds one run and nothing else; write it elsewhere ({option})",
+            path.display(),
+            folder.display()
+        );
+    }
+    Ok(())
 }
 
 /// `fsync` a folder, so that renames and creations in it are durable.
@@ -244,18 +398,6 @@ pub fn lock(dir: &Path, command: &str) -> Result<Lock> {
             .ok()
     };
     Ok(Lock { file, path, stop, heartbeat })
-}
-
-/// Take the lock of `dir` only when it is a writer's folder already (it holds a lock file):
-/// a one-file command such as `datasets export` then waits its turn in a results folder, and
-/// leaves no lock file behind in a plain folder (the file can never be removed safely once made,
-/// as a waiting writer may hold it open).
-pub fn lock_if_shared(dir: &Path, command: &str) -> Result<Option<Lock>> {
-    if dir.join(LOCK_FILE).exists() {
-        lock(dir, command).map(Some)
-    } else {
-        Ok(None)
-    }
 }
 
 fn write_record(file: &mut File, text: &str) -> std::io::Result<()> {

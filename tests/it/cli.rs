@@ -415,13 +415,13 @@ fn compare_writes_statistics_and_refuses_bad_folders() {
     c.ok(&["run", "opt.toml", "--out", "o"]);
     let out = c.ok(&["compare", "o"]);
     assert!(String::from_utf8_lossy(&out.stdout).contains("Friedman over 2 cells x 3 optimisers"));
-    let (h, rows) = read_csv(&c.path("o/compare_cells.csv"));
+    let (h, rows) = read_csv(&c.path("o/compare/compare_cells.csv"));
     assert_eq!(rows.len(), 2 * 3);
     let p = h.iter().position(|x| x == "rank_sum_p").unwrap();
     assert!(rows.iter().all(|r| (0.0..=1.0).contains(&r[p].parse::<f64>().unwrap())));
-    let (_, overall) = read_csv(&c.path("o/compare_overall.csv"));
+    let (_, overall) = read_csv(&c.path("o/compare/compare_overall.csv"));
     assert_eq!(overall.len(), 3);
-    assert!(c.path("o/cd_diagram.png").exists());
+    assert!(c.path("o/compare/cd_diagram.png").exists());
     c.fails(&["compare", "missing"], &["missing/runs.csv"]);
     let text = std::fs::read_to_string(c.path("o/runs.csv")).unwrap();
     let mut lines: Vec<String> = text.lines().map(String::from).collect();
@@ -472,7 +472,7 @@ fn compare_writes_runtime_distributions_and_bayesian_table() {
     assert!(starts.iter().all(|l| l.starts_with("1 ")), "{starts:?}");
     let out = c.ok(&["compare", "o", "--bayes-samples", "2000"]);
     assert!(String::from_utf8_lossy(&out.stdout).contains("Bayesian signed-rank"));
-    let (h, rows) = read_csv(&c.path("o/compare_bayes.csv"));
+    let (h, rows) = read_csv(&c.path("o/compare/compare_bayes.csv"));
     assert_eq!(rows.len(), 3);
     let col = |n: &str| h.iter().position(|x| x == n).unwrap();
     for r in &rows {
@@ -482,7 +482,7 @@ fn compare_writes_runtime_distributions_and_bayesian_table() {
             .sum();
         assert!((s - 1.0).abs() < 1e-3, "{r:?}");
     }
-    let (h, rows) = read_csv(&c.path("o/compare_ecdf.csv"));
+    let (h, rows) = read_csv(&c.path("o/compare/compare_ecdf.csv"));
     let (g, o, e) = (
         h.iter().position(|x| x == "group").unwrap(),
         h.iter().position(|x| x == "optimiser").unwrap(),
@@ -494,18 +494,18 @@ fn compare_writes_runtime_distributions_and_bayesian_table() {
         let (a, b): (f64, f64) = (w[0][e].parse().unwrap(), w[1][e].parse().unwrap());
         assert!((0.0..=1.0).contains(&a) && a <= b, "{w:?}");
     }
-    let (h, rows) = read_csv(&c.path("o/compare_aocc.csv"));
+    let (h, rows) = read_csv(&c.path("o/compare/compare_aocc.csv"));
     let a = h.iter().position(|x| x == "aocc").unwrap();
     assert!(rows.iter().all(|r| (0.0..=1.0).contains(&r[a].parse::<f64>().unwrap())));
-    let (h, rows) = read_csv(&c.path("o/compare_ert.csv"));
+    let (h, rows) = read_csv(&c.path("o/compare/compare_ert.csv"));
     let (hi, ru) =
         (h.iter().position(|x| x == "hits").unwrap(), h.iter().position(|x| x == "runs").unwrap());
     assert!(rows
         .iter()
         .all(|r| r[hi].parse::<usize>().unwrap() <= r[ru].parse::<usize>().unwrap()));
     assert!(
-        c.path("o/compare_ecdf_all.png").exists()
-            && c.path("o/compare_fixed_budget_all.png").exists()
+        c.path("o/compare/compare_ecdf_all.png").exists()
+            && c.path("o/compare/compare_fixed_budget_all.png").exists()
     );
     for f in [
         "compare_cells",
@@ -516,7 +516,7 @@ fn compare_writes_runtime_distributions_and_bayesian_table() {
         "compare_fixed_budget",
         "compare_ert",
     ] {
-        let (_, rows) = read_csv(&c.path(&format!("o/{f}.csv")));
+        let (_, rows) = read_csv(&c.path(&format!("o/compare/{f}.csv")));
         assert!(
             !rows.iter().flatten().any(|x| x.starts_with('-') && x[1..].parse::<f64>() == Ok(0.0)),
             "{f}: negative zero"

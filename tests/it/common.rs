@@ -193,3 +193,25 @@ pictures = false
 models = ["dnsom"]
 grids = ["20x20"]
 "#;
+
+/// A SOM spec of a fraction of a second on the data set `DATA` (replace it).
+pub const SOM_TINY: &str = r#"
+name = "s"
+master_seed = 5
+[som]
+datasets = ["DATA"]
+iterations = 200
+[[som.group]]
+models = ["dnsom"]
+grids = ["6x5"]
+"#;
+
+/// Every file under `dir` with its bytes (the lock file aside: its record is rewritten by every
+/// writer that takes it, refused or not, and is empty once released).
+pub fn snapshot(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    walk(dir)
+        .into_iter()
+        .filter(|p| p.file_name().is_some_and(|n| n != ".somnurbs.lock"))
+        .map(|p| (p.strip_prefix(dir).unwrap().display().to_string(), std::fs::read(&p).unwrap()))
+        .collect()
+}

@@ -15,7 +15,7 @@ fn drift_names_moved_cells_and_refuses_bad_input() {
     c.ok(&["run", "d.toml", "--out", "b", "--jobs", "2"]);
     let out = c.ok(&["drift", "a", "b"]);
     assert!(String::from_utf8_lossy(&out.stdout).contains("no drift"));
-    assert!(c.path("b/drift.csv").exists());
+    assert!(c.path("drift.csv").exists());
     // Baseline on purpose.
     c.ok(&["drift", "--accept", "base", "a"]);
     assert!(c.path("base/appendix_k.csv").exists() && c.path("base/manifest.toml").exists());
@@ -45,7 +45,7 @@ fn drift_names_moved_cells_and_refuses_bad_input() {
             && text.contains("appendix_k.csv:sphere/chord_length/6/6:de_avg"),
         "{text}"
     );
-    let (h, rows) = read_csv(&c.path("b/drift.csv"));
+    let (h, rows) = read_csv(&c.path("drift.csv"));
     let drifted = h.iter().position(|x| x == "drifted").unwrap();
     assert_eq!(rows.iter().filter(|r| r[drifted] == "yes").count(), 1);
     // A loose tolerance for that column hides it.

@@ -7,6 +7,7 @@ mod common;
 mod cli;
 mod drift;
 mod exact_certificate;
+mod folders;
 mod fuzz;
 mod html_report;
 mod own_data;

@@ -2,31 +2,11 @@
 //! class of the issue, each with the issue's reproduction commands and more.
 
 use crate::common::*;
-use std::path::Path;
 use std::process::Stdio;
 use std::time::{Duration, Instant};
 
-const SOM: &str = r#"
-name = "s"
-master_seed = 5
-[som]
-datasets = ["DATA"]
-iterations = 200
-[[som.group]]
-models = ["dnsom"]
-grids = ["6x5"]
-"#;
-
 fn code(out: &std::process::Output) -> i32 {
     out.status.code().unwrap_or(-1)
-}
-
-/// Every file under `dir` with its bytes.
-fn snapshot(dir: &Path) -> Vec<(String, Vec<u8>)> {
-    walk(dir)
-        .into_iter()
-        .map(|p| (p.strip_prefix(dir).unwrap().display().to_string(), std::fs::read(&p).unwrap()))
-        .collect()
 }
 
 /// Start a slow run in the background and wait until it holds its folder.
@@ -89,18 +69,23 @@ fn a_rerun_with_bad_inputs_leaves_a_finished_folder_as_it_was() {
         let out = bin().args(&args).current_dir(c.dir.path()).output().unwrap();
         assert_eq!(code(&out), 2, "{}", c.explain(&args, &out));
     }
-    c.fails(&["run", "bunny.toml", "--out", "done", "--data-dir", "nowhere"], &["bun_zipper.ply"]);
+    // Into the finished folder, every other run is refused before its inputs load; into a fresh
+    // one, the bad input is named.
+    c.fails(&["run", "bunny.toml", "--out", "done"], &["already holds a finished run"]);
+    c.fails(&["run", "bunny.toml", "--out", "fresh", "--data-dir", "nowhere"], &["bun_zipper.ply"]);
     // Another spec whose data file is broken (a mistyped --out): refused before the folder changes.
     c.write("bad.xyz", "1e308 0 0\n-1e308 1 1\n0 0 2\n5 5 5\n");
     c.write(
         "bad.toml",
         &SPEC.replace("\"sphere\"", "\"bad.xyz\"").replace("master_seed = 3", "master_seed = 4"),
     );
-    c.fails(&["run", "bad.toml", "--out", "done"], &["bad.xyz", "non-finite"]);
+    c.fails(&["run", "bad.toml", "--out", "done"], &["already holds a finished run"]);
+    c.fails(&["run", "bad.toml", "--out", "fresh"], &["bad.xyz", "non-finite"]);
     // Maps that do not load.
     c.write("maps/dnsom_sphere_20x20.csv", "i,j,view\n1,2\n");
     c.write("m.toml", &SPEC.replace("maps = \"nowhere\"", "maps = \"maps\""));
-    c.fails(&["run", "m.toml", "--out", "done"], &["dnsom_sphere_20x20.csv"]);
+    c.fails(&["run", "m.toml", "--out", "done"], &["already holds a finished run"]);
+    c.fails(&["run", "m.toml", "--out", "fresh"], &["dnsom_sphere_20x20.csv"]);
     assert!(snapshot(&c.path("done")) == before, "the finished folder changed");
     c.ok(&["drift", "done", "done"]);
 }
@@ -153,8 +138,11 @@ fn one_writer_per_folder_and_readers_wait_for_it() {
             somnurbs::experiment::seeds::seed_hex(11, v["key"].as_str().unwrap())
         );
     }
-    // The lock died with its holder: the next writer is not blocked.
-    c.ok(&["run", "r.toml", "--out", "busy", "--jobs", "1"]);
+    // The lock died with its holder: the next writer is not blocked, and is told what is there.
+    c.fails(
+        &["run", "r.toml", "--out", "busy"],
+        &["already holds an unfinished run of spec `slow`"],
+    );
 }
 
 #[test]
@@ -239,7 +227,7 @@ fn drift_merge_accept_and_resume_refuse_unfinished_or_mixed_folders() {
 #[test]
 fn bad_inputs_are_refused_on_one_line_quickly() {
     let c = Case::new();
-    let som = |data: &str| SOM.replace("DATA", data);
+    let som = |data: &str| SOM_TINY.replace("DATA", data);
     let timed = |args: &[&str], needles: &[&str]| {
         let t0 = Instant::now();
         c.fails(args, needles);
@@ -345,7 +333,8 @@ fn results_do_not_depend_on_where_a_data_file_lives_and_stay_in_the_output_folde
     c.write("deep/down/part.xyz", &points);
     let abs = c.path("deep/down/part.xyz");
     let spec = |data: &str| {
-        SOM.replace("DATA", data)
+        SOM_TINY
+            .replace("DATA", data)
             .replace("iterations = 200", "iterations = 200\nsave_maps = [\"6x5\"]")
     };
     c.write("a.toml", &spec("here/part.xyz"));
@@ -382,7 +371,7 @@ fn results_do_not_depend_on_where_a_data_file_lives_and_stay_in_the_output_folde
     // Two files of one name in one spec are refused, naming both.
     c.write(
         "twice.toml",
-        &SOM.replace("\"DATA\"", &format!("\"here/part.xyz\", \"{}\"", abs.display())),
+        &SOM_TINY.replace("\"DATA\"", &format!("\"here/part.xyz\", \"{}\"", abs.display())),
     );
     c.fails(&["run", "twice.toml", "--dry-run"], &["som.datasets", "both go by the name `part`"]);
 }
@@ -410,7 +399,7 @@ fn big_endian_ply_reads_like_ascii() {
 }
 
 /// A two-view grid CSV of `n` x `n` positions (a lens), for `fit`.
-fn small_grid(n: usize) -> String {
+pub(crate) fn small_grid(n: usize) -> String {
     let mut s = String::from("i,j,view,class,x,y,z\n");
     for (view, sign) in [("bottom", -1.0), ("top", 1.0)] {
         for i in 0..n {
@@ -443,8 +432,8 @@ fn fit_export_and_compare_refuse_a_folder_another_writer_holds() {
         &["fit", "--grid", "g.csv", "--cn", "4x4", "--out", "busy"],
         &["in use", &pid, "run slow.toml"],
     );
-    c.fails(&["datasets", "export", "sphere", "busy/sphere.xyz"], &["in use", &pid]);
-    c.fails(&["compare", "busy"], &["in use", &pid]);
+    c.fails(&["datasets", "export", "sphere", "busy/sphere.xyz"], &["inside the result folder"]);
+    c.fails(&["compare", "busy"], &["being written", &pid]);
     assert!(
         !c.path("busy/control_nets.csv").exists()
             && !c.path("busy/sphere.xyz").exists()
@@ -452,11 +441,11 @@ fn fit_export_and_compare_refuse_a_folder_another_writer_holds() {
     );
     child.kill().unwrap();
     child.wait().unwrap();
-    // Free folders: each command writes, and leaves the lock released for the next writer.
-    c.ok(&["fit", "--grid", "g.csv", "--cn", "4x4", "--out", "busy"]);
-    c.ok(&["datasets", "export", "sphere", "busy/sphere.xyz"]);
+    // Free folders are written, and each command leaves the lock released for the next writer.
+    c.ok(&["fit", "--grid", "g.csv", "--cn", "4x4", "--out", "free"]);
+    c.ok(&["datasets", "export", "sphere", "sphere.xyz"]);
     c.ok(&["compare", "done", "--bayes-samples", "500"]);
-    c.ok(&["run", "r.toml", "--out", "busy", "--jobs", "1"]);
+    c.ok(&["compare", "done", "--bayes-samples", "500"]);
     c.fails(&["compare", "nothere"], &["nothere", "no such results folder"]);
     assert!(!c.path("nothere").exists());
 }

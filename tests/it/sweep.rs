@@ -159,7 +159,7 @@ fn a_sweep_over_de_f_writes_one_folder_whose_variants_differ_and_compare_ranks_t
     );
     // compare ranks the variants like optimisers, with the runtime distributions and the Bayesian test.
     c.ok(&["compare", "sweep", "--bayes-samples", "2000"]);
-    let (bh, brows) = read_csv(&c.path("sweep/compare_bayes.csv"));
+    let (bh, brows) = read_csv(&c.path("sweep/compare/compare_bayes.csv"));
     assert_eq!(brows.len(), 3, "{bh:?} {brows:?}");
     let pairs: BTreeSet<(String, String)> =
         brows.iter().map(|r| (r[0].clone(), r[1].clone())).collect();
@@ -167,7 +167,7 @@ fn a_sweep_over_de_f_writes_one_folder_whose_variants_differ_and_compare_ranks_t
         pairs.contains(&("de@optim.de.f=0.3".to_string(), "de@optim.de.f=0.5".to_string())),
         "{pairs:?}"
     );
-    let (eh, erows) = read_csv(&c.path("sweep/compare_aocc.csv"));
+    let (eh, erows) = read_csv(&c.path("sweep/compare/compare_aocc.csv"));
     let o = col(&eh, "optimiser");
     let ranked: BTreeSet<&str> = erows.iter().map(|r| r[o].as_str()).collect();
     assert_eq!(
@@ -175,7 +175,8 @@ fn a_sweep_over_de_f_writes_one_folder_whose_variants_differ_and_compare_ranks_t
         ["de@optim.de.f=0.3", "de@optim.de.f=0.5", "de@optim.de.f=0.8"].into_iter().collect()
     );
     assert!(
-        c.path("sweep/compare_overall.csv").exists() && c.path("sweep/compare_ert.csv").exists()
+        c.path("sweep/compare/compare_overall.csv").exists()
+            && c.path("sweep/compare/compare_ert.csv").exists()
     );
 }
 

@@ -45,8 +45,10 @@ pub fn fit(args: &FitArgs) -> Result<()> {
         }
     }
     let out = &args.out;
-    // Every input has loaded: the folder is this command's (one writer at a time).
+    // Every input has loaded: the folder is this command's (one writer at a time), and a fit
+    // folder, like a run's, holds one result: it must be missing or empty.
     let _lock = crate::io::outdir::lock(out, "fit")?;
+    crate::io::outdir::require_empty(out)?;
     write_atomic(&out.join("control_nets.csv"), csv_records(&header, &rows)?.as_bytes())?;
     let surfaces = [("bottom", &fit.bottom), ("top", &fit.top)];
     write_atomic(&out.join("surfaces.igs"), export::write_iges(&surfaces, true).as_bytes())?;
@@ -87,6 +89,16 @@ pub fn fit(args: &FitArgs) -> Result<()> {
         format!("{:?}", dense.border_gap),
     ];
     write_atomic(&out.join("fit.csv"), csv_records(&summary, &[row])?.as_bytes())?;
+    // Last, the manifest: its presence says the folder is whole (the drift and merge readers'
+    // identity fields: the grid file stands in for a spec).
+    let manifest = format!(
+        "spec_name = \"fit\"\nspec_path = {:?}\nspec_sha256 = {:?}\nprofile = \"default\"\nmaster_seed = 0\ncommand = {:?}\ncrate_version = {:?}\n",
+        shown,
+        hex::encode(<sha2::Sha256 as sha2::Digest>::digest(text.as_bytes())),
+        std::env::args().skip(1).collect::<Vec<_>>().join(" "),
+        env!("CARGO_PKG_VERSION")
+    );
+    write_atomic(&out.join(crate::io::outdir::MANIFEST), manifest.as_bytes())?;
     println!("surface error {:.6}, gap {:.3e}, excursion {:.3e}; wrote control_nets.csv, surfaces.igs, surfaces.obj, fit.csv in {}", fit.surface_error, fit.gap, dense.excursion, out.display());
     let (lo, hi) = crate::spline::geometry::bounding_box(grid.bottom.iter().chain(&grid.top));
     let diagonal = crate::geom::dist(lo, hi);

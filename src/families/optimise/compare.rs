@@ -131,6 +131,7 @@ fn friedman_overall(
     opts: &[String],
     wins: &Wins,
     args: &CompareArgs,
+    out: &std::path::Path,
 ) -> Result<String> {
     let (_, table) = friedman_table(rows);
     let f = friedman(&table)
@@ -167,12 +168,12 @@ fn friedman_overall(
             ]
         })
         .collect();
-    write_atomic(&args.results.join("compare_overall.csv"), csv_records(&oh, &orows)?.as_bytes())?;
+    write_atomic(&out.join("compare_overall.csv"), csv_records(&oh, &orows)?.as_bytes())?;
     let ranks: Vec<(String, f64)> =
         opts.iter().cloned().zip(f.mean_ranks.iter().copied()).collect();
     let mut cd_note = String::new();
     if let Some(cd) = f.critical_difference {
-        let png = args.results.join("cd_diagram.png");
+        let png = out.join("cd_diagram.png");
         match plots::cd_diagram_png(
             &png,
             &format!("Mean ranks over {} cells (Nemenyi CD = {cd:.3}, alpha 0.05)", f.blocks),
@@ -257,9 +258,11 @@ pub fn compare(args: &CompareArgs) -> Result<()> {
             args.results.join("runs.csv").display()
         );
     }
-    // compare writes its tables into the folder: one writer at a time (a run still writing it
-    // refuses this, naming itself).
+    // Only a finished, whole run is compared, and one compare at a time per results folder.
+    crate::io::outdir::require_finished(&args.results, "the results folder")?;
     let _lock = crate::io::outdir::lock(&args.results, "compare")?;
+    let dest = args.out.clone().unwrap_or_else(|| args.results.join(OUT_DIR));
+    require_compare_folder(&dest)?;
     let rows = read_runs(&args.results)?;
     let mut opts: Vec<String> = Vec::new();
     let mut cells: Cells = BTreeMap::new();
@@ -304,28 +307,56 @@ pub fn compare(args: &CompareArgs) -> Result<()> {
     .iter()
     .map(|s| s.to_string())
     .collect();
-    let (out, wins) = pairwise_cells(&cells, &opts, args.alpha);
-    write_atomic(&args.results.join("compare_cells.csv"), csv_records(&header, &out)?.as_bytes())?;
-    let cd_note = friedman_overall(&rows, &opts, &wins, args)?;
-    // Bayesian signed-rank test of every pair over the cells.
-    let brows = bayes_table(&rows, &opts, args)?;
-    let bh: Vec<String> =
-        ["x", "y", "cells", "rope", "samples", "p_x_better", "p_rope", "p_y_better"]
-            .iter()
-            .map(|s| s.to_string())
-            .collect();
-    write_atomic(&args.results.join("compare_bayes.csv"), csv_records(&bh, &brows)?.as_bytes())?;
-    for r in &brows {
-        println!("  Bayesian signed-rank {} vs {} over {} cells (rope {} of B's error): P({} better) {}, P(equivalent) {}, P({} better) {}", r[0], r[1], r[2], r[3], r[0], r[5], r[6], r[1], r[7]);
+    let (cell_rows, wins) = pairwise_cells(&cells, &opts, args.alpha);
+    // Built whole in a sibling folder and swapped in: a reader sees the old tables or the new.
+    crate::io::outdir::replace_dir(&dest, |out| {
+        write_atomic(&out.join("compare_cells.csv"), csv_records(&header, &cell_rows)?.as_bytes())?;
+        let cd_note = friedman_overall(&rows, &opts, &wins, args, out)?;
+        // Bayesian signed-rank test of every pair over the cells.
+        let brows = bayes_table(&rows, &opts, args)?;
+        let bh: Vec<String> =
+            ["x", "y", "cells", "rope", "samples", "p_x_better", "p_rope", "p_y_better"]
+                .iter()
+                .map(|s| s.to_string())
+                .collect();
+        write_atomic(&out.join("compare_bayes.csv"), csv_records(&bh, &brows)?.as_bytes())?;
+        for r in &brows {
+            println!("  Bayesian signed-rank {} vs {} over {} cells (rope {} of B's error): P({} better) {}, P(equivalent) {}, P({} better) {}", r[0], r[1], r[2], r[3], r[0], r[5], r[6], r[1], r[7]);
+        }
+        let mut written = String::from("compare_cells.csv, compare_overall.csv, compare_bayes.csv");
+        if let Some(probs) = &probs {
+            written.push_str(&runtime_outputs(probs, &opts, out)?);
+        } else {
+            println!("  no ioh/ folder: runtime distributions skipped");
+        }
+        // Last: the record that makes the folder a compare's (a later compare may replace it).
+        let record = format!(
+            "results = {:?}\nalpha = {:?}\nrope = {:?}\nbayes_samples = {}\nsomnurbs = {:?}\n",
+            args.results.display().to_string(),
+            args.alpha,
+            args.rope,
+            args.bayes_samples,
+            env!("CARGO_PKG_VERSION")
+        );
+        write_atomic(&out.join(RECORD), record.as_bytes())?;
+        println!("wrote {written}{cd_note} in {}", dest.display());
+        Ok(())
+    })
+}
+
+/// The folder `compare` writes into by default, inside the results folder it compares.
+pub const OUT_DIR: &str = "compare";
+/// The record `compare` writes last in its folder (what it compared, with which options).
+const RECORD: &str = "compare.toml";
+
+/// `compare` writes a folder of its own: missing, empty, or an earlier compare's (which it
+/// replaces whole); anything else is refused.
+fn require_compare_folder(dest: &std::path::Path) -> Result<()> {
+    let found = crate::io::outdir::entries(dest)?;
+    if found.is_empty() || found.iter().any(|e| e == RECORD) {
+        return Ok(());
     }
-    let mut written = String::from("compare_cells.csv, compare_overall.csv, compare_bayes.csv");
-    if let Some(probs) = probs {
-        written.push_str(&runtime_outputs(&probs, &opts, &args.results)?);
-    } else {
-        println!("  no ioh/ folder: runtime distributions skipped");
-    }
-    println!("wrote {written}{cd_note} in {}", args.results.display());
-    Ok(())
+    crate::io::outdir::require_empty(dest).context("compare --out")
 }
 
 /// Targets per problem: this many, log-spaced over this many decades of the gap between approach
