@@ -12,7 +12,8 @@
 # before each run are printed, since a shared machine's speed varies from hour to hour.
 #
 # Needs the Chapter 4 maps (results/ch4_models/maps, from the README's main job); missing maps are
-# recomputed. SOMNURBS_DATA must name the folder with the talus mesh (e.g. ../shared/data).
+# recomputed (the specs set maps_missing = "recompute"). The talus mesh is read from data/ (or
+# SOMNURBS_DATA), as for the main job.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out="${1:-$(mktemp -d)}"

@@ -17,7 +17,6 @@ shift || true
 if [ $# -eq 0 ]; then opts=(ga de pso csa icsa); else opts=("$@"); fi
 CARGO_BUILD_JOBS="${CARGO_BUILD_JOBS:-1}" cargo bench --bench optim --no-run --quiet 2>/dev/null
 bin=$(ls -t target/release/deps/optim-* | grep -v '\.d$' | head -1)
-export SOMNURBS_DATA="${SOMNURBS_DATA:-../shared/data}"
 tmp=$(mktemp -d)
 count() {
   BENCH_COUNT="$1" BENCH_GENERATIONS="$g" valgrind --tool=callgrind --toggle-collect='*counted*' \

@@ -211,9 +211,10 @@ pub struct ReproduceArgs {
     /// Output folder (default results/<PLAN>, or results/<PLAN>_quick).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Folder of the experiment specs.
-    #[arg(long, default_value = "experiments")]
-    pub specs: PathBuf,
+    /// Folder of the plans and experiment specs (default: experiments, or, run from a folder
+    /// without one, the experiments folder of the clone somnurbs was built from).
+    #[arg(long)]
+    pub specs: Option<PathBuf>,
     /// Worker threads (default: all cores). Results do not depend on it.
     #[arg(long, short = 'j')]
     pub jobs: Option<usize>,

@@ -153,18 +153,14 @@ fn drift(args: &DriftArgs) -> anyhow::Result<ExitCode> {
 
 /// `somnurbs reproduce`: a plan's specs in order into one folder, then the combined report.
 fn reproduce(args: &ReproduceArgs) -> anyhow::Result<ExitCode> {
-    let out = args.out.clone().unwrap_or_else(|| {
-        if args.profile == "quick" {
-            format!("results/{}_quick", args.plan).into()
-        } else {
-            format!("results/{}", args.plan).into()
-        }
-    });
+    use experiment::reproduce::{default_out, specs_dir};
+    let out = args.out.clone().unwrap_or_else(|| default_out(&args.plan, &args.profile));
+    let specs = specs_dir(args.specs.as_deref(), &args.plan)?;
     let ctx = RunContext {
         resume: args.resume,
         ..RunContext::new(out, jobs(args.jobs)?, experiment::data_dir(args.data_dir.as_deref()))
     };
-    let report = experiment::reproduce::reproduce(&args.specs, &args.plan, &args.profile, &ctx)?;
+    let report = experiment::reproduce::reproduce(&specs, &args.plan, &args.profile, &ctx)?;
     eprintln!("somnurbs: wrote {}", report.display());
     Ok(ExitCode::SUCCESS)
 }

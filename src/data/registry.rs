@@ -229,13 +229,27 @@ impl Loader {
     }
 }
 
-/// The data folder the tests use: `SOMNURBS_DATA`, else `../shared/data` beside the crate.
-#[cfg(test)]
-pub fn test_data_dir() -> std::path::PathBuf {
-    match std::env::var_os("SOMNURBS_DATA") {
-        Some(v) if !v.is_empty() => v.into(),
-        _ => Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data"),
+/// The top of the clone this crate was built from (`CARGO_MANIFEST_DIR`): where the tests find
+/// the data, and where `reproduce` finds its plans when run from another folder without `--specs`.
+pub const CLONE_DIR: &str = env!("CARGO_MANIFEST_DIR");
+
+/// The folder of the data files (bunny, talus), the one rule for the main job and the tests:
+/// `flag` (`--data-dir`), else `SOMNURBS_DATA`, else `data` in `top` (the working folder for the
+/// binary, the top of the clone for the tests: [`clone_data_dir`]).
+pub fn data_folder(flag: Option<&Path>, top: &Path) -> PathBuf {
+    if let Some(p) = flag {
+        return p.to_path_buf();
     }
+    match std::env::var_os("SOMNURBS_DATA") {
+        Some(v) if !v.is_empty() => PathBuf::from(v),
+        _ => top.join("data"),
+    }
+}
+
+/// The data folder the tests use: [`data_folder`] at the top of the clone, i.e. what a user's
+/// main job uses when run from there (`SOMNURBS_DATA` if set, else `<clone>/data`).
+pub fn clone_data_dir() -> PathBuf {
+    data_folder(None, Path::new(CLONE_DIR))
 }
 
 #[cfg(test)]
@@ -244,8 +258,7 @@ mod tests {
 
     #[test]
     fn bunny_first_point_after_normalisation() {
-        let b = load_dataset("bunny", &test_data_dir())
-            .expect("bun_zipper.ply in SOMNURBS_DATA or ../shared/data");
+        let b = load_dataset("bunny", &clone_data_dir()).unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(b.points.len(), 35947);
         let want = [0.365193, 0.615243, 0.549817];
         for k in 0..3 {
@@ -255,10 +268,9 @@ mod tests {
 
     #[test]
     fn talus_is_a_fixed_sample() {
-        let a = load_dataset("talus", &test_data_dir())
-            .expect("talus_r.stl in SOMNURBS_DATA or ../shared/data");
+        let a = load_dataset("talus", &clone_data_dir()).unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(a.points.len(), TALUS_POINTS);
-        let b = load_dataset("talus", &test_data_dir()).unwrap();
+        let b = load_dataset("talus", &clone_data_dir()).unwrap();
         assert_eq!(a, b);
         assert!(a.points.iter().all(|p| p.iter().all(|v| (0.0..=1.0).contains(v))));
     }

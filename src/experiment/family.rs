@@ -35,6 +35,9 @@ pub trait Family: Sync {
     /// Read the SOM maps from the folder `maps` (a plan whose earlier spec saved them); families
     /// that read no maps ignore it.
     fn use_maps(&self, spec: &mut Spec, maps: &str);
+    /// Check that the files the section names besides its data sets (Chapter 4's maps) are
+    /// there, before the output folder is touched.
+    fn require_inputs(&self, spec: &Spec) -> Result<()>;
     /// Check every value of the family's section (called once the limits have passed and the
     /// spec has been found to hold this family's section only).
     fn validate(&self, spec: &Spec) -> Result<(), SpecError>;
@@ -221,6 +224,10 @@ pub trait Section: Placed {
     }
     /// Read the SOM maps from the folder `maps` (a plan whose earlier spec saved them).
     fn use_maps(&mut self, _maps: &str) {}
+    /// See [`Family::require_inputs`]; by default nothing to check.
+    fn require_inputs(&self, _spec: &Spec) -> Result<()> {
+        Ok(())
+    }
     /// Whether the section takes `--set`/`--sweep` (None: it does not), and which keys a sweep
     /// may vary.
     const OVERRIDES: Option<Overrides> = None;
@@ -276,6 +283,9 @@ impl<E: Experiment> Family for E {
         if let Some(s) = E::Section::of_mut(&mut spec.file) {
             s.use_maps(maps);
         }
+    }
+    fn require_inputs(&self, spec: &Spec) -> Result<()> {
+        E::Section::of(&spec.file).map_or(Ok(()), |s| s.require_inputs(spec))
     }
     fn validate(&self, spec: &Spec) -> Result<(), SpecError> {
         E::Section::of(&spec.file).map_or(Ok(()), |s| s.validate(spec))

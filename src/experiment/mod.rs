@@ -36,12 +36,24 @@ pub struct RunContext {
     /// Write `report.html` (and its `vendor/`) beside REPORT.md before the manifest: a folder
     /// that is a result of its own (`run`, `merge`), not a chapter of a plan's page.
     pub page: bool,
+    /// The command REPORT.md gives to make this folder again, when it is not `somnurbs run` of
+    /// the spec (a plan's spec: the plan's `somnurbs reproduce` line).
+    pub rerun: Option<String>,
 }
 
 impl RunContext {
     /// A plain run: fresh folder, all cells.
     pub fn new(out: PathBuf, jobs: usize, data_dir: PathBuf) -> RunContext {
-        RunContext { out, jobs, data_dir, resume: false, shard: None, session: None, page: false }
+        RunContext {
+            out,
+            jobs,
+            data_dir,
+            resume: false,
+            shard: None,
+            session: None,
+            page: false,
+            rerun: None,
+        }
     }
 
     /// Make the folder this run's: called by the runner when the first cell is about to run,
@@ -62,10 +74,9 @@ impl RunContext {
     /// How `spec`'s data sets load: from this run's data folder, relative paths from the spec's
     /// own folder, scaled by the spec's `normalise`.
     pub fn loader(&self, spec: &Spec) -> crate::data::registry::Loader {
-        let base = Path::new(&spec.path).parent().map(Path::to_path_buf).unwrap_or_default();
         crate::data::registry::Loader {
             data_dir: self.data_dir.clone(),
-            base,
+            base: spec.dir().to_path_buf(),
             normalise: spec.file.normalise,
         }
     }
@@ -194,6 +205,10 @@ pub fn run_variants(variants: &[Spec], ctx: &RunContext) -> Result<PathBuf> {
             .require_file(d)
             .with_context(|| format!("{}: data set `{d}`", spec.path))?;
     }
+    // So is a maps folder it names (unless it asks for the maps to be recomputed).
+    for f in family::present(spec) {
+        f.require_inputs(spec)?;
+    }
     let _lock = crate::io::outdir::lock(&ctx.out, &format!("run {}", spec.path))?;
     let fp = fingerprint(variants, ctx.shard);
     match claim(&ctx.out, &fp, ctx.resume)? {
@@ -298,7 +313,8 @@ fn run_spec_locked(variants: &[Spec], ctx: &RunContext) -> Result<PathBuf> {
         spec_text: spec.text.clone(),
     };
     if let Some(section) = section {
-        let report = report_md(spec, &manifest, &[section]);
+        let rerun = ctx.rerun.clone().unwrap_or_else(|| run_command(spec, &manifest, &ctx.out));
+        let report = report_md(spec, &manifest, &rerun, &[section]);
         crate::io::write_atomic(&ctx.out.join("REPORT.md"), report.as_bytes())?;
         if ctx.page {
             crate::report::html::write(&ctx.out)?;
@@ -310,8 +326,28 @@ fn run_spec_locked(variants: &[Spec], ctx: &RunContext) -> Result<PathBuf> {
     Ok(ctx.out.clone())
 }
 
-/// REPORT.md: a header naming the run, then the chapters' sections.
-pub fn report_md(spec: &Spec, m: &Manifest, sections: &[String]) -> String {
+/// The `somnurbs run` command that makes the folder `out` again: the spec, its profile, `--out`
+/// unless it is the spec's default folder, and every `--set` and `--sweep`.
+pub fn run_command(spec: &Spec, m: &Manifest, out: &Path) -> String {
+    let mut s = format!("somnurbs run {}", m.spec_path);
+    if m.profile != "default" {
+        let _ = write!(s, " --profile {}", m.profile);
+    }
+    if out != spec.output_dir(None) {
+        let _ = write!(s, " --out {}", out.display());
+    }
+    for a in &m.set {
+        let _ = write!(s, " --set {a}");
+    }
+    for a in &m.sweep {
+        let _ = write!(s, " --sweep {a}");
+    }
+    s
+}
+
+/// REPORT.md: a header naming the run and the command that makes it again (`rerun`), then the
+/// chapters' sections.
+pub fn report_md(spec: &Spec, m: &Manifest, rerun: &str, sections: &[String]) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "# somnurbs report: {}\n", spec.file.name);
     if !spec.file.description.is_empty() {
@@ -328,7 +364,7 @@ pub fn report_md(spec: &Spec, m: &Manifest, sections: &[String]) -> String {
     };
     let _ = writeln!(
         s,
-        "Spec `{}` (sha256 {}), profile `{}`, master seed {}, somnurbs {} at commit {}, {} on {} with {} thread(s): {} cells in {:.1} s wall, {:.1} s CPU in cells. Re-run: `somnurbs run {}{}{}`.\n",
+        "Spec `{}` (sha256 {}), profile `{}`, master seed {}, somnurbs {} at commit {}, {} on {} with {} thread(s): {} cells in {:.1} s wall, {:.1} s CPU in cells. Re-run: `{}`.\n",
         m.spec_path,
         &m.spec_sha256[..12],
         m.profile,
@@ -341,9 +377,7 @@ pub fn report_md(spec: &Spec, m: &Manifest, sections: &[String]) -> String {
         m.cells,
         m.wall_seconds,
         m.cpu_seconds_cells,
-        m.spec_path,
-        if m.profile == "default" { String::new() } else { format!(" --profile {}", m.profile) },
-        m.set.iter().map(|a| format!(" --set {a}")).chain(m.sweep.iter().map(|a| format!(" --sweep {a}"))).collect::<String>()
+        rerun
     );
     if !limits::dataset_entries(spec).is_empty() {
         let _ = writeln!(s, "Data sets are {} (`normalise`); a data set given as a relative path is read from the spec's folder.\n", spec.file.normalise.describe());
@@ -454,13 +488,8 @@ pub fn merge(shards: &[PathBuf], ctx: &RunContext) -> Result<PathBuf> {
     run_spec_locked(&variants, &RunContext { resume: true, shard: None, ..ctx.clone() })
 }
 
-/// Resolve the data directory: flag, else `SOMNURBS_DATA`, else `./data`.
+/// Resolve the data directory: flag, else `SOMNURBS_DATA`, else `./data` (in the working folder;
+/// [`crate::data::registry::data_folder`] is the rule).
 pub fn data_dir(flag: Option<&Path>) -> PathBuf {
-    if let Some(p) = flag {
-        return p.to_path_buf();
-    }
-    match std::env::var_os("SOMNURBS_DATA") {
-        Some(v) if !v.is_empty() => PathBuf::from(v),
-        _ => PathBuf::from("data"),
-    }
+    crate::data::registry::data_folder(flag, Path::new(""))
 }

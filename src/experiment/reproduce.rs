@@ -120,8 +120,11 @@ fn load_specs(
     profile: Option<&str>,
     out: &Path,
 ) -> Result<Vec<Spec>> {
-    let maps =
-        plan.maps_from.as_ref().map(|m| out.join(m).join("maps").to_string_lossy().into_owned());
+    // Absolute: a relative `maps` would resolve against the spec's folder, this one is the run's.
+    let maps = plan.maps_from.as_ref().map(|m| {
+        let dir = out.join(m).join("maps");
+        std::path::absolute(&dir).unwrap_or(dir).to_string_lossy().into_owned()
+    });
     names
         .iter()
         .map(|name| {
@@ -155,6 +158,57 @@ fn has_profile(path: &Path, profile: &str) -> bool {
         .is_some()
 }
 
+/// The folder `--specs` names when it is not given.
+pub const DEFAULT_SPECS: &str = "experiments";
+
+/// The default output folder of a plan: `results/<plan>`, or `results/<plan>_quick`.
+pub fn default_out(plan: &str, profile: &str) -> PathBuf {
+    if profile == "quick" {
+        format!("results/{plan}_quick").into()
+    } else {
+        format!("results/{plan}").into()
+    }
+}
+
+/// The folder of the plans and specs: `--specs`, else `experiments` in the working folder, else,
+/// run from a folder that has no `experiments` (and no `--specs`), the one in the clone somnurbs
+/// was built from (said on stderr). An error names the folders tried and hints `--specs DIR`.
+pub fn specs_dir(flag: Option<&Path>, plan: &str) -> Result<PathBuf> {
+    if let Some(d) = flag {
+        return Ok(d.to_path_buf());
+    }
+    let here = Path::new(DEFAULT_SPECS);
+    let file = format!("{plan}.toml");
+    if here.is_dir() {
+        return Ok(here.to_path_buf());
+    }
+    let clone = Path::new(crate::data::registry::CLONE_DIR).join(DEFAULT_SPECS);
+    if clone.join(&file).is_file() {
+        eprintln!(
+            "somnurbs: reproduce: no {DEFAULT_SPECS}/ in the working folder; using the plans of the clone somnurbs was built from, {} (--specs DIR names another folder)",
+            clone.display()
+        );
+        return Ok(clone);
+    }
+    anyhow::bail!(
+        "--plan {plan}: no folder {DEFAULT_SPECS}/ in the working folder and no {} (run from the top of the clone, or name the folder of the plans with --specs DIR)",
+        clone.join(&file).display()
+    )
+}
+
+/// The `somnurbs reproduce` command that makes the folder `out` again: `--specs` and `--out`
+/// when they are not the defaults.
+fn reproduce_command(specs_dir: &Path, plan: &str, profile: &str, out: &Path) -> String {
+    let mut s = format!("somnurbs reproduce --plan {plan} --profile {profile}");
+    if specs_dir != Path::new(DEFAULT_SPECS) {
+        let _ = write!(s, " --specs {}", specs_dir.display());
+    }
+    if out != default_out(plan, profile) {
+        let _ = write!(s, " --out {}", out.display());
+    }
+    s
+}
+
 /// Run the plan into `ctx.out` and write the combined REPORT.md; returns its path.
 pub fn reproduce(
     specs_dir: &Path,
@@ -164,9 +218,14 @@ pub fn reproduce(
 ) -> Result<PathBuf> {
     let plan_path = specs_dir.join(format!("{plan_name}.toml"));
     if !plan_path.exists() {
-        anyhow::bail!("--plan {plan_name}: no plan file {}", plan_path.display());
+        anyhow::bail!(
+            "--plan {plan_name}: no plan file {} (--specs DIR names the folder of the plans)",
+            plan_path.display()
+        );
     }
     let plan = Plan::load(&plan_path)?;
+    let rerun = reproduce_command(specs_dir, plan_name, profile, &ctx.out);
+    let ctx = &RunContext { rerun: Some(rerun.clone()), ..ctx.clone() };
     let profile = if profile == "full" { None } else { Some(profile) };
     let specs = load_specs(specs_dir, &plan, &plan.specs, &[], profile, &ctx.out)?;
     let reading_specs: Vec<(&ReadingSet, Vec<Spec>)> = plan
@@ -231,6 +290,7 @@ pub fn reproduce(
         &ctx.out,
         &plan,
         plan_name,
+        &rerun,
         &specs,
         &done,
         &combined,
@@ -496,6 +556,7 @@ fn combined_report(
     out: &Path,
     plan: &Plan,
     plan_name: &str,
+    rerun: &str,
     specs: &[Spec],
     done: &[(String, f64)],
     combined: &[Combined],
@@ -506,7 +567,7 @@ fn combined_report(
     let commit = env!("SOMNURBS_GIT_COMMIT");
     let _ = writeln!(
         s,
-        "Plan `{plan_name}`, profile `{profile}`, somnurbs {} at commit {}{}, {}: {} specs in {:.1} s wall. Re-run: `somnurbs reproduce --plan {plan_name} --profile {profile}`.\n",
+        "Plan `{plan_name}`, profile `{profile}`, somnurbs {} at commit {}{}, {}: {} specs in {:.1} s wall. Re-run: `{rerun}`.\n",
         env!("CARGO_PKG_VERSION"),
         &commit[..commit.len().min(12)],
         if env!("SOMNURBS_GIT_DIRTY") == "true" { " (dirty)" } else { "" },

@@ -336,6 +336,16 @@ impl Spec {
         Ok(())
     }
 
+    /// The folder of the spec file, against which every relative path it names resolves.
+    pub fn dir(&self) -> &Path {
+        Path::new(&self.path).parent().unwrap_or(Path::new(""))
+    }
+
+    /// A path the spec names, resolved against the spec's folder (an absolute path stays).
+    pub fn resolve(&self, path: &str) -> std::path::PathBuf {
+        self.dir().join(path)
+    }
+
     /// Output folder: `--out`, else the spec's `output`, else `results/<name>`.
     pub fn output_dir(&self, out: Option<&Path>) -> std::path::PathBuf {
         match (out, &self.file.output) {

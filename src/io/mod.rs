@@ -141,9 +141,50 @@ pub fn csv_records(header: &[String], rows: &[Vec<String>]) -> Result<String> {
     Ok(String::from_utf8(w.into_inner().map_err(|e| e.into_error())?)?)
 }
 
+/// A path as messages and reports show it: `.` and `dir/..` dropped (lexically; the path opened
+/// is unchanged), and relative to the working folder when it lies inside it.
+pub fn shown(path: &Path) -> String {
+    use std::path::{Component, PathBuf};
+    let mut parts: Vec<Component> = Vec::new();
+    for c in path.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir if matches!(parts.last(), Some(Component::Normal(_))) => {
+                parts.pop();
+            }
+            c => parts.push(c),
+        }
+    }
+    let clean: PathBuf = parts.iter().collect();
+    if clean.is_absolute() {
+        if let Some(rel) = std::env::current_dir()
+            .ok()
+            .and_then(|cwd| clean.strip_prefix(cwd).ok().map(Path::to_path_buf))
+            .filter(|r| !r.as_os_str().is_empty())
+        {
+            return rel.display().to_string();
+        }
+    }
+    if clean.as_os_str().is_empty() {
+        return ".".into();
+    }
+    clean.display().to_string()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn shown_paths_are_clean_and_relative_to_the_working_folder() {
+        assert_eq!(shown(Path::new("experiments/../results/ch4/maps")), "results/ch4/maps");
+        assert_eq!(shown(Path::new("./a/./b")), "a/b");
+        assert_eq!(shown(Path::new("../shared/data")), "../shared/data");
+        assert_eq!(shown(Path::new("a/..")), ".");
+        let cwd = std::env::current_dir().unwrap();
+        assert_eq!(shown(&cwd.join("results/x")), "results/x");
+        assert_eq!(shown(Path::new("/nonexistent/x/../y")), "/nonexistent/y");
+    }
 
     #[derive(serde::Serialize)]
     struct Row {

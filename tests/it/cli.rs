@@ -197,8 +197,25 @@ fn chapter_5_reads_or_recomputes_maps_and_writes_appendix_e() {
     c.ok(&["run", "maps.toml", "--out", "ch4"]);
     c.write("fits.toml", &CH5_TINY.replace("MAPS", "ch4/maps"));
     c.ok(&["run", "fits.toml", "--out", "read"]);
-    c.write("fits2.toml", &CH5_TINY.replace("MAPS", "nowhere"));
-    c.ok(&["run", "fits2.toml", "--out", "recomputed"]);
+    c.write(
+        "fits2.toml",
+        &CH5_TINY
+            .replace("MAPS", "nowhere")
+            .replace("[fit.som]", "maps_missing = \"recompute\"\n[fit.som]"),
+    );
+    let said = c.ok(&["run", "fits2.toml", "--out", "recomputed"]);
+    let said = String::from_utf8_lossy(&said.stderr);
+    let line: Vec<&str> = said.lines().filter(|l| l.contains("recomputing")).collect();
+    assert!(
+        line.len() == 1
+            && line[0].contains("no maps folder nowhere")
+            && line[0].contains("dnsom_sphere_20x20.csv")
+            && line[0].contains("[fit.som]"),
+        "{said}"
+    );
+    let report = std::fs::read_to_string(c.path("read/REPORT.md")).unwrap();
+    assert!(report.contains("sphere from ch4/maps/dnsom_sphere_20x20.csv"), "{report}");
+    assert!(report.contains("Re-run: `somnurbs run fits.toml --out read`"), "{report}");
     let map = "maps/dnsom_sphere_20x20.csv";
     let original = std::fs::read_to_string(c.path("ch4").join(map)).unwrap();
     assert_eq!(
@@ -330,7 +347,6 @@ optimisers = ["ga", "de", "pso"]
 repeats = 2
 generations = 15
 population = 8
-maps = "nowhere"
 [optim.som]
 iterations = 500
 "#;
@@ -533,8 +549,7 @@ fn exact_optimum_bounds_every_run_from_below() {
     let c = Case::new();
     c.write(
         "opt.toml",
-        &CH6_TINY
-            .replace("maps = \"nowhere\"", "maps = \"nowhere\"\nexact = true\ninit_range = 1e-3"),
+        &CH6_TINY.replace("[optim.som]", "exact = true\ninit_range = 1e-3\n[optim.som]"),
     );
     c.ok(&["run", "opt.toml", "--out", "o"]);
     let (h, rows) = read_csv(&c.path("o/exact_20x20.csv"));
@@ -584,6 +599,11 @@ specs = ["fits"]
 "#,
     );
     c.ok(&["reproduce", "--specs", "specs", "--plan", "p", "--out", "out"]);
+    // Re-run lines: the plan's command with its --specs and --out, in the sub-reports too.
+    let rerun = "Re-run: `somnurbs reproduce --plan p --profile full --specs specs --out out`";
+    for r in ["out/REPORT.md", "out/fits/REPORT.md", "out/readings/nurbs_book/fits/REPORT.md"] {
+        assert!(std::fs::read_to_string(c.path(r)).unwrap().contains(rerun), "{r}");
+    }
     let (h, rows) = read_csv(&c.path("out/readings.csv"));
     let col = |name: &str| h.iter().position(|x| x == name).unwrap();
     let claims_of = |reading: &str| -> Vec<String> {

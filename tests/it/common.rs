@@ -9,11 +9,11 @@ pub fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_somnurbs"))
 }
 
-pub fn shared_data() -> PathBuf {
-    match std::env::var_os("SOMNURBS_DATA") {
-        Some(v) if !v.is_empty() => PathBuf::from(v),
-        _ => Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data"),
-    }
+/// The data folder the tests give the binary: where a user's main job finds the data when run
+/// from the top of this clone (`SOMNURBS_DATA` if set, else `<clone>/data`; one rule,
+/// `somnurbs::data::registry::data_folder`).
+pub fn data_dir() -> PathBuf {
+    somnurbs::data::registry::clone_data_dir()
 }
 
 pub struct Case {
@@ -37,9 +37,21 @@ impl Case {
         let out = bin()
             .args(args)
             .current_dir(self.dir.path())
-            .env("SOMNURBS_DATA", shared_data())
+            .env("SOMNURBS_DATA", data_dir())
             .output()
             .unwrap();
+        out
+    }
+    /// Runs the binary with the working folder `sub` of the case folder (made if missing).
+    pub fn run_from(&self, sub: &str, args: &[&str]) -> Output {
+        let dir = self.path(sub);
+        std::fs::create_dir_all(&dir).unwrap();
+        bin().args(args).current_dir(dir).env("SOMNURBS_DATA", data_dir()).output().unwrap()
+    }
+    /// [`Case::run_from`] that must succeed.
+    pub fn ok_from(&self, sub: &str, args: &[&str]) -> Output {
+        let out = self.run_from(sub, args);
+        assert!(out.status.success(), "in {sub}: {}", self.explain(args, &out));
         out
     }
     pub fn explain(&self, args: &[&str], out: &Output) -> String {
@@ -157,7 +169,6 @@ optimisers = ["ga", "de"]
 repeats = 2
 generations = 20
 population = 8
-maps = "nowhere"
 [optim.som]
 iterations = 300
 "#;
@@ -175,7 +186,6 @@ optimisers = ["ga", "de", "pso"]
 repeats = 12
 generations = 600
 population = 20
-maps = "nowhere"
 [optim.som]
 iterations = 500
 "#;

@@ -29,7 +29,7 @@ fn check_spec(name: &str, profile: Option<&str>, jobs: usize, check_pipeline: bo
     for knots in KnotRule::ALL {
         let spec = spec(name, profile, knots);
         let dir = tempfile::tempdir().unwrap();
-        let ctx = RunContext::new(dir.path().to_path_buf(), jobs, crate::common::shared_data());
+        let ctx = RunContext::new(dir.path().to_path_buf(), jobs, crate::common::data_dir());
         let pbs = problems(&spec, &ctx).unwrap();
         let o = spec.section::<somnurbs::families::optimise::spec::OptimSpec>().unwrap();
         let tol = o.exact_tol;

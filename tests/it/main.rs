@@ -1,6 +1,6 @@
 //! The integration tests, one binary with a module per topic: each runs the real `somnurbs`
 //! binary in temporary folders (`common::Case`), on the generated data sets and, where a test
-//! needs them, the third-party scans of `SOMNURBS_DATA`.
+//! needs them, the third-party scans in `data/` at the top of the clone (or `SOMNURBS_DATA`).
 
 mod common;
 

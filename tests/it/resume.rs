@@ -22,7 +22,7 @@ fn a_killed_run_resumes_to_the_same_tables() {
     let mut child = bin()
         .args(["run", "slow.toml", "--out", "killed", "--jobs", "1"])
         .current_dir(c.dir.path())
-        .env("SOMNURBS_DATA", shared_data())
+        .env("SOMNURBS_DATA", data_dir())
         .stderr(std::process::Stdio::null())
         .spawn()
         .unwrap();
@@ -186,7 +186,7 @@ fn progress_lines_appear_in_a_log() {
     let status = bin()
         .args(["run", "slow.toml", "--out", "o", "--jobs", "1"])
         .current_dir(c.dir.path())
-        .env("SOMNURBS_DATA", shared_data())
+        .env("SOMNURBS_DATA", data_dir())
         .env("SOMNURBS_PROGRESS_SECS", "0.2")
         .stderr(log)
         .status()

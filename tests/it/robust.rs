@@ -14,7 +14,7 @@ fn start_slow(c: &Case, spec: &str, out: &str) -> std::process::Child {
     let child = bin()
         .args(["run", spec, "--out", out, "--jobs", "1"])
         .current_dir(c.dir.path())
-        .env("SOMNURBS_DATA", shared_data())
+        .env("SOMNURBS_DATA", data_dir())
         .stderr(Stdio::null())
         .spawn()
         .unwrap();
@@ -83,7 +83,14 @@ fn a_rerun_with_bad_inputs_leaves_a_finished_folder_as_it_was() {
     c.fails(&["run", "bad.toml", "--out", "fresh"], &["bad.xyz", "non-finite"]);
     // Maps that do not load.
     c.write("maps/dnsom_sphere_20x20.csv", "i,j,view\n1,2\n");
-    c.write("m.toml", &SPEC.replace("maps = \"nowhere\"", "maps = \"maps\""));
+    c.write(
+        "m.toml",
+        &SPEC.replace(
+            "[optim.som]",
+            "maps = \"maps\"
+[optim.som]",
+        ),
+    );
     c.fails(&["run", "m.toml", "--out", "done"], &["already holds a finished run"]);
     c.fails(&["run", "m.toml", "--out", "fresh"], &["dnsom_sphere_20x20.csv"]);
     assert!(snapshot(&c.path("done")) == before, "the finished folder changed");

@@ -1,12 +1,12 @@
 //! Seed 001 end to end: the quick profile of experiments/seed001_growing_grid.toml in a temp dir,
 //! then real properties of the CSVs it wrote.
 
-use crate::common::{bin, col, read_csv, shared_data};
+use crate::common::{bin, col, data_dir, read_csv};
 use std::path::Path;
 use std::process::Output;
 
 fn run(dir: &Path, args: &[&str]) -> Output {
-    bin().args(args).current_dir(dir).env("SOMNURBS_DATA", shared_data()).output().unwrap()
+    bin().args(args).current_dir(dir).env("SOMNURBS_DATA", data_dir()).output().unwrap()
 }
 
 fn f(s: &str) -> f64 {

@@ -20,7 +20,6 @@ repeats = 2
 generations = 30
 population = 10
 init_range = 1e-3
-maps = "nowhere"
 [optim.som]
 iterations = 300
 "#;
@@ -30,7 +29,7 @@ fn run_with(case: &Case, spec: &str, simd: &str, out: &str) -> std::process::Out
     crate::common::bin()
         .args(["run", spec, "--out", out, "--jobs", "2"])
         .current_dir(case.dir.path())
-        .env("SOMNURBS_DATA", shared_data())
+        .env("SOMNURBS_DATA", data_dir())
         .env("SOMNURBS_SIMD", simd)
         .output()
         .unwrap()

@@ -18,7 +18,6 @@ optimisers = ["ga", "de", "pso"]
 repeats = 2
 generations = 20
 population = 10
-maps = "nowhere"
 [optim.som]
 iterations = 300
 "#;
@@ -77,7 +76,7 @@ fn array(c: &Case, args: &[&str], env: &[(&str, &str)]) -> Output {
         .env("STANDIN_LOG", c.path("sbatch.log"));
     cmd.env("SOMNURBS_BIN", env!("CARGO_BIN_EXE_somnurbs")).env_remove("CPUS");
     // The tiny spec needs no data files; pass the data folder only when there is one.
-    match shared_data() {
+    match data_dir() {
         d if d.is_dir() => cmd.env("SOMNURBS_DATA", d),
         _ => cmd.env_remove("SOMNURBS_DATA"),
     };

@@ -16,7 +16,7 @@ use crate::som::{Model, SomParams};
 use crate::spline::{fit_two_view, FitOptions, TwoSurfaceFit, TwoViewGrid};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
-use spec::{FitCell, FitSom};
+use spec::{FitCell, FitSom, MapsMissing};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -89,32 +89,102 @@ pub fn grid_from_weights(nx: usize, ny: usize, weights: &[crate::geom::Point3]) 
 /// cell key, seed and settings); every map used is copied into `<out>/maps/`.
 pub fn maps(spec: &Spec, ctx: &RunContext) -> Result<BTreeMap<String, MapSource>> {
     let fit = spec.require::<spec::FitSpec>()?;
-    maps_for(spec, ctx, &fit.datasets, fit.grid, fit.maps.as_deref(), fit.som.as_ref())
+    let from = MapsFrom {
+        section: "fit",
+        dir: fit.maps.as_deref(),
+        missing: fit.maps_missing,
+        som: fit.som.as_ref(),
+    };
+    maps_for(spec, ctx, &fit.datasets, fit.grid, &from)
 }
 
-/// The maps of `datasets` at `grid`, from `maps_dir` or recomputed with `som` settings.
+/// Where a section's maps come from: its `maps` key as written (relative to the spec's folder),
+/// what a named folder or map that is not there means, and how a map is recomputed.
+#[derive(Debug, Clone, Copy)]
+pub struct MapsFrom<'a> {
+    /// `fit` or `optim`, for messages.
+    pub section: &'static str,
+    pub dir: Option<&'a str>,
+    pub missing: MapsMissing,
+    pub som: Option<&'a FitSom>,
+}
+
+/// Each data set's entry, name and map file in the folder `from.dir` names (resolved against the
+/// spec's folder; None: no folder named).
+fn map_files<'a>(
+    spec: &Spec,
+    datasets: &'a [String],
+    grid: GridSize,
+    from: &MapsFrom,
+) -> Vec<(&'a String, String, Option<PathBuf>)> {
+    let dir: Option<PathBuf> = from.dir.map(|m| spec.resolve(m));
+    let mut wanted: Vec<(&String, String, Option<PathBuf>)> = Vec::new();
+    for entry in datasets {
+        let data = crate::data::registry::name_of(entry);
+        if wanted.iter().all(|(_, d, _)| *d != data) {
+            let file = dir.as_ref().map(|d| d.join(map_file_name(&data, grid)));
+            wanted.push((entry, data, file));
+        }
+    }
+    wanted
+}
+
+/// Whether the maps a section names are there: an error naming the missing folder or map, unless
+/// `maps_missing = "recompute"`, then the line that says what is recomputed (None: nothing is
+/// missing, or no folder is named and every map is recomputed as the spec says).
+pub fn require_maps(
+    spec: &Spec,
+    datasets: &[String],
+    grid: GridSize,
+    from: &MapsFrom,
+) -> Result<Option<String>> {
+    let Some(dir) = from.dir.map(|m| spec.resolve(m)) else { return Ok(None) };
+    let wanted = map_files(spec, datasets, grid, from);
+    let absent: Vec<&Path> =
+        wanted.iter().filter_map(|(_, _, f)| f.as_deref()).filter(|f| !f.exists()).collect();
+    let Some(first) = absent.first() else { return Ok(None) };
+    let section = from.section;
+    let what = if dir.is_dir() {
+        format!("no map {}", crate::io::shown(first))
+    } else {
+        format!("no maps folder {}", crate::io::shown(&dir))
+    };
+    if from.missing == MapsMissing::Error {
+        anyhow::bail!("{}: {section}.maps: {what} (run the spec that saves the maps first, e.g. Chapter 4's, or set {section}.maps_missing = \"recompute\")", spec.path);
+    }
+    let names: Vec<String> = absent
+        .iter()
+        .filter_map(|f| f.file_name().map(|n| n.to_string_lossy().into_owned()))
+        .collect();
+    Ok(Some(format!(
+        "somnurbs: {}: {what}: recomputing {} from [{section}.som] ({section}.maps_missing = \"recompute\")",
+        spec.path,
+        names.join(", ")
+    )))
+}
+
+/// The maps of `datasets` at `grid`: read from the folder `from.dir` names (resolved against the
+/// spec's folder), recomputed with `from.som` when the spec names no folder. A named folder or map
+/// that is not there is an error naming it, unless `maps_missing = "recompute"`, in which case
+/// one stderr line says what is recomputed ([`require_maps`]).
 pub fn maps_for(
     spec: &Spec,
     ctx: &RunContext,
     datasets: &[String],
     grid: GridSize,
-    maps_dir: Option<&str>,
-    som: Option<&FitSom>,
+    from: &MapsFrom,
 ) -> Result<BTreeMap<String, MapSource>> {
-    let dir: Option<PathBuf> = maps_dir.map(PathBuf::from);
+    if let Some(line) = require_maps(spec, datasets, grid, from)? {
+        eprintln!("{line}");
+    }
+    let wanted = map_files(spec, datasets, grid, from);
     let mut out = BTreeMap::new();
-    for entry in datasets {
-        let data = &crate::data::registry::name_of(entry);
-        if out.contains_key(data) {
-            continue;
-        }
-        let name = map_file_name(data, grid);
-        let from_file = dir.as_ref().map(|d| d.join(&name)).filter(|p| p.exists());
-        let source = match from_file {
+    for (entry, data, file) in wanted {
+        let source = match file.filter(|f| f.exists()) {
             Some(path) => read_map(&path, grid)?,
-            None => recompute_map(spec, ctx, entry, grid, som)?,
+            None => recompute_map(spec, ctx, entry, grid, from.som)?,
         };
-        out.insert(data.clone(), source);
+        out.insert(data, source);
     }
     // Every map has loaded: only now may the folder change.
     ctx.begin()?;
@@ -132,7 +202,7 @@ fn read_map(path: &Path, grid: GridSize) -> Result<MapSource> {
     if (g.nx, g.ny) != (grid.nx, grid.ny) {
         anyhow::bail!("{}: map is {}x{}, the spec's grid is {grid}", path.display(), g.nx, g.ny);
     }
-    Ok(MapSource { grid: g, origin: path.display().to_string() })
+    Ok(MapSource { grid: g, origin: crate::io::shown(path) })
 }
 
 fn recompute_map(
@@ -234,6 +304,15 @@ impl crate::experiment::family::Section for self::spec::FitSpec {
     }
     fn use_maps(&mut self, maps: &str) {
         self.maps = Some(maps.to_string());
+    }
+    fn require_inputs(&self, spec: &Spec) -> Result<()> {
+        let from = MapsFrom {
+            section: "fit",
+            dir: self.maps.as_deref(),
+            missing: self.maps_missing,
+            som: self.som.as_ref(),
+        };
+        require_maps(spec, &self.datasets, self.grid, &from).map(drop)
     }
 }
 

@@ -19,10 +19,15 @@ pub struct FitSpec {
     pub parameterisations: Vec<String>,
     /// A (conventional) and/or B (improved).
     pub approaches: Vec<String>,
-    /// Folder holding `dnsom_<data>_<nx>x<ny>.csv` (Chapter 4's `maps/`); a missing map is
-    /// recomputed from the same seed and settings as Chapter 4 (see `[fit.som]`).
+    /// Folder holding `dnsom_<data>_<nx>x<ny>.csv` (Chapter 4's `maps/`), relative to the spec's
+    /// folder; unset, every map is recomputed from the same seed and settings as Chapter 4 (see
+    /// `[fit.som]`).
     #[serde(default)]
     pub maps: Option<String>,
+    /// What a named `maps` folder or map that is not there means: an error (default) or
+    /// `"recompute"` (said on stderr).
+    #[serde(default)]
+    pub maps_missing: MapsMissing,
     /// How a missing map is recomputed (defaults: this spec's master seed, T = 30000, alpha0 0.9).
     #[serde(default)]
     pub som: Option<FitSom>,
@@ -49,6 +54,18 @@ impl FitSpec {
             fairness: self.fairness,
         }
     }
+}
+
+/// What a run does when the `maps` folder a spec names, or a map in it, is not there.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MapsMissing {
+    /// Refuse the run, naming the folder or file (a mistyped path does not silently cost a
+    /// Chapter 4 run).
+    #[default]
+    Error,
+    /// Recompute the missing maps from `<section>.som`, saying so on stderr.
+    Recompute,
 }
 
 /// Settings of the DNSOM run that recomputes a missing map (the cell key is Chapter 4's,

@@ -128,7 +128,13 @@ pub fn optimiser<'a>(spec: &'a Spec, name: &str) -> Result<&'a dyn Optimiser> {
 /// The control-net problems of every (data, net, parameterisation), from approach B's fit.
 pub fn problems(spec: &Spec, ctx: &RunContext) -> Result<BTreeMap<ProblemKey, ControlNetProblem>> {
     let o = spec.require::<spec::OptimSpec>()?;
-    let maps = fit::maps_for(spec, ctx, &o.datasets, o.grid, o.maps.as_deref(), o.som.as_ref())?;
+    let from = fit::MapsFrom {
+        section: "optim",
+        dir: o.maps.as_deref(),
+        missing: o.maps_missing,
+        som: o.som.as_ref(),
+    };
+    let maps = fit::maps_for(spec, ctx, &o.datasets, o.grid, &from)?;
     let mut out = BTreeMap::new();
     for entry in &o.datasets {
         let d = &crate::data::registry::name_of(entry);
@@ -343,6 +349,15 @@ impl crate::experiment::family::Section for self::spec::OptimSpec {
     }
     fn use_maps(&mut self, maps: &str) {
         self.maps = Some(maps.to_string());
+    }
+    fn require_inputs(&self, spec: &Spec) -> Result<()> {
+        let from = fit::MapsFrom {
+            section: "optim",
+            dir: self.maps.as_deref(),
+            missing: self.maps_missing,
+            som: self.som.as_ref(),
+        };
+        fit::require_maps(spec, &self.datasets, self.grid, &from).map(drop)
     }
     /// Optimiser settings only, so that every variant solves the same problems (same data,
     /// nets, search box) and the variants can be ranked like optimisers.

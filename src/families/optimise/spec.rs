@@ -3,7 +3,7 @@
 
 use crate::experiment::limits::{self, Check};
 use crate::experiment::spec::{GridSize, Spec, SpecError};
-use crate::families::fit::spec::{validate_grid_keys, validate_map_som, FitSom};
+use crate::families::fit::spec::{validate_grid_keys, validate_map_som, FitSom, MapsMissing};
 use serde::Deserialize;
 
 /// Chapter 6 section: data sets x control nets x parameterisations x optimisers x repeats, every
@@ -33,8 +33,12 @@ pub struct OptimSpec {
     /// "control point coordinate range", 5e-6).
     #[serde(default)]
     pub search_range: Option<f64>,
+    /// As `[fit] maps`: Chapter 4's maps folder, relative to the spec's folder.
     #[serde(default)]
     pub maps: Option<String>,
+    /// As `[fit] maps_missing`.
+    #[serde(default)]
+    pub maps_missing: MapsMissing,
     #[serde(default)]
     pub som: Option<FitSom>,
     /// Also solve each cell's convex problem exactly in the box (certified) and report every
