@@ -20,8 +20,12 @@ pub const MAX_REPEATS: u64 = 10_000;
 pub const MAX_GENERATIONS: u64 = 1_000_000;
 /// Individuals (nests, particles) of one optimiser run.
 pub const MAX_POPULATION: u64 = 10_000;
-/// Cells of one spec.
+/// Cells of one spec (all its `--sweep` variants together).
 pub const MAX_CELLS: u64 = 100_000;
+/// Variants of one run: the product of the `--sweep` value counts.
+pub const MAX_VARIANTS: u64 = 1_000;
+/// Cells of one `reproduce` plan: its specs and its reading sets' runs together.
+pub const MAX_PLAN_CELLS: u64 = 1_000_000;
 /// Entries of one list.
 pub const MAX_LIST: usize = 1_000;
 /// Initial range, search range and box margin, in units of the (normalised) data's extent.
@@ -38,6 +42,8 @@ pub const MAX_SAMPLES: u64 = 100_000;
 /// The bound checks a family applies to its section, each error naming the spec and key.
 pub struct Check<'a> {
     pub spec: &'a Spec,
+    /// The cell count the section's [`Check::cells`] computed (read by [`cell_count`]).
+    counted: std::cell::Cell<u64>,
 }
 
 impl Check<'_> {
@@ -124,6 +130,7 @@ impl Check<'_> {
 
     pub fn cells(&self, key: &str, factors: &[usize]) -> Result<(), SpecError> {
         let n = factors.iter().fold(1u64, |a, &f| a.saturating_mul(f as u64));
+        self.counted.set(self.counted.get().saturating_add(n));
         if n > MAX_CELLS {
             return Err(
                 self.err(key, format!("the spec has {n} cells, above the limit {MAX_CELLS}"))
@@ -150,10 +157,10 @@ pub fn dataset_entries(spec: &Spec) -> Vec<&String> {
     super::family::present(spec).into_iter().flat_map(|f| f.datasets(spec)).collect()
 }
 
-/// A usable experiment or file name: not empty, no path separator or NUL, not `.` or `..`.
 /// The penalised least squares weight (`fairness`): at most 10^6.
 pub const MAX_FAIRNESS: f64 = 1e6;
 
+/// A usable experiment or file name: not empty, no path separator or NUL, not `.` or `..`.
 pub fn check_name(name: &str) -> Result<(), String> {
     if name.trim().is_empty() || name.contains(['/', '\\', '\0']) || name == "." || name == ".." {
         return Err(format!("`{name}` must be a non-empty name without slashes, not `.` or `..`"));
@@ -163,13 +170,25 @@ pub fn check_name(name: &str) -> Result<(), String> {
 
 /// Every bound of a spec (see the module doc), before any other check.
 pub fn check(spec: &Spec) -> Result<(), SpecError> {
-    let c = Check { spec };
+    let c = Check { spec, counted: Default::default() };
     let f = &spec.file;
     check_name(&f.name).map_err(|e| c.err("name", e))?;
     for family in super::family::present(spec) {
         family.check_limits(&c)?;
     }
     Ok(())
+}
+
+/// The cells of a spec as its limit counts them (the product of its section's sizes), without
+/// making them; 0 when a limit fails (a spec that passed validation has passed them).
+pub fn cell_count(spec: &Spec) -> u64 {
+    let c = Check { spec, counted: Default::default() };
+    for family in super::family::present(spec) {
+        if family.check_limits(&c).is_err() {
+            return 0;
+        }
+    }
+    c.counted.get()
 }
 
 #[cfg(test)]
