@@ -99,7 +99,7 @@ pub struct FitArgs {
     /// Output folder for control_nets.csv, surfaces.igs, surfaces.obj and fit.csv.
     #[arg(long, default_value = "fit")]
     pub out: PathBuf,
-    /// Evaluation samples per direction in the OBJ mesh.
+    /// Evaluation samples per direction in the OBJ mesh, in [2, 1000].
     #[arg(long, default_value_t = 40)]
     pub samples: usize,
     /// Knot reading for nets smaller than the grid: eq2_10 (the thesis' Eq. 2.10 literally) or

@@ -23,8 +23,7 @@ fn main() -> ExitCode {
     match run(cli) {
         Ok(code) => code,
         Err(e) => {
-            let msg = format!("{e:#}").replace('\n', " ");
-            eprintln!("somnurbs: error: {msg}");
+            eprintln!("somnurbs: error: {}", somnurbs::io::one_line(&format!("{e:#}")));
             ExitCode::from(2)
         }
     }

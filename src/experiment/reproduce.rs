@@ -174,8 +174,7 @@ fn load_specs(
         .map(|name| {
             let path = dir.join(format!("{name}.toml"));
             let shown = path.display().to_string();
-            let text = std::fs::read_to_string(&path)
-                .with_context(|| format!("{shown}: cannot read spec"))?;
+            let text = super::spec::read_spec(&path)?;
             let mut spec = Spec::parse_with(
                 &shown,
                 &text,

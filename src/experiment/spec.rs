@@ -126,6 +126,14 @@ pub struct Spec {
     pub variant: Variant,
 }
 
+/// A spec file's text (UTF-8; a UTF-16 or binary file is named as such).
+pub(crate) fn read_spec(path: &Path) -> Result<String, SpecError> {
+    let shown = path.display().to_string();
+    let bytes =
+        std::fs::read(path).map_err(|e| SpecError(format!("{shown}: cannot read spec: {e}")))?;
+    crate::io::utf8_text(&shown, bytes).map_err(SpecError)
+}
+
 fn toml_error(path: &str, text: &str, e: &toml::de::Error) -> SpecError {
     SpecError(crate::io::toml_message(path, text, e))
 }
@@ -227,8 +235,7 @@ impl Spec {
     /// Read and parse a spec file.
     pub fn load(path: &Path, profile: Option<&str>) -> Result<Spec, SpecError> {
         let shown = path.display().to_string();
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| SpecError(format!("{shown}: cannot read spec: {e}")))?;
+        let text = read_spec(path)?;
         Spec::parse(&shown, &text, profile)
     }
 
@@ -239,8 +246,7 @@ impl Spec {
         cli: &CliOverrides,
     ) -> Result<Vec<Spec>, SpecError> {
         let shown = path.display().to_string();
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| SpecError(format!("{shown}: cannot read spec: {e}")))?;
+        let text = read_spec(path)?;
         cli.variants(&shown, &text, profile)
     }
 
