@@ -70,14 +70,15 @@ pub enum Command {
 pub struct CompareArgs {
     /// A results folder written by a spec with an [optim] section (reads its runs.csv).
     pub results: PathBuf,
-    /// Significance level for the h columns.
+    /// Significance level for the h columns, in (0, 1).
     #[arg(long, default_value_t = 0.05)]
     pub alpha: f64,
     /// Region of practical equivalence of the Bayesian signed-rank test: half-width on the
-    /// difference of the mean errors per cell, each divided by the cell's approach-B error.
+    /// difference of the mean errors per cell, each divided by the cell's approach-B error
+    /// (finite, >= 0).
     #[arg(long, default_value_t = 1e-6)]
     pub rope: f64,
-    /// Monte Carlo samples of the Bayesian signed-rank test.
+    /// Monte Carlo samples of the Bayesian signed-rank test, in [1000, 10^7].
     #[arg(long, default_value_t = 50_000)]
     pub bayes_samples: usize,
 }

@@ -323,6 +323,7 @@ pub fn merge(shards: &[PathBuf], ctx: &RunContext) -> Result<PathBuf> {
     if shards.is_empty() {
         anyhow::bail!("merge: no shard folders given");
     }
+    log::out_is_no_shard(shards, &ctx.out)?;
     let _lock = crate::io::outdir::lock(&ctx.out, "merge")?;
     let mut first: Option<log::Fingerprint> = None;
     let mut seen: BTreeMap<usize, PathBuf> = BTreeMap::new();

@@ -455,7 +455,7 @@ fn fit_export_and_compare_refuse_a_folder_another_writer_holds() {
     // Free folders: each command writes, and leaves the lock released for the next writer.
     c.ok(&["fit", "--grid", "g.csv", "--cn", "4x4", "--out", "busy"]);
     c.ok(&["datasets", "export", "sphere", "busy/sphere.xyz"]);
-    c.ok(&["compare", "done", "--bayes-samples", "500"]);
+    c.ok(&["compare", "done", "--bayes-samples", "1000"]);
     c.ok(&["run", "r.toml", "--out", "busy", "--jobs", "1"]);
     c.fails(&["compare", "nothere"], &["nothere", "no such results folder"]);
     assert!(!c.path("nothere").exists());

@@ -241,16 +241,33 @@ fn runtime_outputs(
     Ok(written)
 }
 
-/// `somnurbs compare`: pairwise tests per cell, Friedman and Bayesian tests over cells, runtime
-/// distributions from the traces; tables into the folder, a summary on stdout.
-pub fn compare(args: &CompareArgs) -> Result<()> {
-    if !(args.rope >= 0.0 && args.rope.is_finite()) || args.bayes_samples == 0 {
+/// `--bayes-samples`: Monte Carlo samples of the Bayesian signed-rank test (below the lower
+/// bound its probabilities move in the second digit; above the upper one a run takes minutes).
+pub const MIN_BAYES_SAMPLES: usize = 1_000;
+pub const MAX_BAYES_SAMPLES: usize = 10_000_000;
+
+/// The options' ranges, before anything is read: `--alpha` in (0, 1), `--rope` finite and >= 0,
+/// `--bayes-samples` in [[`MIN_BAYES_SAMPLES`], [`MAX_BAYES_SAMPLES`]].
+fn check_args(args: &CompareArgs) -> Result<()> {
+    if !(args.alpha > 0.0 && args.alpha < 1.0) {
+        anyhow::bail!("--alpha must be a number in (0, 1), got {}", args.alpha);
+    }
+    if !(args.rope >= 0.0 && args.rope.is_finite()) {
+        anyhow::bail!("--rope must be finite and >= 0, got {}", args.rope);
+    }
+    if !(MIN_BAYES_SAMPLES..=MAX_BAYES_SAMPLES).contains(&args.bayes_samples) {
         anyhow::bail!(
-            "--rope must be finite and >= 0 (got {}) and --bayes-samples at least 1 (got {})",
-            args.rope,
+            "--bayes-samples must be in [{MIN_BAYES_SAMPLES}, {MAX_BAYES_SAMPLES}], got {}",
             args.bayes_samples
         );
     }
+    Ok(())
+}
+
+/// `somnurbs compare`: pairwise tests per cell, Friedman and Bayesian tests over cells, runtime
+/// distributions from the traces; tables into the folder, a summary on stdout.
+pub fn compare(args: &CompareArgs) -> Result<()> {
+    check_args(args)?;
     if !args.results.is_dir() {
         anyhow::bail!(
             "{}: not found (no such results folder)",
