@@ -126,7 +126,8 @@ pub struct RunArgs {
     /// Output folder (default: the spec's `output`, else results/<spec name>).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Worker threads (default: all cores). Results do not depend on it.
+    /// Worker threads (default: all cores; at least 1, at most 4 x the cores: more is cut down
+    /// with a note). Results do not depend on it.
     #[arg(long, short = 'j')]
     pub jobs: Option<usize>,
     /// Folder holding bun_zipper.ply and talus_r.stl (default: $SOMNURBS_DATA, else ./data).
@@ -152,6 +153,8 @@ pub struct RunArgs {
     /// Run the spec once per value of an optimiser setting into one folder, e.g.
     /// `--sweep optim.de.f=0.3,0.5,0.8` (repeatable: every combination). runs.csv gets a
     /// `variant` column and `somnurbs compare` ranks each optimiser@variant like an optimiser.
+    /// At most 1000 variants and 10^5 cells over all of them; a value given twice (compared as
+    /// TOML values: 0.3 and 0.30 are one) is refused.
     #[arg(long, value_name = "KEY=V1,V2,...")]
     pub sweep: Vec<String>,
 }
@@ -183,10 +186,11 @@ pub struct MergeArgs {
     /// The shard folders (each written by `somnurbs run SPEC --shard I/N`), all N of them.
     #[arg(required = true)]
     pub shards: Vec<PathBuf>,
-    /// The folder to write the combined run to (must not hold a run yet).
+    /// The folder to write the combined run to (must not hold a run yet, nor be a shard folder).
     #[arg(long)]
     pub out: PathBuf,
-    /// Worker threads (default: all cores). Results do not depend on it.
+    /// Worker threads (default: all cores; at least 1, at most 4 x the cores: more is cut down
+    /// with a note). Results do not depend on it.
     #[arg(long, short = 'j')]
     pub jobs: Option<usize>,
     /// Folder holding bun_zipper.ply and talus_r.stl (default: $SOMNURBS_DATA, else ./data).
@@ -210,7 +214,8 @@ pub struct ReproduceArgs {
     /// Folder of the experiment specs.
     #[arg(long, default_value = "experiments")]
     pub specs: PathBuf,
-    /// Worker threads (default: all cores). Results do not depend on it.
+    /// Worker threads (default: all cores; at least 1, at most 4 x the cores: more is cut down
+    /// with a note). Results do not depend on it.
     #[arg(long, short = 'j')]
     pub jobs: Option<usize>,
     /// Folder holding bun_zipper.ply and talus_r.stl (default: $SOMNURBS_DATA, else ./data).
