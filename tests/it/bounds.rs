@@ -221,6 +221,12 @@ fn shards_and_traces() {
         let name = dat.file_name().unwrap().to_string_lossy().to_string();
         refused(&c, &["compare", "m"], &[&name, "line 3: value", "is not finite"]);
     }
+    // runs.csv saved as UTF-16 is named as such.
+    let runs = std::fs::read_to_string(c.path("m/runs.csv")).unwrap();
+    let wide: Vec<u8> =
+        [0xFF, 0xFE].into_iter().chain(runs.encode_utf16().flat_map(u16::to_le_bytes)).collect();
+    std::fs::write(c.path("m/runs.csv"), wide).unwrap();
+    refused(&c, &["compare", "m"], &["runs.csv: UTF-16 text (or binary with NUL bytes)"]);
 }
 
 #[test]

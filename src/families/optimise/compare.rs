@@ -55,8 +55,8 @@ type Wins = BTreeMap<(String, String), (usize, usize)>;
 /// The rows of `results/runs.csv`, every one checked.
 fn read_runs(results: &std::path::Path) -> Result<Vec<OptimRow>> {
     let path = results.join("runs.csv");
-    let mut reader =
-        csv::Reader::from_path(&path).with_context(|| format!("cannot read {}", path.display()))?;
+    let text = crate::io::read_text(&path)?;
+    let mut reader = csv::Reader::from_reader(text.as_bytes());
     let mut rows: Vec<OptimRow> = Vec::new();
     for (n, r) in reader.deserialize().enumerate() {
         rows.push(r.with_context(|| {
@@ -390,8 +390,8 @@ fn certified_optima(folder: &std::path::Path) -> Result<BTreeMap<String, f64>> {
         let Some(grid) = name.strip_prefix("exact_").and_then(|g| g.strip_suffix(".csv")) else {
             continue;
         };
-        let mut r =
-            csv::Reader::from_path(&p).with_context(|| format!("cannot read {}", p.display()))?;
+        let text = crate::io::read_text(&p)?;
+        let mut r = csv::Reader::from_reader(text.as_bytes());
         for (n, rec) in r.deserialize::<BTreeMap<String, String>>().enumerate() {
             let rec = rec.with_context(|| format!("{}: line {}", p.display(), n + 2))?;
             let get = |k: &str| {
