@@ -70,14 +70,15 @@ pub enum Command {
 pub struct CompareArgs {
     /// A results folder written by a spec with an [optim] section (reads its runs.csv).
     pub results: PathBuf,
-    /// Significance level for the h columns.
+    /// Significance level for the h columns, in (0, 1).
     #[arg(long, default_value_t = 0.05)]
     pub alpha: f64,
     /// Region of practical equivalence of the Bayesian signed-rank test: half-width on the
-    /// difference of the mean errors per cell, each divided by the cell's approach-B error.
+    /// difference of the mean errors per cell, each divided by the cell's approach-B error
+    /// (finite, >= 0).
     #[arg(long, default_value_t = 1e-6)]
     pub rope: f64,
-    /// Monte Carlo samples of the Bayesian signed-rank test.
+    /// Monte Carlo samples of the Bayesian signed-rank test, in [1000, 10^7].
     #[arg(long, default_value_t = 50_000)]
     pub bayes_samples: usize,
     /// Folder for the tables and charts (default RESULTS/compare). It must be missing, empty or
@@ -103,7 +104,7 @@ pub struct FitArgs {
     /// Output folder for control_nets.csv, surfaces.igs, surfaces.obj and fit.csv.
     #[arg(long, default_value = "fit")]
     pub out: PathBuf,
-    /// Evaluation samples per direction in the OBJ mesh.
+    /// Evaluation samples per direction in the OBJ mesh, in [2, 1000].
     #[arg(long, default_value_t = 40)]
     pub samples: usize,
     /// Knot reading for nets smaller than the grid: eq2_10 (the thesis' Eq. 2.10 literally) or
@@ -129,7 +130,8 @@ pub struct RunArgs {
     /// Output folder (default: the spec's `output`, else results/<spec name>).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Worker threads (default: all cores). Results do not depend on it.
+    /// Worker threads (default: all cores; at least 1, at most 4 x the cores: more is cut down
+    /// with a note). Results do not depend on it.
     #[arg(long, short = 'j')]
     pub jobs: Option<usize>,
     /// Folder holding bun_zipper.ply and talus_r.stl (default: $SOMNURBS_DATA, else ./data).
@@ -155,6 +157,8 @@ pub struct RunArgs {
     /// Run the spec once per value of an optimiser setting into one folder, e.g.
     /// `--sweep optim.de.f=0.3,0.5,0.8` (repeatable: every combination). runs.csv gets a
     /// `variant` column and `somnurbs compare` ranks each optimiser@variant like an optimiser.
+    /// At most 1000 variants and 10^5 cells over all of them; a value given twice (compared as
+    /// TOML values: 0.3 and 0.30 are one) is refused.
     #[arg(long, value_name = "KEY=V1,V2,...")]
     pub sweep: Vec<String>,
 }
@@ -187,10 +191,11 @@ pub struct MergeArgs {
     /// The shard folders (each written by `somnurbs run SPEC --shard I/N`), all N of them.
     #[arg(required = true)]
     pub shards: Vec<PathBuf>,
-    /// The folder to write the combined run to (must not hold a run yet).
+    /// The folder to write the combined run to (must not hold a run yet, nor be a shard folder).
     #[arg(long)]
     pub out: PathBuf,
-    /// Worker threads (default: all cores). Results do not depend on it.
+    /// Worker threads (default: all cores; at least 1, at most 4 x the cores: more is cut down
+    /// with a note). Results do not depend on it.
     #[arg(long, short = 'j')]
     pub jobs: Option<usize>,
     /// Folder holding bun_zipper.ply and talus_r.stl (default: $SOMNURBS_DATA, else ./data).
@@ -215,7 +220,8 @@ pub struct ReproduceArgs {
     /// without one, the experiments folder of the clone somnurbs was built from).
     #[arg(long)]
     pub specs: Option<PathBuf>,
-    /// Worker threads (default: all cores). Results do not depend on it.
+    /// Worker threads (default: all cores; at least 1, at most 4 x the cores: more is cut down
+    /// with a note). Results do not depend on it.
     #[arg(long, short = 'j')]
     pub jobs: Option<usize>,
     /// Folder holding bun_zipper.ply and talus_r.stl (default: $SOMNURBS_DATA, else ./data).

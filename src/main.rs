@@ -23,19 +23,19 @@ fn main() -> ExitCode {
     match run(cli) {
         Ok(code) => code,
         Err(e) => {
-            let msg = format!("{e:#}").replace('\n', " ");
-            eprintln!("somnurbs: error: {msg}");
+            eprintln!("somnurbs: error: {}", somnurbs::io::one_line(&format!("{e:#}")));
             ExitCode::from(2)
         }
     }
 }
 
-/// Worker threads: the flag, else every core.
+/// Worker threads: the flag, else every core; at most a few per core (a note says when the flag
+/// was cut down).
 fn jobs(flag: Option<usize>) -> anyhow::Result<usize> {
-    let jobs =
-        flag.unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1));
-    if jobs == 0 {
-        anyhow::bail!("--jobs must be at least 1");
+    let cpus = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
+    let (jobs, note) = experiment::limits::jobs(flag, cpus)?;
+    if let Some(note) = note {
+        eprintln!("somnurbs: note: {note}");
     }
     Ok(jobs)
 }

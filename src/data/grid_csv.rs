@@ -38,13 +38,15 @@ pub fn parse_two_view_grid(text: &str) -> Result<TwoViewGrid, DataError> {
             let v: f64 = field(c).parse().map_err(|_| {
                 DataError::parse(format!("line {line}"), format!("`{}` is not a number", field(c)))
             })?;
-            if v.is_finite() {
-                Ok(v)
-            } else {
+            if !v.is_finite() {
                 Err(DataError::parse(
                     format!("line {line}"),
                     format!("non-finite coordinate `{}`", field(c)),
                 ))
+            } else if let Some(why) = super::coordinate_problem("coordinate", v) {
+                Err(DataError::parse(format!("line {line}"), why))
+            } else {
+                Ok(v)
             }
         };
         let top = match field(cv) {
@@ -96,6 +98,13 @@ pub fn parse_two_view_grid(text: &str) -> Result<TwoViewGrid, DataError> {
         .map(|p| p.expect("every position filled: counts match and no duplicates"))
         .collect();
     let top: Vec<Point3> = top.into_iter().map(|p| p.expect("every position filled")).collect();
+    if bottom.iter().chain(&top).all(|p| *p == bottom[0]) {
+        return Err(DataError::Invalid(format!(
+            "all {} points of the grid are the same point (its bounding box has zero diagonal): \
+             nothing to fit",
+            2 * nx * ny
+        )));
+    }
     Ok(TwoViewGrid { nx, ny, bottom, top })
 }
 
@@ -128,5 +137,24 @@ mod tests {
         let nan = csv(3, 4).replace("1,2,bottom,0,1,2,0", "1,2,bottom,0,1,NaN,0");
         let e = parse_two_view_grid(&nan).unwrap_err().to_string();
         assert!(e.contains("line 8") && e.contains("NaN"), "{e}");
+        let huge = csv(3, 4).replace("1,2,bottom,0,1,2,0", "1,2,bottom,0,1,-1e300,0");
+        let e = parse_two_view_grid(&huge).unwrap_err().to_string();
+        assert!(e.contains("line 8") && e.contains("beyond the limit"), "{e}");
+        let g = csv(3, 4);
+        let same: String = g
+            .lines()
+            .enumerate()
+            .map(|(k, l)| {
+                if k == 0 {
+                    l.to_string()
+                } else {
+                    let f: Vec<&str> = l.split(',').collect();
+                    format!("{},{},{},{},5,5,5", f[0], f[1], f[2], f[3])
+                }
+            })
+            .collect::<Vec<_>>()
+            .join("\n");
+        let e = parse_two_view_grid(&same).unwrap_err().to_string();
+        assert!(e.contains("all 24 points of the grid are the same point"), "{e}");
     }
 }

@@ -106,16 +106,29 @@ pub fn normalise_min_max(points: &mut [Point3]) {
     }
 }
 
-/// Refuse non-finite coordinates (naming the point and axis) and clouds of fewer than `min_points`.
+/// Largest coordinate magnitude of a point file: beyond it the squared distances of the
+/// parameterisation and the least-squares fit lose the data's own scale (1e300 made the normal
+/// equations singular), so such a file is refused when it is read (README "Own data").
+pub const MAX_COORDINATE: f64 = 1e15;
+
+/// Why a coordinate read from a file is refused (non-finite, or beyond [`MAX_COORDINATE`]).
+pub fn coordinate_problem(axis: &str, v: f64) -> Option<String> {
+    if !v.is_finite() {
+        Some(format!("a non-finite {axis} ({v})"))
+    } else if v.abs() > MAX_COORDINATE {
+        Some(format!("{axis} = {v:e}, beyond the limit |{axis}| <= {MAX_COORDINATE:e}"))
+    } else {
+        None
+    }
+}
+
+/// Refuse non-finite coordinates and coordinates beyond [`MAX_COORDINATE`] (naming the point and
+/// axis) and clouds of fewer than `min_points`.
 pub fn validate(points: &[Point3], min_points: usize) -> Result<(), DataError> {
     for (k, p) in points.iter().enumerate() {
         for (a, axis) in ["x", "y", "z"].iter().enumerate() {
-            if !p[a].is_finite() {
-                return Err(DataError::Invalid(format!(
-                    "point {} has a non-finite {axis} ({})",
-                    k + 1,
-                    p[a]
-                )));
+            if let Some(why) = coordinate_problem(axis, p[a]) {
+                return Err(DataError::Invalid(format!("point {} has {why}", k + 1)));
             }
         }
     }

@@ -206,6 +206,7 @@ impl Loader {
                         &shown,
                     )?
                 } else {
+                    crate::io::not_utf16(&shown, &bytes).map_err(DataError::Invalid)?;
                     let text = String::from_utf8_lossy(&bytes);
                     xyz::parse_xyz(&text).map_err(|e| e.in_file(&shown))?
                 }
@@ -300,7 +301,11 @@ mod tests {
         let huge = dir.path().join("huge.xyz");
         std::fs::write(&huge, "1e308 0 0\n-1e308 1 1\n0 0 2\n5 5 5\n").unwrap();
         let e = load_dataset(huge.to_str().unwrap(), dir.path()).unwrap_err().to_string();
-        assert!(e.contains("huge.xyz") && e.contains("non-finite"), "{e}");
+        assert!(e.contains("huge.xyz: line 1") && e.contains("beyond the limit"), "{e}");
+        let utf16 = dir.path().join("wide.xyz");
+        std::fs::write(&utf16, b"\xFF\xFE1\x00 \x002\x00").unwrap();
+        let e = load_dataset(utf16.to_str().unwrap(), dir.path()).unwrap_err().to_string();
+        assert!(e.contains("wide.xyz: UTF-16 text") && !e.contains('\0'), "{e}");
         let same = dir.path().join("same.csv");
         std::fs::write(&same, "1,2,3\n1,2,3\n1,2,3\n1,2,3\n1,2,3\n").unwrap();
         let e = load_dataset(same.to_str().unwrap(), dir.path()).unwrap_err().to_string();

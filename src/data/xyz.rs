@@ -38,6 +38,11 @@ pub fn parse_xyz(text: &str) -> Result<Vec<Point3>, DataError> {
                 )
             })?;
         }
+        for (a, axis) in ["x", "y", "z"].iter().enumerate() {
+            if let Some(why) = super::coordinate_problem(axis, p[a]) {
+                return Err(DataError::parse(format!("line {}", n + 1), why));
+            }
+        }
         seen_data = true;
         out.push(p);
     }
@@ -60,7 +65,14 @@ mod tests {
         assert!(e.contains("line 2") && e.contains("five"), "{e}");
         let e = parse_xyz("1 2 3\n4 5\n").unwrap_err().to_string();
         assert!(e.contains("line 2"), "{e}");
-        // NaN parses as a number here; validation refuses it with the point's index.
-        assert!(parse_xyz("nan 1 2\n").unwrap()[0][0].is_nan());
+        // Non-finite coordinates and coordinates beyond 1e15 are refused naming their line.
+        let e = parse_xyz("1 2 3\nnan 1 2\n").unwrap_err().to_string();
+        assert!(e.contains("line 2") && e.contains("non-finite x"), "{e}");
+        let e = parse_xyz("1 2 3\n0 0 1e300\n").unwrap_err().to_string();
+        assert!(
+            e.contains("line 2") && e.contains("z = 1e300, beyond the limit |z| <= 1e15"),
+            "{e}"
+        );
+        assert!(parse_xyz("0 0 -1e15\n").is_ok());
     }
 }

@@ -20,8 +20,12 @@ pub const MAX_REPEATS: u64 = 10_000;
 pub const MAX_GENERATIONS: u64 = 1_000_000;
 /// Individuals (nests, particles) of one optimiser run.
 pub const MAX_POPULATION: u64 = 10_000;
-/// Cells of one spec.
+/// Cells of one spec (all its `--sweep` variants together).
 pub const MAX_CELLS: u64 = 100_000;
+/// Variants of one run: the product of the `--sweep` value counts.
+pub const MAX_VARIANTS: u64 = 1_000;
+/// Cells of one `reproduce` plan: its specs and its reading sets' runs together.
+pub const MAX_PLAN_CELLS: u64 = 1_000_000;
 /// Entries of one list.
 pub const MAX_LIST: usize = 1_000;
 /// Initial range, search range and box margin, in units of the (normalised) data's extent.
@@ -35,9 +39,32 @@ pub const MAX_LENGTH: f64 = 1e6;
 /// Points or samples per side of a generated data set (seed 002 grid, seed 003 examples).
 pub const MAX_SAMPLES: u64 = 100_000;
 
+/// Worker threads per available CPU at most (`--jobs`).
+pub const MAX_JOBS_PER_CPU: usize = 4;
+
+/// The worker threads of `--jobs` (`flag`; default: `cpus`): at least 1 (0 is an error), at most
+/// [`MAX_JOBS_PER_CPU`] x `cpus` (a larger flag is cut down, with the note to print).
+pub fn jobs(flag: Option<usize>, cpus: usize) -> anyhow::Result<(usize, Option<String>)> {
+    let cpus = cpus.max(1);
+    let cap = MAX_JOBS_PER_CPU.saturating_mul(cpus);
+    match flag {
+        None => Ok((cpus, None)),
+        Some(0) => anyhow::bail!("--jobs must be at least 1"),
+        Some(n) if n > cap => Ok((
+            cap,
+            Some(format!(
+                "--jobs {n} is above {MAX_JOBS_PER_CPU} x the {cpus} available CPU(s); using {cap}"
+            )),
+        )),
+        Some(n) => Ok((n, None)),
+    }
+}
+
 /// The bound checks a family applies to its section, each error naming the spec and key.
 pub struct Check<'a> {
     pub spec: &'a Spec,
+    /// The cell count the section's [`Check::cells`] computed (read by [`cell_count`]).
+    counted: std::cell::Cell<u64>,
 }
 
 impl Check<'_> {
@@ -124,6 +151,7 @@ impl Check<'_> {
 
     pub fn cells(&self, key: &str, factors: &[usize]) -> Result<(), SpecError> {
         let n = factors.iter().fold(1u64, |a, &f| a.saturating_mul(f as u64));
+        self.counted.set(self.counted.get().saturating_add(n));
         if n > MAX_CELLS {
             return Err(
                 self.err(key, format!("the spec has {n} cells, above the limit {MAX_CELLS}"))
@@ -150,10 +178,10 @@ pub fn dataset_entries(spec: &Spec) -> Vec<&String> {
     super::family::present(spec).into_iter().flat_map(|f| f.datasets(spec)).collect()
 }
 
-/// A usable experiment or file name: not empty, no path separator or NUL, not `.` or `..`.
 /// The penalised least squares weight (`fairness`): at most 10^6.
 pub const MAX_FAIRNESS: f64 = 1e6;
 
+/// A usable experiment or file name: not empty, no path separator or NUL, not `.` or `..`.
 pub fn check_name(name: &str) -> Result<(), String> {
     if name.trim().is_empty() || name.contains(['/', '\\', '\0']) || name == "." || name == ".." {
         return Err(format!("`{name}` must be a non-empty name without slashes, not `.` or `..`"));
@@ -163,7 +191,7 @@ pub fn check_name(name: &str) -> Result<(), String> {
 
 /// Every bound of a spec (see the module doc), before any other check.
 pub fn check(spec: &Spec) -> Result<(), SpecError> {
-    let c = Check { spec };
+    let c = Check { spec, counted: Default::default() };
     let f = &spec.file;
     check_name(&f.name).map_err(|e| c.err("name", e))?;
     for family in super::family::present(spec) {
@@ -172,9 +200,22 @@ pub fn check(spec: &Spec) -> Result<(), SpecError> {
     Ok(())
 }
 
+/// The cells of a spec as its limit counts them (the product of its section's sizes), without
+/// making them; 0 when a limit fails (a spec that passed validation has passed them).
+pub fn cell_count(spec: &Spec) -> u64 {
+    let c = Check { spec, counted: Default::default() };
+    for family in super::family::present(spec) {
+        if family.check_limits(&c).is_err() {
+            return 0;
+        }
+    }
+    c.counted.get()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::experiment::spec::CliOverrides;
 
     const SPEC: &str = "name = \"t\"\nmaster_seed = 1\n[optim]\ndatasets = [\"sphere\"]\ngrid = \"20x20\"\ncontrol_nets = [\"6x6\"]\nparameterisations = [\"uniform\"]\noptimisers = [\"ga\", \"de\"]\nrepeats = 2\ngenerations = 10\npopulation = 8\n";
 
@@ -239,6 +280,76 @@ mod tests {
             let e = Spec::parse("s.toml", &som.replace("iterations = 10", to), None).unwrap_err().0;
             assert!(e.contains(key), "{e}");
         }
+    }
+
+    #[test]
+    fn jobs_are_at_least_one_and_at_most_four_per_cpu() {
+        assert_eq!(jobs(None, 2).unwrap(), (2, None));
+        assert_eq!(jobs(Some(3), 2).unwrap(), (3, None));
+        assert_eq!(jobs(Some(8), 2).unwrap(), (8, None));
+        let (n, note) = jobs(Some(9), 2).unwrap();
+        assert_eq!(n, 8);
+        assert!(note.unwrap().contains("--jobs 9 is above 4 x the 2 available CPU(s); using 8"));
+        assert_eq!(jobs(Some(usize::MAX), 1).unwrap().0, 4);
+        assert!(jobs(Some(0), 2).unwrap_err().to_string().contains("at least 1"));
+    }
+
+    #[test]
+    fn sweeps_are_bounded_before_they_expand() {
+        let text = SPEC.replace("optimisers = [\"ga\", \"de\"]", "optimisers = [\"de\"]");
+        let sweep = |args: &[&str]| {
+            let cli =
+                CliOverrides { set: vec![], sweep: args.iter().map(|s| s.to_string()).collect() };
+            cli.variants("t.toml", &text, None).map(|v| v.len())
+        };
+        let values = |n: usize| {
+            (0..n).map(|k| format!("{}", 0.1 + k as f64 * 1e-4)).collect::<Vec<_>>().join(",")
+        };
+        assert_eq!(sweep(&["optim.de.f=0.3,0.5"]), Ok(2));
+        let t = std::time::Instant::now();
+        let big = [format!("optim.de.f={}", values(1000)), format!("optim.de.cr={}", values(1000))];
+        let e = sweep(&[&big[0], &big[1]]).unwrap_err().0;
+        assert!(e.contains("1000 x 1000 = 1000000 variants, above the limit 1000"), "{e}");
+        assert!(t.elapsed().as_secs_f64() < 1.0);
+        // 500 variants of 200 cells (one optimiser x 200 repeats): 10^5 in all, the limit; one
+        // more repeat is over.
+        let ok = format!("optim.de.f={}", values(500));
+        assert_eq!(sweep(&[&ok, "optim.repeats=200"]), Ok(500));
+        let e = sweep(&[&ok, "optim.repeats=201"]).unwrap_err().0;
+        assert!(e.contains("cells in all, above the limit 100000"), "{e}");
+        for (dup, said) in [
+            ("0.3,0.30", "0.3 and 0.30 are one value"),
+            ("1,1.0", "1 and 1.0 are one value"),
+            ("0.5,5e-1", "0.5 and 5e-1 are one value"),
+            ("0.3,0.3", "the value 0.3 is given twice"),
+        ] {
+            let e = sweep(&[&format!("optim.de.f={dup}")]).unwrap_err().0;
+            assert!(e.contains(said), "{dup}: {e}");
+        }
+    }
+
+    #[test]
+    fn population_minimum_is_that_of_the_optimisers_run() {
+        let spec = |opts: &str, pop: usize, extra: &str| {
+            let t = SPEC
+                .replace("optimisers = [\"ga\", \"de\"]", &format!("optimisers = [{opts}]"))
+                .replace("population = 8", &format!("population = {pop}\n{extra}"));
+            Spec::parse("t.toml", &t, None).map(|_| ()).map_err(|e| e.0)
+        };
+        spec("\"ga\"", 4, "").unwrap();
+        spec("\"ga\", \"pso\", \"csa\"", 3, "[optim.ga]\ntournament = 3").unwrap();
+        spec("\"pso\"", 1, "").unwrap();
+        let e = spec("\"ga\"", 3, "").unwrap_err();
+        assert!(e.contains("t.toml: optim.ga.tournament: 4 is above optim.population = 3"), "{e}");
+        assert!(!e.contains("DE"), "{e}");
+        let e = spec("\"ga\"", 8, "[optim.ga]\ntournament = 20").unwrap_err();
+        assert!(e.contains("optim.ga.tournament: 20 is above optim.population = 8"), "{e}");
+        let e = spec("\"ga\", \"de\"", 3, "[optim.ga]\ntournament = 2").unwrap_err();
+        assert!(e.contains("optim.population: must be at least 4 for de"), "{e}");
+        let e = spec("\"icsa\"", 1, "").unwrap_err();
+        assert!(e.contains("optim.population: must be at least 2 for icsa"), "{e}");
+        let e = spec("\"pso\"", 0, "").unwrap_err();
+        assert!(e.contains("optim.population: must be at least 1 for pso"), "{e}");
     }
 
     #[test]

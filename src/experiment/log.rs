@@ -45,6 +45,22 @@ impl Shard {
     }
 }
 
+/// `merge`'s output folder must not be one of the shard folders it reads (compared as canonical
+/// paths, so `s1`, `./s1/` and a link to it are one folder).
+pub fn out_is_no_shard(shards: &[PathBuf], out: &Path) -> Result<()> {
+    let Ok(target) = out.canonicalize() else { return Ok(()) };
+    for dir in shards {
+        if dir.canonicalize().is_ok_and(|d| d == target) {
+            bail!(
+                "merge: --out {} is the shard folder {} (write the merged run to a new folder)",
+                out.display(),
+                dir.display()
+            );
+        }
+    }
+    Ok(())
+}
+
 impl std::fmt::Display for Shard {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(f, "{}/{}", self.index, self.count)

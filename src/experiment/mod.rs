@@ -199,11 +199,10 @@ pub fn run_spec(spec: &Spec, ctx: &RunContext) -> Result<PathBuf> {
 /// folder: one cell log, one fingerprint and manifest, the family's tables over every variant.
 pub fn run_variants(variants: &[Spec], ctx: &RunContext) -> Result<PathBuf> {
     let spec = variants.first().context("no spec to run")?;
-    // A data file the spec names but that is not there: refused before the folder is touched.
+    // A data file the spec names that is not there or does not load: refused before the folder
+    // is touched (loaded here once more than the run needs: milliseconds for the largest scan).
     for d in limits::dataset_entries(spec) {
-        ctx.loader(spec)
-            .require_file(d)
-            .with_context(|| format!("{}: data set `{d}`", spec.path))?;
+        ctx.loader(spec).load(d).with_context(|| format!("{}: data set `{d}`", spec.path))?;
     }
     // So is a maps folder it names (unless it asks for the maps to be recomputed).
     for f in family::present(spec) {
@@ -398,6 +397,7 @@ pub fn merge(shards: &[PathBuf], ctx: &RunContext) -> Result<PathBuf> {
     if shards.is_empty() {
         anyhow::bail!("merge: no shard folders given");
     }
+    log::out_is_no_shard(shards, &ctx.out)?;
     let _lock = crate::io::outdir::lock(&ctx.out, "merge")?;
     crate::io::outdir::require_empty(&ctx.out).context("merge")?;
     let mut first: Option<log::Fingerprint> = None;

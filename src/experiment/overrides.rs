@@ -44,6 +44,23 @@ fn cli_value(raw: &str) -> toml::Value {
     }
 }
 
+/// Whether two command-line values are the same setting: equal TOML values, an integer and a
+/// float of the same number counting as one (`1` and `1.0`), arrays and tables element-wise.
+fn same_value(a: &toml::Value, b: &toml::Value) -> bool {
+    use toml::Value::{Array, Float, Integer, Table};
+    match (a, b) {
+        (Integer(i), Float(f)) | (Float(f), Integer(i)) => *i as f64 == *f,
+        (Float(x), Float(y)) => x == y || (x.is_nan() && y.is_nan()),
+        (Array(x), Array(y)) => {
+            x.len() == y.len() && x.iter().zip(y).all(|(p, q)| same_value(p, q))
+        }
+        (Table(x), Table(y)) => {
+            x.len() == y.len() && x.iter().all(|(k, v)| y.get(k).is_some_and(|w| same_value(v, w)))
+        }
+        _ => a == b,
+    }
+}
+
 impl CliOverrides {
     pub fn is_empty(&self) -> bool {
         self.set.is_empty() && self.sweep.is_empty()
@@ -57,6 +74,36 @@ impl CliOverrides {
             }
             _ => Err(SpecError(format!("{flag} `{arg}`: expected KEY=VALUE, e.g. optim.de.f=0.5"))),
         }
+    }
+
+    /// A `--sweep KEY=V1,V2,...`: its key and values, none empty and none the same setting as
+    /// another (`0.3` and `0.30`, `1` and `1.0` are one value).
+    fn sweep_values(arg: &str) -> Result<(&str, Vec<&str>), SpecError> {
+        let (key, values) = Self::split("--sweep", arg)?;
+        let values: Vec<&str> = values.split(',').map(str::trim).collect();
+        if values.iter().any(|v| v.is_empty()) {
+            return Err(SpecError(format!("--sweep {key}: an empty value in `{arg}`")));
+        }
+        if values.len() > super::limits::MAX_LIST {
+            return Err(SpecError(format!(
+                "--sweep {key}: {} values, above the limit {}",
+                values.len(),
+                super::limits::MAX_LIST
+            )));
+        }
+        let parsed: Vec<toml::Value> = values.iter().map(|v| cli_value(v)).collect();
+        for (k, v) in parsed.iter().enumerate() {
+            if let Some(j) = parsed[..k].iter().position(|w| same_value(v, w)) {
+                let (a, b) = (values[j], values[k]);
+                let shown = if a == b {
+                    format!("the value {a} is given twice")
+                } else {
+                    format!("{a} and {b} are one value, given twice")
+                };
+                return Err(SpecError(format!("--sweep {key}: {shown}")));
+            }
+        }
+        Ok((key, values))
     }
 
     /// The variants of the spec at `path` (its text and profile): one for a plain run or `--set`
@@ -117,19 +164,21 @@ impl CliOverrides {
             .iter()
             .map(|a| Self::split("--set", a).map(|(k, v)| (k.to_string(), v.to_string())))
             .collect::<Result<_, _>>()?;
+        let sweeps: Vec<(&str, Vec<&str>)> =
+            self.sweep.iter().map(|a| Self::sweep_values(a)).collect::<Result<_, _>>()?;
+        // The number of variants, before any is made.
+        let variants = sweeps.iter().fold(1u64, |n, (_, v)| n.saturating_mul(v.len() as u64));
+        if variants > super::limits::MAX_VARIANTS {
+            let counts: Vec<String> = sweeps.iter().map(|(_, v)| v.len().to_string()).collect();
+            return Err(SpecError(format!(
+                "--sweep: {} = {variants} variants, above the limit {}",
+                counts.join(" x "),
+                super::limits::MAX_VARIANTS
+            )));
+        }
         // Every combination of the swept values, the first sweep outermost.
         let mut combos: Vec<Vec<(String, String)>> = vec![Vec::new()];
-        for arg in &self.sweep {
-            let (key, values) = Self::split("--sweep", arg)?;
-            let values: Vec<&str> = values.split(',').map(str::trim).collect();
-            if values.iter().any(|v| v.is_empty()) {
-                return Err(SpecError(format!("--sweep {key}: an empty value in `{arg}`")));
-            }
-            if let Some(v) =
-                values.iter().enumerate().find(|(k, v)| values[..*k].contains(v)).map(|(_, v)| v)
-            {
-                return Err(SpecError(format!("--sweep {key}: the value {v} is given twice")));
-            }
+        for (key, values) in &sweeps {
             combos = combos
                 .into_iter()
                 .flat_map(|c| {
@@ -139,6 +188,7 @@ impl CliOverrides {
                 })
                 .collect();
         }
+        let mut cells = 0u64;
         combos
             .into_iter()
             .map(|swept| {
@@ -148,6 +198,15 @@ impl CliOverrides {
                     .map(|(k, v)| Override { key: k.clone(), value: cli_value(v) })
                     .collect();
                 let mut spec = Spec::parse_with(path, text, profile, &overrides)?;
+                cells = cells.saturating_add(super::limits::cell_count(&spec));
+                if cells > super::limits::MAX_CELLS {
+                    return Err(SpecError(format!(
+                        "--sweep: the {variants} variants of {path} have at least {cells} cells \
+                         in all, above the limit {} (the limit of one spec holds for all its \
+                         variants together)",
+                        super::limits::MAX_CELLS
+                    )));
+                }
                 spec.cli = self.clone();
                 let pairs = |l: &[(String, String)]| {
                     l.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>()

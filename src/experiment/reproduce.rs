@@ -78,6 +78,9 @@ impl Plan {
         if plan.specs.is_empty() {
             anyhow::bail!("{}: specs: is empty", path.display());
         }
+        if let Some(s) = twice(&plan.specs) {
+            anyhow::bail!("{}: specs: `{s}` is listed twice", path.display());
+        }
         if let Some(m) = plan.maps_from.as_ref().filter(|m| !plan.specs.contains(m)) {
             anyhow::bail!("{}: maps_from: `{m}` is not one of the specs", path.display());
         }
@@ -94,6 +97,13 @@ impl Plan {
                 anyhow::bail!("{}: readings: the name `{}` is used twice", path.display(), r.name);
             }
             names.push(&r.name);
+            if let Some(s) = twice(&r.specs) {
+                anyhow::bail!(
+                    "{}: readings.{}.specs: `{s}` is listed twice",
+                    path.display(),
+                    r.name
+                );
+            }
             if let Some(s) = r.specs.iter().find(|s| !plan.specs.contains(s)) {
                 anyhow::bail!(
                     "{}: readings.{}.specs: `{s}` is not one of the plan's specs",
@@ -107,6 +117,44 @@ impl Plan {
         }
         Ok(plan)
     }
+}
+
+/// The first entry of `list` that an earlier one repeats.
+fn twice(list: &[String]) -> Option<&String> {
+    list.iter().enumerate().find(|(k, s)| list[..*k].contains(s)).map(|(_, s)| s)
+}
+
+/// The loaded specs of a plan, before anything runs: no two with one `name` (they would share an
+/// output folder), and at most [`MAX_PLAN_CELLS`](super::limits::MAX_PLAN_CELLS) cells in all,
+/// the reading sets' runs included.
+fn check_specs(
+    plan_path: &Path,
+    specs: &[Spec],
+    readings: &[(&ReadingSet, Vec<Spec>)],
+) -> Result<()> {
+    for list in std::iter::once(specs).chain(readings.iter().map(|(_, r)| r.as_slice())) {
+        for (k, spec) in list.iter().enumerate() {
+            if let Some(other) = list[..k].iter().find(|o| o.file.name == spec.file.name) {
+                anyhow::bail!(
+                    "{}: {} and {} have the same name `{}` (they would write one folder)",
+                    plan_path.display(),
+                    other.path,
+                    spec.path,
+                    spec.file.name
+                );
+            }
+        }
+    }
+    let all = specs.iter().chain(readings.iter().flat_map(|(_, r)| r));
+    let cells = all.fold(0u64, |n, s| n.saturating_add(super::limits::cell_count(s)));
+    if cells > super::limits::MAX_PLAN_CELLS {
+        anyhow::bail!(
+            "{}: the plan's specs and reading sets have {cells} cells in all, above the limit {}",
+            plan_path.display(),
+            super::limits::MAX_PLAN_CELLS
+        );
+    }
+    Ok(())
 }
 
 /// Load every spec of the plan (all before any runs, so a bad one stops nothing half-way), with
@@ -130,8 +178,7 @@ fn load_specs(
         .map(|name| {
             let path = dir.join(format!("{name}.toml"));
             let shown = path.display().to_string();
-            let text = std::fs::read_to_string(&path)
-                .with_context(|| format!("{shown}: cannot read spec"))?;
+            let text = super::spec::read_spec(&path)?;
             let mut spec = Spec::parse_with(
                 &shown,
                 &text,
@@ -235,6 +282,7 @@ pub fn reproduce(
             Ok((r, load_specs(specs_dir, &plan, &r.specs, &r.overrides(), profile, &ctx.out)?))
         })
         .collect::<Result<_>>()?;
+    check_specs(&plan_path, &specs, &reading_specs)?;
     // Every data set of every spec loads before the folder changes (a bad --data-dir changes nothing).
     for spec in &specs {
         for d in super::limits::dataset_entries(spec) {
@@ -698,6 +746,56 @@ mod tests {
         );
         // Sections that differ are kept.
         assert!(ra.contains("#### Tables\n\nA") && rb.contains("#### Tables\n\nB"), "{rb}");
+    }
+
+    /// Every shipped plan, full and quick, passes the plan's checks (its cell total is printed
+    /// with `--nocapture`); a plan over the cell limit, or with two specs of one name, does not.
+    #[test]
+    fn shipped_plans_pass_the_plan_checks_and_bad_ones_fail() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments");
+        let out = Path::new("/nonexistent");
+        for plan_name in ["thesis", "seeds", "all"] {
+            let path = dir.join(format!("{plan_name}.toml"));
+            let plan = Plan::load(&path).unwrap();
+            for profile in [None, Some("quick")] {
+                let specs = load_specs(&dir, &plan, &plan.specs, &[], profile, out).unwrap();
+                let readings: Vec<(&ReadingSet, Vec<Spec>)> = plan
+                    .readings
+                    .iter()
+                    .map(|r| {
+                        (
+                            r,
+                            load_specs(&dir, &plan, &r.specs, &r.overrides(), profile, out)
+                                .unwrap(),
+                        )
+                    })
+                    .collect();
+                let all = specs.iter().chain(readings.iter().flat_map(|(_, r)| r));
+                let cells: u64 = all.map(super::super::limits::cell_count).sum();
+                println!("{plan_name} {profile:?}: {cells} cells");
+                assert!(cells > 0);
+                check_specs(&path, &specs, &readings).unwrap();
+            }
+        }
+        let plan = Plan::load(&dir.join("thesis.toml")).unwrap();
+        let specs = load_specs(&dir, &plan, &plan.specs, &[], None, out).unwrap();
+        let twice = [specs[0].clone(), specs[1].clone(), specs[0].clone()];
+        let e = check_specs(Path::new("p.toml"), &twice, &[]).unwrap_err().to_string();
+        assert!(
+            e.contains("p.toml") && e.contains("ch4_models.toml and") && e.contains("same name"),
+            "{e}"
+        );
+        // Eleven copies of a spec of 10^5 cells under distinct names: above 10^6.
+        let text = "name = \"n\"\nmaster_seed = 1\n[som]\ndatasets = [\"cube\"]\niterations = 10\nrepeats = 10000\n[[som.group]]\nmodels = [\"som2d\"]\ngrids = [\"10x10\", \"11x11\", \"12x12\", \"13x13\", \"14x14\", \"15x15\", \"16x16\", \"17x17\", \"18x18\", \"19x19\"]\n";
+        let big: Vec<Spec> = (0..11)
+            .map(|k| {
+                Spec::parse("n.toml", &text.replace("\"n\"", &format!("\"n{k}\"")), None).unwrap()
+            })
+            .collect();
+        assert_eq!(super::super::limits::cell_count(&big[0]), 100_000);
+        check_specs(Path::new("p.toml"), &big[..10], &[]).unwrap();
+        let e = check_specs(Path::new("p.toml"), &big, &[]).unwrap_err().to_string();
+        assert!(e.contains("1100000 cells in all, above the limit 1000000"), "{e}");
     }
 
     #[test]

@@ -126,6 +126,14 @@ pub struct Spec {
     pub variant: Variant,
 }
 
+/// A spec file's text (UTF-8; a UTF-16 or binary file is named as such).
+pub(crate) fn read_spec(path: &Path) -> Result<String, SpecError> {
+    let shown = path.display().to_string();
+    let bytes =
+        std::fs::read(path).map_err(|e| SpecError(format!("{shown}: cannot read spec: {e}")))?;
+    crate::io::utf8_text(&shown, bytes).map_err(SpecError)
+}
+
 fn toml_error(path: &str, text: &str, e: &toml::de::Error) -> SpecError {
     SpecError(crate::io::toml_message(path, text, e))
 }
@@ -227,8 +235,7 @@ impl Spec {
     /// Read and parse a spec file.
     pub fn load(path: &Path, profile: Option<&str>) -> Result<Spec, SpecError> {
         let shown = path.display().to_string();
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| SpecError(format!("{shown}: cannot read spec: {e}")))?;
+        let text = read_spec(path)?;
         Spec::parse(&shown, &text, profile)
     }
 
@@ -239,8 +246,7 @@ impl Spec {
         cli: &CliOverrides,
     ) -> Result<Vec<Spec>, SpecError> {
         let shown = path.display().to_string();
-        let text = std::fs::read_to_string(path)
-            .map_err(|e| SpecError(format!("{shown}: cannot read spec: {e}")))?;
+        let text = read_spec(path)?;
         cli.variants(&shown, &text, profile)
     }
 
@@ -276,18 +282,20 @@ impl Spec {
         families[0].validate(self)
     }
 
-    /// The checks every optimisation section shares: its optimiser names (from `allowed`),
-    /// repeats, generations and population, each error naming `<section>.<key>`.
+    /// The checks every optimisation section shares: its optimiser names (from those `offered`),
+    /// repeats, generations, and a population each optimiser the section runs can work with,
+    /// each error naming `<section>.<key>` (the optimiser's own key where one sets the minimum).
     pub(crate) fn validate_runs(
         &self,
         section: &str,
         optimisers: &[String],
-        allowed: &[&str],
+        offered: &[&dyn crate::optim::Optimiser],
         repeats: usize,
         generations: u64,
         population: usize,
     ) -> Result<(), SpecError> {
         let key = |k: &str| format!("{section}.{k}");
+        let allowed = crate::optim::names(offered);
         if optimisers.is_empty() {
             return Err(self.err(&key("optimisers"), "is empty"));
         }
@@ -310,11 +318,30 @@ impl Spec {
         if generations == 0 {
             return Err(self.err(&key("generations"), "must be at least 1"));
         }
-        if population < 4 {
-            return Err(self.err(
-                &key("population"),
-                format!("must be at least 4 (DE/rand/1 needs four), got {population}"),
-            ));
+        for name in optimisers {
+            let Some(opt) = crate::optim::pick(offered, name) else { continue };
+            let need = opt.min_population();
+            if population >= need.n {
+                continue;
+            }
+            return Err(match need.key {
+                Some(k) => self.err(
+                    &key(&format!("{name}.{k}")),
+                    format!(
+                        "{} is above {} = {population} ({})",
+                        need.n,
+                        key("population"),
+                        need.why
+                    ),
+                ),
+                None => self.err(
+                    &key("population"),
+                    format!(
+                        "must be at least {} for {name} ({}), got {population}",
+                        need.n, need.why
+                    ),
+                ),
+            });
         }
         Ok(())
     }

@@ -66,9 +66,44 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     crate::io::outdir::sync_dir(path.parent().unwrap_or(Path::new(".")))
 }
 
-/// Read a whole file as text, naming it on failure.
+/// Read a whole file as text, naming it on failure (a UTF-16 or binary file: [`utf8_text`]).
 pub fn read_text(path: &Path) -> Result<String> {
-    fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))
+    let bytes = fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
+    utf8_text(&path.display().to_string(), bytes).map_err(anyhow::Error::msg)
+}
+
+/// An error chain as one printable line: line breaks become spaces and every other control
+/// character its escape (`\0`, `\u{1b}`), so no input echoed into a message can break the line or
+/// drive the terminal.
+pub fn one_line(msg: &str) -> String {
+    msg.chars()
+        .map(|c| match c {
+            '\n' | '\r' => " ".to_string(),
+            c if c.is_control() => c.escape_debug().to_string(),
+            c => c.to_string(),
+        })
+        .collect()
+}
+
+/// Refuse UTF-16 text (a byte-order mark FF FE or FE FF) and bytes with NUL in them, naming
+/// `shown`: what a parser would otherwise echo into a message.
+pub fn not_utf16(shown: &str, bytes: &[u8]) -> std::result::Result<(), String> {
+    if bytes.starts_with(&[0xFF, 0xFE]) || bytes.starts_with(&[0xFE, 0xFF]) || bytes.contains(&0) {
+        return Err(format!("{shown}: UTF-16 text (or binary with NUL bytes); save it as UTF-8"));
+    }
+    Ok(())
+}
+
+/// A file's bytes as UTF-8 text, or a one-line error naming `shown`: UTF-16 (a byte-order mark
+/// FF FE or FE FF) and NUL bytes are named as such, so no NUL byte reaches a parser's message.
+pub fn utf8_text(shown: &str, bytes: Vec<u8>) -> std::result::Result<String, String> {
+    not_utf16(shown, &bytes)?;
+    String::from_utf8(bytes).map_err(|e| {
+        format!(
+            "{shown}: not UTF-8 text (byte {} is not part of a UTF-8 character); save it as UTF-8",
+            e.utf8_error().valid_up_to() + 1
+        )
+    })
 }
 
 /// A TOML parse error on one line, `path:line:col: message` (toml's own Display spans several
@@ -184,6 +219,18 @@ mod tests {
         let cwd = std::env::current_dir().unwrap();
         assert_eq!(shown(&cwd.join("results/x")), "results/x");
         assert_eq!(shown(Path::new("/nonexistent/x/../y")), "/nonexistent/y");
+    }
+
+    #[test]
+    fn messages_stay_one_printable_line_and_utf16_is_named() {
+        assert_eq!(one_line("a\nb\r\0c\u{1b}[2Jd\tq"), "a b \\0c\\u{1b}[2Jd\\tq");
+        assert_eq!(one_line("plain é ✓"), "plain é ✓");
+        for bytes in [&[0xFF, 0xFE, b'n', 0][..], &[0xFE, 0xFF, 0, b'n'], b"n\0a\0m\0e\0"] {
+            let e = utf8_text("f.toml", bytes.to_vec()).unwrap_err();
+            assert_eq!(e, "f.toml: UTF-16 text (or binary with NUL bytes); save it as UTF-8");
+        }
+        assert!(utf8_text("f", b"ok \xC3\xA9".to_vec()).is_ok());
+        assert!(utf8_text("f", b"ok\n\xE9t\xE9".to_vec()).unwrap_err().contains("byte 4 "));
     }
 
     #[derive(serde::Serialize)]

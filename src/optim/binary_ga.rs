@@ -166,7 +166,7 @@ impl BinaryGa {
         rng: &mut ChaCha8Rng,
     ) -> Result<BinaryGaRun, OptimError> {
         self.validate()?;
-        budget.validate(2)?;
+        budget.validate(self.min_population().n)?;
         check_problem(problem)?;
         if self.elitism >= budget.population {
             return Err(OptimError::param(
@@ -269,6 +269,10 @@ impl BinaryGa {
 impl Optimiser for BinaryGa {
     fn name(&self) -> &'static str {
         "binary_ga"
+    }
+
+    fn min_population(&self) -> super::problem::MinPopulation {
+        super::problem::MinPopulation { n: 2, key: None, why: "rank selection needs two ranks" }
     }
 
     fn run(

@@ -135,6 +135,10 @@ impl Optimiser for Csa {
         "csa"
     }
 
+    fn min_population(&self) -> super::problem::MinPopulation {
+        CUCKOO_MIN_POPULATION
+    }
+
     fn run(
         &self,
         problem: &dyn Problem,
@@ -149,6 +153,10 @@ impl Optimiser for Csa {
 impl Optimiser for Icsa {
     fn name(&self) -> &'static str {
         "icsa"
+    }
+
+    fn min_population(&self) -> super::problem::MinPopulation {
+        CUCKOO_MIN_POPULATION
     }
 
     fn run(
@@ -171,6 +179,13 @@ fn permutation(n: usize, rng: &mut ChaCha8Rng) -> Vec<usize> {
     p
 }
 
+/// CSA's and ICSA's smallest population.
+const CUCKOO_MIN_POPULATION: super::problem::MinPopulation = super::problem::MinPopulation {
+    n: 2,
+    key: None,
+    why: "the discovery walk steps along the difference of two nests",
+};
+
 /// The shared loop of CSA and ICSA; `schedule(t)` gives (pa, alpha) of generation t.
 fn cuckoo_search(
     problem: &dyn Problem,
@@ -179,7 +194,7 @@ fn cuckoo_search(
     beta: f64,
     schedule: &dyn Fn(u64) -> (f64, f64),
 ) -> Result<RunResult, OptimError> {
-    budget.validate(2)?;
+    budget.validate(CUCKOO_MIN_POPULATION.n)?;
     check_problem(problem)?;
     let d = problem.dim();
     let (lo, hi) = problem.bounds();

@@ -72,6 +72,14 @@ impl Optimiser for De {
         "de"
     }
 
+    fn min_population(&self) -> super::problem::MinPopulation {
+        super::problem::MinPopulation {
+            n: 4,
+            key: None,
+            why: "DE/rand/1 draws three donors besides the target",
+        }
+    }
+
     fn run(
         &self,
         problem: &dyn Problem,
@@ -79,7 +87,7 @@ impl Optimiser for De {
         rng: &mut ChaCha8Rng,
     ) -> Result<RunResult, OptimError> {
         self.validate()?;
-        budget.validate(4)?;
+        budget.validate(self.min_population().n)?;
         check_problem(problem)?;
         let d = problem.dim();
         let (lo, hi) = problem.bounds();

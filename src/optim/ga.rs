@@ -89,6 +89,14 @@ impl Optimiser for Ga {
         "ga"
     }
 
+    fn min_population(&self) -> super::problem::MinPopulation {
+        super::problem::MinPopulation {
+            n: self.tournament,
+            key: Some("tournament"),
+            why: "a tournament draws that many distinct individuals",
+        }
+    }
+
     fn run(
         &self,
         problem: &dyn Problem,
@@ -96,7 +104,7 @@ impl Optimiser for Ga {
         rng: &mut ChaCha8Rng,
     ) -> Result<RunResult, OptimError> {
         self.validate()?;
-        budget.validate(self.tournament)?;
+        budget.validate(self.min_population().n)?;
         check_problem(problem)?;
         let d = problem.dim();
         let x0 = problem.initial_point();

@@ -167,7 +167,7 @@ pub fn json_text(meta: &IohMeta, runs: &[IohRun]) -> String {
 }
 
 /// Parse a `.dat` text back into runs of (evaluation, value) rows (a header line starts a run).
-/// Errors name the 1-based line.
+/// Errors name the 1-based line; a value that is not finite (`nan`, `Inf`) is one.
 pub fn parse_dat(text: &str) -> Result<Vec<Vec<(u64, f64)>>, String> {
     let mut runs: Vec<Vec<(u64, f64)>> = Vec::new();
     for (n, line) in text.lines().enumerate() {
@@ -190,6 +190,12 @@ pub fn parse_dat(text: &str) -> Result<Vec<Vec<(u64, f64)>>, String> {
             "-Inf" => f64::NEG_INFINITY,
             y => y.parse().map_err(|_| format!("line {}: value {y:?} is not a number", n + 1))?,
         };
+        if !y.is_finite() {
+            return Err(format!(
+                "line {}: value {y} is not finite (a trace holds the best fitness so far)",
+                n + 1
+            ));
+        }
         runs.last_mut()
             .ok_or_else(|| format!("line {}: a row before the first header", n + 1))?
             .push((e, y));
@@ -229,6 +235,10 @@ mod tests {
         assert_eq!(dat_text(&[c]), "evaluations raw_y\n1 Inf\n2 1e0\n5 1e0\n");
         assert!(parse_dat("1 2\n").unwrap_err().contains("line 1"));
         assert!(parse_dat("evaluations raw_y\n1 x\n").unwrap_err().contains("line 2"));
+        for bad in ["nan", "NaN", "inf", "Inf", "-Inf", "1e999"] {
+            let e = parse_dat(&format!("evaluations raw_y\n1 2\n5 {bad}\n")).unwrap_err();
+            assert!(e.starts_with("line 3: value") && e.contains("is not finite"), "{bad}: {e}");
+        }
     }
 
     #[test]

@@ -23,7 +23,7 @@ pub use cuckoo::{Csa, Icsa};
 pub use de::De;
 pub use exact::{certify, solve_exact, ExactOptions, ExactResult, SumOfNorms};
 pub use ga::Ga;
-pub use problem::{Budget, Evaluator, Optimiser, Problem, RunResult};
+pub use problem::{Budget, Evaluator, MinPopulation, Optimiser, Problem, RunResult};
 pub use pso::Pso;
 
 /// What can go wrong before an optimisation starts.

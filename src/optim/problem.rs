@@ -26,6 +26,11 @@ pub trait Problem: Sync {
 pub trait Optimiser: Send + Sync {
     /// "ga" | "de" | "pso" | "csa" | "icsa".
     fn name(&self) -> &'static str;
+    /// The smallest population a run takes with these parameters (checked by the run and, for
+    /// the optimisers a spec names, when the spec is read).
+    fn min_population(&self) -> MinPopulation {
+        MinPopulation { n: 1, key: None, why: "one individual" }
+    }
     /// One run. Errors only for a malformed problem, budget or parameter set (checked before the
     /// first evaluation).
     fn run(
@@ -34,6 +39,15 @@ pub trait Optimiser: Send + Sync {
         budget: &Budget,
         rng: &mut ChaCha8Rng,
     ) -> Result<RunResult, OptimError>;
+}
+
+/// An optimiser's smallest population: `n`, the parameter of the optimiser's table that sets it
+/// (None: the method itself) and why, for messages.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MinPopulation {
+    pub n: usize,
+    pub key: Option<&'static str>,
+    pub why: &'static str,
 }
 
 /// How much one run may do (thesis Table 6.1: 2000 generations of 40, initial range 5e-6).

@@ -64,7 +64,7 @@ impl Optimiser for Pso {
         rng: &mut ChaCha8Rng,
     ) -> Result<RunResult, OptimError> {
         self.validate()?;
-        budget.validate(1)?;
+        budget.validate(self.min_population().n)?;
         check_problem(problem)?;
         let d = problem.dim();
         let (lo, hi) = problem.bounds();

@@ -80,7 +80,11 @@ fn a_rerun_with_bad_inputs_leaves_a_finished_folder_as_it_was() {
         &SPEC.replace("\"sphere\"", "\"bad.xyz\"").replace("master_seed = 3", "master_seed = 4"),
     );
     c.fails(&["run", "bad.toml", "--out", "done"], &["already holds a finished run"]);
-    c.fails(&["run", "bad.toml", "--out", "fresh"], &["bad.xyz", "non-finite"]);
+    c.fails(
+        &["run", "bad.toml", "--out", "fresh"],
+        &["bad.xyz: line 1", "x = 1e308, beyond the limit"],
+    );
+    assert!(!c.path("fresh").exists(), "a refused input made the output folder");
     // Maps that do not load.
     c.write("maps/dnsom_sphere_20x20.csv", "i,j,view\n1,2\n");
     c.write(
@@ -255,10 +259,11 @@ fn bad_inputs_are_refused_on_one_line_quickly() {
     // An STL sampled with a huge point count (crashed).
     c.write("huge.toml", &som("tri.stl:100000000000"));
     timed(&["run", "huge.toml", "--out", "o4", "--dry-run"], &["som.datasets", "100000000000"]);
-    // XYZ values that overflow the normalisation (ran with qe = inf) and all-equal points.
+    // XYZ values that overflow the normalisation (ran with qe = inf; now beyond |x| <= 1e15,
+    // refused naming the line) and all-equal points.
     c.write("far.xyz", "1e308 0 0\n-1e308 1 1\n0 0 2\n5 5 5\n");
     c.write("far.toml", &som("far.xyz"));
-    timed(&["run", "far.toml", "--out", "o5"], &["far.xyz", "non-finite"]);
+    timed(&["run", "far.toml", "--out", "o5"], &["far.xyz: line 1", "beyond the limit"]);
     c.write("same.xyz", "1 2 3\n1 2 3\n1 2 3\n1 2 3\n");
     c.write("same.toml", &som("same.xyz"));
     timed(&["run", "same.toml", "--out", "o6"], &["same.xyz", "same point"]);
@@ -451,8 +456,8 @@ fn fit_export_and_compare_refuse_a_folder_another_writer_holds() {
     // Free folders are written, and each command leaves the lock released for the next writer.
     c.ok(&["fit", "--grid", "g.csv", "--cn", "4x4", "--out", "free"]);
     c.ok(&["datasets", "export", "sphere", "sphere.xyz"]);
-    c.ok(&["compare", "done", "--bayes-samples", "500"]);
-    c.ok(&["compare", "done", "--bayes-samples", "500"]);
+    c.ok(&["compare", "done", "--bayes-samples", "1000"]);
+    c.ok(&["compare", "done", "--bayes-samples", "1000"]);
     c.fails(&["compare", "nothere"], &["nothere", "no such results folder"]);
     assert!(!c.path("nothere").exists());
 }

@@ -8,6 +8,10 @@ use crate::spline::{
 };
 use anyhow::{Context, Result};
 
+/// `--samples`: evaluations per direction of the OBJ mesh (two make one quad per surface).
+pub const MIN_SAMPLES: usize = 2;
+pub const MAX_SAMPLES: usize = 1000;
+
 pub fn fit(args: &FitArgs) -> Result<()> {
     let cn: GridSize = args.cn.parse().map_err(anyhow::Error::msg).context("--cn")?;
     let param: Parameterisation =
@@ -18,6 +22,12 @@ pub fn fit(args: &FitArgs) -> Result<()> {
     let error_a: ErrorA = args.error_a.parse().map_err(anyhow::Error::msg).context("--error-a")?;
     if !(0.0..=1e6).contains(&args.fairness) {
         anyhow::bail!("--fairness: must be in [0, 1e6], got {}", args.fairness);
+    }
+    if !(MIN_SAMPLES..=MAX_SAMPLES).contains(&args.samples) {
+        anyhow::bail!(
+            "--samples: must be in [{MIN_SAMPLES}, {MAX_SAMPLES}] (evaluations per direction of the OBJ mesh), got {}",
+            args.samples
+        );
     }
     let opts = FitOptions { knots, error_a, fairness: args.fairness };
     let shown = args.grid.display().to_string();

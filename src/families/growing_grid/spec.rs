@@ -117,7 +117,7 @@ pub(crate) fn validate(spec: &Spec, g: &GrowingGridSpec) -> Result<(), SpecError
     spec.validate_runs(
         "growing_grid",
         &g.optimisers,
-        &crate::optim::names(&g.offered()),
+        &g.offered(),
         g.repeats,
         g.generations as u64,
         g.population,

@@ -55,8 +55,8 @@ type Wins = BTreeMap<(String, String), (usize, usize)>;
 /// The rows of `results/runs.csv`, every one checked.
 fn read_runs(results: &std::path::Path) -> Result<Vec<OptimRow>> {
     let path = results.join("runs.csv");
-    let mut reader =
-        csv::Reader::from_path(&path).with_context(|| format!("cannot read {}", path.display()))?;
+    let text = crate::io::read_text(&path)?;
+    let mut reader = csv::Reader::from_reader(text.as_bytes());
     let mut rows: Vec<OptimRow> = Vec::new();
     for (n, r) in reader.deserialize().enumerate() {
         rows.push(r.with_context(|| {
@@ -242,16 +242,33 @@ fn runtime_outputs(
     Ok(written)
 }
 
-/// `somnurbs compare`: pairwise tests per cell, Friedman and Bayesian tests over cells, runtime
-/// distributions from the traces; tables into the folder, a summary on stdout.
-pub fn compare(args: &CompareArgs) -> Result<()> {
-    if !(args.rope >= 0.0 && args.rope.is_finite()) || args.bayes_samples == 0 {
+/// `--bayes-samples`: Monte Carlo samples of the Bayesian signed-rank test (below the lower
+/// bound its probabilities move in the second digit; above the upper one a run takes minutes).
+pub const MIN_BAYES_SAMPLES: usize = 1_000;
+pub const MAX_BAYES_SAMPLES: usize = 10_000_000;
+
+/// The options' ranges, before anything is read: `--alpha` in (0, 1), `--rope` finite and >= 0,
+/// `--bayes-samples` in [[`MIN_BAYES_SAMPLES`], [`MAX_BAYES_SAMPLES`]].
+fn check_args(args: &CompareArgs) -> Result<()> {
+    if !(args.alpha > 0.0 && args.alpha < 1.0) {
+        anyhow::bail!("--alpha must be a number in (0, 1), got {}", args.alpha);
+    }
+    if !(args.rope >= 0.0 && args.rope.is_finite()) {
+        anyhow::bail!("--rope must be finite and >= 0, got {}", args.rope);
+    }
+    if !(MIN_BAYES_SAMPLES..=MAX_BAYES_SAMPLES).contains(&args.bayes_samples) {
         anyhow::bail!(
-            "--rope must be finite and >= 0 (got {}) and --bayes-samples at least 1 (got {})",
-            args.rope,
+            "--bayes-samples must be in [{MIN_BAYES_SAMPLES}, {MAX_BAYES_SAMPLES}], got {}",
             args.bayes_samples
         );
     }
+    Ok(())
+}
+
+/// `somnurbs compare`: pairwise tests per cell, Friedman and Bayesian tests over cells, runtime
+/// distributions from the traces; tables into the folder, a summary on stdout.
+pub fn compare(args: &CompareArgs) -> Result<()> {
+    check_args(args)?;
     if !args.results.is_dir() {
         anyhow::bail!(
             "{}: not found (no such results folder)",
@@ -404,8 +421,8 @@ fn certified_optima(folder: &std::path::Path) -> Result<BTreeMap<String, f64>> {
         let Some(grid) = name.strip_prefix("exact_").and_then(|g| g.strip_suffix(".csv")) else {
             continue;
         };
-        let mut r =
-            csv::Reader::from_path(&p).with_context(|| format!("cannot read {}", p.display()))?;
+        let text = crate::io::read_text(&p)?;
+        let mut r = csv::Reader::from_reader(text.as_bytes());
         for (n, rec) in r.deserialize::<BTreeMap<String, String>>().enumerate() {
             let rec = rec.with_context(|| format!("{}: line {}", p.display(), n + 2))?;
             let get = |k: &str| {

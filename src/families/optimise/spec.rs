@@ -112,7 +112,7 @@ pub(crate) fn validate(spec: &Spec, o: &OptimSpec) -> Result<(), SpecError> {
     spec.validate_runs(
         "optim",
         &o.optimisers,
-        &crate::optim::names(&o.offered()),
+        &o.offered(),
         o.repeats,
         o.generations as u64,
         o.population,

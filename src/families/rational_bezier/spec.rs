@@ -124,7 +124,7 @@ pub(crate) fn validate(spec: &Spec, s: &Seed002Spec) -> Result<(), SpecError> {
     spec.validate_runs(
         "seed002",
         &s.optimisers,
-        &crate::optim::names(&s.offered()),
+        &s.offered(),
         s.repeats,
         s.generations as u64,
         s.population,
