@@ -155,10 +155,11 @@ fn drift(args: &DriftArgs) -> anyhow::Result<ExitCode> {
 fn reproduce(args: &ReproduceArgs) -> anyhow::Result<ExitCode> {
     use experiment::reproduce::{default_out, specs_dir};
     let out = args.out.clone().unwrap_or_else(|| default_out(&args.plan, &args.profile));
+    let jobs = jobs(args.jobs)?;
     let specs = specs_dir(args.specs.as_deref(), &args.plan)?;
     let ctx = RunContext {
         resume: args.resume,
-        ..RunContext::new(out, jobs(args.jobs)?, experiment::data_dir(args.data_dir.as_deref()))
+        ..RunContext::new(out, jobs, experiment::data_dir(args.data_dir.as_deref()))
     };
     let report = experiment::reproduce::reproduce(&specs, &args.plan, &args.profile, &ctx)?;
     eprintln!("somnurbs: wrote {}", report.display());

@@ -79,7 +79,7 @@ fn a_rerun_with_bad_inputs_leaves_a_finished_folder_as_it_was() {
         "bad.toml",
         &SPEC.replace("\"sphere\"", "\"bad.xyz\"").replace("master_seed = 3", "master_seed = 4"),
     );
-    c.fails(&["run", "bad.toml", "--out", "done"], &["already holds a finished run"]);
+    c.fails(&["run", "bad.toml", "--out", "done"], &["bad.xyz: line 1"]);
     c.fails(
         &["run", "bad.toml", "--out", "fresh"],
         &["bad.xyz: line 1", "x = 1e308, beyond the limit"],
