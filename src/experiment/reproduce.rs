@@ -291,7 +291,14 @@ pub fn reproduce(
     }
     let _lock = crate::io::outdir::lock(&ctx.out, &format!("reproduce --plan {plan_name}"))?;
     let record = PlanRecord::new(plan_name, &plan_path, profile.unwrap_or("full"))?;
-    if claim_plan(&ctx.out, &record, ctx.resume)? == Claimed::Finished {
+    let layout = PlanLayout {
+        specs: specs.iter().map(|s| s.file.name.clone()).collect(),
+        readings: reading_specs
+            .iter()
+            .map(|(r, rs)| (r.name.clone(), rs.iter().map(|s| s.file.name.clone()).collect()))
+            .collect(),
+    };
+    if claim_plan(&ctx.out, &layout, &record, ctx.resume)? == Claimed::Finished {
         eprintln!(
             "somnurbs: {} already holds this reproduction, finished; nothing to do",
             ctx.out.display()
@@ -413,8 +420,14 @@ impl PlanRecord {
 
 /// The folder contract for a plan: a fresh reproduction needs an empty folder; `--resume` needs an
 /// empty folder or one holding the same plan and profile ([`PlanRecord`]), unfinished (a finished
-/// one is left as it is); its specs' folders are then claimed one by one as `run --resume` does.
-fn claim_plan(out: &Path, record: &PlanRecord, resume: bool) -> Result<Claimed> {
+/// one is left as it is) whose folders are only the plan's (its specs', the reading sets' and
+/// `vendor/`); its specs' folders are then claimed one by one as `run --resume` does.
+fn claim_plan(
+    out: &Path,
+    layout: &PlanLayout,
+    record: &PlanRecord,
+    resume: bool,
+) -> Result<Claimed> {
     if !resume {
         crate::io::outdir::require_empty(out)?;
         return Ok(Claimed::Start);
@@ -434,8 +447,44 @@ fn claim_plan(out: &Path, record: &PlanRecord, resume: bool) -> Result<Claimed> 
     if !out.join(crate::io::outdir::INCOMPLETE).exists() {
         return Ok(Claimed::Finished);
     }
+    require_plan_folders(out, layout)?;
     crate::io::outdir::remove_leftovers(out)?;
     Ok(Claimed::Start)
+}
+
+/// The folders a plan makes: one per spec (its `name`), and per reading set one per spec it runs.
+struct PlanLayout {
+    specs: Vec<String>,
+    readings: Vec<(String, Vec<String>)>,
+}
+
+/// Refuse a plan folder holding a folder the plan does not make (another spec's, another
+/// reading set's), naming it.
+fn require_plan_folders(out: &Path, layout: &PlanLayout) -> Result<()> {
+    let check = |dir: &Path, allowed: &[&str]| -> Result<()> {
+        for e in crate::io::outdir::entries(dir)? {
+            let Some(name) = e.strip_suffix('/') else { continue };
+            if !allowed.contains(&name) {
+                anyhow::bail!(
+                    "cannot resume in {}: the folder {} is not one of this plan's (its specs: {}); a plan folder holds exactly its plan",
+                    out.display(),
+                    dir.join(name).display(),
+                    layout.specs.join(", ")
+                );
+            }
+        }
+        Ok(())
+    };
+    let mut top: Vec<&str> = layout.specs.iter().map(String::as_str).collect();
+    top.extend([READINGS_DIR, "vendor"]);
+    check(out, &top)?;
+    let sets: Vec<&str> = layout.readings.iter().map(|r| r.0.as_str()).collect();
+    check(&out.join(READINGS_DIR), &sets)?;
+    for (name, specs) in &layout.readings {
+        let specs: Vec<&str> = specs.iter().map(String::as_str).collect();
+        check(&out.join(READINGS_DIR).join(name), &specs)?;
+    }
+    Ok(())
 }
 
 /// Each family's part of the combined report, from its specs' finished folders.

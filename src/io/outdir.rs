@@ -342,6 +342,9 @@ impl std::fmt::Debug for Lock {
 /// Take the one-writer lock of `dir` (created if missing) for `command` (shown to a refused
 /// writer, e.g. `run spec.toml`).
 pub fn lock(dir: &Path, command: &str) -> Result<Lock> {
+    if dir.exists() && !dir.is_dir() {
+        bail!("output folder {} is not a folder (a file is there); choose another", dir.display());
+    }
     crate::io::ensure_dir(dir)?;
     let path = dir.join(LOCK_FILE);
     let mut file = OpenOptions::new()

@@ -35,6 +35,8 @@ fn a_finished_folder_is_never_mixed_with_another_run() {
     c.write("g.csv", &crate::robust::small_grid(6));
     c.fails(&["fit", "--grid", "g.csv", "--cn", "4x4", "--out", "o"], &["already holds"]);
     c.fails(&["merge", "x", "--out", "o"], &["merge", "already holds"]);
+    c.write("afile", "mine\n");
+    c.fails(&["run", "a.toml", "--out", "afile"], &["afile", "is not a folder"]);
     c.write("mine/notes.txt", "mine\n");
     c.fails(&["run", "a.toml", "--out", "mine"], &["mine", "not a somnurbs result", "notes.txt"]);
     assert_eq!(std::fs::read_to_string(c.path("mine/notes.txt")).unwrap(), "mine\n");
@@ -124,8 +126,12 @@ fn a_plan_folder_holds_exactly_its_plan() {
     let out = c.ok(&strs(&run("p", true)));
     assert!(String::from_utf8_lossy(&out.stderr).contains("nothing to do"));
     assert!(snapshot(&c.path("p")) == before, "the finished plan folder changed");
-    // An interrupted reproduction resumes: its finished spec folders stay as they are.
+    // An interrupted reproduction resumes: its finished spec folders stay as they are; a folder
+    // the plan does not make is refused.
     std::fs::write(c.path("p/.somnurbs-incomplete"), "").unwrap();
+    std::fs::create_dir(c.path("p/old_spec")).unwrap();
+    c.fails(&strs(&run("p", true)), &["cannot resume", "p/old_spec", "not one of this plan's"]);
+    std::fs::remove_dir(c.path("p/old_spec")).unwrap();
     std::fs::remove_file(c.path("p/b/manifest.toml")).unwrap();
     let a_before = snapshot(&c.path("p/a"));
     c.ok(&strs(&run("p", true)));

@@ -16,6 +16,7 @@ pub mod cd_diagram;
 pub mod line_chart;
 pub mod mesh3d;
 pub mod overview;
+mod palette;
 pub mod scale;
 pub mod style;
 
@@ -85,15 +86,8 @@ impl PlotError {
     }
 }
 
-/// The temporary name a chart is rendered under: `.<file name>.tmp.png` in the same folder, so the
-/// final `rename` stays on one file system and the bitmap encoder still sees a `.png` extension.
-pub fn temp_path(path: &Path) -> Option<PathBuf> {
-    let name = path.file_name()?.to_str()?;
-    Some(path.with_file_name(format!(".{name}.tmp.png")))
-}
-
 /// Renders `draw` onto a white `size` bitmap and writes it atomically to `path` (a `.png` file in
-/// an existing folder). No temporary file is left behind, whatever happens.
+/// an existing folder) as a palette PNG. No temporary file is left behind, whatever happens.
 pub(crate) fn render_png<F>(path: &Path, size: (u32, u32), draw: F) -> Result<(), PlotError>
 where
     F: FnOnce(&DrawingArea<BitMapBackend<'_>, Shift>) -> Result<(), DrawError>,
@@ -110,7 +104,9 @@ where
     if !is_png {
         return Err(PlotError::input(path, "the file name must end in .png"));
     }
-    let tmp = temp_path(path).ok_or_else(|| PlotError::input(path, "no usable file name"))?;
+    // The temporary sibling every writer uses (`.NAME.PID.N.tmp`: a resumed run removes one a
+    // kill left behind).
+    let tmp = crate::io::outdir::temp_name(path, "tmp");
     let folder = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
@@ -137,10 +133,10 @@ where
     }
     style::ensure_fonts().map_err(|source| PlotError::Draw { path: path.to_path_buf(), source })?;
 
-    // The backend writes the file when presented (or, on an early error, when dropped), so the
-    // clean-up below runs only after the backend is gone.
+    // Drawn into memory, then encoded as a palette PNG (`palette`) into the temporary file.
+    let mut rgb = vec![255u8; w as usize * h as usize * 3];
     let outcome = catch_unwind(AssertUnwindSafe(|| -> Result<(), DrawError> {
-        let root = BitMapBackend::new(&tmp, size).into_drawing_area();
+        let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
         root.fill(&WHITE)?;
         draw(&root)?;
         root.present()?;
@@ -158,8 +154,19 @@ where
         }
     };
     if let Err(source) = drawn {
-        let _ = std::fs::remove_file(&tmp);
         return Err(PlotError::Draw { path: path.to_path_buf(), source });
+    }
+    let bytes = palette::encode(&rgb, w, h).map_err(|e| PlotError::Draw {
+        path: path.to_path_buf(),
+        source: DrawError::Backend(format!("cannot encode the PNG: {e}")),
+    })?;
+    if let Err(source) = std::fs::write(&tmp, &bytes) {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(PlotError::Io {
+            path: path.to_path_buf(),
+            what: "cannot write the rendered file",
+            source,
+        });
     }
     if let Err(source) = std::fs::rename(&tmp, path) {
         let _ = std::fs::remove_file(&tmp);
@@ -210,12 +217,6 @@ pub(crate) mod testutil {
 mod tests {
     use super::testutil::*;
     use super::*;
-
-    #[test]
-    fn temp_path_is_hidden_png_beside_target() {
-        let t = temp_path(Path::new("/a/b/chart.png")).unwrap();
-        assert_eq!(t, Path::new("/a/b/.chart.png.tmp.png"));
-    }
 
     #[test]
     fn render_png_rejects_bad_sizes_and_extensions() {
