@@ -518,8 +518,8 @@ struct EcdfRow {
     problems: usize,
 }
 
-/// One fixed-budget curve: at each budget the mean over runs of (best - best known) / (reference
-/// - best known), the reference being the start of the problem's targets (approach B's error where
+/// One fixed-budget curve: at each budget the mean over runs of (best - best known) /
+/// (reference - best known), the reference being the start of the problem's targets (approach B's error where
 /// something beats it); None when the denominator is zero (then `note` says why). For "all" the
 /// mean of the per-problem curves, each problem weighing the same.
 struct GapRow {
@@ -650,7 +650,7 @@ fn problems(rows: &[OptimRow], folder: &std::path::Path) -> Result<Vec<Problem>>
     Ok(out.into_values().collect())
 }
 
-/// Targets per problem in words: "16 targets per problem", or "16 targets per problem (1 in 2)"
+/// Targets per problem in words: "16 targets each", or "16 targets each (1 in 2)"
 /// where some problems have another count.
 fn targets_desc(problems: &[Problem]) -> String {
     let mut counts: BTreeMap<usize, usize> = BTreeMap::new();
@@ -663,9 +663,9 @@ fn targets_desc(problems: &[Problem]) -> String {
         .map(|(k, n)| format!("{k} in {n}"))
         .collect();
     if others.is_empty() {
-        format!("{TARGETS} targets per problem")
+        format!("{TARGETS} targets each")
     } else {
-        format!("{TARGETS} targets per problem ({})", others.join(", "))
+        format!("{TARGETS} targets each ({})", others.join(", "))
     }
 }
 
@@ -967,7 +967,7 @@ fn render_ecdf(
         rt.ecdf.iter().map(|r| (r.group.clone(), r.optimiser.clone(), r.values.clone())).collect();
     let title = if group == "all" {
         let n = group_problems(rt.ecdf.iter().map(|e| (e.group.as_str(), e.problems)), group);
-        format!("all: share of (run, target) pairs reached, mean over {n} problems weighing the same ({})", rt.targets_desc)
+        format!("all: mean ECDF of {n} problems (equal weight), {}", rt.targets_desc)
     } else {
         format!("{group}: share of (run, target) pairs reached")
     };
@@ -1002,15 +1002,15 @@ fn render_fixed_budget(
             rt.fixed_budget.iter().map(|g| (g.group.as_str(), g.problems)),
             group,
         );
-        format!("all: mean normalised gap after a budget, mean over {n} problems weighing the same")
+        format!("all: mean normalised gap of {n} problems (equal weight)")
     } else {
         let rule = rt.fixed_budget.iter().find(|g| g.group == group).map(|g| g.rule.as_str());
         let reference = match rule {
             Some("b_to_best_known") => "B's error",
-            Some("best_first_to_best_known") => "best first value (no run beats B)",
-            _ => "worst first value (no run beats B)",
+            Some("best_first_to_best_known") => "best first value",
+            _ => "worst first value",
         };
-        format!("{group}: mean (best - best known) / (reference - best known), reference {reference}")
+        format!("{group}: normalised gap, 1 = {reference}")
     };
     plots::line_chart_png(
         path,
