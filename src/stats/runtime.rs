@@ -45,6 +45,38 @@ pub fn log_targets(start: f64, best: f64, count: usize, decades: f64) -> Vec<f64
     t
 }
 
+/// Where a problem's targets start (the top of the log-spaced range down to the best known value,
+/// also the reference that makes the fixed-budget gap 1), and the rule that chose it:
+/// - `b_to_best_known`: approach B's error, when some run (or the certified optimum) beats it;
+/// - `best_first_to_best_known`: when nothing beats B, the best first value of any run (the
+///   improvement the optimisers made over their best start, as IOHanalyzer's default targets span
+///   the observed values);
+/// - `worst_first_to_best_known`: when that best start is itself the best known, the worst first
+///   value;
+/// - `none`: no run ever improved (every first value is the best known): no range (None); the
+///   problem gets the single target `best_known` and no fixed-budget gap.
+pub fn target_range(b: f64, best_known: f64, firsts: &[f64]) -> (Option<f64>, &'static str) {
+    let best_first = firsts.iter().copied().fold(f64::INFINITY, f64::min);
+    let worst_first = firsts.iter().copied().filter(|v| v.is_finite()).fold(f64::NAN, f64::max);
+    if b > best_known {
+        (Some(b), "b_to_best_known")
+    } else if best_first.is_finite() && best_first > best_known {
+        (Some(best_first), "best_first_to_best_known")
+    } else if worst_first > best_known {
+        (Some(worst_first), "worst_first_to_best_known")
+    } else {
+        (None, "none")
+    }
+}
+
+/// The mean of curves tabulated at the same points, each curve weighing the same (the ECDF or
+/// fixed-budget values of several problems aggregated with equal weight per problem, as
+/// IOHanalyzer and COCO aggregate over functions); empty when there is no curve.
+pub fn mean_curve(curves: &[&[f64]]) -> Vec<f64> {
+    let Some(len) = curves.iter().map(|c| c.len()).min() else { return Vec::new() };
+    (0..len).map(|k| curves.iter().map(|c| c[k]).sum::<f64>() / curves.len() as f64).collect()
+}
+
 /// The expected running time to reach `target`: the evaluations of all runs (until the hit for
 /// those that hit, all for the others) over the number of hits; +inf when no run hits.
 pub fn ert(runs: &[Trace], target: f64) -> (f64, usize) {
@@ -67,7 +99,8 @@ pub fn hitting_times(runs: &[Trace], targets: &[f64]) -> Vec<Option<u64>> {
     runs.iter().flat_map(|r| targets.iter().map(move |&t| r.hitting_time(t))).collect()
 }
 
-/// The ECDF of hitting times (pairs pooled over problems) at each of `budgets`: the share of
+/// The ECDF of hitting times (the (run, target) pairs of one problem, each weighing the same; over
+/// several problems average their ECDFs with [`mean_curve`]) at each of `budgets`: the share of
 /// pairs reached within the budget.
 pub fn ecdf(times: &[Option<u64>], budgets: &[u64]) -> Vec<f64> {
     let mut hit: Vec<u64> = times.iter().flatten().copied().collect();
@@ -153,5 +186,35 @@ mod tests {
         assert_eq!(log_targets(1.0, 1.0, 5, 3.0), vec![1.0]);
         assert_eq!(log_budgets(100, 3), vec![1, 10, 100]);
         assert_eq!(*log_budgets(4040, 30).last().unwrap(), 4040);
+    }
+
+    /// The targets' rule: B when something beats it; else the best first value; else the worst
+    /// first value; else none (a constant problem).
+    #[test]
+    fn target_range_rules() {
+        assert_eq!(target_range(5.0, 4.0, &[6.0, 7.0]), (Some(5.0), "b_to_best_known"));
+        // Nothing beats B = 3 (best known 3.5): from the best start 6 down to 3.5.
+        assert_eq!(target_range(3.0, 3.5, &[6.0, 7.0]), (Some(6.0), "best_first_to_best_known"));
+        // The best start is the best known: from the worst start.
+        assert_eq!(target_range(3.0, 3.5, &[3.5, 7.0]), (Some(7.0), "worst_first_to_best_known"));
+        assert_eq!(target_range(3.0, 3.5, &[3.5, 3.5]), (None, "none"));
+        assert_eq!(target_range(3.0, 3.5, &[]), (None, "none"));
+        let (start, _) = target_range(3.0, 3.5, &[6.0]);
+        assert_eq!(log_targets(start.unwrap(), 3.5, 16, 3.0).len(), 16);
+    }
+
+    /// Equal weight per problem: problem a has 2 (run, target) pairs, b has 8; their ECDFs at
+    /// budgets (1, 2) are (0.5, 1) and (0.25, 0.5), the mean (0.375, 0.75); pooling the 10 pairs
+    /// would give (0.3, 0.6), weighing b four times as much as a.
+    #[test]
+    fn curves_weigh_problems_equally() {
+        let a = [Some(1), Some(2)];
+        let b = [Some(1), Some(1), Some(2), Some(2), None, None, None, None];
+        let (ea, eb) = (ecdf(&a, &[1, 2]), ecdf(&b, &[1, 2]));
+        assert_eq!((ea.clone(), eb.clone()), (vec![0.5, 1.0], vec![0.25, 0.5]));
+        assert_eq!(mean_curve(&[&ea, &eb]), vec![0.375, 0.75]);
+        let pooled: Vec<Option<u64>> = a.iter().chain(&b).copied().collect();
+        assert_eq!(ecdf(&pooled, &[1, 2]), vec![0.3, 0.6]);
+        assert!(mean_curve(&[]).is_empty());
     }
 }

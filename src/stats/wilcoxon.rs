@@ -32,6 +32,23 @@ fn subset_sum_counts(n: usize) -> Vec<f64> {
     c
 }
 
+/// The smallest two-sided p-value the exact signed-rank test can give with `n` pairs: both
+/// extremes of W+ (0 and n(n+1)/2) have one subset each, so 2 / 2^n (capped at 1; n = 3 gives
+/// 0.25). From the exact distribution up to n = 50 (where [`signed_rank`] uses it), by the closed
+/// form above that. With fewer than `n` non-zero differences, or with ties, it can only be larger.
+pub fn min_p_two_sided(n: usize) -> f64 {
+    if n == 0 {
+        return 1.0;
+    }
+    let p = if n <= 50 {
+        let c = subset_sum_counts(n);
+        2.0 * c[0] / c.iter().sum::<f64>()
+    } else {
+        2.0 * 0.5f64.powi(n.min(i32::MAX as usize) as i32)
+    };
+    p.min(1.0)
+}
+
 pub fn signed_rank(x: &[f64], y: &[f64], alt: Alternative) -> Result<SignedRank, StatsError> {
     if x.len() != y.len() {
         return Err(StatsError::LengthMismatch(x.len(), y.len()));
@@ -145,5 +162,19 @@ mod tests {
             signed_rank(&[1.0], &[1.0, 2.0], Alternative::TwoSided),
             Err(StatsError::LengthMismatch(1, 2))
         );
+    }
+
+    /// Closed forms: 2 / 2^n two-sided (n = 3: 0.25, so 3 repeats never reach 0.05; n = 6:
+    /// 0.03125, the first below 0.05), and the test itself attains it.
+    #[test]
+    fn smallest_attainable_p() {
+        assert_eq!(min_p_two_sided(3), 0.25);
+        assert_eq!(min_p_two_sided(1), 1.0);
+        assert_eq!(min_p_two_sided(0), 1.0);
+        assert_eq!(min_p_two_sided(5), 0.0625);
+        assert_eq!(min_p_two_sided(6), 0.03125);
+        assert_eq!(min_p_two_sided(60), 2.0 * 0.5f64.powi(60));
+        let r = signed_rank(&[1.0, 2.0, 3.0], &[2.0, 4.0, 6.0], Alternative::TwoSided).unwrap();
+        assert_eq!(r.p_value, min_p_two_sided(3));
     }
 }

@@ -435,8 +435,31 @@ fn compare_writes_statistics_and_refuses_bad_folders() {
     assert_eq!(rows.len(), 2 * 3);
     let p = h.iter().position(|x| x == "rank_sum_p").unwrap();
     assert!(rows.iter().all(|r| (0.0..=1.0).contains(&r[p].parse::<f64>().unwrap())));
-    let (_, overall) = read_csv(&c.path("o/compare/compare_overall.csv"));
+    // A12 by direction (minimisation) and the per-cell summaries: a12_x_better > 0.5 goes with a
+    // smaller median of x unless the medians tie; `better` names a side and its grounds.
+    let col = |n: &str| h.iter().position(|x| x == n).unwrap_or_else(|| panic!("no {n}"));
+    for r in &rows {
+        let a: f64 = r[col("a12_x_better")].parse().unwrap();
+        let (mx, my): (f64, f64) =
+            (r[col("median_x")].parse().unwrap(), r[col("median_y")].parse().unwrap());
+        assert!((0.0..=1.0).contains(&a), "{r:?}");
+        if a == 1.0 {
+            assert!(mx < my && r[col("better")] == "x", "{r:?}");
+        }
+        assert!(r[col("mean_x")].parse::<f64>().is_ok() && r[col("mean_y")].parse::<f64>().is_ok());
+        assert!(["x", "y", "none"].contains(&r[col("better")].as_str()), "{r:?}");
+        assert!(!r[col("better_by")].is_empty());
+        // Six repeats: 2/2^6 = 0.03125 and 2/C(12, 6) reach 0.05.
+        assert_eq!(
+            (r[col("min_p_signed_rank")].as_str(), r[col("can_reach_alpha")].as_str()),
+            ("0.031250", "both")
+        );
+    }
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("cannot reach alpha"));
+    let (oh, overall) = read_csv(&c.path("o/compare/compare_overall.csv"));
     assert_eq!(overall.len(), 3);
+    let t = oh.iter().position(|x| x == "cells_rank_sum_can_reach_alpha").unwrap();
+    assert!(overall.iter().all(|r| r[t] == "2"), "{overall:?}");
     assert!(c.path("o/compare/cd_diagram.png").exists());
     c.fails(&["compare", "missing"], &["missing/runs.csv"]);
     let text = std::fs::read_to_string(c.path("o/runs.csv")).unwrap();
@@ -488,6 +511,23 @@ fn compare_writes_runtime_distributions_and_bayesian_table() {
     assert!(starts.iter().all(|l| l.starts_with("1 ")), "{starts:?}");
     let out = c.ok(&["compare", "o", "--bayes-samples", "2000"]);
     assert!(String::from_utf8_lossy(&out.stdout).contains("Bayesian signed-rank"));
+    // Three repeats: no test can reach 0.05 (2/2^3 = 0.25, 2/C(6, 3) = 0.1): one warning line.
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.matches("cannot reach alpha 0.05").count(), 1, "{err}");
+    let (h, rows) = read_csv(&c.path("o/compare/compare_cells.csv"));
+    let col = |n: &str| h.iter().position(|x| x == n).unwrap_or_else(|| panic!("no {n}"));
+    for r in &rows {
+        assert_eq!(
+            (
+                r[col("min_p_signed_rank")].as_str(),
+                r[col("min_p_rank_sum")].as_str(),
+                r[col("can_reach_alpha")].as_str(),
+                r[col("h_rank_sum")].as_str()
+            ),
+            ("0.250000", "0.100000", "neither", "0"),
+            "{r:?}"
+        );
+    }
     let (h, rows) = read_csv(&c.path("o/compare/compare_bayes.csv"));
     assert_eq!(rows.len(), 3);
     let col = |n: &str| h.iter().position(|x| x == n).unwrap();
@@ -510,9 +550,50 @@ fn compare_writes_runtime_distributions_and_bayesian_table() {
         let (a, b): (f64, f64) = (w[0][e].parse().unwrap(), w[1][e].parse().unwrap());
         assert!((0.0..=1.0).contains(&a) && a <= b, "{w:?}");
     }
+    // "all" weighs problems equally: at every budget its ECDF is the mean of the problems' ECDFs.
+    let (w, pr) = (
+        h.iter().position(|x| x == "weighting").unwrap(),
+        h.iter().position(|x| x == "problems").unwrap(),
+    );
+    let ev = h.iter().position(|x| x == "evaluations").unwrap();
+    for r in rows.iter().filter(|r| r[g] == "all") {
+        assert_eq!(r[w], "problems_equal");
+        let per: Vec<f64> = rows
+            .iter()
+            .filter(|x| x[g] != "all" && x[o] == r[o] && x[ev] == r[ev])
+            .map(|x| x[e].parse().unwrap())
+            .collect();
+        assert_eq!(per.len().to_string(), r[pr]);
+        let mean = per.iter().sum::<f64>() / per.len() as f64;
+        assert!((mean - r[e].parse::<f64>().unwrap()).abs() < 2e-6, "{r:?} {per:?}");
+    }
     let (h, rows) = read_csv(&c.path("o/compare/compare_aocc.csv"));
     let a = h.iter().position(|x| x == "aocc").unwrap();
     assert!(rows.iter().all(|r| (0.0..=1.0).contains(&r[a].parse::<f64>().unwrap())));
+    // Every problem states its targets' rule; a fixed-budget gap is a number or left out with a
+    // note, never a 0 standing for a zero denominator.
+    let (h, rows) = read_csv(&c.path("o/compare/compare_targets.csv"));
+    let (ru, nt) = (
+        h.iter().position(|x| x == "rule").unwrap(),
+        h.iter().position(|x| x == "n_targets").unwrap(),
+    );
+    for r in &rows {
+        let rule = r[ru].as_str();
+        assert!(
+            ["b_to_best_known", "best_first_to_best_known", "worst_first_to_best_known", "none"]
+                .contains(&rule),
+            "{r:?}"
+        );
+        assert_eq!(r[nt], if rule == "none" { "1" } else { "16" }, "{r:?}");
+    }
+    let (h, rows) = read_csv(&c.path("o/compare/compare_fixed_budget.csv"));
+    let (v, note) = (
+        h.iter().position(|x| x == "mean_normalised_gap").unwrap(),
+        h.iter().position(|x| x == "note").unwrap(),
+    );
+    for r in rows.iter().filter(|r| r[0] != "all") {
+        assert_eq!(r[v].is_empty(), !r[note].is_empty(), "{r:?}");
+    }
     let (h, rows) = read_csv(&c.path("o/compare/compare_ert.csv"));
     let (hi, ru) =
         (h.iter().position(|x| x == "hits").unwrap(), h.iter().position(|x| x == "runs").unwrap());

@@ -167,6 +167,11 @@ fn a_sweep_over_de_f_writes_one_folder_whose_variants_differ_and_compare_ranks_t
         pairs.contains(&("de@optim.de.f=0.3".to_string(), "de@optim.de.f=0.5".to_string())),
         "{pairs:?}"
     );
+    // The per-cell table pairs the variants by name, A12 by direction.
+    let (ch, crows) = read_csv(&c.path("sweep/compare/compare_cells.csv"));
+    let (x, a12) = (col(&ch, "x"), col(&ch, "a12_x_better"));
+    assert!(crows.iter().any(|r| r[x] == "de@optim.de.f=0.3"), "{crows:?}");
+    assert!(crows.iter().all(|r| (0.0..=1.0).contains(&r[a12].parse::<f64>().unwrap())));
     let (eh, erows) = read_csv(&c.path("sweep/compare/compare_aocc.csv"));
     let o = col(&eh, "optimiser");
     let ranked: BTreeSet<&str> = erows.iter().map(|r| r[o].as_str()).collect();

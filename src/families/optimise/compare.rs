@@ -49,8 +49,48 @@ pub fn friedman_table(rows: &[OptimRow]) -> (Vec<String>, Vec<Vec<f64>>) {
 
 /// Per cell, per competitor: its (repeat, best) pairs.
 type Cells = BTreeMap<CellKey, BTreeMap<String, Vec<(usize, f64)>>>;
-/// Per pair of competitors: cells where the rank-sum test favours the first, the second.
-type Wins = BTreeMap<(String, String), (usize, usize)>;
+/// Per pair of competitors: cells where the rank-sum test favours the first, the second, and the
+/// cells where the rank-sum test can reach alpha at all.
+type Wins = BTreeMap<(String, String), (usize, usize, usize)>;
+
+/// The columns of `compare_cells.csv`.
+const CELL_HEADER: [&str; 24] = [
+    "data",
+    "grid",
+    "cn",
+    "parameterisation",
+    "x",
+    "y",
+    "n",
+    "mean_x",
+    "mean_y",
+    "median_x",
+    "median_y",
+    "signed_rank_v",
+    "signed_rank_p",
+    "rank_sum_w",
+    "rank_sum_p",
+    "a12_x_better",
+    "a12_magnitude",
+    "h_signed_rank",
+    "h_rank_sum",
+    "min_p_signed_rank",
+    "min_p_rank_sum",
+    "can_reach_alpha",
+    "better",
+    "better_by",
+];
+
+/// Cell comparisons whose tests cannot reach alpha with their repeats: by the signed-rank test, by
+/// the rank-sum test, of all comparisons, and the smallest (n, signed-rank min p, rank-sum min p)
+/// among them.
+#[derive(Default)]
+struct Unreachable {
+    signed_rank: usize,
+    rank_sum: usize,
+    of: usize,
+    smallest: Option<(usize, f64, f64)>,
+}
 
 /// The rows of `results/runs.csv`, every one checked.
 fn read_runs(results: &std::path::Path) -> Result<Vec<OptimRow>> {
@@ -69,12 +109,95 @@ fn read_runs(results: &std::path::Path) -> Result<Vec<OptimRow>> {
     Ok(rows)
 }
 
+/// Which of x and y is better in one cell (minimisation), and on what grounds: the signed-rank
+/// test when its p < alpha (x when W+ < W-, i.e. x - y mostly negative); else the rank-sum test when
+/// its p < alpha (direction by A12); else A12 alone when its magnitude is not negligible (no test
+/// significant); else none.
+fn better(
+    sr: Option<&stats::wilcoxon::SignedRank>,
+    rs: Option<&stats::rank_sum::RankSum>,
+    a12_x: f64,
+    alpha: f64,
+) -> (&'static str, &'static str) {
+    let side = |x_better: bool| if x_better { "x" } else { "y" };
+    match (sr.filter(|r| r.p_value < alpha), rs.filter(|r| r.p_value < alpha)) {
+        (Some(r), _) => (side(r.w_plus < r.w_minus), "signed_rank"),
+        (None, Some(_)) => (side(a12_x > 0.5), "rank_sum"),
+        (None, None) if a12_x.is_finite() && effect::magnitude(a12_x) != "negligible" => {
+            (side(a12_x > 0.5), "a12 (no test significant)")
+        }
+        _ => ("none", "none (no test significant, a12 negligible)"),
+    }
+}
+
+/// One `compare_cells.csv` row: the tests and effect size of x against y in cell `k`, and whether
+/// the rank-sum test favours x (Some(true)), y (Some(false)) or neither at alpha.
+fn cell_pair(
+    k: &CellKey,
+    (x, y): (&str, &str),
+    (xa, xb): (&[f64], &[f64]),
+    alpha: f64,
+) -> (Vec<String>, Option<bool>, (bool, bool)) {
+    let sr =
+        if xa.len() == xb.len() { signed_rank(xa, xb, Alternative::TwoSided).ok() } else { None };
+    let rs = rank_sum(xa, xb, Alternative::TwoSided).ok();
+    let a12 = effect::a12_x_better(xa, xb);
+    let min_sr = if xa.len() == xb.len() {
+        Some(stats::wilcoxon::min_p_two_sided(xa.len()))
+    } else {
+        None
+    };
+    let min_rs = stats::rank_sum::min_p_two_sided(xa.len(), xb.len());
+    let reach = (min_sr.is_some_and(|p| p < alpha), min_rs < alpha);
+    let h = |p: Option<f64>| p.map(|p| if p < alpha { "1" } else { "0" }).unwrap_or("").to_string();
+    let (b, by) = better(sr.as_ref(), rs.as_ref(), a12, alpha);
+    let favours = rs.as_ref().filter(|r| r.p_value < alpha).map(|_| a12 > 0.5);
+    let row = vec![
+        k.0.clone(),
+        format!("{}x{}", k.1, k.2),
+        format!("{}x{}", k.3, k.4),
+        k.5.clone(),
+        x.to_string(),
+        y.to_string(),
+        xa.len().to_string(),
+        num(stats::describe::mean_var(xa).0),
+        num(stats::describe::mean_var(xb).0),
+        num(stats::describe::median(xa)),
+        num(stats::describe::median(xb)),
+        sr.as_ref().map(|r| r.w_plus.to_string()).unwrap_or_default(),
+        sr.as_ref().map(|r| format!("{:.6}", r.p_value)).unwrap_or_default(),
+        rs.as_ref().map(|r| r.w.to_string()).unwrap_or_default(),
+        rs.as_ref().map(|r| format!("{:.6}", r.p_value)).unwrap_or_default(),
+        format!("{a12:.4}"),
+        effect::magnitude(a12).to_string(),
+        h(sr.as_ref().map(|r| r.p_value)),
+        h(rs.as_ref().map(|r| r.p_value)),
+        min_sr.map(|p| format!("{p:.6}")).unwrap_or_default(),
+        format!("{min_rs:.6}"),
+        match reach {
+            (true, true) => "both",
+            (true, false) => "signed_rank",
+            (false, true) => "rank_sum",
+            (false, false) => "neither",
+        }
+        .to_string(),
+        b.to_string(),
+        by.to_string(),
+    ];
+    (row, favours, reach)
+}
+
 /// The signed-rank and rank-sum tests and A12 of every pair in every cell (`compare_cells.csv`
-/// rows), and the cells where the rank-sum test favours each side.
-fn pairwise_cells(cells: &Cells, opts: &[String], alpha: f64) -> (Vec<Vec<String>>, Wins) {
+/// rows), the cells where the rank-sum test favours each side, and the pairs that cannot reach
+/// alpha with their repeats.
+fn pairwise_cells(
+    cells: &Cells,
+    opts: &[String],
+    alpha: f64,
+) -> (Vec<Vec<String>>, Wins, Unreachable) {
     let mut out = Vec::new();
     let mut wins: Wins = BTreeMap::new();
-    let h = |p: Option<f64>| p.map(|p| if p < alpha { "1" } else { "0" }).unwrap_or("").to_string();
+    let mut unreachable = Unreachable::default();
     for (k, per) in cells {
         for i in 0..opts.len() {
             for j in i + 1..opts.len() {
@@ -85,42 +208,29 @@ fn pairwise_cells(cells: &Cells, opts: &[String], alpha: f64) -> (Vec<Vec<String
                 b.sort_by_key(|x| x.0);
                 let xa: Vec<f64> = a.iter().map(|x| x.1).collect();
                 let xb: Vec<f64> = b.iter().map(|x| x.1).collect();
-                let sr = if xa.len() == xb.len() {
-                    signed_rank(&xa, &xb, Alternative::TwoSided).ok()
-                } else {
-                    None
-                };
-                let rs = rank_sum(&xa, &xb, Alternative::TwoSided).ok();
-                let a12 = effect::a12(&xa, &xb);
-                if rs.as_ref().map(|r| r.p_value < alpha).unwrap_or(false) {
-                    let e = wins.entry((opts[i].clone(), opts[j].clone())).or_default();
-                    if a12 < 0.5 {
-                        e.0 += 1;
-                    } else {
-                        e.1 += 1;
+                let (row, favours, reach) = cell_pair(k, (&opts[i], &opts[j]), (&xa, &xb), alpha);
+                let e = wins.entry((opts[i].clone(), opts[j].clone())).or_default();
+                match favours {
+                    Some(true) => e.0 += 1,
+                    Some(false) => e.1 += 1,
+                    None => {}
+                }
+                unreachable.of += 1;
+                unreachable.signed_rank += usize::from(!reach.0);
+                unreachable.rank_sum += usize::from(!reach.1);
+                e.2 += usize::from(reach.1);
+                if !(reach.0 && reach.1) {
+                    let n = xa.len().min(xb.len());
+                    if unreachable.smallest.is_none_or(|s| n < s.0) {
+                        let sr = stats::wilcoxon::min_p_two_sided(n);
+                        unreachable.smallest = Some((n, sr, stats::rank_sum::min_p_two_sided(n, n)));
                     }
                 }
-                out.push(vec![
-                    k.0.clone(),
-                    format!("{}x{}", k.1, k.2),
-                    format!("{}x{}", k.3, k.4),
-                    k.5.clone(),
-                    opts[i].clone(),
-                    opts[j].clone(),
-                    xa.len().to_string(),
-                    sr.as_ref().map(|r| r.w_plus.to_string()).unwrap_or_default(),
-                    sr.as_ref().map(|r| format!("{:.6}", r.p_value)).unwrap_or_default(),
-                    rs.as_ref().map(|r| r.w.to_string()).unwrap_or_default(),
-                    rs.as_ref().map(|r| format!("{:.6}", r.p_value)).unwrap_or_default(),
-                    format!("{a12:.4}"),
-                    effect::magnitude(a12).to_string(),
-                    h(sr.as_ref().map(|r| r.p_value)),
-                    h(rs.as_ref().map(|r| r.p_value)),
-                ]);
+                out.push(row);
             }
         }
     }
-    (out, wins)
+    (out, wins, unreachable)
 }
 
 /// Friedman over cells on the mean best of each optimiser, with Holm-adjusted pairwise tests:
@@ -146,6 +256,7 @@ fn friedman_overall(
         "p_holm",
         "cells_x_better",
         "cells_y_better",
+        "cells_rank_sum_can_reach_alpha",
     ]
     .iter()
     .map(|s| s.to_string())
@@ -154,7 +265,8 @@ fn friedman_overall(
         .pairwise
         .iter()
         .map(|&(i, j, z, p, ph)| {
-            let w = wins.get(&(opts[i].clone(), opts[j].clone())).copied().unwrap_or((0, 0));
+            let w =
+                wins.get(&(opts[i].clone(), opts[j].clone())).copied().unwrap_or((0, 0, 0));
             vec![
                 opts[i].clone(),
                 opts[j].clone(),
@@ -165,6 +277,7 @@ fn friedman_overall(
                 format!("{ph:.6}"),
                 w.0.to_string(),
                 w.1.to_string(),
+                w.2.to_string(),
             ]
         })
         .collect();
@@ -192,7 +305,7 @@ fn friedman_overall(
         println!("  mean rank {o:<5} {r:.3}");
     }
     for row in &orows {
-        println!("  {} vs {}: z {}, p {} (Holm {}); cells where the rank-sum test favours {}: {}, {}: {}", row[0], row[1], row[4], row[5], row[6], row[0], row[7], row[1], row[8]);
+        println!("  {} vs {}: z {}, p {} (Holm {}); cells where the rank-sum test favours {}: {}, {}: {} (of {} where it can reach alpha)", row[0], row[1], row[4], row[5], row[6], row[0], row[7], row[1], row[8], row[9]);
     }
     Ok(cd_note)
 }
@@ -214,28 +327,29 @@ fn runtime_outputs(
     for g in &groups {
         let dir =
             if g == "all" { results.to_path_buf() } else { results.join("png").join("compare") };
-        for (kind, res) in [
-            ("ecdf", render_ecdf(&rt, g, opts, &dir.join(format!("compare_ecdf_{g}.png")))),
-            (
-                "fixed_budget",
-                render_fixed_budget(
-                    &rt,
-                    g,
-                    opts,
-                    &dir.join(format!("compare_fixed_budget_{g}.png")),
-                ),
-            ),
-        ] {
-            match res {
-                Ok(()) => pngs += 1,
-                Err(e) => eprintln!("somnurbs: warning: {kind} picture of {g} skipped: {e}"),
-            }
+        match render_ecdf(&rt, g, opts, &dir.join(format!("compare_ecdf_{g}.png"))) {
+            Ok(()) => pngs += 1,
+            Err(e) => eprintln!("somnurbs: warning: ecdf picture of {g} skipped: {e}"),
+        }
+        let png = dir.join(format!("compare_fixed_budget_{g}.png"));
+        match render_fixed_budget(&rt, g, opts, &png) {
+            Ok(true) => pngs += 1,
+            Ok(false) => println!("  no fixed-budget chart of {g}: {NO_GAP}"),
+            Err(e) => eprintln!("somnurbs: warning: fixed_budget picture of {g} skipped: {e}"),
         }
     }
-    for (g, o, _, a, pairs) in rt.ecdf.iter().filter(|r| r.0 == "all") {
+    let moved: Vec<&Problem> = probs.iter().filter(|p| p.rule != "b_to_best_known").collect();
+    if !moved.is_empty() {
         println!(
-            "  runtime ECDF {g} {o}: AOCC {a:.4} over {pairs} (run, target) pairs, budget {}",
-            rt.budget
+            "  targets: in {} of {} problems no run beats approach B; their targets start at a first value of a run (rule in compare_targets.csv)",
+            moved.len(),
+            probs.len()
+        );
+    }
+    for e in rt.ecdf.iter().filter(|r| r.group == "all") {
+        println!(
+            "  runtime ECDF all {}: AOCC {:.4}, mean over {} problems weighing the same ({} (run, target) pairs), budget {}",
+            e.optimiser, e.aocc, e.problems, e.pairs, rt.budget
         );
     }
     written.push_str(&format!(", {pngs} runtime charts (compare_ecdf_all.png, compare_fixed_budget_all.png, per problem in png/compare/)"));
@@ -304,27 +418,11 @@ pub fn compare(args: &CompareArgs) -> Result<()> {
     } else {
         None
     };
-    let header: Vec<String> = [
-        "data",
-        "grid",
-        "cn",
-        "parameterisation",
-        "x",
-        "y",
-        "n",
-        "signed_rank_v",
-        "signed_rank_p",
-        "rank_sum_w",
-        "rank_sum_p",
-        "a12",
-        "a12_magnitude",
-        "h_signed_rank",
-        "h_rank_sum",
-    ]
-    .iter()
-    .map(|s| s.to_string())
-    .collect();
-    let (cell_rows, wins) = pairwise_cells(&cells, &opts, args.alpha);
+    let header: Vec<String> = CELL_HEADER.iter().map(|s| s.to_string()).collect();
+    let (cell_rows, wins, unreachable) = pairwise_cells(&cells, &opts, args.alpha);
+    if let Some((n, sr, rs)) = unreachable.smallest {
+        eprintln!("somnurbs: warning: of {} cell comparisons, {} cannot reach alpha {} by the signed-rank test and {} by the rank-sum test with their repeats (with {n} repeats a two-sided p is at least {sr} signed-rank, {rs} rank-sum): there h is 0 and no cell is favoured whatever the data (compare_cells.csv: min_p_signed_rank, min_p_rank_sum, can_reach_alpha)", unreachable.of, unreachable.signed_rank, args.alpha, unreachable.rank_sum);
+    }
     // Built whole in a sibling folder and swapped in: a reader sees the old tables or the new.
     crate::io::outdir::replace_dir(&dest, |out| {
         write_atomic(&out.join("compare_cells.csv"), csv_records(&header, &cell_rows)?.as_bytes())?;
@@ -376,13 +474,17 @@ fn require_compare_folder(dest: &std::path::Path) -> Result<()> {
     crate::io::outdir::require_empty(dest).context("compare --out")
 }
 
-/// Targets per problem: this many, log-spaced over this many decades of the gap between approach
-/// B's error and the best known value (the last target is the best known value itself).
+/// Targets per problem: this many, log-spaced over this many decades of the gap between the
+/// range's start (approach B's error, or where nothing beats B the best first value of a run: see
+/// [`stats::runtime::target_range`]) and the best known value (the last target is the best known
+/// value itself).
 const TARGETS: usize = 16;
 const TARGET_DECADES: f64 = 3.0;
 /// Budgets at which the ECDF and the fixed-budget values are tabulated (log-spaced).
 const BUDGETS: usize = 40;
 
+/// (problem, optimiser, target index, target, hits, runs, ERT)
+type ErtRow = (String, String, usize, f64, usize, usize, f64);
 /// A run's (evaluations, improvement rows).
 type RunTrace = (u64, Vec<(u64, f64)>);
 /// Per cell: approach B's error and per optimiser (sum of best errors, runs).
@@ -394,21 +496,52 @@ struct Problem {
     b: f64,
     best_known: f64,
     certified: bool,
+    /// The start of the targets' range (the fixed-budget gap's reference), None when no run ever
+    /// improved, and the rule that chose it.
+    reference: Option<f64>,
+    rule: &'static str,
     targets: Vec<f64>,
     /// Per optimiser, its runs' (evaluations, improvements).
     runs: BTreeMap<String, Vec<RunTrace>>,
+}
+
+/// One ECDF (a problem's, or "all": the mean of an optimiser's per-problem ECDFs, each problem
+/// weighing the same).
+struct EcdfRow {
+    group: String,
+    optimiser: String,
+    /// At each budget.
+    values: Vec<f64>,
+    aocc: f64,
+    /// (run, target) pairs behind it, and problems.
+    pairs: usize,
+    problems: usize,
+}
+
+/// One fixed-budget curve: at each budget the mean over runs of (best - best known) /
+/// (reference - best known), the reference being the start of the problem's targets (approach B's error where
+/// something beats it); None when the denominator is zero (then `note` says why). For "all" the
+/// mean of the per-problem curves, each problem weighing the same.
+struct GapRow {
+    group: String,
+    optimiser: String,
+    values: Option<Vec<f64>>,
+    runs: usize,
+    problems: usize,
+    rule: String,
+    note: String,
 }
 
 /// What the runtime-distribution tables and charts show, computed before anything is written.
 struct Runtime {
     budget: u64,
     budgets: Vec<u64>,
-    /// (group, optimiser, ECDF at each budget, AOCC, pairs)
-    ecdf: Vec<(String, String, Vec<f64>, f64, usize)>,
-    /// (group, optimiser, at each budget: mean normalised gap (best - best known)/(B - best known), runs)
-    fixed_budget: Vec<(String, String, Vec<f64>, usize)>,
-    /// (problem, optimiser, target index, target, hits, runs, ERT)
-    ert: Vec<(String, String, usize, f64, usize, usize, f64)>,
+    ecdf: Vec<EcdfRow>,
+    fixed_budget: Vec<GapRow>,
+    /// Targets per problem, for the charts' titles ("16 targets per problem", or the counts).
+    targets_desc: String,
+    /// Per problem, optimiser and target.
+    ert: Vec<ErtRow>,
 }
 
 /// The certified optima of a folder's `exact_<grid>.csv` tables, by problem name.
@@ -486,6 +619,8 @@ fn problems(rows: &[OptimRow], folder: &std::path::Path) -> Result<Vec<Problem>>
             b: exp[0].b,
             best_known: f64::INFINITY,
             certified: false,
+            reference: None,
+            rule: "none",
             targets: Vec::new(),
             runs: BTreeMap::new(),
         });
@@ -502,79 +637,147 @@ fn problems(rows: &[OptimRow], folder: &std::path::Path) -> Result<Vec<Problem>>
             p.best_known = f.min(found);
             p.certified = true;
         }
-        p.targets = stats::runtime::log_targets(p.b, p.best_known, TARGETS, TARGET_DECADES);
+        let firsts: Vec<f64> =
+            p.runs.values().flatten().filter_map(|r| r.1.first().map(|x| x.1)).collect();
+        (p.reference, p.rule) = stats::runtime::target_range(p.b, p.best_known, &firsts);
+        p.targets = match p.reference {
+            Some(start) => {
+                stats::runtime::log_targets(start, p.best_known, TARGETS, TARGET_DECADES)
+            }
+            None => vec![p.best_known],
+        };
     }
     Ok(out.into_values().collect())
 }
 
-/// Compute every runtime table: per optimiser, over all problems ("all") and per problem.
+/// Targets per problem in words: "16 targets each", or "16 targets each (1 in 2)"
+/// where some problems have another count.
+fn targets_desc(problems: &[Problem]) -> String {
+    let mut counts: BTreeMap<usize, usize> = BTreeMap::new();
+    for p in problems {
+        *counts.entry(p.targets.len()).or_default() += 1;
+    }
+    let others: Vec<String> = counts
+        .iter()
+        .filter(|(k, _)| **k != TARGETS)
+        .map(|(k, n)| format!("{k} in {n}"))
+        .collect();
+    if others.is_empty() {
+        format!("{TARGETS} targets each")
+    } else {
+        format!("{TARGETS} targets each ({})", others.join(", "))
+    }
+}
+
+/// Why a problem has no fixed-budget gap.
+const NO_GAP: &str = "left out: no run improved on its first value (zero denominator)";
+
+/// One problem's curves for one optimiser: its ECDF row, its fixed-budget row, its ERT rows.
+fn problem_runtime(
+    p: &Problem,
+    o: &str,
+    runs: &[RunTrace],
+    budgets: &[u64],
+    budget: u64,
+) -> (EcdfRow, GapRow, Vec<ErtRow>) {
+    use stats::runtime::{aocc, ecdf, ert, hitting_times, Trace};
+    let ts: Vec<Trace> =
+        runs.iter().map(|(e, imp)| Trace { improvements: imp, evaluations: *e }).collect();
+    let times = hitting_times(&ts, &p.targets);
+    let e = EcdfRow {
+        group: p.name.clone(),
+        optimiser: o.to_string(),
+        values: ecdf(&times, budgets),
+        aocc: aocc(&times, budget),
+        pairs: times.len(),
+        problems: 1,
+    };
+    let values = p.reference.map(|r| {
+        let span = r - p.best_known;
+        budgets
+            .iter()
+            .map(|&b| {
+                ts.iter().map(|t| (t.best_at(b) - p.best_known) / span).sum::<f64>()
+                    / ts.len().max(1) as f64
+            })
+            .collect()
+    });
+    let g = GapRow {
+        group: p.name.clone(),
+        optimiser: o.to_string(),
+        note: if values.is_some() { String::new() } else { NO_GAP.to_string() },
+        values,
+        runs: ts.len(),
+        problems: 1,
+        rule: p.rule.to_string(),
+    };
+    let ert_rows = p
+        .targets
+        .iter()
+        .enumerate()
+        .map(|(k, &t)| {
+            let (e, hits) = ert(&ts, t);
+            (p.name.clone(), o.to_string(), k, t, hits, ts.len(), e)
+        })
+        .collect();
+    (e, g, ert_rows)
+}
+
+/// Compute every runtime table: per optimiser, per problem and over all problems ("all": every
+/// problem the optimiser ran weighing the same, as IOHanalyzer and COCO aggregate over functions).
 fn runtime(problems: &[Problem], opts: &[String]) -> Runtime {
-    use stats::runtime::{aocc, ecdf, ert, hitting_times, log_budgets, Trace};
     let budget =
         problems.iter().flat_map(|p| p.runs.values().flatten().map(|r| r.0)).max().unwrap_or(1);
-    let budgets = log_budgets(budget, BUDGETS);
+    let budgets = stats::runtime::log_budgets(budget, BUDGETS);
     let mut rt = Runtime {
         budget,
         budgets: budgets.clone(),
         ecdf: Vec::new(),
         fixed_budget: Vec::new(),
+        targets_desc: targets_desc(problems),
         ert: Vec::new(),
     };
     for o in opts {
-        let mut all_times = Vec::new();
-        let mut all_gaps = vec![0.0; budgets.len()];
-        let mut all_runs = 0usize;
+        let (mut es, mut gs) = (Vec::new(), Vec::new());
         for p in problems {
             let Some(runs) = p.runs.get(o) else { continue };
-            let ts: Vec<Trace> =
-                runs.iter().map(|(e, imp)| Trace { improvements: imp, evaluations: *e }).collect();
-            let times = hitting_times(&ts, &p.targets);
-            rt.ecdf.push((
-                p.name.clone(),
-                o.clone(),
-                ecdf(&times, &budgets),
-                aocc(&times, budget),
-                times.len(),
-            ));
-            let span = p.b - p.best_known;
-            let gaps: Vec<f64> = budgets
-                .iter()
-                .map(|&e| {
-                    ts.iter()
-                        .map(
-                            |t| if span > 0.0 { (t.best_at(e) - p.best_known) / span } else { 0.0 },
-                        )
-                        .sum::<f64>()
-                        / ts.len() as f64
-                })
-                .collect();
-            for (a, g) in all_gaps.iter_mut().zip(&gaps) {
-                *a += g * ts.len() as f64;
-            }
-            all_runs += ts.len();
-            rt.fixed_budget.push((p.name.clone(), o.clone(), gaps, ts.len()));
-            for (k, &t) in p.targets.iter().enumerate() {
-                let (e, hits) = ert(&ts, t);
-                rt.ert.push((p.name.clone(), o.clone(), k, t, hits, ts.len(), e));
-            }
-            all_times.extend(times);
+            let (e, g, ert_rows) = problem_runtime(p, o, runs, &budgets, budget);
+            es.push(e);
+            gs.push(g);
+            rt.ert.extend(ert_rows);
         }
-        if all_runs == 0 {
+        if es.is_empty() {
             continue;
         }
-        rt.ecdf.push((
-            "all".into(),
-            o.clone(),
-            ecdf(&all_times, &budgets),
-            aocc(&all_times, budget),
-            all_times.len(),
-        ));
-        rt.fixed_budget.push((
-            "all".into(),
-            o.clone(),
-            all_gaps.iter().map(|g| g / all_runs as f64).collect(),
-            all_runs,
-        ));
+        let curves: Vec<&[f64]> = es.iter().map(|e| e.values.as_slice()).collect();
+        let all = EcdfRow {
+            group: "all".into(),
+            optimiser: o.clone(),
+            values: stats::runtime::mean_curve(&curves),
+            aocc: es.iter().map(|e| e.aocc).sum::<f64>() / es.len() as f64,
+            pairs: es.iter().map(|e| e.pairs).sum(),
+            problems: es.len(),
+        };
+        let with: Vec<&GapRow> = gs.iter().filter(|g| g.values.is_some()).collect();
+        let curves: Vec<&[f64]> = with.iter().filter_map(|g| g.values.as_deref()).collect();
+        let left_out = gs.len() - with.len();
+        let all_gap = GapRow {
+            group: "all".into(),
+            optimiser: o.clone(),
+            values: (!curves.is_empty()).then(|| stats::runtime::mean_curve(&curves)),
+            runs: with.iter().map(|g| g.runs).sum(),
+            problems: with.len(),
+            rule: "per problem".into(),
+            note: match (with.len(), left_out) {
+                (0, _) => NO_GAP.to_string(),
+                (_, 0) => "mean over problems, equal weight".to_string(),
+                (_, k) => format!("mean over problems, equal weight; {k} {NO_GAP}"),
+            },
+        };
+        rt.ecdf.extend(es);
+        rt.ecdf.push(all);
+        rt.fixed_budget.extend(gs);
+        rt.fixed_budget.push(all_gap);
     }
     rt
 }
@@ -582,8 +785,19 @@ fn runtime(problems: &[Problem], opts: &[String]) -> Runtime {
 fn num(v: f64) -> String {
     if v.is_finite() {
         format!("{v}")
+    } else if v.is_nan() {
+        "nan".into()
     } else {
         "inf".into()
+    }
+}
+
+/// How an ECDF row weighs its (run, target) pairs.
+fn weighting(e: &EcdfRow) -> &'static str {
+    if e.group == "all" {
+        "problems_equal"
+    } else {
+        "pairs_equal"
     }
 }
 
@@ -595,46 +809,74 @@ fn write_runtime_tables(
 ) -> Result<()> {
     let h = |v: &[&str]| -> Vec<String> { v.iter().map(|s| s.to_string()).collect() };
     let mut rows = Vec::new();
-    for (g, o, e, _, pairs) in &rt.ecdf {
-        for (b, v) in rt.budgets.iter().zip(e) {
+    for e in &rt.ecdf {
+        for (b, v) in rt.budgets.iter().zip(&e.values) {
             rows.push(vec![
-                g.clone(),
-                o.clone(),
+                e.group.clone(),
+                e.optimiser.clone(),
                 b.to_string(),
                 format!("{v:.6}"),
-                pairs.to_string(),
+                e.pairs.to_string(),
+                e.problems.to_string(),
+                weighting(e).to_string(),
             ]);
         }
     }
-    write_atomic(
-        &folder.join("compare_ecdf.csv"),
-        csv_records(&h(&["group", "optimiser", "evaluations", "ecdf", "pairs"]), &rows)?.as_bytes(),
-    )?;
+    let eh = ["group", "optimiser", "evaluations", "ecdf", "pairs", "problems", "weighting"];
+    write_atomic(&folder.join("compare_ecdf.csv"), csv_records(&h(&eh), &rows)?.as_bytes())?;
     let rows: Vec<Vec<String>> = rt
         .ecdf
         .iter()
-        .map(|(g, o, _, a, pairs)| {
-            vec![g.clone(), o.clone(), pairs.to_string(), rt.budget.to_string(), format!("{a:.6}")]
+        .map(|e| {
+            vec![
+                e.group.clone(),
+                e.optimiser.clone(),
+                e.pairs.to_string(),
+                e.problems.to_string(),
+                weighting(e).to_string(),
+                rt.budget.to_string(),
+                format!("{:.6}", e.aocc),
+            ]
         })
         .collect();
-    write_atomic(
-        &folder.join("compare_aocc.csv"),
-        csv_records(&h(&["group", "optimiser", "pairs", "budget", "aocc"]), &rows)?.as_bytes(),
-    )?;
+    let ah = ["group", "optimiser", "pairs", "problems", "weighting", "budget", "aocc"];
+    write_atomic(&folder.join("compare_aocc.csv"), csv_records(&h(&ah), &rows)?.as_bytes())?;
     let mut rows = Vec::new();
-    for (g, o, gaps, n) in &rt.fixed_budget {
-        for (b, v) in rt.budgets.iter().zip(gaps) {
-            rows.push(vec![g.clone(), o.clone(), b.to_string(), num(*v), n.to_string()]);
+    for g in &rt.fixed_budget {
+        for (k, b) in rt.budgets.iter().enumerate() {
+            rows.push(vec![
+                g.group.clone(),
+                g.optimiser.clone(),
+                b.to_string(),
+                g.values.as_ref().map(|v| num(v[k])).unwrap_or_default(),
+                g.runs.to_string(),
+                g.problems.to_string(),
+                g.rule.clone(),
+                g.note.clone(),
+            ]);
         }
     }
-    write_atomic(
-        &folder.join("compare_fixed_budget.csv"),
-        csv_records(
-            &h(&["group", "optimiser", "evaluations", "mean_normalised_gap", "runs"]),
-            &rows,
-        )?
-        .as_bytes(),
-    )?;
+    let fh = [
+        "group",
+        "optimiser",
+        "evaluations",
+        "mean_normalised_gap",
+        "runs",
+        "problems",
+        "rule",
+        "note",
+    ];
+    write_atomic(&folder.join("compare_fixed_budget.csv"), csv_records(&h(&fh), &rows)?.as_bytes())?;
+    write_ert_and_targets(rt, problems, folder)
+}
+
+/// `compare_ert.csv` and `compare_targets.csv`.
+fn write_ert_and_targets(
+    rt: &Runtime,
+    problems: &[Problem],
+    folder: &std::path::Path,
+) -> Result<()> {
+    let h = |v: &[&str]| -> Vec<String> { v.iter().map(|s| s.to_string()).collect() };
     let rows: Vec<Vec<String>> = rt
         .ert
         .iter()
@@ -666,15 +908,24 @@ fn write_runtime_tables(
                 num(p.b),
                 num(p.best_known),
                 if p.certified { "certified optimum" } else { "best run" }.to_string(),
+                p.rule.to_string(),
+                p.reference.map(num).unwrap_or_default(),
+                p.targets.len().to_string(),
                 p.targets.iter().map(|t| num(*t)).collect::<Vec<_>>().join(" "),
             ]
         })
         .collect();
-    write_atomic(
-        &folder.join("compare_targets.csv"),
-        csv_records(&h(&["problem", "b", "best_known", "best_known_from", "targets"]), &rows)?
-            .as_bytes(),
-    )?;
+    let th = [
+        "problem",
+        "b",
+        "best_known",
+        "best_known_from",
+        "rule",
+        "reference",
+        "n_targets",
+        "targets",
+    ];
+    write_atomic(&folder.join("compare_targets.csv"), csv_records(&h(&th), &rows)?.as_bytes())?;
     Ok(())
 }
 
@@ -699,6 +950,12 @@ fn series_of(
         .collect()
 }
 
+/// The problems behind group `group`'s curves (1 for a problem, the most any optimiser ran for
+/// "all").
+fn group_problems<'a>(counts: impl Iterator<Item = (&'a str, usize)>, group: &str) -> usize {
+    counts.filter(|(g, _)| *g == group).map(|(_, n)| n).max().unwrap_or(0)
+}
+
 /// The ECDF chart of one group.
 fn render_ecdf(
     rt: &Runtime,
@@ -707,9 +964,13 @@ fn render_ecdf(
     path: &std::path::Path,
 ) -> Result<(), plots::PlotError> {
     let rows: Vec<(String, String, Vec<f64>)> =
-        rt.ecdf.iter().map(|r| (r.0.clone(), r.1.clone(), r.2.clone())).collect();
-    let title =
-        format!("{group}: share of (run, target) pairs reached ({TARGETS} targets per problem)");
+        rt.ecdf.iter().map(|r| (r.group.clone(), r.optimiser.clone(), r.values.clone())).collect();
+    let title = if group == "all" {
+        let n = group_problems(rt.ecdf.iter().map(|e| (e.group.as_str(), e.problems)), group);
+        format!("all: mean ECDF of {n} problems (equal weight), {}", rt.targets_desc)
+    } else {
+        format!("{group}: share of (run, target) pairs reached")
+    };
     plots::line_chart_png(
         path,
         &title,
@@ -720,24 +981,46 @@ fn render_ecdf(
     )
 }
 
-/// The fixed-budget chart of one group.
+/// The fixed-budget chart of one group (Ok(false): no optimiser has a gap there, nothing drawn).
 fn render_fixed_budget(
     rt: &Runtime,
     group: &str,
     opts: &[String],
     path: &std::path::Path,
-) -> Result<(), plots::PlotError> {
-    let rows: Vec<(String, String, Vec<f64>)> =
-        rt.fixed_budget.iter().map(|r| (r.0.clone(), r.1.clone(), r.2.clone())).collect();
-    let title = format!("{group}: mean (best - best known) / (B - best known) after a budget");
+) -> Result<bool, plots::PlotError> {
+    let rows: Vec<(String, String, Vec<f64>)> = rt
+        .fixed_budget
+        .iter()
+        .filter_map(|r| Some((r.group.clone(), r.optimiser.clone(), r.values.clone()?)))
+        .collect();
+    let series = series_of(&rows, group, &rt.budgets, opts);
+    if series.is_empty() {
+        return Ok(false);
+    }
+    let title = if group == "all" {
+        let n = group_problems(
+            rt.fixed_budget.iter().map(|g| (g.group.as_str(), g.problems)),
+            group,
+        );
+        format!("all: mean normalised gap of {n} problems (equal weight)")
+    } else {
+        let rule = rt.fixed_budget.iter().find(|g| g.group == group).map(|g| g.rule.as_str());
+        let reference = match rule {
+            Some("b_to_best_known") => "B's error",
+            Some("best_first_to_best_known") => "best first value",
+            _ => "worst first value",
+        };
+        format!("{group}: normalised gap, 1 = {reference}")
+    };
     plots::line_chart_png(
         path,
         &title,
         "log10 evaluations",
-        "normalised gap (1 = approach B, 0 = best known)",
-        &series_of(&rows, group, &rt.budgets, opts),
+        "normalised gap (1 = reference, 0 = best known)",
+        &series,
         true,
     )
+    .map(|()| true)
 }
 
 /// The Bayesian signed-rank test of every pair over the cells every optimiser ran: each cell's
@@ -793,4 +1076,28 @@ fn bayes_table(rows: &[OptimRow], opts: &[String], args: &CompareArgs) -> Result
         }
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The `better` rule: the signed-rank test first (x when W+ < W-), then the rank-sum test
+    /// (direction by A12), then A12 alone when not negligible, else none.
+    #[test]
+    fn better_rule() {
+        let (x, y) = ([1.0, 2.0, 3.0, 4.0, 5.0, 6.0], [7.0, 8.0, 9.0, 10.0, 11.0, 12.0]);
+        let sr = signed_rank(&x, &y, Alternative::TwoSided).unwrap();
+        let rs = rank_sum(&x, &y, Alternative::TwoSided).unwrap();
+        let a = effect::a12_x_better(&x, &y);
+        assert_eq!(better(Some(&sr), Some(&rs), a, 0.05), ("x", "signed_rank"));
+        assert_eq!(better(None, Some(&rs), a, 0.05), ("x", "rank_sum"));
+        // Three repeats reach neither test at 0.05: A12 decides, and says so.
+        let sr = signed_rank(&y[..3], &x[..3], Alternative::TwoSided).unwrap();
+        let rs = rank_sum(&y[..3], &x[..3], Alternative::TwoSided).unwrap();
+        let a = effect::a12_x_better(&y[..3], &x[..3]);
+        assert_eq!(better(Some(&sr), Some(&rs), a, 0.05), ("y", "a12 (no test significant)"));
+        assert_eq!(better(Some(&sr), Some(&rs), 0.52, 0.05).0, "none");
+        assert_eq!(better(None, None, f64::NAN, 0.05).0, "none");
+    }
 }
