@@ -38,10 +38,8 @@ fn quantise(rgb: &[u8]) -> (Vec<[u8; 3]>, Vec<u8>) {
     let mut by_count: Vec<([u8; 3], u64)> = counts.into_iter().collect();
     by_count.sort_unstable_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
     let palette: Vec<[u8; 3]> = by_count.iter().take(MAX_COLOURS).map(|c| c.0).collect();
-    let index: HashMap<[u8; 3], u8> = by_count
-        .iter()
-        .map(|&(colour, _)| (colour, nearest(&palette, colour)))
-        .collect();
+    let index: HashMap<[u8; 3], u8> =
+        by_count.iter().map(|&(colour, _)| (colour, nearest(&palette, colour))).collect();
     let indices = rgb.chunks_exact(3).map(|p| index[&[p[0], p[1], p[2]]]).collect();
     (palette, indices)
 }
