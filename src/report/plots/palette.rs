@@ -84,11 +84,16 @@ mod tests {
 
     #[test]
     fn many_colours_keep_the_frequent_ones_and_map_the_rest_to_the_nearest() {
-        // 300 colours: white in most pixels, then 299 greys of one pixel each.
+        // 301 colours: white in most pixels, 255 greys of two pixels each, and 45 colours of one
+        // pixel each, one step of blue from a grey.
         let mut rgb = vec![255u8; 3 * 1000];
-        for k in 0..299usize {
-            let g = (k % 250) as u8;
-            rgb[3 * k..3 * k + 3].copy_from_slice(&[g, g, g.saturating_add((k / 250) as u8)]);
+        for k in 0..255usize {
+            let g = k as u8;
+            rgb[6 * k..6 * k + 6].copy_from_slice(&[g, g, g, g, g, g]);
+        }
+        for k in 0..45usize {
+            let g = k as u8;
+            rgb[1530 + 3 * k..1533 + 3 * k].copy_from_slice(&[g, g, g + 1]);
         }
         let (palette, indices) = quantise(&rgb);
         assert_eq!(palette.len(), MAX_COLOURS);
@@ -96,7 +101,7 @@ mod tests {
         for (p, &i) in rgb.chunks_exact(3).zip(&indices) {
             let got = palette[i as usize];
             let err: i32 = (0..3).map(|k| (i32::from(got[k]) - i32::from(p[k])).abs()).sum();
-            assert!(err <= 3, "{p:?} -> {got:?}");
+            assert!(err <= 1, "{p:?} -> {got:?}");
         }
         assert_eq!(quantise(&rgb), (palette, indices), "deterministic");
     }
