@@ -22,6 +22,8 @@ struct Export {
     units: Units,
     /// The line the IGES start section and the OBJ comments carry.
     note: String,
+    /// Said on stderr once the output folder is this command's (no frame found).
+    warn: Option<String>,
 }
 
 /// How `--frame` and `--units` and the frame beside `grid` (if any) place the exports.
@@ -34,9 +36,12 @@ fn export_frame(grid: &Path, frame: Option<Frame>, which: &str, units: &str) -> 
     };
     let shown = crate::io::shown(grid);
     let Some(f) = frame else {
-        eprintln!("somnurbs: note: no frame beside {shown} ({}): the exports are in the map's own coordinates", crate::io::shown(&crate::data::frame::sidecar(grid)));
+        let warn = format!(
+            "somnurbs: note: no frame beside {shown} ({}): the exports are in the map's own coordinates",
+            crate::io::shown(&crate::data::frame::sidecar(grid))
+        );
         let note = format!("Frame: the coordinates of the map {shown} as they are (no frame file beside it).");
-        return Ok(Export { label: "map", affine: None, units, note });
+        return Ok(Export { label: "map", affine: None, units, note, warn: Some(warn) });
     };
     let normalised = f.normalise != crate::data::Normalise::None;
     if data || !normalised {
@@ -46,7 +51,8 @@ fn export_frame(grid: &Path, frame: Option<Frame>, which: &str, units: &str) -> 
             "the spec did not normalise".to_string()
         };
         let note = format!("Frame: {} ({how}).", f.describe());
-        return Ok(Export { label: "data", affine: Some((f.offset, f.scale)), units, note });
+        let affine = Some((f.offset, f.scale));
+        return Ok(Export { label: "data", affine, units, note, warn: None });
     }
     if units != Units::Unknown {
         anyhow::bail!("--units: the normalised frame has no length unit (use --frame data)");
@@ -55,7 +61,7 @@ fn export_frame(grid: &Path, frame: Option<Frame>, which: &str, units: &str) -> 
         "Frame: the normalised box the map was trained in ({} of {}); the data's coordinates are offset + scale * these, offset {:?}, scale {:?}.",
         normalise_name(f.normalise), f.source, f.offset, f.scale
     );
-    Ok(Export { label: "normalised", affine: None, units, note })
+    Ok(Export { label: "normalised", affine: None, units, note, warn: None })
 }
 
 fn normalise_name(n: crate::data::Normalise) -> &'static str {
@@ -121,6 +127,9 @@ pub fn fit(args: &FitArgs) -> Result<()> {
     // folder, like a run's, holds one result: it must be missing or empty.
     let _lock = crate::io::outdir::lock(out, "fit")?;
     crate::io::outdir::require_empty(out)?;
+    if let Some(line) = &export.warn {
+        eprintln!("{line}");
+    }
     write_atomic(&out.join("control_nets.csv"), csv_records(&header, &rows)?.as_bytes())?;
     let notes = [export.note.clone()];
     write_atomic(
