@@ -118,6 +118,15 @@ pub struct FitArgs {
     /// as 1e-4 keeps near-square nets bounded between the data points.
     #[arg(long, default_value_t = 0.0)]
     pub fairness: f64,
+    /// Coordinates of control_nets.csv, surfaces.igs and surfaces.obj: `data` (the data set's
+    /// own, the normalisation undone with the frame Chapter 4 saved beside the map,
+    /// MAP.frame.toml) or `normalised` (the map's). A map without a frame is exported as it is.
+    #[arg(long, default_value = "data")]
+    pub frame: String,
+    /// Length unit of the data's coordinates, for the IGES unit flag: unknown (flag 2, MM,
+    /// marked nominal in the start section), mm, cm, m, um, in or ft.
+    #[arg(long, default_value = "unknown")]
+    pub units: String,
 }
 
 #[derive(Debug, Args)]

@@ -1,10 +1,13 @@
 //! Data sets: deterministic generators for the thesis' primitives, loaders for point files
-//! (PLY, STL, XYZ/CSV), and the thesis' per-axis min-max normalisation. Pure apart from
-//! `registry`, the one place that reads files.
+//! (PLY, STL, OFF, OBJ, XYZ/CSV), the thesis' per-axis min-max normalisation and the frame that
+//! undoes it. Pure apart from `registry`, the one place that reads files.
 
 pub mod cylinder;
+pub mod frame;
 pub mod generators;
 pub mod grid_csv;
+pub mod obj;
+pub mod off;
 pub mod ply;
 pub mod registry;
 pub mod stl;
@@ -18,6 +21,8 @@ use thiserror::Error;
 pub struct PointCloud {
     pub name: String,
     pub points: Vec<Point3>,
+    /// How `points` were normalised from the data's own coordinates.
+    pub frame: frame::Frame,
 }
 
 /// What can be wrong with data; messages name the file, line or element at fault.

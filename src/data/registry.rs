@@ -1,6 +1,7 @@
 //! Named data sets and user files: the one place in `data` that reads files.
 
-use super::{generators, ply, stl, validate, xyz, DataError, Normalise, PointCloud};
+use super::frame::{Frame, GENERATED};
+use super::{generators, obj, off, ply, stl, validate, xyz, DataError, Normalise, PointCloud};
 use crate::geom::Point3;
 use rand::SeedableRng;
 use std::path::{Path, PathBuf};
@@ -27,7 +28,7 @@ pub const DEFAULT_STL_POINTS: usize = 5000;
 /// The most points `path.stl:N` may ask for.
 pub const MAX_STL_POINTS: usize = 10_000_000;
 /// File types a data-set path may have.
-pub const EXTENSIONS: [&str; 5] = [".ply", ".stl", ".xyz", ".csv", ".txt"];
+pub const EXTENSIONS: [&str; 7] = [".ply", ".stl", ".off", ".obj", ".xyz", ".csv", ".txt"];
 
 /// [`dataset_name`] of an entry validation has passed (the entry itself if it would not).
 pub fn name_of(entry: &str) -> String {
@@ -64,7 +65,7 @@ pub fn dataset_name(entry: &str) -> Result<String, DataError> {
     let lower = file.to_ascii_lowercase();
     if !EXTENSIONS.iter().any(|e| lower.ends_with(e)) {
         return Err(DataError::Invalid(format!(
-            "unknown data set `{entry}` (built-in: {}; or a .ply/.stl/.xyz/.csv/.txt file)",
+            "unknown data set `{entry}` (built-in: {}; or a .ply/.stl/.off/.obj/.xyz/.csv/.txt file)",
             BUILTIN.join(", ")
         )));
     }
@@ -160,59 +161,14 @@ impl Loader {
         Ok(())
     }
 
-    /// Load a data set by name (`somnurbs datasets list`) or a point file path (.ply, .xyz, .csv,
-    /// .txt, or .stl, sampled with `path.stl:N` points, default 5000). Points are validated
-    /// (finite, at least 4, not all equal) and scaled by `normalise`.
+    /// Load a data set by name (`somnurbs datasets list`) or a point file path (.ply, .off, .obj,
+    /// .xyz, .csv, .txt, or .stl, sampled with `path.stl:N` points, default 5000). Points are
+    /// validated (finite, at least 4, not all equal) and scaled by `normalise`; the cloud's frame
+    /// records how.
     pub fn load(&self, name: &str) -> Result<PointCloud, DataError> {
-        let data_dir = &self.data_dir;
-        let mut points = match name {
-            "cube" => generators::cube(),
-            "sphere" => generators::sphere(),
-            "spindle" => generators::spindle(),
-            "oiltank" => generators::oiltank(),
-            "cylinder" => generators::cylinder(),
-            "semi_sphere" => generators::semi_sphere(),
-            "saddle" => generators::saddle(),
-            "bunny" => {
-                let path = data_dir.join(BUNNY_FILE);
-                let shown = path.display().to_string();
-                ply::parse_ply(&read(&path, &where_to_get(BUNNY_FILE))?)
-                    .map_err(|e| e.in_file(&shown))?
-            }
-            "talus" => {
-                let path = data_dir.join(TALUS_FILE);
-                let shown = path.display().to_string();
-                sample_stl(
-                    &read(&path, &where_to_get(TALUS_FILE))?,
-                    TALUS_POINTS,
-                    TALUS_SAMPLE_SEED,
-                    &shown,
-                )?
-            }
-            other => {
-                self.require_file(other)?;
-                let (_, count) = split_count(other)?;
-                let path = self.resolve(other)?;
-                let shown = path.display().to_string();
-                let lower = shown.to_ascii_lowercase();
-                let bytes = read(&path, "Check the path in the spec.")?;
-                if lower.ends_with(".ply") {
-                    ply::parse_ply(&bytes).map_err(|e| e.in_file(&shown))?
-                } else if lower.ends_with(".stl") {
-                    sample_stl(
-                        &bytes,
-                        count.unwrap_or(DEFAULT_STL_POINTS),
-                        TALUS_SAMPLE_SEED,
-                        &shown,
-                    )?
-                } else {
-                    crate::io::not_utf16(&shown, &bytes).map_err(DataError::Invalid)?;
-                    let text = String::from_utf8_lossy(&bytes);
-                    xyz::parse_xyz(&text).map_err(|e| e.in_file(&shown))?
-                }
-            }
-        };
+        let (mut points, source) = self.read_points(name)?;
         validate(&points, 4).map_err(|e| e.in_file(name))?;
+        let frame = Frame::of(self.normalise, &points, &dataset_name(name)?, &source);
         self.normalise.apply(&mut points);
         // Coordinates near the f64 limit overflow the ranges into inf and the points into NaN.
         validate(&points, 4).map_err(|e| {
@@ -226,7 +182,85 @@ impl Loader {
                 points.len()
             )));
         }
-        Ok(PointCloud { name: dataset_name(name)?, points })
+        Ok(PointCloud { name: dataset_name(name)?, points, frame })
+    }
+
+    /// The points of a data set as they are (before normalisation) and where they came from (the
+    /// file as read, or `generated`).
+    fn read_points(&self, name: &str) -> Result<(Vec<Point3>, String), DataError> {
+        let data_dir = &self.data_dir;
+        let generated = |p: Vec<Point3>| Ok((p, GENERATED.to_string()));
+        match name {
+            "cube" => generated(generators::cube()),
+            "sphere" => generated(generators::sphere()),
+            "spindle" => generated(generators::spindle()),
+            "oiltank" => generated(generators::oiltank()),
+            "cylinder" => generated(generators::cylinder()),
+            "semi_sphere" => generated(generators::semi_sphere()),
+            "saddle" => generated(generators::saddle()),
+            "bunny" => {
+                let path = data_dir.join(BUNNY_FILE);
+                let shown = path.display().to_string();
+                let p = ply::parse_ply(&read(&path, &where_to_get(BUNNY_FILE))?)
+                    .map_err(|e| e.in_file(&shown))?;
+                Ok((p, shown))
+            }
+            "talus" => {
+                let path = data_dir.join(TALUS_FILE);
+                let shown = path.display().to_string();
+                let bytes = read(&path, &where_to_get(TALUS_FILE))?;
+                Ok((sample_stl(&bytes, TALUS_POINTS, TALUS_SAMPLE_SEED, &shown)?, shown))
+            }
+            other => {
+                self.require_file(other)?;
+                let (_, count) = split_count(other)?;
+                let path = self.resolve(other)?;
+                let shown = path.display().to_string();
+                let bytes = read(&path, "Check the path in the spec.")?;
+                Ok((parse_file(&bytes, &shown, count)?, shown))
+            }
+        }
+    }
+}
+
+/// The points of a user's file by its extension (`shown` names it in errors and notes).
+fn parse_file(bytes: &[u8], shown: &str, count: Option<usize>) -> Result<Vec<Point3>, DataError> {
+    let lower = shown.to_ascii_lowercase();
+    let ext = lower.rsplit('.').next().unwrap_or("");
+    if !matches!(ext, "ply" | "stl") {
+        // A text format: UTF-16 (or NUL bytes) is named as such, not parsed into odd errors.
+        crate::io::not_utf16(shown, bytes).map_err(DataError::Invalid)?;
+    }
+    match ext {
+        "ply" => ply::parse_ply(bytes).map_err(|e| e.in_file(shown)),
+        "off" => off::parse_off(bytes).map_err(|e| e.in_file(shown)),
+        "obj" => obj::parse_obj(bytes).map_err(|e| e.in_file(shown)),
+        "stl" => sample_stl(bytes, count.unwrap_or(DEFAULT_STL_POINTS), TALUS_SAMPLE_SEED, shown),
+        _ => {
+            let text = String::from_utf8_lossy(bytes);
+            let (points, extra) = xyz::parse_xyz_columns(&text).map_err(|e| e.in_file(shown))?;
+            if extra > 0 {
+                note_once(
+                    shown,
+                    &format!(
+                        "{shown}: the {extra} column{} after x y z ignored (e.g. normals)",
+                        if extra == 1 { "" } else { "s" }
+                    ),
+                );
+            }
+            Ok(points)
+        }
+    }
+}
+
+/// Print `somnurbs: note: MESSAGE` on stderr the first time `key` is noted in this process (a
+/// file read by several steps of one run is noted once).
+fn note_once(key: &str, message: &str) {
+    static NOTED: std::sync::Mutex<std::collections::BTreeSet<String>> =
+        std::sync::Mutex::new(std::collections::BTreeSet::new());
+    let first = NOTED.lock().map(|mut s| s.insert(key.to_string())).unwrap_or(true);
+    if first {
+        eprintln!("somnurbs: note: {message}");
     }
 }
 
@@ -294,7 +328,7 @@ mod tests {
         assert_eq!(dataset_name("cube").unwrap(), "cube");
         assert_eq!(dataset_name("/abs/path/part.xyz").unwrap(), "part");
         assert_eq!(dataset_name("../up/part.stl:500").unwrap(), "part");
-        for bad in ["../.xyz", "x.stl:0", "x.stl:99999999999", "x.obj", "..", "."] {
+        for bad in ["../.xyz", "x.stl:0", "x.stl:99999999999", "x.step", "..", "."] {
             assert!(dataset_name(bad).is_err(), "{bad}");
         }
         let dir = tempfile::tempdir().unwrap();

@@ -1,12 +1,19 @@
 //! XYZ / CSV point files: three numeric columns separated by white space, commas or semicolons;
 //! blank lines and `#` comments are skipped, one leading non-numeric header line is allowed, and
-//! columns after the third are ignored.
+//! columns after the third are ignored (the loader says so once per file).
 
 use super::DataError;
 use crate::geom::Point3;
 
 pub fn parse_xyz(text: &str) -> Result<Vec<Point3>, DataError> {
+    parse_xyz_columns(text).map(|(points, _)| points)
+}
+
+/// [`parse_xyz`], and the most columns after the third on any data line (normals `nx ny nz`: 3),
+/// which are ignored; the caller says so once per file.
+pub fn parse_xyz_columns(text: &str) -> Result<(Vec<Point3>, usize), DataError> {
     let mut out = Vec::new();
+    let mut extra = 0;
     let mut seen_data = false;
     let mut header_used = false;
     for (n, raw) in text.lines().enumerate() {
@@ -44,9 +51,10 @@ pub fn parse_xyz(text: &str) -> Result<Vec<Point3>, DataError> {
             }
         }
         seen_data = true;
+        extra = extra.max(fields.len() - 3);
         out.push(p);
     }
-    Ok(out)
+    Ok((out, extra))
 }
 
 #[cfg(test)]
@@ -57,6 +65,10 @@ mod tests {
     fn header_comments_separators() {
         let t = "x,y,z\n# a comment\n1,2,3\n\n4 5 6 7\n7;8;9 # trailing\n";
         assert_eq!(parse_xyz(t).unwrap(), vec![[1.0, 2.0, 3.0], [4.0, 5.0, 6.0], [7.0, 8.0, 9.0]]);
+        assert_eq!(parse_xyz_columns(t).unwrap().1, 1);
+        let normals = "x y z nx ny nz\n0 0 0 0 0 1\n1 0 0 0 0 1\n";
+        assert_eq!(parse_xyz_columns(normals).unwrap(), (vec![[0.0; 3], [1.0, 0.0, 0.0]], 3));
+        assert_eq!(parse_xyz_columns("1 2 3\n").unwrap().1, 0);
     }
 
     #[test]

@@ -12,7 +12,7 @@ pub fn datasets(action: DatasetsAction, data_dir: &Path) -> Result<()> {
             for name in registry::BUILTIN {
                 println!("{name:<12} {}", registry::describe(name).unwrap_or(""));
             }
-            println!("\nAny .ply/.stl/.xyz/.csv/.txt path is accepted as a data set too. Data directory: {}", data_dir.display());
+            println!("\nAny .ply/.stl/.off/.obj/.xyz/.csv/.txt path is accepted as a data set too. Data directory: {}", data_dir.display());
         }
         DatasetsAction::Show { name } => {
             let cloud = registry::load_dataset(&name, data_dir)?;

@@ -41,9 +41,92 @@ fn pack(tokens: &[String], width: usize) -> Vec<String> {
     lines
 }
 
-/// IGES 5.3 text with one entity 128 per surface. `units_mm`: unit flag 2 (mm), else 1 (inch).
-pub fn write_iges(surfaces: &[(&str, &BSplineSurface)], units_mm: bool) -> String {
-    let start = vec!["somnurbs: cubic B-spline surfaces (entity 128, all weights 1)".to_string()];
+/// The length unit of exported coordinates: one of IGES 5.3's unit flags (global parameter 14,
+/// with its name, parameter 15), or unknown.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Units {
+    /// Not known (a scan's numbers as they are, or a normalised box): written as flag 2 (MM), the
+    /// flag CAD readers expect, and the start section says the flag is nominal. (Flag 3, a unit
+    /// named in parameter 15, would need a name the reader knows, which "unknown" is not.)
+    Unknown,
+    /// A known unit: IGES flag and name.
+    Flag(u8, &'static str),
+}
+
+impl std::str::FromStr for Units {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Units, String> {
+        Ok(match s {
+            "unknown" => Units::Unknown,
+            "in" => Units::Flag(1, "IN"),
+            "mm" => Units::Flag(2, "MM"),
+            "ft" => Units::Flag(4, "FT"),
+            "m" => Units::Flag(6, "M"),
+            "um" => Units::Flag(9, "UM"),
+            "cm" => Units::Flag(10, "CM"),
+            _ => return Err(format!("unknown unit `{s}` (unknown, mm, cm, m, um, in, ft)")),
+        })
+    }
+}
+
+impl Units {
+    /// The sentence the IGES start section carries.
+    pub fn describe(self) -> String {
+        match self {
+            Units::Unknown => format!("{}; the IGES unit flag 2 (MM) is nominal.", self.line()),
+            Units::Flag(..) => format!("{}.", self.line()),
+        }
+    }
+
+    /// `Units: ...` without the IGES flag (an OBJ comment).
+    pub fn line(self) -> String {
+        match self {
+            Units::Unknown => "Units: unknown (the numbers as they are)".into(),
+            Units::Flag(_, name) => format!("Units: {name}"),
+        }
+    }
+
+    fn flag_and_name(self) -> (u8, &'static str) {
+        match self {
+            Units::Unknown => (2, "MM"),
+            Units::Flag(f, n) => (f, n),
+        }
+    }
+}
+
+/// `text` in lines of at most `width` characters, broken at spaces (a longer word is cut).
+fn wrap(text: &str, width: usize) -> Vec<String> {
+    let mut lines: Vec<String> = Vec::new();
+    let mut line = String::new();
+    for word in text.split_whitespace() {
+        let chars: Vec<char> =
+            word.chars().filter(|c| c.is_ascii() && !c.is_ascii_control()).collect();
+        for piece in chars.chunks(width) {
+            let piece: String = piece.iter().collect();
+            if !line.is_empty() && line.len() + 1 + piece.len() > width {
+                lines.push(std::mem::take(&mut line));
+            }
+            if !line.is_empty() {
+                line.push(' ');
+            }
+            line.push_str(&piece);
+        }
+    }
+    if !line.is_empty() || lines.is_empty() {
+        lines.push(line);
+    }
+    lines
+}
+
+/// IGES 5.3 text with one entity 128 per surface; `units` in the global section, and `notes`
+/// (say, the coordinate frame) in the start section after the line naming the writer.
+pub fn write_iges(surfaces: &[(&str, &BSplineSurface)], units: Units, notes: &[String]) -> String {
+    let mut start =
+        vec!["somnurbs: cubic B-spline surfaces (entity 128, all weights 1)".to_string()];
+    for note in notes.iter().cloned().chain([units.describe()]) {
+        start.extend(wrap(&note, 72));
+    }
+    let (flag, unit_name) = units.flag_and_name();
     let global_tokens: Vec<String> = vec![
         "1H,".into(),
         "1H;".into(),
@@ -58,8 +141,8 @@ pub fn write_iges(surfaces: &[(&str, &BSplineSurface)], units_mm: bool) -> Strin
         "15".into(),
         hollerith("somnurbs"),
         "1.0".into(),
-        if units_mm { "2".into() } else { "1".into() },
-        hollerith(if units_mm { "MM" } else { "IN" }),
+        flag.to_string(),
+        hollerith(unit_name),
         "1".into(),
         "1.0".into(),
         hollerith("20260101.000000"),
@@ -209,14 +292,20 @@ pub fn parse_iges_128(text: &str) -> Result<Vec<BSplineSurface>, SplineError> {
 }
 
 /// Wavefront OBJ: each surface evaluated on a uniform `samples_u x samples_v` parameter grid, as
-/// an object of quads.
+/// an object of quads; `notes` are `#` comment lines after the one naming the writer.
 pub fn write_obj(
     surfaces: &[(&str, &BSplineSurface)],
     samples_u: usize,
     samples_v: usize,
+    notes: &[String],
 ) -> String {
     let (su, sv) = (samples_u.max(2), samples_v.max(2));
     let mut out = String::from("# somnurbs: evaluated cubic B-spline surfaces\n");
+    for note in notes {
+        for line in note.lines() {
+            let _ = writeln!(out, "# {line}");
+        }
+    }
     let mut base = 1;
     for (name, s) in surfaces {
         let _ = writeln!(out, "o {name}");
@@ -263,11 +352,24 @@ mod tests {
     #[test]
     fn iges_round_trip_re_evaluates_the_same_points() {
         let (a, b) = (surface(6, 18, 1), surface(16, 28, 2));
-        let text = write_iges(&[("bottom", &a), ("top", &b)], true);
+        let long = format!("Frame: the data's own coordinates, from {}", "/very/long".repeat(12));
+        let text = write_iges(&[("bottom", &a), ("top", &b)], Units::Unknown, &[long]);
         for (n, line) in text.lines().enumerate() {
             assert_eq!(line.len(), 80, "line {} is not 80 columns: {line:?}", n + 1);
         }
-        assert!(text.lines().last().unwrap().starts_with("S      1G"));
+        let start: Vec<&str> = text.lines().filter(|l| &l[72..73] == "S").collect();
+        assert!(start.len() >= 4 && start[1].starts_with("Frame: the data's own"), "{start:?}");
+        assert!(start.iter().any(|l| l.contains("Units: unknown")), "{start:?}");
+        assert!(text.lines().last().unwrap().starts_with(&format!("S{:>7}G", start.len())));
+        // Units are global parameters 14 and 15.
+        let global = |t: &str| -> String {
+            t.lines().filter(|l| &l[72..73] == "G").map(|l| l[..72].trim_end()).collect()
+        };
+        assert!(global(&text).contains(",1.0,2,2HMM,"), "{text}");
+        let inches = write_iges(&[("s", &a)], "in".parse().unwrap(), &[]);
+        assert!(global(&inches).contains(",1.0,1,2HIN,"), "{inches}");
+        assert!(inches.contains("Units: IN."), "{inches}");
+        assert!("yards".parse::<Units>().is_err());
         let back = parse_iges_128(&text).unwrap();
         assert_eq!(back.len(), 2);
         for (orig, read) in [(&a, &back[0]), (&b, &back[1])] {
@@ -287,7 +389,8 @@ mod tests {
     #[test]
     fn obj_counts_and_points_on_the_surface() {
         let s = surface(5, 7, 3);
-        let text = write_obj(&[("s", &s)], 11, 9);
+        let text = write_obj(&[("s", &s)], 11, 9, &["frame: the normalised unit box".into()]);
+        assert_eq!(text.lines().nth(1), Some("# frame: the normalised unit box"));
         assert_eq!(text.lines().filter(|l| l.starts_with("v ")).count(), 99);
         assert_eq!(text.lines().filter(|l| l.starts_with("f ")).count(), 80);
         let v: Vec<f64> = text.lines().find(|l| l.starts_with("v ")).unwrap()[2..]

@@ -6,7 +6,7 @@
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use somnurbs::data::{ply, stl, xyz};
+use somnurbs::data::{obj, off, ply, stl, xyz};
 use somnurbs::experiment::spec::Spec;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -211,6 +211,11 @@ fn readers_and_spec_loader_survive_random_mutations() {
         b"x,y,z\n# points\n0 0 0\n1,0,0\n0;1;0\n0.5 0.5 1 extra\n1e-3 2e-3 3e-3\n".to_vec();
     let xyz =
         fuzz("XYZ", &[xyz_seed], &mut rng, |b| xyz::parse_xyz(&String::from_utf8_lossy(b)).is_ok());
+    let off_seed = b"OFF\n# a tetrahedron\n4 4 6\n0 0 0\n1 0 0 0 0 1\n0 1 0\n0 0 1\n3 0 1 2\n3 0 1 3\n3 0 2 3\n3 1 2 3\n".to_vec();
+    let off = fuzz("OFF", &[off_seed], &mut rng, |b| off::parse_off(b).is_ok());
+    let obj_seed =
+        b"# quad\no q\nv 0 0 0\nv 1 0 0 1.0\nvn 0 0 1\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n".to_vec();
+    let obj = fuzz("OBJ", &[obj_seed], &mut rng, |b| obj::parse_obj(b).is_ok());
     let specs = fuzz("spec", &spec_seeds(), &mut rng, |b| {
         let text = String::from_utf8_lossy(b);
         somnurbs::families::install();
@@ -223,7 +228,9 @@ fn readers_and_spec_loader_survive_random_mutations() {
         plain.is_ok() || quick.is_ok()
     });
     // Both outcomes occur: the mutations reach past the first check.
-    for (what, (ok, total)) in [("PLY", ply), ("STL", stl), ("XYZ", xyz), ("spec", specs)] {
+    for (what, (ok, total)) in
+        [("PLY", ply), ("STL", stl), ("XYZ", xyz), ("OFF", off), ("OBJ", obj), ("spec", specs)]
+    {
         assert!(ok > 0 && ok < total, "{what}: {ok} of {total} parsed");
     }
     assert!(started.elapsed() < Duration::from_secs(120), "{:?}", started.elapsed());

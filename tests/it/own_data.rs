@@ -221,3 +221,169 @@ fn reproduce_finds_its_plans_from_another_working_folder() {
         "{err}"
     );
 }
+
+/// A smooth closed surface (an ellipsoid) spanning about [-3, 5] x [10, 11] x [0, 100]: the
+/// points of a scan in its own frame.
+fn scan() -> Vec<[f64; 3]> {
+    let mut p = Vec::new();
+    for i in 0..40 {
+        let t = std::f64::consts::PI * (i as f64 + 0.5) / 40.0;
+        for j in 0..50 {
+            let f = 2.0 * std::f64::consts::PI * j as f64 / 50.0;
+            p.push([
+                1.0 + 4.0 * t.sin() * f.cos(),
+                10.5 + 0.5 * t.sin() * f.sin(),
+                50.0 + 50.0 * t.cos(),
+            ]);
+        }
+    }
+    p
+}
+
+const CH4_OWN: &str = "name = \"pts\"\nmaster_seed = 3\n[som]\ndatasets = [\"DATA\"]\niterations = 4000\nsave_maps = [\"12x12\"]\npictures = false\n[[som.group]]\nmodels = [\"dnsom\"]\ngrids = [\"12x12\"]\n";
+
+/// The vertices of an OBJ file and the control points of an IGES file.
+fn exported(c: &Case, dir: &str) -> (Vec<[f64; 3]>, Vec<[f64; 3]>, String, String) {
+    let obj = std::fs::read_to_string(c.path(&format!("{dir}/surfaces.obj"))).unwrap();
+    let igs = std::fs::read_to_string(c.path(&format!("{dir}/surfaces.igs"))).unwrap();
+    let verts = obj
+        .lines()
+        .filter_map(|l| l.strip_prefix("v "))
+        .map(|l| {
+            let v: Vec<f64> = l.split(' ').map(|x| x.parse().unwrap()).collect();
+            [v[0], v[1], v[2]]
+        })
+        .collect();
+    let control = somnurbs::spline::export::parse_iges_128(&igs)
+        .unwrap()
+        .iter()
+        .flat_map(|s| s.control.clone())
+        .collect();
+    (verts, control, obj, igs)
+}
+
+/// Every point within the box [lo, hi] widened by `tol` of each axis' range.
+fn within(points: &[[f64; 3]], lo: [f64; 3], hi: [f64; 3], tol: f64, what: &str) {
+    assert!(!points.is_empty(), "{what}: no points");
+    for p in points {
+        for a in 0..3 {
+            let slack = tol * (hi[a] - lo[a]);
+            assert!(
+                p[a] >= lo[a] - slack && p[a] <= hi[a] + slack,
+                "{what}: {p:?} outside [{lo:?}, {hi:?}]"
+            );
+        }
+    }
+}
+
+#[test]
+fn off_and_obj_scans_export_in_their_own_frame_or_the_normalised_one() {
+    let c = Case::new();
+    let pts = scan();
+    let mut off = format!("OFF\n# a scan\n{} 0 0\n", pts.len());
+    let mut obj = String::from("# a scan\no scan\n");
+    for p in &pts {
+        off.push_str(&format!("{} {} {}\n", p[0], p[1], p[2]));
+        obj.push_str(&format!("v {} {} {}\nvn 0 0 1\n", p[0], p[1], p[2]));
+    }
+    c.write("pts.off", &off);
+    c.write("scan.obj", &obj);
+    let lo = [0, 1, 2].map(|a| pts.iter().map(|p| p[a]).fold(f64::MAX, f64::min));
+    let hi = [0, 1, 2].map(|a| pts.iter().map(|p| p[a]).fold(f64::MIN, f64::max));
+    for (file, data) in [("pts.off", "pts"), ("scan.obj", "scan")] {
+        c.write(&format!("{data}.toml"), &CH4_OWN.replace("DATA", file));
+        c.ok(&["run", &format!("{data}.toml"), "--out", &format!("ch4_{data}")]);
+        let map = format!("ch4_{data}/maps/dnsom_{data}_12x12.csv");
+        let frame = std::fs::read_to_string(c.path(&map.replace(".csv", ".frame.toml"))).unwrap();
+        assert!(frame.contains("normalise = \"per_axis\"") && frame.contains(file), "{frame}");
+        // The data's frame (the default).
+        let out = format!("{data}_f");
+        c.ok(&["fit", "--grid", &map, "--cn", "6x6", "--out", &out]);
+        let (verts, control, obj_text, igs) = exported(&c, &out);
+        within(&verts, lo, hi, 0.05, "OBJ vertices (data)");
+        // A control net lies outside the convex surface it shapes (by up to a third of the box
+        // here, at the poles): near the box, far from [0, 1]^3 on y and z.
+        within(&control, lo, hi, 0.5, "IGES control points (data)");
+        assert!(verts.iter().any(|v| v[2] > 50.0), "not in the data's frame");
+        assert!(
+            obj_text
+                .lines()
+                .any(|l| l.starts_with("# Frame: the data's own coordinates") && l.contains(file)),
+            "{obj_text}"
+        );
+        let start: String = igs
+            .lines()
+            .filter(|l| &l[72..73] == "S")
+            .map(|l| l[..72].trim_end().to_string() + " ")
+            .collect();
+        assert!(
+            start.contains("the data's own coordinates")
+                && start.contains(file)
+                && start.contains("Units: unknown"),
+            "{start}"
+        );
+        let (h, rows) = read_csv(&c.path(&format!("{out}/fit.csv")));
+        assert_eq!(rows[0][col(&h, "frame")], "data");
+        let (nh, nets) = read_csv(&c.path(&format!("{out}/control_nets.csv")));
+        assert!(nets.iter().any(|r| r[col(&nh, "z")].parse::<f64>().unwrap() > 50.0));
+        // The normalised frame.
+        let out = format!("{data}_n");
+        c.ok(&["fit", "--grid", &map, "--cn", "6x6", "--frame", "normalised", "--out", &out]);
+        let (n_verts, n_control, obj_text, _) = exported(&c, &out);
+        within(&n_verts, [0.0; 3], [1.0; 3], 0.05, "OBJ vertices (normalised)");
+        // The two exports are one affine map apart (the frame: offset lo, scale hi - lo).
+        for (d, n) in control.iter().zip(&n_control).chain(verts.iter().zip(&n_verts)) {
+            for a in 0..3 {
+                let want = lo[a] + (hi[a] - lo[a]) * n[a];
+                assert!((d[a] - want).abs() <= 1e-9 * (1.0 + want.abs()), "{d:?} {n:?}");
+            }
+        }
+        within(&n_control, [0.0; 3], [1.0; 3], 0.5, "IGES control points (normalised)");
+        assert!(obj_text.contains("# Frame: the normalised box"), "{obj_text}");
+        let (h, rows) = read_csv(&c.path(&format!("{out}/fit.csv")));
+        assert_eq!(rows[0][col(&h, "frame")], "normalised");
+    }
+    // A map without a frame: its own coordinates, said in one line.
+    std::fs::copy(c.path("ch4_pts/maps/dnsom_pts_12x12.csv"), c.path("hand.csv")).unwrap();
+    let said = c.ok(&["fit", "--grid", "hand.csv", "--cn", "6x6", "--units", "mm", "--out", "h"]);
+    let said = String::from_utf8_lossy(&said.stderr);
+    let notes: Vec<&str> = said.lines().filter(|l| l.contains("no frame")).collect();
+    assert!(
+        notes.len() == 1
+            && notes[0].starts_with("somnurbs: note:")
+            && notes[0].contains("hand.frame.toml"),
+        "{said}"
+    );
+    let (verts, _, _, igs) = exported(&c, "h");
+    within(&verts, [0.0; 3], [1.0; 3], 0.05, "OBJ vertices (no frame)");
+    assert!(igs.contains("Units: MM."), "{igs}");
+    let (h, rows) = read_csv(&c.path("h/fit.csv"));
+    assert_eq!(rows[0][col(&h, "frame")], "map");
+    c.fails(
+        &["fit", "--grid", "hand.csv", "--cn", "6x6", "--frame", "box", "--out", "x"],
+        &["--frame", "box"],
+    );
+}
+
+#[test]
+fn bad_off_counts_are_refused_and_xyz_normals_are_noted_once() {
+    let c = Case::new();
+    c.write("huge.off", "OFF\n# claims a trillion\n1000000000000 0 0\n0 0 0\n");
+    c.write("huge.toml", &CH4_OWN.replace("DATA", "huge.off"));
+    c.fails(&["run", "huge.toml", "--out", "o"], &["huge.off", "line 3", "1000000000000 vertices"]);
+    let normals: String =
+        scan().iter().map(|p| format!("{} {} {} 0 0 1\n", p[0], p[1], p[2])).collect();
+    c.write("n.xyz", &format!("x y z nx ny nz\n{normals}"));
+    c.write("n.toml", &CH4_OWN.replace("DATA", "n.xyz"));
+    let said = c.ok(&["run", "n.toml", "--out", "n"]);
+    assert!(c.path("n/maps/dnsom_n_12x12.frame.toml").exists());
+    let said = String::from_utf8_lossy(&said.stderr);
+    let notes: Vec<&str> = said.lines().filter(|l| l.contains("ignored")).collect();
+    assert!(
+        notes.len() == 1
+            && notes[0].starts_with("somnurbs: note: ")
+            && notes[0].contains("n.xyz")
+            && notes[0].contains("3 columns"),
+        "{said}"
+    );
+}

@@ -1,12 +1,97 @@
-//! `somnurbs fit`: fit a user's two-view grid and write its control nets, IGES and OBJ.
+//! `somnurbs fit`: fit a user's two-view grid and write its control nets, IGES and OBJ, in the
+//! data's own coordinates when the map has its frame beside it (or, asked for, the map's).
 
 use crate::cli::FitArgs;
 use crate::experiment::spec::GridSize;
 use crate::io::{csv_records, read_text, write_atomic};
+use crate::data::frame::Frame;
+use crate::spline::export::Units;
 use crate::spline::{
-    export, fit_two_view, Approach, ErrorA, FitOptions, KnotRule, Parameterisation,
+    export, fit_two_view, Approach, BSplineSurface, ErrorA, FitOptions, KnotRule,
+    Parameterisation,
 };
 use anyhow::{Context, Result};
+use std::path::Path;
+
+/// The coordinates the exports are written in.
+struct Export {
+    /// fit.csv's `frame`: `data`, `normalised` or `map` (no frame found).
+    label: &'static str,
+    /// Taken from the map's coordinates to the exports' (None: the map's as they are).
+    affine: Option<([f64; 3], [f64; 3])>,
+    units: Units,
+    /// The line the IGES start section and the OBJ comments carry.
+    note: String,
+    /// Said on stderr once the output folder is this command's (no frame found).
+    warn: Option<String>,
+}
+
+/// How `--frame` and `--units` and the frame beside `grid` (if any) place the exports.
+fn export_frame(grid: &Path, frame: Option<Frame>, which: &str, units: &str) -> Result<Export> {
+    let units: Units = units.parse().map_err(anyhow::Error::msg).context("--units")?;
+    let data = match which {
+        "data" => true,
+        "normalised" => false,
+        other => anyhow::bail!("--frame: `{other}` is neither data nor normalised"),
+    };
+    let shown = crate::io::shown(grid);
+    let Some(f) = frame else {
+        let warn = format!(
+            "somnurbs: note: no frame beside {shown} ({}): the exports are in the map's own coordinates",
+            crate::io::shown(&crate::data::frame::sidecar(grid))
+        );
+        let note = format!("Frame: the coordinates of the map {shown} as they are (no frame file beside it).");
+        return Ok(Export { label: "map", affine: None, units, note, warn: Some(warn) });
+    };
+    let normalised = f.normalise != crate::data::Normalise::None;
+    if data || !normalised {
+        let how = if normalised {
+            format!("the {} normalisation of the map undone", normalise_name(f.normalise))
+        } else {
+            "the spec did not normalise".to_string()
+        };
+        let note = format!("Frame: {} ({how}).", f.describe());
+        let affine = Some((f.offset, f.scale));
+        return Ok(Export { label: "data", affine, units, note, warn: None });
+    }
+    if units != Units::Unknown {
+        anyhow::bail!("--units: the normalised frame has no length unit (use --frame data)");
+    }
+    let note = format!(
+        "Frame: the normalised box the map was trained in ({} of {}); the data's coordinates are offset + scale * these, offset {:?}, scale {:?}.",
+        normalise_name(f.normalise), f.source, f.offset, f.scale
+    );
+    Ok(Export { label: "normalised", affine: None, units, note, warn: None })
+}
+
+fn normalise_name(n: crate::data::Normalise) -> &'static str {
+    match n {
+        crate::data::Normalise::PerAxis => "per-axis min-max [0, 1]",
+        crate::data::Normalise::Uniform => "uniform (longest axis to [0, 1])",
+        crate::data::Normalise::None => "none",
+    }
+}
+
+/// control_nets.csv's rows: view, a, b, x, y, z.
+fn net_rows(surfaces: &[(&str, &BSplineSurface)]) -> Vec<Vec<String>> {
+    let mut rows = Vec::new();
+    for (view, s) in surfaces {
+        for a in 0..s.cn_x {
+            for b in 0..s.cn_y {
+                let p = s.control[a * s.cn_y + b];
+                rows.push(vec![
+                    view.to_string(),
+                    a.to_string(),
+                    b.to_string(),
+                    format!("{:?}", p[0]),
+                    format!("{:?}", p[1]),
+                    format!("{:?}", p[2]),
+                ]);
+            }
+        }
+    }
+    rows
+}
 
 /// `--samples`: evaluations per direction of the OBJ mesh (two make one quad per surface).
 pub const MIN_SAMPLES: usize = 2;
@@ -36,35 +121,35 @@ pub fn fit(args: &FitArgs) -> Result<()> {
     let fit = fit_two_view(&grid, cn.nx, cn.ny, param, approach, &opts)
         .with_context(|| format!("{shown}: {}x{} grid", grid.nx, grid.ny))?;
 
+    let frame = crate::families::fit::read_frame(&args.grid)?;
+    let export = export_frame(&args.grid, frame, &args.frame, &args.units)?;
+    let placed = |s: &BSplineSurface| match export.affine {
+        Some((offset, scale)) => s.affine(offset, scale),
+        None => s.clone(),
+    };
+    let (bottom, top) = (placed(&fit.bottom), placed(&fit.top));
+    let surfaces = [("bottom", &bottom), ("top", &top)];
     let header: Vec<String> =
         ["view", "a", "b", "x", "y", "z"].iter().map(|s| s.to_string()).collect();
-    let mut rows = Vec::new();
-    for (view, s) in [("bottom", &fit.bottom), ("top", &fit.top)] {
-        for a in 0..s.cn_x {
-            for b in 0..s.cn_y {
-                let p = s.control[a * s.cn_y + b];
-                rows.push(vec![
-                    view.to_string(),
-                    a.to_string(),
-                    b.to_string(),
-                    format!("{:?}", p[0]),
-                    format!("{:?}", p[1]),
-                    format!("{:?}", p[2]),
-                ]);
-            }
-        }
-    }
+    let rows = net_rows(&surfaces);
     let out = &args.out;
     // Every input has loaded: the folder is this command's (one writer at a time), and a fit
     // folder, like a run's, holds one result: it must be missing or empty.
     let _lock = crate::io::outdir::lock(out, "fit")?;
     crate::io::outdir::require_empty(out)?;
+    if let Some(line) = &export.warn {
+        eprintln!("{line}");
+    }
     write_atomic(&out.join("control_nets.csv"), csv_records(&header, &rows)?.as_bytes())?;
-    let surfaces = [("bottom", &fit.bottom), ("top", &fit.top)];
-    write_atomic(&out.join("surfaces.igs"), export::write_iges(&surfaces, true).as_bytes())?;
+    let notes = [export.note.clone()];
+    write_atomic(
+        &out.join("surfaces.igs"),
+        export::write_iges(&surfaces, export.units, &notes).as_bytes(),
+    )?;
+    let obj_notes = [export.note.clone(), format!("{}.", export.units.line())];
     write_atomic(
         &out.join("surfaces.obj"),
-        export::write_obj(&surfaces, args.samples, args.samples).as_bytes(),
+        export::write_obj(&surfaces, args.samples, args.samples, &obj_notes).as_bytes(),
     )?;
     let dense = fit.dense_geometry(&grid);
     let summary: Vec<String> = [
@@ -80,6 +165,7 @@ pub fn fit(args: &FitArgs) -> Result<()> {
         "excursion",
         "max_control",
         "dense_gap",
+        "frame",
     ]
     .iter()
     .map(|s| s.to_string())
@@ -97,6 +183,7 @@ pub fn fit(args: &FitArgs) -> Result<()> {
         format!("{:?}", dense.excursion),
         format!("{:?}", dense.max_control),
         format!("{:?}", dense.border_gap),
+        export.label.to_string(),
     ];
     write_atomic(&out.join("fit.csv"), csv_records(&summary, &[row])?.as_bytes())?;
     // Last, the manifest: its presence says the folder is whole (the drift and merge readers'

@@ -66,6 +66,9 @@ impl runner::Logged for FitRun {
 pub struct MapSource {
     pub grid: TwoViewGrid,
     pub origin: String,
+    /// The data set's frame (the map file's sidecar, or the recomputation's cloud); None: a map
+    /// saved without one.
+    pub frame: Option<crate::data::frame::Frame>,
 }
 
 /// The map file name Chapter 4 writes and Chapter 5 reads.
@@ -190,7 +193,11 @@ pub fn maps_for(
     ctx.begin()?;
     for (data, source) in &out {
         let text = crate::families::som::report::two_view_grid_csv(&source.grid)?;
-        write_atomic(&ctx.out.join("maps").join(map_file_name(data, grid)), text.as_bytes())?;
+        let file = ctx.out.join("maps").join(map_file_name(data, grid));
+        write_atomic(&file, text.as_bytes())?;
+        if let Some(frame) = &source.frame {
+            crate::families::som::report::write_frame(&file, frame)?;
+        }
     }
     Ok(out)
 }
@@ -202,7 +209,20 @@ fn read_map(path: &Path, grid: GridSize) -> Result<MapSource> {
     if (g.nx, g.ny) != (grid.nx, grid.ny) {
         anyhow::bail!("{}: map is {}x{}, the spec's grid is {grid}", path.display(), g.nx, g.ny);
     }
-    Ok(MapSource { grid: g, origin: crate::io::shown(path) })
+    Ok(MapSource { grid: g, origin: crate::io::shown(path), frame: read_frame(path)? })
+}
+
+/// The frame saved beside a map (`X.frame.toml` beside `X.csv`), None when there is none; a frame
+/// file that is there but cannot be read is an error naming it.
+pub fn read_frame(map: &Path) -> Result<Option<crate::data::frame::Frame>> {
+    let file = crate::data::frame::sidecar(map);
+    if !file.exists() {
+        return Ok(None);
+    }
+    let text = crate::io::read_text(&file)?;
+    let frame =
+        crate::data::frame::Frame::parse(&text).map_err(|e| e.in_file(&crate::io::shown(&file)))?;
+    Ok(Some(frame))
 }
 
 fn recompute_map(
@@ -225,6 +245,7 @@ fn recompute_map(
     som::require_points(data, clouds[&name].points.len(), &cell)?;
     let run = som::run_cell(&cell, &clouds[&name].points, &params, seed)?;
     Ok(MapSource {
+        frame: Some(clouds[&name].frame.clone()),
         grid: grid_from_weights(grid.nx, grid.ny, &run.weights),
         origin: format!(
             "recomputed: {} with master seed {seed}, T = {}",

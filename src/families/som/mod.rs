@@ -153,8 +153,12 @@ pub fn run_cell(
     Ok(SomRun { cell: cell.clone(), row, weights: trained.weights })
 }
 
-/// Run every SOM cell of a spec, logging each finished cell to the folder's cell log.
-pub fn run(spec: &Spec, ctx: &RunContext) -> Result<Vec<SomRun>> {
+/// Each data set's frame (how its points were normalised), by name.
+pub type Frames = BTreeMap<String, crate::data::frame::Frame>;
+
+/// Run every SOM cell of a spec, logging each finished cell to the folder's cell log; also each
+/// data set's frame, for the saved maps.
+pub fn run(spec: &Spec, ctx: &RunContext) -> Result<(Vec<SomRun>, Frames)> {
     let som_spec = spec.require::<spec::SomSpec>()?;
     let data = load_datasets(spec, &som_spec.datasets, ctx)?;
     let params = SomParams {
@@ -169,13 +173,14 @@ pub fn run(spec: &Spec, ctx: &RunContext) -> Result<Vec<SomRun>> {
             require_points(entry, data[&name].points.len(), c)?;
         }
     }
-    runner::run_logged(
+    let runs = runner::run_logged(
         &cells,
         ctx,
         &spec.file.name,
         |cell| run_cell(cell, &data[&cell.dataset].points, &params, spec.file.master_seed),
         |cell, (row, weights)| Ok(SomRun { cell: cell.clone(), row, weights }),
-    )
+    )?;
+    Ok((runs, data.iter().map(|(name, cloud)| (name.clone(), cloud.frame.clone())).collect()))
 }
 
 /// Chapter 4's family: the `[som]` section.
@@ -215,8 +220,9 @@ impl crate::experiment::family::Experiment for Som {
         ctx: &RunContext,
         tables: bool,
     ) -> Result<crate::experiment::family::Outcome> {
-        let runs = run(spec, ctx)?;
-        let section = if tables { Some(self::report::write(spec, &runs, &ctx.out)?) } else { None };
+        let (runs, frames) = run(spec, ctx)?;
+        let section =
+            if tables { Some(self::report::write(spec, &runs, &frames, &ctx.out)?) } else { None };
         Ok(crate::experiment::family::Outcome {
             section,
             cpu_s: runs.iter().map(|r| r.row.cpu_s).sum(),

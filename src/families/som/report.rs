@@ -205,8 +205,16 @@ pub fn dnsom_map_csv(run: &SomRun) -> Result<String> {
     two_view_grid_csv(&crate::families::fit::grid_from_weights(g.nx, g.ny, &run.weights))
 }
 
-/// Write every Chapter 4 file; returns the REPORT.md section.
-pub fn write(spec: &Spec, runs: &[SomRun], out: &Path) -> Result<String> {
+/// Write `frame` beside the map file `map` ([`crate::data::frame::sidecar`]).
+pub fn write_frame(map: &Path, frame: &crate::data::frame::Frame) -> Result<()> {
+    let name = map.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let text = frame.to_toml(&name)?;
+    write_atomic(&crate::data::frame::sidecar(map), text.as_bytes())
+}
+
+/// Write every Chapter 4 file; returns the REPORT.md section. Each saved map has its data set's
+/// frame beside it (`maps/dnsom_<data>_<grid>.frame.toml`, not a table: drift skips `maps/`).
+pub fn write(spec: &Spec, runs: &[SomRun], frames: &super::Frames, out: &Path) -> Result<String> {
     let rows: Vec<_> = runs.iter().map(|r| r.row.clone()).collect();
     write_atomic(&out.join("runs.csv"), csv_text(&rows)?.as_bytes())?;
     let mut written = vec!["runs.csv".to_string()];
@@ -241,6 +249,9 @@ pub fn write(spec: &Spec, runs: &[SomRun], out: &Path) -> Result<String> {
     }) {
         let name = format!("maps/dnsom_{}_{}.csv", run.cell.dataset, run.cell.grid);
         write_atomic(&out.join(&name), dnsom_map_csv(run)?.as_bytes())?;
+        if let Some(frame) = frames.get(&run.cell.dataset) {
+            write_frame(&out.join(&name), frame)?;
+        }
         maps.push(name);
     }
     let pictures = if spec.section::<super::spec::SomSpec>().map(|s| s.pictures).unwrap_or(false) {

@@ -1,0 +1,156 @@
+//! The frame of a data set: how its points were scaled before use (the spec's `normalise`), so
+//! that anything made in the normalised coordinates (a DNSOM map, a fitted surface) can be taken
+//! back to the data's own coordinates. Chapter 4 writes it beside each saved map as
+//! `<map>.frame.toml`; `somnurbs fit` reads it. Pure: text in, text out.
+
+use super::{DataError, Normalise};
+use crate::geom::Point3;
+use serde::{Deserialize, Serialize};
+
+/// Data = `offset + scale * normalised`, axis by axis (x, y, z). An axis of zero range (mapped to
+/// 0 by the normalisation) has scale 0, so it maps back to its one value.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Frame {
+    /// The data set's name (a built-in's, a file's stem).
+    pub dataset: String,
+    /// Where the points came from: the file as it was read (relative to the working folder when
+    /// the spec's folder was), or `generated` for a built-in generator.
+    pub source: String,
+    /// The normalisation the spec asked for.
+    pub normalise: Normalise,
+    pub offset: [f64; 3],
+    pub scale: [f64; 3],
+}
+
+/// The `source` of a generated data set.
+pub const GENERATED: &str = "generated";
+
+impl Frame {
+    /// The frame `normalise` will apply to `points` (the same bounding box and ranges as
+    /// [`super::normalise_min_max`] and [`super::normalise_uniform`]).
+    pub fn of(normalise: Normalise, points: &[Point3], dataset: &str, source: &str) -> Frame {
+        let (offset, scale) = match (normalise, crate::geom::bounding_box(points)) {
+            (Normalise::None, _) | (_, None) => ([0.0; 3], [1.0; 3]),
+            (Normalise::PerAxis, Some((lo, hi))) => {
+                (lo, [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]].map(|r| r.max(0.0)))
+            }
+            (Normalise::Uniform, Some((lo, hi))) => {
+                let range = (0..3).map(|a| hi[a] - lo[a]).fold(0.0, f64::max);
+                (lo, [range; 3])
+            }
+        };
+        Frame { dataset: dataset.to_string(), source: source.to_string(), normalise, offset, scale }
+    }
+
+    /// A point of the normalised coordinates in the data's own.
+    pub fn to_data(&self, p: Point3) -> Point3 {
+        [0, 1, 2].map(|a| self.offset[a] + self.scale[a] * p[a])
+    }
+
+    /// The file's text: a comment line, then the fields.
+    pub fn to_toml(&self, map: &str) -> Result<String, DataError> {
+        let body = toml::to_string(self)
+            .map_err(|e| DataError::Invalid(format!("frame of {map}: {e}")))?;
+        Ok(format!(
+            "# The frame of {map}: data = offset + scale * map, per axis (x, y, z).\n{body}"
+        ))
+    }
+
+    /// Parse a frame file's text; offsets and scales must be finite, scales not negative.
+    pub fn parse(text: &str) -> Result<Frame, DataError> {
+        let f: Frame = toml::from_str(text).map_err(|e| {
+            let line = e
+                .span()
+                .map(|s| text[..s.start.min(text.len())].matches('\n').count() + 1)
+                .map(|l| format!("line {l}"))
+                .unwrap_or_else(|| "frame".into());
+            DataError::parse(line, e.message().to_string())
+        })?;
+        for (a, axis) in ["x", "y", "z"].iter().enumerate() {
+            if !(f.offset[a].is_finite() && f.scale[a].is_finite() && f.scale[a] >= 0.0) {
+                return Err(DataError::Invalid(format!(
+                    "the {axis} offset ({}) or scale ({}) is not a finite number (scale >= 0)",
+                    f.offset[a], f.scale[a]
+                )));
+            }
+        }
+        Ok(f)
+    }
+
+    /// One phrase for the exported files: where the coordinates come from.
+    pub fn describe(&self) -> String {
+        if self.source == GENERATED {
+            format!("the coordinates of the generated data set {}", self.dataset)
+        } else {
+            format!("the data's own coordinates, from {}", self.source)
+        }
+    }
+}
+
+/// The frame file beside a map: `X.csv` -> `X.frame.toml` (any other name: `.frame.toml` added).
+pub fn sidecar(map: &std::path::Path) -> std::path::PathBuf {
+    let name = map.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let stem = name.strip_suffix(".csv").unwrap_or(&name);
+    map.with_file_name(format!("{stem}.frame.toml"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cloud() -> Vec<Point3> {
+        vec![[-3.0, 10.0, 0.0], [5.0, 11.0, 100.0], [1.0, 10.5, 7.0], [0.25, 10.0, 3.0]]
+    }
+
+    #[test]
+    fn the_frame_inverts_every_normalisation() {
+        for mode in [Normalise::PerAxis, Normalise::Uniform, Normalise::None] {
+            let raw = cloud();
+            let frame = Frame::of(mode, &raw, "c", "c.xyz");
+            let mut n = raw.clone();
+            mode.apply(&mut n);
+            for (p, q) in raw.iter().zip(&n) {
+                let back = frame.to_data(*q);
+                for a in 0..3 {
+                    assert!((back[a] - p[a]).abs() <= 1e-12 * (1.0 + p[a].abs()), "{mode:?}");
+                }
+            }
+        }
+        let f = Frame::of(Normalise::PerAxis, &cloud(), "c", "c.xyz");
+        assert_eq!((f.offset, f.scale), ([-3.0, 10.0, 0.0], [8.0, 1.0, 100.0]));
+        let u = Frame::of(Normalise::Uniform, &cloud(), "c", "c.xyz");
+        assert_eq!(u.scale, [100.0; 3]);
+        // A flat axis maps back to its one value.
+        let flat = vec![[0.0, 2.0, 1.0], [1.0, 2.0, 3.0]];
+        let f = Frame::of(Normalise::PerAxis, &flat, "f", GENERATED);
+        assert_eq!(f.to_data([0.5, 0.0, 0.5]), [0.5, 2.0, 2.0]);
+    }
+
+    #[test]
+    fn toml_round_trip_is_exact_and_bad_frames_are_refused() {
+        let f = Frame::of(
+            Normalise::PerAxis,
+            &[[0.1, -1e-7, 3.0], [0.7, 2.0 / 3.0, 1e9]],
+            "d",
+            "x.off",
+        );
+        let text = f.to_toml("dnsom_d_6x6.csv").unwrap();
+        assert!(text.starts_with("# The frame of dnsom_d_6x6.csv"), "{text}");
+        assert_eq!(Frame::parse(&text).unwrap(), f);
+        let e = Frame::parse(&text.replace("per_axis", "cube")).unwrap_err().to_string();
+        assert!(e.contains("line") && e.contains("cube"), "{e}");
+        let e = Frame::parse(&format!("{text}units = \"mm\"\n")).unwrap_err().to_string();
+        assert!(e.contains("line 7") && e.contains("units"), "{e}");
+        let bad: Vec<&str> = text
+            .lines()
+            .map(|l| if l.starts_with("scale") { "scale = [-2.0, 1.0, 1.0]" } else { l })
+            .collect();
+        let e = Frame::parse(&bad.join("\n")).unwrap_err().to_string();
+        assert!(e.contains("x offset"), "{e}");
+        assert_eq!(
+            sidecar(std::path::Path::new("maps/dnsom_a_6x6.csv")),
+            std::path::Path::new("maps/dnsom_a_6x6.frame.toml")
+        );
+    }
+}
