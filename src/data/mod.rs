@@ -38,6 +38,19 @@ pub enum DataError {
     Invalid(String),
 }
 
+/// The point of the first three of `words` (x, y, z), each a finite number; an error names `ctx`
+/// (the file's line) and the word at fault.
+pub(crate) fn finite_point(words: &[&str], ctx: &str) -> Result<Point3, DataError> {
+    let mut p = [0.0; 3];
+    for (a, v) in p.iter_mut().enumerate() {
+        let w = words.get(a).copied().unwrap_or("");
+        *v = w.parse::<f64>().ok().filter(|v| v.is_finite()).ok_or_else(|| {
+            DataError::parse(ctx.to_string(), format!("`{w}` is not a finite number"))
+        })?;
+    }
+    Ok(p)
+}
+
 impl DataError {
     pub fn parse(context: impl Into<String>, message: impl Into<String>) -> DataError {
         DataError::Parse { context: context.into(), message: message.into() }

@@ -24,13 +24,7 @@ pub fn parse_obj(bytes: &[u8]) -> Result<Vec<Point3>, DataError> {
                 format!("a vertex needs `v x y z`, got `{}`", line.trim()),
             ));
         }
-        let mut p = [0.0; 3];
-        for a in 0..3 {
-            p[a] = vals[a].parse::<f64>().ok().filter(|v| v.is_finite()).ok_or_else(|| {
-                DataError::parse(ctx.clone(), format!("`{}` is not a finite number", vals[a]))
-            })?;
-        }
-        points.push(p);
+        points.push(super::finite_point(&vals, &ctx)?);
     }
     if points.is_empty() {
         return Err(DataError::Invalid("no vertex (`v x y z`) lines".into()));

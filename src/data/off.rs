@@ -97,13 +97,7 @@ pub fn parse_off(bytes: &[u8]) -> Result<Vec<Point3>, DataError> {
         if w.len() < 3 {
             return Err(DataError::parse(ctx, format!("a vertex needs x y z, got `{line}`")));
         }
-        let mut p = [0.0; 3];
-        for a in 0..3 {
-            p[a] = w[a].parse::<f64>().ok().filter(|v| v.is_finite()).ok_or_else(|| {
-                DataError::parse(ctx.clone(), format!("`{}` is not a finite number", w[a]))
-            })?;
-        }
-        points.push(p);
+        points.push(super::finite_point(&w, &ctx)?);
     }
     Ok(points)
 }
