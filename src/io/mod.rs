@@ -214,7 +214,7 @@ mod tests {
     fn shown_paths_are_clean_and_relative_to_the_working_folder() {
         assert_eq!(shown(Path::new("experiments/../results/ch4/maps")), "results/ch4/maps");
         assert_eq!(shown(Path::new("./a/./b")), "a/b");
-        assert_eq!(shown(Path::new("../shared/data")), "../shared/data");
+        assert_eq!(shown(Path::new("../elsewhere/data")), "../elsewhere/data");
         assert_eq!(shown(Path::new("a/..")), ".");
         let cwd = std::env::current_dir().unwrap();
         assert_eq!(shown(&cwd.join("results/x")), "results/x");
