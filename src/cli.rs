@@ -108,7 +108,7 @@ pub struct FitArgs {
     #[arg(long, default_value_t = 40)]
     pub samples: usize,
     /// Knot reading for nets smaller than the grid: eq2_10 (the thesis' Eq. 2.10 literally) or
-    /// nurbs_book (The NURBS Book eq. 9.68-9.69). See the README's "Readings" table.
+    /// nurbs_book (The NURBS Book eq. 9.68-9.69). See docs/readings.md.
     #[arg(long, default_value = "eq2_10")]
     pub knots: String,
     /// Reading of approach A's surface error: per_surface or nov_bottom.

@@ -126,7 +126,7 @@ pub fn normalise_min_max(points: &mut [Point3]) {
 
 /// Largest coordinate magnitude of a point file: beyond it the squared distances of the
 /// parameterisation and the least-squares fit lose the data's own scale (1e300 made the normal
-/// equations singular), so such a file is refused when it is read (README "Own data").
+/// equations singular), so such a file is refused when it is read (docs/specs.md, "Own data").
 pub const MAX_COORDINATE: f64 = 1e15;
 
 /// Why a coordinate read from a file is refused (non-finite, or beyond [`MAX_COORDINATE`]).

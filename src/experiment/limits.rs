@@ -1,8 +1,8 @@
 //! Bounds checked on every spec before anything else in validation (so `--dry-run` too): each
-//! size, count and radius has a documented finite range (README, "Spec limits"), lists hold no
-//! entry twice, and the experiment's name and data-set names can only name files inside the output
-//! folder. The checks only read numbers and list lengths: nothing is allocated from a spec value
-//! before it has passed, so a bad value is a one-line error naming its key at once.
+//! size, count and radius has a documented finite range (docs/specs.md, "Spec limits"), lists
+//! hold no entry twice, and the experiment's name and data-set names can only name files inside
+//! the output folder. The checks only read numbers and list lengths: nothing is allocated from a
+//! spec value before it has passed, so a bad value is a one-line error naming its key at once.
 
 use super::spec::{GridSize, Spec, SpecError};
 use std::collections::HashSet;

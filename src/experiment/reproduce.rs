@@ -39,7 +39,7 @@ pub struct Plan {
     pub readings: Vec<ReadingSet>,
 }
 
-/// A named set of readings (README "Readings"): dotted spec keys and the values to use.
+/// A named set of readings (docs/readings.md): dotted spec keys and the values to use.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ReadingSet {
@@ -589,7 +589,7 @@ fn render_readings(out: &Path, plan: &Plan, rows: &[ReadingClaim]) -> Result<Str
     write_atomic(&out.join("readings.csv"), csv_records(&header, &csv_rows)?.as_bytes())?;
     let mut readings = vec![plan.reading.clone()];
     readings.extend(plan.readings.iter().map(|r| r.name.clone()));
-    let mut s = String::from("\n---\n\n# Readings matrix\n\nThe thesis leaves some steps ambiguous; each is a named spec option (README, \"Readings\"). The plan's specs ran as written");
+    let mut s = String::from("\n---\n\n# Readings matrix\n\nThe thesis leaves some steps ambiguous; each is a named spec option (docs/readings.md). The plan's specs ran as written");
     let _ = write!(s, " (reading `{}`) and again under each reading set below, from the same maps and seeds; every claim is shown under every reading, so a reader sees which conclusions rest on which reading (`readings.csv`).\n\n", plan.reading);
     for r in &plan.readings {
         let keys: Vec<String> = r.set.iter().map(|(k, v)| format!("`{k} = {v}`")).collect();

@@ -33,7 +33,7 @@ use std::fmt;
 use std::str::FromStr;
 
 /// How approach A's surface error is scored (thesis Section 5.2.4 defines Eq. 5.13 "for the
-/// improved approach" only; a named reading, README "Readings").
+/// improved approach" only; a named reading, docs/readings.md).
 #[derive(
     Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default, Serialize, Deserialize,
 )]

@@ -2,7 +2,7 @@
 //!
 //! The thesis gives only the averaging method, Eq. 2.9-2.11, written for as many control points as
 //! parameters, and does not say what it does when the control net is smaller than the grid (every
-//! Chapter 5 net but none of its formulas). Two readings are kept, by name (README "Readings"):
+//! Chapter 5 net but none of its formulas). Two readings are kept, by name (docs/readings.md):
 //! - [`KnotRule::Eq2_10`]: Eq. 2.10 applied literally with n = CN - 1, T_{j+p} = (1/p)
 //!   sum_{i=j}^{j+p-1} t_i for j = 1..n-p, so a smaller net uses only the first parameters
 //!   t_1..t_{CN-2}. This is the reading that reproduces the thesis' errors (Appendices E, F).

@@ -151,7 +151,7 @@ pub(crate) fn validate(spec: &Spec, s: &Seed004Spec) -> Result<(), SpecError> {
     Ok(())
 }
 
-/// The bounds of the `[seed004]` section's sizes and counts (README, "Spec limits").
+/// The bounds of the `[seed004]` section's sizes and counts (docs/specs.md, "Spec limits").
 pub(crate) fn limits(c: &Check, s: &Seed004Spec) -> Result<(), SpecError> {
     c.list("seed004.control_points", &s.control_points)?;
     c.list("seed004.table2_control_points", &s.table2_control_points)?;

@@ -5,7 +5,7 @@ use super::Seed003Spec;
 use crate::experiment::limits::{self, Check};
 use crate::experiment::spec::SpecError;
 
-/// The bounds of the `[seed003]` section's sizes and counts (README, "Spec limits").
+/// The bounds of the `[seed003]` section's sizes and counts (docs/specs.md, "Spec limits").
 pub(crate) fn limits(c: &Check, s: &Seed003Spec) -> Result<(), SpecError> {
     c.list("seed003.examples", &s.examples)?;
     c.list("seed003.methods", &s.methods)?;

@@ -35,7 +35,7 @@ pub struct FitRow {
     pub surface_error: f64,
     /// Largest distance between the two fitted surfaces along the shared border.
     pub gap: f64,
-    /// The readings the fit used (README "Readings").
+    /// The readings the fit used (docs/readings.md).
     pub knots: String,
     pub error_a: String,
     /// Between the data points (dense evaluation): largest distance of a surface point from the

@@ -34,10 +34,10 @@ pub struct FitSpec {
     /// Pictures like Appendices G/H and the error-vs-control-net chart.
     #[serde(default = "crate::families::som::spec::default_true")]
     pub pictures: bool,
-    /// Reading of the knot rule for nets smaller than the grid (README "Readings").
+    /// Reading of the knot rule for nets smaller than the grid (docs/readings.md).
     #[serde(default)]
     pub knots: crate::spline::KnotRule,
-    /// Reading of approach A's surface error (README "Readings").
+    /// Reading of approach A's surface error (docs/readings.md).
     #[serde(default)]
     pub error_a: crate::spline::ErrorA,
     /// Beyond the thesis: penalised least squares weight (0 = the thesis' plain least squares).
@@ -215,7 +215,7 @@ impl FitCell {
     }
 }
 
-/// The bounds of the `[fit]` section's sizes and counts (README, "Spec limits").
+/// The bounds of the `[fit]` section's sizes and counts (docs/specs.md, "Spec limits").
 pub(crate) fn limits(c: &Check, s: &FitSpec) -> Result<(), SpecError> {
     c.datasets("fit.datasets", &s.datasets)?;
     c.grids("fit.grid", [&s.grid])?;

@@ -140,7 +140,7 @@ pub(crate) fn validate(spec: &Spec, g: &GrowingGridSpec) -> Result<(), SpecError
     Ok(())
 }
 
-/// The bounds of the `[growing_grid]` section's sizes and counts (README, "Spec limits").
+/// The bounds of the `[growing_grid]` section's sizes and counts (docs/specs.md, "Spec limits").
 pub(crate) fn limits(c: &Check, g: &GrowingGridSpec) -> Result<(), SpecError> {
     c.datasets("growing_grid.datasets", &g.datasets)?;
     c.grids("growing_grid.grid", [&g.grid])?;

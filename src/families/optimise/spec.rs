@@ -64,7 +64,7 @@ pub struct OptimSpec {
     pub csa: crate::optim::cuckoo::Csa,
     #[serde(default)]
     pub icsa: crate::optim::cuckoo::Icsa,
-    /// Reading of the knot rule of approach B's start (README "Readings").
+    /// Reading of the knot rule of approach B's start (docs/readings.md).
     #[serde(default)]
     pub knots: crate::spline::KnotRule,
     /// Beyond the thesis: penalised least squares weight of B's start (0 = plain least squares).
@@ -223,7 +223,7 @@ impl OptimCell {
     }
 }
 
-/// The bounds of the `[optim]` section's sizes and counts (README, "Spec limits").
+/// The bounds of the `[optim]` section's sizes and counts (docs/specs.md, "Spec limits").
 pub(crate) fn limits(c: &Check, o: &OptimSpec) -> Result<(), SpecError> {
     c.datasets("optim.datasets", &o.datasets)?;
     c.grids("optim.grid", [&o.grid])?;

@@ -182,7 +182,7 @@ pub(crate) fn validate(spec: &Spec, s: &Seed002Spec) -> Result<(), SpecError> {
     Ok(())
 }
 
-/// The bounds of the `[seed002]` section's sizes and counts (README, "Spec limits").
+/// The bounds of the `[seed002]` section's sizes and counts (docs/specs.md, "Spec limits").
 pub(crate) fn limits(c: &Check, s: &Seed002Spec) -> Result<(), SpecError> {
     c.list("seed002.surfaces", &s.surfaces)?;
     c.list("seed002.optimisers", &s.optimisers)?;

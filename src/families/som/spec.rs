@@ -162,7 +162,7 @@ impl SomCell {
     }
 }
 
-/// The bounds of the `[som]` section's sizes and counts (README, "Spec limits").
+/// The bounds of the `[som]` section's sizes and counts (docs/specs.md, "Spec limits").
 pub(crate) fn limits(c: &Check, s: &SomSpec) -> Result<(), SpecError> {
     c.datasets("som.datasets", &s.datasets)?;
     c.int("som.iterations", s.iterations, limits::MAX_ITERATIONS)?;
