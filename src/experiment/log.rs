@@ -14,7 +14,7 @@ use std::fs::{File, OpenOptions};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-pub use crate::io::outdir::{FINGERPRINT_FILE, LOG_FILE};
+pub use crate::io::outdir::{FINGERPRINT_FILE, LOG_FILE, LOG_GZ};
 
 /// The `I`-th of `N` deterministic slices of a spec's cells (1-based): cell number k belongs to
 /// shard (k mod N) + 1, so every shard gets a mix of small and large cells.
@@ -147,16 +147,21 @@ struct Line<T> {
     record: T,
 }
 
-/// The finished cells a folder's log holds, by key (the last line wins if a key repeats). A torn
-/// last line (no newline: the write was cut short) is dropped and cut off the file; any other
-/// malformed line is an error naming the file and line, and so is a line whose seed is not the
-/// cell's seed under `master_seed` (a log that mixes runs).
+/// The finished cells a folder's log holds, by key (the last line wins if a key repeats): the
+/// compressed log of a finished run ([`LOG_GZ`]) first, then the plain one ([`LOG_FILE`]). A torn
+/// last line of the plain log (no newline: the write was cut short) is dropped and cut off the
+/// file; any other malformed line is an error naming the file and line, and so is a line whose
+/// seed is not the cell's seed under `master_seed` (a log that mixes runs).
 pub fn read_records<T: DeserializeOwned>(
     dir: &Path,
     master_seed: u64,
 ) -> Result<BTreeMap<String, T>> {
-    let path = dir.join(LOG_FILE);
     let mut out = BTreeMap::new();
+    let gz = dir.join(LOG_GZ);
+    if gz.exists() {
+        parse_lines(&gz, &gunzip(&gz)?, master_seed, &mut out)?;
+    }
+    let path = dir.join(LOG_FILE);
     if !path.exists() {
         return Ok(out);
     }
@@ -166,7 +171,25 @@ pub fn read_records<T: DeserializeOwned>(
         Some(k) => k + 1,
         None => 0,
     };
-    for (n, line) in text[..complete].lines().enumerate() {
+    parse_lines(&path, &text[..complete], master_seed, &mut out)?;
+    if complete < text.len() {
+        let f = OpenOptions::new()
+            .write(true)
+            .open(&path)
+            .with_context(|| format!("cannot open {}", path.display()))?;
+        f.set_len(complete as u64)
+            .with_context(|| format!("cannot cut the torn last line of {}", path.display()))?;
+    }
+    Ok(out)
+}
+
+fn parse_lines<T: DeserializeOwned>(
+    path: &Path,
+    text: &str,
+    master_seed: u64,
+    out: &mut BTreeMap<String, T>,
+) -> Result<()> {
+    for (n, line) in text.lines().enumerate() {
         if line.trim().is_empty() {
             continue;
         }
@@ -179,15 +202,56 @@ pub fn read_records<T: DeserializeOwned>(
         }
         out.insert(l.key, l.record);
     }
-    if complete < text.len() {
-        let f = OpenOptions::new()
-            .write(true)
-            .open(&path)
-            .with_context(|| format!("cannot open {}", path.display()))?;
-        f.set_len(complete as u64)
-            .with_context(|| format!("cannot cut the torn last line of {}", path.display()))?;
+    Ok(())
+}
+
+/// The text of a gzip-compressed log, whole (a truncated or corrupt file is an error naming it).
+fn gunzip(path: &Path) -> Result<String> {
+    use std::io::Read;
+    let file = File::open(path).with_context(|| format!("cannot open {}", path.display()))?;
+    let mut text = String::new();
+    flate2::read::GzDecoder::new(std::io::BufReader::new(file))
+        .read_to_string(&mut text)
+        .with_context(|| format!("{}: not a whole gzip-compressed cell log", path.display()))?;
+    if !text.is_empty() && !text.ends_with('\n') {
+        bail!("{}: its last line is torn", path.display());
     }
-    Ok(out)
+    Ok(text)
+}
+
+/// The whole log of a folder as text, compressed part first (for tests and tools that read it).
+pub fn log_text(dir: &Path) -> Result<String> {
+    let mut text = String::new();
+    let gz = dir.join(LOG_GZ);
+    if gz.exists() {
+        text = gunzip(&gz)?;
+    }
+    let plain = dir.join(LOG_FILE);
+    if plain.exists() {
+        text.push_str(
+            &std::fs::read_to_string(&plain)
+                .with_context(|| format!("cannot read {}", plain.display()))?,
+        );
+    }
+    Ok(text)
+}
+
+/// Compress a finished run's log: the plain log's complete lines are added to `cells.jsonl.gz`
+/// (written whole, atomically), then the plain log is removed. Interrupted at any point, the
+/// folder still holds every line once: [`read_records`] reads both files.
+pub fn compress(dir: &Path) -> Result<()> {
+    use std::io::Write as _;
+    let plain = dir.join(LOG_FILE);
+    if !plain.exists() {
+        return Ok(());
+    }
+    let text = log_text(dir)?;
+    let complete = text.rfind('\n').map(|k| k + 1).unwrap_or(0);
+    let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::new(6));
+    enc.write_all(&text.as_bytes()[..complete]).context("cannot compress the cell log")?;
+    let bytes = enc.finish().context("cannot compress the cell log")?;
+    crate::io::write_atomic(&dir.join(LOG_GZ), &bytes)?;
+    std::fs::remove_file(&plain).with_context(|| format!("cannot remove {}", plain.display()))
 }
 
 /// Appends one line per finished cell, flushed at once.
@@ -300,6 +364,33 @@ mod tests {
             back["k"].iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
             xs.iter().map(|v| v.to_bits()).collect::<Vec<_>>()
         );
+    }
+
+    #[test]
+    fn a_compressed_log_reads_as_the_plain_one_and_takes_more_lines_after_it() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut log = CellLog::open(dir.path(), false, 3).unwrap();
+        for (k, v) in [("a", 1.0), ("b", 0.1 + 0.2)] {
+            log.push(k, &vec![v]).unwrap();
+        }
+        drop(log);
+        let plain: BTreeMap<String, Vec<f64>> = read_records(dir.path(), 3).unwrap();
+        compress(dir.path()).unwrap();
+        assert!(!dir.path().join(LOG_FILE).exists() && dir.path().join(LOG_GZ).exists());
+        assert_eq!(read_records::<Vec<f64>>(dir.path(), 3).unwrap(), plain);
+        // A resumed run appends to a new plain log; both are read, and compressed again whole.
+        CellLog::open(dir.path(), true, 3).unwrap().push("c", &vec![2.0]).unwrap();
+        assert_eq!(read_records::<Vec<f64>>(dir.path(), 3).unwrap().len(), 3);
+        compress(dir.path()).unwrap();
+        let all: BTreeMap<String, Vec<f64>> = read_records(dir.path(), 3).unwrap();
+        assert_eq!((all.len(), all["b"][0].to_bits()), (3, (0.1f64 + 0.2).to_bits()));
+        assert_eq!(log_text(dir.path()).unwrap().lines().count(), 3);
+        // A truncated compressed log is named.
+        let gz = dir.path().join(LOG_GZ);
+        let bytes = std::fs::read(&gz).unwrap();
+        std::fs::write(&gz, &bytes[..bytes.len() / 2]).unwrap();
+        let e = read_records::<Vec<f64>>(dir.path(), 3).unwrap_err().to_string();
+        assert!(e.contains("cells.jsonl.gz") && e.contains("not a whole"), "{e}");
     }
 
     #[test]

@@ -7,6 +7,7 @@ pub mod grid_size;
 pub mod limits;
 pub mod log;
 pub mod overrides;
+pub mod packed;
 pub mod reproduce;
 pub mod runner;
 pub mod seeds;
@@ -39,6 +40,9 @@ pub struct RunContext {
     /// The command REPORT.md gives to make this folder again, when it is not `somnurbs run` of
     /// the spec (a plan's spec: the plan's `somnurbs reproduce` line).
     pub rerun: Option<String>,
+    /// Draw the pictures and 3-D views (off for a plan's reading variants, whose tables and
+    /// claims are what the readings matrix compares).
+    pub pictures: bool,
 }
 
 impl RunContext {
@@ -53,6 +57,7 @@ impl RunContext {
             session: None,
             page: false,
             rerun: None,
+            pictures: true,
         }
     }
 
@@ -240,7 +245,7 @@ fn claim(out: &Path, fp: &log::Fingerprint, resume: bool) -> Result<Claimed> {
         return Ok(Claimed::Start);
     }
     let Some(old) = log::Fingerprint::read(out)? else {
-        if out.join(log::LOG_FILE).exists() {
+        if out.join(log::LOG_FILE).exists() || out.join(log::LOG_GZ).exists() {
             anyhow::bail!(
                 "cannot resume in {}: it has a cell log but no {}",
                 out.display(),
@@ -313,11 +318,18 @@ fn run_spec_locked(variants: &[Spec], ctx: &RunContext) -> Result<PathBuf> {
     };
     if let Some(section) = section {
         let rerun = ctx.rerun.clone().unwrap_or_else(|| run_command(spec, &manifest, &ctx.out));
-        let report = report_md(spec, &manifest, &rerun, &[section]);
+        let mut report = report_md(spec, &manifest, &rerun, &[section]);
+        if !ctx.pictures {
+            report.push_str(NO_PICTURES);
+        }
         crate::io::write_atomic(&ctx.out.join("REPORT.md"), report.as_bytes())?;
         if ctx.page {
             crate::report::html::write(&ctx.out)?;
         }
+    }
+    // A finished run's log is kept compressed (a shard's stays plain for `merge`).
+    if tables {
+        log::compress(&ctx.out)?;
     }
     // The manifest is the very last write: its presence says every file above is whole.
     let text = toml::to_string_pretty(&manifest).context("cannot serialise the manifest")?;
@@ -378,6 +390,7 @@ pub fn report_md(spec: &Spec, m: &Manifest, rerun: &str, sections: &[String]) ->
         m.cpu_seconds_cells,
         rerun
     );
+    s.push_str(&profile_note(spec));
     if !limits::dataset_entries(spec).is_empty() {
         let _ = writeln!(s, "Data sets are {} (`normalise`); a data set given as a relative path is read from the spec's folder.\n", spec.file.normalise.describe());
     }
@@ -387,6 +400,28 @@ pub fn report_md(spec: &Spec, m: &Manifest, rerun: &str, sections: &[String]) ->
     }
     s
 }
+
+/// What the profile changed from the spec as written and, for a reduced profile, the caveat that
+/// its counts are no evidence (empty for the spec as written).
+pub fn profile_note(spec: &Spec) -> String {
+    let changes = spec.profile_changes();
+    let Some(profile) = spec.profile.as_deref().filter(|_| !changes.is_empty()) else {
+        return String::new();
+    };
+    let list: Vec<String> = changes.iter().map(|c| format!("`{} = {}`", c.key, c.value)).collect();
+    let mut s =
+        format!("Profile `{profile}` changes the spec as written: {}.\n\n", list.join(", "));
+    if spec.reduced() {
+        s.push_str(NOT_EVIDENCE);
+    }
+    s
+}
+
+/// The note of a run drawn without pictures.
+pub const NO_PICTURES: &str = "\nNo pictures or 3-D views are drawn in this folder: it is a reading variant of a plan, whose tables and claims the plan's readings matrix compares. Run the spec with the variant's keys (`somnurbs run SPEC --set KEY=VALUE ...`) to draw them.\n";
+
+/// The caveat a reduced run carries at the top of its report.
+pub const NOT_EVIDENCE: &str = "> **Not evidence.** This is a reduced run (fewer cells, repeats or iterations than the spec as written), for checking the harness and the pipeline. Its counts are too few to support or refute a claim, and its verdicts are mostly *undecided* for that reason; cite only a run of the spec as written.\n\n";
 
 /// Combine shard folders of one spec into `out` and write its tables: the shards' fingerprints
 /// must agree (apart from the shard) and cover 1..N once, each shard finished, its logged seeds

@@ -328,7 +328,7 @@ pub fn reproduce(
     for (reading, rspecs) in &reading_specs {
         for spec in rspecs {
             let folder = Path::new(READINGS_DIR).join(&reading.name).join(&spec.file.name);
-            let sub = RunContext { out: ctx.out.join(&folder), ..ctx.clone() };
+            let sub = RunContext { out: ctx.out.join(&folder), pictures: false, ..ctx.clone() };
             eprintln!(
                 "somnurbs: reproduce: {} under the readings `{}` -> {}",
                 spec.file.name,
@@ -567,7 +567,7 @@ fn readings_matrix(out: &Path, plan: &Plan) -> Result<Vec<ReadingClaim>> {
 /// and whether the verdict changes with the reading.
 fn render_readings(out: &Path, plan: &Plan, rows: &[ReadingClaim]) -> Result<String> {
     let header: Vec<String> =
-        ["spec", "chapter", "claim", "reading", "verdict", "holds", "checked", "note"]
+        ["spec", "chapter", "grid", "claim", "reading", "verdict", "holds", "checked", "note"]
             .iter()
             .map(|s| s.to_string())
             .collect();
@@ -577,6 +577,7 @@ fn render_readings(out: &Path, plan: &Plan, rows: &[ReadingClaim]) -> Result<Str
             vec![
                 r.folder.clone(),
                 r.claim.chapter.clone(),
+                r.claim.grid.clone(),
                 r.claim.statement.clone(),
                 r.reading.clone(),
                 r.claim.verdict().to_string(),
@@ -603,25 +604,28 @@ fn render_readings(out: &Path, plan: &Plan, rows: &[ReadingClaim]) -> Result<Str
             r.name
         );
     }
-    let mut keys: Vec<(String, String)> = Vec::new();
+    let mut keys: Vec<(String, String, String)> = Vec::new();
     for r in rows {
-        let k = (r.folder.clone(), r.claim.statement.clone());
+        let k = (r.folder.clone(), r.claim.grid.clone(), r.claim.statement.clone());
         if !keys.contains(&k) {
             keys.push(k);
         }
     }
-    let mut h = vec!["spec".to_string(), "claim".into()];
+    let mut h = vec!["spec".to_string(), "grid".into(), "claim".into()];
     h.extend(readings.iter().map(|r| format!("`{r}`")));
     h.push("changes with the reading".into());
     let mut md_rows = Vec::new();
     let mut changing = 0;
-    for (folder, statement) in &keys {
+    for (folder, grid, statement) in &keys {
         let cells: Vec<Option<&Claim>> = readings
             .iter()
             .map(|rd| {
                 rows.iter()
                     .find(|r| {
-                        &r.reading == rd && &r.folder == folder && &r.claim.statement == statement
+                        &r.reading == rd
+                            && &r.folder == folder
+                            && &r.claim.grid == grid
+                            && &r.claim.statement == statement
                     })
                     .map(|r| &r.claim)
             })
@@ -629,7 +633,7 @@ fn render_readings(out: &Path, plan: &Plan, rows: &[ReadingClaim]) -> Result<Str
         let verdicts: Vec<&str> = cells.iter().flatten().map(|c| c.verdict()).collect();
         let changes = verdicts.windows(2).any(|w| w[0] != w[1]);
         changing += changes as usize;
-        let mut row = vec![folder.clone(), statement.clone()];
+        let mut row = vec![folder.clone(), grid.clone(), statement.clone()];
         row.extend(cells.iter().map(|c| {
             c.map(|c| format!("{} {}/{}", c.verdict(), c.ours.0, c.ours.1))
                 .unwrap_or_else(|| "-".into())
@@ -672,6 +676,9 @@ fn combined_report(
         done.len(),
         wall
     );
+    if specs.iter().any(Spec::reduced) {
+        s.push_str(super::NOT_EVIDENCE);
+    }
     s.push_str("| spec | folder | wall s |\n|---|---|---|\n");
     for (name, secs) in done {
         let _ = writeln!(s, "| {name} | [`{name}/`]({name}/REPORT.md) | {secs:.1} |");
@@ -693,17 +700,19 @@ fn combined_report(
             if beyond.contains(&spec.file.name) {
                 // Claims of the specs beyond the source's protocol say so.
                 for c in cs.iter_mut() {
-                    c.chapter = format!("{} ({})", c.chapter, spec.file.name);
+                    c.chapter = format!("{} (beyond the source's protocol)", c.chapter);
                 }
             }
             all.extend(cs);
         }
     }
     all.extend(plan_claims);
-    let table = claims::write(out, &all)?;
+    let table = claims::write(out, plan_name, &all, true)?;
     let holding = all.iter().filter(|c| c.holds()).count();
+    let compared = all.iter().filter(|c| !c.agreement().is_empty()).count();
+    let agree = all.iter().filter(|c| c.agreement() == "agrees").count();
     if !all.is_empty() {
-        let _ = writeln!(s, "\n## Claims\n\nEach claim of the thesis (or, for the other seeds, of the paper) is counted on this reproduction (`here`) and, where the published tables allow, on the source's own figures; {holding} of {} hold here without qualification (verdict **holds**: in every case checked, or, for a best-of-several claim, ahead of every rival). Also in `claims.csv`.\n", all.len());
+        let _ = writeln!(s, "\n## Claims\n\nEach claim of the thesis (or, for the other seeds, of the paper) is counted on this reproduction (`here`), one row per spec, grid and claim, and, where the published tables hold the same cells, on the source's own figures. {holding} of {} hold here; {agree} of the {compared} with the source's own count agree with it. Also in `claims.csv`.\n", all.len());
         s.push_str(&table);
     }
     s.push_str(&sections);

@@ -232,6 +232,23 @@ impl Spec {
         Ok(spec)
     }
 
+    /// What the profile changes from the spec as written: each leaf key it sets, its value,
+    /// and whether that reduces the run (a smaller number, or a shorter list, than the spec's).
+    pub fn profile_changes(&self) -> Vec<ProfileChange> {
+        let Some(over) = self.profile.as_deref().and_then(|p| self.file.profiles.get(p)) else {
+            return Vec::new();
+        };
+        let base: toml::Table = toml::from_str(&self.text).unwrap_or_default();
+        let mut out = Vec::new();
+        profile_leaves(&base, over, "", &mut out);
+        out
+    }
+
+    /// Whether the profile reduces the run in any key (see [`Spec::profile_changes`]).
+    pub fn reduced(&self) -> bool {
+        self.profile_changes().iter().any(|c| c.reduces)
+    }
+
     /// Read and parse a spec file.
     pub fn load(path: &Path, profile: Option<&str>) -> Result<Spec, SpecError> {
         let shown = path.display().to_string();
@@ -386,3 +403,32 @@ impl Spec {
 #[cfg(test)]
 #[path = "spec_tests.rs"]
 mod tests;
+
+/// One key a profile sets (see [`Spec::profile_changes`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ProfileChange {
+    pub key: String,
+    pub value: String,
+    pub reduces: bool,
+}
+
+fn profile_leaves(base: &toml::Table, over: &toml::Table, at: &str, out: &mut Vec<ProfileChange>) {
+    for (k, v) in over {
+        let key = if at.is_empty() { k.clone() } else { format!("{at}.{k}") };
+        let was = base.get(k);
+        match (v, was) {
+            (toml::Value::Table(t), Some(toml::Value::Table(b))) => profile_leaves(b, t, &key, out),
+            (toml::Value::Table(t), _) => profile_leaves(&toml::Table::new(), t, &key, out),
+            _ => {
+                let num =
+                    |x: &toml::Value| x.as_float().or_else(|| x.as_integer().map(|i| i as f64));
+                let reduces = match (v, was) {
+                    (toml::Value::Array(a), Some(toml::Value::Array(b))) => a.len() < b.len(),
+                    (x, Some(y)) => matches!((num(x), num(y)), (Some(a), Some(b)) if a < b),
+                    _ => false,
+                };
+                out.push(ProfileChange { key, value: v.to_string(), reduces });
+            }
+        }
+    }
+}

@@ -25,6 +25,24 @@ fn parses_expands_and_applies_profile() {
     assert_eq!(crate::families::som::spec::cells(&q)[3].key(), "som/cube/dnsom/18x30/r0");
 }
 
+/// A profile's changes are listed, and one that lowers a number or shortens a list reduces the
+/// run (the reports' "not evidence" caveat); raising one does not.
+#[test]
+fn profile_changes_say_whether_the_run_is_reduced() {
+    let q = Spec::parse("t.toml", SPEC, Some("quick")).unwrap();
+    assert_eq!(
+        q.profile_changes(),
+        vec![ProfileChange { key: "som.iterations".into(), value: "7".into(), reduces: true }]
+    );
+    assert!(q.reduced() && !Spec::parse("t.toml", SPEC, None).unwrap().reduced());
+    let more = SPEC.replace("iterations = 7", "iterations = 700");
+    let m = Spec::parse("t.toml", &more, Some("quick")).unwrap();
+    assert!(!m.reduced(), "{:?}", m.profile_changes());
+    // A shorter list reduces too.
+    let text = "name = \"f\"\nmaster_seed = 1\n[fit]\ndatasets = [\"cube\", \"sphere\"]\ngrid = \"20x20\"\ncontrol_nets = [\"6x6\"]\nparameterisations = [\"uniform\"]\napproaches = [\"A\"]\n[profiles.quick.fit]\ndatasets = [\"cube\"]\n";
+    assert!(Spec::parse("f.toml", text, Some("quick")).unwrap().reduced());
+}
+
 /// A reading set's keys go through the same parsing and validation as the file's own values;
 /// a key of a section the spec does not have is skipped.
 #[test]

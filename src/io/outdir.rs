@@ -40,6 +40,8 @@ pub const LOCK_FILE: &str = ".somnurbs.lock";
 pub const MANIFEST: &str = "manifest.toml";
 /// The cell log of a run (one JSON record per finished cell; see `experiment::log`).
 pub const LOG_FILE: &str = "cells.jsonl";
+/// The cell log of a finished run, gzip-compressed (see `experiment::log::compress`).
+pub const LOG_GZ: &str = "cells.jsonl.gz";
 /// The fingerprint of the run a folder holds (what `--resume` and `merge` compare).
 pub const FINGERPRINT_FILE: &str = "fingerprint.toml";
 /// Present in a `reproduce` folder from the moment its inputs have loaded until its REPORT.md.
@@ -47,7 +49,8 @@ pub const INCOMPLETE: &str = ".somnurbs-incomplete";
 /// The record of the plan a `reproduce` folder holds (what `reproduce --resume` compares).
 pub const PLAN_FILE: &str = "plan_fingerprint.toml";
 /// The files that make a folder a result folder (a run, a shard, a plan or a `fit`).
-const MARKERS: [&str; 6] = [MANIFEST, FINGERPRINT_FILE, LOG_FILE, INCOMPLETE, PLAN_FILE, LOCK_FILE];
+const MARKERS: [&str; 7] =
+    [MANIFEST, FINGERPRINT_FILE, LOG_FILE, LOG_GZ, INCOMPLETE, PLAN_FILE, LOCK_FILE];
 /// How often a lock holder refreshes its record.
 pub const HEARTBEAT: Duration = Duration::from_secs(20);
 /// A record of another host older than this is taken to be left by a dead writer.
@@ -154,7 +157,7 @@ fn describe(dir: &Path, entries: &[String]) -> String {
             None => format!("a finished run{}", spec(&m)),
         };
     }
-    if has(FINGERPRINT_FILE) || has(LOG_FILE) {
+    if has(FINGERPRINT_FILE) || has(LOG_FILE) || has(LOG_GZ) {
         return format!(
             "an unfinished run{} (continue it with --resume and the same spec, profile and options)",
             spec(&named(FINGERPRINT_FILE))
@@ -503,7 +506,7 @@ pub fn require_finished(dir: &Path, role: &str) -> Result<()> {
         if has(INCOMPLETE) {
             bail!("{role} {} is unfinished: its reproduction did not complete ({INCOMPLETE} is still there); finish it with `somnurbs reproduce --resume`", shown.display());
         }
-        let marker = [FINGERPRINT_FILE, LOG_FILE].into_iter().find(|f| has(f));
+        let marker = [FINGERPRINT_FILE, LOG_FILE, LOG_GZ].into_iter().find(|f| has(f));
         if !has(MANIFEST) {
             if let Some(m) = marker {
                 bail!("{role} {} is unfinished: it has {m} but no {MANIFEST} (the run did not complete; finish it with `somnurbs run SPEC --out {} --resume`)", shown.display(), shown.display());

@@ -1,133 +1,309 @@
-//! Qualitative claims of the thesis, each checked on the thesis' own published numbers and on a
-//! reproduction's, with the counts behind the verdict.
+//! Qualitative claims of the sources, each counted on a run and, where the published tables hold
+//! the same cells, on the source's own figures, with one verdict rule for all
+//! (docs/statistics.md, "Verdicts"):
+//! - an [`Kind::Every`] claim (soundness: surfaces near the data, elitism, the bound never beaten;
+//!   and what a source states for every case) holds only in every case checked;
+//! - a [`Kind::Most`] claim ("in most cells") holds when the Wilson 95% interval of its share lies
+//!   above one half, does not hold when it lies below, and is undecided otherwise;
+//! - a [`Kind::Best`] claim ("X is the best of several") is judged the same way on X's cells
+//!   against its best rival's (X's share of the cells the two win);
+//! - beside the source's count, `agreement` says whether the two shares agree: Newcombe's 95%
+//!   interval of their difference holds 0 ("agrees") or not ("differs").
 
+use crate::stats::proportion::{difference, wilson, Z95};
 use anyhow::Context;
 use std::fmt::Write;
 
+/// How a claim is judged (see the module doc).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    Every,
+    Most,
+    Best,
+}
+
+impl Kind {
+    pub fn name(self) -> &'static str {
+        match self {
+            Kind::Every => "every",
+            Kind::Most => "most",
+            Kind::Best => "best",
+        }
+    }
+
+    fn parse(s: &str) -> Option<Kind> {
+        [Kind::Every, Kind::Most, Kind::Best].into_iter().find(|k| k.name() == s)
+    }
+}
+
 #[derive(Debug, Clone)]
 pub struct Claim {
+    /// The spec whose run counted it (filled by [`write`] when empty).
+    pub spec: String,
     pub chapter: String,
+    /// The grid it was counted on; empty for a claim over every run of the spec.
+    pub grid: String,
+    pub kind: Kind,
     pub statement: String,
-    /// (cases where it holds, cases checked) on the reproduction.
+    /// (cases where it holds, cases checked) on this run.
     pub ours: (usize, usize),
-    /// The same count on the thesis' published figures, when they allow it.
+    /// The same count on the source's published figures for the same cells, when they hold them
+    /// all.
     pub thesis: Option<(usize, usize)>,
-    /// For a claim that one option is the best of several ("X is the best parameterisation"):
-    /// the most cases any other option wins here. The claim then holds when `ours.0` is above it,
-    /// so that `ours` counts the same units (cells won out of cells) as the thesis' count.
+    /// For a [`Kind::Best`] claim: the most cases any other option wins here.
     pub rival: Option<usize>,
     pub note: String,
 }
 
 impl Claim {
-    /// Whether the claim holds here without qualification (the verdict "holds").
+    fn new(kind: Kind, chapter: &str, statement: impl Into<String>, ours: (usize, usize)) -> Self {
+        Claim {
+            spec: String::new(),
+            chapter: chapter.into(),
+            grid: String::new(),
+            kind,
+            statement: statement.into(),
+            ours,
+            thesis: None,
+            rival: None,
+            note: String::new(),
+        }
+    }
+
+    /// A claim that must hold in every case.
+    pub fn every(chapter: &str, statement: impl Into<String>, ours: (usize, usize)) -> Self {
+        Self::new(Kind::Every, chapter, statement, ours)
+    }
+
+    /// A claim that holds in most cases.
+    pub fn most(chapter: &str, statement: impl Into<String>, ours: (usize, usize)) -> Self {
+        Self::new(Kind::Most, chapter, statement, ours)
+    }
+
+    /// "X is the best of several": X wins `ours.0` of `ours.1` cases, its best rival `rival`.
+    pub fn best(
+        chapter: &str,
+        statement: impl Into<String>,
+        ours: (usize, usize),
+        rival: usize,
+    ) -> Self {
+        Claim { rival: Some(rival), ..Self::new(Kind::Best, chapter, statement, ours) }
+    }
+
+    pub fn on_grid(mut self, grid: impl ToString) -> Self {
+        self.grid = grid.to_string();
+        self
+    }
+
+    /// The source's own count over the same cells; a count over another number of cases (the
+    /// source lacks some of this run's cells) is not comparable and is dropped.
+    pub fn thesis(mut self, thesis: Option<(usize, usize)>) -> Self {
+        self.thesis = thesis.filter(|t| t.1 > 0 && t.1 == self.ours.1);
+        self
+    }
+
+    pub fn note(mut self, note: impl Into<String>) -> Self {
+        self.note = note.into();
+        self
+    }
+
+    /// Whether the claim holds here (the verdict "holds").
     pub fn holds(&self) -> bool {
         self.verdict() == "holds"
     }
 
+    /// The (successes, trials) the verdict judges: the cases, or for a best-of-several claim
+    /// X's cases against its best rival's.
+    fn trials(&self) -> (usize, usize) {
+        match (self.kind, self.rival) {
+            (Kind::Best, Some(r)) => (self.ours.0, self.ours.0 + r),
+            _ => self.ours,
+        }
+    }
+
+    /// The Wilson 95% interval of the judged share (None for an every-case claim).
+    pub fn interval(&self) -> Option<(f64, f64)> {
+        let (k, n) = self.trials();
+        (self.kind != Kind::Every && n > 0).then(|| wilson(k, n, Z95))
+    }
+
     pub fn verdict(&self) -> &'static str {
-        match (self.ours, self.rival) {
-            ((_, 0), _) => "not checked",
-            // Best of several: ahead of every other option.
-            ((a, _), Some(r)) if a > r => "holds",
-            ((a, _), Some(r)) if a == r => "tied",
-            (_, Some(_)) => "does not hold",
-            ((a, b), None) if a == b => "holds",
-            ((a, b), None) if 2 * a > b => "mostly holds",
-            _ => "does not hold",
+        if self.ours.1 == 0 {
+            return "not checked";
+        }
+        match (self.kind, self.interval()) {
+            (Kind::Every, _) if self.ours.0 == self.ours.1 => "holds",
+            (Kind::Every, _) => "does not hold",
+            (_, None) => "undecided",
+            (_, Some((lo, _))) if lo > 0.5 => "holds",
+            (_, Some((_, hi))) if hi < 0.5 => "does not hold",
+            _ => "undecided",
+        }
+    }
+
+    /// Whether this run's share agrees with the source's ("agrees" / "differs"), or "" without
+    /// the source's count.
+    pub fn agreement(&self) -> &'static str {
+        match self.thesis {
+            Some((a, b)) if self.ours.1 > 0 => {
+                let (lo, hi) = difference(self.ours.0, self.ours.1, a, b, Z95);
+                if lo <= 0.0 && 0.0 <= hi {
+                    "agrees"
+                } else {
+                    "differs"
+                }
+            }
+            _ => "",
         }
     }
 }
 
-/// The columns of `claims.csv`, which every chapter's report writes (and `reproduce` collects).
-/// `best_rival_here` is filled for "X is the best of several" claims only (see [`Claim::rival`]).
-pub const CSV_HEADER: [&str; 9] = [
+/// The columns of `claims.csv`, which every chapter's report writes (and `reproduce` collects):
+/// one row per (spec, grid, claim). `low_95`/`high_95` bound the judged share (empty for an
+/// every-case claim); `best_rival_here` is filled for best-of-several claims only.
+pub const CSV_HEADER: [&str; 15] = [
+    "spec",
     "chapter",
+    "grid",
     "claim",
+    "kind",
     "verdict",
     "holds_here",
     "checked_here",
+    "low_95",
+    "high_95",
+    "best_rival_here",
     "holds_thesis",
     "checked_thesis",
-    "best_rival_here",
+    "agreement",
     "note",
 ];
 
-/// Write `claims.csv` into `out` and return the markdown table of the same claims.
-pub fn write(out: &std::path::Path, claims: &[Claim]) -> anyhow::Result<String> {
-    let rows: Vec<Vec<String>> = claims
+fn csv_row(c: &Claim) -> Vec<String> {
+    let (ht, ct) = c.thesis.map(|(a, b)| (a.to_string(), b.to_string())).unwrap_or_default();
+    let (lo, hi) =
+        c.interval().map(|(l, h)| (format!("{l:.4}"), format!("{h:.4}"))).unwrap_or_default();
+    vec![
+        c.spec.clone(),
+        c.chapter.clone(),
+        c.grid.clone(),
+        c.statement.clone(),
+        c.kind.name().into(),
+        c.verdict().into(),
+        c.ours.0.to_string(),
+        c.ours.1.to_string(),
+        lo,
+        hi,
+        c.rival.map(|r| r.to_string()).unwrap_or_default(),
+        ht,
+        ct,
+        c.agreement().into(),
+        c.note.clone(),
+    ]
+}
+
+/// Write `claims.csv` into `out` (the claims checked in at least one case, each without a spec
+/// named taking `spec`) and return their markdown table (`with_spec`: a spec column).
+pub fn write(
+    out: &std::path::Path,
+    spec: &str,
+    claims: &[Claim],
+    with_spec: bool,
+) -> anyhow::Result<String> {
+    let claims: Vec<Claim> = claims
         .iter()
-        .map(|c| {
-            let (ht, ct) =
-                c.thesis.map(|(a, b)| (a.to_string(), b.to_string())).unwrap_or_default();
-            let rival = c.rival.map(|r| r.to_string()).unwrap_or_default();
-            vec![
-                c.chapter.clone(),
-                c.statement.clone(),
-                c.verdict().to_string(),
-                c.ours.0.to_string(),
-                c.ours.1.to_string(),
-                ht,
-                ct,
-                rival,
-                c.note.clone(),
-            ]
+        .filter(|c| c.ours.1 > 0)
+        .map(|c| Claim {
+            spec: if c.spec.is_empty() { spec.into() } else { c.spec.clone() },
+            ..c.clone()
         })
         .collect();
+    let rows: Vec<Vec<String>> = claims.iter().map(csv_row).collect();
     let header: Vec<String> = CSV_HEADER.iter().map(|h| h.to_string()).collect();
     crate::io::write_atomic(
         &out.join("claims.csv"),
         crate::io::csv_records(&header, &rows)?.as_bytes(),
     )?;
-    Ok(markdown(claims))
+    Ok(markdown(&claims, with_spec))
 }
 
 /// Claims read back from a `claims.csv` (for the combined report of `reproduce`).
 pub fn read(path: &std::path::Path) -> anyhow::Result<Vec<Claim>> {
     let mut rd = csv::Reader::from_path(path).with_context(|| format!("{}", path.display()))?;
+    let header = rd.headers().with_context(|| format!("{}", path.display()))?.clone();
+    if header.iter().ne(CSV_HEADER.iter().copied()) {
+        anyhow::bail!(
+            "{}: not a claims table of this version (columns {})",
+            path.display(),
+            CSV_HEADER.join(",")
+        );
+    }
     let mut out = Vec::new();
     for (n, rec) in rd.records().enumerate() {
         let rec = rec.with_context(|| format!("{}", path.display()))?;
-        let num = |k: usize| -> anyhow::Result<usize> {
-            rec.get(k).unwrap_or("").parse().map_err(|_| {
-                anyhow::anyhow!(
-                    "{}: line {}: column {} is not a count",
-                    path.display(),
-                    n + 2,
-                    CSV_HEADER[k]
-                )
-            })
+        let at = |k: usize| rec.get(k).unwrap_or("");
+        let bad = |k: usize| {
+            anyhow::anyhow!(
+                "{}: line {}: column {} is not valid",
+                path.display(),
+                n + 2,
+                CSV_HEADER[k]
+            )
         };
-        let thesis =
-            if rec.get(5).unwrap_or("").is_empty() { None } else { Some((num(5)?, num(6)?)) };
-        let rival = if rec.get(7).unwrap_or("").is_empty() { None } else { Some(num(7)?) };
+        let num = |k: usize| -> anyhow::Result<usize> { at(k).parse().map_err(|_| bad(k)) };
+        let opt = |k: usize| -> anyhow::Result<Option<usize>> {
+            if at(k).is_empty() {
+                Ok(None)
+            } else {
+                num(k).map(Some)
+            }
+        };
+        let thesis = match (opt(11)?, opt(12)?) {
+            (Some(a), Some(b)) => Some((a, b)),
+            _ => None,
+        };
         out.push(Claim {
-            chapter: rec.get(0).unwrap_or("").into(),
-            statement: rec.get(1).unwrap_or("").into(),
-            ours: (num(3)?, num(4)?),
+            spec: at(0).into(),
+            chapter: at(1).into(),
+            grid: at(2).into(),
+            statement: at(3).into(),
+            kind: Kind::parse(at(4)).ok_or_else(|| bad(4))?,
+            ours: (num(6)?, num(7)?),
+            rival: opt(10)?,
             thesis,
-            rival,
-            note: rec.get(8).unwrap_or("").into(),
+            note: at(14).into(),
         });
     }
     Ok(out)
 }
 
-/// Markdown table of claims.
-pub fn markdown(claims: &[Claim]) -> String {
-    let mut s = String::from("| chapter | claim | verdict here | here | source's own figures (thesis or paper) | note |\n|---|---|---|---|---|---|\n");
+/// The verdict rule in one paragraph, for the reports that show claims.
+pub const RULE: &str = "Verdicts (docs/statistics.md, \"Verdicts\"): a claim of kind *every* (soundness checks, and what a source states for every case) holds only in every case; a claim of kind *most* holds when the Wilson 95% interval of its share lies above 1/2, does not hold when it lies below, and is *undecided* otherwise; a *best*-of-several claim is judged the same way on its cases against its best rival's. *Agreement* with the source's own count (over the same cells) is Newcombe's 95% interval of the difference of the two shares holding 0.";
+
+/// Markdown table of claims, after the rule (empty without claims).
+pub fn markdown(claims: &[Claim], with_spec: bool) -> String {
+    let mut s = String::new();
+    if claims.is_empty() {
+        return s;
+    }
+    let spec_col = if with_spec { "spec | " } else { "" };
+    let _ = writeln!(s, "{RULE}\n\n| {spec_col}chapter | grid | claim | verdict here | here | 95% interval | source's own figures | agreement | note |\n|{}---|---|---|---|---|---|---|---|---|", if with_spec { "---|" } else { "" });
     for c in claims {
         let thesis = c.thesis.map(|(a, b)| format!("{a}/{b}")).unwrap_or_else(|| "-".into());
         let rival = c.rival.map(|r| format!(" (best rival {r})")).unwrap_or_default();
+        let interval =
+            c.interval().map(|(l, h)| format!("{l:.2}-{h:.2}")).unwrap_or_else(|| "-".into());
+        let spec = if with_spec { format!("{} | ", c.spec) } else { String::new() };
+        let grid = if c.grid.is_empty() { "all" } else { c.grid.as_str() };
         let _ = writeln!(
             s,
-            "| {} | {} | **{}** | {}/{}{rival} | {} | {} |",
+            "| {spec}{} | {grid} | {} | **{}** | {}/{}{rival} | {interval} | {thesis} | {} | {} |",
             c.chapter,
             c.statement,
             c.verdict(),
             c.ours.0,
             c.ours.1,
-            thesis,
+            c.agreement(),
             c.note
         );
     }
@@ -139,53 +315,58 @@ mod tests {
     use super::*;
 
     #[test]
-    fn claims_round_trip_through_csv_with_verdicts() {
+    fn one_verdict_rule_for_every_kind() {
+        // Every: only 100% holds.
+        assert_eq!(Claim::every("5", "near", (280, 280)).verdict(), "holds");
+        assert_eq!(Claim::every("5", "near", (279, 280)).verdict(), "does not hold");
+        // Most: the Wilson interval against one half (7/10: 0.40-0.89, undecided).
+        assert_eq!(Claim::most("6", "x", (7, 10)).verdict(), "undecided");
+        assert_eq!(Claim::most("6", "x", (5, 10)).verdict(), "undecided");
+        assert_eq!(Claim::most("6", "x", (122, 140)).verdict(), "holds");
+        assert_eq!(Claim::most("6", "x", (1, 10)).verdict(), "does not hold");
+        assert_eq!(Claim::most("6", "x", (0, 0)).verdict(), "not checked");
+        // Best: X's cases against its best rival's (14 against 11 of 35: undecided).
+        assert_eq!(Claim::best("5", "x", (14, 35), 11).verdict(), "undecided");
+        assert_eq!(Claim::best("5", "x", (30, 35), 5).verdict(), "holds");
+        assert_eq!(Claim::best("5", "x", (2, 35), 18).verdict(), "does not hold");
+        // Agreement: 10/15 against the thesis' 15/15 differs, 118/140 against 118/140 agrees.
+        assert_eq!(Claim::most("4", "x", (10, 15)).thesis(Some((15, 15))).agreement(), "differs");
+        assert_eq!(
+            Claim::most("5", "x", (118, 140)).thesis(Some((118, 140))).agreement(),
+            "agrees"
+        );
+        assert_eq!(Claim::most("5", "x", (1, 2)).agreement(), "");
+    }
+
+    #[test]
+    fn claims_round_trip_through_csv_one_row_per_spec_grid_and_claim() {
         let dir = tempfile::tempdir().unwrap();
         let claims = vec![
-            Claim {
-                chapter: "4".into(),
-                statement: "DNSOM has the lowest TE, \"always\"".into(),
-                ours: (10, 15),
-                thesis: Some((15, 15)),
-                rival: None,
-                note: "a, b".into(),
-            },
-            Claim {
-                chapter: "6".into(),
-                statement: "x".into(),
-                ours: (3, 3),
-                thesis: None,
-                rival: None,
-                note: String::new(),
-            },
-            Claim {
-                chapter: "5".into(),
-                statement: "exponential is the best".into(),
-                ours: (12, 35),
-                thesis: Some((14, 35)),
-                rival: Some(13),
-                note: "wins".into(),
-            },
+            Claim::most("4", "DNSOM has the lowest TE, \"always\"", (10, 15))
+                .thesis(Some((15, 15)))
+                .note("a, b"),
+            Claim::every("6", "x", (3, 3)).on_grid("20x20"),
+            Claim::best("5", "exponential is the best", (12, 35), 13)
+                .on_grid("18x30")
+                .thesis(Some((14, 35))),
+            Claim::every("6", "never checked", (0, 0)),
         ];
-        let md = write(dir.path(), &claims).unwrap();
-        assert!(md.contains("**mostly holds**") && md.contains("**holds**"));
+        let md = write(dir.path(), "ch5_same", &claims, false).unwrap();
+        assert!(md.contains("**undecided**") && md.contains("**holds**") && md.contains("Wilson"));
+        assert!(!md.contains("never checked"), "a claim checked in no case is left out");
         let back = read(&dir.path().join("claims.csv")).unwrap();
         assert_eq!(back.len(), 3);
-        // A best-of-several claim counts cells like the thesis and is judged against its rival.
+        assert!(back.iter().all(|c| c.spec == "ch5_same"));
+        assert_eq!((back[1].grid.as_str(), back[1].kind), ("20x20", Kind::Every));
         assert_eq!(
-            (back[2].ours, back[2].rival, back[2].verdict()),
-            ((12, 35), Some(13), "does not hold")
+            (back[2].ours, back[2].rival, back[2].thesis, back[2].verdict()),
+            ((12, 35), Some(13), Some((14, 35)), "undecided")
         );
-        assert_eq!(Claim { rival: Some(11), ..back[2].clone() }.verdict(), "holds");
-        assert_eq!(Claim { rival: Some(12), ..back[2].clone() }.verdict(), "tied");
-        // The count of claims that hold follows the verdict for both kinds.
-        assert!(Claim { rival: Some(11), ..back[2].clone() }.holds() && !back[2].holds());
-        assert!(back[1].holds() && !back[0].holds());
-        assert_eq!(
-            (back[0].statement.as_str(), back[0].ours, back[0].thesis),
-            (claims[0].statement.as_str(), (10, 15), Some((15, 15)))
-        );
-        assert_eq!((back[1].ours, back[1].thesis), ((3, 3), None));
-        assert_eq!(back[0].verdict(), "mostly holds");
+        assert_eq!(back[0].statement, claims[0].statement);
+        assert_eq!((back[0].thesis, back[0].agreement()), (Some((15, 15)), "differs"));
+        // A file of another layout is refused by name.
+        std::fs::write(dir.path().join("old.csv"), "chapter,claim\n4,x\n").unwrap();
+        let e = read(&dir.path().join("old.csv")).unwrap_err().to_string();
+        assert!(e.contains("old.csv") && e.contains("not a claims table"), "{e}");
     }
 }

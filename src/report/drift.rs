@@ -754,14 +754,14 @@ mod tests {
             config: DriftConfig { timing_rows: vec!["fastest".into()], ..DriftConfig::default() },
             ..DriftOptions::default()
         };
-        let r = cmp(claims, &claims.replace("fastest,holds,5", "fastest,mostly holds,4"), &speed);
+        let r = cmp(claims, &claims.replace("fastest,holds,5", "fastest,undecided,4"), &speed);
         assert!(
             !r.drifted()
                 && r.findings.iter().all(|f| matches!(f, Finding::Cell { judged: false, .. })),
             "{:?}",
             r.findings
         );
-        assert!(cmp(claims, &claims.replace("exact,holds", "exact,mostly holds"), &speed).drifted());
+        assert!(cmp(claims, &claims.replace("exact,holds", "exact,undecided"), &speed).drifted());
     }
 
     #[test]

@@ -17,7 +17,7 @@ use std::path::Path;
 pub const FILE: &str = "views3d.js";
 
 /// The most rows (or columns) of a surface grid written out.
-pub const MAX_SIDE: usize = 40;
+pub const MAX_SIDE: usize = 30;
 
 /// A colour as `#rrggbb`.
 pub fn hex(c: plotters::style::RGBColor) -> String {
@@ -65,6 +65,19 @@ pub fn thin(n: usize, max: usize) -> Vec<usize> {
     let mut idx: Vec<usize> = (0..max).map(|k| (k * (n - 1) + (max - 1) / 2) / (max - 1)).collect();
     idx.dedup();
     idx
+}
+
+/// A row-major `rows x cols` grid thinned to at most `side` rows and columns (first and last
+/// kept), for views shown in numbers: (points, rows, cols).
+pub fn coarse(
+    points: &[Point3],
+    rows: usize,
+    cols: usize,
+    side: usize,
+) -> (Vec<Point3>, usize, usize) {
+    let (ri, ci) = (thin(rows, side), thin(cols, side));
+    let pts = ri.iter().flat_map(|&i| ci.iter().map(move |&j| points[i * cols + j])).collect();
+    (pts, ri.len(), ci.len())
 }
 
 fn coords(points: impl Iterator<Item = Point3> + Clone, c: usize) -> String {

@@ -123,11 +123,43 @@ impl Lattice {
         }
         edges
     }
+
+    /// The edges of [`Lattice::unit_edges`] that lie on the box's outer faces (both ends share a
+    /// face coordinate 0 or dims - 1 on an axis the edge does not run along): the lattice's
+    /// outer shell, as a picture can show it.
+    pub fn shell_edges(&self) -> Vec<(u32, u32)> {
+        let on_face = |a: usize, c: i32| c == 0 || c as usize + 1 == self.dims[a];
+        self.unit_edges()
+            .into_iter()
+            .filter(|&(u, v)| {
+                let (p, q) = (self.index[u as usize], self.index[v as usize]);
+                (0..3).any(|a| p[a] == q[a] && on_face(a, p[a]))
+            })
+            .collect()
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_shell_of_a_cube_lattice_has_12_times_n_minus_1_squared_edges() {
+        // Six faces of 2n(n-1) edges each, the 12 cube edges' n-1 edges shared by two faces.
+        for n in [2usize, 4, 7] {
+            let mut index = Vec::new();
+            for i in 0..n {
+                for j in 0..n {
+                    for k in 0..n {
+                        index.push([i as i32, j as i32, k as i32]);
+                    }
+                }
+            }
+            let l = Lattice::new([n, n, n], index);
+            assert_eq!(l.unit_edges().len(), 3 * n * n * (n - 1));
+            assert_eq!(l.shell_edges().len(), 12 * (n - 1) * (n - 1), "n = {n}");
+        }
+    }
 
     #[test]
     fn neighbourhood_matches_brute_force() {

@@ -133,6 +133,11 @@ pub trait Topology: Send + Sync {
     fn adjacent(&self, a: usize, b: usize) -> bool {
         self.lattice().dist2(a, b) == 1
     }
-    /// Wireframe edges over units, grouped by colour.
+    /// The units a picture draws, in order (default: all); [`Topology::edge_groups`] indexes
+    /// into this list.
+    fn drawn_units(&self) -> Vec<usize> {
+        (0..self.lattice().len()).collect()
+    }
+    /// Wireframe edges over the drawn units, grouped by colour.
     fn edge_groups(&self) -> Vec<EdgeGroup>;
 }

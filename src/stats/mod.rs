@@ -8,6 +8,7 @@ pub mod describe;
 pub mod effect;
 pub mod friedman;
 pub mod holm;
+pub mod proportion;
 pub mod rank_sum;
 pub mod ranks;
 pub mod runtime;

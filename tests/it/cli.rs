@@ -40,7 +40,9 @@ fn run_writes_every_table_with_the_thesis_columns() {
     ] {
         assert!(out.join(f).exists(), "missing {f}: {:?}", walk(&out));
     }
-    assert!(out.join("cells.jsonl").exists() && out.join("fingerprint.toml").exists());
+    // A finished run keeps its cell log compressed.
+    assert!(out.join("cells.jsonl.gz").exists() && out.join("fingerprint.toml").exists());
+    assert!(!out.join("cells.jsonl").exists());
     let reference = Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/reference");
     for t in ["appendix_b.csv", "appendix_c.csv"] {
         assert_eq!(read_csv(&out.join(t)).0, read_csv(&reference.join(t)).0, "{t} columns");

@@ -324,6 +324,7 @@ impl crate::experiment::family::Experiment for Seed004 {
             let sweep = analytical_sweep(spec, &data)?;
             let top = top_view(spec, &data, &runs, 7)?;
             Some(self::report::write(
+                &spec.file.name,
                 s4,
                 &runs,
                 &sweep,

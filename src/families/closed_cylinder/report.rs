@@ -224,6 +224,7 @@ fn render_pictures(
 
 /// Write the tables and charts; return the REPORT.md section.
 pub fn write(
+    spec_name: &str,
     s4: &Seed004Spec,
     runs: &[Run],
     sweep: &[(usize, f64)],
@@ -258,8 +259,11 @@ pub fn write(
     render_table_2(&t2, &md2, out, &mut s)?;
     render_table_3(&t3, &md3, sweep, out, &mut s)?;
     // Claims.
-    let _ = writeln!(s, "\n### The paper's claims, checked here\n");
-    s.push_str(&crate::report::claims::write(out, &claims)?);
+    let claims_md = crate::report::claims::write(out, spec_name, &claims, false)?;
+    if !claims_md.is_empty() {
+        let _ = writeln!(s, "\n### The paper's claims, checked here\n");
+        s.push_str(&claims_md);
+    }
     s.push_str(&explanations(s4));
     render_pictures(
         s4,
@@ -384,66 +388,40 @@ fn claims(
         })
     };
     if let Some((an, ga)) = row3(7) {
-        claims.push(crate::report::claims::Claim {
-            chapter: "seed004".into(),
-            rival: None,
-            statement: "GA's least error beats the analytical method's at 7 control points (paper: 0.0164 vs 0.0174, 5.7471%)".into(),
-            ours: ((ga < an) as usize, 1),
-            thesis: Some(((0.0164 < 0.0174) as usize, 1)),
-            note: format!("here: GA {ga:.6} vs analytical {an:.6}, {:+.3}%", (an - ga) / an * 100.0),
-        });
+        claims.push(crate::report::claims::Claim::every("seed004", "GA's least error beats the analytical method's at 7 control points (paper: 0.0164 vs 0.0174, 5.7471%)", ((ga < an) as usize, 1))
+            .thesis(Some(((0.0164 < 0.0174) as usize, 1)))
+            .note(format!("here: GA {ga:.6} vs analytical {an:.6}, {:+.3}%", (an - ga) / an * 100.0)));
     }
     let argmin = |v: &[(usize, f64)]| v.iter().copied().min_by(|a, b| a.1.total_cmp(&b.1));
     if let (Some((cp, v)), Some((pcp, _))) = (argmin(ga_by_cp), argmin(paper_by_cp)) {
-        claims.push(crate::report::claims::Claim {
-            chapter: "seed004".into(),
-            rival: None,
-            statement: "The GA's fitness is best (least error) between 25 and 30 control points (Table III)".into(),
-            ours: ((25..=30).contains(&cp) as usize, 1),
-            thesis: Some(((25..=30).contains(&pcp) as usize, 1)),
-            note: format!("here: least GA RMS {v:.6} at {cp} control points (of {:?}); paper: at {pcp}", ga_by_cp.iter().map(|x| x.0).collect::<Vec<_>>()),
-        });
+        claims.push(crate::report::claims::Claim::every("seed004", "The GA's fitness is best (least error) between 25 and 30 control points (Table III)", ((25..=30).contains(&cp) as usize, 1))
+            .thesis(Some(((25..=30).contains(&pcp) as usize, 1)))
+            .note(format!("here: least GA RMS {v:.6} at {cp} control points (of {:?}); paper: at {pcp}", ga_by_cp.iter().map(|x| x.0).collect::<Vec<_>>())));
     }
     if let Some((cp, v)) = argmin(sweep) {
-        claims.push(crate::report::claims::Claim {
-            chapter: "seed004".into(),
-            rival: None,
-            statement: "The analytical method's least error is at 28 control points (0.001132)"
-                .into(),
-            ours: ((cp == 28) as usize, 1),
-            thesis: None,
-            note: format!(
+        claims.push(crate::report::claims::Claim::every("seed004", "The analytical method's least error is at 28 control points (0.001132)"
+                , ((cp == 28) as usize, 1))
+            .thesis(None)
+            .note(format!(
                 "here: least analytical RMS {v:.6} at {cp} of {}..{} control points",
                 sweep.first().map(|x| x.0).unwrap_or(0),
                 sweep.last().map(|x| x.0).unwrap_or(0)
-            ),
-        });
+            )));
     }
     let better =
         ga_by_cp.iter().filter(|(cp, ga)| row3(*cp).is_some_and(|(an, _)| *ga < an)).count();
-    claims.push(crate::report::claims::Claim {
-        chapter: "seed004".into(),
-        rival: None,
-        statement: "The GA improves on the analytical control points for the other numbers of control points too".into(),
-        ours: (better, ga_by_cp.len()),
-        thesis: None,
-        note: "numbers of control points where the GA's best RMS is below the analytical RMS (the paper states it but gives analytical numbers only at 7 and 28)".into(),
-    });
+    claims.push(crate::report::claims::Claim::every("seed004", "The GA improves on the analytical control points for the other numbers of control points too", (better, ga_by_cp.len()))
+            .thesis(None)
+            .note("numbers of control points where the GA's best RMS is below the analytical RMS (the paper states it but gives analytical numbers only at 7 and 28)"));
     let falls = runs
         .iter()
         .filter(|r| r.population_best.last().is_some_and(|l| *l < r.population_best[0]))
         .count();
-    claims.push(crate::report::claims::Claim {
-        chapter: "seed004".into(),
-        rival: None,
-        statement:
-            "The fitness improves (the error decreases) as the generations increase (Table II)"
-                .into(),
-        ours: (falls, runs.len()),
-        thesis: None,
-        note: "runs whose last population's best RMS is below their initial population's best"
-            .into(),
-    });
+    claims.push(crate::report::claims::Claim::every("seed004", "The fitness improves (the error decreases) as the generations increase (Table II)"
+                , (falls, runs.len()))
+            .thesis(None)
+            .note("runs whose last population's best RMS is below their initial population's best"
+            ));
     claims
 }
 
@@ -584,5 +562,5 @@ fn top_view_chart(t: &TopView, out: &Path) -> (&'static str, Result<(), plots::P
     let name = "png/seed004_top_view.png";
     let title =
         format!("Top view, {} control points, best GA run (Fig. 2a analogue)", t.control_points);
-    (name, plots::line_chart_png(&out.join(name), &title, "x", "y", &series, false))
+    (name, plots::xy_chart_png(&out.join(name), &title, "x", "y", &series))
 }

@@ -381,7 +381,7 @@ impl crate::experiment::family::Experiment for Seed003 {
     ) -> Result<crate::experiment::family::Outcome> {
         let s3 = section(spec)?;
         let runs = run(spec, ctx)?;
-        let section = if tables { Some(self::report::write(s3, &runs, &ctx.out)?) } else { None };
+        let section = if tables { Some(self::report::write(&spec.file.name, s3, &runs, &ctx.out)?) } else { None };
         Ok(crate::experiment::family::Outcome {
             section,
             cpu_s: runs.iter().map(|r| r.row.cpu_s).sum(),

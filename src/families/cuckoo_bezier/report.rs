@@ -106,7 +106,7 @@ fn write_csv(out: &Path, name: &str, header: &[&str], rows: &[Vec<String>]) -> R
 }
 
 /// Write runs.csv, the tables and the pictures; return the REPORT.md section.
-pub fn write(s: &Seed003Spec, runs: &[Run], out: &Path) -> Result<String> {
+pub fn write(spec_name: &str, s: &Seed003Spec, runs: &[Run], out: &Path) -> Result<String> {
     let rows: Vec<_> = runs.iter().map(|r| r.row.clone()).collect();
     crate::io::write_atomic(&out.join("runs.csv"), crate::io::csv_text(&rows)?.as_bytes())?;
     let examples: Vec<&str> =
@@ -145,6 +145,7 @@ pub fn write(s: &Seed003Spec, runs: &[Run], out: &Path) -> Result<String> {
         .collect();
     if methods.contains(&"csa") && !others.is_empty() {
         write_tests(
+            spec_name,
             s,
             runs,
             &examples,
@@ -381,14 +382,12 @@ fn agreement_claims(
         .map(|(o, comp, _)| {
             let rows: Vec<&Vec<String>> = agree.iter().filter(|r| &r[0] == comp).collect();
             let paper: Vec<String> = rows.iter().map(|r| format!("{}: {} better", r[1], if r[3].is_empty() { "?" } else { &r[3] })).collect();
-            crate::report::claims::Claim {
-                chapter: "seed003".into(),
-                rival: None,
-                statement: format!("CSA vs {o}: the better method and the significance of both Wilcoxon tests are as in the paper's Tables 4-5"),
-                ours: (rows.iter().filter(|r| r[10] == "yes").count(), rows.len()),
-                thesis: None,
-                note: format!("examples where both agree (seed003_agreement.csv); paper: {}", paper.join(", ")),
-            }
+            crate::report::claims::Claim::every(
+                "seed003",
+                format!("CSA vs {o}: the better method and the significance of both Wilcoxon tests are as in the paper's Tables 4-5"),
+                (rows.iter().filter(|r| r[10] == "yes").count(), rows.len()),
+            )
+            .note(format!("examples where both agree (seed003_agreement.csv); paper: {}", paper.join(", ")))
         })
         .collect()
 }
@@ -398,6 +397,7 @@ fn agreement_claims(
 /// significance: h of each test at the spec's alpha.
 #[allow(clippy::too_many_arguments)]
 fn write_tests(
+    spec_name: &str,
     s: &Seed003Spec,
     runs: &[Run],
     examples: &[&str],
@@ -410,7 +410,8 @@ fn write_tests(
 ) -> Result<()> {
     let results = table5(s, runs, examples, others, ref5, out, md)?;
     let agree = agreement(s, examples, &results, ref4, ref5, out, md, stats)?;
-    crate::report::claims::write(out, &agreement_claims(&results, &agree)).map(|_| ())
+    crate::report::claims::write(out, spec_name, &agreement_claims(&results, &agree), false)
+        .map(|_| ())
 }
 
 /// Convergence diagrams: per example, the median and quartiles over the runs of CSA's and ICSA's

@@ -358,9 +358,10 @@ impl crate::experiment::family::Experiment for Fit {
         let runs = run(spec, ctx, &maps)?;
         let origins: Vec<(String, String)> =
             maps.iter().map(|(d, m)| (d.clone(), m.origin.clone())).collect();
-        let pictures = spec.section::<spec::FitSpec>().map(|f| f.pictures).unwrap_or(false);
+        let pictures =
+            ctx.pictures && spec.section::<spec::FitSpec>().map(|f| f.pictures).unwrap_or(false);
         let section = if tables {
-            Some(self::report::write(&runs, &ctx.out, &origins, pictures)?)
+            Some(self::report::write(&spec.file.name, &runs, &ctx.out, &origins, pictures)?)
         } else {
             None
         };

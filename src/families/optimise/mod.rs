@@ -257,7 +257,9 @@ pub fn run(
             })
         },
     )?;
-    picture_points(spec, &mut runs, largest, problem)?;
+    if ctx.pictures {
+        picture_points(spec, &mut runs, largest, problem)?;
+    }
     Ok(runs)
 }
 
@@ -314,8 +316,12 @@ fn picture_points<'a>(
 /// One sentence on the start and the search box of a spec's runs, for the report.
 pub fn setting(spec: &Spec) -> String {
     let Some(o) = spec.section::<spec::OptimSpec>() else { return String::new() };
-    let start =
-        format!("Each individual starts at B + U[-{r:e}, {r:e}] per coordinate", r = o.init_range);
+    let fair = if o.fairness > 0.0 { format!(", fairness {:e}", o.fairness) } else { String::new() };
+    let start = format!(
+        "Readings: knots `{}`{fair} (docs/readings.md). Each individual starts at B + U[-{r:e}, {r:e}] per coordinate",
+        o.knots.name(),
+        r = o.init_range
+    );
     match o.search_range {
         Some(r) => format!("{start}; the search box is B +- {r:e} per coordinate (Table 6.1's \"control point coordinate range [-5e-6, 5e-6]\" read as the search space, as the thesis' tiny improvements over B imply; PSO's maximum velocity is half that box)."),
         None if o.bounds_margin == 0.0 => format!("{start}; the search box is the smallest per-axis box holding the data and B's control points."),
@@ -403,11 +409,19 @@ impl crate::experiment::family::Experiment for Optim {
             }));
         }
         let section = if tables {
-            Some(self::report::write(&runs, &problems, &exact, &setting(first), &ctx.out)?)
+            Some(self::report::write(
+                &first.file.name,
+                &runs,
+                &problems,
+                &exact,
+                &setting(first),
+                &ctx.out,
+                ctx.pictures,
+            )?)
         } else {
             None
         };
-        if tables {
+        if tables && ctx.pictures {
             crate::report::views3d::write(&ctx.out, &pictures::views(&runs, &problems))?;
         }
         Ok(crate::experiment::family::Outcome {

@@ -63,10 +63,9 @@ fn side_by_side(
 
 /// `<name>_vs_thesis.csv` (long: one row per cell and column, ours, the thesis', the ratio) and
 /// the Markdown table of the median ratio per control net and column.
-fn render_side_by_side(pairs: &[Beside], name: &str, out: &Path) -> Result<String> {
+fn render_side_by_side(pairs: &[Beside], name: &str, timing: bool, out: &Path) -> Result<String> {
     // CPU seconds are measured, never identical across runs: their columns end in `_s`, which
     // marks a timing column for `drift` (reported, not judged).
-    let timing = pairs.iter().any(|b| b.measure.ends_with("_s"));
     let values: [&str; 3] =
         if timing { ["ours_s", "thesis_s", "ratio_s"] } else { ["ours", "thesis", "ratio"] };
     let h: Vec<String> = ["data", "parameterisation", "cn_x", "cn_y", "measure"]
@@ -97,28 +96,50 @@ fn render_side_by_side(pairs: &[Beside], name: &str, out: &Path) -> Result<Strin
         ordered(pairs.iter().map(|b| {
             (b.key[2].parse::<usize>().unwrap_or(0), b.key[3].parse::<usize>().unwrap_or(0))
         }));
-    let mut mh = vec!["CN".to_string()];
-    mh.extend(shown.iter().map(|m| m.to_string()));
+    let mh: Vec<String> = ["CN", "measure", "ours (median)", "thesis (median)", "median ratio ours/thesis", "cells"]
+        .iter()
+        .map(|x| x.to_string())
+        .collect();
     let mut mrows = Vec::new();
     for (cx, cy) in nets {
-        let mut r = vec![format!("{cx}x{cy}")];
         for m in &shown {
-            let v: Vec<f64> = pairs
+            let here: Vec<&Beside> = pairs
                 .iter()
                 .filter(|b| {
-                    &&b.measure == m
-                        && b.key[2] == cx.to_string()
-                        && b.key[3] == cy.to_string()
-                        && b.thesis != 0.0
+                    &&b.measure == m && b.key[2] == cx.to_string() && b.key[3] == cy.to_string()
                 })
-                .map(|b| b.ours / b.thesis)
                 .collect();
-            r.push(crate::report::markdown::num(crate::report::markdown::median(&v), 3));
+            let med = |f: &dyn Fn(&Beside) -> f64| {
+                crate::report::markdown::median(&here.iter().map(|b| f(b)).collect::<Vec<_>>())
+            };
+            let ratios: Vec<f64> =
+                here.iter().filter(|b| b.thesis != 0.0).map(|b| b.ours / b.thesis).collect();
+            mrows.push(vec![
+                format!("{cx}x{cy}"),
+                m.to_string(),
+                significant(med(&|b| b.ours)),
+                significant(med(&|b| b.thesis)),
+                significant(crate::report::markdown::median(&ratios)),
+                here.len().to_string(),
+            ]);
         }
-        mrows.push(r);
     }
     let what = if timing { "CPU seconds per run" } else { "surface error" };
-    Ok(format!("\n**`{name}_vs_thesis.csv`**: ours beside the thesis' {what}, cell by cell; below, the median ratio ours/thesis per control net\n\n{}", table(&mh, &mrows)))
+    Ok(format!("\n**`{name}_vs_thesis.csv`**: ours beside the thesis' {what}, cell by cell; below, per control net, the medians over the cells of ours, the thesis' and their ratio\n\n{}", table(&mh, &mrows)))
+}
+
+/// Five significant digits, in scientific notation outside [1e-2, 1e5) (CPU seconds of 1e-4
+/// must not print as 0.000).
+fn significant(v: Option<f64>) -> String {
+    match v {
+        None => "-".into(),
+        Some(0.0) => "0".into(),
+        Some(v) if (1e-2..1e5).contains(&v.abs()) => {
+            let d = (4 - v.abs().log10().floor() as i32).max(0) as usize;
+            format!("{v:.d$}")
+        }
+        Some(v) => format!("{v:.4e}"),
+    }
 }
 
 /// The runs of one (cell, optimiser), mapped by `f`.
@@ -284,51 +305,101 @@ impl GridTables {
                 ]
             })
             .collect();
-        table(&h, &rows)
+        // One optimiser is least of nothing: its "least" columns are left out.
+        let keep: Vec<usize> = if self.opts.len() > 1 { (0..h.len()).collect() } else { vec![0, 3, 4] };
+        let pick = |r: &Vec<String>| keep.iter().map(|&k| r[k].clone()).collect::<Vec<_>>();
+        table(&pick(&h), &rows.iter().map(pick).collect::<Vec<_>>())
     }
 }
 
 /// The thesis' own win count of optimiser `o` in its table `t` (`suffix` "" for errors, "_s"
-/// for CPU seconds): (wins, cells).
-fn thesis_wins(t: Option<&reference::RefTable>, suffix: &str, o: &str) -> Option<(usize, usize)> {
+/// for CPU seconds) over the cells this run has: (wins, cells of ours the table has).
+fn thesis_wins(
+    t: Option<&reference::RefTable>,
+    suffix: &str,
+    o: &str,
+    cells: &[CellKey],
+) -> Option<(usize, usize)> {
     let t = t?;
     let names = ["ga", "de", "pso"];
-    let mut w = 0;
+    let (mut w, mut n) = (0, 0);
     for row in &t.rows {
+        let at = |k: &str| row.get(k).map(String::as_str).unwrap_or("");
+        let ours = cells.iter().any(|c| {
+            at("data") == c.0
+                && at("parameterisation") == c.1.name()
+                && at("cn_x") == c.2.nx.to_string()
+                && at("cn_y") == c.2.ny.to_string()
+        });
         let v: Vec<f64> = names
             .iter()
             .filter_map(|n| row.get(&format!("{n}_avg{suffix}")).and_then(|x| x.parse().ok()))
             .collect();
-        if v.len() == 3 {
+        if ours && v.len() == 3 {
             let k =
                 v.iter().enumerate().min_by(|a, b| a.1.total_cmp(b.1)).map(|x| x.0).unwrap_or(0);
             w += (names[k] == o) as usize;
+            n += 1;
         }
     }
-    Some((w, t.rows.len()))
+    Some((w, n))
 }
 
-/// The grid's claims against the thesis' own tables.
+/// An optimiser's name as the reports write it (GA, DE, PSO, CSA, ICSA).
+pub fn label(o: &str) -> String {
+    o.to_uppercase()
+}
+
+/// The grid's claims, with the thesis' own counts over the same cells where this run compared
+/// the thesis' three optimisers (its counts rank GA, DE and PSO against each other only).
 fn grid_claims(t: &GridTables, grid: GridSize, err_name: &str, time_name: &str) -> Vec<Claim> {
     let n = t.cells.len();
     let mut claims = Vec::new();
-    if let Some(k) = t.opts.iter().position(|o| o == "de") {
-        claims.push(Claim { rival: None, chapter: "6".into(), statement: format!("DE gives the least average error in most cells (grid {grid})"), ours: (t.err_wins[k], n), thesis: thesis_wins(reference::table(err_name).as_ref(), "", "de"), note: "thesis: 126/140 and 117/140 (Tables 6.4, 6.5); verdict 'mostly holds' when more than half".into() });
+    let mut sorted = t.opts.clone();
+    sorted.sort();
+    let thesis_set = sorted == ["de", "ga", "pso"];
+    let against = |me: &str| -> String {
+        let others: Vec<String> = t.opts.iter().filter(|o| *o != me).map(|o| label(o)).collect();
+        others.join(" and ")
+    };
+    let own = |table: &str, suffix: &str, o: &str| {
+        if thesis_set {
+            thesis_wins(reference::table(table).as_ref(), suffix, o, &t.cells)
+        } else {
+            None
+        }
+    };
+    // A comparison needs a rival: with one optimiser no "least" claim is made.
+    if let Some(k) = t.opts.iter().position(|o| o == "de").filter(|_| t.opts.len() > 1) {
+        claims.push(
+            Claim::most(
+                "6",
+                format!("DE gives the least average error in most cells (against {})", against("de")),
+                (t.err_wins[k], n),
+            )
+            .on_grid(grid)
+            .thesis(own(err_name, "", "de"))
+            .note("least AVG error per cell (Tables 6.4, 6.5)"),
+        );
     }
-    if let Some(k) = t.opts.iter().position(|o| o == "ga") {
-        claims.push(Claim { rival: None, chapter: "6".into(), statement: format!("GA is the fastest (grid {grid})"), ours: (t.time_wins[k], n), thesis: thesis_wins(reference::table(time_name).as_ref(), "_s", "ga"), note: "least AVG CPU time per cell; thesis 140/140 (Tables 6.6, 6.7); GA makes 2 evaluations per generation, DE and PSO 40".into() });
+    if let Some(k) = t.opts.iter().position(|o| o == "ga").filter(|_| t.opts.len() > 1) {
+        claims.push(
+            Claim::most(
+                "6",
+                format!("GA is the fastest (against {})", against("ga")),
+                (t.time_wins[k], n),
+            )
+            .on_grid(grid)
+            .thesis(own(time_name, "_s", "ga"))
+            .note("least AVG CPU time per cell (Tables 6.6, 6.7); GA makes 2 evaluations per generation, DE and PSO a population's"),
+        );
     }
     for (k, o) in t.opts.iter().enumerate() {
-        claims.push(Claim {
-            rival: None,
-            chapter: "6".into(),
-            statement: format!("{o} lowers the surface error below B (grid {grid})"),
-            ours: (t.beats_b[k], n),
-            thesis: None,
-            note:
-                "AVG over repeats below B's error; the +-5e-6 start can leave an optimiser above B"
-                    .into(),
-        });
+        claims.push(
+            Claim::most("6", format!("{} lowers the surface error below B", label(o)), (t.beats_b[k], n))
+                .on_grid(grid)
+                .note("cells whose AVG over repeats is below B's error; the +-5e-6 start can leave an optimiser above B"),
+        );
     }
     claims
 }
@@ -408,14 +479,10 @@ fn exact_section(
             e.iterations
         );
     }
-    let claim = Claim {
-        rival: None,
-        chapter: "6".into(),
-        statement: format!("No optimiser beats the certified lower bound (grid {grid})"),
-        ours: (checked - below, checked),
-        thesis: None,
-        note: "a sanity check of the bound and the fitness".into(),
-    };
+    let claim =
+        Claim::every("6", "No optimiser beats the certified lower bound", (checked - below, checked))
+            .on_grid(grid)
+            .note("a sanity check of the bound and the fitness");
     Ok(Some((s, claim)))
 }
 
@@ -436,7 +503,12 @@ fn budgets(runs: &[OptimRun]) -> String {
             }
         })
         .collect();
-    format!("Fitness evaluations per run: {}. GA is steady-state (thesis 6.2.4.1) and evaluates two offspring per generation, DE and PSO their whole population each generation; its lead in CPU time (Tables 6.6, 6.7) rests on that smaller budget.\n", budgets.join(", "))
+    let ga = if runs.iter().any(|r| r.cell.optimiser == "ga") && budgets.len() > 1 {
+        " GA is steady-state (thesis 6.2.4.1) and evaluates two offspring per generation, the others their whole population each generation; its lead in CPU time (Tables 6.6, 6.7) rests on that smaller budget."
+    } else {
+        ""
+    };
+    format!("Fitness evaluations per run: {}.{ga}\n", budgets.join(", "))
 }
 
 /// The claims over every run: the surfaces stay near the data, elitism holds.
@@ -446,22 +518,10 @@ fn run_claims(runs: &[OptimRun]) -> Vec<Claim> {
     let worst = runs.iter().max_by(|a, b| a.row.excursion.total_cmp(&b.row.excursion));
     let kept = runs.iter().filter(|r| r.row.best <= r.row.initial_best).count();
     vec![
-        Claim {
-            chapter: "6".into(),
-            rival: None,
-            statement: "The optimised surfaces stay near the data".into(),
-            ours: (near, runs.len()),
-            thesis: None,
-            note: format!("runs whose best surfaces' dense excursion from the data's bounding box is at most {}{}", crate::families::fit::report::NEAR, worst.map(|w| format!("; largest {:.3e} at {}", w.row.excursion, w.row.cell)).unwrap_or_default()),
-        },
-        Claim {
-            rival: None,
-            chapter: "6".into(),
-            statement: "Every run's best is no worse than its initial population's best".into(),
-            ours: (kept, runs.len()),
-            thesis: None,
-            note: "elitism check over all runs".into(),
-        },
+        Claim::every("6", "The optimised surfaces stay near the data", (near, runs.len()))
+            .note(format!("runs whose best surfaces' dense excursion from the data's bounding box is at most {}{}", crate::families::fit::report::NEAR, worst.map(|w| format!("; largest {:.3e} at {}", w.row.excursion, w.row.cell)).unwrap_or_default())),
+        Claim::every("6", "Every run's best is no worse than its initial population's best", (kept, runs.len()))
+            .note("elitism check over all runs"),
     ]
 }
 
@@ -473,6 +533,7 @@ fn write_grid(
     problems: &BTreeMap<ProblemKey, ControlNetProblem>,
     exact: &BTreeMap<ProblemKey, ExactResult>,
     out: &Path,
+    pictures: bool,
     s: &mut String,
 ) -> Result<Vec<Claim>> {
     let t = GridTables::compute(g);
@@ -485,9 +546,13 @@ fn write_grid(
     write_atomic(&out.join(format!("{err_name}.csv")), csv_records(&t.eh, &t.erows)?.as_bytes())?;
     write_atomic(&out.join(format!("{time_name}.csv")), csv_records(&t.th, &t.trows)?.as_bytes())?;
     let mut beside_md = String::new();
-    for (name, h, rows) in [(err_name, &t.eh, &t.erows), (time_name, &t.th, &t.trows)] {
-        if let Some(r) = reference::table(name) {
-            beside_md.push_str(&render_side_by_side(&side_by_side(h, rows, &r), name, out)?);
+    for (name, h, rows, timing) in
+        [(err_name, &t.eh, &t.erows, false), (time_name, &t.th, &t.trows, true)]
+    {
+        // Only where the thesis has values for some of these cells: no empty table.
+        let pairs = reference::table(name).map(|r| side_by_side(h, rows, &r)).unwrap_or_default();
+        if !pairs.is_empty() {
+            beside_md.push_str(&render_side_by_side(&pairs, name, timing, out)?);
         }
     }
     for (name, time) in [(t_err, false), (t_time, true)] {
@@ -507,18 +572,22 @@ fn write_grid(
         s.push_str(&part);
         claims.push(claim);
     }
-    appendix_ij(g, &t.cells, &t.opts, problems, grid, out, s)?;
-    convergence_charts(g, &t.cells, &t.opts, problems, exact, grid, out, s)?;
+    if pictures {
+        appendix_ij(g, &t.cells, &t.opts, problems, grid, out, s)?;
+        convergence_charts(g, &t.cells, &t.opts, problems, exact, grid, out, s)?;
+    }
     Ok(claims)
 }
 
 /// Write every Chapter 6 file; returns the REPORT.md section.
 pub fn write(
+    spec_name: &str,
     runs: &[OptimRun],
     problems: &BTreeMap<ProblemKey, ControlNetProblem>,
     exact: &BTreeMap<ProblemKey, ExactResult>,
     setting: &str,
     out: &Path,
+    pictures: bool,
 ) -> Result<String> {
     let rows: Vec<_> = runs.iter().map(|r| r.row.clone()).collect();
     write_atomic(&out.join("runs.csv"), csv_text(&rows)?.as_bytes())?;
@@ -529,14 +598,17 @@ pub fn write(
     let mut claims = Vec::new();
     for grid in ordered(runs.iter().map(|r| r.cell.grid)) {
         let g: Vec<&OptimRun> = runs.iter().filter(|r| r.cell.grid == grid).collect();
-        claims.extend(write_grid(&g, grid, problems, exact, out, &mut s)?);
+        claims.extend(write_grid(&g, grid, problems, exact, out, pictures, &mut s)?);
     }
     s.push_str(&friedman_section(runs));
     let n_ioh = super::ioh::write(runs, out)?;
     let _ = writeln!(s, "\nEvery run's improvements of the best so far in the IOHprofiler format (`ioh/<optimiser>/`: {n_ioh} JSON meta-data files, format version 0.3.3 or later, each with its improvement-based `.dat`), loadable by IOHanalyzer and iohinspector.");
     claims.extend(run_claims(runs));
-    s.push_str("\n### Claims\n\n");
-    s.push_str(&crate::report::claims::write(out, &claims)?);
+    let claims_md = crate::report::claims::write(out, spec_name, &claims, false)?;
+    if !claims_md.is_empty() {
+        s.push_str("\n### Claims\n\n");
+        s.push_str(&claims_md);
+    }
     Ok(s)
 }
 
@@ -735,12 +807,24 @@ fn convergence_charts(
             } else {
                 let _ = writeln!(s, "\n![{conv}]({conv})");
             }
+            // B (where every run starts) and the certified optimum across the boxes, so an
+            // optimiser that ends above B shows as such.
+            let mut levels = Vec::new();
+            if let Some(problem) = problems.get(&(d.clone(), cn, p0)) {
+                let b = problem.fitness(problem.initial_point());
+                levels.push(plots::Level { key: "b", label: format!("B {b:.6}"), y: b });
+            }
+            if let Some(e) = exact.get(&(d.clone(), cn, p0)) {
+                let label = format!("certified optimum {:.6}", e.f);
+                levels.push(plots::Level { key: "exact", label, y: e.f });
+            }
             let bx = format!("png/boxplot_{grid}_{d}_{}_{cn}.png", p0.name());
             if let Err(e) = plots::box_plot_png(
                 &out.join(&bx),
                 &format!("{d}, {} {cn} on {grid}: best surface error per repeat", p0.name()),
                 "surface error",
                 &groups,
+                &levels,
             ) {
                 eprintln!("somnurbs: warning: picture skipped: {e}");
             } else {
@@ -791,5 +875,19 @@ pub fn table_names(
         (20, 20) => Some(("appendix_k", "appendix_m", "table_6_4", "table_6_6")),
         (18, 30) => Some(("appendix_l", "appendix_n", "table_6_5", "table_6_7")),
         _ => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::significant;
+
+    #[test]
+    fn significant_keeps_small_cpu_seconds_visible() {
+        assert_eq!(significant(Some(1.07612)), "1.0761");
+        assert_eq!(significant(Some(32.846866)), "32.847");
+        assert_eq!(significant(Some(0.000123456)), "1.2346e-4");
+        assert_eq!(significant(Some(0.0)), "0");
+        assert_eq!(significant(None), "-");
     }
 }

@@ -313,13 +313,12 @@ fn write_curves(curves: &[CurveRun], out: &Path, s: &mut String) -> Result<()> {
             });
         }
         let png = format!("png/seed002_outline_{ol}.png");
-        if let Err(e) = plots::line_chart_png(
+        if let Err(e) = plots::xy_chart_png(
             &out.join(&png),
             &format!("{ol}: SAM06 corners and fitted conics (best run)"),
             "x",
             "y",
             &series,
-            false,
         ) {
             eprintln!("somnurbs: warning: picture skipped: {e}");
         } else {

@@ -7,6 +7,7 @@ pub mod spec;
 
 use crate::data::PointCloud;
 use crate::experiment::spec::{Spec, SpecError};
+use crate::experiment::packed::PackedPoints;
 use crate::experiment::{runner, seeds, RunContext};
 use crate::geom::Point3;
 use crate::som::{self, FinalMetrics, NeuronCounts, OnlineMetrics, SomParams};
@@ -21,14 +22,22 @@ use std::sync::Arc;
 pub struct SomRun {
     pub cell: SomCell,
     pub row: SomRow,
-    /// Trained weights, one per unit.
+    /// Trained weights of the units a picture draws (`Topology::drawn_units`: every unit, but
+    /// only the outer shell of the 3-D lattice), in that order; rounded to single precision for
+    /// every model but DNSOM (they serve the pictures only).
     pub weights: Vec<Point3>,
 }
 
 impl runner::Logged for SomRun {
-    type Record = (SomRow, Vec<Point3>);
+    /// The weights in the compact form: exact bits, in single precision where the run rounded
+    /// them so (every model but DNSOM, whose maps feed Chapters 5 and 6).
+    type Record = (SomRow, PackedPoints);
     fn record(&self) -> Self::Record {
-        (self.row.clone(), self.weights.clone())
+        if self.cell.model == som::Model::Dnsom {
+            (self.row.clone(), PackedPoints::exact(self.weights.clone()))
+        } else {
+            (self.row.clone(), PackedPoints::single(&self.weights))
+        }
     }
 }
 
@@ -150,7 +159,16 @@ pub fn run_cell(
         fin,
         cpu_s,
     );
-    Ok(SomRun { cell: cell.clone(), row, weights: trained.weights })
+    // Only the units a picture draws are kept (the 3-D lattice's shell; every other model's all),
+    // and only for pictures, in single precision, but DNSOM's, whose maps feed Chapters 5 and 6:
+    // a run resumed from its log draws the same pictures.
+    let drawn: Vec<Point3> = topo.drawn_units().into_iter().map(|u| trained.weights[u]).collect();
+    let weights = if cell.model == som::Model::Dnsom {
+        drawn
+    } else {
+        PackedPoints::single(&drawn).points
+    };
+    Ok(SomRun { cell: cell.clone(), row, weights })
 }
 
 /// Each data set's frame (how its points were normalised), by name.
@@ -178,7 +196,22 @@ pub fn run(spec: &Spec, ctx: &RunContext) -> Result<(Vec<SomRun>, Frames)> {
         ctx,
         &spec.file.name,
         |cell| run_cell(cell, &data[&cell.dataset].points, &params, spec.file.master_seed),
-        |cell, (row, weights)| Ok(SomRun { cell: cell.clone(), row, weights }),
+        |cell, (row, weights): (SomRow, PackedPoints)| {
+            let units = cell
+                .model
+                .topology(cell.grid.nx, cell.grid.ny)
+                .map_err(anyhow::Error::msg)?
+                .drawn_units()
+                .len();
+            if weights.points.len() != units {
+                anyhow::bail!(
+                    "cell {}: the log holds {} weights for a map of {units} units",
+                    cell.key(),
+                    weights.points.len()
+                );
+            }
+            Ok(SomRun { cell: cell.clone(), row, weights: weights.points })
+        },
     )?;
     Ok((runs, data.iter().map(|(name, cloud)| (name.clone(), cloud.frame.clone())).collect()))
 }
@@ -222,7 +255,7 @@ impl crate::experiment::family::Experiment for Som {
     ) -> Result<crate::experiment::family::Outcome> {
         let (runs, frames) = run(spec, ctx)?;
         let section =
-            if tables { Some(self::report::write(spec, &runs, &frames, &ctx.out)?) } else { None };
+            if tables { Some(self::report::write(spec, &runs, &frames, &ctx.out, ctx.pictures)?) } else { None };
         Ok(crate::experiment::family::Outcome {
             section,
             cpu_s: runs.iter().map(|r| r.row.cpu_s).sum(),

@@ -33,6 +33,14 @@ pub fn meshes(run: &SomRun) -> Vec<LineMesh> {
         .collect()
 }
 
+/// The lattice a cell trains: n x n x n for the 3-D SOM, the grid otherwise.
+fn lattice_label(model: Model, grid: crate::experiment::spec::GridSize) -> String {
+    match model {
+        Model::Som3d => format!("{0}x{0}x{0} lattice", grid.nx),
+        _ => grid.to_string(),
+    }
+}
+
 fn cell_picture_name(run: &SomRun) -> String {
     format!("png/{}_{}_{}.png", run.cell.dataset, run.cell.model.key(), run.cell.grid)
 }
@@ -46,8 +54,12 @@ pub fn write(runs: &[SomRun], out: &Path) -> Result<Vec<String>> {
         .par_iter()
         .filter_map(|run| {
             let name = cell_picture_name(run);
-            let title =
-                format!("{} {} {}", run.cell.dataset, run.cell.model.label(), run.cell.grid);
+            let title = format!(
+                "{} {} {}",
+                run.cell.dataset,
+                run.cell.model.label(),
+                lattice_label(run.cell.model, run.cell.grid)
+            );
             match plots::mesh_png(&out.join(&name), &title, &meshes(run), style::MESH_SIZE) {
                 Ok(()) => Some(name),
                 Err(e) => {
@@ -58,10 +70,14 @@ pub fn write(runs: &[SomRun], out: &Path) -> Result<Vec<String>> {
         })
         .collect();
     for (square, name, title) in [
-        (true, "appendix_a.png", "Appendix A: the SOM models on each data set (rows: data, n; columns: 2-D SOM, 3-D SOM, CKSOM, DNSOM)"),
-        (false, "appendix_d.png", "Appendix D: CKSOM and DNSOM with different width and length of grid"),
+        (true, "appendix_a.png", "Appendix A: the SOM models on each data set (rows: data, n"),
+        (false, "appendix_d.png", "Appendix D: the models at different width and length of grid (rows: data, grid"),
     ] {
-        let models: Vec<Model> = if square { Model::ALL.to_vec() } else { vec![Model::Cksom, Model::Dnsom] };
+        // Only the models that ran: no empty column.
+        let shown: &[Model] = if square { &Model::ALL } else { &[Model::Cksom, Model::Dnsom] };
+        let models: Vec<Model> = shown.iter().copied().filter(|&m| first.iter().any(|r| r.cell.model == m)).collect();
+        let labels: Vec<&str> = models.iter().map(|m| m.label()).collect();
+        let title = format!("{title}; columns: {})", labels.join(", "));
         let mut rows: Vec<(String, crate::experiment::spec::GridSize)> = Vec::new();
         for r in &first {
             let key = (r.cell.dataset.clone(), r.cell.grid);
@@ -77,12 +93,15 @@ pub fn write(runs: &[SomRun], out: &Path) -> Result<Vec<String>> {
             for &m in &models {
                 let run = first.iter().find(|r| &r.cell.dataset == data && r.cell.grid == *grid && r.cell.model == m);
                 panels.push(Panel {
-                    title: format!("{data} {} {grid}", m.label()),
+                    title: format!("{data} {} {}", m.label(), lattice_label(m, *grid)),
                     meshes: run.map(|r| meshes(r)).unwrap_or_default(),
                 });
             }
         }
-        match plots::overview_png(&out.join(name), title, &panels, models.len()) {
+        if models.is_empty() {
+            continue;
+        }
+        match plots::overview_png(&out.join(name), &title, &panels, models.len()) {
             Ok(()) => written.push(name.to_string()),
             Err(e) => eprintln!("somnurbs: warning: picture skipped: {e}"),
         }

@@ -214,7 +214,13 @@ pub fn write_frame(map: &Path, frame: &crate::data::frame::Frame) -> Result<()> 
 
 /// Write every Chapter 4 file; returns the REPORT.md section. Each saved map has its data set's
 /// frame beside it (`maps/dnsom_<data>_<grid>.frame.toml`, not a table: drift skips `maps/`).
-pub fn write(spec: &Spec, runs: &[SomRun], frames: &super::Frames, out: &Path) -> Result<String> {
+pub fn write(
+    spec: &Spec,
+    runs: &[SomRun],
+    frames: &super::Frames,
+    out: &Path,
+    pictures: bool,
+) -> Result<String> {
     let rows: Vec<_> = runs.iter().map(|r| r.row.clone()).collect();
     write_atomic(&out.join("runs.csv"), csv_text(&rows)?.as_bytes())?;
     let mut written = vec!["runs.csv".to_string()];
@@ -254,12 +260,14 @@ pub fn write(spec: &Spec, runs: &[SomRun], frames: &super::Frames, out: &Path) -
         }
         maps.push(name);
     }
-    let pictures = if spec.section::<super::spec::SomSpec>().map(|s| s.pictures).unwrap_or(false) {
+    let pictures = if pictures
+        && spec.section::<super::spec::SomSpec>().map(|s| s.pictures).unwrap_or(false)
+    {
         super::pictures::write(runs, out)?
     } else {
         Vec::new()
     };
-    let claims_md = crate::report::claims::write(out, &claims(runs))?;
+    let claims_md = crate::report::claims::write(out, &spec.file.name, &claims(runs), false)?;
     Ok(section(runs, &written, &maps, &pictures, &claims_md))
 }
 
@@ -332,38 +340,37 @@ const RANKINGS: [Ranking; 8] = {
 /// A value source: (data, model, grid, metric stem) -> the mean over repeats.
 type Src<'a> = &'a dyn Fn(&str, Model, GridSize, &str) -> Option<f64>;
 
-/// (cases where the ranking holds, cases with every value) over the data sets and grids.
-fn ranking_count(rk: &Ranking, src: Src, data: &[String], gs: &[GridSize]) -> (usize, usize) {
-    let (mut yes, mut all) = (0, 0);
-    for d in data {
-        for &g in gs {
-            let vals: Option<Vec<f64>> = rk.models.iter().map(|&m| src(d, m, g, rk.stem)).collect();
-            let (Some(vals), Some(t)) = (vals, src(d, rk.target, g, rk.stem)) else { continue };
-            all += 1;
-            yes += vals.iter().all(|&v| if rk.highest { t >= v } else { t <= v }) as usize;
-        }
-    }
-    (yes, all)
+/// Whether the ranking holds in one (data, grid) case of a source (None without every value).
+fn ranking_case(rk: &Ranking, src: Src, d: &str, g: GridSize) -> Option<bool> {
+    let vals: Vec<f64> = rk.models.iter().map(|&m| src(d, m, g, rk.stem)).collect::<Option<_>>()?;
+    let t = src(d, rk.target, g, rk.stem)?;
+    Some(vals.iter().all(|&v| if rk.highest { t >= v } else { t <= v }))
 }
 
-/// QE falls as n grows: (per (data, model) series over the square grids that fall, series).
-fn qe_falls(src: Src, data: &[String], sq: &[GridSize]) -> (usize, usize) {
-    let (mut yes, mut all) = (0, 0);
-    let mut sorted = sq.to_vec();
-    sorted.sort();
-    for d in data {
-        for m in Model::ALL {
-            let v: Option<Vec<f64>> = sorted.iter().map(|&g| src(d, m, g, "qe")).collect();
-            if let Some(v) = v.filter(|v| v.len() >= 2) {
-                all += 1;
-                yes += v.windows(2).all(|w| w[1] < w[0]) as usize;
-            }
-        }
-    }
-    (yes, all)
+/// Whether QE falls along one (data, model) series of square grids (None without two values).
+fn qe_falls_case(src: Src, d: &str, m: Model, sorted: &[GridSize]) -> Option<bool> {
+    let v: Vec<f64> = sorted.iter().map(|&g| src(d, m, g, "qe")).collect::<Option<_>>()?;
+    (v.len() >= 2).then(|| v.windows(2).all(|w| w[1] < w[0]))
 }
 
-/// Chapter 4 claims, checked on the runs and on the thesis' own Appendix B/C.
+/// (holds, checked) over the cases this run has, and the same count on the thesis when it has
+/// every one of those cases (else None: the counts would not be of the same cells).
+fn paired(
+    cases: impl Iterator<Item = (Option<bool>, Option<bool>)>,
+) -> ((usize, usize), Option<(usize, usize)>) {
+    let (mut ours, mut theirs, mut covered) = ((0, 0), (0, 0), true);
+    for (o, t) in cases {
+        let Some(o) = o else { continue };
+        ours = (ours.0 + o as usize, ours.1 + 1);
+        match t {
+            Some(t) => theirs = (theirs.0 + t as usize, theirs.1 + 1),
+            None => covered = false,
+        }
+    }
+    (ours, covered.then_some(theirs))
+}
+
+/// Chapter 4 claims, checked on the runs and, for the same cases, on the thesis' Appendix B/C.
 pub fn claims(runs: &[SomRun]) -> Vec<Claim> {
     let thesis_b = reference::table("appendix_b");
     let thesis_c = reference::table("appendix_c");
@@ -384,28 +391,26 @@ pub fn claims(runs: &[SomRun]) -> Vec<Claim> {
         }
     };
     let data = datasets(runs);
-    let sq = grids(runs, true);
+    let mut sq = grids(runs, true);
+    sq.sort();
     let nsq = grids(runs, false);
-    let claim = |statement: &str, o: (usize, usize), t: (usize, usize), note: &str| Claim {
-        chapter: "4".into(),
-        rival: None,
-        statement: statement.into(),
-        ours: o,
-        thesis: (t.1 > 0).then_some(t),
-        note: note.into(),
+    let claim = |statement: &str, (o, t): ((usize, usize), Option<(usize, usize)>), note: &str| {
+        Claim::most("4", statement, o).thesis(t).note(note)
     };
+    let series = data.iter().flat_map(|d| Model::ALL.iter().map(move |&m| (d, m)));
     let mut claims = vec![claim(
         "QE falls as n grows, for every model",
-        qe_falls(&ours, &data, &sq),
-        qe_falls(&theirs, &data, &sq),
+        paired(series.map(|(d, m)| {
+            (qe_falls_case(&ours, d, m, &sq), qe_falls_case(&theirs, d, m, &sq))
+        })),
         "per (data, model) series",
     )];
     for rk in &RANKINGS {
         let gs = if rk.square { &sq } else { &nsq };
+        let cases = data.iter().flat_map(|d| gs.iter().map(move |&g| (d, g)));
         claims.push(claim(
             rk.statement,
-            ranking_count(rk, &ours, &data, gs),
-            ranking_count(rk, &theirs, &data, gs),
+            paired(cases.map(|(d, g)| (ranking_case(rk, &ours, d, g), ranking_case(rk, &theirs, d, g)))),
             rk.note,
         ));
     }
@@ -416,13 +421,16 @@ pub fn claims(runs: &[SomRun]) -> Vec<Claim> {
 const THESIS_SQUARE: [&str; 2] = ["appendix_b", "section_4_bunny"];
 
 fn side_by_side(runs: &[SomRun], square: bool, thesis: Option<&RefTable>) -> String {
+    // Only the models that ran, and "(thesis)" only where the thesis has a value for a cell.
+    let shown: &[Model] = if square { &Model::ALL } else { &[Model::Cksom, Model::Dnsom] };
     let models: Vec<Model> =
-        if square { Model::ALL.to_vec() } else { vec![Model::Cksom, Model::Dnsom] };
+        shown.iter().copied().filter(|&m| runs.iter().any(|r| r.cell.model == m)).collect();
     let mut s = String::new();
     for (stem, label) in METRICS {
         let mut header = vec!["data".to_string(), "grid".to_string()];
         header.extend(models.iter().map(|m| m.label().to_string()));
         let mut rows = Vec::new();
+        let mut any_thesis = false;
         for d in datasets(runs) {
             for g in grids(runs, square) {
                 let mut row = vec![d.clone(), g.to_string()];
@@ -436,6 +444,7 @@ fn side_by_side(runs: &[SomRun], square: bool, thesis: Option<&RefTable>) -> Str
                         if square { vec!["data", "n"] } else { vec!["data", "n_x", "n_y"] };
                     let t =
                         thesis.and_then(|t| t.value(&cols, &key, &format!("{stem}_{}", m.key())));
+                    any_thesis |= t.is_some();
                     row.push(beside(
                         mean_of(runs, &d, m, g, stem),
                         t,
@@ -445,7 +454,8 @@ fn side_by_side(runs: &[SomRun], square: bool, thesis: Option<&RefTable>) -> Str
                 rows.push(row);
             }
         }
-        let _ = write!(s, "\n**{label}** — ours (thesis)\n\n{}", table(&header, &rows));
+        let whose = if any_thesis { "ours (thesis)" } else { "ours (the thesis has none of these cells)" };
+        let _ = write!(s, "\n**{label}** — {whose}\n\n{}", table(&header, &rows));
     }
     s
 }
@@ -527,8 +537,10 @@ fn section(
         written.iter().map(|w| format!("`{w}`")).collect::<Vec<_>>().join(", ")
     );
     s.push_str(DEFINITIONS);
-    s.push_str("\n### Claims\n\n");
-    s.push_str(claims_md);
+    if !claims_md.is_empty() {
+        s.push_str("\n### Claims\n\n");
+        s.push_str(claims_md);
+    }
     if appendix_table(runs, true).is_some() {
         s.push_str("\n### Appendix B, side by side\n");
         s.push_str(&side_by_side(runs, true, reference::joined(&THESIS_SQUARE).as_ref()));

@@ -72,19 +72,35 @@ pub fn box_plot_png(
     title: &str,
     y_label: &str,
     groups: &[(String, Vec<f64>)],
+    levels: &[Level],
 ) -> Result<(), PlotError> {
     let stats: Vec<Option<BoxStats>> =
         groups.iter().map(|(_, v)| BoxStats::from_values(v)).collect();
-    let (lo, hi) = extent(stats.iter().flatten().flat_map(|s| {
-        [s.lower_whisker, s.upper_whisker].into_iter().chain(s.outliers.iter().copied())
-    }))
+    let (lo, hi) = extent(
+        stats
+            .iter()
+            .flatten()
+            .flat_map(|s| {
+                [s.lower_whisker, s.upper_whisker].into_iter().chain(s.outliers.iter().copied())
+            })
+            .chain(levels.iter().map(|l| l.y)),
+    )
     .ok_or_else(|| {
         PlotError::input(path, format!("none of the {} groups has a finite value", groups.len()))
     })?;
     let y_axis = Axis::linear(lo, hi, 7);
     render_png(path, box_plot_size(groups.len()), |root| {
-        draw_box_plot(root, title, y_label, groups, &stats, &y_axis)
+        draw_box_plot(root, title, y_label, groups, &stats, &y_axis, levels)
     })
+}
+
+/// A reference level across a box plot (where every run started, a certified optimum), so a
+/// box that ends above it shows as such; `key` picks its colour ([`style::optimiser_colour`]).
+#[derive(Debug, Clone)]
+pub struct Level {
+    pub key: &'static str,
+    pub label: String,
+    pub y: f64,
 }
 
 fn draw_box_plot(
@@ -94,6 +110,7 @@ fn draw_box_plot(
     groups: &[(String, Vec<f64>)],
     stats: &[Option<BoxStats>],
     y_axis: &Axis,
+    levels: &[Level],
 ) -> Result<(), DrawError> {
     let label_font = style::text(style::LABEL_PX);
     let small_font = style::text(12.0).color(&style::GREY);
@@ -119,6 +136,22 @@ fn draw_box_plot(
         .y_label_formatter(&yf)
         .draw()?;
 
+    // The reference levels first, dashed under the boxes, each named at its right end.
+    for l in levels {
+        let colour = style::optimiser_colour(l.key).unwrap_or(style::GREY);
+        let steps = 40;
+        let dashes = (0..steps).step_by(2).map(|i| {
+            let x = |j: usize| 0.5 + k * j as f64 / steps as f64;
+            PathElement::new(vec![(x(i), l.y), (x(i + 1), l.y)], colour.stroke_width(2))
+        });
+        chart.draw_series(dashes)?;
+        let (px, py) = chart.backend_coord(&(k + 0.5, l.y));
+        root.draw(&Text::new(
+            l.label.clone(),
+            (px - 4, py - 4),
+            style::text(12.0).color(&colour).pos(Pos::new(HPos::Right, VPos::Bottom)),
+        ))?;
+    }
     let slot_px =
         chart.backend_coord(&(1.5, y_axis.lo)).0 - chart.backend_coord(&(0.5, y_axis.lo)).0;
     for (i, ((name, _), st)) in groups.iter().zip(stats).enumerate() {
@@ -218,22 +251,51 @@ mod tests {
             ("de".to_string(), vec![14.742461, 14.742462, 14.742461, 14.742463, f64::NAN]),
             ("empty".to_string(), vec![f64::NAN]),
         ];
-        box_plot_png(&p, "Final fitness", "fitness", &g).unwrap();
+        box_plot_png(&p, "Final fitness", "fitness", &g, &[]).unwrap();
         assert_eq!(png_size(&p), box_plot_size(3));
         assert_eq!(listing(dir.path()), vec!["box.png".to_string()]);
         assert_eq!(box_plot_size(20).0, 160 + 70 * 20);
+    }
+
+    /// Pixels of `colour` in a PNG written by the plots (palette or RGB).
+    fn count_colour(path: &Path, colour: RGBColor) -> usize {
+        let mut dec = png::Decoder::new(std::fs::File::open(path).unwrap());
+        dec.set_transformations(png::Transformations::EXPAND);
+        let mut reader = dec.read_info().unwrap();
+        let mut buf = vec![0; reader.output_buffer_size()];
+        let info = reader.next_frame(&mut buf).unwrap();
+        let step = info.color_type.samples();
+        buf[..info.buffer_size()]
+            .chunks(step)
+            .filter(|p| p[0] == colour.0 && p[1] == colour.1 && p[2] == colour.2)
+            .count()
+    }
+
+    #[test]
+    fn a_reference_level_is_drawn_even_above_every_box() {
+        let dir = tempfile::tempdir().unwrap();
+        let g = vec![("de".to_string(), vec![1.0, 1.1, 1.2]), ("pso".to_string(), vec![1.3, 1.4])];
+        let (plain, with) = (dir.path().join("plain.png"), dir.path().join("with.png"));
+        box_plot_png(&plain, "t", "y", &g, &[]).unwrap();
+        let b = Level { key: "b", label: "B 2.0".into(), y: 2.0 };
+        box_plot_png(&with, "t", "y", &g, &[b]).unwrap();
+        let grey = style::optimiser_colour("b").unwrap();
+        let (n0, n1) = (count_colour(&plain, grey), count_colour(&with, grey));
+        assert!(n1 > n0 + 200, "the level B = 2.0 adds {} grey pixels", n1 as i64 - n0 as i64);
     }
 
     #[test]
     fn box_plot_errors_name_the_path() {
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("nobox.png");
-        let e =
-            box_plot_png(&p, "t", "y", &[("a".into(), vec![f64::NAN])]).unwrap_err().to_string();
+        let e = box_plot_png(&p, "t", "y", &[("a".into(), vec![f64::NAN])], &[])
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("nobox.png"), "{e}");
         let q = missing_folder_path(dir.path());
-        let e =
-            box_plot_png(&q, "t", "y", &[("a".into(), vec![1.0, 2.0])]).unwrap_err().to_string();
+        let e = box_plot_png(&q, "t", "y", &[("a".into(), vec![1.0, 2.0])], &[])
+            .unwrap_err()
+            .to_string();
         assert!(e.contains(&q.display().to_string()), "{e}");
         assert!(listing(dir.path()).is_empty());
     }

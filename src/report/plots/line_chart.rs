@@ -63,8 +63,55 @@ pub fn line_chart_png(
 ) -> Result<(), PlotError> {
     let (x_ext, y_axis) = axes(path, series, log_y)?;
     render_png(path, style::CHART_SIZE, |root| {
-        draw_line_chart(root, title, x_label, y_label, series, x_ext, &y_axis)
+        draw_line_chart(root, title, x_label, y_label, series, x_ext, &y_axis).map(|_| ())
     })
+}
+
+/// A line chart of points in a plane (an outline, a top view) with equal scales on both axes,
+/// so a circle is drawn round: the shorter data range is widened about its centre until a unit
+/// takes as many pixels across as up.
+pub fn xy_chart_png(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    series: &[Series],
+) -> Result<(), PlotError> {
+    let (x_ext, y_axis) = axes(path, series, false)?;
+    // The unpadded data extents (Axis::linear pads both by the same factor).
+    let y_ext = (y_axis.lo / 2.0 + y_axis.hi / 2.0, (y_axis.hi - y_axis.lo) / 2.0 / 1.1);
+    let y_ext = (y_ext.0 - y_ext.1, y_ext.0 + y_ext.1);
+    render_png(path, style::CHART_SIZE, |root| {
+        // Measure the plotting area, widen one range to its aspect and draw again (the y labels'
+        // width can move the area by a few pixels, so until it stays put).
+        let draw = |xe: (f64, f64), ye: (f64, f64)| {
+            let y_axis = Axis::linear(ye.0, ye.1, 7);
+            draw_line_chart(root, title, x_label, y_label, series, xe, &y_axis)
+        };
+        let mut dims = draw(x_ext, y_ext)?;
+        for _ in 0..3 {
+            let (xe, ye) = equal_scale(x_ext, y_ext, dims);
+            root.fill(&WHITE)?;
+            let now = draw(xe, ye)?;
+            if now == dims {
+                break;
+            }
+            dims = now;
+        }
+        Ok(())
+    })
+}
+
+/// The extents widened so that one unit takes as many pixels in x as in y on a plotting area of
+/// `dims` pixels (the longer range per pixel is kept; the other is centred).
+fn equal_scale(x: (f64, f64), y: (f64, f64), dims: (u32, u32)) -> ((f64, f64), (f64, f64)) {
+    let (w, h) = (f64::from(dims.0.max(1)), f64::from(dims.1.max(1)));
+    let per_px = ((x.1 - x.0) / w).max((y.1 - y.0) / h);
+    let widen = |e: (f64, f64), px: f64| {
+        let (mid, half) = (e.0 / 2.0 + e.1 / 2.0, per_px * px / 2.0);
+        (mid - half, mid + half)
+    };
+    (widen(x, w), widen(y, h))
 }
 
 /// Size of one panel of [`small_multiples_png`].
@@ -165,7 +212,7 @@ fn draw_line_chart(
     series: &[Series],
     x_ext: (f64, f64),
     y_axis: &Axis,
-) -> Result<(), DrawError> {
+) -> Result<(u32, u32), DrawError> {
     let label_font = style::text(style::LABEL_PX);
     let names: Vec<String> = series
         .iter()
@@ -259,7 +306,8 @@ fn draw_line_chart(
 
     // Legend, top-aligned with the plot.
     let top = chart.plotting_area().get_base_pixel().1 - root.get_base_pixel().1;
-    draw_legend(&legend_area, series, &names, top, &label_font)
+    draw_legend(&legend_area, series, &names, top, &label_font)?;
+    Ok(chart.plotting_area().dim_in_pixel())
 }
 
 /// The legend: per series a swatch (band patch behind a line) and its label, from `top` down.
@@ -294,6 +342,23 @@ fn draw_legend(
 mod tests {
     use super::super::testutil::*;
     use super::*;
+
+    #[test]
+    fn equal_scale_widens_the_shorter_range_about_its_centre() {
+        // x: 10 units over 200 px (0.05 per px); y: 1 unit over 100 px -> 5 units about 0.5.
+        let (x, y) = equal_scale((0.0, 10.0), (0.0, 1.0), (200, 100));
+        assert_eq!(x, (0.0, 10.0));
+        assert!((y.0 + 2.0).abs() < 1e-12 && (y.1 - 3.0).abs() < 1e-12, "{y:?}");
+        let dir = tempfile::tempdir().unwrap();
+        let p = dir.path().join("xy.png");
+        let circle: Vec<(f64, f64)> = (0..=64)
+            .map(|k| (k as f64 / 64.0 * std::f64::consts::TAU))
+            .map(|t| (t.cos(), 0.2 * t.sin()))
+            .collect();
+        let s = Series { label: "ellipse".into(), colour: style::BLUE, points: circle, band: None };
+        xy_chart_png(&p, "equal axes", "x", "y", &[s]).unwrap();
+        assert_eq!(png_size(&p), style::CHART_SIZE);
+    }
 
     fn conv(label: &str, colour: RGBColor, scale: f64) -> Series {
         let pts: Vec<(f64, f64)> = (0..50)

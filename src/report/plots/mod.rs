@@ -20,9 +20,9 @@ mod palette;
 pub mod scale;
 pub mod style;
 
-pub use boxplot::{box_plot_png, box_plot_size, BoxStats};
+pub use boxplot::{box_plot_png, box_plot_size, BoxStats, Level};
 pub use cd_diagram::{cd_cliques, cd_diagram_png, cd_diagram_size};
-pub use line_chart::{line_chart_png, small_multiples_png, Series};
+pub use line_chart::{line_chart_png, small_multiples_png, xy_chart_png, Series};
 pub use mesh3d::{
     draw_meshes, grid_edges, lattice_edges, magnified_difference, mesh_png, LineMesh, View3d,
 };

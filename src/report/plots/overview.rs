@@ -165,11 +165,12 @@ mod tests {
 
     #[test]
     fn size_is_cols_by_rows_of_panels_plus_header() {
-        assert_eq!(overview_size(12, 4), Some((1200, 3 * 300 + HEADER_PX)));
-        assert_eq!(overview_size(5, 4), Some((1200, 2 * 300 + HEADER_PX)));
+        let p = style::PANEL_PX;
+        assert_eq!(overview_size(12, 4), Some((4 * p, 3 * p + HEADER_PX)));
+        assert_eq!(overview_size(5, 4), Some((4 * p, 2 * p + HEADER_PX)));
         assert_eq!(
             overview_size(2, 4),
-            Some((600, 300 + HEADER_PX)),
+            Some((2 * p, p + HEADER_PX)),
             "cols clamped to panel count"
         );
         assert_eq!(overview_size(0, 4), None);

@@ -42,9 +42,9 @@ pub const CAPTION_PX: f64 = 16.0;
 /// Size of a 2-D chart (line chart, box plot) in pixels.
 pub const CHART_SIZE: (u32, u32) = (960, 600);
 /// Side of one overview panel (pixels), caption included.
-pub const PANEL_PX: u32 = 300;
+pub const PANEL_PX: u32 = 200;
 /// Default size of a single mesh picture.
-pub const MESH_SIZE: (u32, u32) = (800, 700);
+pub const MESH_SIZE: (u32, u32) = (480, 420);
 
 /// Okabe-Ito black.
 pub const BLACK: RGBColor = RGBColor(0, 0, 0);
