@@ -359,6 +359,7 @@ pub fn reproduce(
             report.extend(part.readings.iter().map(String::as_str));
         }
     }
+    report.push_str(&readings_score(&ctx.out, &plan)?);
     let path = ctx.out.join("REPORT.md");
     write_atomic(&path, report.as_bytes())?;
     crate::report::html::write(&ctx.out)?;
@@ -646,6 +647,103 @@ fn render_readings(out: &Path, plan: &Plan, rows: &[ReadingClaim]) -> Result<Str
         "\n{changing} of {} claims change their verdict with the reading.\n",
         keys.len()
     );
+    s.push_str(&crate::report::markdown::table(&h, &md_rows));
+    Ok(s)
+}
+
+/// `readings_score.csv` and its REPORT.md section: per spec folder and reading, the published
+/// table cells whose ratio ours/published lies in the band and the claims that agree with the
+/// source's own count ([`crate::report::score`]); totals over the specs every reading ran.
+fn readings_score(out: &Path, plan: &Plan) -> Result<String> {
+    use crate::report::score::{folder_score, Score, BAND};
+    let mut readings: Vec<(String, Vec<(String, PathBuf)>)> =
+        vec![(plan.reading.clone(), plan.specs.iter().map(|s| (s.clone(), out.join(s))).collect())];
+    for r in &plan.readings {
+        let root = out.join(READINGS_DIR).join(&r.name);
+        readings
+            .push((r.name.clone(), r.specs.iter().map(|s| (s.clone(), root.join(s))).collect()));
+    }
+    let mut rows = Vec::new();
+    let mut scores: Vec<(String, String, Score)> = Vec::new();
+    for (reading, folders) in &readings {
+        for (spec, folder) in folders {
+            if !folder.is_dir() {
+                continue;
+            }
+            let sc = folder_score(folder)?;
+            if sc.cells + sc.claims == 0 {
+                continue;
+            }
+            let share = if sc.cells > 0 {
+                format!("{:.4}", sc.within as f64 / sc.cells as f64)
+            } else {
+                String::new()
+            };
+            rows.push(vec![
+                reading.clone(),
+                spec.clone(),
+                sc.cells.to_string(),
+                sc.within.to_string(),
+                share,
+                sc.claims.to_string(),
+                sc.agree.to_string(),
+            ]);
+            scores.push((reading.clone(), spec.clone(), sc));
+        }
+    }
+    if rows.is_empty() {
+        return Ok(String::new());
+    }
+    let header: Vec<String> = [
+        "reading",
+        "spec",
+        "published_cells",
+        "within_band",
+        "share_within",
+        "claims_with_source",
+        "claims_agree",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    write_atomic(&out.join("readings_score.csv"), csv_records(&header, &rows)?.as_bytes())?;
+    let names: Vec<&String> = readings.iter().map(|r| &r.0).collect();
+    let specs: Vec<&String> = crate::report::ordered(scores.iter().map(|s| &s.1));
+    let cell = |sc: Option<&Score>| match sc {
+        None => "-".to_string(),
+        Some(s) => {
+            let share = if s.cells > 0 {
+                format!("{:.1}% of {} cells", 100.0 * s.within as f64 / s.cells as f64, s.cells)
+            } else {
+                "no cells".into()
+            };
+            format!("{share}; {}/{} claims agree", s.agree, s.claims)
+        }
+    };
+    let find = |r: &str, s: &str| scores.iter().find(|x| x.0 == r && x.1 == s).map(|x| &x.2);
+    let mut h = vec!["spec".to_string()];
+    h.extend(names.iter().map(|n| format!("`{n}`")));
+    let mut md_rows: Vec<Vec<String>> = specs
+        .iter()
+        .map(|s| {
+            std::iter::once(s.to_string()).chain(names.iter().map(|r| cell(find(r, s)))).collect()
+        })
+        .collect();
+    // Comparable totals: over the specs every reading ran.
+    let common: Vec<&&String> =
+        specs.iter().filter(|s| names.iter().all(|r| find(r, s).is_some())).collect();
+    if names.len() > 1 && !common.is_empty() {
+        let total = |r: &str| {
+            common.iter().filter_map(|s| find(r, s)).fold(Score::default(), |a, b| a + *b)
+        };
+        let mut row = vec![format!(
+            "**all of {}**",
+            common.iter().map(|s| s.as_str()).collect::<Vec<_>>().join(", ")
+        )];
+        row.extend(names.iter().map(|r| cell(Some(&total(r)))));
+        md_rows.push(row);
+    }
+    let mut s = format!("\n---\n\n# Readings score\n\nFor each reading and spec: the share of the published tables' value cells (Appendices B-F, K, L and the seeds' tables; CPU seconds left out) whose ratio ours/published lies in [{}, {}], and how many of the claims with the source's own count agree with it (`readings_score.csv`). The reading that reproduces the published numbers best has the highest shares.\n\n", BAND.0, BAND.1);
     s.push_str(&crate::report::markdown::table(&h, &md_rows));
     Ok(s)
 }

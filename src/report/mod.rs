@@ -7,6 +7,7 @@ pub mod html;
 pub mod markdown;
 pub mod plots;
 pub mod reference;
+pub mod score;
 pub mod views3d;
 
 /// The distinct items in order of first appearance.

@@ -293,7 +293,7 @@ fn friedman_overall(
             &ranks,
             cd,
         ) {
-            Ok(()) => cd_note = format!(", critical-difference diagram {}", png.display()),
+            Ok(()) => cd_note = ", critical-difference diagram cd_diagram.png".into(),
             Err(e) => eprintln!("somnurbs: warning: picture skipped: {e}"),
         }
     }

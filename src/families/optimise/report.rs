@@ -170,6 +170,8 @@ struct GridTables {
     beats_b: Vec<usize>,
     /// Per (data, parameterisation): the error and time wins per optimiser.
     per_dp: Vec<(String, Parameterisation, Vec<usize>, Vec<usize>)>,
+    /// Per cell (in `cells` order): the optimiser with the least AVG error.
+    winner: Vec<Option<usize>>,
 }
 
 impl GridTables {
@@ -199,6 +201,7 @@ impl GridTables {
             time_wins: vec![0; n],
             beats_b: vec![0; n],
             per_dp: Vec::new(),
+            winner: Vec::new(),
         };
         for c in &cells {
             t.add_cell(g, c);
@@ -239,6 +242,7 @@ impl GridTables {
                 self.per_dp.len() - 1
             }
         };
+        self.winner.push(argmin(&avgs));
         if let Some(k) = argmin(&avgs) {
             self.err_wins[k] += 1;
             self.per_dp[dp].2[k] += 1;
@@ -343,6 +347,97 @@ fn thesis_wins(
         }
     }
     Some((w, n))
+}
+
+/// The thesis' optimiser with the least AVG error in one of our cells (from its Appendix K/L).
+fn thesis_winner(t: &reference::RefTable, c: &CellKey) -> Option<&'static str> {
+    let key = [c.0.clone(), c.1.name().to_string(), c.2.nx.to_string(), c.2.ny.to_string()];
+    let row = t.find(&["data", "parameterisation", "cn_x", "cn_y"], &key)?;
+    let names = ["ga", "de", "pso"];
+    let v: Vec<f64> =
+        names.iter().map(|n| row.get(&format!("{n}_avg")).and_then(|x| x.parse().ok())).collect::<Option<_>>()?;
+    v.iter().enumerate().min_by(|a, b| a.1.total_cmp(b.1)).map(|(k, _)| names[k])
+}
+
+/// Chapter 6's winner pattern by net size (`winners_by_net_<grid>.csv` and its chart): per
+/// control net, the cells where each optimiser has the least AVG error, and the thesis' count over
+/// the same cells where this run compared the thesis' three optimisers.
+fn winners_by_net(t: &GridTables, grid: GridSize, err_name: &str, out: &Path, pictures: bool) -> Result<String> {
+    let mut sorted = t.opts.clone();
+    sorted.sort();
+    let thesis = if sorted == ["de", "ga", "pso"] { reference::table(err_name) } else { None };
+    let nets = ordered(t.cells.iter().map(|c| c.2));
+    let mut h = vec!["cn_x".to_string(), "cn_y".into(), "cells".into()];
+    h.extend(t.opts.iter().map(|o| format!("{o}_wins")));
+    let mut any_thesis = false;
+    let mut rows = Vec::new();
+    let mut ours_series: Vec<Vec<(f64, f64)>> = vec![Vec::new(); t.opts.len()];
+    let mut thesis_series: Vec<Vec<(f64, f64)>> = vec![Vec::new(); t.opts.len()];
+    for cn in &nets {
+        let here: Vec<usize> = (0..t.cells.len()).filter(|&i| t.cells[i].2 == *cn).collect();
+        let mut row = vec![cn.nx.to_string(), cn.ny.to_string(), here.len().to_string()];
+        let ours: Vec<usize> =
+            (0..t.opts.len()).map(|k| here.iter().filter(|&&i| t.winner[i] == Some(k)).count()).collect();
+        row.extend(ours.iter().map(|w| w.to_string()));
+        // The thesis' count only where it has every one of these cells.
+        let theirs: Option<Vec<usize>> = thesis.as_ref().and_then(|tt| {
+            let w: Option<Vec<&str>> = here.iter().map(|&i| thesis_winner(tt, &t.cells[i])).collect();
+            w.map(|w| t.opts.iter().map(|o| w.iter().filter(|x| **x == o).count()).collect())
+        });
+        if let Some(th) = &theirs {
+            any_thesis = true;
+            row.extend(th.iter().map(|w| w.to_string()));
+        }
+        for k in 0..t.opts.len() {
+            ours_series[k].push((cn.nx as f64, ours[k] as f64));
+            if let Some(th) = &theirs {
+                thesis_series[k].push((cn.nx as f64, th[k] as f64));
+            }
+        }
+        rows.push(row);
+    }
+    if any_thesis {
+        h.extend(t.opts.iter().map(|o| format!("{o}_wins_thesis")));
+        rows.retain(|r| r.len() == h.len());
+    }
+    let name = format!("winners_by_net_{grid}");
+    write_atomic(&out.join(format!("{name}.csv")), csv_records(&h, &rows)?.as_bytes())?;
+    let mut s = format!("\n**`{name}.csv`**: per control net, the cells where each optimiser has the least AVG error{}\n\n{}", if any_thesis { ", ours beside the thesis' over the same cells" } else { "" }, table(&h, &rows));
+    if pictures {
+        let series = |pts: &[Vec<(f64, f64)>]| -> Vec<Series> {
+            t.opts
+                .iter()
+                .enumerate()
+                .map(|(k, o)| Series {
+                    label: label(o),
+                    colour: style::optimiser_colour(o).unwrap_or_else(|| style::cycle_colour(k)),
+                    points: pts[k].clone(),
+                    band: None,
+                })
+                .collect()
+        };
+        let mut panels = vec![("this run".to_string(), series(&ours_series))];
+        if any_thesis {
+            panels.push(("the thesis, same cells".to_string(), series(&thesis_series)));
+        }
+        let png = format!("png/{name}.png");
+        crate::io::ensure_dir(&out.join("png"))?;
+        match plots::small_multiples_png(
+            &out.join(&png),
+            &format!("Grid {grid}: cells where each optimiser has the least average error, by control net"),
+            "control net (first side)",
+            "cells won",
+            &panels,
+            2,
+            false,
+        ) {
+            Ok(()) => {
+                let _ = writeln!(s, "\n![{png}]({png})");
+            }
+            Err(e) => eprintln!("somnurbs: warning: picture skipped: {e}"),
+        }
+    }
+    Ok(s)
 }
 
 /// An optimiser's name as the reports write it (GA, DE, PSO, CSA, ICSA).
@@ -566,6 +661,9 @@ fn write_grid(
     s.push_str(&t.summary(g));
     if t.opts.iter().any(|o| o == "de") {
         s.push_str(&beside_md);
+    }
+    if t.opts.len() > 1 {
+        s.push_str(&winners_by_net(&t, grid, err_name, out, pictures)?);
     }
     let mut claims = grid_claims(&t, grid, err_name, time_name);
     if let Some((part, claim)) = exact_section(g, &t, exact, grid, out)? {

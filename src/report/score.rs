@@ -1,0 +1,144 @@
+//! The readings score: how near a run's tables are to the published ones, cell by cell, and how
+//! many of the sources' claims it counts as the sources do, so that the readings of an ambiguous
+//! text can be ranked by how well each reproduces the published numbers.
+
+use super::claims;
+use super::reference::{self, RefTable};
+use anyhow::{Context, Result};
+use std::path::Path;
+
+/// A ratio ours/published inside this band counts as reproduced.
+pub const BAND: (f64, f64) = (0.8, 1.25);
+
+/// Columns that name a row of a published table (the rest are values).
+const KEYS: [&str; 9] =
+    ["data", "n", "n_x", "n_y", "cn_x", "cn_y", "parameterisation", "statistic", "control_points"];
+
+/// A value column that is no result of the method: CPU seconds (machine-dependent) and the
+/// generation at which a best was found.
+fn scored(column: &str) -> bool {
+    !(column.starts_with("cpu") || column.ends_with("_s") || column == "generation")
+}
+
+/// One folder's score.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Score {
+    /// Published value cells this folder's tables also hold (both finite, the published non-zero).
+    pub cells: usize,
+    /// Of those, the cells whose ratio ours/published lies in [`BAND`].
+    pub within: usize,
+    /// Claims with the source's own count over the same cells.
+    pub claims: usize,
+    /// Of those, the claims whose share agrees with the source's (`Claim::agreement`).
+    pub agree: usize,
+}
+
+impl std::ops::Add for Score {
+    type Output = Score;
+    fn add(self, o: Score) -> Score {
+        Score {
+            cells: self.cells + o.cells,
+            within: self.within + o.within,
+            claims: self.claims + o.claims,
+            agree: self.agree + o.agree,
+        }
+    }
+}
+
+/// (cells compared, cells within the band) of one of our tables against the published one.
+pub fn table_score(ours: &RefTable, published: &RefTable) -> (usize, usize) {
+    let keys: Vec<&str> =
+        published.header.iter().map(String::as_str).filter(|c| KEYS.contains(c)).collect();
+    let values: Vec<&str> = published
+        .header
+        .iter()
+        .map(String::as_str)
+        .filter(|c| !KEYS.contains(c) && scored(c) && ours.header.iter().any(|h| h == c))
+        .collect();
+    let (mut cells, mut within) = (0, 0);
+    for row in &published.rows {
+        let key: Vec<String> =
+            keys.iter().map(|k| row.get(*k).cloned().unwrap_or_default()).collect();
+        let Some(mine) = ours.find(&keys, &key) else { continue };
+        for c in &values {
+            let num = |r: &std::collections::BTreeMap<String, String>| {
+                r.get(*c).and_then(|v| v.parse::<f64>().ok()).filter(|v| v.is_finite())
+            };
+            if let (Some(o), Some(p)) = (num(mine), num(row).filter(|p| *p != 0.0)) {
+                cells += 1;
+                let r = o / p;
+                within += (BAND.0..=BAND.1).contains(&r) as usize;
+            }
+        }
+    }
+    (cells, within)
+}
+
+/// The score of a run folder: every CSV named like a published table, and its `claims.csv`.
+pub fn folder_score(folder: &Path) -> Result<Score> {
+    let mut score = Score::default();
+    let entries =
+        std::fs::read_dir(folder).with_context(|| format!("cannot list {}", folder.display()))?;
+    let mut names: Vec<String> = entries
+        .filter_map(|e| e.ok())
+        .filter_map(|e| e.file_name().to_str().map(String::from))
+        .filter(|n| n.ends_with(".csv"))
+        .collect();
+    names.sort();
+    for name in names {
+        let Some(published) = reference::table(name.trim_end_matches(".csv")) else { continue };
+        let path = folder.join(&name);
+        let ours = RefTable::parse(&crate::io::read_text(&path)?);
+        let (c, w) = table_score(&ours, &published);
+        score.cells += c;
+        score.within += w;
+    }
+    let path = folder.join("claims.csv");
+    if path.exists() {
+        for c in claims::read(&path)? {
+            match c.agreement() {
+                "" => {}
+                a => {
+                    score.claims += 1;
+                    score.agree += (a == "agrees") as usize;
+                }
+            }
+        }
+    }
+    Ok(score)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cells_are_matched_by_key_and_counted_inside_the_band() {
+        let published = reference::table("appendix_k").unwrap();
+        // Two rows of ours: the first equal to the thesis, the second 30% above it (outside).
+        let row = |k: usize, f: f64| -> String {
+            let r = &published.rows[k];
+            published
+                .header
+                .iter()
+                .map(|h| match r[h].parse::<f64>() {
+                    Ok(v) if !KEYS.contains(&h.as_str()) => format!("{}", v * f),
+                    _ => r[h].clone(),
+                })
+                .collect::<Vec<_>>()
+                .join(",")
+        };
+        let text = format!("{}\n{}\n{}\n", published.header.join(","), row(0, 1.0), row(5, 1.3));
+        let ours = RefTable::parse(&text);
+        // 10 value columns per row (ga/de/pso avg, min, max and b).
+        assert_eq!(table_score(&ours, &published), (20, 10));
+        // CPU seconds are not scored.
+        let m = reference::table("appendix_m").unwrap();
+        assert_eq!(table_score(&m, &m).0, 0);
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("appendix_k.csv"), &text).unwrap();
+        std::fs::write(dir.path().join("other.csv"), "a,b\n1,2\n").unwrap();
+        let s = folder_score(dir.path()).unwrap();
+        assert_eq!((s.cells, s.within, s.claims), (20, 10, 0));
+    }
+}
