@@ -85,6 +85,11 @@ pub struct CompareArgs {
     /// an earlier compare's, which is replaced whole; the run's own files are never changed.
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// An IOHprofiler folder of optimisers from outside somnurbs (written by the Python
+    /// package's `somnurbs.ioh_adapter.Logger`), compared beside the folder's own (repeatable);
+    /// refused unless its problems are the folder's (spec, profile, reading, box, B's error).
+    #[arg(long, value_name = "DIR")]
+    pub external: Vec<PathBuf>,
 }
 
 #[derive(Debug, Args)]

@@ -3,6 +3,7 @@
 //! runs on its own stream and is logged at once.
 
 pub mod compare;
+pub mod external;
 pub mod ioh;
 pub mod overall;
 pub mod pictures;
