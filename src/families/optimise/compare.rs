@@ -584,9 +584,10 @@ fn certified_optima(folder: &std::path::Path) -> Result<BTreeMap<String, f64>> {
 fn problems(
     rows: &[OptimRow],
     folder: &std::path::Path,
-    external: Vec<super::ioh::LoadedProblem>,
+    external: super::external::External,
 ) -> Result<Vec<Problem>> {
-    let certified = certified_optima(folder)?;
+    let mut certified = certified_optima(folder)?;
+    external.add_optima(&mut certified);
     let name = |r: &OptimRow| {
         super::ioh::problem_name(
             &r.dataset,
@@ -600,7 +601,7 @@ fn problems(
         expected.entry((name(r), r.competitor())).or_default().push(r);
     }
     let mut out: BTreeMap<String, Problem> = BTreeMap::new();
-    for lp in super::ioh::read(folder)?.into_iter().chain(external) {
+    for lp in super::ioh::read(folder)?.into_iter().chain(external.traces) {
         let mut exp = expected
             .remove(&(lp.function_name.clone(), lp.optimiser.clone()))
             .with_context(|| {

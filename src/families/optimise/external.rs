@@ -131,13 +131,32 @@ fn check_suite(v: &Value, suite: &[String; 4], file: &Path, results: &Path) -> R
     Ok(())
 }
 
-/// The external runs of one JSON file, checked against the folder's rows, as rows and traces.
+/// What the external folders add to `compare`: their runs' traces and, per problem, the certified
+/// optimum their logs carry (run attribute `somnurbs_optimum`).
+#[derive(Debug, Default)]
+pub struct External {
+    pub traces: Vec<LoadedProblem>,
+    pub optima: BTreeMap<String, f64>,
+}
+
+impl External {
+    /// The certified optima of the results folder (`exact_<grid>.csv`), with the external logs'
+    /// for the problems it has none of (a folder run without `exact = true`).
+    pub fn add_optima(&self, certified: &mut BTreeMap<String, f64>) {
+        for (k, f) in &self.optima {
+            certified.entry(k.clone()).or_insert(*f);
+        }
+    }
+}
+
+/// The external runs of one JSON file, checked against the folder's rows, as rows, traces and
+/// the certified optimum the runs carry.
 fn read_file(
     file: &Path,
     suite: &[String; 4],
     results: &Path,
     by_name: &BTreeMap<String, &OptimRow>,
-) -> Result<(Vec<OptimRow>, LoadedProblem)> {
+) -> Result<(Vec<OptimRow>, LoadedProblem, Option<f64>)> {
     let v: Value = serde_json::from_str(&read_text(file)?)
         .with_context(|| format!("{}: not JSON", file.display()))?;
     check_suite(&v, suite, file, results)?;
@@ -152,6 +171,7 @@ fn read_file(
     };
     let mut rows = Vec::new();
     let mut traces = Vec::new();
+    let mut optimum: Option<f64> = None;
     for s in field(&v, "scenarios", file)?.as_array().into_iter().flatten() {
         let dim = s.get("dimension").and_then(|d| d.as_u64()).unwrap_or(0) as usize;
         if dim != row.dimension {
@@ -176,6 +196,9 @@ fn read_file(
             if let Some(bound) = num("somnurbs_bound").filter(|lb| best < *lb) {
                 anyhow::bail!("{}: {name}: a run ends at {best:e}, below the certified lower bound {bound:e}: not this problem, or a wrong bound", file.display());
             }
+            if let Some(f) = num("somnurbs_optimum") {
+                optimum = Some(optimum.map_or(f, |o| o.min(f)));
+            }
             let evals = r.get("evals").and_then(|e| e.as_u64()).with_context(|| format!("{}: a run has no evals", file.display()))?;
             let repeat = rows.len();
             rows.push(OptimRow {
@@ -195,18 +218,18 @@ fn read_file(
             traces.push((evals, imp));
         }
     }
-    Ok((rows, LoadedProblem { optimiser, function_name: name, runs: traces }))
+    Ok((rows, LoadedProblem { optimiser, function_name: name, runs: traces }, optimum))
 }
 
 /// The runs of the external folders, as runs.csv rows beside `rows` (the folder's) and as the
-/// traces of the runtime statistics; `rows` with the external ones appended.
+/// traces and optima of the runtime statistics; `rows` with the external ones appended.
 pub fn join(
     results: &Path,
     folders: &[PathBuf],
     mut rows: Vec<OptimRow>,
-) -> Result<(Vec<OptimRow>, Vec<LoadedProblem>)> {
+) -> Result<(Vec<OptimRow>, External)> {
     if folders.is_empty() {
-        return Ok((rows, Vec::new()));
+        return Ok((rows, External::default()));
     }
     let suite = folder_suite(results)?;
     let by_name: BTreeMap<String, &OptimRow> = rows
@@ -219,20 +242,24 @@ pub fn join(
         .collect();
     let ours: Vec<String> = rows.iter().map(|r| r.competitor()).collect();
     let mut extra = Vec::new();
-    let mut traces: Vec<LoadedProblem> = Vec::new();
+    let mut ext = External::default();
     for folder in folders {
         for file in json_files(folder)? {
-            let (r, lp) = read_file(&file, &suite, results, &by_name)?;
+            let (r, lp, optimum) = read_file(&file, &suite, results, &by_name)?;
             if ours.contains(&lp.optimiser) {
                 anyhow::bail!("{}: algorithm name {:?} is one of {}'s optimisers: give the external optimiser another name", file.display(), lp.optimiser, results.display());
             }
-            if traces.iter().any(|t| t.optimiser == lp.optimiser && t.function_name == lp.function_name) {
+            if ext.traces.iter().any(|t| t.optimiser == lp.optimiser && t.function_name == lp.function_name) {
                 anyhow::bail!("{}: {} on {} is given twice", file.display(), lp.optimiser, lp.function_name);
             }
+            if let Some(f) = optimum {
+                let o = ext.optima.entry(lp.function_name.clone()).or_insert(f);
+                *o = o.min(f);
+            }
             extra.extend(r);
-            traces.push(lp);
+            ext.traces.push(lp);
         }
     }
     rows.extend(extra);
-    Ok((rows, traces))
+    Ok((rows, ext))
 }
