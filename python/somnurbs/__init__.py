@@ -17,7 +17,8 @@ folders ``somnurbs compare --external`` reads. See docs/python.md.
 
 from ._native import Problem, __version__, problems
 
-SPECS = ("ch6_same", "ch6_diff", "ch6_exact", "ch6_beyond")
-"""The shipped Chapter 6 specs (experiments/<name>.toml)."""
+SPECS = ("ch6_same", "ch6_diff", "ch6_exact", "ch6_beyond", "seed001_growing_grid")
+"""The shipped specs with control-net problems (experiments/<name>.toml): Chapter 6's, and seed
+001's open surfaces (one view, no exact solver)."""
 
 __all__ = ["Problem", "problems", "SPECS", "__version__"]

@@ -21,7 +21,8 @@ certified optimum and lower bound as run attributes::
 
 import ioh
 
-#: The run attributes ``Logger`` writes for every run (``compare`` reads them).
+#: The run attributes ``Logger`` writes for every run (``compare`` reads them); the last two only
+#: for problems with an exact solver (all of Chapter 6's, none of seed 001's).
 RUN_ATTRIBUTES = ("somnurbs_b", "somnurbs_optimum", "somnurbs_bound")
 #: The experiment attributes (strings) ``Logger`` writes once per folder.
 EXPERIMENT_ATTRIBUTES = ("somnurbs_spec", "somnurbs_profile", "somnurbs_reading", "somnurbs_box")
@@ -44,10 +45,14 @@ def box_label(problem, box="spec"):
 
 def wrap(problem, box="spec", instance=1):
     """An ``ioh`` problem of ``problem`` in ``box`` ("spec" or "data"), minimised, with the
-    certified optimum of that box (computed on first use, a second or less per problem)."""
+    certified optimum of that box (computed on first use, a second or less per problem; seed
+    001's open surfaces have none, and ioh's default stands)."""
     lower, upper = box_arrays(problem, box)
-    exact = problem.exact(box)
-    x_opt, f_opt = [float(v) for v in exact["x"]], float(exact["f"])
+    extra = {}
+    if problem.has_exact_solver:
+        exact = problem.exact(box)
+        x_opt, f_opt = [float(v) for v in exact["x"]], float(exact["f"])
+        extra["calculate_objective"] = lambda _instance, _dimension: ioh.RealSolution(x_opt, f_opt)
     fitness = problem.f
     wrapped = ioh.wrap_problem(
         lambda x: fitness(x),
@@ -56,7 +61,7 @@ def wrap(problem, box="spec", instance=1):
         instance=instance,
         lb=0.0,
         ub=1.0,
-        calculate_objective=lambda _instance, _dimension: ioh.RealSolution(x_opt, f_opt),
+        **extra,
     )
     wrapped.bounds.lb = lower
     wrapped.bounds.ub = upper
@@ -78,9 +83,8 @@ class Logger:
             store_positions=False,
         )
         self.analyzer.full_precision = True
-        for name in RUN_ATTRIBUTES:
-            self.analyzer.add_run_attribute(name, 0.0)
         self._suite = None
+        self._exact = None
 
     @property
     def output_directory(self):
@@ -92,17 +96,21 @@ class Logger:
         if self._suite is None:
             for name, value in zip(EXPERIMENT_ATTRIBUTES, suite):
                 self.analyzer.add_experiment_attribute(name, value)
+            self._exact = problem.has_exact_solver
+            for name in RUN_ATTRIBUTES if self._exact else RUN_ATTRIBUTES[:1]:
+                self.analyzer.add_run_attribute(name, 0.0)
             self._suite = suite
         elif suite != self._suite:
             raise ValueError(
                 f"{problem.name}: (spec, profile, reading, box) {suite} differs from this "
                 f"logger's {self._suite}: use one Logger per suite"
             )
-        exact = problem.exact(box)
+        exact = problem.exact(box) if self._exact else None
         wrapped.attach_logger(self.analyzer)
         self.analyzer.set_run_attribute("somnurbs_b", float(problem.b))
-        self.analyzer.set_run_attribute("somnurbs_optimum", float(exact["f"]))
-        self.analyzer.set_run_attribute("somnurbs_bound", float(exact["lower_bound"]))
+        if exact is not None:
+            self.analyzer.set_run_attribute("somnurbs_optimum", float(exact["f"]))
+            self.analyzer.set_run_attribute("somnurbs_bound", float(exact["lower_bound"]))
 
     def close(self):
         self.analyzer.close()

@@ -4,12 +4,12 @@
 //! Evaluation reads a C-contiguous float64 array in place and runs with the GIL released.
 
 use numpy::{PyArray1, PyReadonlyArrayDyn, PyUntypedArrayMethods};
-use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyNotImplementedError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use somnurbs::families::optimise::suite::{self, Suite, SuiteProblem};
+use somnurbs::families::optimise::suite::{self, Fitness, Suite, SuiteProblem};
 use somnurbs::optim::exact::ExactResult;
-use somnurbs::optim::{ExactOptions, Problem as _};
+use somnurbs::optim::ExactOptions;
 use std::sync::{Arc, OnceLock};
 
 /// What every problem of one `problems()` call shares.
@@ -51,14 +51,14 @@ fn float_array<'py>(x: &Bound<'py, PyAny>) -> PyResult<PyReadonlyArrayDyn<'py, f
     let kw = PyDict::new(x.py());
     kw.set_item("dtype", "float64")?;
     let c = np.getattr("ascontiguousarray")?.call((x,), Some(&kw))?;
-    Ok(c.extract::<PyReadonlyArrayDyn<'py, f64>>()?)
+    c.extract::<PyReadonlyArrayDyn<'py, f64>>()
 }
 
 impl PyProblem {
     fn exact_result(&self, py: Python<'_>, which: &str) -> PyResult<&ExactResult> {
-        let (cell, problem) = match which {
-            "spec" => (&self.exact_spec, &self.p.problem),
-            "data" => (&self.exact_wide, &self.p.wide),
+        let (cell, data_range) = match which {
+            "spec" => (&self.exact_spec, false),
+            "data" => (&self.exact_wide, true),
             _ => {
                 return Err(PyValueError::new_err(format!(
                     "box must be 'spec' or 'data', got {which:?}"
@@ -68,8 +68,15 @@ impl PyProblem {
         if let Some(r) = cell.get() {
             return Ok(r);
         }
+        if !self.has_exact_solver() {
+            return Err(PyNotImplementedError::new_err(format!(
+                "{}: seed 001's open surfaces have no exact solver",
+                self.p.name
+            )));
+        }
         let opts = self.meta.exact.clone();
-        let r = py.detach(|| problem.exact_optimum(&opts)).map_err(err)?;
+        let p = &self.p;
+        let r = py.detach(|| p.exact(data_range, &opts)).map_err(err)?;
         Ok(cell.get_or_init(|| r))
     }
 }
@@ -81,10 +88,10 @@ impl PyProblem {
     /// n rows. Not clamped to any box; the GIL is released while it runs.
     fn f<'py>(&self, py: Python<'py>, x: &Bound<'py, PyAny>) -> PyResult<Py<PyAny>> {
         let a = float_array(x)?;
-        let d = self.p.problem.dim();
+        let problem = self.p.problem();
+        let d = problem.dim();
         let shape = a.shape().to_vec();
         let data = a.as_slice().map_err(|e| PyValueError::new_err(e.to_string()))?;
-        let problem = &self.p.problem;
         match shape.as_slice() {
             [n] if *n == d => {
                 Ok(py.detach(|| problem.fitness(data)).into_pyobject(py)?.into_any().unbind())
@@ -144,35 +151,35 @@ impl PyProblem {
     }
     #[getter]
     fn dimension(&self) -> usize {
-        self.p.problem.dim()
+        self.p.problem().dim()
     }
     /// Approach B's control points: the thesis' start.
     #[getter]
     fn x0<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        array(py, self.p.problem.initial_point())
+        array(py, self.p.problem().initial_point())
     }
     /// B's error, f(x0).
     #[getter]
     fn b(&self) -> f64 {
-        self.p.problem.fitness(self.p.problem.initial_point())
+        self.p.problem().fitness(self.p.problem().initial_point())
     }
     /// The spec's search box (the one `somnurbs run` searches), lower bounds.
     #[getter]
     fn lower<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        array(py, self.p.problem.bounds().0)
+        array(py, self.p.problem().bounds().0)
     }
     #[getter]
     fn upper<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        array(py, self.p.problem.bounds().1)
+        array(py, self.p.problem().bounds().1)
     }
     /// The data-range box (the data and B's control points per axis), lower bounds.
     #[getter]
     fn lower_data<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        array(py, self.p.wide.bounds().0)
+        array(py, self.p.data_box().0)
     }
     #[getter]
     fn upper_data<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        array(py, self.p.wide.bounds().1)
+        array(py, self.p.data_box().1)
     }
 
     /// The certified optimum in a box ("spec" or "data"), computed on first call and kept: a dict
@@ -189,6 +196,13 @@ impl PyProblem {
         d.set_item("iterations", r.iterations)?;
         d.set_item("x", array(py, &r.x))?;
         Ok(d)
+    }
+
+    /// Whether `exact()` can certify an optimum (Chapter 6's double nets: yes; seed 001's open
+    /// surfaces: no).
+    #[getter]
+    fn has_exact_solver(&self) -> bool {
+        matches!(self.p.fitness, Fitness::ControlNet { .. })
     }
 
     /// Whether `exact(box)` has been computed already (no computation).

@@ -1,18 +1,32 @@
 //! Chapter 6's problems outside a run, as a benchmark suite (issue 39): what the Python package
 //! (`python/`) and any other caller get. The problems are made by the run's own code path
-//! ([`super::problems`]) from the same spec, profile and `--set` readings, so a problem's fitness
-//! is bit for bit the one `somnurbs run` optimises; this module only adds what a benchmark user
-//! needs beside it (names, a second box, the metadata that `compare` checks an external
-//! optimiser's logs against).
+//! ([`super::problems`] for an `[optim]` spec; `growing_grid::{maps, problems}` for seed 001's open
+//! surfaces) from the same spec, profile and `--set` readings, so a problem's fitness is bit for
+//! bit the one `somnurbs run` optimises; this module only adds what a benchmark user needs beside
+//! it (names, a second box, the metadata that `compare` checks an external optimiser's logs
+//! against).
 
 use super::spec::OptimSpec;
 use crate::experiment::overrides::CliOverrides;
 use crate::experiment::spec::{GridSize, Spec};
 use crate::experiment::RunContext;
-use crate::optim::ExactOptions;
-use crate::spline::{BoxSpec, ControlNetProblem, Parameterisation};
+use crate::families::growing_grid;
+use crate::optim::exact::ExactResult;
+use crate::optim::{ExactOptions, OptimError, Problem};
+use crate::spline::open_surface::OpenSurfaceProblem;
+use crate::spline::{BoxSpec, ControlNetProblem, KnotRule, Parameterisation};
 use anyhow::{Context, Result};
 use std::path::{Path, PathBuf};
+
+/// The fitness of a suite problem: Chapter 6's double net, or seed 001's one open surface.
+#[derive(Debug, Clone)]
+pub enum Fitness {
+    /// In the spec's box, and the same fitness in the data-range box (the smallest per-axis box
+    /// holding the data and B's control points, `BoxSpec::Cover { fraction: 0 }`).
+    ControlNet { problem: Box<ControlNetProblem>, wide: Box<ControlNetProblem> },
+    /// Its box is the spec's (the data and the least-squares net, widened by `bounds_margin`).
+    OpenSurface(Box<OpenSurfaceProblem>),
+}
 
 /// One control-net problem of a spec.
 #[derive(Debug, Clone)]
@@ -24,11 +38,39 @@ pub struct SuiteProblem {
     pub grid: GridSize,
     pub net: GridSize,
     pub param: Parameterisation,
-    /// In the spec's search box: the problem `somnurbs run` optimises.
-    pub problem: ControlNetProblem,
-    /// The same fitness in the data-range box (the smallest per-axis box holding the data and
-    /// B's control points, `BoxSpec::Cover { fraction: 0 }`).
-    pub wide: ControlNetProblem,
+    pub fitness: Fitness,
+}
+
+impl SuiteProblem {
+    /// The problem `somnurbs run` optimises (its box is the spec's).
+    pub fn problem(&self) -> &dyn Problem {
+        match &self.fitness {
+            Fitness::ControlNet { problem, .. } => problem.as_ref(),
+            Fitness::OpenSurface(p) => p.as_ref(),
+        }
+    }
+
+    /// The data-range box (lower, upper).
+    pub fn data_box(&self) -> (&[f64], &[f64]) {
+        match &self.fitness {
+            Fitness::ControlNet { wide, .. } => wide.bounds(),
+            Fitness::OpenSurface(p) => p.bounds(),
+        }
+    }
+
+    /// The certified optimum in the spec's box (`data_range: false`) or the data-range box; an
+    /// error for seed 001's open surfaces, which have no exact solver.
+    pub fn exact(&self, data_range: bool, opts: &ExactOptions) -> Result<ExactResult, OptimError> {
+        match &self.fitness {
+            Fitness::ControlNet { problem, wide } => {
+                if data_range { wide } else { problem }.exact_optimum(opts)
+            }
+            Fitness::OpenSurface(_) => Err(OptimError::Problem(format!(
+                "{}: seed 001's open surfaces have no exact solver",
+                self.name
+            ))),
+        }
+    }
 }
 
 /// Every problem of a spec, with the metadata common to them.
@@ -68,11 +110,11 @@ pub fn spec_path(spec: &str) -> PathBuf {
     Path::new(crate::data::registry::CLONE_DIR).join("experiments").join(format!("{spec}.toml"))
 }
 
-/// Load every control-net problem of a Chapter 6 spec (`[optim]`) under `profile` and the
-/// `KEY=VALUE` settings of `set` (as `somnurbs run --set`, e.g. `optim.knots=nurbs_book`).
-/// Data files come from `data_dir` (else as the CLI finds them, falling back to the clone's
-/// `data/`); a map the spec names but that is missing is recomputed as the run would, written
-/// into `work` (a folder the caller owns).
+/// Load every control-net problem of a Chapter 6 spec (`[optim]`) or of seed 001's
+/// (`[growing_grid]`) under `profile` and the `KEY=VALUE` settings of `set` (as
+/// `somnurbs run --set`, e.g. `optim.knots=nurbs_book`). Data files come from `data_dir` (else as
+/// the CLI finds them, falling back to the clone's `data/`); a map the spec names but that is
+/// missing is recomputed as the run would, written into `work` (a folder the caller owns).
 pub fn load(
     spec: &str,
     profile: Option<&str>,
@@ -86,7 +128,6 @@ pub fn load(
     let cli = CliOverrides { set: set.to_vec(), sweep: Vec::new() };
     let mut variants = Spec::load_variants(&path, profile, &cli)?;
     let spec = variants.pop().context("no spec")?;
-    let o = spec.require::<OptimSpec>()?;
     let data_dir = match data_dir {
         Some(d) => d.to_path_buf(),
         None => {
@@ -99,6 +140,10 @@ pub fn load(
         }
     };
     let ctx = RunContext::new(work.to_path_buf(), 1, data_dir);
+    if spec.section::<growing_grid::spec::GrowingGridSpec>().is_some() {
+        return open_surfaces(&spec, &ctx, profile);
+    }
+    let o = spec.require::<OptimSpec>()?;
     let built = super::problems(&spec, &ctx)?;
     let mut problems = Vec::with_capacity(built.len());
     for ((dataset, net, param), problem) in built {
@@ -115,8 +160,7 @@ pub fn load(
             grid: o.grid,
             net,
             param,
-            problem,
-            wide,
+            fitness: Fitness::ControlNet { problem: Box::new(problem), wide: Box::new(wide) },
         });
     }
     Ok(Suite {
@@ -125,6 +169,39 @@ pub fn load(
         reading: o.knots.name().to_string(),
         box_label: box_label(o),
         exact: o.exact_options(),
+        problems,
+    })
+}
+
+/// Seed 001's problems: the Growing Grid maps and the open surfaces of its run
+/// (`growing_grid::maps` then `growing_grid::problems`, as `somnurbs run` calls them).
+fn open_surfaces(spec: &Spec, ctx: &RunContext, profile: Option<&str>) -> Result<Suite> {
+    let g = spec.require::<growing_grid::spec::GrowingGridSpec>()?;
+    let maps = growing_grid::maps(spec, ctx)?;
+    let mut problems = Vec::new();
+    for ((dataset, net, param), p) in growing_grid::problems(spec, &maps)? {
+        let grid = GridSize { nx: p.nx, ny: p.ny };
+        problems.push(SuiteProblem {
+            name: super::ioh::problem_name(
+                &dataset,
+                &grid.to_string(),
+                &net.to_string(),
+                param.name(),
+            ),
+            dataset,
+            grid,
+            net,
+            param,
+            fitness: Fitness::OpenSurface(Box::new(p)),
+        });
+    }
+    Ok(Suite {
+        spec_name: spec.file.name.clone(),
+        profile: profile.map(String::from),
+        // `OpenSurfaceProblem` builds its knots by The NURBS Book's rule.
+        reading: KnotRule::NurbsBook.name().to_string(),
+        box_label: format!("cover+{:e}", g.bounds_margin),
+        exact: ExactOptions::default(),
         problems,
     })
 }
