@@ -41,7 +41,7 @@ pub enum Command {
     /// Holm-corrected pairwise tests and a critical-difference diagram; the Bayesian signed-rank
     /// test; runtime ECDFs, ERT, fixed-budget curves and AOCC from the IOHprofiler traces.
     #[command(
-        after_help = "Examples (after `somnurbs reproduce`):\n  somnurbs compare results/thesis/ch6_same\n  somnurbs compare results/thesis/ch6_diff --alpha 0.01 --rope 1e-5"
+        after_help = "Examples (after `somnurbs reproduce`):\n  somnurbs compare results/thesis/ch6_same\n  somnurbs compare results/thesis/ch6_diff --alpha 0.01 --rope 1e-5\n  somnurbs compare results/ch6_exact --external ioh_data   # optimisers logged from Python (docs/python.md)"
     )]
     Compare(CompareArgs),
     /// Regenerate the thesis: Chapters 4, 5 and 6 in order (each chapter's maps feed the next),

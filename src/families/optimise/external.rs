@@ -263,3 +263,36 @@ pub fn join(
     rows.extend(extra);
     Ok((rows, ext))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An Analyzer `.dat`: a header per run, columns found by name, the closing row of a run that
+    /// did not improve dropped, and only strict improvements kept.
+    #[test]
+    fn dat_rows_become_strict_improvements_per_run() {
+        let text = "evaluations raw_y\n1 3.5\n2 3.25\n5 3.75\nevaluations x0 raw_y\n1 0 2\n3 0 2\n4 0 1.5\n";
+        let runs = dat_runs(text).unwrap();
+        assert_eq!(runs, vec![vec![(1, 3.5), (2, 3.25)], vec![(1, 2.0), (4, 1.5)]]);
+        assert!(dat_runs("1 2\n").is_err());
+        assert!(dat_runs("evaluations y\n1 2\n").is_err());
+    }
+
+    /// The four experiment attributes must all be there and equal the folder's.
+    #[test]
+    fn a_file_of_another_suite_is_refused_naming_the_attribute() {
+        let suite = ["ch6_exact", "quick", "eq2_10", "B+-5e-6"].map(String::from);
+        let json = |reading: &str| -> Value {
+            serde_json::json!({ "experiment_attributes": [
+                {"somnurbs_box": "B+-5e-6"}, {"somnurbs_profile": "quick"},
+                {"somnurbs_reading": reading}, {"somnurbs_spec": "ch6_exact"}] })
+        };
+        let (f, r) = (Path::new("f.json"), Path::new("results"));
+        assert!(check_suite(&json("eq2_10"), &suite, f, r).is_ok());
+        let e = check_suite(&json("nurbs_book"), &suite, f, r).unwrap_err().to_string();
+        assert!(e.contains("somnurbs_reading") && e.contains("nurbs_book"), "{e}");
+        let e = check_suite(&serde_json::json!({}), &suite, f, r).unwrap_err().to_string();
+        assert!(e.contains("no experiment attribute somnurbs_spec"), "{e}");
+    }
+}

@@ -205,3 +205,44 @@ fn open_surfaces(spec: &Spec, ctx: &RunContext, profile: Option<&str>) -> Result
         problems,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The quick ch6_exact suite: the run's problems under their IOHprofiler names, B's box and
+    /// the data-range box around the same start, the spec's metadata; another reading moves B.
+    #[test]
+    fn ch6_exact_quick_suite() {
+        let work = tempfile::tempdir().unwrap();
+        let data = crate::data::registry::clone_data_dir();
+        let s = load("ch6_exact", Some("quick"), &[], Some(&data), work.path()).unwrap();
+        assert_eq!((s.spec_name.as_str(), s.reading.as_str()), ("ch6_exact", "eq2_10"));
+        assert_eq!((s.box_label.as_str(), s.exact.tol_rel_gap), ("B+-5e-6", 1e-7));
+        let names: Vec<&str> = s.problems.iter().map(|p| p.name.as_str()).collect();
+        assert_eq!(
+            names,
+            [
+                "sphere_20x20_6x6_chord_length",
+                "sphere_20x20_12x12_chord_length",
+                "spindle_20x20_6x6_chord_length",
+                "spindle_20x20_12x12_chord_length"
+            ]
+        );
+        for p in &s.problems {
+            let q = p.problem();
+            let x0 = q.initial_point();
+            let (lo, hi) = q.bounds();
+            assert!(x0.iter().zip(lo).all(|(x, l)| *l == x - 5e-6));
+            assert!(x0.iter().zip(hi).all(|(x, h)| *h == x + 5e-6));
+            let (dlo, dhi) = p.data_box();
+            assert!((0..x0.len()).all(|k| dlo[k] <= x0[k] && x0[k] <= dhi[k]));
+            assert!(p.exact(false, &s.exact).unwrap().lower_bound <= q.fitness(x0));
+        }
+        let nb = load("ch6_exact", Some("quick"), &["optim.knots=nurbs_book".into()], Some(&data), work.path())
+            .unwrap();
+        assert_eq!(nb.reading, "nurbs_book");
+        let b = |s: &Suite| s.problems[0].problem().fitness(s.problems[0].problem().initial_point());
+        assert_ne!(b(&nb), b(&s));
+    }
+}
