@@ -257,3 +257,17 @@ def test_seed001_open_surfaces_equal_the_cli_bit_for_bit(tmp_path):
         run = json.loads(file.read_text())["scenarios"][0]["runs"][0]
         assert run["somnurbs_b"] == probs[json.loads(file.read_text())["function_name"]].b
         assert "somnurbs_optimum" not in run and "somnurbs_bound" not in run
+
+
+def test_threads_evaluate_concurrently_with_the_same_values(probs):
+    """f keeps its work space per thread: four threads on one problem give the single thread's
+    values bit for bit."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    p = max(probs.values(), key=lambda q: q.dimension)
+    rng = np.random.default_rng(11)
+    batches = [p.x0 + rng.uniform(-1e-4, 1e-4, size=(64, p.dimension)) for _ in range(8)]
+    want = [p.f(X) for X in batches]
+    with ThreadPoolExecutor(max_workers=4) as pool:
+        got = list(pool.map(p.f, batches))
+    assert all(np.array_equal(a, b) for a, b in zip(got, want))
