@@ -41,7 +41,7 @@ pub enum Command {
     /// Holm-corrected pairwise tests and a critical-difference diagram; the Bayesian signed-rank
     /// test; runtime ECDFs, ERT, fixed-budget curves and AOCC from the IOHprofiler traces.
     #[command(
-        after_help = "Examples (after `somnurbs reproduce`):\n  somnurbs compare results/thesis/ch6_same\n  somnurbs compare results/thesis/ch6_diff --alpha 0.01 --rope 1e-5"
+        after_help = "Examples (after `somnurbs reproduce`):\n  somnurbs compare results/thesis/ch6_same\n  somnurbs compare results/thesis/ch6_diff --alpha 0.01 --rope 1e-5\n  somnurbs compare results/ch6_exact --external ioh_data   # optimisers logged from Python (docs/python.md)"
     )]
     Compare(CompareArgs),
     /// Regenerate the thesis: Chapters 4, 5 and 6 in order (each chapter's maps feed the next),
@@ -85,6 +85,11 @@ pub struct CompareArgs {
     /// an earlier compare's, which is replaced whole; the run's own files are never changed.
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// An IOHprofiler folder of optimisers from outside somnurbs (written by the Python
+    /// package's `somnurbs.ioh_adapter.Logger`), compared beside the folder's own (repeatable);
+    /// refused unless its problems are the folder's (spec, profile, reading, box, B's error).
+    #[arg(long, value_name = "DIR")]
+    pub external: Vec<PathBuf>,
 }
 
 #[derive(Debug, Args)]

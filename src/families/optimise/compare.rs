@@ -395,6 +395,8 @@ pub fn compare(args: &CompareArgs) -> Result<()> {
     let dest = args.out.clone().unwrap_or_else(|| args.results.join(OUT_DIR));
     require_compare_folder(&dest)?;
     let rows = read_runs(&args.results)?;
+    // Optimisers from outside somnurbs (issue 39), matched and checked first: external.rs.
+    let (rows, external) = super::external::join(&args.results, &args.external, rows)?;
     let mut opts: Vec<String> = Vec::new();
     let mut cells: Cells = BTreeMap::new();
     for r in &rows {
@@ -414,7 +416,7 @@ pub fn compare(args: &CompareArgs) -> Result<()> {
     }
     // The traces first, so that a folder whose ioh/ does not match runs.csv gets nothing written.
     let probs = if args.results.join("ioh").is_dir() {
-        Some(problems(&rows, &args.results)?)
+        Some(problems(&rows, &args.results, external)?)
     } else {
         None
     };
@@ -579,8 +581,13 @@ fn certified_optima(folder: &std::path::Path) -> Result<BTreeMap<String, f64>> {
 
 /// Gather the problems from runs.csv and the folder's `ioh/` traces (which must list the same runs
 /// with the same evaluation counts and final values).
-fn problems(rows: &[OptimRow], folder: &std::path::Path) -> Result<Vec<Problem>> {
-    let certified = certified_optima(folder)?;
+fn problems(
+    rows: &[OptimRow],
+    folder: &std::path::Path,
+    external: super::external::External,
+) -> Result<Vec<Problem>> {
+    let mut certified = certified_optima(folder)?;
+    external.add_optima(&mut certified);
     let name = |r: &OptimRow| {
         super::ioh::problem_name(
             &r.dataset,
@@ -594,7 +601,7 @@ fn problems(rows: &[OptimRow], folder: &std::path::Path) -> Result<Vec<Problem>>
         expected.entry((name(r), r.competitor())).or_default().push(r);
     }
     let mut out: BTreeMap<String, Problem> = BTreeMap::new();
-    for lp in super::ioh::read(folder)? {
+    for lp in super::ioh::read(folder)?.into_iter().chain(external.traces) {
         let mut exp = expected
             .remove(&(lp.function_name.clone(), lp.optimiser.clone()))
             .with_context(|| {

@@ -3,17 +3,19 @@
 //! runs on its own stream and is logged at once.
 
 pub mod compare;
+pub mod external;
 pub mod ioh;
 pub mod overall;
 pub mod pictures;
 pub mod report;
 pub mod spec;
+pub mod suite;
 
 use crate::experiment::spec::GridSize;
 use crate::experiment::spec::{Spec, SpecError};
 use crate::experiment::{runner, seeds, RunContext};
 use crate::families::fit;
-use crate::optim::{Budget, ExactOptions, Optimiser, Problem, RunResult};
+use crate::optim::{Budget, Optimiser, Problem, RunResult};
 use crate::spline::BoxSpec;
 use crate::spline::ControlNetProblem;
 use crate::spline::{fit_two_view, Approach, Parameterisation};
@@ -105,12 +107,7 @@ pub fn exact_optima(
         ctx.jobs,
         "exact optima",
         |k| {
-            let opts = ExactOptions {
-                tol_rel_gap: o.exact_tol,
-                max_newton_steps: o.exact_newton_steps,
-                ..ExactOptions::default()
-            };
-            problems[*k].exact_optimum(&opts).map_err(|e| {
+            problems[*k].exact_optimum(&o.exact_options()).map_err(|e| {
                 anyhow::anyhow!("exact optimum of {} {} {}: {e}", k.0, k.1, k.2.name())
             })
         },

@@ -81,6 +81,15 @@ impl OptimSpec {
             ..Default::default()
         }
     }
+
+    /// The exact solver's settings (`exact_tol`, `exact_newton_steps`).
+    pub fn exact_options(&self) -> crate::optim::ExactOptions {
+        crate::optim::ExactOptions {
+            tol_rel_gap: self.exact_tol,
+            max_newton_steps: self.exact_newton_steps,
+            ..crate::optim::ExactOptions::default()
+        }
+    }
 }
 
 pub(crate) fn default_ten() -> usize {

@@ -1,0 +1,293 @@
+//! `somnurbs._native`: the Python face of somnurbs' Chapter 6 problems (issue 39). The problems
+//! come from [`somnurbs::families::optimise::suite::load`], the code path of `somnurbs run`, and
+//! `f` calls the same compiled fitness, so values are bit for bit the CLI's on the same machine.
+//! Evaluation reads a C-contiguous float64 array in place and runs with the GIL released.
+
+use numpy::{PyArray1, PyReadonlyArrayDyn, PyUntypedArrayMethods};
+use pyo3::exceptions::{PyNotImplementedError, PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use somnurbs::families::optimise::suite::{self, Fitness, Suite, SuiteProblem};
+use somnurbs::optim::exact::ExactResult;
+use somnurbs::optim::ExactOptions;
+use std::sync::{Arc, OnceLock};
+
+/// What every problem of one `problems()` call shares.
+struct Meta {
+    spec: String,
+    profile: Option<String>,
+    reading: String,
+    box_label: String,
+    exact: ExactOptions,
+}
+
+/// One control-net problem: minimise Eq. 6.2 over the control points.
+#[pyclass(frozen, module = "somnurbs", name = "Problem")]
+struct PyProblem {
+    p: Arc<SuiteProblem>,
+    meta: Arc<Meta>,
+    /// The exact optimum in the spec's box and in the data-range box, once asked for.
+    exact_spec: OnceLock<ExactResult>,
+    exact_wide: OnceLock<ExactResult>,
+}
+
+fn err(e: impl std::fmt::Display) -> PyErr {
+    PyRuntimeError::new_err(format!("{e:#}"))
+}
+
+fn array<'py>(py: Python<'py>, v: &[f64]) -> Bound<'py, PyArray1<f64>> {
+    PyArray1::from_slice(py, v)
+}
+
+/// `x` as a float64 array; other dtypes, lists and non-contiguous arrays go through
+/// `numpy.ascontiguousarray` (one copy), a C-contiguous float64 array is read in place.
+fn float_array<'py>(x: &Bound<'py, PyAny>) -> PyResult<PyReadonlyArrayDyn<'py, f64>> {
+    if let Ok(a) = x.extract::<PyReadonlyArrayDyn<'py, f64>>() {
+        if a.is_c_contiguous() {
+            return Ok(a);
+        }
+    }
+    let np = x.py().import("numpy")?;
+    let kw = PyDict::new(x.py());
+    kw.set_item("dtype", "float64")?;
+    let c = np.getattr("ascontiguousarray")?.call((x,), Some(&kw))?;
+    c.extract::<PyReadonlyArrayDyn<'py, f64>>()
+}
+
+impl PyProblem {
+    fn exact_result(&self, py: Python<'_>, which: &str) -> PyResult<&ExactResult> {
+        let (cell, data_range) = match which {
+            "spec" => (&self.exact_spec, false),
+            "data" => (&self.exact_wide, true),
+            _ => {
+                return Err(PyValueError::new_err(format!(
+                    "box must be 'spec' or 'data', got {which:?}"
+                )))
+            }
+        };
+        if let Some(r) = cell.get() {
+            return Ok(r);
+        }
+        if !self.has_exact_solver() {
+            return Err(PyNotImplementedError::new_err(format!(
+                "{}: seed 001's open surfaces have no exact solver",
+                self.p.name
+            )));
+        }
+        let opts = self.meta.exact.clone();
+        let p = &self.p;
+        let r = py.detach(|| p.exact(data_range, &opts)).map_err(err)?;
+        Ok(cell.get_or_init(|| r))
+    }
+}
+
+#[pymethods]
+impl PyProblem {
+    /// The fitness (Eq. 6.2, the sum of distances between the two-view grid and the surfaces):
+    /// a float for one point (1-D array of `dimension`), an array of n floats for a 2-D array of
+    /// n rows. Not clamped to any box; the GIL is released while it runs.
+    fn f<'py>(&self, py: Python<'py>, x: &Bound<'py, PyAny>) -> PyResult<Py<PyAny>> {
+        let a = float_array(x)?;
+        let problem = self.p.problem();
+        let d = problem.dim();
+        let shape = a.shape().to_vec();
+        let data = a.as_slice().map_err(|e| PyValueError::new_err(e.to_string()))?;
+        match shape.as_slice() {
+            [n] if *n == d => {
+                Ok(py.detach(|| problem.fitness(data)).into_pyobject(py)?.into_any().unbind())
+            }
+            [_, n] if *n == d => {
+                let out: Vec<f64> =
+                    py.detach(|| data.chunks_exact(d).map(|row| problem.fitness(row)).collect());
+                Ok(PyArray1::from_vec(py, out).into_any().unbind())
+            }
+            _ => Err(PyValueError::new_err(format!(
+                "{}: x must have shape ({d},) or (n, {d}), got {shape:?}",
+                self.p.name
+            ))),
+        }
+    }
+
+    /// The IOHprofiler function name, `<dataset>_<grid>_<net>_<parameterisation>`.
+    #[getter]
+    fn name(&self) -> &str {
+        &self.p.name
+    }
+    #[getter]
+    fn dataset(&self) -> &str {
+        &self.p.dataset
+    }
+    /// The SOM map's size, e.g. "20x20".
+    #[getter]
+    fn grid(&self) -> String {
+        self.p.grid.to_string()
+    }
+    /// The control net's size, e.g. "18x18".
+    #[getter]
+    fn net(&self) -> String {
+        self.p.net.to_string()
+    }
+    #[getter]
+    fn parameterisation(&self) -> &str {
+        self.p.param.name()
+    }
+    /// The knot reading of B (README "Readings"): "eq2_10" or "nurbs_book".
+    #[getter]
+    fn reading(&self) -> &str {
+        &self.meta.reading
+    }
+    #[getter]
+    fn spec(&self) -> &str {
+        &self.meta.spec
+    }
+    #[getter]
+    fn profile(&self) -> Option<&str> {
+        self.meta.profile.as_deref()
+    }
+    /// The spec's search box in words: "B+-5e-6" (Table 6.1) or "cover+0e0" (data and B).
+    #[getter]
+    fn box_label(&self) -> &str {
+        &self.meta.box_label
+    }
+    #[getter]
+    fn dimension(&self) -> usize {
+        self.p.problem().dim()
+    }
+    /// Approach B's control points: the thesis' start.
+    #[getter]
+    fn x0<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        array(py, self.p.problem().initial_point())
+    }
+    /// B's error, f(x0).
+    #[getter]
+    fn b(&self) -> f64 {
+        self.p.problem().fitness(self.p.problem().initial_point())
+    }
+    /// The spec's search box (the one `somnurbs run` searches), lower bounds.
+    #[getter]
+    fn lower<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        array(py, self.p.problem().bounds().0)
+    }
+    #[getter]
+    fn upper<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        array(py, self.p.problem().bounds().1)
+    }
+    /// The data-range box (the data and B's control points per axis), lower bounds.
+    #[getter]
+    fn lower_data<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        array(py, self.p.data_box().0)
+    }
+    #[getter]
+    fn upper_data<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        array(py, self.p.data_box().1)
+    }
+
+    /// The certified optimum in a box ("spec" or "data"), computed on first call and kept: a dict
+    /// with `f` (the optimum found), `lower_bound` (proven: no point of the box is below it),
+    /// `gap`, `converged`, `iterations` and `x`.
+    #[pyo3(signature = (r#box = "spec"))]
+    fn exact<'py>(&self, py: Python<'py>, r#box: &str) -> PyResult<Bound<'py, PyDict>> {
+        let r = self.exact_result(py, r#box)?;
+        let d = PyDict::new(py);
+        d.set_item("f", r.f)?;
+        d.set_item("lower_bound", r.lower_bound)?;
+        d.set_item("gap", r.gap)?;
+        d.set_item("converged", r.converged)?;
+        d.set_item("iterations", r.iterations)?;
+        d.set_item("x", array(py, &r.x))?;
+        Ok(d)
+    }
+
+    /// Whether `exact()` can certify an optimum (Chapter 6's double nets: yes; seed 001's open
+    /// surfaces: no).
+    #[getter]
+    fn has_exact_solver(&self) -> bool {
+        matches!(self.p.fitness, Fitness::ControlNet { .. })
+    }
+
+    /// Whether `exact(box)` has been computed already (no computation).
+    #[pyo3(signature = (r#box = "spec"))]
+    fn has_exact(&self, r#box: &str) -> bool {
+        match r#box {
+            "data" => self.exact_wide.get().is_some(),
+            _ => self.exact_spec.get().is_some(),
+        }
+    }
+
+    /// Everything that identifies the problem, as `compare` checks it.
+    fn metadata<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        d.set_item("name", &self.p.name)?;
+        d.set_item("dataset", &self.p.dataset)?;
+        d.set_item("grid", self.grid())?;
+        d.set_item("net", self.net())?;
+        d.set_item("parameterisation", self.p.param.name())?;
+        d.set_item("reading", &self.meta.reading)?;
+        d.set_item("spec", &self.meta.spec)?;
+        d.set_item("profile", self.meta.profile.as_deref())?;
+        d.set_item("box", &self.meta.box_label)?;
+        d.set_item("dimension", self.dimension())?;
+        d.set_item("b", self.b())?;
+        Ok(d)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "<somnurbs.Problem {} dim {} ({}{}, reading {}, box {})>",
+            self.p.name,
+            self.dimension(),
+            self.meta.spec,
+            self.meta.profile.as_deref().map(|p| format!(" --profile {p}")).unwrap_or_default(),
+            self.meta.reading,
+            self.meta.box_label
+        )
+    }
+}
+
+/// Every control-net problem of a Chapter 6 spec (a shipped name such as "ch6_same", or a TOML
+/// path), under a profile ("quick") and a knot reading ("eq2_10", "nurbs_book"; None: the
+/// spec's); `set` takes further `KEY=VALUE` settings as `somnurbs run --set`. Data files come
+/// from `data_dir`, else `SOMNURBS_DATA`, else `data/` here, else the clone's `data/`.
+#[pyfunction]
+#[pyo3(signature = (spec = "ch6_same", profile = None, reading = None, set = None, data_dir = None))]
+fn problems(
+    py: Python<'_>,
+    spec: &str,
+    profile: Option<&str>,
+    reading: Option<&str>,
+    set: Option<Vec<String>>,
+    data_dir: Option<std::path::PathBuf>,
+) -> PyResult<Vec<PyProblem>> {
+    let mut set = set.unwrap_or_default();
+    if let Some(r) = reading {
+        set.push(format!("optim.knots={r}"));
+    }
+    let work = tempfile::tempdir().map_err(err)?;
+    let s: Suite = py
+        .detach(|| suite::load(spec, profile, &set, data_dir.as_deref(), work.path()))
+        .map_err(err)?;
+    let meta = Arc::new(Meta {
+        spec: s.spec_name,
+        profile: s.profile,
+        reading: s.reading,
+        box_label: s.box_label,
+        exact: s.exact,
+    });
+    Ok(s.problems
+        .into_iter()
+        .map(|p| PyProblem {
+            p: Arc::new(p),
+            meta: meta.clone(),
+            exact_spec: OnceLock::new(),
+            exact_wide: OnceLock::new(),
+        })
+        .collect())
+}
+
+#[pymodule]
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(problems, m)?)?;
+    m.add_class::<PyProblem>()?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}
