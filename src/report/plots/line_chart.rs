@@ -352,7 +352,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let p = dir.path().join("xy.png");
         let circle: Vec<(f64, f64)> = (0..=64)
-            .map(|k| (k as f64 / 64.0 * std::f64::consts::TAU))
+            .map(|k| k as f64 / 64.0 * std::f64::consts::TAU)
             .map(|t| (t.cos(), 0.2 * t.sin()))
             .collect();
         let s = Series { label: "ellipse".into(), colour: style::BLUE, points: circle, band: None };
