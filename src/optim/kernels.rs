@@ -389,13 +389,24 @@ pub struct PsoCoefficients {
 }
 
 /// The box of a PSO run per coordinate: positions in [lo, hi], velocities in [-vmax, vmax] with
-/// vmax = vmax_fraction (hi - lo), computed in the move (one rounding each, the same bits as a
-/// stored vmax; the move reads seven slices instead of eight, and it is bound by their traffic).
+/// vmax = vmax_fraction (vhi - vlo), computed in the move (one rounding each, the same bits as a
+/// stored vmax). `vlo`, `vhi` are the range the clamp is a fraction of: `lo`, `hi` themselves
+/// (the search box) or the data set's range (`Pso::vmax_range`); when they are the same slices
+/// the move reads the same cache lines twice.
 #[derive(Debug, Clone, Copy)]
 pub struct PsoBounds<'a> {
     pub lo: &'a [f64],
     pub hi: &'a [f64],
+    pub vlo: &'a [f64],
+    pub vhi: &'a [f64],
     pub vmax_fraction: f64,
+}
+
+impl<'a> PsoBounds<'a> {
+    /// Positions in [lo, hi] and the clamp a fraction of that box's width.
+    pub fn search_box(lo: &'a [f64], hi: &'a [f64], vmax_fraction: f64) -> PsoBounds<'a> {
+        PsoBounds { lo, hi, vlo: lo, vhi: hi, vmax_fraction }
+    }
 }
 
 /// One coordinate's move from its 64-bit word: (new x, new v).
@@ -437,9 +448,10 @@ fn pso_move_scalar(
 ) {
     let n = out.len();
     let (x, v, p, g, lo, hi) = (&x[..n], &mut v[..n], &p[..n], &g[..n], &b.lo[..n], &b.hi[..n]);
+    let (vlo, vhi) = (&b.vlo[..n], &b.vhi[..n]);
     for j in from..n {
         let word = rng.next_word(j % PSO_LANES);
-        let vmax = b.vmax_fraction * (hi[j] - lo[j]);
+        let vmax = b.vmax_fraction * (vhi[j] - vlo[j]);
         (out[j], v[j]) = pso_coordinate(x[j], v[j], p[j], g[j], lo[j], hi[j], vmax, word, co);
     }
 }
@@ -470,6 +482,7 @@ macro_rules! pso_move_simd {
         let n = out.len();
         let (x, v, p, g, lo, hi) =
             (&$x[..n], &mut $v[..n], &$p[..n], &$g[..n], &$b.lo[..n], &$b.hi[..n]);
+        let (vlo, vhi) = (&$b.vlo[..n], &$b.vhi[..n]);
         let fraction = _mm256_set1_pd($b.vmax_fraction);
         let mantissa_top32 = _mm256_set1_epi64x(0x000f_ffff_fff0_0000);
         let one = _mm256_set1_epi64x(0x3ff0_0000_0000_0000);
@@ -515,7 +528,13 @@ macro_rules! pso_move_simd {
                 // max(a, b) is a > b ? a : b, so max(lo, v) = v < lo ? lo : v, as `clamp`.
                 let (hij, loj) =
                     (_mm256_loadu_pd(hi.as_ptr().add(j)), _mm256_loadu_pd(lo.as_ptr().add(j)));
-                let vm = _mm256_mul_pd(fraction, _mm256_sub_pd(hij, loj));
+                let vm = _mm256_mul_pd(
+                    fraction,
+                    _mm256_sub_pd(
+                        _mm256_loadu_pd(vhi.as_ptr().add(j)),
+                        _mm256_loadu_pd(vlo.as_ptr().add(j)),
+                    ),
+                );
                 let vel = _mm256_min_pd(vm, _mm256_max_pd(_mm256_xor_pd(vm, sign), vel));
                 _mm256_storeu_pd(v.as_mut_ptr().add(j), vel);
                 let xn = _mm256_add_pd(xj, vel);
@@ -541,7 +560,7 @@ macro_rules! pso_move_simd {
                 _mm256_storeu_si256(state[r].as_mut_ptr().add(4).cast(), *hg);
             }
         }
-        let bounds = PsoBounds { lo, hi, vmax_fraction: $b.vmax_fraction };
+        let bounds = PsoBounds { lo, hi, vlo, vhi, vmax_fraction: $b.vmax_fraction };
         pso_move_scalar(out, x, v, p, g, bounds, $rng, co, done);
     }};
 }
@@ -696,7 +715,7 @@ mod tests {
             assert_eq!(single, generic.2);
         }
         let co = PsoCoefficients { k: 0.729, c1: 2.05, c2: 2.05 };
-        let bounds = PsoBounds { lo: &lo, hi: &hi, vmax_fraction: 0.2 };
+        let bounds = PsoBounds::search_box(&lo, &hi, 0.2);
         let gen = PsoLanes::from_rng(&mut ChaCha8Rng::seed_from_u64(2));
         let (mut x1, mut v1, mut g1) = (a.clone(), b.clone(), gen.clone());
         let (mut x2, mut v2, mut g2) = (a.clone(), b.clone(), gen.clone());
@@ -837,7 +856,7 @@ pub mod timing {
                 best_ns(n, || unsafe { copy(&mut t, src, 0.3, &mut lanes, threshold) })
             ));
         }
-        let bounds = PsoBounds { lo: &lo, hi: &hi, vmax_fraction: 0.5 };
+        let bounds = PsoBounds::search_box(&lo, &hi, 0.5);
         let co = PsoCoefficients { k: 0.729, c1: 2.05, c2: 2.05 };
         let mut gen = PsoLanes::from_rng(&mut ChaCha8Rng::seed_from_u64(2));
         let (mut x, mut vel, mut moved) = (v.clone(), vec![0.0; n], vec![0.0; n]);

@@ -18,6 +18,12 @@ pub trait Problem: Sync {
     fn initial_point(&self) -> &[f64];
     /// Lower and upper bound of every coordinate.
     fn bounds(&self) -> (&[f64], &[f64]);
+    /// The data set's range per coordinate (its min and max along the coordinate's axis), for
+    /// the optimisers whose parameters the thesis states against "the range of the dataset"
+    /// (PSO's `vmax_range` and `position_range`); None where the problem has no data set.
+    fn data_range(&self) -> Option<(&[f64], &[f64])> {
+        None
+    }
     /// The value to minimise.
     fn fitness(&self, x: &[f64]) -> f64;
 }

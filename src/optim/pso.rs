@@ -22,6 +22,7 @@ use super::sampling::PsoLanes;
 use super::{check_range, OptimError};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
+use std::borrow::Cow;
 
 /// PSO parameters (defaults: thesis Table 6.1).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -33,13 +34,98 @@ pub struct Pso {
     pub c1: f64,
     /// Social acceleration c2.
     pub c2: f64,
-    /// Velocity clamp as a fraction of the range (upper - lower) per coordinate.
+    /// Velocity clamp as a fraction of the width of the range `vmax_range` names, per
+    /// coordinate, in [0, 1]. Table 6.1, row 11: "PSO Maximum Velocity: Half of the range of the
+    /// dataset". 0.5 (default) reads "range" as the search box's width (2 x 5e-6 in the thesis'
+    /// specs, so |v| <= 5e-6); 0.25 reads it as Table 6.1's "control point coordinate range
+    /// [-5e-6, 5e-6]" taken as +-r, r = 5e-6, so |v| <= r / 2 = 2.5e-6 (the thesis plan's
+    /// reading set `pso_vmax_half_r`).
     pub vmax_fraction: f64,
+    /// The range the velocity clamp is a fraction of: `"search_box"` (default: the problem's
+    /// search box, B +- 5e-6 in the thesis' specs, so |v| <= 5e-6) or `"data"` (the data set's
+    /// range along the coordinate's axis, so |v| <= half the data's width). A reading of Section
+    /// 6.2.2: "The maximum velocity and position of the PSO was set to half of the range of the
+    /// data set and the range of the data set respectively. Maximum velocity was used as the
+    /// velocity clamping" (Table 6.1, row 11: "PSO Maximum Velocity: Half of the range of the
+    /// dataset").
+    pub vmax_range: PsoRange,
+    /// Where positions are kept: `"search_box"` (default: the problem's search box) or `"data"`
+    /// (the data set's range along the coordinate's axis, widened where the search box sticks
+    /// out of it so that every start is inside; PSO may then leave the search box that bounds
+    /// GA and DE). A reading of Section 6.2.2: "maximum position is set to prevent the particle
+    /// from moving beyond the boundaries of the search space" (Table 6.1, row 12: "PSO Maximum
+    /// Position: The range of the dataset").
+    pub position_range: PsoRange,
+}
+
+/// The range a PSO bound is taken from (`vmax_range`, `position_range`): one of two values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PsoRange {
+    /// The problem's search box ([`Problem::bounds`]).
+    #[default]
+    SearchBox,
+    /// The data set's range per coordinate ([`Problem::data_range`]).
+    Data,
 }
 
 impl Default for Pso {
     fn default() -> Pso {
-        Pso { k: 0.729, c1: 2.05, c2: 2.05, vmax_fraction: 0.5 }
+        Pso {
+            k: 0.729,
+            c1: 2.05,
+            c2: 2.05,
+            vmax_fraction: 0.5,
+            vmax_range: PsoRange::SearchBox,
+            position_range: PsoRange::SearchBox,
+        }
+    }
+}
+
+/// The boxes of one run: positions in `lo..hi`, the clamp a fraction of `vlo..vhi`'s width
+/// (borrowed from the problem where they are its own, so that by default the move reads the
+/// search box's cache lines only).
+struct RunBoxes<'a> {
+    lo: Cow<'a, [f64]>,
+    hi: Cow<'a, [f64]>,
+    vlo: &'a [f64],
+    vhi: &'a [f64],
+}
+
+impl RunBoxes<'_> {
+    fn pso_bounds(&self, vmax_fraction: f64) -> PsoBounds<'_> {
+        PsoBounds { lo: &self.lo, hi: &self.hi, vlo: self.vlo, vhi: self.vhi, vmax_fraction }
+    }
+}
+
+impl Pso {
+    /// The position box and the clamp's range of `problem` under `position_range` and
+    /// `vmax_range`; an error if one names the data and the problem has none.
+    fn boxes<'a>(&self, problem: &'a dyn Problem) -> Result<RunBoxes<'a>, OptimError> {
+        let (lo, hi) = problem.bounds();
+        let uses_data = [self.vmax_range, self.position_range].contains(&PsoRange::Data);
+        let (dlo, dhi) = match problem.data_range() {
+            Some(d) => d,
+            None if uses_data => {
+                return Err(OptimError::param(
+                    "pso.vmax_range/position_range",
+                    "\"data\" needs a problem with a data set's range".to_string(),
+                ))
+            }
+            None => (lo, hi),
+        };
+        let (vlo, vhi) = match self.vmax_range {
+            PsoRange::SearchBox => (lo, hi),
+            PsoRange::Data => (dlo, dhi),
+        };
+        let (lo, hi) = match self.position_range {
+            PsoRange::SearchBox => (Cow::Borrowed(lo), Cow::Borrowed(hi)),
+            PsoRange::Data => (
+                lo.iter().zip(dlo).map(|(a, b)| a.min(*b)).collect(),
+                hi.iter().zip(dhi).map(|(a, b)| a.max(*b)).collect(),
+            ),
+        };
+        Ok(RunBoxes { lo, hi, vlo, vhi })
     }
 }
 
@@ -67,7 +153,7 @@ impl Optimiser for Pso {
         budget.validate(self.min_population().n)?;
         check_problem(problem)?;
         let d = problem.dim();
-        let (lo, hi) = problem.bounds();
+        let boxes = self.boxes(problem)?;
         let mut eval = Evaluator::new(problem, budget);
         // A particle's position is its personal best's buffer while the two are equal
         // (`at_best`, true after the initial population and after every improvement), else
@@ -85,7 +171,7 @@ impl Optimiser for Pso {
         let mut gbest = pbest[g].clone();
         let mut bulk = PsoLanes::from_rng(rng);
         let co = PsoCoefficients { k: self.k, c1: self.c1, c2: self.c2 };
-        let bounds = PsoBounds { lo, hi, vmax_fraction: self.vmax_fraction };
+        let bounds = boxes.pso_bounds(self.vmax_fraction);
         for _ in 0..budget.generations {
             // Each particle is evaluated right after its move, while its coordinates are in
             // cache; the global best it moved towards is the previous iteration's (a copy).
@@ -153,5 +239,77 @@ mod tests {
         let r = Pso::default().run(&p, &budget, &mut ChaCha8Rng::seed_from_u64(1)).unwrap();
         assert_eq!(r.best_x, p.x0);
         assert_eq!(r.evaluations, 21);
+    }
+
+    /// Sphere's box with a data set's range beside it.
+    struct WithData {
+        inner: crate::optim::problem::tests::Sphere,
+        dlo: Vec<f64>,
+        dhi: Vec<f64>,
+    }
+
+    impl Problem for WithData {
+        fn dim(&self) -> usize {
+            self.inner.dim()
+        }
+        fn initial_point(&self) -> &[f64] {
+            self.inner.initial_point()
+        }
+        fn bounds(&self) -> (&[f64], &[f64]) {
+            self.inner.bounds()
+        }
+        fn data_range(&self) -> Option<(&[f64], &[f64])> {
+            Some((&self.dlo, &self.dhi))
+        }
+        fn fitness(&self, x: &[f64]) -> f64 {
+            self.inner.fitness(x)
+        }
+    }
+
+    /// One move with K = 1, c1 = c2 = 0 (so v is kept, then clamped) from x = (0.5, 0) with
+    /// v = (10, 10), in the box [-1, 1]^2 beside data ranges [-4, 4] and [0.5, 0.75], at
+    /// vmax_fraction 0.5. By hand: the box's clamp is 0.5 * 2 = 1 on both coordinates, the
+    /// data's 0.5 * 8 = 4 and 0.5 * 0.25 = 0.125; positions stay in [-1, 1] (search box), or in
+    /// [-4, 4] and [-1, 1] (data, widened to hold the box).
+    #[test]
+    fn velocity_and_position_ranges_clamp_as_computed_by_hand() {
+        use crate::optim::kernels::pso_move;
+        use crate::optim::problem::tests::Sphere;
+        use rand::SeedableRng;
+        let mut inner = Sphere::new(2);
+        (inner.lo, inner.hi) = (vec![-1.0; 2], vec![1.0; 2]);
+        let p = WithData { inner, dlo: vec![-4.0, 0.5], dhi: vec![4.0, 0.75] };
+        let (b, d) = (PsoRange::SearchBox, PsoRange::Data);
+        let cases = [
+            (b, b, [1.0, 1.0], [1.0, 1.0]),
+            (d, b, [4.0, 0.125], [1.0, 0.125]),
+            (b, d, [1.0, 1.0], [1.5, 1.0]),
+            (d, d, [4.0, 0.125], [4.0, 0.125]),
+        ];
+        for (vmax_range, position_range, v_want, x_want) in cases {
+            let pso =
+                Pso { k: 1.0, c1: 0.0, c2: 0.0, vmax_range, position_range, ..Pso::default() };
+            let boxes = pso.boxes(&p).unwrap();
+            let (x, mut v, mut out) = ([0.5, 0.0], [10.0, 10.0], [0.0; 2]);
+            let mut lanes = PsoLanes::from_rng(&mut ChaCha8Rng::seed_from_u64(3));
+            let co = PsoCoefficients { k: pso.k, c1: pso.c1, c2: pso.c2 };
+            let bounds = boxes.pso_bounds(pso.vmax_fraction);
+            pso_move(&mut out, &x, &mut v, &[0.0; 2], &[0.0; 2], &mut lanes, co, bounds);
+            assert_eq!((v, out), (v_want, x_want), "{vmax_range:?} {position_range:?}");
+        }
+    }
+
+    #[test]
+    fn ranges_are_read_by_name_and_data_needs_a_data_range() {
+        let pso: Pso = toml::from_str("vmax_range = \"data\"\nposition_range = \"data\"").unwrap();
+        assert_eq!((pso.vmax_range, pso.position_range), (PsoRange::Data, PsoRange::Data));
+        assert!(toml::from_str::<Pso>("vmax_range = \"dataset\"").is_err());
+        let p = crate::optim::problem::tests::Sphere::new(3);
+        assert!(pso.boxes(&p).is_err());
+        let b = Pso::default().boxes(&p).unwrap();
+        assert_eq!(
+            (&b.lo[..], &b.hi[..], b.vlo, b.vhi),
+            (&p.lo[..], &p.hi[..], &p.lo[..], &p.hi[..])
+        );
     }
 }

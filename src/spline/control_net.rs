@@ -62,6 +62,10 @@ pub struct ControlNetProblem {
     lower: Aligned,
     upper: Aligned,
     box_axes: (Point3, Point3),
+    /// The grid data's box per coordinate (min, max along the coordinate's axis): the thesis'
+    /// "range of the dataset" ([`Problem::data_range`]).
+    data_lower: Aligned,
+    data_upper: Aligned,
     /// Grid data, per grid column j, per coordinate, over the lanes i: bottom all (i, j), top
     /// the interior only.
     data_b: Aligned,
@@ -885,6 +889,8 @@ impl ControlNetProblem {
             lower: Aligned::from_slice(&lower),
             upper: Aligned::from_slice(&upper),
             box_axes,
+            data_lower: (0..3 * nov).map(|k| dlo[k % 3]).collect(),
+            data_upper: (0..3 * nov).map(|k| dhi[k % 3]).collect(),
             data_b,
             data_t,
             isa: crate::optim::kernels::simd()?,
@@ -1008,6 +1014,10 @@ impl Problem for ControlNetProblem {
 
     fn bounds(&self) -> (&[f64], &[f64]) {
         (&self.lower, &self.upper)
+    }
+
+    fn data_range(&self) -> Option<(&[f64], &[f64])> {
+        Some((&self.data_lower, &self.data_upper))
     }
 
     fn fitness(&self, x: &[f64]) -> f64 {
