@@ -40,9 +40,9 @@ pub struct RunContext {
     /// The command REPORT.md gives to make this folder again, when it is not `somnurbs run` of
     /// the spec (a plan's spec: the plan's `somnurbs reproduce` line).
     pub rerun: Option<String>,
-    /// Draw the pictures and 3-D views (off for a plan's reading variants, whose tables and
-    /// claims are what the readings matrix compares).
-    pub pictures: bool,
+    /// Write the pictures, the 3-D views and the IOHprofiler export (off for a plan's reading
+    /// variants, whose tables and claims are what the readings matrix compares).
+    pub extras: bool,
 }
 
 impl RunContext {
@@ -57,7 +57,7 @@ impl RunContext {
             session: None,
             page: false,
             rerun: None,
-            pictures: true,
+            extras: true,
         }
     }
 
@@ -319,7 +319,7 @@ fn run_spec_locked(variants: &[Spec], ctx: &RunContext) -> Result<PathBuf> {
     if let Some(section) = section {
         let rerun = ctx.rerun.clone().unwrap_or_else(|| run_command(spec, &manifest, &ctx.out));
         let mut report = report_md(spec, &manifest, &rerun, &[section]);
-        if !ctx.pictures {
+        if !ctx.extras {
             report.push_str(NO_PICTURES);
         }
         crate::io::write_atomic(&ctx.out.join("REPORT.md"), report.as_bytes())?;
@@ -418,7 +418,7 @@ pub fn profile_note(spec: &Spec) -> String {
 }
 
 /// The note of a run drawn without pictures.
-pub const NO_PICTURES: &str = "\nNo pictures or 3-D views are drawn in this folder: it is a reading variant of a plan, whose tables and claims the plan's readings matrix compares. Run the spec with the variant's keys (`somnurbs run SPEC --set KEY=VALUE ...`) to draw them.\n";
+pub const NO_PICTURES: &str = "\nNo pictures, 3-D views or IOHprofiler export are written in this folder: it is a reading variant of a plan, whose tables and claims the plan's readings matrix compares. Run the spec with the variant's keys (`somnurbs run SPEC --set KEY=VALUE ...`) to have them.\n";
 
 /// The caveat a reduced run carries at the top of its report.
 pub const NOT_EVIDENCE: &str = "> **Not evidence.** This is a reduced run (fewer cells, repeats or iterations than the spec as written), for checking the harness and the pipeline. Its counts are too few to support or refute a claim, and its verdicts are mostly *undecided* for that reason; cite only a run of the spec as written.\n\n";

@@ -328,7 +328,7 @@ pub fn reproduce(
     for (reading, rspecs) in &reading_specs {
         for spec in rspecs {
             let folder = Path::new(READINGS_DIR).join(&reading.name).join(&spec.file.name);
-            let sub = RunContext { out: ctx.out.join(&folder), pictures: false, ..ctx.clone() };
+            let sub = RunContext { out: ctx.out.join(&folder), extras: false, ..ctx.clone() };
             eprintln!(
                 "somnurbs: reproduce: {} under the readings `{}` -> {}",
                 spec.file.name,

@@ -359,7 +359,7 @@ impl crate::experiment::family::Experiment for Fit {
         let origins: Vec<(String, String)> =
             maps.iter().map(|(d, m)| (d.clone(), m.origin.clone())).collect();
         let pictures =
-            ctx.pictures && spec.section::<spec::FitSpec>().map(|f| f.pictures).unwrap_or(false);
+            ctx.extras && spec.section::<spec::FitSpec>().map(|f| f.pictures).unwrap_or(false);
         let section = if tables {
             Some(self::report::write(&spec.file.name, &runs, &ctx.out, &origins, pictures)?)
         } else {

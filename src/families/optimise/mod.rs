@@ -254,7 +254,7 @@ pub fn run(
             })
         },
     )?;
-    if ctx.pictures {
+    if ctx.extras {
         picture_points(spec, &mut runs, largest, problem)?;
     }
     Ok(runs)
@@ -413,12 +413,12 @@ impl crate::experiment::family::Experiment for Optim {
                 &exact,
                 &setting(first),
                 &ctx.out,
-                ctx.pictures,
+                ctx.extras,
             )?)
         } else {
             None
         };
-        if tables && ctx.pictures {
+        if tables && ctx.extras {
             crate::report::views3d::write(&ctx.out, &pictures::views(&runs, &problems))?;
         }
         Ok(crate::experiment::family::Outcome {

@@ -362,7 +362,7 @@ fn thesis_winner(t: &reference::RefTable, c: &CellKey) -> Option<&'static str> {
 /// Chapter 6's winner pattern by net size (`winners_by_net_<grid>.csv` and its chart): per
 /// control net, the cells where each optimiser has the least AVG error, and the thesis' count over
 /// the same cells where this run compared the thesis' three optimisers.
-fn winners_by_net(t: &GridTables, grid: GridSize, err_name: &str, out: &Path, pictures: bool) -> Result<String> {
+fn winners_by_net(t: &GridTables, grid: GridSize, err_name: &str, out: &Path, extras: bool) -> Result<String> {
     let mut sorted = t.opts.clone();
     sorted.sort();
     let thesis = if sorted == ["de", "ga", "pso"] { reference::table(err_name) } else { None };
@@ -403,7 +403,7 @@ fn winners_by_net(t: &GridTables, grid: GridSize, err_name: &str, out: &Path, pi
     let name = format!("winners_by_net_{grid}");
     write_atomic(&out.join(format!("{name}.csv")), csv_records(&h, &rows)?.as_bytes())?;
     let mut s = format!("\n**`{name}.csv`**: per control net, the cells where each optimiser has the least AVG error{}\n\n{}", if any_thesis { ", ours beside the thesis' over the same cells" } else { "" }, table(&h, &rows));
-    if pictures {
+    if extras {
         let series = |pts: &[Vec<(f64, f64)>]| -> Vec<Series> {
             t.opts
                 .iter()
@@ -628,7 +628,7 @@ fn write_grid(
     problems: &BTreeMap<ProblemKey, ControlNetProblem>,
     exact: &BTreeMap<ProblemKey, ExactResult>,
     out: &Path,
-    pictures: bool,
+    extras: bool,
     s: &mut String,
 ) -> Result<Vec<Claim>> {
     let t = GridTables::compute(g);
@@ -663,14 +663,14 @@ fn write_grid(
         s.push_str(&beside_md);
     }
     if t.opts.len() > 1 {
-        s.push_str(&winners_by_net(&t, grid, err_name, out, pictures)?);
+        s.push_str(&winners_by_net(&t, grid, err_name, out, extras)?);
     }
     let mut claims = grid_claims(&t, grid, err_name, time_name);
     if let Some((part, claim)) = exact_section(g, &t, exact, grid, out)? {
         s.push_str(&part);
         claims.push(claim);
     }
-    if pictures {
+    if extras {
         appendix_ij(g, &t.cells, &t.opts, problems, grid, out, s)?;
         convergence_charts(g, &t.cells, &t.opts, problems, exact, grid, out, s)?;
     }
@@ -685,7 +685,7 @@ pub fn write(
     exact: &BTreeMap<ProblemKey, ExactResult>,
     setting: &str,
     out: &Path,
-    pictures: bool,
+    extras: bool,
 ) -> Result<String> {
     let rows: Vec<_> = runs.iter().map(|r| r.row.clone()).collect();
     write_atomic(&out.join("runs.csv"), csv_text(&rows)?.as_bytes())?;
@@ -696,11 +696,13 @@ pub fn write(
     let mut claims = Vec::new();
     for grid in ordered(runs.iter().map(|r| r.cell.grid)) {
         let g: Vec<&OptimRun> = runs.iter().filter(|r| r.cell.grid == grid).collect();
-        claims.extend(write_grid(&g, grid, problems, exact, out, pictures, &mut s)?);
+        claims.extend(write_grid(&g, grid, problems, exact, out, extras, &mut s)?);
     }
     s.push_str(&friedman_section(runs));
-    let n_ioh = super::ioh::write(runs, out)?;
-    let _ = writeln!(s, "\nEvery run's improvements of the best so far in the IOHprofiler format (`ioh/<optimiser>/`: {n_ioh} JSON meta-data files, format version 0.3.3 or later, each with its improvement-based `.dat`), loadable by IOHanalyzer and iohinspector.");
+    if extras {
+        let n_ioh = super::ioh::write(runs, out)?;
+        let _ = writeln!(s, "\nEvery run's improvements of the best so far in the IOHprofiler format (`ioh/<optimiser>/`: {n_ioh} JSON meta-data files, format version 0.3.3 or later, each with its improvement-based `.dat`), loadable by IOHanalyzer and iohinspector.");
+    }
     claims.extend(run_claims(runs));
     let claims_md = crate::report::claims::write(out, spec_name, &claims, false)?;
     if !claims_md.is_empty() {

@@ -255,7 +255,7 @@ impl crate::experiment::family::Experiment for Som {
     ) -> Result<crate::experiment::family::Outcome> {
         let (runs, frames) = run(spec, ctx)?;
         let section =
-            if tables { Some(self::report::write(spec, &runs, &frames, &ctx.out, ctx.pictures)?) } else { None };
+            if tables { Some(self::report::write(spec, &runs, &frames, &ctx.out, ctx.extras)?) } else { None };
         Ok(crate::experiment::family::Outcome {
             section,
             cpu_s: runs.iter().map(|r| r.row.cpu_s).sum(),
