@@ -131,7 +131,7 @@ impl PyProblem {
     fn parameterisation(&self) -> &str {
         self.p.param.name()
     }
-    /// The knot reading of B (README "Readings"): "eq2_10" or "nurbs_book".
+    /// The knot reading of B (docs/readings.md): "eq2_10" or "nurbs_book".
     #[getter]
     fn reading(&self) -> &str {
         &self.meta.reading

@@ -411,7 +411,7 @@ pub fn profile_note(spec: &Spec) -> String {
     let list: Vec<String> = changes.iter().map(|c| format!("`{} = {}`", c.key, c.value)).collect();
     let mut s =
         format!("Profile `{profile}` changes the spec as written: {}.\n\n", list.join(", "));
-    if spec.reduced() {
+    if changes.iter().any(|c| c.reduces) {
         s.push_str(NOT_EVIDENCE);
     }
     s

@@ -101,7 +101,7 @@ fn view(r: &OptimRun, d: &str, grid: GridSize, problem: &ControlNetProblem, furt
         "{d} on {grid}, CN {}, {}: {what} ({} r{}, best {:.4e}, excursion {:.3e})",
         r.cell.cn,
         r.cell.param.name(),
-        r.cell.optimiser.to_uppercase(),
+        super::report::label(&r.cell.optimiser),
         r.cell.repeat,
         r.row.best,
         r.row.excursion

@@ -325,37 +325,20 @@ fn thesis_wins(
     cells: &[CellKey],
 ) -> Option<(usize, usize)> {
     let t = t?;
-    let names = ["ga", "de", "pso"];
-    let (mut w, mut n) = (0, 0);
-    for row in &t.rows {
-        let at = |k: &str| row.get(k).map(String::as_str).unwrap_or("");
-        let ours = cells.iter().any(|c| {
-            at("data") == c.0
-                && at("parameterisation") == c.1.name()
-                && at("cn_x") == c.2.nx.to_string()
-                && at("cn_y") == c.2.ny.to_string()
-        });
-        let v: Vec<f64> = names
-            .iter()
-            .filter_map(|n| row.get(&format!("{n}_avg{suffix}")).and_then(|x| x.parse().ok()))
-            .collect();
-        if ours && v.len() == 3 {
-            let k =
-                v.iter().enumerate().min_by(|a, b| a.1.total_cmp(b.1)).map(|x| x.0).unwrap_or(0);
-            w += (names[k] == o) as usize;
-            n += 1;
-        }
-    }
-    Some((w, n))
+    let winners: Vec<&str> = cells.iter().filter_map(|c| thesis_winner(t, c, suffix)).collect();
+    Some((winners.iter().filter(|w| **w == o).count(), winners.len()))
 }
 
-/// The thesis' optimiser with the least AVG error in one of our cells (from its Appendix K/L).
-fn thesis_winner(t: &reference::RefTable, c: &CellKey) -> Option<&'static str> {
+/// The thesis' optimiser with the least AVG of `<o>_avg<suffix>` in one of our cells (from its
+/// Appendix K-N); None where the table lacks the cell or a value.
+fn thesis_winner(t: &reference::RefTable, c: &CellKey, suffix: &str) -> Option<&'static str> {
     let key = [c.0.clone(), c.1.name().to_string(), c.2.nx.to_string(), c.2.ny.to_string()];
     let row = t.find(&["data", "parameterisation", "cn_x", "cn_y"], &key)?;
     let names = ["ga", "de", "pso"];
-    let v: Vec<f64> =
-        names.iter().map(|n| row.get(&format!("{n}_avg")).and_then(|x| x.parse().ok())).collect::<Option<_>>()?;
+    let v: Vec<f64> = names
+        .iter()
+        .map(|n| row.get(&format!("{n}_avg{suffix}")).and_then(|x| x.parse().ok()))
+        .collect::<Option<_>>()?;
     v.iter().enumerate().min_by(|a, b| a.1.total_cmp(b.1)).map(|(k, _)| names[k])
 }
 
@@ -381,7 +364,7 @@ fn winners_by_net(t: &GridTables, grid: GridSize, err_name: &str, out: &Path, ex
         row.extend(ours.iter().map(|w| w.to_string()));
         // The thesis' count only where it has every one of these cells.
         let theirs: Option<Vec<usize>> = thesis.as_ref().and_then(|tt| {
-            let w: Option<Vec<&str>> = here.iter().map(|&i| thesis_winner(tt, &t.cells[i])).collect();
+            let w: Option<Vec<&str>> = here.iter().map(|&i| thesis_winner(tt, &t.cells[i], "")).collect();
             w.map(|w| t.opts.iter().map(|o| w.iter().filter(|x| **x == o).count()).collect())
         });
         if let Some(th) = &theirs {
@@ -788,12 +771,12 @@ fn appendix_ij(
                                 Some((m, k, dmax)) => (
                                     format!(
                                         "{}: (MIN - B) x{k:.0}, max {dmax:.0e}",
-                                        o.to_uppercase()
+                                        label(o)
                                     ),
                                     grey.iter().cloned().chain(m).collect(),
                                 ),
                                 None => (
-                                    format!("{} MIN ({:.4}) = B", o.to_uppercase(), r.row.best),
+                                    format!("{} MIN ({:.4}) = B", label(o), r.row.best),
                                     b.clone(),
                                 ),
                             };
@@ -875,24 +858,28 @@ fn convergence_charts(
                     band: Some(band),
                 });
             }
-            // B (where every run starts) and, where the folder has it, the certified optimum.
+            // B (where every run starts) and, where the folder has it, the certified optimum:
+            // flat lines on the convergence chart, dashed levels across the box plot (so an
+            // optimiser that ends above B shows as such).
+            let mut levels = Vec::new();
+            if let Some(problem) = problems.get(&(d.clone(), cn, p0)) {
+                let b = problem.fitness(problem.initial_point());
+                levels.push(plots::Level { key: "b", label: format!("B {b:.6}"), y: b });
+            }
+            if let Some(e) = exact.get(&(d.clone(), cn, p0)) {
+                let label = format!("certified optimum {:.6}", e.f);
+                levels.push(plots::Level { key: "exact", label, y: e.f });
+            }
             let (x0, x1) = series
                 .iter()
                 .flat_map(|s| s.points.iter().map(|p| p.0))
                 .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| (a.min(x), b.max(x)));
-            let level = |label: String, name: &str, y: f64| Series {
-                label,
-                colour: style::optimiser_colour(name).unwrap_or(style::GREY),
-                points: vec![(x0, y), (x1, y)],
+            series.extend(levels.iter().map(|l| Series {
+                label: l.label.clone(),
+                colour: style::optimiser_colour(l.key).unwrap_or(style::GREY),
+                points: vec![(x0, l.y), (x1, l.y)],
                 band: None,
-            };
-            if let Some(problem) = problems.get(&(d.clone(), cn, p0)) {
-                let b = problem.fitness(problem.initial_point());
-                series.push(level(format!("B {b:.6}"), "b", b));
-            }
-            if let Some(e) = exact.get(&(d.clone(), cn, p0)) {
-                series.push(level(format!("certified optimum {:.6}", e.f), "exact", e.f));
-            }
+            }));
             let conv = format!("png/convergence_{grid}_{d}_{}_{cn}.png", p0.name());
             crate::io::ensure_dir(&out.join("png"))?;
             if let Err(e) = plots::line_chart_png(
@@ -906,17 +893,6 @@ fn convergence_charts(
                 eprintln!("somnurbs: warning: picture skipped: {e}");
             } else {
                 let _ = writeln!(s, "\n![{conv}]({conv})");
-            }
-            // B (where every run starts) and the certified optimum across the boxes, so an
-            // optimiser that ends above B shows as such.
-            let mut levels = Vec::new();
-            if let Some(problem) = problems.get(&(d.clone(), cn, p0)) {
-                let b = problem.fitness(problem.initial_point());
-                levels.push(plots::Level { key: "b", label: format!("B {b:.6}"), y: b });
-            }
-            if let Some(e) = exact.get(&(d.clone(), cn, p0)) {
-                let label = format!("certified optimum {:.6}", e.f);
-                levels.push(plots::Level { key: "exact", label, y: e.f });
             }
             let bx = format!("png/boxplot_{grid}_{d}_{}_{cn}.png", p0.name());
             if let Err(e) = plots::box_plot_png(

@@ -78,7 +78,7 @@ impl SuiteProblem {
 pub struct Suite {
     pub spec_name: String,
     pub profile: Option<String>,
-    /// The knot reading of approach B's start (README "Readings"): `eq2_10` or `nurbs_book`.
+    /// The knot reading of approach B's start (docs/readings.md): `eq2_10` or `nurbs_book`.
     pub reading: String,
     /// The spec's search box in words ([`box_label`]).
     pub box_label: String,

@@ -33,12 +33,16 @@ impl runner::Logged for SomRun {
     /// them so (every model but DNSOM, whose maps feed Chapters 5 and 6).
     type Record = (SomRow, PackedPoints);
     fn record(&self) -> Self::Record {
-        if self.cell.model == som::Model::Dnsom {
-            (self.row.clone(), PackedPoints::exact(self.weights.clone()))
-        } else {
-            (self.row.clone(), PackedPoints::single(&self.weights))
-        }
+        // `run_cell` rounded them already: written as f32, they stay exact.
+        let points = PackedPoints { points: self.weights.clone(), single: single(self.cell.model) };
+        (self.row.clone(), points)
     }
+}
+
+/// Whether a model's weights are kept in single precision: they serve the pictures only (every
+/// model but DNSOM, whose maps feed Chapters 5 and 6).
+fn single(model: som::Model) -> bool {
+    model != som::Model::Dnsom
 }
 
 /// One row of `runs.csv` (tidy: one row per cell x repeat).
@@ -163,11 +167,7 @@ pub fn run_cell(
     // and only for pictures, in single precision, but DNSOM's, whose maps feed Chapters 5 and 6:
     // a run resumed from its log draws the same pictures.
     let drawn: Vec<Point3> = topo.drawn_units().into_iter().map(|u| trained.weights[u]).collect();
-    let weights = if cell.model == som::Model::Dnsom {
-        drawn
-    } else {
-        PackedPoints::single(&drawn).points
-    };
+    let weights = if single(cell.model) { PackedPoints::single(&drawn).points } else { drawn };
     Ok(SomRun { cell: cell.clone(), row, weights })
 }
 

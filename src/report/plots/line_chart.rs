@@ -77,10 +77,8 @@ pub fn xy_chart_png(
     y_label: &str,
     series: &[Series],
 ) -> Result<(), PlotError> {
-    let (x_ext, y_axis) = axes(path, series, false)?;
-    // The unpadded data extents (Axis::linear pads both by the same factor).
-    let y_ext = (y_axis.lo / 2.0 + y_axis.hi / 2.0, (y_axis.hi - y_axis.lo) / 2.0 / 1.1);
-    let y_ext = (y_ext.0 - y_ext.1, y_ext.0 + y_ext.1);
+    // The data's extents; Axis::linear pads both by the same factor, keeping the aspect.
+    let (x_ext, y_ext) = extents(path, series, false)?;
     render_png(path, style::CHART_SIZE, |root| {
         // Measure the plotting area, widen one range to its aspect and draw again (the y labels'
         // width can move the area by a few pixels, so until it stays put).
@@ -153,6 +151,21 @@ pub fn small_multiples_png(
 
 /// The x extent and the y axis that show every drawable point of `series`.
 fn axes(path: &Path, series: &[Series], log_y: bool) -> Result<((f64, f64), Axis), PlotError> {
+    let (x_ext, y_ext) = extents(path, series, log_y)?;
+    let y_axis = if log_y {
+        Axis::log10(y_ext.0, y_ext.1, 7)
+            .ok_or_else(|| PlotError::input(path, "log axis without positive values"))?
+    } else {
+        Axis::linear(y_ext.0, y_ext.1, 7)
+    };
+    Ok((x_ext, y_axis))
+}
+
+/// A (least, greatest) range of values.
+type Span = (f64, f64);
+
+/// The x and y extents of every drawable point of `series` (an error naming `path` without one).
+fn extents(path: &Path, series: &[Series], log_y: bool) -> Result<(Span, Span), PlotError> {
     let ok_y = |y: f64| if log_y { y > 0.0 } else { true };
     let xs = series
         .iter()
@@ -164,26 +177,17 @@ fn axes(path: &Path, series: &[Series], log_y: bool) -> Result<((f64, f64), Axis
             .map(|p| p.1)
             .chain(s.band.iter().flatten().filter(|b| b.0.is_finite()).flat_map(|b| [b.1, b.2]))
     });
-    let (x_ext, y_ext) = match (extent(xs), extent(ys.filter(|y| ok_y(*y)))) {
-        (Some(x), Some(y)) => (x, y),
-        _ => {
-            return Err(PlotError::input(
-                path,
-                format!(
-                    "no drawable point in {} series (all values non-finite{})",
-                    series.len(),
-                    if log_y { " or not positive on the log axis" } else { "" }
-                ),
-            ))
-        }
-    };
-    let y_axis = if log_y {
-        Axis::log10(y_ext.0, y_ext.1, 7)
-            .ok_or_else(|| PlotError::input(path, "log axis without positive values"))?
-    } else {
-        Axis::linear(y_ext.0, y_ext.1, 7)
-    };
-    Ok((x_ext, y_axis))
+    match (extent(xs), extent(ys.filter(|y| ok_y(*y)))) {
+        (Some(x), Some(y)) => Ok((x, y)),
+        _ => Err(PlotError::input(
+            path,
+            format!(
+                "no drawable point in {} series (all values non-finite{})",
+                series.len(),
+                if log_y { " or not positive on the log axis" } else { "" }
+            ),
+        )),
+    }
 }
 
 /// A linear x axis with at most 8 ticks, fewer until their labels fit in 60 % of `plot_w`.
