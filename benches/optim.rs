@@ -29,7 +29,8 @@ fn main() {
         repeat: 0,
     };
     let run = families::som::run_cell(&cell, &spindle.points, &SomParams::default(), 2023).unwrap();
-    let grid = families::fit::grid_from_weights(20, 20, &run.weights);
+    let grid =
+        somnurbs::double_net::TwoViewGrid::from_weights(20, 20, &run.weights).expect("a DNSOM map");
     let fit = fit_two_view(
         &grid,
         18,
@@ -393,7 +394,11 @@ fn scaling(points: &[Point3], mhz: f64) {
                 repeat: 0,
             };
             let run = families::som::run_cell(&cell, points, &SomParams::default(), 2023).unwrap();
-            maps.push((m, families::fit::grid_from_weights(m, m, &run.weights)));
+            maps.push((
+                m,
+                somnurbs::double_net::TwoViewGrid::from_weights(m, m, &run.weights)
+                    .expect("a DNSOM map"),
+            ));
         }
         let grid = &maps.iter().find(|(k, _)| *k == m).unwrap().1;
         let fit = fit_two_view(

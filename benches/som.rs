@@ -3,7 +3,7 @@
 //! - the whole Appendix B grid (5 data x n in {10,20,30} x 4 models) wall time on all cores, and
 //!   its ratio to the thesis' summed CPU times.
 
-use somnurbs::experiment::{runner, spec::Spec, RunContext};
+use somnurbs::experiment::{runner, RunContext};
 use somnurbs::families;
 use somnurbs::som::{self, Model, SomParams};
 use std::time::Instant;
@@ -35,18 +35,16 @@ fn main() {
     // 2. The whole Appendix B grid on all cores.
     let spec_path =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/ch4_models.toml");
-    families::install();
-    let spec = Spec::load(&spec_path, None).expect("spec");
-    let cells: Vec<_> =
-        families::som::spec::cells(&spec).into_iter().filter(|c| c.grid.nx == c.grid.ny).collect();
+    let loaded = families::Loaded::load(&spec_path, None).expect("spec");
+    let som_spec: &families::som::spec::SomSpec = loaded.section().expect("a [som] spec");
+    let spec = &loaded.spec;
+    let cells: Vec<_> = families::som::spec::cells(som_spec)
+        .into_iter()
+        .filter(|c| c.grid.nx == c.grid.ny)
+        .collect();
     let jobs = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
     let ctx = RunContext { jobs, ..ctx };
-    let data = families::som::load_datasets(
-        &spec,
-        &spec.section::<families::som::spec::SomSpec>().unwrap().datasets,
-        &ctx,
-    )
-    .expect("data sets");
+    let data = families::som::load_datasets(spec, &som_spec.datasets, &ctx).expect("data sets");
     let t0 = Instant::now();
     let runs = runner::run_cells(
         &cells,
@@ -58,7 +56,9 @@ fn main() {
     .unwrap();
     let wall = t0.elapsed().as_secs_f64();
     let cpu: f64 = runs.iter().map(|r| r.row.cpu_s).sum();
-    let thesis = somnurbs::report::reference::table("appendix_b").unwrap();
+    let thesis =
+        somnurbs::report::reference::lookup(families::som::report::PUBLISHED, "appendix_b")
+            .unwrap();
     let thesis_cpu: f64 = thesis
         .rows
         .iter()

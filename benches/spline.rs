@@ -36,7 +36,8 @@ fn maps(grid: (usize, usize)) -> Vec<TwoViewGrid> {
             let cell = SomCell { dataset: d.clone(), model: Model::Dnsom, grid: g, repeat: 0 };
             let run = families::som::run_cell(&cell, &data[d].points, &SomParams::default(), 2023)
                 .unwrap();
-            families::fit::grid_from_weights(grid.0, grid.1, &run.weights)
+            somnurbs::double_net::TwoViewGrid::from_weights(grid.0, grid.1, &run.weights)
+                .expect("a DNSOM map")
         })
         .collect()
 }

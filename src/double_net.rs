@@ -18,6 +18,29 @@ pub struct TwoViewGrid {
     pub top: Vec<crate::geom::Point3>,
 }
 
+impl TwoViewGrid {
+    /// A trained DNSOM's weights, one per class, as a two-view grid (border positions share
+    /// their class's weight); None when the grid has a side under 2 or there are fewer weights
+    /// than classes.
+    pub fn from_weights(
+        nx: usize,
+        ny: usize,
+        weights: &[crate::geom::Point3],
+    ) -> Option<TwoViewGrid> {
+        let net = DoubleNet::new(nx, ny)?;
+        if weights.len() < net.nov() {
+            return None;
+        }
+        let view = |v: View| {
+            (0..nx)
+                .flat_map(|i| (0..ny).map(move |j| (i, j)))
+                .map(|(i, j)| weights[net.class(v, i, j)])
+                .collect()
+        };
+        Some(TwoViewGrid { nx, ny, bottom: view(View::Bottom), top: view(View::Top) })
+    }
+}
+
 /// Which of the two views a grid position belongs to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum View {

@@ -2,12 +2,8 @@
 
 use clap::Parser;
 use somnurbs::cli::{Cli, Command, DatasetsAction, DriftArgs, ReproduceArgs, RunArgs};
-use somnurbs::experiment::{
-    self,
-    log::Shard,
-    spec::{CliOverrides, Spec},
-    RunContext,
-};
+use somnurbs::experiment::{self, log::Shard, spec::CliOverrides, RunContext};
+use somnurbs::families::{Loaded, Section};
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
@@ -18,7 +14,6 @@ fn main() -> ExitCode {
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
-    somnurbs::families::install();
     let cli = Cli::parse();
     match run(cli) {
         Ok(code) => code,
@@ -54,7 +49,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
                     experiment::data_dir(args.data_dir.as_deref()),
                 )
             };
-            let out = experiment::merge(&args.shards, &ctx)?;
+            let out = experiment::merge::<Section>(&args.shards, &ctx)?;
             eprintln!(
                 "somnurbs: merged {} shards into {} and {}",
                 args.shards.len(),
@@ -83,8 +78,8 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
 /// `somnurbs run`: one spec (or its variants) into one folder, or one shard of it.
 fn run_spec(args: &RunArgs) -> anyhow::Result<ExitCode> {
     let cli = CliOverrides { set: args.set.clone(), sweep: args.sweep.clone() };
-    let variants = Spec::load_variants(&args.spec, args.profile.as_deref(), &cli)?;
-    let spec = &variants[0];
+    let variants = Loaded::load_variants(&args.spec, args.profile.as_deref(), &cli)?;
+    let spec = &variants[0].spec;
     if args.dry_run {
         for (key, seed) in variants.iter().flat_map(experiment::dry_run_listing) {
             println!("{key}\tseed {seed}");
@@ -161,7 +156,8 @@ fn reproduce(args: &ReproduceArgs) -> anyhow::Result<ExitCode> {
         resume: args.resume,
         ..RunContext::new(out, jobs, experiment::data_dir(args.data_dir.as_deref()))
     };
-    let report = experiment::reproduce::reproduce(&specs, &args.plan, &args.profile, &ctx)?;
+    let report =
+        experiment::reproduce::reproduce::<Section>(&specs, &args.plan, &args.profile, &ctx)?;
     eprintln!("somnurbs: wrote {}", report.display());
     Ok(ExitCode::SUCCESS)
 }

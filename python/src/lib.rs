@@ -1,5 +1,5 @@
 //! `somnurbs._native`: the Python face of somnurbs' Chapter 6 problems (issue 39). The problems
-//! come from [`somnurbs::families::optimise::suite::load`], the code path of `somnurbs run`, and
+//! come from [`somnurbs::families::suite::load`], the code path of `somnurbs run`, and
 //! `f` calls the same compiled fitness, so values are bit for bit the CLI's on the same machine.
 //! Evaluation reads a C-contiguous float64 array in place and runs with the GIL released.
 
@@ -7,7 +7,7 @@ use numpy::{PyArray1, PyReadonlyArrayDyn, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyNotImplementedError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use somnurbs::families::optimise::suite::{self, Fitness, Suite, SuiteProblem};
+use somnurbs::families::suite::{self, Fitness, Suite, SuiteProblem};
 use somnurbs::optim::exact::ExactResult;
 use somnurbs::optim::ExactOptions;
 use std::sync::{Arc, OnceLock};

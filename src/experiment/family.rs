@@ -1,13 +1,17 @@
 //! The family contract: one family per kind of spec section (Chapter 4's `[som]`, Chapter 5's
-//! `[fit]`, Chapter 6's `[optim]`, and one per other seed). `run_spec`, `--dry-run`, the
-//! fingerprint and `merge` see a family only through [`Family`], so a new experiment (another
-//! seed's problem) plugs in as one folder under `src/families/` implementing it plus one line in
-//! the registry (`families/mod.rs`), which `install()` hands to the engine as a [`Registry`];
-//! nothing in the engine changes for it, and the engine imports no family.
+//! `[fit]`, Chapter 6's `[optim]`, and one per other seed). A family is written as an
+//! [`Experiment`]: its section type (parsed and checked once), its cells' keys and its run, each
+//! method given the section as that type. The `families!` macro of `families/mod.rs` (the only
+//! list of families) makes the enum of their sections, which implements [`Families`]; the engine
+//! is generic over it, reaches each family through [`Family`] (implemented for every
+//! `Experiment` below) and names no family. No section is ever held as `Any`: a family gets its
+//! own from the enum by [`Holds`], a `match` the macro writes.
 
-use super::spec::{Spec, SpecError, SpecFile};
+use super::limits::Check;
+use super::spec::{Loaded, Spec, SpecError, SpecFile};
 use super::RunContext;
 use crate::report::claims::Claim;
+use crate::report::reference::{Published, RefTable};
 use anyhow::Result;
 use std::path::{Path, PathBuf};
 
@@ -21,59 +25,86 @@ pub struct Outcome {
     pub cells: usize,
 }
 
+/// The set of families a harness knows: the enum of their sections that the `families!` macro
+/// writes, one variant per family. The engine is generic over it.
+pub trait Families: Clone + std::fmt::Debug + Send + Sync + Sized + 'static {
+    /// Every family, in the order their sections are named in messages.
+    fn all() -> &'static [&'static dyn Family<Self>];
+    /// Parse a spec file's text: its header, and each family section it holds (in registry
+    /// order; validation requires exactly one). Unknown keys are refused, so serde names the
+    /// line and column of a bad one.
+    fn parse(text: &str) -> Result<(SpecFile, Vec<Self>), toml::de::Error>;
+    /// The family this section belongs to.
+    fn family(&self) -> &'static dyn Family<Self>;
+}
+
+/// A family's section inside the enum `Self` (written by the `families!` macro: a `match`).
+pub trait Holds<S>: Families {
+    /// The section, when it is this family's.
+    fn get(&self) -> Option<&S>;
+    /// The same, to change (see [`Section::use_maps`]).
+    fn get_mut(&mut self) -> Option<&mut S>;
+}
+
 /// One experiment family as the engine sees it: which spec section selects it, its cells' keys,
-/// and how it runs. Implemented for every [`Experiment`] by the blanket impl below.
-pub trait Family: Sync {
+/// and how it runs. Implemented for every [`Experiment`] by the blanket impl below; every method
+/// takes the spec's section as the enum `F` and hands the family its own type.
+pub trait Family<F>: Sync {
     /// The spec section (`som`, `fit`, `optim`, `seed002`, ...), for messages.
     fn section(&self) -> &'static str;
-    /// Whether the spec has this family's section.
-    fn present(&self, spec: &Spec) -> bool;
     /// Check the bounds of the section's sizes and counts (before anything is allocated from them).
-    fn check_limits(&self, c: &super::limits::Check) -> Result<(), SpecError>;
+    fn check_limits(&self, c: &Check, s: &F) -> Result<(), SpecError>;
     /// The data-set entries of the section, as written (names or paths).
-    fn datasets<'a>(&self, spec: &'a Spec) -> Vec<&'a String>;
+    fn datasets<'a>(&self, s: &'a F) -> Vec<&'a String>;
     /// Read the SOM maps from the folder `maps` (a plan whose earlier spec saved them); families
     /// that read no maps ignore it.
-    fn use_maps(&self, spec: &mut Spec, maps: &str);
+    fn use_maps(&self, s: &mut F, maps: &str);
     /// Check that the files the section names besides its data sets (Chapter 4's maps) are
     /// there, before the output folder is touched.
-    fn require_inputs(&self, spec: &Spec) -> Result<()>;
+    fn require_inputs(&self, spec: &Spec, s: &F) -> Result<()>;
     /// Check every value of the family's section (called once the limits have passed and the
     /// spec has been found to hold this family's section only).
-    fn validate(&self, spec: &Spec) -> Result<(), SpecError>;
+    fn validate(&self, spec: &Spec, s: &F) -> Result<(), SpecError>;
     /// The keys of every cell that goes through the cell log, in cell order (what `--resume`
     /// and `merge` must find; cell k goes to shard k mod N + 1).
-    fn logged_keys(&self, spec: &Spec) -> Vec<String>;
+    fn logged_keys(&self, spec: &Spec, s: &F) -> Vec<String>;
     /// Keys of cells that run (on their own streams) but are not logged: a resumed run or a merge
     /// runs them again. Listed by `--dry-run` only.
-    fn unlogged_keys(&self, spec: &Spec) -> Vec<String>;
-    /// Run the cells of `ctx`'s slice; with `tables`, write the tables and pictures into
-    /// `ctx.out` and return the REPORT.md section.
-    fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<Outcome>;
-    /// Run the variants of a spec (`--sweep`) into one folder, their tables together. A family
-    /// whose tables cannot tell variants apart runs one variant only.
-    fn run_variants(&self, variants: &[Spec], ctx: &RunContext, tables: bool) -> Result<Outcome>;
+    fn unlogged_keys(&self, spec: &Spec, s: &F) -> Vec<String>;
+    /// Run the variants of a spec (one for a plain run; `--sweep` makes more) into one folder;
+    /// with `tables`, write the tables and pictures into `ctx.out` and return the REPORT.md
+    /// section. A family whose tables cannot tell variants apart runs one variant only.
+    fn run_variants(
+        &self,
+        variants: &[Loaded<F>],
+        ctx: &RunContext,
+        tables: bool,
+    ) -> Result<Outcome>;
     /// Which keys `--set` and `--sweep` may change in the section (None: none).
     fn overrides(&self) -> Option<Overrides>;
-    /// The family's part of a plan's combined report, from its specs' finished folders.
-    fn combine(&self, view: &PlanView) -> Result<Combined>;
+    /// The family's part of a plan's combined report, from its specs' finished folders (the
+    /// view's specs of other families are left out).
+    fn combine(&self, view: &PlanView<F>) -> Result<Combined>;
     /// The exact definitions of the metrics the family reports (the manifest's `[definitions]`).
     fn definitions(&self) -> super::Definitions;
+    /// The published tables the family reproduces (the readings score compares every CSV of its
+    /// folders named like one).
+    fn published(&self) -> Published;
 }
 
 /// A finished plan as one family sees it, for the parts of the combined report that need more
-/// than one of its specs (the thesis' Tables 6.8 and 6.9 sum two specs' tables).
-pub struct PlanView<'a> {
+/// than one of its specs (the thesis' Tables 6.8 and 6.9 sum two specs' tables). `S` is the
+/// family's section type (the engine's view holds the sections' enum).
+pub struct PlanView<'a, S> {
     /// The plan's output folder; spec `s` ran into `out/s`.
     pub out: &'a Path,
-    /// The plan's specs of this family, in plan order.
-    pub specs: Vec<&'a Spec>,
+    /// The plan's specs of this family, in plan order, each with its section.
+    pub specs: Vec<(&'a Spec, &'a S)>,
     /// The plan's own reading (`eq2_10`).
     pub reading: &'a str,
     /// The reading sets that ran some specs again.
     pub readings: Vec<ReadingRun>,
 }
-
 /// One reading set of a plan: its name, the specs it ran again and the folder holding them
 /// (spec `s` ran into `root/s`).
 #[derive(Debug, Clone)]
@@ -133,81 +164,6 @@ impl Overrides {
 pub trait Placed: Sized + Clone + std::fmt::Debug + Send + Sync + 'static {
     /// The section's name in the spec file (also used in messages).
     const NAME: &'static str;
-    /// The section in a spec file, if the file has it.
-    fn of(file: &SpecFile) -> Option<&Self> {
-        file.sections.get(Self::NAME)?.as_any().downcast_ref()
-    }
-    /// The same, to change (see [`Section::use_maps`]).
-    fn of_mut(file: &mut SpecFile) -> Option<&mut Self> {
-        file.sections.get_mut(Self::NAME)?.as_any_mut().downcast_mut()
-    }
-}
-
-/// A family's section as the engine holds it, whatever its type.
-pub trait AnySection: std::fmt::Debug + Send + Sync {
-    fn as_any(&self) -> &dyn std::any::Any;
-    fn as_any_mut(&mut self) -> &mut dyn std::any::Any;
-    fn clone_box(&self) -> Box<dyn AnySection>;
-}
-
-impl<T: Placed> AnySection for T {
-    fn as_any(&self) -> &dyn std::any::Any {
-        self
-    }
-    fn as_any_mut(&mut self) -> &mut dyn std::any::Any {
-        self
-    }
-    fn clone_box(&self) -> Box<dyn AnySection> {
-        Box::new(self.clone())
-    }
-}
-
-/// The family sections of a spec file, by section name, in the file's order of the registry.
-#[derive(Debug, Default)]
-pub struct Sections(Vec<(&'static str, Box<dyn AnySection>)>);
-
-impl Clone for Sections {
-    fn clone(&self) -> Sections {
-        Sections(self.0.iter().map(|(n, s)| (*n, s.as_ref().clone_box())).collect())
-    }
-}
-
-impl Sections {
-    pub fn insert(&mut self, name: &'static str, section: Box<dyn AnySection>) {
-        self.0.push((name, section));
-    }
-    pub fn get(&self, name: &str) -> Option<&dyn AnySection> {
-        self.0.iter().find(|(n, _)| *n == name).map(|(_, s)| s.as_ref())
-    }
-    pub fn get_mut(&mut self, name: &str) -> Option<&mut dyn AnySection> {
-        match self.0.iter_mut().find(|(n, _)| *n == name) {
-            Some((_, s)) => Some(s.as_mut()),
-            None => None,
-        }
-    }
-}
-
-/// The families as the engine reaches them: written by the `families!` macro in
-/// `families/mod.rs` and handed over by its `install()`, so the engine imports no family.
-pub struct Registry {
-    /// Every family, in the order their sections are named in messages.
-    pub families: &'static [&'static dyn Family],
-    /// Parse a spec file's text (the header and every family's optional section).
-    pub parse: fn(&str) -> Result<SpecFile, toml::de::Error>,
-}
-
-static INSTALLED: std::sync::OnceLock<&'static Registry> = std::sync::OnceLock::new();
-
-/// Hand the engine its families (the first call wins; `main` makes it before anything else).
-pub fn install(registry: &'static Registry) {
-    let _ = INSTALLED.set(registry);
-}
-
-/// The installed families. Unit tests install the crate's own on first use.
-pub fn registry() -> &'static Registry {
-    #[cfg(test)]
-    crate::families::install();
-    INSTALLED.get().expect("somnurbs::families::install() must run before a spec is read")
 }
 
 /// A family's spec section (`[som]`, `[optim]`, `[seed004]`, ...): how it is checked. The
@@ -215,7 +171,7 @@ pub fn registry() -> &'static Registry {
 pub trait Section: Placed {
     /// Check the bounds of the section's sizes and counts (before anything is allocated from
     /// them).
-    fn limits(&self, c: &super::limits::Check) -> Result<(), SpecError>;
+    fn limits(&self, c: &Check) -> Result<(), SpecError>;
     /// Check every value of the section (once the limits have passed).
     fn validate(&self, spec: &Spec) -> Result<(), SpecError>;
     /// The data-set entries of the section, as written (names or paths).
@@ -233,23 +189,35 @@ pub trait Section: Placed {
     const OVERRIDES: Option<Overrides> = None;
 }
 
-/// A family as it is written: its section type, its cells and its run. Every `Experiment` is a
-/// [`Family`] (the engine's object-safe view) through the blanket impl below, so a family writes
-/// none of the section plumbing itself.
-pub trait Experiment: Sync {
+/// A family as it is written: its section type, its cells and its run, each given the spec and
+/// the family's own section. Every `Experiment` is a [`Family`] (the engine's object-safe view)
+/// through the blanket impl below, so a family writes none of the section plumbing itself.
+pub trait Experiment: Sync + 'static {
     type Section: Section;
     /// See [`Family::logged_keys`].
-    fn logged_keys(&self, spec: &Spec) -> Vec<String>;
+    fn logged_keys(&self, spec: &Spec, s: &Self::Section) -> Vec<String>;
     /// See [`Family::unlogged_keys`].
-    fn unlogged_keys(&self, _spec: &Spec) -> Vec<String> {
+    fn unlogged_keys(&self, _spec: &Spec, _s: &Self::Section) -> Vec<String> {
         Vec::new()
     }
-    /// See [`Family::run`].
-    fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<Outcome>;
+    /// Run the spec's cells of `ctx`'s slice; with `tables`, write the tables and pictures into
+    /// `ctx.out` and return the REPORT.md section.
+    fn run(
+        &self,
+        spec: &Spec,
+        s: &Self::Section,
+        ctx: &RunContext,
+        tables: bool,
+    ) -> Result<Outcome>;
     /// See [`Family::run_variants`]; by default a sweep is refused.
-    fn run_variants(&self, variants: &[Spec], ctx: &RunContext, tables: bool) -> Result<Outcome> {
+    fn run_variants(
+        &self,
+        variants: &[(&Spec, &Self::Section)],
+        ctx: &RunContext,
+        tables: bool,
+    ) -> Result<Outcome> {
         match variants {
-            [one] => self.run(one, ctx, tables),
+            [(spec, s)] => self.run(spec, s, ctx, tables),
             _ => anyhow::bail!(
                 "--sweep: [{}] specs run one variant at a time (sweeps work on [optim] specs)",
                 Self::Section::NAME
@@ -257,69 +225,90 @@ pub trait Experiment: Sync {
         }
     }
     /// See [`Family::combine`]; by default nothing.
-    fn combine(&self, _view: &PlanView) -> Result<Combined> {
+    fn combine(&self, _view: &PlanView<Self::Section>) -> Result<Combined> {
         Ok(Combined::default())
     }
     /// See [`Family::definitions`]; by default none.
     fn definitions(&self) -> super::Definitions {
         super::Definitions::default()
     }
+    /// See [`Family::published`]; by default none.
+    fn published(&self) -> Published {
+        &[]
+    }
 }
 
-impl<E: Experiment> Family for E {
+/// The message for a section handed to a family it does not belong to (the engine asks each
+/// section's own family, so this is never seen).
+fn foreign(name: &str) -> SpecError {
+    SpecError(format!("internal: a section that is not [{name}] was handed to the [{name}] family"))
+}
+
+impl<F: Holds<E::Section>, E: Experiment> Family<F> for E {
     fn section(&self) -> &'static str {
         E::Section::NAME
     }
-    fn present(&self, spec: &Spec) -> bool {
-        E::Section::of(&spec.file).is_some()
+    fn check_limits(&self, c: &Check, s: &F) -> Result<(), SpecError> {
+        s.get().ok_or_else(|| foreign(E::Section::NAME))?.limits(c)
     }
-    fn check_limits(&self, c: &super::limits::Check) -> Result<(), SpecError> {
-        E::Section::of(&c.spec.file).map_or(Ok(()), |s| s.limits(c))
+    fn datasets<'a>(&self, s: &'a F) -> Vec<&'a String> {
+        s.get().map(|s| s.datasets().iter().collect()).unwrap_or_default()
     }
-    fn datasets<'a>(&self, spec: &'a Spec) -> Vec<&'a String> {
-        E::Section::of(&spec.file).map(|s| s.datasets().iter().collect()).unwrap_or_default()
-    }
-    fn use_maps(&self, spec: &mut Spec, maps: &str) {
-        if let Some(s) = E::Section::of_mut(&mut spec.file) {
+    fn use_maps(&self, s: &mut F, maps: &str) {
+        if let Some(s) = s.get_mut() {
             s.use_maps(maps);
         }
     }
-    fn require_inputs(&self, spec: &Spec) -> Result<()> {
-        E::Section::of(&spec.file).map_or(Ok(()), |s| s.require_inputs(spec))
+    fn require_inputs(&self, spec: &Spec, s: &F) -> Result<()> {
+        s.get().ok_or_else(|| foreign(E::Section::NAME))?.require_inputs(spec)
     }
-    fn validate(&self, spec: &Spec) -> Result<(), SpecError> {
-        E::Section::of(&spec.file).map_or(Ok(()), |s| s.validate(spec))
+    fn validate(&self, spec: &Spec, s: &F) -> Result<(), SpecError> {
+        s.get().ok_or_else(|| foreign(E::Section::NAME))?.validate(spec)
     }
-    fn logged_keys(&self, spec: &Spec) -> Vec<String> {
-        Experiment::logged_keys(self, spec)
+    fn logged_keys(&self, spec: &Spec, s: &F) -> Vec<String> {
+        s.get().map(|s| Experiment::logged_keys(self, spec, s)).unwrap_or_default()
     }
-    fn unlogged_keys(&self, spec: &Spec) -> Vec<String> {
-        Experiment::unlogged_keys(self, spec)
+    fn unlogged_keys(&self, spec: &Spec, s: &F) -> Vec<String> {
+        s.get().map(|s| Experiment::unlogged_keys(self, spec, s)).unwrap_or_default()
     }
-    fn run(&self, spec: &Spec, ctx: &RunContext, tables: bool) -> Result<Outcome> {
-        Experiment::run(self, spec, ctx, tables)
-    }
-    fn run_variants(&self, variants: &[Spec], ctx: &RunContext, tables: bool) -> Result<Outcome> {
-        Experiment::run_variants(self, variants, ctx, tables)
+    fn run_variants(
+        &self,
+        variants: &[Loaded<F>],
+        ctx: &RunContext,
+        tables: bool,
+    ) -> Result<Outcome> {
+        let typed: Vec<(&Spec, &E::Section)> = variants
+            .iter()
+            .map(|v| Ok((&v.spec, v.section.get().ok_or_else(|| foreign(E::Section::NAME))?)))
+            .collect::<Result<_, SpecError>>()?;
+        Experiment::run_variants(self, &typed, ctx, tables)
     }
     fn overrides(&self) -> Option<Overrides> {
         E::Section::OVERRIDES
     }
-    fn combine(&self, view: &PlanView) -> Result<Combined> {
-        Experiment::combine(self, view)
+    fn combine(&self, view: &PlanView<F>) -> Result<Combined> {
+        let own = PlanView {
+            out: view.out,
+            specs: view.specs.iter().filter_map(|(spec, s)| Some((*spec, s.get()?))).collect(),
+            reading: view.reading,
+            readings: view.readings.clone(),
+        };
+        Experiment::combine(self, &own)
     }
     fn definitions(&self) -> super::Definitions {
         Experiment::definitions(self)
     }
+    fn published(&self) -> Published {
+        Experiment::published(self)
+    }
 }
 
-/// The families whose sections the spec has (validation requires exactly one). The engine reaches
-/// the families only through the installed [`Registry`].
-pub fn present(spec: &Spec) -> Vec<&'static dyn Family> {
-    registry().families.iter().copied().filter(|f| f.present(spec)).collect()
+/// The published table `name`, from whichever family of `F` compiles it in.
+pub fn published<F: Families>(name: &str) -> Option<RefTable> {
+    F::all().iter().find_map(|f| crate::report::reference::lookup(f.published(), name))
 }
 
 /// The section names, as `[som], [fit], ...`, for messages.
-pub fn section_list() -> String {
-    registry().families.iter().map(|f| format!("[{}]", f.section())).collect::<Vec<_>>().join(", ")
+pub fn section_list<F: Families>() -> String {
+    F::all().iter().map(|f| format!("[{}]", f.section())).collect::<Vec<_>>().join(", ")
 }

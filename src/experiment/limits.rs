@@ -4,7 +4,8 @@
 //! the output folder. The checks only read numbers and list lengths: nothing is allocated from a
 //! spec value before it has passed, so a bad value is a one-line error naming its key at once.
 
-use super::spec::{GridSize, Spec, SpecError};
+use super::family::Families;
+use super::spec::{GridSize, Loaded, Spec, SpecError};
 use std::collections::HashSet;
 use std::fmt::Display;
 
@@ -174,8 +175,8 @@ impl Check<'_> {
 }
 
 /// The data-set entries of a spec's section (as written: names or paths).
-pub fn dataset_entries(spec: &Spec) -> Vec<&String> {
-    super::family::present(spec).into_iter().flat_map(|f| f.datasets(spec)).collect()
+pub fn dataset_entries<F: Families>(spec: &Loaded<F>) -> Vec<&String> {
+    spec.family().datasets(&spec.section)
 }
 
 /// The penalised least squares weight (`fairness`): at most 10^6.
@@ -189,27 +190,21 @@ pub fn check_name(name: &str) -> Result<(), String> {
     Ok(())
 }
 
-/// Every bound of a spec (see the module doc), before any other check.
-pub fn check(spec: &Spec) -> Result<(), SpecError> {
+/// Every bound of a spec and its section (see the module doc), before any other check.
+pub fn check<F: Families>(spec: &Spec, section: &F) -> Result<(), SpecError> {
     let c = Check { spec, counted: Default::default() };
-    let f = &spec.file;
-    check_name(&f.name).map_err(|e| c.err("name", e))?;
-    for family in super::family::present(spec) {
-        family.check_limits(&c)?;
-    }
-    Ok(())
+    check_name(&spec.file.name).map_err(|e| c.err("name", e))?;
+    section.family().check_limits(&c, section)
 }
 
 /// The cells of a spec as its limit counts them (the product of its section's sizes), without
 /// making them; 0 when a limit fails (a spec that passed validation has passed them).
-pub fn cell_count(spec: &Spec) -> u64 {
-    let c = Check { spec, counted: Default::default() };
-    for family in super::family::present(spec) {
-        if family.check_limits(&c).is_err() {
-            return 0;
-        }
+pub fn cell_count<F: Families>(spec: &Loaded<F>) -> u64 {
+    let c = Check { spec: &spec.spec, counted: Default::default() };
+    match spec.family().check_limits(&c, &spec.section) {
+        Ok(()) => c.counted.get(),
+        Err(_) => 0,
     }
-    c.counted.get()
 }
 
 #[cfg(test)]
@@ -223,14 +218,14 @@ mod tests {
         let t = std::time::Instant::now();
         let text = SPEC.replace(from, to);
         assert_ne!(text, SPEC, "{from} not in the spec");
-        let e = Spec::parse("t.toml", &text, None).unwrap_err().0;
+        let e = crate::families::Loaded::parse("t.toml", &text, None).unwrap_err().0;
         assert!(e.contains(key) && !e.contains('\n'), "{to}: {e}");
         assert!(t.elapsed().as_secs_f64() < 1.0, "{to}: slow refusal");
     }
 
     #[test]
     fn every_size_has_a_bound_named_by_its_key() {
-        Spec::parse("t.toml", SPEC, None).unwrap();
+        crate::families::Loaded::parse("t.toml", SPEC, None).unwrap();
         refused("grid = \"20x20\"", "grid = \"100000x100000\"", "optim.grid");
         refused(
             "control_nets = [\"6x6\"]",
@@ -267,8 +262,13 @@ mod tests {
             ("grids = [\"10x10\"]\n[som.x]", "unknown field"),
             ("grids = [\"10x10\", \"10x10\"]", "`10x10` is listed twice"),
         ] {
-            let e =
-                Spec::parse("s.toml", &som.replace("grids = [\"10x10\"]", to), None).unwrap_err().0;
+            let e = crate::families::Loaded::parse(
+                "s.toml",
+                &som.replace("grids = [\"10x10\"]", to),
+                None,
+            )
+            .unwrap_err()
+            .0;
             assert!(e.contains(key), "{e}");
         }
         for (to, key) in [
@@ -277,7 +277,10 @@ mod tests {
             ("iterations = 10\nsigma0 = inf", "som.sigma0"),
             ("iterations = 10\nrepeats = 1000000000", "som.repeats"),
         ] {
-            let e = Spec::parse("s.toml", &som.replace("iterations = 10", to), None).unwrap_err().0;
+            let e =
+                crate::families::Loaded::parse("s.toml", &som.replace("iterations = 10", to), None)
+                    .unwrap_err()
+                    .0;
             assert!(e.contains(key), "{e}");
         }
     }
@@ -300,7 +303,7 @@ mod tests {
         let sweep = |args: &[&str]| {
             let cli =
                 CliOverrides { set: vec![], sweep: args.iter().map(|s| s.to_string()).collect() };
-            cli.variants("t.toml", &text, None).map(|v| v.len())
+            cli.variants::<crate::families::Section>("t.toml", &text, None).map(|v| v.len())
         };
         let values = |n: usize| {
             (0..n).map(|k| format!("{}", 0.1 + k as f64 * 1e-4)).collect::<Vec<_>>().join(",")
@@ -334,7 +337,7 @@ mod tests {
             let t = SPEC
                 .replace("optimisers = [\"ga\", \"de\"]", &format!("optimisers = [{opts}]"))
                 .replace("population = 8", &format!("population = {pop}\n{extra}"));
-            Spec::parse("t.toml", &t, None).map(|_| ()).map_err(|e| e.0)
+            crate::families::Loaded::parse("t.toml", &t, None).map(|_| ()).map_err(|e| e.0)
         };
         spec("\"ga\"", 4, "").unwrap();
         spec("\"ga\", \"pso\", \"csa\"", 3, "[optim.ga]\ntournament = 3").unwrap();
@@ -356,21 +359,20 @@ mod tests {
     fn many_repeats_expand_in_linear_time() {
         let som = "name = \"s\"\nmaster_seed = 1\n[som]\ndatasets = [\"cube\"]\niterations = 10\nrepeats = 10000\n[[som.group]]\nmodels = [\"som2d\", \"dnsom\"]\ngrids = [\"10x10\", \"12x12\"]\n[[som.group]]\nmodels = [\"som2d\"]\ngrids = [\"10x10\"]\n";
         let t = std::time::Instant::now();
-        let spec = Spec::parse("s.toml", som, None).unwrap();
-        assert_eq!(crate::families::som::spec::cells(&spec).len(), 40_000);
+        let spec = crate::families::Loaded::parse("s.toml", som, None).unwrap();
+        assert_eq!(crate::families::som::spec::cells(spec.section().unwrap()).len(), 40_000);
         assert!(t.elapsed().as_secs_f64() < 2.0, "{:?}", t.elapsed());
     }
 
     #[test]
     fn file_names_become_stems_in_keys() {
         let text = SPEC.replace("datasets = [\"sphere\"]", "datasets = [\"/some/where/part.xyz\"]");
-        let spec = Spec::parse("t.toml", &text, None).unwrap();
+        let spec = crate::families::Loaded::parse("t.toml", &text, None).unwrap();
+        let cells = || crate::families::optimise::spec::cells(&spec.spec, spec.section().unwrap());
         assert!(
-            crate::families::optimise::spec::cells(&spec)
-                .iter()
-                .all(|c| c.key().starts_with("optim/part/")),
+            cells().iter().all(|c| c.key().starts_with("optim/part/")),
             "{:?}",
-            crate::families::optimise::spec::cells(&spec)[0].key()
+            cells()[0].key()
         );
     }
 }

@@ -1,6 +1,7 @@
 //! Experiments: spec -> cells -> runs (on per-cell random streams) -> report files and manifest.
 
 pub mod datasets;
+pub mod defaults;
 pub mod family;
 pub mod finite;
 pub mod grid_size;
@@ -14,8 +15,9 @@ pub mod seeds;
 pub mod spec;
 
 use anyhow::{Context, Result};
+use family::Families;
 use serde::Serialize;
-use spec::Spec;
+use spec::{Loaded, Spec};
 use std::collections::BTreeMap;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
@@ -100,24 +102,24 @@ pub struct Session {
 }
 
 /// One line per cell for `--dry-run`: key and seed.
-pub fn dry_run_listing(spec: &Spec) -> Vec<(String, String)> {
+pub fn dry_run_listing<F: Families>(spec: &Loaded<F>) -> Vec<(String, String)> {
     let mut keys = logged_cell_keys(spec);
-    keys.extend(family::present(spec).iter().flat_map(|f| f.unlogged_keys(spec)));
+    keys.extend(spec.family().unlogged_keys(&spec.spec, &spec.section));
     keys.into_iter()
         .map(|k| {
-            let s = seeds::seed_hex(spec.file.master_seed, &k);
+            let s = seeds::seed_hex(spec.spec.file.master_seed, &k);
             (k, s)
         })
         .collect()
 }
 
 /// The keys of every cell of a spec that goes through the cell log (what a merge must find).
-pub fn logged_cell_keys(spec: &Spec) -> Vec<String> {
-    family::present(spec).iter().flat_map(|f| f.logged_keys(spec)).collect()
+pub fn logged_cell_keys<F: Families>(spec: &Loaded<F>) -> Vec<String> {
+    spec.family().logged_keys(&spec.spec, &spec.section)
 }
 
 /// [`logged_cell_keys`] of every variant of a run, in order.
-fn logged_variant_keys(variants: &[Spec]) -> Vec<String> {
+fn logged_variant_keys<F: Families>(variants: &[Loaded<F>]) -> Vec<String> {
     variants.iter().flat_map(logged_cell_keys).collect()
 }
 
@@ -172,8 +174,11 @@ impl Serialize for Definitions {
 
 /// The fingerprint of a run of a spec's variants (one for a plain run) in a folder (what
 /// `--resume` and `merge` compare).
-pub fn fingerprint(variants: &[Spec], shard: Option<log::Shard>) -> log::Fingerprint {
-    let spec = &variants[0];
+pub fn fingerprint<F: Families>(
+    variants: &[Loaded<F>],
+    shard: Option<log::Shard>,
+) -> log::Fingerprint {
+    let spec = &variants[0].spec;
     log::Fingerprint {
         spec_name: spec.file.name.clone(),
         spec_path: spec.path.clone(),
@@ -196,23 +201,22 @@ pub fn fingerprint(variants: &[Spec], shard: Option<log::Shard>) -> log::Fingerp
 /// writes them). With `resume`, the cells in the folder's log are kept if the folder's
 /// fingerprint and every logged seed match, else the run is refused before anything is touched;
 /// a folder that already holds this run finished is left as it is.
-pub fn run_spec(spec: &Spec, ctx: &RunContext) -> Result<PathBuf> {
+pub fn run_spec<F: Families>(spec: &Loaded<F>, ctx: &RunContext) -> Result<PathBuf> {
     run_variants(std::slice::from_ref(spec), ctx)
 }
 
 /// [`run_spec`] of the variants of one spec (`--set`/`--sweep`: [`spec::CliOverrides`]) into one
 /// folder: one cell log, one fingerprint and manifest, the family's tables over every variant.
-pub fn run_variants(variants: &[Spec], ctx: &RunContext) -> Result<PathBuf> {
-    let spec = variants.first().context("no spec to run")?;
+pub fn run_variants<F: Families>(variants: &[Loaded<F>], ctx: &RunContext) -> Result<PathBuf> {
+    let first = variants.first().context("no spec to run")?;
+    let spec = &first.spec;
     // A data file the spec names that is not there or does not load: refused before the folder
     // is touched (loaded here once more than the run needs: milliseconds for the largest scan).
-    for d in limits::dataset_entries(spec) {
+    for d in limits::dataset_entries(first) {
         ctx.loader(spec).load(d).with_context(|| format!("{}: data set `{d}`", spec.path))?;
     }
     // So is a maps folder it names (unless it asks for the maps to be recomputed).
-    for f in family::present(spec) {
-        f.require_inputs(spec)?;
-    }
+    first.family().require_inputs(spec, &first.section)?;
     let _lock = crate::io::outdir::lock(&ctx.out, &format!("run {}", spec.path))?;
     let fp = fingerprint(variants, ctx.shard);
     match claim(&ctx.out, &fp, ctx.resume)? {
@@ -272,8 +276,9 @@ fn claim(out: &Path, fp: &log::Fingerprint, resume: bool) -> Result<Claimed> {
 }
 
 /// [`run_variants`] in a folder the caller has locked and claimed.
-fn run_spec_locked(variants: &[Spec], ctx: &RunContext) -> Result<PathBuf> {
-    let spec = variants.first().context("no spec to run")?;
+fn run_spec_locked<F: Families>(variants: &[Loaded<F>], ctx: &RunContext) -> Result<PathBuf> {
+    let first = variants.first().context("no spec to run")?;
+    let spec = &first.spec;
     let fp = fingerprint(variants, ctx.shard);
     let manifest_path = ctx.out.join(crate::io::outdir::MANIFEST);
     let session = Arc::new(Session {
@@ -288,8 +293,7 @@ fn run_spec_locked(variants: &[Spec], ctx: &RunContext) -> Result<PathBuf> {
         .unwrap_or(0);
     let tables = ctx.shard.is_none();
 
-    let family =
-        family::present(spec).into_iter().next().context("the spec has no experiment section")?;
+    let family = first.family();
     let family::Outcome { section, cpu_s: cpu, cells } =
         family.run_variants(variants, ctx, tables)?;
     ctx.begin()?;
@@ -318,7 +322,7 @@ fn run_spec_locked(variants: &[Spec], ctx: &RunContext) -> Result<PathBuf> {
     };
     if let Some(section) = section {
         let rerun = ctx.rerun.clone().unwrap_or_else(|| run_command(spec, &manifest, &ctx.out));
-        let mut report = report_md(spec, &manifest, &rerun, &[section]);
+        let mut report = report_md(first, &manifest, &rerun, &[section]);
         if !ctx.extras {
             report.push_str(NO_PICTURES);
         }
@@ -358,7 +362,13 @@ pub fn run_command(spec: &Spec, m: &Manifest, out: &Path) -> String {
 
 /// REPORT.md: a header naming the run and the command that makes it again (`rerun`), then the
 /// chapters' sections.
-pub fn report_md(spec: &Spec, m: &Manifest, rerun: &str, sections: &[String]) -> String {
+pub fn report_md<F: Families>(
+    loaded: &Loaded<F>,
+    m: &Manifest,
+    rerun: &str,
+    sections: &[String],
+) -> String {
+    let spec = &loaded.spec;
     let mut s = String::new();
     let _ = writeln!(s, "# somnurbs report: {}\n", spec.file.name);
     if !spec.file.description.is_empty() {
@@ -391,7 +401,7 @@ pub fn report_md(spec: &Spec, m: &Manifest, rerun: &str, sections: &[String]) ->
         rerun
     );
     s.push_str(&profile_note(spec));
-    if !limits::dataset_entries(spec).is_empty() {
+    if !limits::dataset_entries(loaded).is_empty() {
         let _ = writeln!(s, "Data sets are {} (`normalise`); a data set given as a relative path is read from the spec's folder.\n", spec.file.normalise.describe());
     }
     for sec in sections {
@@ -428,7 +438,7 @@ pub const NOT_EVIDENCE: &str = "> **Not evidence.** This is a reduced run (fewer
 /// the spec's, and their cell logs together hold exactly the spec's cells; the logs are joined and
 /// the spec is run in `out` (locked, and empty) with every cell restored from the log, so the
 /// tables equal a one-machine run's.
-pub fn merge(shards: &[PathBuf], ctx: &RunContext) -> Result<PathBuf> {
+pub fn merge<F: Families>(shards: &[PathBuf], ctx: &RunContext) -> Result<PathBuf> {
     if shards.is_empty() {
         anyhow::bail!("merge: no shard folders given");
     }
@@ -493,7 +503,7 @@ pub fn merge(shards: &[PathBuf], ctx: &RunContext) -> Result<PathBuf> {
         anyhow::bail!("merge: shard {missing}/{count} is missing");
     }
     let fp = first.expect("at least one shard");
-    let variants = fp
+    let variants: Vec<Loaded<F>> = fp
         .overrides()
         .variants(
             &fp.spec_path,

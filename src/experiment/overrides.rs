@@ -2,7 +2,8 @@
 //! KEY=V1,V2,...` and a reading set's dotted keys, each applied to the spec's TOML table after
 //! its profile and validated exactly as the file's own value.
 
-use super::spec::{Spec, SpecError};
+use super::family::Families;
+use super::spec::{Loaded, SpecError};
 use std::fmt;
 
 /// The command line's changes to a spec, as written: `--set KEY=VALUE` (one value) and
@@ -111,13 +112,13 @@ impl CliOverrides {
     /// is parsed and validated exactly as if its values were written in the file; an unknown key,
     /// a bad value, a key given twice or a swept value given twice is a one-line error naming
     /// the key.
-    pub fn variants(
+    pub fn variants<F: Families>(
         &self,
         path: &str,
         text: &str,
         profile: Option<&str>,
-    ) -> Result<Vec<Spec>, SpecError> {
-        let base = Spec::parse(path, text, profile)?;
+    ) -> Result<Vec<Loaded<F>>, SpecError> {
+        let base = Loaded::<F>::parse(path, text, profile)?;
         if self.is_empty() {
             return Ok(vec![base]);
         }
@@ -133,11 +134,8 @@ impl CliOverrides {
             }
             seen.push(key.to_string());
             // The sections that take --set/--sweep, as the families declare them.
-            let takers: Vec<_> = super::family::registry()
-                .families
-                .iter()
-                .filter_map(|f| f.overrides().map(|o| (*f, o)))
-                .collect();
+            let takers: Vec<_> =
+                F::all().iter().filter_map(|f| f.overrides().map(|o| (*f, o))).collect();
             let list = takers
                 .iter()
                 .map(|(f, _)| format!("[{0}] section ({0}.KEY)", f.section()))
@@ -149,7 +147,7 @@ impl CliOverrides {
                     "{flag} {key}: only keys of the {list} can be set or swept"
                 )));
             };
-            if !family.present(&base) {
+            if family.section() != base.family().section() {
                 return Err(SpecError(format!(
                     "{flag} {key}: {path} has no [{section}] section (--set and --sweep work on \
                      specs with one)"
@@ -197,7 +195,7 @@ impl CliOverrides {
                     .chain(&swept)
                     .map(|(k, v)| Override { key: k.clone(), value: cli_value(v) })
                     .collect();
-                let mut spec = Spec::parse_with(path, text, profile, &overrides)?;
+                let mut spec = Loaded::<F>::parse_with(path, text, profile, &overrides)?;
                 cells = cells.saturating_add(super::limits::cell_count(&spec));
                 if cells > super::limits::MAX_CELLS {
                     return Err(SpecError(format!(
@@ -207,11 +205,11 @@ impl CliOverrides {
                         super::limits::MAX_CELLS
                     )));
                 }
-                spec.cli = self.clone();
+                spec.spec.cli = self.clone();
                 let pairs = |l: &[(String, String)]| {
                     l.iter().map(|(k, v)| format!("{k}={v}")).collect::<Vec<_>>()
                 };
-                spec.variant = Variant { set: pairs(&set), swept: pairs(&swept) };
+                spec.spec.variant = Variant { set: pairs(&set), swept: pairs(&swept) };
                 Ok(spec)
             })
             .collect()

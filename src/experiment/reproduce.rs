@@ -6,8 +6,8 @@
 //!
 //! [`Family::combine`]: super::family::Family::combine
 
-use super::family::{Combined, PlanView, ReadingRun};
-use super::spec::{Override, Spec};
+use super::family::{Combined, Families, PlanView, ReadingRun};
+use super::spec::{Loaded, Override, Spec};
 use super::{run_spec, Claimed, RunContext};
 use crate::io::outdir::PLAN_FILE;
 use crate::io::{csv_records, write_atomic};
@@ -127,14 +127,17 @@ fn twice(list: &[String]) -> Option<&String> {
 /// The loaded specs of a plan, before anything runs: no two with one `name` (they would share an
 /// output folder), and at most [`MAX_PLAN_CELLS`](super::limits::MAX_PLAN_CELLS) cells in all,
 /// the reading sets' runs included.
-fn check_specs(
+fn check_specs<F: Families>(
     plan_path: &Path,
-    specs: &[Spec],
-    readings: &[(&ReadingSet, Vec<Spec>)],
+    specs: &[Loaded<F>],
+    readings: &[(&ReadingSet, Vec<Loaded<F>>)],
 ) -> Result<()> {
     for list in std::iter::once(specs).chain(readings.iter().map(|(_, r)| r.as_slice())) {
         for (k, spec) in list.iter().enumerate() {
-            if let Some(other) = list[..k].iter().find(|o| o.file.name == spec.file.name) {
+            let spec = &spec.spec;
+            if let Some(other) =
+                list[..k].iter().map(|o| &o.spec).find(|o| o.file.name == spec.file.name)
+            {
                 anyhow::bail!(
                     "{}: {} and {} have the same name `{}` (they would write one folder)",
                     plan_path.display(),
@@ -160,14 +163,14 @@ fn check_specs(
 /// Load every spec of the plan (all before any runs, so a bad one stops nothing half-way), with
 /// the maps of the later ones pointed at `<out>/<maps_from>/maps`; `names` and `overrides` select
 /// a reading set's specs and apply its keys.
-fn load_specs(
+fn load_specs<F: Families>(
     dir: &Path,
     plan: &Plan,
     names: &[String],
     overrides: &[Override],
     profile: Option<&str>,
     out: &Path,
-) -> Result<Vec<Spec>> {
+) -> Result<Vec<Loaded<F>>> {
     // Absolute: a relative `maps` would resolve against the spec's folder, this one is the run's.
     let maps = plan.maps_from.as_ref().map(|m| {
         let dir = out.join(m).join("maps");
@@ -179,16 +182,15 @@ fn load_specs(
             let path = dir.join(format!("{name}.toml"));
             let shown = path.display().to_string();
             let text = super::spec::read_spec(&path)?;
-            let mut spec = Spec::parse_with(
+            let mut spec = Loaded::<F>::parse_with(
                 &shown,
                 &text,
                 profile.filter(|p| has_profile(&path, p)),
                 overrides,
             )?;
             if let Some(maps) = &maps {
-                for family in super::family::present(&spec) {
-                    family.use_maps(&mut spec, maps);
-                }
+                let family = spec.family();
+                family.use_maps(&mut spec.section, maps);
             }
             Ok(spec)
         })
@@ -257,7 +259,7 @@ fn reproduce_command(specs_dir: &Path, plan: &str, profile: &str, out: &Path) ->
 }
 
 /// Run the plan into `ctx.out` and write the combined REPORT.md; returns its path.
-pub fn reproduce(
+pub fn reproduce<F: Families>(
     specs_dir: &Path,
     plan_name: &str,
     profile: &str,
@@ -275,7 +277,8 @@ pub fn reproduce(
     let ctx = &RunContext { rerun: Some(rerun.clone()), ..ctx.clone() };
     let profile = if profile == "full" { None } else { Some(profile) };
     let specs = load_specs(specs_dir, &plan, &plan.specs, &[], profile, &ctx.out)?;
-    let reading_specs: Vec<(&ReadingSet, Vec<Spec>)> = plan
+    let specs: Vec<Loaded<F>> = specs;
+    let reading_specs: Vec<(&ReadingSet, Vec<Loaded<F>>)> = plan
         .readings
         .iter()
         .map(|r| {
@@ -286,16 +289,17 @@ pub fn reproduce(
     // Every data set of every spec loads before the folder changes (a bad --data-dir changes nothing).
     for spec in &specs {
         for d in super::limits::dataset_entries(spec) {
+            let spec = &spec.spec;
             ctx.loader(spec).load(d).with_context(|| format!("{}: data set `{d}`", spec.path))?;
         }
     }
     let _lock = crate::io::outdir::lock(&ctx.out, &format!("reproduce --plan {plan_name}"))?;
     let record = PlanRecord::new(plan_name, &plan_path, profile.unwrap_or("full"))?;
     let layout = PlanLayout {
-        specs: specs.iter().map(|s| s.file.name.clone()).collect(),
+        specs: specs.iter().map(|s| s.spec.file.name.clone()).collect(),
         readings: reading_specs
             .iter()
-            .map(|(r, rs)| (r.name.clone(), rs.iter().map(|s| s.file.name.clone()).collect()))
+            .map(|(r, rs)| (r.name.clone(), rs.iter().map(|s| s.spec.file.name.clone()).collect()))
             .collect(),
     };
     if claim_plan(&ctx.out, &layout, &record, ctx.resume)? == Claimed::Finished {
@@ -319,19 +323,20 @@ pub fn reproduce(
     let started = Instant::now();
     let mut done = Vec::new();
     for spec in &specs {
-        let sub = RunContext { out: ctx.out.join(&spec.file.name), ..ctx.clone() };
-        eprintln!("somnurbs: reproduce: {} -> {}", spec.file.name, sub.out.display());
+        let name = &spec.spec.file.name;
+        let sub = RunContext { out: ctx.out.join(name), ..ctx.clone() };
+        eprintln!("somnurbs: reproduce: {name} -> {}", sub.out.display());
         let t = Instant::now();
         run_spec(spec, &sub)?;
-        done.push((spec.file.name.clone(), t.elapsed().as_secs_f64()));
+        done.push((name.clone(), t.elapsed().as_secs_f64()));
     }
     for (reading, rspecs) in &reading_specs {
         for spec in rspecs {
-            let folder = Path::new(READINGS_DIR).join(&reading.name).join(&spec.file.name);
+            let folder = Path::new(READINGS_DIR).join(&reading.name).join(&spec.spec.file.name);
             let sub = RunContext { out: ctx.out.join(&folder), extras: false, ..ctx.clone() };
             eprintln!(
                 "somnurbs: reproduce: {} under the readings `{}` -> {}",
-                spec.file.name,
+                spec.spec.file.name,
                 reading.name,
                 sub.out.display()
             );
@@ -346,7 +351,7 @@ pub fn reproduce(
         &plan,
         plan_name,
         &rerun,
-        &specs,
+        &specs.iter().map(|s| &s.spec).collect::<Vec<_>>(),
         &done,
         &combined,
         profile.unwrap_or("full"),
@@ -359,7 +364,7 @@ pub fn reproduce(
             report.extend(part.readings.iter().map(String::as_str));
         }
     }
-    report.push_str(&readings_score(&ctx.out, &plan)?);
+    report.push_str(&readings_score::<F>(&ctx.out, &plan)?);
     let path = ctx.out.join("REPORT.md");
     write_atomic(&path, report.as_bytes())?;
     crate::report::html::write(&ctx.out)?;
@@ -489,7 +494,7 @@ fn require_plan_folders(out: &Path, layout: &PlanLayout) -> Result<()> {
 }
 
 /// Each family's part of the combined report, from its specs' finished folders.
-fn combine(out: &Path, plan: &Plan, specs: &[Spec]) -> Result<Vec<Combined>> {
+fn combine<F: Families>(out: &Path, plan: &Plan, specs: &[Loaded<F>]) -> Result<Vec<Combined>> {
     let readings: Vec<ReadingRun> = plan
         .readings
         .iter()
@@ -499,13 +504,16 @@ fn combine(out: &Path, plan: &Plan, specs: &[Spec]) -> Result<Vec<Combined>> {
             root: out.join(READINGS_DIR).join(&r.name),
         })
         .collect();
-    super::family::registry()
-        .families
+    F::all()
         .iter()
         .map(|f| {
             let view = PlanView {
                 out,
-                specs: specs.iter().filter(|s| f.present(s)).collect(),
+                specs: specs
+                    .iter()
+                    .filter(|s| s.family().section() == f.section())
+                    .map(|s| (&s.spec, &s.section))
+                    .collect(),
                 reading: &plan.reading,
                 readings: readings.clone(),
             };
@@ -654,7 +662,7 @@ fn render_readings(out: &Path, plan: &Plan, rows: &[ReadingClaim]) -> Result<Str
 /// `readings_score.csv` and its REPORT.md section: per spec folder and reading, the published
 /// table cells whose ratio ours/published lies in the band and the claims that agree with the
 /// source's own count ([`crate::report::score`]); totals over the specs every reading ran.
-fn readings_score(out: &Path, plan: &Plan) -> Result<String> {
+fn readings_score<F: Families>(out: &Path, plan: &Plan) -> Result<String> {
     use crate::report::score::{folder_score, Score, BAND};
     let mut readings: Vec<(String, Vec<(String, PathBuf)>)> =
         vec![(plan.reading.clone(), plan.specs.iter().map(|s| (s.clone(), out.join(s))).collect())];
@@ -670,7 +678,7 @@ fn readings_score(out: &Path, plan: &Plan) -> Result<String> {
             if !folder.is_dir() {
                 continue;
             }
-            let sc = folder_score(folder)?;
+            let sc = folder_score(folder, &super::family::published::<F>)?;
             if sc.cells + sc.claims == 0 {
                 continue;
             }
@@ -756,7 +764,7 @@ fn combined_report(
     plan: &Plan,
     plan_name: &str,
     rerun: &str,
-    specs: &[Spec],
+    specs: &[&Spec],
     done: &[(String, f64)],
     combined: &[Combined],
     profile: &str,
@@ -774,7 +782,7 @@ fn combined_report(
         done.len(),
         wall
     );
-    if specs.iter().any(Spec::reduced) {
+    if specs.iter().any(|s| s.reduced()) {
         s.push_str(super::NOT_EVIDENCE);
     }
     s.push_str("| spec | folder | wall s |\n|---|---|---|\n");
@@ -914,8 +922,9 @@ mod tests {
             let path = dir.join(format!("{plan_name}.toml"));
             let plan = Plan::load(&path).unwrap();
             for profile in [None, Some("quick")] {
-                let specs = load_specs(&dir, &plan, &plan.specs, &[], profile, out).unwrap();
-                let readings: Vec<(&ReadingSet, Vec<Spec>)> = plan
+                let specs: Vec<Loaded<crate::families::Section>> =
+                    load_specs(&dir, &plan, &plan.specs, &[], profile, out).unwrap();
+                let readings: Vec<(&ReadingSet, Vec<_>)> = plan
                     .readings
                     .iter()
                     .map(|r| {
@@ -934,7 +943,8 @@ mod tests {
             }
         }
         let plan = Plan::load(&dir.join("thesis.toml")).unwrap();
-        let specs = load_specs(&dir, &plan, &plan.specs, &[], None, out).unwrap();
+        let specs: Vec<crate::families::Loaded> =
+            load_specs(&dir, &plan, &plan.specs, &[], None, out).unwrap();
         let twice = [specs[0].clone(), specs[1].clone(), specs[0].clone()];
         let e = check_specs(Path::new("p.toml"), &twice, &[]).unwrap_err().to_string();
         assert!(
@@ -943,9 +953,9 @@ mod tests {
         );
         // Eleven copies of a spec of 10^5 cells under distinct names: above 10^6.
         let text = "name = \"n\"\nmaster_seed = 1\n[som]\ndatasets = [\"cube\"]\niterations = 10\nrepeats = 10000\n[[som.group]]\nmodels = [\"som2d\"]\ngrids = [\"10x10\", \"11x11\", \"12x12\", \"13x13\", \"14x14\", \"15x15\", \"16x16\", \"17x17\", \"18x18\", \"19x19\"]\n";
-        let big: Vec<Spec> = (0..11)
+        let big: Vec<crate::families::Loaded> = (0..11)
             .map(|k| {
-                Spec::parse("n.toml", &text.replace("\"n\"", &format!("\"n{k}\"")), None).unwrap()
+                Loaded::parse("n.toml", &text.replace("\"n\"", &format!("\"n{k}\"")), None).unwrap()
             })
             .collect();
         assert_eq!(super::super::limits::cell_count(&big[0]), 100_000);

@@ -245,6 +245,37 @@ where
         .collect()
 }
 
+/// The run protocol every cell follows: `work` on the cell's own stream (from the master seed and
+/// the cell's key, [`super::seeds::cell_rng`]), timed in the thread's CPU seconds (the rows'
+/// `cpu_s`).
+pub fn on_stream<T>(
+    master_seed: u64,
+    key: &str,
+    work: impl FnOnce(&mut rand_chacha::ChaCha8Rng) -> T,
+) -> (T, f64) {
+    let mut rng = super::seeds::cell_rng(master_seed, key);
+    timed(|| work(&mut rng))
+}
+
+/// The same for a cell that draws no random number (a deterministic fit).
+pub fn timed<T>(work: impl FnOnce() -> T) -> (T, f64) {
+    let t0 = thread_cpu_seconds();
+    let out = work();
+    (out, thread_cpu_seconds() - t0)
+}
+
+/// One optimiser run of a cell through [`on_stream`]; an error names the cell.
+pub fn optimise(
+    opt: &dyn crate::optim::Optimiser,
+    problem: &dyn crate::optim::Problem,
+    budget: &crate::optim::Budget,
+    master_seed: u64,
+    key: &str,
+) -> Result<(crate::optim::RunResult, f64)> {
+    let (r, cpu_s) = on_stream(master_seed, key, |rng| opt.run(problem, budget, rng));
+    Ok((r.with_context(|| key.to_string())?, cpu_s))
+}
+
 /// CPU seconds used by the calling thread so far (CLOCK_THREAD_CPUTIME_ID).
 pub fn thread_cpu_seconds() -> f64 {
     let mut ts = libc::timespec { tv_sec: 0, tv_nsec: 0 };

@@ -4,6 +4,7 @@
 //! is read, so a profile can change any key (e.g. `som.iterations = 3000`) and nothing else.
 //! Errors are one line and name the file, the line and column, and the key at fault.
 
+use super::family::{Families, Family, Holds};
 pub use super::grid_size::GridSize;
 use super::overrides::apply_override;
 pub use super::overrides::{CliOverrides, Override, Variant};
@@ -25,14 +26,25 @@ impl std::error::Error for SpecError {}
 /// Declares the experiment families, once (invoked in `families/mod.rs`, the only list of
 /// families): each family's module (the first part of its section's path: `som::spec::SomSpec`
 /// is in folder `som/`), where each section type sits in the spec file
-/// ([`Placed`](super::family::Placed)), and the [`Registry`](super::family::Registry) the engine
-/// reaches the families through once `install()` has handed it over: the families in the order
-/// their sections are named in messages, and the parser of the whole file (the header plus one
+/// ([`Placed`](super::family::Placed)), and `Section`, the enum of the families' sections (one
+/// variant per family, named after its [`Experiment`](super::family::Experiment) type) that the
+/// engine is generic over ([`Families`](super::family::Families)): the families in the order
+/// their sections are named in messages, the parser of the whole file (the header plus one
 /// optional section per family, `deny_unknown_fields`, so serde names the file, line and column
-/// of a bad key). A family is one folder plus one line here.
+/// of a bad key), and each family's typed view of the enum ([`Holds`](super::family::Holds)).
+/// A family is one folder plus one line here.
 macro_rules! families {
-    ($($(#[$doc:meta])* $field:ident: $module:ident :: $($section:ident)::+ => $($family:ident)::+),* $(,)?) => {
+    ($($(#[$doc:meta])* $field:ident: $module:ident :: $($section:ident)::+ => $fmod:ident :: $family:ident),* $(,)?) => {
         $(pub mod $module;)*
+
+        /// The section of a spec: one variant per family, holding its checked section type.
+        #[derive(Debug, Clone)]
+        pub enum Section {
+            $($(#[$doc])* $family($module::$($section)::+),)*
+        }
+
+        /// A spec as the engine holds it, with the families of this harness.
+        pub type Loaded = $crate::experiment::spec::Loaded<Section>;
 
         /// The whole spec file as written: the header and one optional section per family.
         #[derive(serde::Deserialize)]
@@ -51,45 +63,56 @@ macro_rules! families {
             profiles: std::collections::BTreeMap<String, toml::Table>,
         }
 
-        /// Parse a spec file's text: the header, and each section the file has.
-        fn parse(text: &str) -> Result<$crate::experiment::spec::SpecFile, toml::de::Error> {
-            let w: Whole = toml::from_str(text)?;
-            let mut sections = $crate::experiment::family::Sections::default();
-            $(if let Some(s) = w.$field {
-                sections.insert(stringify!($field), Box::new(s));
-            })*
-            Ok($crate::experiment::spec::SpecFile {
-                name: w.name,
-                description: w.description,
-                master_seed: w.master_seed,
-                output: w.output,
-                normalise: w.normalise,
-                profiles: w.profiles,
-                sections,
-            })
+        impl $crate::experiment::family::Families for Section {
+            fn all() -> &'static [&'static dyn $crate::experiment::family::Family<Section>] {
+                &[$(&$fmod::$family),*]
+            }
+
+            fn parse(
+                text: &str,
+            ) -> Result<($crate::experiment::spec::SpecFile, Vec<Section>), toml::de::Error> {
+                let w: Whole = toml::from_str(text)?;
+                let mut sections = Vec::new();
+                $(if let Some(s) = w.$field {
+                    sections.push(Section::$family(s));
+                })*
+                let file = $crate::experiment::spec::SpecFile {
+                    name: w.name,
+                    description: w.description,
+                    master_seed: w.master_seed,
+                    output: w.output,
+                    normalise: w.normalise,
+                    profiles: w.profiles,
+                };
+                Ok((file, sections))
+            }
+
+            fn family(&self) -> &'static dyn $crate::experiment::family::Family<Section> {
+                match self {
+                    $(Section::$family(_) => &$fmod::$family,)*
+                }
+            }
         }
 
-        /// The registry of every family the harness knows.
-        pub static REGISTRY: $crate::experiment::family::Registry =
-            $crate::experiment::family::Registry {
-                families: &[$(&$($family)::+),*],
-                parse,
-            };
-
-        /// Hand the families to the engine (once per process, before any spec is read).
-        pub fn install() {
-            $crate::experiment::family::install(&REGISTRY);
+        $(impl $crate::experiment::family::Holds<$module::$($section)::+> for Section {
+            fn get(&self) -> Option<&$module::$($section)::+> {
+                #[allow(irrefutable_let_patterns)]
+                if let Section::$family(s) = self { Some(s) } else { None }
+            }
+            fn get_mut(&mut self) -> Option<&mut $module::$($section)::+> {
+                #[allow(irrefutable_let_patterns)]
+                if let Section::$family(s) = self { Some(s) } else { None }
+            }
         }
 
-        $(impl $crate::experiment::family::Placed for $module::$($section)::+ {
+        impl $crate::experiment::family::Placed for $module::$($section)::+ {
             const NAME: &'static str = stringify!($field);
         })*
     };
 }
 pub(crate) use families;
 
-/// A spec file as read: the header every spec has, and the family sections it holds (one, once
-/// validated; reached through [`Spec::section`]).
+/// A spec file's header, as read (the family section beside it is in [`Loaded`]).
 #[derive(Debug, Clone)]
 pub struct SpecFile {
     /// Experiment name; the default output folder is `results/<name>`.
@@ -103,16 +126,10 @@ pub struct SpecFile {
     pub normalise: crate::data::Normalise,
     /// Named overrides, merged over the spec by `--profile NAME`.
     pub profiles: std::collections::BTreeMap<String, toml::Table>,
-    /// The family sections the file has.
-    pub sections: super::family::Sections,
 }
 
-/// The spec text parsed by the installed families' parser.
-fn parse_file(text: &str) -> Result<SpecFile, toml::de::Error> {
-    (super::family::registry().parse)(text)
-}
-
-/// A spec read from a file, with the profile applied.
+/// A spec read from a file, with the profile applied: what every family's method is given beside
+/// its own section (the engine holds both in a [`Loaded`]).
 #[derive(Debug, Clone)]
 pub struct Spec {
     pub file: SpecFile,
@@ -150,16 +167,27 @@ fn merge(base: &mut toml::Table, over: &toml::Table) {
     }
 }
 
-impl Spec {
-    /// This spec's section of type `S` (a family's), if it has one.
-    pub fn section<S: super::family::Placed>(&self) -> Option<&S> {
-        S::of(&self.file)
+/// A spec as the engine holds it: the spec (header, text, profile, variant) and its one family
+/// section, parsed into its own type and checked once, by [`Loaded::parse`] and its kin. `F` is
+/// the enum of the harness' families' sections (`families::Section`).
+#[derive(Debug, Clone)]
+pub struct Loaded<F> {
+    pub spec: Spec,
+    pub section: F,
+}
+
+impl<F: Families> Loaded<F> {
+    /// The family of the spec's section.
+    pub fn family(&self) -> &'static dyn Family<F> {
+        self.section.family()
     }
 
-    /// The same, or an error naming the missing section.
-    pub fn require<S: super::family::Placed>(&self) -> anyhow::Result<&S> {
-        use anyhow::Context;
-        self.section().with_context(|| format!("spec has no [{}] section", S::NAME))
+    /// The section of type `S` (a family's), if the spec's section is one.
+    pub fn section<S>(&self) -> Option<&S>
+    where
+        F: Holds<S>,
+    {
+        self.section.get()
     }
 
     /// Parse spec text with a reading set's overrides applied after the profile (each validated
@@ -169,36 +197,35 @@ impl Spec {
         text: &str,
         profile: Option<&str>,
         overrides: &[Override],
-    ) -> Result<Spec, SpecError> {
-        let mut spec = Spec::parse(path, text, profile)?;
+    ) -> Result<Loaded<F>, SpecError> {
+        let spec = Loaded::parse(path, text, profile)?;
         if overrides.is_empty() {
             return Ok(spec);
         }
         let mut table: toml::Table =
             toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
-        if let Some(over) = profile.and_then(|p| spec.file.profiles.get(p)) {
+        if let Some(over) = profile.and_then(|p| spec.spec.file.profiles.get(p)) {
             merge(&mut table, &over.clone());
         }
         for o in overrides {
             apply_override(&mut table, o).map_err(|e| SpecError(format!("{path}: {e}")))?;
         }
         let merged = toml::to_string(&table).map_err(|e| SpecError(format!("{path}: {e}")))?;
-        spec.file = parse_file(&merged).map_err(|e| {
+        let (file, sections) = F::parse(&merged).map_err(|e| {
             SpecError(format!(
                 "{path}: with {}: {}",
                 overrides.iter().map(|o| o.to_string()).collect::<Vec<_>>().join(", "),
                 e.message().replace('\n', " ")
             ))
         })?;
-        spec.validate()?;
-        Ok(spec)
+        Loaded::checked(Spec { file, ..spec.spec }, sections)
     }
 
     /// Parse spec text; `path` is used in messages only.
-    pub fn parse(path: &str, text: &str, profile: Option<&str>) -> Result<Spec, SpecError> {
-        let file = parse_file(text).map_err(|e| toml_error(path, text, &e))?;
-        let file = match profile {
-            None => file,
+    pub fn parse(path: &str, text: &str, profile: Option<&str>) -> Result<Loaded<F>, SpecError> {
+        let (file, sections) = F::parse(text).map_err(|e| toml_error(path, text, &e))?;
+        let (file, sections) = match profile {
+            None => (file, sections),
             Some(name) => {
                 let over = file.profiles.get(name).ok_or_else(|| {
                     let known: Vec<&str> = file.profiles.keys().map(|s| s.as_str()).collect();
@@ -212,7 +239,7 @@ impl Spec {
                 merge(&mut table, over);
                 let merged =
                     toml::to_string(&table).map_err(|e| SpecError(format!("{path}: {e}")))?;
-                parse_file(&merged).map_err(|e| {
+                F::parse(&merged).map_err(|e| {
                     SpecError(format!(
                         "{path}: [profiles.{name}]: {}",
                         e.message().replace('\n', " ")
@@ -228,10 +255,66 @@ impl Spec {
             cli: CliOverrides::default(),
             variant: Variant::default(),
         };
-        spec.validate()?;
-        Ok(spec)
+        Loaded::checked(spec, sections)
     }
 
+    /// Read and parse a spec file.
+    pub fn load(path: &Path, profile: Option<&str>) -> Result<Loaded<F>, SpecError> {
+        let shown = path.display().to_string();
+        let text = read_spec(path)?;
+        Loaded::parse(&shown, &text, profile)
+    }
+
+    /// Read a spec file and make its variants ([`CliOverrides::variants`]).
+    pub fn load_variants(
+        path: &Path,
+        profile: Option<&str>,
+        cli: &CliOverrides,
+    ) -> Result<Vec<Loaded<F>>, SpecError> {
+        let shown = path.display().to_string();
+        let text = read_spec(path)?;
+        cli.variants(&shown, &text, profile)
+    }
+
+    /// Checks every value once, so that a run never starts on a spec it would fail on later: the
+    /// name, the spec's one family section, its bounds (before anything is allocated from a
+    /// size) and then every value.
+    fn checked(spec: Spec, sections: Vec<F>) -> Result<Loaded<F>, SpecError> {
+        let f = &spec.file;
+        if f.name.trim().is_empty() || f.name.contains(['/', '\\']) {
+            return Err(spec.err("name", "must be a non-empty name without slashes"));
+        }
+        if sections.len() != 1 {
+            return Err(section_count_error(&spec, &sections));
+        }
+        let Some(section) = sections.into_iter().next() else {
+            return Err(section_count_error::<F>(&spec, &[]));
+        };
+        super::limits::check(&spec, &section)?;
+        section.family().validate(&spec, &section)?;
+        Ok(Loaded { spec, section })
+    }
+}
+
+/// The error for a spec with no family section, or more than one.
+fn section_count_error<F: Families>(spec: &Spec, sections: &[F]) -> SpecError {
+    if sections.is_empty() {
+        return SpecError(format!(
+            "{}: the spec has no experiment section (add one of {})",
+            spec.path,
+            super::family::section_list::<F>()
+        ));
+    }
+    let names: Vec<String> =
+        sections.iter().map(|s| format!("[{}]", s.family().section())).collect();
+    SpecError(format!(
+        "{}: one experiment section per spec, this one has {} (they write the same files: split the spec)",
+        spec.path,
+        names.join(" and ")
+    ))
+}
+
+impl Spec {
     /// What the profile changes from the spec as written: each leaf key it sets, its value,
     /// and whether that reduces the run (a smaller number, or a shorter list, than the spec's).
     pub fn profile_changes(&self) -> Vec<ProfileChange> {
@@ -249,54 +332,9 @@ impl Spec {
         self.profile_changes().iter().any(|c| c.reduces)
     }
 
-    /// Read and parse a spec file.
-    pub fn load(path: &Path, profile: Option<&str>) -> Result<Spec, SpecError> {
-        let shown = path.display().to_string();
-        let text = read_spec(path)?;
-        Spec::parse(&shown, &text, profile)
-    }
-
-    /// Read a spec file and make its variants ([`CliOverrides::variants`]).
-    pub fn load_variants(
-        path: &Path,
-        profile: Option<&str>,
-        cli: &CliOverrides,
-    ) -> Result<Vec<Spec>, SpecError> {
-        let shown = path.display().to_string();
-        let text = read_spec(path)?;
-        cli.variants(&shown, &text, profile)
-    }
-
     /// An error naming the spec file and the key at fault.
     pub(crate) fn err(&self, key: &str, msg: impl fmt::Display) -> SpecError {
         SpecError(format!("{}: {key}: {msg}", self.path))
-    }
-
-    /// Checks every value once, so that a run never starts on a spec it would fail on later.
-    pub fn validate(&self) -> Result<(), SpecError> {
-        let f = &self.file;
-        if f.name.trim().is_empty() || f.name.contains(['/', '\\']) {
-            return Err(self.err("name", "must be a non-empty name without slashes"));
-        }
-        // Bounds, duplicates and names first: later checks allocate from sizes.
-        super::limits::check(self)?;
-        let families = super::family::present(self);
-        match families.len() {
-            0 => {
-                return Err(SpecError(format!(
-                    "{}: the spec has no experiment section (add one of {})",
-                    self.path,
-                    super::family::section_list()
-                )))
-            }
-            1 => {}
-            _ => {
-                let names: Vec<String> =
-                    families.iter().map(|f| format!("[{}]", f.section())).collect();
-                return Err(SpecError(format!("{}: one experiment section per spec, this one has {} (they write the same files: split the spec)", self.path, names.join(" and "))));
-            }
-        }
-        families[0].validate(self)
     }
 
     /// The checks every optimisation section shares: its optimiser names (from those `offered`),
@@ -335,6 +373,7 @@ impl Spec {
         if generations == 0 {
             return Err(self.err(&key("generations"), "must be at least 1"));
         }
+        self.validate_optimiser_params(section, offered)?;
         for name in optimisers {
             let Some(opt) = crate::optim::pick(offered, name) else { continue };
             let need = opt.min_population();
@@ -363,14 +402,15 @@ impl Spec {
         Ok(())
     }
 
-    /// The optimisers' own parameter checks, their keys placed under `section`.
-    pub(crate) fn validate_optimiser_params<const N: usize>(
+    /// The parameter tables of the optimisers a section offers ([`crate::optim::Optimiser::validate`]),
+    /// their keys placed under `section`.
+    pub(crate) fn validate_optimiser_params(
         &self,
         section: &str,
-        checks: [Result<(), crate::optim::OptimError>; N],
+        offered: &[&dyn crate::optim::Optimiser],
     ) -> Result<(), SpecError> {
-        for check in checks {
-            check.map_err(|e| match e {
+        for opt in offered {
+            opt.validate().map_err(|e| match e {
                 crate::optim::OptimError::InvalidParameter { key, message } => {
                     self.err(&format!("{section}.{key}"), message)
                 }

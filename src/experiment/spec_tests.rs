@@ -2,6 +2,9 @@
 
 use super::*;
 
+/// The crate's own families.
+type L = crate::families::Loaded;
+
 const SPEC: &str = r#"
 name = "t"
 master_seed = 1
@@ -17,30 +20,33 @@ iterations = 7
 
 #[test]
 fn parses_expands_and_applies_profile() {
-    let s = Spec::parse("t.toml", SPEC, None).unwrap();
-    assert_eq!(crate::families::som::spec::cells(&s).len(), 4);
+    let s = L::parse("t.toml", SPEC, None).unwrap();
+    assert_eq!(crate::families::som::spec::cells(s.section().unwrap()).len(), 4);
     assert_eq!(s.section::<crate::families::som::spec::SomSpec>().unwrap().iterations, 100);
-    let q = Spec::parse("t.toml", SPEC, Some("quick")).unwrap();
+    let q = L::parse("t.toml", SPEC, Some("quick")).unwrap();
     assert_eq!(q.section::<crate::families::som::spec::SomSpec>().unwrap().iterations, 7);
-    assert_eq!(crate::families::som::spec::cells(&q)[3].key(), "som/cube/dnsom/18x30/r0");
+    assert_eq!(
+        crate::families::som::spec::cells(q.section().unwrap())[3].key(),
+        "som/cube/dnsom/18x30/r0"
+    );
 }
 
 /// A profile's changes are listed, and one that lowers a number or shortens a list reduces the
 /// run (the reports' "not evidence" caveat); raising one does not.
 #[test]
 fn profile_changes_say_whether_the_run_is_reduced() {
-    let q = Spec::parse("t.toml", SPEC, Some("quick")).unwrap();
+    let q = L::parse("t.toml", SPEC, Some("quick")).unwrap();
     assert_eq!(
-        q.profile_changes(),
+        q.spec.profile_changes(),
         vec![ProfileChange { key: "som.iterations".into(), value: "7".into(), reduces: true }]
     );
-    assert!(q.reduced() && !Spec::parse("t.toml", SPEC, None).unwrap().reduced());
+    assert!(q.spec.reduced() && !L::parse("t.toml", SPEC, None).unwrap().spec.reduced());
     let more = SPEC.replace("iterations = 7", "iterations = 700");
-    let m = Spec::parse("t.toml", &more, Some("quick")).unwrap();
-    assert!(!m.reduced(), "{:?}", m.profile_changes());
+    let m = L::parse("t.toml", &more, Some("quick")).unwrap();
+    assert!(!m.spec.reduced(), "{:?}", m.spec.profile_changes());
     // A shorter list reduces too.
     let text = "name = \"f\"\nmaster_seed = 1\n[fit]\ndatasets = [\"cube\", \"sphere\"]\ngrid = \"20x20\"\ncontrol_nets = [\"6x6\"]\nparameterisations = [\"uniform\"]\napproaches = [\"A\"]\n[profiles.quick.fit]\ndatasets = [\"cube\"]\n";
-    assert!(Spec::parse("f.toml", text, Some("quick")).unwrap().reduced());
+    assert!(L::parse("f.toml", text, Some("quick")).unwrap().spec.reduced());
 }
 
 /// A reading set's keys go through the same parsing and validation as the file's own values;
@@ -49,7 +55,7 @@ fn profile_changes_say_whether_the_run_is_reduced() {
 fn overrides_apply_after_the_profile_and_are_validated() {
     let text = "name = \"f\"\nmaster_seed = 1\n[fit]\ndatasets = [\"cube\"]\ngrid = \"20x20\"\ncontrol_nets = [\"6x6\"]\nparameterisations = [\"uniform\"]\napproaches = [\"A\"]\n[profiles.quick.fit]\nfairness = 0.5\n";
     let ov = |k: &str, v: toml::Value| Override { key: k.into(), value: v };
-    let plain = Spec::parse("f.toml", text, Some("quick")).unwrap();
+    let plain = L::parse("f.toml", text, Some("quick")).unwrap();
     let fit = plain.section::<crate::families::fit::spec::FitSpec>().unwrap();
     assert_eq!(
         (fit.knots, fit.error_a, fit.fairness),
@@ -60,7 +66,7 @@ fn overrides_apply_after_the_profile_and_are_validated() {
         ov("fit.error_a", "nov_bottom".into()),
         ov("optim.knots", "nurbs_book".into()),
     ];
-    let s = Spec::parse_with("f.toml", text, Some("quick"), &set).unwrap();
+    let s = L::parse_with("f.toml", text, Some("quick"), &set).unwrap();
     let fit = s.section::<crate::families::fit::spec::FitSpec>().unwrap();
     assert_eq!(
         (fit.knots, fit.error_a, fit.fairness),
@@ -70,15 +76,15 @@ fn overrides_apply_after_the_profile_and_are_validated() {
         s.section::<crate::families::optimise::spec::OptimSpec>().is_none(),
         "a key of an absent section is skipped"
     );
-    let e = Spec::parse_with("f.toml", text, None, &[ov("fit.knots", "9.69".into())])
+    let e = L::parse_with("f.toml", text, None, &[ov("fit.knots", "9.69".into())])
         .unwrap_err()
         .to_string();
     assert!(e.contains("fit.knots") && e.contains("9.69"), "{e}");
-    let e = Spec::parse_with("f.toml", text, None, &[ov("fit.fairness", toml::Value::Float(-1.0))])
+    let e = L::parse_with("f.toml", text, None, &[ov("fit.fairness", toml::Value::Float(-1.0))])
         .unwrap_err()
         .to_string();
     assert!(e.contains("fit.fairness"), "{e}");
-    let e = Spec::parse_with("f.toml", text, None, &[ov("fit.colour", "red".into())])
+    let e = L::parse_with("f.toml", text, None, &[ov("fit.colour", "red".into())])
         .unwrap_err()
         .to_string();
     assert!(e.contains("colour"), "{e}");
@@ -87,20 +93,20 @@ fn overrides_apply_after_the_profile_and_are_validated() {
 #[test]
 fn exactly_one_experiment_section() {
     let none = "name = \"t\"\nmaster_seed = 1\n";
-    let e = Spec::parse("t.toml", none, None).unwrap_err().0;
+    let e = L::parse("t.toml", none, None).unwrap_err().0;
     assert!(
         e.contains("no experiment section") && e.contains("[som]") && e.contains("[seed002]"),
         "{e}"
     );
     let two = format!("{SPEC}\n[seed002]\nsurfaces = [\"surface1\"]\n");
-    let e = Spec::parse("t.toml", &two, None).unwrap_err().0;
+    let e = L::parse("t.toml", &two, None).unwrap_err().0;
     assert!(e.contains("[som] and [seed002]"), "{e}");
 }
 
 #[test]
 fn unknown_key_names_line_and_key() {
     let bad = SPEC.replace("iterations = 100", "iteratons = 100");
-    let e = Spec::parse("t.toml", &bad, None).unwrap_err().0;
+    let e = L::parse("t.toml", &bad, None).unwrap_err().0;
     assert!(e.starts_with("t.toml:6:1:") && e.contains("iteratons"), "{e}");
     assert!(!e.contains('\n'));
 }
@@ -108,16 +114,17 @@ fn unknown_key_names_line_and_key() {
 #[test]
 fn bad_values_name_their_key() {
     for (from, to, key) in [
-        ("\"som2d\", \"dnsom\"", "\"som2d\", \"kohonen\"", "som.group[0].models"),
+        // A name is read into its type with the file: the error gives the line and column.
+        ("\"som2d\", \"dnsom\"", "\"som2d\", \"kohonen\"", "t.toml:8:"),
         ("iterations = 100", "iterations = 0", "som.iterations"),
         ("\"10x10\", \"18x30\"", "\"2x2\"", "som.group[0].grids"),
         ("datasets = [\"cube\"]", "datasets = []", "som.datasets"),
     ] {
-        let e = Spec::parse("t.toml", &SPEC.replace(from, to), None).unwrap_err().0;
+        let e = L::parse("t.toml", &SPEC.replace(from, to), None).unwrap_err().0;
         assert!(e.contains(key), "{e}");
     }
-    let e = Spec::parse("t.toml", "name = \"x\"\nmaster_seed = -1\n", None).unwrap_err().0;
+    let e = L::parse("t.toml", "name = \"x\"\nmaster_seed = -1\n", None).unwrap_err().0;
     assert!(e.starts_with("t.toml:2:"), "{e}");
-    let e = Spec::parse("t.toml", SPEC, Some("full")).unwrap_err().0;
+    let e = L::parse("t.toml", SPEC, Some("full")).unwrap_err().0;
     assert!(e.contains("no profile `full`") && e.contains("quick"), "{e}");
 }

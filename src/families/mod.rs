@@ -1,4 +1,4 @@
-//! The experiment families, one folder each: `mod.rs` implements [`Family`] for the family's
+//! The experiment families, one folder each: `mod.rs` implements [`Experiment`] for the family's
 //! spec section, `report.rs` writes its tables, pictures and REPORT.md section. This file holds
 //! the only list of families (the macro declares their modules too): a new one is its folder plus
 //! one line here.
@@ -19,3 +19,6 @@ crate::experiment::spec::families! {
     /// Seed 004: closed B-spline surface of a cylinder by a binary-coded GA.
     seed004: closed_cylinder::spec::Seed004Spec => closed_cylinder::Seed004,
 }
+
+pub mod maps;
+pub mod suite;

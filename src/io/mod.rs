@@ -3,6 +3,7 @@
 //! so a reader never sees half a file and two writers never share a temporary file (the rest of
 //! the output-folder contract is in [`crate::io::outdir`]).
 
+pub mod map_file;
 pub mod outdir;
 
 use anyhow::{Context, Result};

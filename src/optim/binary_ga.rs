@@ -267,6 +267,9 @@ impl BinaryGa {
 }
 
 impl Optimiser for BinaryGa {
+    fn validate(&self) -> Result<(), OptimError> {
+        BinaryGa::validate(self)
+    }
     fn name(&self) -> &'static str {
         "binary_ga"
     }

@@ -131,6 +131,9 @@ impl Icsa {
 }
 
 impl Optimiser for Csa {
+    fn validate(&self) -> Result<(), OptimError> {
+        Csa::validate(self)
+    }
     fn name(&self) -> &'static str {
         "csa"
     }
@@ -151,6 +154,9 @@ impl Optimiser for Csa {
 }
 
 impl Optimiser for Icsa {
+    fn validate(&self) -> Result<(), OptimError> {
+        Icsa::validate(self)
+    }
     fn name(&self) -> &'static str {
         "icsa"
     }

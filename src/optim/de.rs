@@ -68,6 +68,9 @@ fn three_others(i: usize, n: usize, rng: &mut ChaCha8Rng) -> (usize, usize, usiz
 }
 
 impl Optimiser for De {
+    fn validate(&self) -> Result<(), OptimError> {
+        De::validate(self)
+    }
     fn name(&self) -> &'static str {
         "de"
     }

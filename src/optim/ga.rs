@@ -85,6 +85,9 @@ impl Ga {
 const MAX_TOURNAMENT: usize = 16;
 
 impl Optimiser for Ga {
+    fn validate(&self) -> Result<(), OptimError> {
+        Ga::validate(self)
+    }
     fn name(&self) -> &'static str {
         "ga"
     }

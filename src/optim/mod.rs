@@ -55,20 +55,33 @@ pub(crate) fn check_range(key: &str, value: f64, lo: f64, hi: f64) -> Result<(),
     }
 }
 
-/// Every optimiser the harness knows, with its default parameters (thesis Table 6.1, seed 003):
-/// a new optimiser is its own file implementing [`Optimiser`] plus one line here (and a parameter
-/// table in each spec section that offers it, listed by the section's `offered`).
-pub static REGISTRY: &[fn() -> Box<dyn Optimiser>] = &[
-    || Box::new(Ga::default()),
-    || Box::new(De::default()),
-    || Box::new(Pso::default()),
-    || Box::new(Csa::default()),
-    || Box::new(Icsa::default()),
+/// One optimiser the harness knows: how to make it with its default parameters (thesis Table
+/// 6.1, seed 003, seed 004) and its colour in every chart (Okabe-Ito, as RGB).
+pub struct Registered {
+    pub make: fn() -> Box<dyn Optimiser>,
+    pub colour: [u8; 3],
+}
+
+/// Every optimiser the harness knows: a new one is its own file implementing [`Optimiser`] (its
+/// parameter table is checked by [`Optimiser::validate`]) plus one line here, and a parameter
+/// table in each spec section that offers it (the section's `offered`).
+pub static REGISTRY: &[Registered] = &[
+    Registered { make: || Box::new(Ga::default()), colour: [230, 159, 0] },
+    Registered { make: || Box::new(De::default()), colour: [0, 114, 178] },
+    Registered { make: || Box::new(Pso::default()), colour: [0, 158, 115] },
+    Registered { make: || Box::new(Csa::default()), colour: [204, 121, 167] },
+    Registered { make: || Box::new(Icsa::default()), colour: [213, 94, 0] },
+    Registered { make: || Box::new(BinaryGa::default()), colour: [86, 180, 233] },
 ];
+
+/// The registered optimiser named `name`.
+pub fn registered(name: &str) -> Option<&'static Registered> {
+    REGISTRY.iter().find(|r| (r.make)().name() == name)
+}
 
 /// The optimisers by name with their default parameters.
 pub fn default_optimiser(name: &str) -> Option<Box<dyn Optimiser>> {
-    REGISTRY.iter().map(|make| make()).find(|o| o.name() == name)
+    registered(name).map(|r| (r.make)())
 }
 
 /// The optimiser named `name` among those a spec section offers (each with the section's
@@ -147,11 +160,15 @@ pub(crate) mod optimiser_tests {
     }
 
     #[test]
-    fn registry_knows_the_five() {
-        let all: Vec<Box<dyn Optimiser>> = REGISTRY.iter().map(|make| make()).collect();
+    fn registry_knows_the_six() {
+        let all: Vec<Box<dyn Optimiser>> = REGISTRY.iter().map(|r| (r.make)()).collect();
         let offered: Vec<&dyn Optimiser> = all.iter().map(|o| o.as_ref()).collect();
-        assert_eq!(names(&offered), ["ga", "de", "pso", "csa", "icsa"]);
-        for name in ["ga", "de", "pso", "csa", "icsa"] {
+        let six = ["ga", "de", "pso", "csa", "icsa", "binary_ga"];
+        assert_eq!(names(&offered), six);
+        let colours: std::collections::HashSet<[u8; 3]> =
+            REGISTRY.iter().map(|r| r.colour).collect();
+        assert_eq!(colours.len(), six.len(), "one colour each");
+        for name in six {
             assert_eq!(default_optimiser(name).unwrap().name(), name);
             assert_eq!(pick(&offered, name).unwrap().name(), name);
         }

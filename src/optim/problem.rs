@@ -37,6 +37,11 @@ pub trait Optimiser: Send + Sync {
     fn min_population(&self) -> MinPopulation {
         MinPopulation { n: 1, key: None, why: "one individual" }
     }
+    /// Check the parameter table (each error names its key: `cr must be in [0,1], got 1.5`); a
+    /// spec is checked with it when it is read.
+    fn validate(&self) -> Result<(), super::OptimError> {
+        Ok(())
+    }
     /// One run. Errors only for a malformed problem, budget or parameter set (checked before the
     /// first evaluation).
     fn run(

@@ -139,6 +139,9 @@ impl Pso {
 }
 
 impl Optimiser for Pso {
+    fn validate(&self) -> Result<(), OptimError> {
+        Pso::validate(self)
+    }
     fn name(&self) -> &'static str {
         "pso"
     }

@@ -1,5 +1,5 @@
-//! The thesis' published tables (transcribed CSV, `experiments/reference/`), compiled in so that a
-//! report can always set a reproduction beside them.
+//! Published tables (transcribed CSV, `experiments/reference/`) as a report reads them; each
+//! family compiles in its own ([`Published`]).
 
 use std::collections::BTreeMap;
 
@@ -36,35 +36,19 @@ impl RefTable {
     }
 }
 
-/// Appendix B (SOM models at n x n), Appendix C (CKSOM vs DNSOM at nx x ny), E/F (surface error),
-/// K/L (optimised surface error), M/N (optimiser CPU time).
-pub fn table(name: &str) -> Option<RefTable> {
-    let text = match name {
-        "appendix_b" => include_str!("../../experiments/reference/appendix_b.csv"),
-        "appendix_c" => include_str!("../../experiments/reference/appendix_c.csv"),
-        "appendix_e" => include_str!("../../experiments/reference/appendix_e.csv"),
-        "appendix_f" => include_str!("../../experiments/reference/appendix_f.csv"),
-        "appendix_k" => include_str!("../../experiments/reference/appendix_k.csv"),
-        "appendix_l" => include_str!("../../experiments/reference/appendix_l.csv"),
-        "appendix_m" => include_str!("../../experiments/reference/appendix_m.csv"),
-        "appendix_n" => include_str!("../../experiments/reference/appendix_n.csv"),
-        // Section 4.3's text (thesis line "The QE and TE of the experiment were 0.049694 and
-        // 0.225400 ... CPU time ... 5.386289 seconds"), in Appendix B's columns, DNSOM only.
-        "section_4_bunny" => include_str!("../../experiments/reference/section_4_bunny.csv"),
-        "seed003_table3" => include_str!("../../experiments/reference/seed003_table3.csv"),
-        "seed003_table4" => include_str!("../../experiments/reference/seed003_table4.csv"),
-        "seed003_table5" => include_str!("../../experiments/reference/seed003_table5.csv"),
-        "seed004_table2" => include_str!("../../experiments/reference/seed004_table2.csv"),
-        "seed004_table3" => include_str!("../../experiments/reference/seed004_table3.csv"),
-        _ => return None,
-    };
-    Some(RefTable::parse(text))
+/// A family's published tables, (name, CSV text), compiled in by the family that reproduces
+/// them so that a report can always set a reproduction beside them (the toolkit lists none).
+pub type Published = &'static [(&'static str, &'static str)];
+
+/// The table `name` of `published`.
+pub fn lookup(published: Published, name: &str) -> Option<RefTable> {
+    published.iter().find(|(n, _)| *n == name).map(|(_, text)| RefTable::parse(text))
 }
 
-/// Several published tables with the same columns read as one (e.g. Appendix B and the bunny
-/// figures of Section 4.3's text); None when none of them is known.
-pub fn joined(names: &[&str]) -> Option<RefTable> {
-    let mut parts = names.iter().filter_map(|n| table(n));
+/// Several tables of `published` with the same columns read as one (e.g. Appendix B and the
+/// bunny figures of Section 4.3's text); None when none of them is there.
+pub fn joined(published: Published, names: &[&str]) -> Option<RefTable> {
+    let mut parts = names.iter().filter_map(|n| lookup(published, n));
     let mut first = parts.next()?;
     for t in parts {
         debug_assert_eq!(
@@ -78,20 +62,20 @@ pub fn joined(names: &[&str]) -> Option<RefTable> {
 
 #[cfg(test)]
 mod tests {
+    const PUBLISHED: super::Published = &[
+        ("t1", "data,n,qe\nbunny,30,0.5\ncube,10,0.25\n"),
+        ("t2", "data,n,qe\nsphere,20,0.125\n"),
+    ];
+
     #[test]
-    fn published_tables_load() {
-        let j = super::joined(&["appendix_b", "section_4_bunny"]).unwrap();
-        assert_eq!(
-            j.value(&["data", "n"], &["bunny".into(), "30".into()], "qe_dnsom"),
-            Some(0.049694)
-        );
-        assert_eq!(j.value(&["data", "n"], &["bunny".into(), "30".into()], "qe_som2d"), None);
-        let b = super::table("appendix_b").unwrap();
-        assert_eq!(b.rows.len(), 15);
-        assert_eq!(
-            b.value(&["data", "n"], &["spindle".into(), "30".into()], "cpu_s_dnsom"),
-            Some(5.309147)
-        );
-        assert_eq!(super::table("appendix_k").unwrap().rows.len(), 140);
+    fn tables_are_found_by_name_and_joined() {
+        let one = super::lookup(PUBLISHED, "t1").unwrap();
+        assert_eq!(one.value(&["data", "n"], &["cube".into(), "10".into()], "qe"), Some(0.25));
+        assert!(super::lookup(PUBLISHED, "t3").is_none());
+        let j = super::joined(PUBLISHED, &["t1", "t3", "t2"]).unwrap();
+        assert_eq!(j.rows.len(), 3);
+        assert_eq!(j.value(&["data", "n"], &["sphere".into(), "20".into()], "qe"), Some(0.125));
+        assert_eq!(j.value(&["data", "n"], &["sphere".into(), "20".into()], "te"), None);
+        assert!(super::joined(PUBLISHED, &["t3"]).is_none());
     }
 }

@@ -3,7 +3,7 @@
 //! text can be ranked by how well each reproduces the published numbers.
 
 use super::claims;
-use super::reference::{self, RefTable};
+use super::reference::RefTable;
 use anyhow::{Context, Result};
 use std::path::Path;
 
@@ -74,8 +74,9 @@ pub fn table_score(ours: &RefTable, published: &RefTable) -> (usize, usize) {
     (cells, within)
 }
 
-/// The score of a run folder: every CSV named like a published table, and its `claims.csv`.
-pub fn folder_score(folder: &Path) -> Result<Score> {
+/// The score of a run folder: every CSV named like a table `published` finds, and its
+/// `claims.csv`.
+pub fn folder_score(folder: &Path, published: &dyn Fn(&str) -> Option<RefTable>) -> Result<Score> {
     let mut score = Score::default();
     let entries =
         std::fs::read_dir(folder).with_context(|| format!("cannot list {}", folder.display()))?;
@@ -86,7 +87,7 @@ pub fn folder_score(folder: &Path) -> Result<Score> {
         .collect();
     names.sort();
     for name in names {
-        let Some(published) = reference::table(name.trim_end_matches(".csv")) else { continue };
+        let Some(published) = published(name.trim_end_matches(".csv")) else { continue };
         let path = folder.join(&name);
         let ours = RefTable::parse(&crate::io::read_text(&path)?);
         let (c, w) = table_score(&ours, &published);
@@ -114,7 +115,8 @@ mod tests {
 
     #[test]
     fn cells_are_matched_by_key_and_counted_inside_the_band() {
-        let published = reference::table("appendix_k").unwrap();
+        let k = crate::families::optimise::report::PUBLISHED;
+        let published = crate::report::reference::lookup(k, "appendix_k").unwrap();
         // Two rows of ours: the first equal to the thesis, the second 30% above it (outside).
         let row = |k: usize, f: f64| -> String {
             let r = &published.rows[k];
@@ -133,12 +135,12 @@ mod tests {
         // 10 value columns per row (ga/de/pso avg, min, max and b).
         assert_eq!(table_score(&ours, &published), (20, 10));
         // CPU seconds are not scored.
-        let m = reference::table("appendix_m").unwrap();
+        let m = crate::report::reference::lookup(k, "appendix_m").unwrap();
         assert_eq!(table_score(&m, &m).0, 0);
         let dir = tempfile::tempdir().unwrap();
         std::fs::write(dir.path().join("appendix_k.csv"), &text).unwrap();
         std::fs::write(dir.path().join("other.csv"), "a,b\n1,2\n").unwrap();
-        let s = folder_score(dir.path()).unwrap();
+        let s = folder_score(dir.path(), &|n| crate::report::reference::lookup(k, n)).unwrap();
         assert_eq!((s.cells, s.within, s.claims), (20, 10, 0));
     }
 }

@@ -19,8 +19,10 @@ use std::str::FromStr;
 pub use lattice::Lattice;
 pub use train::{final_map_metrics, train, FinalMetrics, OnlineMetrics, SomParams, TrainResult};
 
-/// The four SOM models compared in Chapter 4 (Table 4.1).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+/// The four SOM models compared in Chapter 4 (Table 4.1) (in a spec by name, as [`FromStr`]
+/// reads it).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Deserialize)]
+#[serde(try_from = "String")]
 pub enum Model {
     Som2d,
     Som3d,
@@ -75,6 +77,13 @@ impl Model {
 impl fmt::Display for Model {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.key())
+    }
+}
+
+impl TryFrom<String> for Model {
+    type Error = String;
+    fn try_from(s: String) -> Result<Self, String> {
+        s.parse()
     }
 }
 

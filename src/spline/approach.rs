@@ -85,8 +85,9 @@ pub struct FitOptions {
     pub fairness: f64,
 }
 
-/// Conventional (A) or improved (B).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+/// Conventional (A) or improved (B) (in a spec by letter or name, as [`FromStr`] reads it).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Deserialize)]
+#[serde(try_from = "String")]
 pub enum Approach {
     Conventional,
     Improved,
@@ -105,6 +106,13 @@ impl Approach {
 impl fmt::Display for Approach {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.letter())
+    }
+}
+
+impl TryFrom<String> for Approach {
+    type Error = String;
+    fn try_from(s: String) -> Result<Self, String> {
+        s.parse()
     }
 }
 

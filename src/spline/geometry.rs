@@ -20,6 +20,10 @@ use crate::geom::{self, Point3};
 /// The sampling density the harness uses: 4 points per data interval (at least 4x the data).
 pub const DENSE_FACTOR: usize = 4;
 
+/// What counts as "near the data": the thesis' data are normalised to the unit box, so an
+/// excursion of a tenth of its side.
+pub const NEAR: f64 = 0.1;
+
 /// The dense measures of a pair of surfaces.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct DenseGeometry {

@@ -4,8 +4,9 @@ use crate::geom::{self, Point3};
 use std::fmt;
 use std::str::FromStr;
 
-/// The four parameterisation methods of Chapter 5.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+/// The four parameterisation methods of Chapter 5 (in a spec by name, as [`FromStr`] reads it).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Deserialize)]
+#[serde(try_from = "String")]
 pub enum Parameterisation {
     Uniform,
     ChordLength,
@@ -41,6 +42,13 @@ impl Parameterisation {
 impl fmt::Display for Parameterisation {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.name())
+    }
+}
+
+impl TryFrom<String> for Parameterisation {
+    type Error = String;
+    fn try_from(s: String) -> Result<Self, String> {
+        s.parse()
     }
 }
 

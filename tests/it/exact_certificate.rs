@@ -4,23 +4,23 @@
 //! never above approach B's error (B lies in the box), the lower bound is below it, and the
 //! relative gap is certified to the spec's `exact_tol` (1e-7), or at the very least to 1e-6.
 
-use somnurbs::experiment::spec::{Override, Spec};
+use somnurbs::experiment::spec::Override;
 use somnurbs::experiment::RunContext;
 use somnurbs::families::optimise::{exact_optima, problems};
+use somnurbs::families::Loaded;
 use somnurbs::optim::exact::{certify_dual, ExactOptions};
 use somnurbs::optim::problem::Problem;
 use somnurbs::spline::KnotRule;
 use std::path::Path;
 use std::time::Instant;
 
-fn spec(name: &str, profile: Option<&str>, knots: KnotRule) -> Spec {
+fn spec(name: &str, profile: Option<&str>, knots: KnotRule) -> Loaded {
     let path =
         Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments").join(format!("{name}.toml"));
     let text = std::fs::read_to_string(&path).unwrap();
     let over =
         Override { key: "optim.knots".into(), value: toml::Value::String(knots.name().into()) };
-    somnurbs::families::install();
-    Spec::parse_with(&path.display().to_string(), &text, profile, &[over]).unwrap()
+    Loaded::parse_with(&path.display().to_string(), &text, profile, &[over]).unwrap()
 }
 
 /// Every cell of `name` under `profile` and every knot reading: (label, B, result, seconds).
@@ -30,8 +30,8 @@ fn check_spec(name: &str, profile: Option<&str>, jobs: usize, check_pipeline: bo
         let spec = spec(name, profile, knots);
         let dir = tempfile::tempdir().unwrap();
         let ctx = RunContext::new(dir.path().to_path_buf(), jobs, crate::common::data_dir());
-        let pbs = problems(&spec, &ctx).unwrap();
         let o = spec.section::<somnurbs::families::optimise::spec::OptimSpec>().unwrap();
+        let pbs = problems(&spec.spec, o, &ctx).unwrap();
         let tol = o.exact_tol;
         let opts = ExactOptions {
             tol_rel_gap: o.exact_tol,
@@ -90,7 +90,7 @@ fn check_spec(name: &str, profile: Option<&str>, jobs: usize, check_pipeline: bo
         println!("{name} {knots}: {} cells in {total:.2} s", pbs.len());
         if check_pipeline && only.is_empty() {
             // The pipeline's own call gives the same numbers (it is what the tables print).
-            let solved = exact_optima(&spec, &ctx, &pbs).unwrap();
+            let solved = exact_optima(o, &ctx, &pbs).unwrap();
             assert_eq!(solved.len(), pbs.len());
             for (key, res) in &solved {
                 assert_eq!(Some(res), mine.get(key), "{name} {knots} {key:?}");

@@ -7,7 +7,6 @@
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use somnurbs::data::{obj, off, ply, stl, xyz};
-use somnurbs::experiment::spec::Spec;
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
@@ -218,9 +217,8 @@ fn readers_and_spec_loader_survive_random_mutations() {
     let obj = fuzz("OBJ", &[obj_seed], &mut rng, |b| obj::parse_obj(b).is_ok());
     let specs = fuzz("spec", &spec_seeds(), &mut rng, |b| {
         let text = String::from_utf8_lossy(b);
-        somnurbs::families::install();
-        let plain = Spec::parse("fuzz.toml", &text, None);
-        let quick = Spec::parse("fuzz.toml", &text, Some("quick"));
+        let plain = somnurbs::families::Loaded::parse("fuzz.toml", &text, None);
+        let quick = somnurbs::families::Loaded::parse("fuzz.toml", &text, Some("quick"));
         // A spec that passes must also list its cells quickly.
         if let Ok(s) = plain.as_ref().or(quick.as_ref()) {
             let _ = somnurbs::experiment::dry_run_listing(s);

@@ -86,13 +86,8 @@ impl runner::Logged for Run {
     }
 }
 
-fn section(spec: &Spec) -> Result<&Seed004Spec> {
-    spec.require::<spec::Seed004Spec>()
-}
-
 /// The flat list of cells.
-pub fn cells(spec: &Spec) -> Vec<Cell> {
-    let Some(s) = spec.section::<spec::Seed004Spec>() else { return Vec::new() };
+pub fn cells(s: &Seed004Spec) -> Vec<Cell> {
     s.control_points
         .iter()
         .flat_map(|&control_points| {
@@ -126,13 +121,12 @@ pub fn problem(s: &Seed004Spec, data: &RingData, control_points: usize) -> Resul
 }
 
 /// Run one cell (alone it gives the same numbers as inside the full run).
-pub fn run_cell(spec: &Spec, data: &RingData, cell: &Cell) -> Result<Run> {
-    run_cell_on(spec, &problem(section(spec)?, data, cell.control_points)?, cell)
+pub fn run_cell(spec: &Spec, s: &Seed004Spec, data: &RingData, cell: &Cell) -> Result<Run> {
+    run_cell_on(spec, s, &problem(s, data, cell.control_points)?, cell)
 }
 
 /// Run one cell on its number of control points' problem (built once for all its repeats).
-fn run_cell_on(spec: &Spec, problem: &RingNetProblem, cell: &Cell) -> Result<Run> {
-    let s = section(spec)?;
+fn run_cell_on(spec: &Spec, s: &Seed004Spec, problem: &RingNetProblem, cell: &Cell) -> Result<Run> {
     let budget = Budget {
         generations: s.generations as u64,
         population: s.population,
@@ -140,10 +134,10 @@ fn run_cell_on(spec: &Spec, problem: &RingNetProblem, cell: &Cell) -> Result<Run
         trace_every_evals: s.population as u64,
     };
     let key = cell.key();
-    let mut rng = seeds::cell_rng(spec.file.master_seed, &key);
-    let t0 = runner::thread_cpu_seconds();
-    let r = s.ga.run_with_history(problem, &budget, &mut rng).with_context(|| key.clone())?;
-    let cpu_s = runner::thread_cpu_seconds() - t0;
+    let (r, cpu_s) = runner::on_stream(spec.file.master_seed, &key, |rng| {
+        s.ga.run_with_history(problem, &budget, rng)
+    });
+    let r = r.with_context(|| key.clone())?;
     let analytical = problem.analytical().rms;
     let row = Row {
         cell: key.clone(),
@@ -176,8 +170,7 @@ fn run_cell_on(spec: &Spec, problem: &RingNetProblem, cell: &Cell) -> Result<Run
 
 /// Run every cell of the spec on `data` (the analytical fit of each number of control points
 /// once, on the worker threads).
-pub fn run(spec: &Spec, ctx: &RunContext, data: &RingData) -> Result<Vec<Run>> {
-    let s = section(spec)?;
+pub fn run(spec: &Spec, s: &Seed004Spec, ctx: &RunContext, data: &RingData) -> Result<Vec<Run>> {
     let cps: Vec<usize> = crate::report::ordered(s.control_points.iter().copied());
     let problems = runner::run_cells(
         &cps,
@@ -188,7 +181,7 @@ pub fn run(spec: &Spec, ctx: &RunContext, data: &RingData) -> Result<Vec<Run>> {
     )?;
     let by_cp: std::collections::BTreeMap<usize, &RingNetProblem> =
         cps.iter().copied().zip(problems.iter()).collect();
-    let cells = cells(spec);
+    let cells = cells(s);
     runner::run_logged(
         &cells,
         ctx,
@@ -196,6 +189,7 @@ pub fn run(spec: &Spec, ctx: &RunContext, data: &RingData) -> Result<Vec<Run>> {
         |cell| {
             run_cell_on(
                 spec,
+                s,
                 by_cp
                     .get(&cell.control_points)
                     .context("seed004: no problem for a cell's control points")?,
@@ -210,8 +204,7 @@ pub fn run(spec: &Spec, ctx: &RunContext, data: &RingData) -> Result<Vec<Run>> {
 
 /// The analytical method alone at every number of control points from the smallest to the
 /// largest of the spec's list (deterministic and cheap: not logged): (control points, RMS).
-pub fn analytical_sweep(spec: &Spec, data: &RingData) -> Result<Vec<(usize, f64)>> {
-    let s = section(spec)?;
+pub fn analytical_sweep(s: &Seed004Spec, data: &RingData) -> Result<Vec<(usize, f64)>> {
     let (lo, hi) = (
         s.control_points.iter().min().copied().unwrap_or(0),
         s.control_points.iter().max().copied().unwrap_or(0),
@@ -230,11 +223,10 @@ pub fn analytical_sweep(spec: &Spec, data: &RingData) -> Result<Vec<(usize, f64)
 
 /// RMS distance of the data to the exact cylinder (sqrt(x^2 + y^2) - radius): a floor under
 /// every fit's RMS error at the data's own radial scatter.
-pub fn data_floor(spec: &Spec, data: &RingData) -> Result<f64> {
-    let s = section(spec)?;
+pub fn data_floor(s: &Seed004Spec, data: &RingData) -> f64 {
     let sse: f64 =
         data.points().map(|p| ((p[0] * p[0] + p[1] * p[1]).sqrt() - s.radius).powi(2)).sum();
-    Ok((sse / data.n_points().max(1) as f64).sqrt())
+    (sse / data.n_points().max(1) as f64).sqrt()
 }
 
 /// What the Fig. 2(a) analogue draws: the bottom ring of the data, the GA's best curve and its
@@ -253,12 +245,11 @@ pub struct TopView {
 
 /// The top view of the lowest-RMS run at `control_points` (None if there is no such run).
 pub fn top_view(
-    spec: &Spec,
+    s: &Seed004Spec,
     data: &RingData,
     runs: &[Run],
     control_points: usize,
 ) -> Result<Option<TopView>> {
-    let s = section(spec)?;
     let Some(best) = runs
         .iter()
         .filter(|r| r.cell.control_points == control_points && !r.best_x.is_empty())
@@ -306,29 +297,32 @@ impl crate::experiment::family::Section for self::spec::Seed004Spec {
 }
 
 impl crate::experiment::family::Experiment for Seed004 {
+    fn published(&self) -> crate::report::reference::Published {
+        self::report::PUBLISHED
+    }
     type Section = self::spec::Seed004Spec;
-    fn logged_keys(&self, spec: &Spec) -> Vec<String> {
-        cells(spec).iter().map(|c| c.key()).collect()
+    fn logged_keys(&self, _spec: &Spec, s: &Seed004Spec) -> Vec<String> {
+        cells(s).iter().map(|c| c.key()).collect()
     }
     fn run(
         &self,
         spec: &Spec,
+        s4: &Seed004Spec,
         ctx: &RunContext,
         tables: bool,
     ) -> Result<crate::experiment::family::Outcome> {
-        let s4 = section(spec)?;
         // The lattice and its rings once, for the runs and the report.
         let data = data(s4);
-        let runs = run(spec, ctx, &data)?;
+        let runs = run(spec, s4, ctx, &data)?;
         let section = if tables {
-            let sweep = analytical_sweep(spec, &data)?;
-            let top = top_view(spec, &data, &runs, 7)?;
+            let sweep = analytical_sweep(s4, &data)?;
+            let top = top_view(s4, &data, &runs, 7)?;
             Some(self::report::write(
                 &spec.file.name,
                 s4,
                 &runs,
                 &sweep,
-                data_floor(spec, &data)?,
+                data_floor(s4, &data),
                 top.as_ref(),
                 &ctx.out,
             )?)

@@ -48,11 +48,11 @@ pub struct Seed004Spec {
     /// Table II's checkpoints (0 = the initial population; each at most `generations`).
     #[serde(default = "default_s4_table2_generations")]
     pub table2_generations: Vec<usize>,
-    #[serde(default = "crate::families::optimise::spec::default_ten")]
+    #[serde(default = "crate::experiment::defaults::ten")]
     pub repeats: usize,
     #[serde(default = "default_s4_generations")]
     pub generations: usize,
-    #[serde(default = "crate::families::optimise::spec::default_ten")]
+    #[serde(default = "crate::experiment::defaults::ten")]
     pub population: usize,
     /// Order around (closed; 3 = quadratic pieces) and up (clamped; 2 = linear), rows of the net.
     #[serde(default = "default_s4_three")]

@@ -202,13 +202,8 @@ impl runner::Logged for Run {
     }
 }
 
-fn section(spec: &Spec) -> Result<&Seed003Spec> {
-    spec.require::<Seed003Spec>()
-}
-
 /// The flat list of cells: examples x methods x runs.
-pub fn cells(spec: &Spec) -> Vec<Cell> {
-    let Some(s) = spec.section::<Seed003Spec>() else { return Vec::new() };
+pub fn cells(s: &Seed003Spec) -> Vec<Cell> {
     runner::product_cells(&s.examples, &s.methods, s.runs, |e, m, run| Cell {
         example: e.clone(),
         method: m.clone(),
@@ -284,8 +279,7 @@ pub fn budget(s: &Seed003Spec, e: &ExampleSpec) -> Budget {
 }
 
 /// Run one cell (alone it gives the same numbers as inside the full run).
-pub fn run_cell(spec: &Spec, cell: &Cell) -> Result<Run> {
-    let s = section(spec)?;
+pub fn run_cell(spec: &Spec, s: &Seed003Spec, cell: &Cell) -> Result<Run> {
     let e = s
         .example(&cell.example)
         .with_context(|| format!("seed003.examples: unknown example `{}`", cell.example))?;
@@ -293,14 +287,14 @@ pub fn run_cell(spec: &Spec, cell: &Cell) -> Result<Run> {
     let master = spec.file.master_seed;
     let d = data(master, &cell.example, e, cell.run)?;
     let n = d.points.len();
-    let t0 = runner::thread_cpu_seconds();
-    let (y, initial, evaluations, iterations, trace, dim) = if let Some(p) = classical(&cell.method)
+    let ((y, initial, evaluations, iterations, trace, dim), cpu_s) = if let Some(p) =
+        classical(&cell.method)
     {
         let x = classical_start(&d, p);
         let prob = BezierParamProblem::new(e.degree, e.degree, d.layout, d.points, x.clone())
             .map_err(|err| anyhow::anyhow!("{key}: {err}"))?;
-        let y = prob.fitness(&x);
-        (y, y, 1, 0, Vec::new(), prob.dim())
+        let (y, cpu_s) = runner::timed(|| prob.fitness(&x));
+        ((y, y, 1, 0, Vec::new(), prob.dim()), cpu_s)
     } else {
         let centre = vec![
             0.5;
@@ -314,13 +308,10 @@ pub fn run_cell(spec: &Spec, cell: &Cell) -> Result<Run> {
         let Some(opt) = crate::optim::pick(&s.offered(), &cell.method) else {
             anyhow::bail!("seed003.methods: unknown method `{}`", cell.method)
         };
-        let mut rng = seeds::cell_rng(master, &key);
-        let r = opt
-            .run(&prob, &budget(s, e), &mut rng)
-            .map_err(|err| anyhow::anyhow!("{key}: {err}"))?;
-        (r.best_fitness, r.initial_best_fitness, r.evaluations, e.generations, r.trace, prob.dim())
+        let (r, cpu_s) = runner::optimise(opt, &prob, &budget(s, e), master, &key)?;
+        let dim = prob.dim();
+        ((r.best_fitness, r.initial_best_fitness, r.evaluations, e.generations, r.trace, dim), cpu_s)
     };
-    let cpu_s = runner::thread_cpu_seconds() - t0;
     let row = Row {
         cell: key.clone(),
         example: cell.example.clone(),
@@ -344,13 +335,13 @@ pub fn run_cell(spec: &Spec, cell: &Cell) -> Result<Run> {
 }
 
 /// Run every cell of the spec.
-pub fn run(spec: &Spec, ctx: &RunContext) -> Result<Vec<Run>> {
-    let cells = cells(spec);
+pub fn run(spec: &Spec, s: &Seed003Spec, ctx: &RunContext) -> Result<Vec<Run>> {
+    let cells = cells(s);
     runner::run_logged(
         &cells,
         ctx,
         &spec.file.name,
-        |cell| run_cell(spec, cell),
+        |cell| run_cell(spec, s, cell),
         |_, (row, trace)| Ok(Run { row, trace }),
     )
 }
@@ -364,23 +355,26 @@ impl crate::experiment::family::Section for Seed003Spec {
     }
     fn validate(&self, spec: &Spec) -> Result<(), SpecError> {
         self.validate().map_err(|(key, msg)| spec.err(&key, msg))?;
-        spec.validate_optimiser_params("seed003", [self.csa.validate(), self.icsa.validate()])
+        spec.validate_optimiser_params("seed003", &self.offered())
     }
 }
 
 impl crate::experiment::family::Experiment for Seed003 {
+    fn published(&self) -> crate::report::reference::Published {
+        self::report::PUBLISHED
+    }
     type Section = Seed003Spec;
-    fn logged_keys(&self, spec: &Spec) -> Vec<String> {
-        cells(spec).iter().map(|c| c.key()).collect()
+    fn logged_keys(&self, _spec: &Spec, s: &Seed003Spec) -> Vec<String> {
+        cells(s).iter().map(|c| c.key()).collect()
     }
     fn run(
         &self,
         spec: &Spec,
+        s3: &Seed003Spec,
         ctx: &RunContext,
         tables: bool,
     ) -> Result<crate::experiment::family::Outcome> {
-        let s3 = section(spec)?;
-        let runs = run(spec, ctx)?;
+        let runs = run(spec, s3, ctx)?;
         let section = if tables { Some(self::report::write(&spec.file.name, s3, &runs, &ctx.out)?) } else { None };
         Ok(crate::experiment::family::Outcome {
             section,

@@ -7,7 +7,7 @@
 
 use super::{Run, Seed003Spec, EXAMPLES, METHODS};
 use crate::report::plots::{self, boxplot::quantile_type7, style, Series};
-use crate::report::reference::{table, RefTable};
+use crate::report::reference::RefTable;
 use crate::stats::{rank_sum::rank_sum, wilcoxon::signed_rank, Alternative};
 use anyhow::Result;
 use std::fmt::Write;
@@ -53,6 +53,18 @@ impl Stats {
         }
     }
 }
+
+/// A published table of [`PUBLISHED`].
+fn table(name: &str) -> Option<RefTable> {
+    crate::report::reference::lookup(PUBLISHED, name)
+}
+
+/// Seed 003's Tables 3, 4 and 5.
+pub const PUBLISHED: crate::report::reference::Published = &[
+    ("seed003_table3", include_str!("../../../experiments/reference/seed003_table3.csv")),
+    ("seed003_table4", include_str!("../../../experiments/reference/seed003_table4.csv")),
+    ("seed003_table5", include_str!("../../../experiments/reference/seed003_table5.csv")),
+];
 
 /// Table 3's rows (and Table 4's without the error rates).
 const STATS: [&str; 6] = ["y_mean", "y_best", "y_var", "y_std", "rmse_mean", "rmse_best"];

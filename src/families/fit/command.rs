@@ -121,7 +121,7 @@ pub fn fit(args: &FitArgs) -> Result<()> {
     let fit = fit_two_view(&grid, cn.nx, cn.ny, param, approach, &opts)
         .with_context(|| format!("{shown}: {}x{} grid", grid.nx, grid.ny))?;
 
-    let frame = crate::families::fit::read_frame(&args.grid)?;
+    let frame = crate::io::map_file::read_frame(&args.grid)?;
     let export = export_frame(&args.grid, frame, &args.frame, &args.units)?;
     let placed = |s: &BSplineSurface| match export.affine {
         Some((offset, scale)) => s.affine(offset, scale),

@@ -19,7 +19,7 @@ struct FitPoint {
 
 /// The readings matrix's chart: the first fit spec every reading ran, its first data set, chord
 /// length, approach B; nothing when no reading ran a fit spec.
-pub fn combine(view: &PlanView) -> Result<Combined> {
+pub fn combine(view: &PlanView<super::spec::FitSpec>) -> Result<Combined> {
     let mut readings = Vec::new();
     if let Some(chart) = error_vs_excursion(view)? {
         readings.push(format!("\n![{chart}]({chart})\n\nSurface error against the largest distance of the fitted surfaces from the data's bounding box (log scale), one point per control net, for one data set under each reading: a reading can lower the error at the data points while its surfaces leave the data between them.\n"));
@@ -28,11 +28,11 @@ pub fn combine(view: &PlanView) -> Result<Combined> {
 }
 
 /// Draws the chart into the plan's folder; returns its file name.
-fn error_vs_excursion(view: &PlanView) -> Result<Option<String>> {
+fn error_vs_excursion(view: &PlanView<super::spec::FitSpec>) -> Result<Option<String>> {
     if view.readings.is_empty() {
         return Ok(None);
     }
-    let Some(spec) = view.specs.iter().map(|s| s.file.name.as_str()).find(|s| {
+    let Some(spec) = view.specs.iter().map(|(s, _)| s.file.name.as_str()).find(|s| {
         view.readings.iter().all(|r| r.specs.iter().any(|x| x == s))
             && view.out.join(s).join("runs.csv").exists()
     }) else {
@@ -77,9 +77,9 @@ fn error_vs_excursion(view: &PlanView) -> Result<Option<String>> {
     let errors = series.iter().flat_map(|s| s.points.iter().map(|p| p.1));
     let (lo, hi) = errors.fold((f64::INFINITY, f64::NEG_INFINITY), |a, y| (a.0.min(y), a.1.max(y)));
     if lo.is_finite() {
-        let x = super::report::NEAR.log10();
+        let x = crate::spline::geometry::NEAR.log10();
         series.push(crate::report::plots::Series {
-            label: format!("near the data: excursion {}", super::report::NEAR),
+            label: format!("near the data: excursion {}", crate::spline::geometry::NEAR),
             colour: crate::report::plots::style::GREY,
             points: vec![(x, lo), (x, hi)],
             band: None,

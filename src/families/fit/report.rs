@@ -13,6 +13,12 @@ use anyhow::Result;
 use std::fmt::Write;
 use std::path::Path;
 
+/// The thesis' Appendices E and F (surface error of approaches A and B).
+pub const PUBLISHED: crate::report::reference::Published = &[
+    ("appendix_e", include_str!("../../../experiments/reference/appendix_e.csv")),
+    ("appendix_f", include_str!("../../../experiments/reference/appendix_f.csv")),
+];
+
 /// Names of a grid's tables: (appendix, param wins for A, param wins for B, A vs B).
 fn table_names(grid: GridSize) -> (String, String, String, String) {
     match (grid.nx, grid.ny) {
@@ -142,7 +148,7 @@ impl GridRuns {
             cns: ordered(runs.iter().map(|r| r.cell.cn)),
             params: ordered(runs.iter().map(|r| r.cell.param)),
             approaches: ordered(runs.iter().map(|r| r.cell.approach)),
-            thesis: reference::table(&names.0),
+            thesis: reference::lookup(PUBLISHED, &names.0),
             names,
             runs,
         }
@@ -578,10 +584,6 @@ fn geometry_rows(runs: &[FitRun], cns: &[GridSize], approaches: &[Approach]) -> 
     out
 }
 
-/// What counts as "near the data": the thesis' data are normalised to the unit box, so an
-/// excursion of a tenth of its side.
-pub const NEAR: f64 = 0.1;
-
 fn render_geometry(
     geo: &[GeometryRow],
     runs: &[FitRun],
@@ -613,11 +615,11 @@ fn render_geometry(
         crate::spline::DENSE_FACTOR,
         table(&h, &rows)
     );
-    let near = runs.iter().filter(|r| r.row.excursion <= NEAR).count();
+    let near = runs.iter().filter(|r| r.row.excursion <= crate::spline::geometry::NEAR).count();
     let worst = runs.iter().max_by(|a, b| a.row.excursion.total_cmp(&b.row.excursion));
     let claim = Claim::every("5", "The fitted surfaces stay near the data", (near, runs.len()))
         .on_grid(grid)
-        .note(format!("fits whose dense excursion from the data's bounding box is at most {NEAR} (the unit box's side is 1){}", worst.map(|w| format!("; largest {:.3e} at {}", w.row.excursion, w.row.cell)).unwrap_or_default()));
+        .note(format!("fits whose dense excursion from the data's bounding box is at most {} (the unit box's side is 1){}", crate::spline::geometry::NEAR, worst.map(|w| format!("; largest {:.3e} at {}", w.row.excursion, w.row.cell)).unwrap_or_default()));
     Ok((md, claim))
 }
 

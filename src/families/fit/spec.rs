@@ -4,6 +4,7 @@
 
 use crate::experiment::limits::{self, Check};
 use crate::experiment::spec::{GridSize, Spec, SpecError};
+use crate::families::maps::{validate_grid_keys, validate_map_som, MapSom, MapsMissing};
 use serde::Deserialize;
 
 /// Chapter 5 section: data sets x control nets x parameterisations x approaches on one grid size.
@@ -16,9 +17,9 @@ pub struct FitSpec {
     /// Control-net sizes CNx x CNy.
     pub control_nets: Vec<GridSize>,
     /// uniform, chord_length, centripetal, exponential.
-    pub parameterisations: Vec<String>,
+    pub parameterisations: Vec<crate::spline::Parameterisation>,
     /// A (conventional) and/or B (improved).
-    pub approaches: Vec<String>,
+    pub approaches: Vec<crate::spline::Approach>,
     /// Folder holding `dnsom_<data>_<nx>x<ny>.csv` (Chapter 4's `maps/`), relative to the spec's
     /// folder; unset, every map is recomputed from the same seed and settings as Chapter 4 (see
     /// `[fit.som]`).
@@ -30,9 +31,9 @@ pub struct FitSpec {
     pub maps_missing: MapsMissing,
     /// How a missing map is recomputed (defaults: this spec's master seed, T = 30000, alpha0 0.9).
     #[serde(default)]
-    pub som: Option<FitSom>,
+    pub som: Option<MapSom>,
     /// Pictures like Appendices G/H and the error-vs-control-net chart.
-    #[serde(default = "crate::families::som::spec::default_true")]
+    #[serde(default = "crate::experiment::defaults::yes")]
     pub pictures: bool,
     /// Reading of the knot rule for nets smaller than the grid (docs/readings.md).
     #[serde(default)]
@@ -56,93 +57,6 @@ impl FitSpec {
     }
 }
 
-/// What a run does when the `maps` folder a spec names, or a map in it, is not there.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum MapsMissing {
-    /// Refuse the run, naming the folder or file (a mistyped path does not silently cost a
-    /// Chapter 4 run).
-    #[default]
-    Error,
-    /// Recompute the missing maps from `<section>.som`, saying so on stderr.
-    Recompute,
-}
-
-/// Settings of the DNSOM run that recomputes a missing map (the cell key is Chapter 4's,
-/// `som/<data>/dnsom/<grid>/r0`, so the same seed gives the same map).
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct FitSom {
-    #[serde(default)]
-    pub master_seed: Option<u64>,
-    #[serde(default = "crate::families::som::spec::default_iterations")]
-    pub iterations: usize,
-    #[serde(default = "crate::families::som::spec::default_alpha0")]
-    pub alpha0: f64,
-}
-
-/// The keys a `[fit]` and an `[optim]` section share (data sets, grid, control nets,
-/// parameterisations), each error naming `<section>.<key>`.
-pub(crate) fn validate_grid_keys(
-    spec: &Spec,
-    section: &str,
-    datasets: &[String],
-    grid: GridSize,
-    control_nets: &[GridSize],
-    parameterisations: &[String],
-) -> Result<(), SpecError> {
-    let key = |k: &str| format!("{section}.{k}");
-    if datasets.is_empty() {
-        return Err(spec.err(&key("datasets"), "is empty"));
-    }
-    if grid.nx.min(grid.ny) < 3 {
-        return Err(
-            spec.err(&key("grid"), format!("grid {grid} is too small (each side at least 3)"))
-        );
-    }
-    if control_nets.is_empty() {
-        return Err(spec.err(&key("control_nets"), "is empty"));
-    }
-    for cn in control_nets {
-        if cn.nx < 4 || cn.ny < 4 {
-            return Err(spec.err(&key("control_nets"), format!("control net {cn} is smaller than 4 (cubic needs p + 1 = 4 control points a side)")));
-        }
-        if cn.nx > grid.nx || cn.ny > grid.ny {
-            return Err(spec.err(
-                &key("control_nets"),
-                format!("control net {cn} is larger than the grid {grid}"),
-            ));
-        }
-    }
-    if parameterisations.is_empty() {
-        return Err(spec.err(&key("parameterisations"), "is empty"));
-    }
-    for p in parameterisations {
-        p.parse::<crate::spline::Parameterisation>()
-            .map_err(|e| spec.err(&key("parameterisations"), e))?;
-    }
-    Ok(())
-}
-
-/// The settings of the map recomputation (`<section>.som`).
-pub(crate) fn validate_map_som(
-    spec: &Spec,
-    section: &str,
-    som: Option<&FitSom>,
-) -> Result<(), SpecError> {
-    let Some(som) = som else { return Ok(()) };
-    if som.iterations == 0 {
-        return Err(spec.err(&format!("{section}.som.iterations"), "must be at least 1"));
-    }
-    if !(som.alpha0 > 0.0 && som.alpha0 <= 1.0) {
-        return Err(spec.err(
-            &format!("{section}.som.alpha0"),
-            format!("must be in (0, 1], got {}", som.alpha0),
-        ));
-    }
-    Ok(())
-}
-
 /// Every value of the `[fit]` section (after the limits).
 pub(crate) fn validate(spec: &Spec, fit: &FitSpec) -> Result<(), SpecError> {
     validate_grid_keys(
@@ -156,22 +70,16 @@ pub(crate) fn validate(spec: &Spec, fit: &FitSpec) -> Result<(), SpecError> {
     if fit.approaches.is_empty() {
         return Err(spec.err("fit.approaches", "is empty"));
     }
-    for a in &fit.approaches {
-        a.parse::<crate::spline::Approach>().map_err(|e| spec.err("fit.approaches", e))?;
-    }
     validate_map_som(spec, "fit", fit.som.as_ref())
 }
 
 /// The flat list of fit cells (data set x control net x parameterisation x approach).
-pub fn cells(spec: &Spec) -> Vec<FitCell> {
-    let Some(fit) = spec.section::<FitSpec>() else { return Vec::new() };
+pub fn cells(fit: &FitSpec) -> Vec<FitCell> {
     let mut cells = Vec::new();
     for dataset in &fit.datasets {
         for cn in &fit.control_nets {
-            for p in &fit.parameterisations {
-                let Ok(param) = p.parse() else { continue };
-                for a in &fit.approaches {
-                    let Ok(approach) = a.parse() else { continue };
+            for &param in &fit.parameterisations {
+                for &approach in &fit.approaches {
                     cells.push(FitCell {
                         dataset: crate::data::registry::name_of(dataset),
                         grid: fit.grid,

@@ -98,21 +98,15 @@ impl runner::Logged for Run {
     }
 }
 
-/// (data set, control net, parameterisation), as in Chapter 6.
-pub use crate::families::optimise::ProblemKey;
-
-fn section(spec: &Spec) -> Result<&GrowingGridSpec> {
-    spec.require::<spec::GrowingGridSpec>()
-}
+/// A problem: (data set, control net, parameterisation).
+pub type ProblemKey = (String, GridSize, Parameterisation);
 
 /// Every cell in a fixed order: data, net, parameterisation, optimiser, repeat.
-pub fn cells(spec: &Spec) -> Vec<Cell> {
-    let Some(g) = spec.section::<spec::GrowingGridSpec>() else { return Vec::new() };
+pub fn cells(g: &GrowingGridSpec) -> Vec<Cell> {
     let mut out = Vec::new();
     for d in g.datasets.iter().map(|d| registry::name_of(d)) {
         for &cn in &g.control_nets {
-            for p in &g.parameterisations {
-                let Ok(param) = p.parse::<Parameterisation>() else { continue };
+            for &param in &g.parameterisations {
                 for o in &g.optimisers {
                     for repeat in 0..g.repeats {
                         out.push(Cell {
@@ -131,8 +125,7 @@ pub fn cells(spec: &Spec) -> Vec<Cell> {
 }
 
 /// Grow one map per data set (in parallel; each on its own stream).
-pub fn maps(spec: &Spec, ctx: &RunContext) -> Result<Vec<MapRun>> {
-    let g = section(spec)?;
+pub fn maps(spec: &Spec, g: &GrowingGridSpec, ctx: &RunContext) -> Result<Vec<MapRun>> {
     let params = g.params();
     let data: Vec<(String, Vec<Point3>)> = g
         .datasets
@@ -149,12 +142,11 @@ pub fn maps(spec: &Spec, ctx: &RunContext) -> Result<Vec<MapRun>> {
         ctx.jobs,
         "growing grids",
         |(d, points)| {
-            let mut rng = seeds::cell_rng(spec.file.master_seed, &format!("seed001/map/{d}"));
-            let t0 = runner::thread_cpu_seconds();
-            let map = grow(points, &params, &mut rng)
-                .map_err(anyhow::Error::msg)
-                .with_context(|| format!("growing grid on {d}"))?;
-            let cpu_s = runner::thread_cpu_seconds() - t0;
+            let key = format!("seed001/map/{d}");
+            let (map, cpu_s) =
+                runner::on_stream(spec.file.master_seed, &key, |rng| grow(points, &params, rng));
+            let map =
+                map.map_err(anyhow::Error::msg).with_context(|| format!("growing grid on {d}"))?;
             let m = map.metrics(points);
             Ok(MapRun { dataset: d.clone(), points: points.len(), map, qe: m.qe, te: m.te, cpu_s })
         },
@@ -163,13 +155,14 @@ pub fn maps(spec: &Spec, ctx: &RunContext) -> Result<Vec<MapRun>> {
 }
 
 /// The problem of every (data, net, parameterisation).
-pub fn problems(spec: &Spec, maps: &[MapRun]) -> Result<BTreeMap<ProblemKey, OpenSurfaceProblem>> {
-    let g = section(spec)?;
+pub fn problems(
+    g: &GrowingGridSpec,
+    maps: &[MapRun],
+) -> Result<BTreeMap<ProblemKey, OpenSurfaceProblem>> {
     let mut out = BTreeMap::new();
     for m in maps {
         for &cn in &g.control_nets {
-            for p in &g.parameterisations {
-                let param: Parameterisation = p.parse().map_err(anyhow::Error::msg)?;
+            for &param in &g.parameterisations {
                 let pr = OpenSurfaceProblem::new(
                     &m.map.weights,
                     m.map.nx,
@@ -180,7 +173,7 @@ pub fn problems(spec: &Spec, maps: &[MapRun]) -> Result<BTreeMap<ProblemKey, Ope
                     g.bounds_margin,
                 )
                 .map_err(anyhow::Error::msg)
-                .with_context(|| format!("{} {cn} {p}", m.dataset))?;
+                .with_context(|| format!("{} {cn} {param}", m.dataset))?;
                 out.insert((m.dataset.clone(), cn, param), pr);
             }
         }
@@ -193,8 +186,12 @@ fn optimiser<'a>(g: &'a GrowingGridSpec, name: &str) -> Result<&'a dyn Optimiser
 }
 
 /// Run one cell (alone or inside the full run: the same numbers).
-pub fn run_cell(spec: &Spec, cell: &Cell, problem: &OpenSurfaceProblem) -> Result<Run> {
-    let g = section(spec)?;
+pub fn run_cell(
+    spec: &Spec,
+    g: &GrowingGridSpec,
+    cell: &Cell,
+    problem: &OpenSurfaceProblem,
+) -> Result<Run> {
     let opt = optimiser(g, &cell.optimiser)?;
     let budget = Budget {
         generations: g.generations as u64,
@@ -203,10 +200,7 @@ pub fn run_cell(spec: &Spec, cell: &Cell, problem: &OpenSurfaceProblem) -> Resul
         trace_every_evals: g.trace_every_evals,
     };
     let key = cell.key();
-    let mut rng = seeds::cell_rng(spec.file.master_seed, &key);
-    let t0 = runner::thread_cpu_seconds();
-    let r = opt.run(problem, &budget, &mut rng).with_context(|| key.clone())?;
-    let cpu_s = runner::thread_cpu_seconds() - t0;
+    let (r, cpu_s) = runner::optimise(opt, problem, &budget, spec.file.master_seed, &key)?;
     let n = (problem.nx * problem.ny) as f64;
     let row = Row {
         cell: key.clone(),
@@ -233,15 +227,16 @@ pub fn run_cell(spec: &Spec, cell: &Cell, problem: &OpenSurfaceProblem) -> Resul
 /// Run every cell of the spec.
 pub fn run(
     spec: &Spec,
+    g: &GrowingGridSpec,
     ctx: &RunContext,
     problems: &BTreeMap<ProblemKey, OpenSurfaceProblem>,
 ) -> Result<Vec<Run>> {
-    let cells = cells(spec);
+    let cells = cells(g);
     runner::run_logged(
         &cells,
         ctx,
         &spec.file.name,
-        |c| run_cell(spec, c, &problems[&(c.dataset.clone(), c.cn, c.param)]),
+        |c| run_cell(spec, g, c, &problems[&(c.dataset.clone(), c.cn, c.param)]),
         |c, (row, best_x)| Ok(Run { cell: c.clone(), row, best_x }),
     )
 }
@@ -263,18 +258,19 @@ impl crate::experiment::family::Section for self::spec::GrowingGridSpec {
 
 impl crate::experiment::family::Experiment for Seed001 {
     type Section = self::spec::GrowingGridSpec;
-    fn logged_keys(&self, spec: &Spec) -> Vec<String> {
-        cells(spec).iter().map(|c| c.key()).collect()
+    fn logged_keys(&self, _spec: &Spec, g: &GrowingGridSpec) -> Vec<String> {
+        cells(g).iter().map(|c| c.key()).collect()
     }
     fn run(
         &self,
         spec: &Spec,
+        g: &GrowingGridSpec,
         ctx: &RunContext,
         tables: bool,
     ) -> Result<crate::experiment::family::Outcome> {
-        let maps = maps(spec, ctx)?;
-        let problems = problems(spec, &maps)?;
-        let runs = run(spec, ctx, &problems)?;
+        let maps = maps(spec, g, ctx)?;
+        let problems = problems(g, &maps)?;
+        let runs = run(spec, g, ctx, &problems)?;
         let section = if tables {
             Some(self::report::write(&maps, &problems, &runs, &ctx.out)?)
         } else {

@@ -14,21 +14,21 @@ pub struct GrowingGridSpec {
     /// Target size of the grown map.
     pub grid: GridSize,
     pub control_nets: Vec<GridSize>,
-    pub parameterisations: Vec<String>,
+    pub parameterisations: Vec<crate::spline::Parameterisation>,
     /// ga, de, pso.
     pub optimisers: Vec<String>,
-    #[serde(default = "crate::families::optimise::spec::default_ten")]
+    #[serde(default = "crate::experiment::defaults::ten")]
     pub repeats: usize,
-    #[serde(default = "crate::families::optimise::spec::default_generations")]
+    #[serde(default = "crate::experiment::defaults::generations")]
     pub generations: usize,
-    #[serde(default = "crate::families::optimise::spec::default_population")]
+    #[serde(default = "crate::experiment::defaults::population")]
     pub population: usize,
-    #[serde(default = "crate::families::optimise::spec::default_init_range")]
+    #[serde(default = "crate::experiment::defaults::init_range")]
     pub init_range: f64,
     /// The search box: the data and the least-squares control points, widened by this share.
     #[serde(default)]
     pub bounds_margin: f64,
-    #[serde(default = "crate::families::optimise::spec::default_trace_every")]
+    #[serde(default = "crate::experiment::defaults::trace_every")]
     pub trace_every_evals: u64,
     /// Constants of the growing grid (defaults: `som::growing_grid::GrowingGridParams`).
     #[serde(default)]
@@ -109,10 +109,6 @@ pub(crate) fn validate(spec: &Spec, g: &GrowingGridSpec) -> Result<(), SpecError
     }
     if g.parameterisations.is_empty() {
         return Err(spec.err("growing_grid.parameterisations", "is empty"));
-    }
-    for p in &g.parameterisations {
-        p.parse::<crate::spline::Parameterisation>()
-            .map_err(|e| spec.err("growing_grid.parameterisations", e))?;
     }
     spec.validate_runs(
         "growing_grid",

@@ -26,19 +26,20 @@ fn folder_suite(results: &Path) -> Result<[String; 4]> {
         format!("{}: no fingerprint: cannot tell which problems it holds", results.display())
     })?;
     let profile = if fp.profile == "default" { None } else { Some(fp.profile.as_str()) };
-    crate::families::install();
-    let spec = fp
+    let spec: crate::families::Loaded = fp
         .overrides()
         .variants(&fp.spec_path, &fp.spec_text, profile)?
         .into_iter()
         .next()
         .context("no spec")?;
-    let o = spec.require::<super::spec::OptimSpec>()?;
+    let o = spec.section::<super::spec::OptimSpec>().with_context(|| {
+        format!("{}: its spec has no [optim] section", results.display())
+    })?;
     Ok([
         fp.spec_name.clone(),
         profile.unwrap_or("").to_string(),
         o.knots.name().to_string(),
-        super::suite::box_label(o),
+        crate::families::suite::box_label(o),
     ])
 }
 

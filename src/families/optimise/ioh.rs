@@ -33,8 +33,8 @@ pub fn write(runs: &[OptimRun], out: &Path) -> Result<usize> {
         if !problems.contains(&key(r)) {
             problems.push(key(r));
         }
-        if !opts.contains(&r.cell.optimiser) {
-            opts.push(r.cell.optimiser.clone());
+        if !opts.contains(&r.competitor) {
+            opts.push(r.competitor.clone());
         }
     }
     let mut n = 0;
@@ -43,7 +43,7 @@ pub fn write(runs: &[OptimRun], out: &Path) -> Result<usize> {
         remove_info_files(&dir)?;
         for (k, name) in problems.iter().enumerate() {
             let mut rs: Vec<&OptimRun> =
-                runs.iter().filter(|r| &r.cell.optimiser == o && &key(r) == name).collect();
+                runs.iter().filter(|r| &r.competitor == o && &key(r) == name).collect();
             if rs.is_empty() {
                 continue;
             }

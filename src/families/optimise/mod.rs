@@ -9,13 +9,13 @@ pub mod overall;
 pub mod pictures;
 pub mod report;
 pub mod spec;
-pub mod suite;
 
 use crate::experiment::spec::GridSize;
 use crate::experiment::spec::{Spec, SpecError};
 use crate::experiment::{runner, seeds, RunContext};
-use crate::families::fit;
-use crate::optim::{Budget, Optimiser, Problem, RunResult};
+use spec::OptimSpec;
+use crate::families::maps;
+use crate::optim::{Budget, Optimiser, Problem};
 use crate::spline::BoxSpec;
 use crate::spline::ControlNetProblem;
 use crate::spline::{fit_two_view, Approach, Parameterisation};
@@ -69,6 +69,9 @@ impl OptimRow {
 #[derive(Debug, Clone)]
 pub struct OptimRun {
     pub cell: OptimCell,
+    /// What the tables, charts and `compare` rank it as: its optimiser, or in a sweep
+    /// `optimiser@variant` ([`OptimRow::competitor`]).
+    pub competitor: String,
     pub row: OptimRow,
     pub trace: Vec<(u64, f64)>,
     /// (evaluation, fitness) at every improvement of the best so far, from evaluation 1 (the
@@ -93,11 +96,10 @@ pub type ProblemKey = (String, GridSize, Parameterisation);
 /// The certified exact optimum of every problem, when the spec asks for it (deterministic, so
 /// computed once per problem and in parallel).
 pub fn exact_optima(
-    spec: &Spec,
+    o: &OptimSpec,
     ctx: &RunContext,
     problems: &BTreeMap<ProblemKey, ControlNetProblem>,
 ) -> Result<BTreeMap<ProblemKey, crate::optim::exact::ExactResult>> {
-    let o = spec.require::<spec::OptimSpec>()?;
     if !o.exact {
         return Ok(BTreeMap::new());
     }
@@ -117,38 +119,39 @@ pub fn exact_optima(
 }
 
 /// Build the optimiser a cell names, with the spec's parameters.
-pub fn optimiser<'a>(spec: &'a Spec, name: &str) -> Result<&'a dyn Optimiser> {
-    let o = spec.require::<spec::OptimSpec>()?;
+pub fn optimiser<'a>(o: &'a OptimSpec, name: &str) -> Result<&'a dyn Optimiser> {
     crate::optim::pick(&o.offered(), name).with_context(|| format!("unknown optimiser `{name}`"))
 }
 
 /// The control-net problems of every (data, net, parameterisation), from approach B's fit.
-pub fn problems(spec: &Spec, ctx: &RunContext) -> Result<BTreeMap<ProblemKey, ControlNetProblem>> {
-    let o = spec.require::<spec::OptimSpec>()?;
-    let from = fit::MapsFrom {
+pub fn problems(
+    spec: &Spec,
+    o: &OptimSpec,
+    ctx: &RunContext,
+) -> Result<BTreeMap<ProblemKey, ControlNetProblem>> {
+    let from = maps::MapsFrom {
         section: "optim",
         dir: o.maps.as_deref(),
         missing: o.maps_missing,
         som: o.som.as_ref(),
     };
-    let maps = fit::maps_for(spec, ctx, &o.datasets, o.grid, &from)?;
+    let maps = maps::maps_for(spec, ctx, &o.datasets, o.grid, &from)?;
     let mut out = BTreeMap::new();
     for entry in &o.datasets {
         let d = &crate::data::registry::name_of(entry);
         for &cn in &o.control_nets {
-            for p in &o.parameterisations {
-                let param: Parameterisation = p.parse().map_err(anyhow::Error::msg)?;
+            for &param in &o.parameterisations {
                 let grid = &maps[d].grid;
                 let fit =
                     fit_two_view(grid, cn.nx, cn.ny, param, Approach::Improved, &o.fit_options())
-                        .with_context(|| format!("{d} {cn} {p}"))?;
+                        .with_context(|| format!("{d} {cn} {param}"))?;
                 let parts = fit.control_net_parts(grid)?;
                 let bounds = match o.search_range {
                     Some(half_width) => BoxSpec::AroundStart { half_width },
                     None => BoxSpec::Cover { fraction: o.bounds_margin },
                 };
                 let problem = ControlNetProblem::new(parts, bounds)
-                    .with_context(|| format!("{d} {cn} {p}"))?;
+                    .with_context(|| format!("{d} {cn} {param}"))?;
                 out.insert((d.clone(), cn, param), problem);
             }
         }
@@ -157,9 +160,13 @@ pub fn problems(spec: &Spec, ctx: &RunContext) -> Result<BTreeMap<ProblemKey, Co
 }
 
 /// Run one cell (also alone: the same numbers as inside the full run).
-pub fn run_cell(spec: &Spec, cell: &OptimCell, problem: &ControlNetProblem) -> Result<OptimRun> {
-    let o = spec.require::<spec::OptimSpec>()?;
-    let opt = optimiser(spec, &cell.optimiser)?;
+pub fn run_cell(
+    spec: &Spec,
+    o: &OptimSpec,
+    cell: &OptimCell,
+    problem: &ControlNetProblem,
+) -> Result<OptimRun> {
+    let opt = optimiser(o, &cell.optimiser)?;
     let budget = Budget {
         generations: o.generations as u64,
         population: o.population,
@@ -167,10 +174,7 @@ pub fn run_cell(spec: &Spec, cell: &OptimCell, problem: &ControlNetProblem) -> R
         trace_every_evals: o.trace_every_evals,
     };
     let key = cell.key();
-    let mut rng = seeds::cell_rng(spec.file.master_seed, &key);
-    let t0 = runner::thread_cpu_seconds();
-    let r: RunResult = opt.run(problem, &budget, &mut rng).with_context(|| key.clone())?;
-    let cpu_s = runner::thread_cpu_seconds() - t0;
+    let (r, cpu_s) = runner::optimise(opt, problem, &budget, spec.file.master_seed, &key)?;
     if !r.best_fitness.is_finite() {
         anyhow::bail!("{key}: the best fitness is not finite ({})", r.best_fitness);
     }
@@ -198,6 +202,7 @@ pub fn run_cell(spec: &Spec, cell: &OptimCell, problem: &ControlNetProblem) -> R
     };
     Ok(OptimRun {
         cell: cell.clone(),
+        competitor: row.competitor(),
         row,
         trace: r.trace,
         improvements: r.improvements,
@@ -227,10 +232,11 @@ fn pictured(cell: &OptimCell, largest: GridSize) -> bool {
 /// Run every optimisation cell of a spec (its shard's, with `--shard`).
 pub fn run(
     spec: &Spec,
+    o: &OptimSpec,
     ctx: &RunContext,
     problems: &BTreeMap<ProblemKey, ControlNetProblem>,
 ) -> Result<Vec<OptimRun>> {
-    let cells = spec::cells(spec);
+    let cells = spec::cells(spec, o);
     let largest = cells.iter().map(|c| c.cn).max().unwrap_or(GridSize { nx: 0, ny: 0 });
     let problem = |cell: &OptimCell| &problems[&(cell.dataset.clone(), cell.cn, cell.param)];
     let mut runs = runner::run_logged(
@@ -238,7 +244,7 @@ pub fn run(
         ctx,
         &spec.file.name,
         |cell| {
-            let mut r = run_cell(spec, cell, problem(cell))?;
+            let mut r = run_cell(spec, o, cell, problem(cell))?;
             if !pictured(cell, largest) {
                 r.best_x = Vec::new();
             }
@@ -247,6 +253,7 @@ pub fn run(
         |cell, rec: OptimRecord| {
             Ok(OptimRun {
                 cell: cell.clone(),
+                competitor: rec.row.competitor(),
                 row: rec.row,
                 trace: rec.trace,
                 improvements: rec.improvements,
@@ -255,7 +262,7 @@ pub fn run(
         },
     )?;
     if ctx.extras {
-        picture_points(spec, &mut runs, largest, problem)?;
+        picture_points(spec, o, &mut runs, largest, problem)?;
     }
     Ok(runs)
 }
@@ -280,6 +287,7 @@ pub(crate) fn furthest(runs: &[OptimRun]) -> BTreeMap<(GridSize, String), usize>
 /// processes).
 fn picture_points<'a>(
     spec: &Spec,
+    o: &OptimSpec,
     runs: &mut [OptimRun],
     largest: GridSize,
     problem: impl Fn(&OptimCell) -> &'a ControlNetProblem,
@@ -300,7 +308,7 @@ fn picture_points<'a>(
         best.into_values().chain(furthest(runs).into_values()).collect();
     for k in wanted {
         if runs[k].best_x.is_empty() {
-            let again = run_cell(spec, &runs[k].cell, problem(&runs[k].cell))?;
+            let again = run_cell(spec, o, &runs[k].cell, problem(&runs[k].cell))?;
             if again.row.best.to_bits() != runs[k].row.best.to_bits() {
                 anyhow::bail!("cell {}: re-run gives {} but the cell log has {} (the code changed since the log was written?)", runs[k].row.cell, again.row.best, runs[k].row.best);
             }
@@ -311,8 +319,7 @@ fn picture_points<'a>(
 }
 
 /// One sentence on the start and the search box of a spec's runs, for the report.
-pub fn setting(spec: &Spec) -> String {
-    let Some(o) = spec.section::<spec::OptimSpec>() else { return String::new() };
+pub fn setting(o: &OptimSpec) -> String {
     let fair = if o.fairness > 0.0 { format!(", fairness {:e}", o.fairness) } else { String::new() };
     let start = format!(
         "Readings: knots `{}`{fair} (docs/readings.md). Each individual starts at B + U[-{r:e}, {r:e}] per coordinate",
@@ -329,10 +336,10 @@ pub fn setting(spec: &Spec) -> String {
 /// Chapter 6's family: the `[optim]` section.
 pub struct Optim;
 
-/// What `--sweep` may vary in `[optim]`: every registered optimiser's table and the run's
-/// budget and start range.
+/// What `--sweep` may vary in `[optim]`: every registered optimiser's table (a table the section
+/// does not have is refused when the variant is read) and the run's budget and start range.
 fn sweepable_keys() -> Vec<String> {
-    let opts = crate::optim::REGISTRY.iter().map(|make| format!("optim.{}.", make().name()));
+    let opts = crate::optim::REGISTRY.iter().map(|r| format!("optim.{}.", (r.make)().name()));
     opts.chain(
         ["optim.generations", "optim.population", "optim.init_range", "optim.repeats"]
             .map(String::from),
@@ -354,13 +361,13 @@ impl crate::experiment::family::Section for self::spec::OptimSpec {
         self.maps = Some(maps.to_string());
     }
     fn require_inputs(&self, spec: &Spec) -> Result<()> {
-        let from = fit::MapsFrom {
+        let from = maps::MapsFrom {
             section: "optim",
             dir: self.maps.as_deref(),
             missing: self.maps_missing,
             som: self.som.as_ref(),
         };
-        fit::require_maps(spec, &self.datasets, self.grid, &from).map(drop)
+        maps::require_maps(spec, &self.datasets, self.grid, &from).map(drop)
     }
     /// Optimiser settings only, so that every variant solves the same problems (same data,
     /// nets, search box) and the variants can be ranked like optimisers.
@@ -369,21 +376,25 @@ impl crate::experiment::family::Section for self::spec::OptimSpec {
 }
 
 impl crate::experiment::family::Experiment for Optim {
+    fn published(&self) -> crate::report::reference::Published {
+        self::report::PUBLISHED
+    }
     type Section = self::spec::OptimSpec;
-    fn logged_keys(&self, spec: &Spec) -> Vec<String> {
-        spec::cells(spec).iter().map(|c| c.key()).collect()
+    fn logged_keys(&self, spec: &Spec, s: &OptimSpec) -> Vec<String> {
+        spec::cells(spec, s).iter().map(|c| c.key()).collect()
     }
     fn run(
         &self,
         spec: &Spec,
+        s: &OptimSpec,
         ctx: &RunContext,
         tables: bool,
     ) -> Result<crate::experiment::family::Outcome> {
-        self.run_variants(std::slice::from_ref(spec), ctx, tables)
+        self.run_variants(&[(spec, s)], ctx, tables)
     }
     fn combine(
         &self,
-        view: &crate::experiment::family::PlanView,
+        view: &crate::experiment::family::PlanView<OptimSpec>,
     ) -> Result<crate::experiment::family::Combined> {
         overall::combine(view)
     }
@@ -391,19 +402,16 @@ impl crate::experiment::family::Experiment for Optim {
     /// only), then one set of tables in which each `optimiser@variant` of a sweep is a column.
     fn run_variants(
         &self,
-        variants: &[Spec],
+        variants: &[(&Spec, &OptimSpec)],
         ctx: &RunContext,
         tables: bool,
     ) -> Result<crate::experiment::family::Outcome> {
-        let [first, ..] = variants else { anyhow::bail!("no variant to run") };
-        let problems = problems(first, ctx)?;
-        let exact = if tables { exact_optima(first, ctx, &problems)? } else { BTreeMap::new() };
+        let [(first, o), ..] = variants else { anyhow::bail!("no variant to run") };
+        let problems = problems(first, o, ctx)?;
+        let exact = if tables { exact_optima(o, ctx, &problems)? } else { BTreeMap::new() };
         let mut runs = Vec::new();
-        for v in variants {
-            runs.extend(run(v, ctx, &problems)?.into_iter().map(|mut r| {
-                r.cell.optimiser = r.row.competitor();
-                r
-            }));
+        for (v, vo) in variants {
+            runs.extend(run(v, vo, ctx, &problems)?);
         }
         let section = if tables {
             Some(self::report::write(
@@ -411,7 +419,7 @@ impl crate::experiment::family::Experiment for Optim {
                 &runs,
                 &problems,
                 &exact,
-                &setting(first),
+                &setting(o),
                 &ctx.out,
                 ctx.extras,
             )?)

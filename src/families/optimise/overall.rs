@@ -18,17 +18,14 @@ const GRIDS: [(usize, usize); 2] = [(20, 20), (18, 30)];
 
 /// The plan's thesis protocol (the first spec on each grid without the exact solve), Tables 6.8
 /// and 6.9 from its win tables, the claims summed over both grids; the other specs are beyond.
-pub fn combine(view: &PlanView) -> Result<Combined> {
+pub fn combine(view: &PlanView<OptimSpec>) -> Result<Combined> {
     let protocol: Vec<(&str, (usize, usize))> = GRIDS
         .iter()
         .filter_map(|&g| {
             view.specs
                 .iter()
-                .find(|s| {
-                    s.section::<OptimSpec>()
-                        .is_some_and(|o| !o.exact && (o.grid.nx, o.grid.ny) == g)
-                })
-                .map(|s| (s.file.name.as_str(), g))
+                .find(|(_, o)| !o.exact && (o.grid.nx, o.grid.ny) == g)
+                .map(|(s, _)| (s.file.name.as_str(), g))
         })
         .collect();
     let mut per_grid = Vec::new();
@@ -74,7 +71,7 @@ pub fn combine(view: &PlanView) -> Result<Combined> {
         beyond: view
             .specs
             .iter()
-            .map(|s| s.file.name.clone())
+            .map(|(s, _)| s.file.name.clone())
             .filter(|n| !protocol.iter().any(|p| p.0 == n))
             .collect(),
         claims: overall_claims(&per_grid),

@@ -35,7 +35,7 @@ pub fn views(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProble
                 if r.cell.grid != grid || r.cell.dataset != d || r.best_x.is_empty() || k == k_far {
                     continue;
                 }
-                let e = min.entry((r.cell.param, r.cell.optimiser.clone())).or_insert(k);
+                let e = min.entry((r.cell.param, r.competitor.clone())).or_insert(k);
                 let held = &runs[*e];
                 // The largest net; there the least error.
                 if r.cell.cn > held.cell.cn || (r.cell.cn == held.cell.cn && r.row.best < held.row.best)
@@ -101,7 +101,7 @@ fn view(r: &OptimRun, d: &str, grid: GridSize, problem: &ControlNetProblem, furt
         "{d} on {grid}, CN {}, {}: {what} ({} r{}, best {:.4e}, excursion {:.3e})",
         r.cell.cn,
         r.cell.param.name(),
-        super::report::label(&r.cell.optimiser),
+        super::report::label(&r.competitor),
         r.cell.repeat,
         r.row.best,
         r.row.excursion

@@ -33,6 +33,14 @@ fn stats(v: &[f64]) -> Option<(f64, f64, f64)> {
 
 type CellKey = (String, Parameterisation, GridSize);
 
+/// The thesis' Appendices K and L (optimised surface error) and M and N (CPU time).
+pub const PUBLISHED: crate::report::reference::Published = &[
+    ("appendix_k", include_str!("../../../experiments/reference/appendix_k.csv")),
+    ("appendix_l", include_str!("../../../experiments/reference/appendix_l.csv")),
+    ("appendix_m", include_str!("../../../experiments/reference/appendix_m.csv")),
+    ("appendix_n", include_str!("../../../experiments/reference/appendix_n.csv")),
+];
+
 /// One value of ours beside the thesis' (Appendices K-N): the row key (data, parameterisation,
 /// cn_x, cn_y), the column, ours, the thesis'.
 struct Beside {
@@ -149,7 +157,7 @@ fn of(g: &[&OptimRun], c: &CellKey, o: &str, f: &dyn Fn(&OptimRun) -> f64) -> Ve
             r.cell.dataset == c.0
                 && r.cell.param == c.1
                 && r.cell.cn == c.2
-                && r.cell.optimiser == o
+                && r.competitor == o
         })
         .map(|r| f(r))
         .collect()
@@ -176,7 +184,7 @@ struct GridTables {
 
 impl GridTables {
     fn compute(g: &[&OptimRun]) -> GridTables {
-        let opts = ordered(g.iter().map(|r| r.cell.optimiser.clone()));
+        let opts = ordered(g.iter().map(|r| r.competitor.clone()));
         let cells: Vec<CellKey> =
             ordered(g.iter().map(|r| (r.cell.dataset.clone(), r.cell.param, r.cell.cn)));
         let mut eh =
@@ -299,7 +307,7 @@ impl GridTables {
             .enumerate()
             .map(|(k, o)| {
                 let cpu: f64 =
-                    g.iter().filter(|r| &r.cell.optimiser == o).map(|r| r.row.cpu_s).sum();
+                    g.iter().filter(|r| &r.competitor == o).map(|r| r.row.cpu_s).sum();
                 vec![
                     o.clone(),
                     format!("{}/{n}", self.err_wins[k]),
@@ -348,7 +356,7 @@ fn thesis_winner(t: &reference::RefTable, c: &CellKey, suffix: &str) -> Option<&
 fn winners_by_net(t: &GridTables, grid: GridSize, err_name: &str, out: &Path, extras: bool) -> Result<String> {
     let mut sorted = t.opts.clone();
     sorted.sort();
-    let thesis = if sorted == ["de", "ga", "pso"] { reference::table(err_name) } else { None };
+    let thesis = if sorted == ["de", "ga", "pso"] { reference::lookup(PUBLISHED, err_name) } else { None };
     let nets = ordered(t.cells.iter().map(|c| c.2));
     let mut h = vec!["cn_x".to_string(), "cn_y".into(), "cells".into()];
     h.extend(t.opts.iter().map(|o| format!("{o}_wins")));
@@ -442,7 +450,7 @@ fn grid_claims(t: &GridTables, grid: GridSize, err_name: &str, time_name: &str) 
     };
     let own = |table: &str, suffix: &str, o: &str| {
         if thesis_set {
-            thesis_wins(reference::table(table).as_ref(), suffix, o, &t.cells)
+            thesis_wins(reference::lookup(PUBLISHED, table).as_ref(), suffix, o, &t.cells)
         } else {
             None
         }
@@ -567,11 +575,11 @@ fn exact_section(
 /// "Fitness evaluations per run: ..." (the budgets differ by optimiser, and Tables 6.6/6.7,
 /// "GA is the fastest", rest on them).
 fn budgets(runs: &[OptimRun]) -> String {
-    let budgets: Vec<String> = ordered(runs.iter().map(|r| r.cell.optimiser.clone()))
+    let budgets: Vec<String> = ordered(runs.iter().map(|r| r.competitor.clone()))
         .iter()
         .map(|o| {
             let e: Vec<u64> =
-                runs.iter().filter(|r| &r.cell.optimiser == o).map(|r| r.row.evaluations).collect();
+                runs.iter().filter(|r| &r.competitor == o).map(|r| r.row.evaluations).collect();
             let (lo, hi) =
                 (e.iter().min().copied().unwrap_or(0), e.iter().max().copied().unwrap_or(0));
             if lo == hi {
@@ -581,7 +589,7 @@ fn budgets(runs: &[OptimRun]) -> String {
             }
         })
         .collect();
-    let ga = if runs.iter().any(|r| r.cell.optimiser == "ga") && budgets.len() > 1 {
+    let ga = if runs.iter().any(|r| r.competitor == "ga") && budgets.len() > 1 {
         " GA is steady-state (thesis 6.2.4.1) and evaluates two offspring per generation, the others their whole population each generation; its lead in CPU time (Tables 6.6, 6.7) rests on that smaller budget."
     } else {
         ""
@@ -592,12 +600,12 @@ fn budgets(runs: &[OptimRun]) -> String {
 /// The claims over every run: the surfaces stay near the data, elitism holds.
 fn run_claims(runs: &[OptimRun]) -> Vec<Claim> {
     let near =
-        runs.iter().filter(|r| r.row.excursion <= crate::families::fit::report::NEAR).count();
+        runs.iter().filter(|r| r.row.excursion <= crate::spline::geometry::NEAR).count();
     let worst = runs.iter().max_by(|a, b| a.row.excursion.total_cmp(&b.row.excursion));
     let kept = runs.iter().filter(|r| r.row.best <= r.row.initial_best).count();
     vec![
         Claim::every("6", "The optimised surfaces stay near the data", (near, runs.len()))
-            .note(format!("runs whose best surfaces' dense excursion from the data's bounding box is at most {}{}", crate::families::fit::report::NEAR, worst.map(|w| format!("; largest {:.3e} at {}", w.row.excursion, w.row.cell)).unwrap_or_default())),
+            .note(format!("runs whose best surfaces' dense excursion from the data's bounding box is at most {}{}", crate::spline::geometry::NEAR, worst.map(|w| format!("; largest {:.3e} at {}", w.row.excursion, w.row.cell)).unwrap_or_default())),
         Claim::every("6", "Every run's best is no worse than its initial population's best", (kept, runs.len()))
             .note("elitism check over all runs"),
     ]
@@ -628,7 +636,7 @@ fn write_grid(
         [(err_name, &t.eh, &t.erows, false), (time_name, &t.th, &t.trows, true)]
     {
         // Only where the thesis has values for some of these cells: no empty table.
-        let pairs = reference::table(name).map(|r| side_by_side(h, rows, &r)).unwrap_or_default();
+        let pairs = reference::lookup(PUBLISHED, name).map(|r| side_by_side(h, rows, &r)).unwrap_or_default();
         if !pairs.is_empty() {
             beside_md.push_str(&render_side_by_side(&pairs, name, timing, out)?);
         }
@@ -762,7 +770,7 @@ fn appendix_ij(
                             r.cell.dataset == d
                                 && r.cell.param == p
                                 && r.cell.cn == cn
-                                && &r.cell.optimiser == o
+                                && &r.competitor == o
                         })
                         .min_by(|a, b| a.row.best.total_cmp(&b.row.best));
                     if let Some(r) = min {
@@ -832,7 +840,7 @@ fn convergence_charts(
                         r.cell.dataset == d
                             && r.cell.param == p0
                             && r.cell.cn == cn
-                            && &r.cell.optimiser == o
+                            && &r.competitor == o
                     })
                     .collect();
                 groups.push((o.clone(), rs.iter().map(|r| r.row.best).collect::<Vec<f64>>()));

@@ -3,7 +3,7 @@
 
 use crate::experiment::limits::{self, Check};
 use crate::experiment::spec::{GridSize, Spec, SpecError};
-use crate::families::fit::spec::{validate_grid_keys, validate_map_som, FitSom, MapsMissing};
+use crate::families::maps::{validate_grid_keys, validate_map_som, MapSom, MapsMissing};
 use serde::Deserialize;
 
 /// Chapter 6 section: data sets x control nets x parameterisations x optimisers x repeats, every
@@ -14,17 +14,17 @@ pub struct OptimSpec {
     pub datasets: Vec<String>,
     pub grid: GridSize,
     pub control_nets: Vec<GridSize>,
-    pub parameterisations: Vec<String>,
+    pub parameterisations: Vec<crate::spline::Parameterisation>,
     /// ga, de, pso, csa, icsa.
     pub optimisers: Vec<String>,
-    #[serde(default = "default_ten")]
+    #[serde(default = "crate::experiment::defaults::ten")]
     pub repeats: usize,
-    #[serde(default = "default_generations")]
+    #[serde(default = "crate::experiment::defaults::generations")]
     pub generations: usize,
-    #[serde(default = "default_population")]
+    #[serde(default = "crate::experiment::defaults::population")]
     pub population: usize,
     /// Half-width of the initial range around B (Table 6.1: 5e-6).
-    #[serde(default = "default_init_range")]
+    #[serde(default = "crate::experiment::defaults::init_range")]
     pub init_range: f64,
     /// The search box: the data and B's control points, widened by this share of its size.
     #[serde(default)]
@@ -40,7 +40,7 @@ pub struct OptimSpec {
     #[serde(default)]
     pub maps_missing: MapsMissing,
     #[serde(default)]
-    pub som: Option<FitSom>,
+    pub som: Option<MapSom>,
     /// Also solve each cell's convex problem exactly in the box (certified) and report every
     /// optimiser's gap to it.
     #[serde(default)]
@@ -52,7 +52,7 @@ pub struct OptimSpec {
     #[serde(default = "default_exact_tol")]
     pub exact_tol: f64,
     /// Trace checkpoint: the best fitness so far is recorded every this many evaluations.
-    #[serde(default = "default_trace_every")]
+    #[serde(default = "crate::experiment::defaults::trace_every")]
     pub trace_every_evals: u64,
     #[serde(default)]
     pub ga: crate::optim::ga::Ga,
@@ -92,26 +92,11 @@ impl OptimSpec {
     }
 }
 
-pub(crate) fn default_ten() -> usize {
-    10
-}
-pub(crate) fn default_generations() -> usize {
-    2000
-}
-pub(crate) fn default_population() -> usize {
-    40
-}
 fn default_exact_newton_steps() -> usize {
     300
 }
 fn default_exact_tol() -> f64 {
     1e-7
-}
-pub(crate) fn default_trace_every() -> u64 {
-    400
-}
-pub(crate) fn default_init_range() -> f64 {
-    5e-6
 }
 
 /// Every value of the `[optim]` section (after the limits).
@@ -157,21 +142,15 @@ pub(crate) fn validate(spec: &Spec, o: &OptimSpec) -> Result<(), SpecError> {
     if !(o.exact_tol > 0.0 && o.exact_tol < 1.0) {
         return Err(spec.err("optim.exact_tol", format!("must be in (0,1), got {}", o.exact_tol)));
     }
-    spec.validate_optimiser_params(
-        "optim",
-        [o.ga.validate(), o.de.validate(), o.pso.validate(), o.csa.validate(), o.icsa.validate()],
-    )?;
     Ok(())
 }
 
 /// The flat list of optimisation cells (data x net x parameterisation x optimiser x repeat).
-pub fn cells(spec: &Spec) -> Vec<OptimCell> {
-    let Some(o) = spec.section::<OptimSpec>() else { return Vec::new() };
+pub fn cells(spec: &Spec, o: &OptimSpec) -> Vec<OptimCell> {
     let mut cells = Vec::new();
     for dataset in &o.datasets {
         for cn in &o.control_nets {
-            for p in &o.parameterisations {
-                let Ok(param) = p.parse() else { continue };
+            for &param in &o.parameterisations {
                 for opt in &o.optimisers {
                     for repeat in 0..o.repeats {
                         cells.push(OptimCell {

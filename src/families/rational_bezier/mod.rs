@@ -7,7 +7,7 @@ pub mod spec;
 
 use crate::experiment::spec::{Spec, SpecError};
 use crate::experiment::{runner, seeds, RunContext};
-use crate::optim::{Budget, Optimiser, Problem, RunResult};
+use crate::optim::{Budget, Optimiser, Problem};
 use crate::spline::conic::{self, ConicProblem, P2};
 use crate::spline::rational_bezier::{SurfaceSse, TestSurface};
 use anyhow::{Context, Result};
@@ -73,13 +73,8 @@ impl runner::Logged for Run {
     }
 }
 
-fn section(spec: &Spec) -> Result<&Seed002Spec> {
-    spec.require::<spec::Seed002Spec>()
-}
-
 /// The flat list of cells.
-pub fn cells(spec: &Spec) -> Vec<Cell> {
-    let Some(s) = spec.section::<spec::Seed002Spec>() else { return Vec::new() };
+pub fn cells(s: &Seed002Spec) -> Vec<Cell> {
     runner::product_cells(&s.surfaces, &s.optimisers, s.repeats, |sf, o, repeat| Cell {
         surface: sf.clone(),
         optimiser: o.clone(),
@@ -100,8 +95,7 @@ fn optimiser<'a>(s: &'a Seed002Spec, name: &str) -> Result<&'a dyn Optimiser> {
 }
 
 /// Run one cell (alone it gives the same numbers as inside the full run).
-pub fn run_cell(spec: &Spec, cell: &Cell) -> Result<Run> {
-    let s = section(spec)?;
+pub fn run_cell(spec: &Spec, s: &Seed002Spec, cell: &Cell) -> Result<Run> {
     let problem = problem(s, &cell.surface)?;
     let opt = optimiser(s, &cell.optimiser)?;
     // init_range is a share of the data's largest bounding-box extent (the domains differ in scale).
@@ -121,10 +115,7 @@ pub fn run_cell(spec: &Spec, cell: &Cell) -> Result<Run> {
         trace_every_evals: s.trace_every_evals,
     };
     let key = cell.key();
-    let mut rng = seeds::cell_rng(spec.file.master_seed, &key);
-    let t0 = runner::thread_cpu_seconds();
-    let r: RunResult = opt.run(&problem, &budget, &mut rng).with_context(|| key.clone())?;
-    let cpu_s = runner::thread_cpu_seconds() - t0;
+    let (r, cpu_s) = runner::optimise(opt, &problem, &budget, spec.file.master_seed, &key)?;
     let n = problem.n_points();
     let row = Row {
         cell: key.clone(),
@@ -146,13 +137,13 @@ pub fn run_cell(spec: &Spec, cell: &Cell) -> Result<Run> {
 }
 
 /// Run every cell of the spec.
-pub fn run(spec: &Spec, ctx: &RunContext) -> Result<Vec<Run>> {
-    let cells = cells(spec);
+pub fn run(spec: &Spec, s: &Seed002Spec, ctx: &RunContext) -> Result<Vec<Run>> {
+    let cells = cells(s);
     runner::run_logged(
         &cells,
         ctx,
         &spec.file.name,
-        |cell| run_cell(spec, cell),
+        |cell| run_cell(spec, s, cell),
         |cell, (row, trace)| Ok(Run { cell: cell.clone(), row, trace, best_x: Vec::new() }),
     )
 }
@@ -202,8 +193,7 @@ pub struct CurveRun {
     pub conics: Vec<([P2; 3], f64)>,
 }
 
-pub fn curve_cells(spec: &Spec) -> Vec<CurveCell> {
-    let Some(s) = spec.section::<spec::Seed002Spec>() else { return Vec::new() };
+pub fn curve_cells(s: &Seed002Spec) -> Vec<CurveCell> {
     runner::product_cells(&s.outlines, &s.optimisers, s.repeats, |ol, o, repeat| CurveCell {
         outline: ol.clone(),
         optimiser: o.clone(),
@@ -213,8 +203,7 @@ pub fn curve_cells(spec: &Spec) -> Vec<CurveCell> {
 
 /// Sample the outline, detect its corners (SAM06), cut it into conic runs and fit each run's
 /// conic with the cell's optimiser, all on the cell's stream in run order.
-pub fn run_curve_cell(spec: &Spec, cell: &CurveCell) -> Result<CurveRun> {
-    let s = section(spec)?;
+pub fn run_curve_cell(spec: &Spec, s: &Seed002Spec, cell: &CurveCell) -> Result<CurveRun> {
     let (pieces, truth) = conic::outline(&cell.outline)
         .with_context(|| format!("seed002.outlines: unknown outline `{}`", cell.outline))?;
     let points = conic::sample_closed(&pieces, s.outline_spacing);
@@ -230,25 +219,27 @@ pub fn run_curve_cell(spec: &Spec, cell: &CurveCell) -> Result<CurveRun> {
         .count();
     let opt = optimiser(s, &cell.optimiser)?;
     let key = cell.key();
-    let mut rng = seeds::cell_rng(spec.file.master_seed, &key);
-    let t0 = runner::thread_cpu_seconds();
-    let (mut sse, mut start_sse, mut evals, mut conics) = (0.0, 0.0, 0u64, Vec::new());
-    for run in conic::conic_runs(&points, &corners) {
-        let problem = ConicProblem::new(run, s.bounds_margin, s.w_min, 10.0);
-        let ext = problem.bounds().1[0] - problem.bounds().0[0];
-        let budget = Budget {
-            generations: s.curve_generations as u64,
-            population: s.population,
-            init_range: s.init_range * ext,
-            trace_every_evals: s.trace_every_evals,
-        };
-        let r = opt.run(&problem, &budget, &mut rng).with_context(|| key.clone())?;
-        start_sse += problem.fitness(problem.initial_point());
-        sse += r.best_fitness;
-        evals += r.evaluations;
-        conics.push(problem.control(&r.best_x));
-    }
-    let cpu_s = runner::thread_cpu_seconds() - t0;
+    // Every conic of the outline runs on the cell's one stream, in order.
+    let (fits, cpu_s) = runner::on_stream(spec.file.master_seed, &key, |rng| {
+        let (mut sse, mut start_sse, mut evals, mut conics) = (0.0, 0.0, 0u64, Vec::new());
+        for run in conic::conic_runs(&points, &corners) {
+            let problem = ConicProblem::new(run, s.bounds_margin, s.w_min, 10.0);
+            let ext = problem.bounds().1[0] - problem.bounds().0[0];
+            let budget = Budget {
+                generations: s.curve_generations as u64,
+                population: s.population,
+                init_range: s.init_range * ext,
+                trace_every_evals: s.trace_every_evals,
+            };
+            let r = opt.run(&problem, &budget, rng).with_context(|| key.clone())?;
+            start_sse += problem.fitness(problem.initial_point());
+            sse += r.best_fitness;
+            evals += r.evaluations;
+            conics.push(problem.control(&r.best_x));
+        }
+        anyhow::Ok((sse, start_sse, evals, conics))
+    });
+    let (sse, start_sse, evals, conics) = fits?;
     let row = CurveRow {
         cell: key.clone(),
         outline: cell.outline.clone(),
@@ -270,13 +261,13 @@ pub fn run_curve_cell(spec: &Spec, cell: &CurveCell) -> Result<CurveRun> {
 
 /// The curve cells (a fraction of a second in all; not logged: a resumed run or a merge runs
 /// them again, deterministically).
-pub fn run_curves(spec: &Spec, ctx: &RunContext) -> Result<Vec<CurveRun>> {
-    let cells = curve_cells(spec);
+pub fn run_curves(spec: &Spec, s: &Seed002Spec, ctx: &RunContext) -> Result<Vec<CurveRun>> {
+    let cells = curve_cells(s);
     runner::run_cells(
         &cells,
         ctx.jobs,
         "seed002 curves",
-        |c| run_curve_cell(spec, c),
+        |c| run_curve_cell(spec, s, c),
         |_, _| Ok(()),
     )
 }
@@ -295,21 +286,21 @@ impl crate::experiment::family::Section for self::spec::Seed002Spec {
 
 impl crate::experiment::family::Experiment for Seed002 {
     type Section = self::spec::Seed002Spec;
-    fn logged_keys(&self, spec: &Spec) -> Vec<String> {
-        cells(spec).iter().map(|c| c.key()).collect()
+    fn logged_keys(&self, _spec: &Spec, s: &Seed002Spec) -> Vec<String> {
+        cells(s).iter().map(|c| c.key()).collect()
     }
-    fn unlogged_keys(&self, spec: &Spec) -> Vec<String> {
-        curve_cells(spec).iter().map(|c| c.key()).collect()
+    fn unlogged_keys(&self, _spec: &Spec, s: &Seed002Spec) -> Vec<String> {
+        curve_cells(s).iter().map(|c| c.key()).collect()
     }
     fn run(
         &self,
         spec: &Spec,
+        s: &Seed002Spec,
         ctx: &RunContext,
         tables: bool,
     ) -> Result<crate::experiment::family::Outcome> {
-        let s = section(spec)?;
-        let runs = run(spec, ctx)?;
-        let curves = run_curves(spec, ctx)?;
+        let runs = run(spec, s, ctx)?;
+        let curves = run_curves(spec, s, ctx)?;
         let section = if tables {
             Some(self::report::write(&runs, &curves, s.population, &ctx.out)?)
         } else {

@@ -147,12 +147,9 @@ pub fn run_cell(
 ) -> Result<SomRun> {
     let key = cell.key();
     let topo = cell.model.topology(cell.grid.nx, cell.grid.ny).map_err(anyhow::Error::msg)?;
-    let mut rng = seeds::cell_rng(master_seed, &key);
-    let t0 = runner::thread_cpu_seconds();
-    let trained = som::train(topo.as_ref(), data, params, &mut rng)
-        .map_err(anyhow::Error::msg)
-        .with_context(|| key.clone())?;
-    let cpu_s = runner::thread_cpu_seconds() - t0;
+    let (trained, cpu_s) =
+        runner::on_stream(master_seed, &key, |rng| som::train(topo.as_ref(), data, params, rng));
+    let trained = trained.map_err(anyhow::Error::msg).with_context(|| key.clone())?;
     let fin = som::final_map_metrics(topo.as_ref(), &trained.weights, data);
     let row = SomRow::new(
         cell,
@@ -176,15 +173,18 @@ pub type Frames = BTreeMap<String, crate::data::frame::Frame>;
 
 /// Run every SOM cell of a spec, logging each finished cell to the folder's cell log; also each
 /// data set's frame, for the saved maps.
-pub fn run(spec: &Spec, ctx: &RunContext) -> Result<(Vec<SomRun>, Frames)> {
-    let som_spec = spec.require::<spec::SomSpec>()?;
+pub fn run(
+    spec: &Spec,
+    som_spec: &spec::SomSpec,
+    ctx: &RunContext,
+) -> Result<(Vec<SomRun>, Frames)> {
     let data = load_datasets(spec, &som_spec.datasets, ctx)?;
     let params = SomParams {
         iterations: som_spec.iterations,
         alpha0: som_spec.alpha0,
         sigma0: som_spec.sigma0,
     };
-    let cells = spec::cells(spec);
+    let cells = spec::cells(som_spec);
     for entry in &som_spec.datasets {
         let name = crate::data::registry::name_of(entry);
         for c in cells.iter().filter(|c| c.dataset == name) {
@@ -232,6 +232,9 @@ impl crate::experiment::family::Section for self::spec::SomSpec {
 }
 
 impl crate::experiment::family::Experiment for Som {
+    fn published(&self) -> crate::report::reference::Published {
+        self::report::PUBLISHED
+    }
     /// Chapter 4's metrics, exactly as computed (libraries disagree on them).
     fn definitions(&self) -> crate::experiment::Definitions {
         crate::experiment::Definitions(&[
@@ -244,18 +247,22 @@ impl crate::experiment::family::Experiment for Som {
         ])
     }
     type Section = self::spec::SomSpec;
-    fn logged_keys(&self, spec: &Spec) -> Vec<String> {
-        spec::cells(spec).iter().map(|c| c.key()).collect()
+    fn logged_keys(&self, _spec: &Spec, s: &spec::SomSpec) -> Vec<String> {
+        spec::cells(s).iter().map(|c| c.key()).collect()
     }
     fn run(
         &self,
         spec: &Spec,
+        s: &spec::SomSpec,
         ctx: &RunContext,
         tables: bool,
     ) -> Result<crate::experiment::family::Outcome> {
-        let (runs, frames) = run(spec, ctx)?;
-        let section =
-            if tables { Some(self::report::write(spec, &runs, &frames, &ctx.out, ctx.extras)?) } else { None };
+        let (runs, frames) = run(spec, s, ctx)?;
+        let section = if tables {
+            Some(self::report::write(spec, s, &runs, &frames, &ctx.out, ctx.extras)?)
+        } else {
+            None
+        };
         Ok(crate::experiment::family::Outcome {
             section,
             cpu_s: runs.iter().map(|r| r.row.cpu_s).sum(),

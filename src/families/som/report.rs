@@ -2,7 +2,6 @@
 //! saved DNSOM maps, the pictures and the Chapter 4 section of REPORT.md. Reads only the runs.
 
 use super::SomRun;
-use crate::double_net::View;
 use crate::experiment::spec::{GridSize, Spec};
 use crate::io::{csv_records, csv_text, write_atomic};
 use crate::report::claims::Claim;
@@ -68,7 +67,7 @@ fn grids(runs: &[SomRun], square: bool) -> Vec<GridSize> {
 /// exact columns. Returns (header, rows) or None when the runs hold no such cell.
 pub fn appendix_table(runs: &[SomRun], square: bool) -> Option<(Vec<String>, Vec<Vec<String>>)> {
     let name = if square { "appendix_b" } else { "appendix_c" };
-    let header = reference::table(name)?.header;
+    let header = reference::lookup(PUBLISHED, name)?.header;
     let models: Vec<Model> =
         if square { Model::ALL.to_vec() } else { vec![Model::Cksom, Model::Dnsom] };
     let mut rows = Vec::new();
@@ -168,54 +167,19 @@ pub fn table_4_14() -> (Vec<String>, Vec<Vec<String>>) {
     (["n_x", "n_y", "non", "nov", "nor"].iter().map(|s| s.to_string()).collect(), rows)
 }
 
-/// A two-view grid as CSV: i, j, view, class (1-based class number), x, y, z; one row per
-/// position of both views (NON rows), bottom view first. Chapter 5 and `somnurbs fit` read it back.
-pub fn two_view_grid_csv(grid: &crate::spline::TwoViewGrid) -> Result<String> {
-    let net = crate::double_net::DoubleNet::new(grid.nx, grid.ny)
-        .ok_or_else(|| anyhow::anyhow!("grid {}x{} is too small", grid.nx, grid.ny))?;
-    let mut rows = Vec::with_capacity(net.non());
-    for view in View::BOTH {
-        let points = match view {
-            View::Bottom => &grid.bottom,
-            View::Top => &grid.top,
-        };
-        for i in 0..net.nx {
-            for j in 0..net.ny {
-                let w = points[net.at(i, j)];
-                rows.push(vec![
-                    i.to_string(),
-                    j.to_string(),
-                    view.name().to_string(),
-                    (net.class(view, i, j) + 1).to_string(),
-                    format!("{:?}", w[0]),
-                    format!("{:?}", w[1]),
-                    format!("{:?}", w[2]),
-                ]);
-            }
-        }
-    }
-    let header: Vec<String> =
-        ["i", "j", "view", "class", "x", "y", "z"].iter().map(|s| s.to_string()).collect();
-    csv_records(&header, &rows)
-}
-
 /// The saved DNSOM map of a run.
 pub fn dnsom_map_csv(run: &SomRun) -> Result<String> {
     let g = run.cell.grid;
-    two_view_grid_csv(&crate::families::fit::grid_from_weights(g.nx, g.ny, &run.weights))
-}
-
-/// Write `frame` beside the map file `map` ([`crate::data::frame::sidecar`]).
-pub fn write_frame(map: &Path, frame: &crate::data::frame::Frame) -> Result<()> {
-    let name = map.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let text = frame.to_toml(&name)?;
-    write_atomic(&crate::data::frame::sidecar(map), text.as_bytes())
+    let grid = crate::double_net::TwoViewGrid::from_weights(g.nx, g.ny, &run.weights)
+        .ok_or_else(|| anyhow::anyhow!("{}: not a DNSOM map", run.row.cell))?;
+    crate::io::map_file::text(&grid)
 }
 
 /// Write every Chapter 4 file; returns the REPORT.md section. Each saved map has its data set's
 /// frame beside it (`maps/dnsom_<data>_<grid>.frame.toml`, not a table: drift skips `maps/`).
 pub fn write(
     spec: &Spec,
+    som: &super::spec::SomSpec,
     runs: &[SomRun],
     frames: &super::Frames,
     out: &Path,
@@ -247,8 +211,7 @@ pub fn write(
     write_atomic(&out.join("table_4_14.csv"), csv_records(&h, &r)?.as_bytes())?;
     written.push("table_4_14.csv".into());
 
-    let save =
-        &spec.section::<super::spec::SomSpec>().map(|s| s.save_maps.clone()).unwrap_or_default();
+    let save = &som.save_maps;
     let mut maps = Vec::new();
     for run in runs.iter().filter(|r| {
         r.cell.model == Model::Dnsom && r.cell.repeat == 0 && save.contains(&r.cell.grid)
@@ -256,13 +219,11 @@ pub fn write(
         let name = format!("maps/dnsom_{}_{}.csv", run.cell.dataset, run.cell.grid);
         write_atomic(&out.join(&name), dnsom_map_csv(run)?.as_bytes())?;
         if let Some(frame) = frames.get(&run.cell.dataset) {
-            write_frame(&out.join(&name), frame)?;
+            crate::io::map_file::write_frame(&out.join(&name), frame)?;
         }
         maps.push(name);
     }
-    let pictures = if pictures
-        && spec.section::<super::spec::SomSpec>().map(|s| s.pictures).unwrap_or(false)
-    {
+    let pictures = if pictures && som.pictures {
         super::pictures::write(runs, out)?
     } else {
         Vec::new()
@@ -372,8 +333,8 @@ fn paired(
 
 /// Chapter 4 claims, checked on the runs and, for the same cases, on the thesis' Appendix B/C.
 pub fn claims(runs: &[SomRun]) -> Vec<Claim> {
-    let thesis_b = reference::table("appendix_b");
-    let thesis_c = reference::table("appendix_c");
+    let thesis_b = reference::lookup(PUBLISHED, "appendix_b");
+    let thesis_c = reference::lookup(PUBLISHED, "appendix_c");
     let ours = |d: &str, m: Model, g: GridSize, s: &str| mean_of(runs, d, m, g, s);
     let theirs = |d: &str, m: Model, g: GridSize, s: &str| -> Option<f64> {
         if g.nx == g.ny {
@@ -418,6 +379,15 @@ pub fn claims(runs: &[SomRun]) -> Vec<Claim> {
 }
 
 /// The thesis' figures at n x n: Appendix B and the bunny run of Section 4.3 (Figure 4.13).
+/// The thesis' Appendices B and C, and Section 4.3's bunny figures (its line "The QE and TE of the
+/// experiment were 0.049694 and 0.225400 ... CPU time ... 5.386289 seconds", in Appendix B's
+/// columns, DNSOM only).
+pub const PUBLISHED: reference::Published = &[
+    ("appendix_b", include_str!("../../../experiments/reference/appendix_b.csv")),
+    ("appendix_c", include_str!("../../../experiments/reference/appendix_c.csv")),
+    ("section_4_bunny", include_str!("../../../experiments/reference/section_4_bunny.csv")),
+];
+
 const THESIS_SQUARE: [&str; 2] = ["appendix_b", "section_4_bunny"];
 
 fn side_by_side(runs: &[SomRun], square: bool, thesis: Option<&RefTable>) -> String {
@@ -461,8 +431,8 @@ fn side_by_side(runs: &[SomRun], square: bool, thesis: Option<&RefTable>) -> Str
 }
 
 fn speed_section(runs: &[SomRun]) -> String {
-    let tb = reference::joined(&THESIS_SQUARE);
-    let tc = reference::table("appendix_c");
+    let tb = reference::joined(PUBLISHED, &THESIS_SQUARE);
+    let tc = reference::lookup(PUBLISHED, "appendix_c");
     let mut rows = Vec::new();
     for m in Model::ALL {
         let mut ratios = Vec::new();
@@ -543,11 +513,11 @@ fn section(
     }
     if appendix_table(runs, true).is_some() {
         s.push_str("\n### Appendix B, side by side\n");
-        s.push_str(&side_by_side(runs, true, reference::joined(&THESIS_SQUARE).as_ref()));
+        s.push_str(&side_by_side(runs, true, reference::joined(PUBLISHED, &THESIS_SQUARE).as_ref()));
     }
     if appendix_table(runs, false).is_some() {
         s.push_str("\n### Appendix C, side by side\n");
-        s.push_str(&side_by_side(runs, false, reference::table("appendix_c").as_ref()));
+        s.push_str(&side_by_side(runs, false, reference::lookup(PUBLISHED, "appendix_c").as_ref()));
     }
     s.push_str(&speed_section(runs));
     let sq = grids(runs, true);

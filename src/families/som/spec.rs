@@ -5,17 +5,8 @@ use crate::experiment::limits::{self, Check};
 use crate::experiment::spec::{GridSize, Spec, SpecError};
 use serde::Deserialize;
 
-pub(crate) fn default_iterations() -> usize {
-    30_000
-}
-pub(crate) fn default_alpha0() -> f64 {
-    0.9
-}
 fn default_repeats() -> usize {
     1
-}
-pub(crate) fn default_true() -> bool {
-    true
 }
 
 /// Chapter 4 section: data sets x groups of (models x grids) x repeats.
@@ -25,10 +16,10 @@ pub struct SomSpec {
     /// Data-set names (`somnurbs datasets list`) or paths to point files.
     pub datasets: Vec<String>,
     /// Maximum iteration T (Table 4.1).
-    #[serde(default = "default_iterations")]
+    #[serde(default = "crate::experiment::defaults::som_iterations")]
     pub iterations: usize,
     /// Initial learning rate alpha0 (Table 4.1).
-    #[serde(default = "default_alpha0")]
+    #[serde(default = "crate::experiment::defaults::som_alpha0")]
     pub alpha0: f64,
     /// Initial radius; default half the smaller grid side (Table 4.1).
     #[serde(default)]
@@ -42,14 +33,14 @@ pub struct SomSpec {
     #[serde(default)]
     pub save_maps: Vec<GridSize>,
     /// One PNG per cell and the overview pictures.
-    #[serde(default = "default_true")]
+    #[serde(default = "crate::experiment::defaults::yes")]
     pub pictures: bool,
 }
 
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SomGroup {
-    pub models: Vec<String>,
+    pub models: Vec<crate::som::Model>,
     pub grids: Vec<GridSize>,
 }
 
@@ -85,9 +76,7 @@ pub(crate) fn validate(spec: &Spec, som: &SomSpec) -> Result<(), SpecError> {
         if group.grids.is_empty() {
             return Err(spec.err(&format!("{key}.grids"), "is empty"));
         }
-        for m in &group.models {
-            let model: crate::som::Model =
-                m.parse().map_err(|e| spec.err(&format!("{key}.models"), e))?;
+        for &model in &group.models {
             for grid in &group.grids {
                 if som.sigma0.is_none() && grid.nx.min(grid.ny) < 3 {
                     return Err(spec.err(
@@ -103,7 +92,7 @@ pub(crate) fn validate(spec: &Spec, som: &SomSpec) -> Result<(), SpecError> {
     }
     for grid in &som.save_maps {
         let has =
-            cells(spec).iter().any(|c| c.model == crate::som::Model::Dnsom && c.grid == *grid);
+            cells(som).iter().any(|c| c.model == crate::som::Model::Dnsom && c.grid == *grid);
         if !has {
             return Err(spec.err("som.save_maps", format!("no DNSOM cell at grid {grid} to save")));
         }
@@ -112,16 +101,14 @@ pub(crate) fn validate(spec: &Spec, som: &SomSpec) -> Result<(), SpecError> {
 }
 
 /// The flat list of SOM cells (data set x group x grid x model x repeat), in report order.
-pub fn cells(spec: &Spec) -> Vec<SomCell> {
-    let Some(som) = spec.section::<SomSpec>() else { return Vec::new() };
+pub fn cells(som: &SomSpec) -> Vec<SomCell> {
     let mut cells = Vec::new();
     // Groups may share a (model, grid): each cell once, in first-seen order.
     let mut seen = std::collections::HashSet::new();
     for dataset in &som.datasets {
         for group in &som.groups {
             for grid in &group.grids {
-                for m in &group.models {
-                    let Ok(model) = m.parse() else { continue };
+                for &model in &group.models {
                     for repeat in 0..som.repeats {
                         let cell = SomCell {
                             dataset: crate::data::registry::name_of(dataset),

@@ -80,19 +80,17 @@ pub fn cycle_colour(i: usize) -> RGBColor {
     CYCLE[i % CYCLE.len()]
 }
 
-/// One colour per optimiser (case-insensitive): ga, de, pso, csa, icsa, exact (the certified
-/// convex optimum) and b (approach B's least-squares control points, the starting point).
+/// One colour per optimiser (case-insensitive): each registered one's (`optim::REGISTRY`), and
+/// exact (the certified convex optimum) and b (approach B's least-squares control points, the
+/// starting point).
 /// Unknown names get `None`; use [`cycle_colour`] for them.
 pub fn optimiser_colour(name: &str) -> Option<RGBColor> {
     match name.trim().to_ascii_lowercase().as_str() {
-        "ga" => Some(ORANGE),
-        "de" => Some(BLUE),
-        "pso" => Some(GREEN),
-        "csa" => Some(PURPLE),
-        "icsa" => Some(VERMILLION),
         "exact" => Some(BLACK),
         "b" => Some(GREY),
-        _ => None,
+        other => {
+            crate::optim::registered(other).map(|r| RGBColor(r.colour[0], r.colour[1], r.colour[2]))
+        }
     }
 }
 

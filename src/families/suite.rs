@@ -1,16 +1,18 @@
-//! Chapter 6's problems outside a run, as a benchmark suite (issue 39): what the Python package
-//! (`python/`) and any other caller get. The problems are made by the run's own code path
-//! ([`super::problems`] for an `[optim]` spec; `growing_grid::{maps, problems}` for seed 001's open
-//! surfaces) from the same spec, profile and `--set` readings, so a problem's fitness is bit for
+//! Chapter 6's problems outside a run, as a benchmark suite: what the Python package
+//! (`python/`) and any other caller get. It sits beside the registry, not in a family, because it
+//! serves two: the problems are made by the runs' own code paths
+//! ([`optimise::problems`] for an `[optim]` spec; `growing_grid::{maps, problems}` for seed 001's
+//! open surfaces) from the same spec, profile and `--set` readings, so a problem's fitness is bit for
 //! bit the one `somnurbs run` optimises; this module only adds what a benchmark user needs beside
 //! it (names, a second box, the metadata that `compare` checks an external optimiser's logs
 //! against).
 
-use super::spec::OptimSpec;
+use super::growing_grid::{self, spec::GrowingGridSpec};
+use super::optimise::{self, spec::OptimSpec};
+use super::{Loaded, Section};
 use crate::experiment::overrides::CliOverrides;
 use crate::experiment::spec::{GridSize, Spec};
 use crate::experiment::RunContext;
-use crate::families::growing_grid;
 use crate::optim::exact::ExactResult;
 use crate::optim::{ExactOptions, OptimError, Problem};
 use crate::spline::open_surface::OpenSurfaceProblem;
@@ -122,12 +124,10 @@ pub fn load(
     data_dir: Option<&Path>,
     work: &Path,
 ) -> Result<Suite> {
-    // The CLI's families (the engine reads specs through them; a no-op once installed).
-    crate::families::install();
     let path = spec_path(spec);
     let cli = CliOverrides { set: set.to_vec(), sweep: Vec::new() };
-    let mut variants = Spec::load_variants(&path, profile, &cli)?;
-    let spec = variants.pop().context("no spec")?;
+    let mut variants = Loaded::load_variants(&path, profile, &cli)?;
+    let Loaded { spec, section } = variants.pop().context("no spec")?;
     let data_dir = match data_dir {
         Some(d) => d.to_path_buf(),
         None => {
@@ -140,17 +140,22 @@ pub fn load(
         }
     };
     let ctx = RunContext::new(work.to_path_buf(), 1, data_dir);
-    if spec.section::<growing_grid::spec::GrowingGridSpec>().is_some() {
-        return open_surfaces(&spec, &ctx, profile);
-    }
-    let o = spec.require::<OptimSpec>()?;
-    let built = super::problems(&spec, &ctx)?;
+    let o = match &section {
+        Section::Optim(o) => o,
+        Section::Seed001(g) => return open_surfaces(&spec, g, &ctx, profile),
+        _ => anyhow::bail!(
+            "{}: a suite is made of an [optim] or a [growing_grid] spec's problems",
+            spec.path
+        ),
+    };
+    let built = optimise::problems(&spec, o, &ctx)?;
     let mut problems = Vec::with_capacity(built.len());
     for ((dataset, net, param), problem) in built {
-        let wide = ControlNetProblem::new(problem.parts().clone(), BoxSpec::Cover { fraction: 0.0 })
-            .with_context(|| format!("{dataset} {net} {}: the data-range box", param.name()))?;
+        let wide =
+            ControlNetProblem::new(problem.parts().clone(), BoxSpec::Cover { fraction: 0.0 })
+                .with_context(|| format!("{dataset} {net} {}: the data-range box", param.name()))?;
         problems.push(SuiteProblem {
-            name: super::ioh::problem_name(
+            name: optimise::ioh::problem_name(
                 &dataset,
                 &o.grid.to_string(),
                 &net.to_string(),
@@ -175,14 +180,18 @@ pub fn load(
 
 /// Seed 001's problems: the Growing Grid maps and the open surfaces of its run
 /// (`growing_grid::maps` then `growing_grid::problems`, as `somnurbs run` calls them).
-fn open_surfaces(spec: &Spec, ctx: &RunContext, profile: Option<&str>) -> Result<Suite> {
-    let g = spec.require::<growing_grid::spec::GrowingGridSpec>()?;
-    let maps = growing_grid::maps(spec, ctx)?;
+fn open_surfaces(
+    spec: &Spec,
+    g: &GrowingGridSpec,
+    ctx: &RunContext,
+    profile: Option<&str>,
+) -> Result<Suite> {
+    let maps = growing_grid::maps(spec, g, ctx)?;
     let mut problems = Vec::new();
-    for ((dataset, net, param), p) in growing_grid::problems(spec, &maps)? {
+    for ((dataset, net, param), p) in growing_grid::problems(g, &maps)? {
         let grid = GridSize { nx: p.nx, ny: p.ny };
         problems.push(SuiteProblem {
-            name: super::ioh::problem_name(
+            name: optimise::ioh::problem_name(
                 &dataset,
                 &grid.to_string(),
                 &net.to_string(),
@@ -239,10 +248,17 @@ mod tests {
             assert!((0..x0.len()).all(|k| dlo[k] <= x0[k] && x0[k] <= dhi[k]));
             assert!(p.exact(false, &s.exact).unwrap().lower_bound <= q.fitness(x0));
         }
-        let nb = load("ch6_exact", Some("quick"), &["optim.knots=nurbs_book".into()], Some(&data), work.path())
-            .unwrap();
+        let nb = load(
+            "ch6_exact",
+            Some("quick"),
+            &["optim.knots=nurbs_book".into()],
+            Some(&data),
+            work.path(),
+        )
+        .unwrap();
         assert_eq!(nb.reading, "nurbs_book");
-        let b = |s: &Suite| s.problems[0].problem().fitness(s.problems[0].problem().initial_point());
+        let b =
+            |s: &Suite| s.problems[0].problem().fitness(s.problems[0].problem().initial_point());
         assert_ne!(b(&nb), b(&s));
     }
 }

@@ -1,0 +1,260 @@
+//! The DNSOM maps Chapter 4 saves and Chapters 5 and 6 fit (`[fit]` and `[optim]` read them
+//! alike): where a section's maps come from (`maps`, `maps_missing`, `[<section>.som]`), reading
+//! them, recomputing a missing one exactly as Chapter 4's cell would (same key, seed and
+//! settings), and the keys both sections share. It sits beside the registry, not in a family,
+//! because two families use it; it reaches Chapter 4's family only to train a map.
+
+use super::som::{self, spec::SomCell};
+use crate::double_net::TwoViewGrid;
+use crate::experiment::spec::{GridSize, Spec, SpecError};
+use crate::experiment::RunContext;
+use crate::io::write_atomic;
+use crate::som::{Model, SomParams};
+use anyhow::{Context, Result};
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// What a run does when the `maps` folder a spec names, or a map in it, is not there.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MapsMissing {
+    /// Refuse the run, naming the folder or file (a mistyped path does not silently cost a
+    /// Chapter 4 run).
+    #[default]
+    Error,
+    /// Recompute the missing maps from `<section>.som`, saying so on stderr.
+    Recompute,
+}
+
+/// Settings of the DNSOM run that recomputes a missing map (the cell key is Chapter 4's,
+/// `som/<data>/dnsom/<grid>/r0`, so the same seed gives the same map).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MapSom {
+    #[serde(default)]
+    pub master_seed: Option<u64>,
+    #[serde(default = "crate::experiment::defaults::som_iterations")]
+    pub iterations: usize,
+    #[serde(default = "crate::experiment::defaults::som_alpha0")]
+    pub alpha0: f64,
+}
+
+/// The keys a `[fit]` and an `[optim]` section share (data sets, grid, control nets,
+/// parameterisations), each error naming `<section>.<key>`.
+pub(crate) fn validate_grid_keys(
+    spec: &Spec,
+    section: &str,
+    datasets: &[String],
+    grid: GridSize,
+    control_nets: &[GridSize],
+    parameterisations: &[crate::spline::Parameterisation],
+) -> Result<(), SpecError> {
+    let key = |k: &str| format!("{section}.{k}");
+    if datasets.is_empty() {
+        return Err(spec.err(&key("datasets"), "is empty"));
+    }
+    if grid.nx.min(grid.ny) < 3 {
+        return Err(
+            spec.err(&key("grid"), format!("grid {grid} is too small (each side at least 3)"))
+        );
+    }
+    if control_nets.is_empty() {
+        return Err(spec.err(&key("control_nets"), "is empty"));
+    }
+    for cn in control_nets {
+        if cn.nx < 4 || cn.ny < 4 {
+            return Err(spec.err(&key("control_nets"), format!("control net {cn} is smaller than 4 (cubic needs p + 1 = 4 control points a side)")));
+        }
+        if cn.nx > grid.nx || cn.ny > grid.ny {
+            return Err(spec.err(
+                &key("control_nets"),
+                format!("control net {cn} is larger than the grid {grid}"),
+            ));
+        }
+    }
+    if parameterisations.is_empty() {
+        return Err(spec.err(&key("parameterisations"), "is empty"));
+    }
+    Ok(())
+}
+
+/// The settings of the map recomputation (`<section>.som`).
+pub(crate) fn validate_map_som(
+    spec: &Spec,
+    section: &str,
+    som: Option<&MapSom>,
+) -> Result<(), SpecError> {
+    let Some(som) = som else { return Ok(()) };
+    if som.iterations == 0 {
+        return Err(spec.err(&format!("{section}.som.iterations"), "must be at least 1"));
+    }
+    if !(som.alpha0 > 0.0 && som.alpha0 <= 1.0) {
+        return Err(spec.err(
+            &format!("{section}.som.alpha0"),
+            format!("must be in (0, 1], got {}", som.alpha0),
+        ));
+    }
+    Ok(())
+}
+
+/// Where a map came from.
+#[derive(Debug, Clone)]
+pub struct MapSource {
+    pub grid: TwoViewGrid,
+    pub origin: String,
+    /// The data set's frame (the map file's sidecar, or the recomputation's cloud); None: a map
+    /// saved without one.
+    pub frame: Option<crate::data::frame::Frame>,
+}
+
+/// The map file name Chapter 4 writes and Chapter 5 reads.
+pub fn map_file_name(dataset: &str, grid: GridSize) -> String {
+    format!("dnsom_{dataset}_{grid}.csv")
+}
+
+/// Where a section's maps come from: its `maps` key as written (relative to the spec's folder),
+/// what a named folder or map that is not there means, and how a map is recomputed.
+#[derive(Debug, Clone, Copy)]
+pub struct MapsFrom<'a> {
+    /// `fit` or `optim`, for messages.
+    pub section: &'static str,
+    pub dir: Option<&'a str>,
+    pub missing: MapsMissing,
+    pub som: Option<&'a MapSom>,
+}
+
+/// Each data set's entry, name and map file in the folder `from.dir` names (resolved against the
+/// spec's folder; None: no folder named).
+fn map_files<'a>(
+    spec: &Spec,
+    datasets: &'a [String],
+    grid: GridSize,
+    from: &MapsFrom,
+) -> Vec<(&'a String, String, Option<PathBuf>)> {
+    let dir: Option<PathBuf> = from.dir.map(|m| spec.resolve(m));
+    let mut wanted: Vec<(&String, String, Option<PathBuf>)> = Vec::new();
+    for entry in datasets {
+        let data = crate::data::registry::name_of(entry);
+        if wanted.iter().all(|(_, d, _)| *d != data) {
+            let file = dir.as_ref().map(|d| d.join(map_file_name(&data, grid)));
+            wanted.push((entry, data, file));
+        }
+    }
+    wanted
+}
+
+/// Whether the maps a section names are there: an error naming the missing folder or map, unless
+/// `maps_missing = "recompute"`, then the line that says what is recomputed (None: nothing is
+/// missing, or no folder is named and every map is recomputed as the spec says).
+pub fn require_maps(
+    spec: &Spec,
+    datasets: &[String],
+    grid: GridSize,
+    from: &MapsFrom,
+) -> Result<Option<String>> {
+    let Some(dir) = from.dir.map(|m| spec.resolve(m)) else { return Ok(None) };
+    let wanted = map_files(spec, datasets, grid, from);
+    let absent: Vec<&Path> =
+        wanted.iter().filter_map(|(_, _, f)| f.as_deref()).filter(|f| !f.exists()).collect();
+    let Some(first) = absent.first() else { return Ok(None) };
+    let section = from.section;
+    let what = if dir.is_dir() {
+        format!("no map {}", crate::io::shown(first))
+    } else {
+        format!("no maps folder {}", crate::io::shown(&dir))
+    };
+    if from.missing == MapsMissing::Error {
+        anyhow::bail!("{}: {section}.maps: {what} (run the spec that saves the maps first, e.g. Chapter 4's, or set {section}.maps_missing = \"recompute\")", spec.path);
+    }
+    let names: Vec<String> = absent
+        .iter()
+        .filter_map(|f| f.file_name().map(|n| n.to_string_lossy().into_owned()))
+        .collect();
+    Ok(Some(format!(
+        "somnurbs: {}: {what}: recomputing {} from [{section}.som] ({section}.maps_missing = \"recompute\")",
+        spec.path,
+        names.join(", ")
+    )))
+}
+
+/// The maps of `datasets` at `grid`: read from the folder `from.dir` names (resolved against the
+/// spec's folder), recomputed with `from.som` when the spec names no folder. A named folder or map
+/// that is not there is an error naming it, unless `maps_missing = "recompute"`, in which case
+/// one stderr line says what is recomputed ([`require_maps`]).
+pub fn maps_for(
+    spec: &Spec,
+    ctx: &RunContext,
+    datasets: &[String],
+    grid: GridSize,
+    from: &MapsFrom,
+) -> Result<BTreeMap<String, MapSource>> {
+    if let Some(line) = require_maps(spec, datasets, grid, from)? {
+        eprintln!("{line}");
+    }
+    let wanted = map_files(spec, datasets, grid, from);
+    let mut out = BTreeMap::new();
+    for (entry, data, file) in wanted {
+        let source = match file.filter(|f| f.exists()) {
+            Some(path) => read_map(&path, grid)?,
+            None => recompute_map(spec, ctx, entry, grid, from.som)?,
+        };
+        out.insert(data, source);
+    }
+    // Every map has loaded: only now may the folder change.
+    ctx.begin()?;
+    for (data, source) in &out {
+        let text = crate::io::map_file::text(&source.grid)?;
+        let file = ctx.out.join("maps").join(map_file_name(data, grid));
+        write_atomic(&file, text.as_bytes())?;
+        if let Some(frame) = &source.frame {
+            crate::io::map_file::write_frame(&file, frame)?;
+        }
+    }
+    Ok(out)
+}
+
+fn read_map(path: &Path, grid: GridSize) -> Result<MapSource> {
+    let text = crate::io::read_text(path)?;
+    let g = crate::data::grid_csv::parse_two_view_grid(&text)
+        .with_context(|| path.display().to_string())?;
+    if (g.nx, g.ny) != (grid.nx, grid.ny) {
+        anyhow::bail!("{}: map is {}x{}, the spec's grid is {grid}", path.display(), g.nx, g.ny);
+    }
+    Ok(MapSource {
+        grid: g,
+        origin: crate::io::shown(path),
+        frame: crate::io::map_file::read_frame(path)?,
+    })
+}
+
+fn recompute_map(
+    spec: &Spec,
+    ctx: &RunContext,
+    data: &str,
+    grid: GridSize,
+    som: Option<&MapSom>,
+) -> Result<MapSource> {
+    let (seed, params) = match som {
+        Some(s) => (
+            s.master_seed.unwrap_or(spec.file.master_seed),
+            SomParams { iterations: s.iterations, alpha0: s.alpha0, sigma0: None },
+        ),
+        None => (spec.file.master_seed, SomParams::default()),
+    };
+    let clouds = som::load_datasets(spec, &[data.to_string()], ctx)?;
+    let name = crate::data::registry::name_of(data);
+    let cell = SomCell { dataset: name.clone(), model: Model::Dnsom, grid, repeat: 0 };
+    som::require_points(data, clouds[&name].points.len(), &cell)?;
+    let run = som::run_cell(&cell, &clouds[&name].points, &params, seed)?;
+    Ok(MapSource {
+        frame: Some(clouds[&name].frame.clone()),
+        grid: TwoViewGrid::from_weights(grid.nx, grid.ny, &run.weights)
+            .with_context(|| format!("{}: not a DNSOM map", cell.key()))?,
+        origin: format!(
+            "recomputed: {} with master seed {seed}, T = {}",
+            cell.key(),
+            params.iterations
+        ),
+    })
+}
