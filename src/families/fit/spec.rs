@@ -43,6 +43,13 @@ pub struct FitSpec {
     /// Beyond the thesis: penalised least squares weight (0 = the thesis' plain least squares).
     #[serde(default)]
     pub fairness: f64,
+    /// Reading of Eq. 2.8's power factor for the exponential method (Section 2.3.2: 0.8), in
+    /// (0, 1] (docs/readings.md).
+    #[serde(default = "default_exponential_alpha")]
+    pub exponential_alpha: f64,
+    /// Reading of the grid lines Eq. 5.1/5.2 average: `all` or `middle` (docs/readings.md).
+    #[serde(default)]
+    pub param_rows: crate::spline::ParamRows,
 }
 
 impl FitSpec {
@@ -52,8 +59,23 @@ impl FitSpec {
             knots: self.knots,
             error_a: self.error_a,
             fairness: self.fairness,
+            param: crate::spline::ParamReading {
+                exponential_alpha: self.exponential_alpha,
+                rows: self.param_rows,
+            },
         }
     }
+}
+
+/// Section 2.3.2's alpha = 0.8 of the exponential method.
+pub(crate) fn default_exponential_alpha() -> f64 {
+    crate::spline::param::EXPONENTIAL_ALPHA
+}
+
+/// `<section>.exponential_alpha` in (0, 1] (Eq. 2.8; 1 is chord length).
+pub(crate) fn check_exponential_alpha(c: &Check, section: &str, v: f64) -> Result<(), SpecError> {
+    let (lo, hi) = crate::spline::param::EXPONENTIAL_ALPHA_RANGE;
+    c.real(&format!("{section}.exponential_alpha"), v, lo, false, hi)
 }
 
 /// What a run does when the `maps` folder a spec names, or a map in it, is not there.
@@ -227,6 +249,7 @@ pub(crate) fn limits(c: &Check, s: &FitSpec) -> Result<(), SpecError> {
         c.int("fit.som.iterations", som.iterations, limits::MAX_ITERATIONS)?;
     }
     c.real("fit.fairness", s.fairness, 0.0, true, limits::MAX_FAIRNESS)?;
+    check_exponential_alpha(c, "fit", s.exponential_alpha)?;
     c.cells(
         "fit",
         &[s.datasets.len(), s.control_nets.len(), s.parameterisations.len(), s.approaches.len()],
