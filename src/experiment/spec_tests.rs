@@ -84,6 +84,39 @@ fn overrides_apply_after_the_profile_and_are_validated() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("fit.fairness"), "{e}");
+    // The parameterisation readings: defaults (Section 2.3.2's 0.8, Eq. 5.1/5.2 over all lines),
+    // a set value reaches the fit options, and alpha outside (0, 1] is refused naming the key.
+    let opts = plain.section::<crate::families::fit::spec::FitSpec>().unwrap().fit_options();
+    assert_eq!(opts.param, crate::spline::ParamReading::default());
+    assert_eq!(opts.param.exponential_alpha, 0.8);
+    let set = [
+        ov("fit.exponential_alpha", toml::Value::Float(0.9)),
+        ov("fit.param_rows", "middle".into()),
+    ];
+    let s = L::parse_with("f.toml", text, None, &set).unwrap();
+    let opts = s.section::<crate::families::fit::spec::FitSpec>().unwrap().fit_options();
+    assert_eq!(
+        opts.param,
+        crate::spline::ParamReading {
+            exponential_alpha: 0.9,
+            rows: crate::spline::ParamRows::Middle
+        }
+    );
+    for bad in [0.0, 1.5, f64::NAN] {
+        let e = L::parse_with(
+            "f.toml",
+            text,
+            None,
+            &[ov("fit.exponential_alpha", toml::Value::Float(bad))],
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("fit.exponential_alpha"), "{e}");
+    }
+    let e = L::parse_with("f.toml", text, None, &[ov("fit.param_rows", "first".into())])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("fit.param_rows") || e.contains("first"), "{e}");
     let e = L::parse_with("f.toml", text, None, &[ov("fit.colour", "red".into())])
         .unwrap_err()
         .to_string();

@@ -40,6 +40,21 @@ pub struct MapSom {
     pub alpha0: f64,
 }
 
+/// Section 2.3.2's alpha = 0.8 of the exponential method.
+pub(crate) fn default_exponential_alpha() -> f64 {
+    crate::spline::param::EXPONENTIAL_ALPHA
+}
+
+/// `<section>.exponential_alpha` in (0, 1] (Eq. 2.8; 1 is chord length).
+pub(crate) fn check_exponential_alpha(
+    c: &crate::experiment::limits::Check,
+    section: &str,
+    v: f64,
+) -> Result<(), SpecError> {
+    let (lo, hi) = crate::spline::param::EXPONENTIAL_ALPHA_RANGE;
+    c.real(&format!("{section}.exponential_alpha"), v, lo, false, hi)
+}
+
 /// The keys a `[fit]` and an `[optim]` section share (data sets, grid, control nets,
 /// parameterisations), each error naming `<section>.<key>`.
 pub(crate) fn validate_grid_keys(

@@ -3,8 +3,9 @@
 //!
 //! Every choice, so that an independent implementation gets the same surface errors:
 //! - Grids are row-major (i * ny + j); u runs along i (nx values), v along j (ny values).
-//! - Parameters: per column j the polyline over i, per row i the polyline over j (Eq. 2.7/2.8),
-//!   averaged (Eq. 5.1, 5.2). B averages the two views' averaged parameters (Eq. 5.3, 5.4).
+//! - Parameters: per column j the polyline over i, per row i the polyline over j (Eq. 2.7/2.8,
+//!   the exponential alpha by [`FitOptions::param`]), averaged (Eq. 5.1, 5.2; or the middle
+//!   column and row alone, the same reading). B averages the two views' parameters (Eq. 5.3, 5.4).
 //! - Knots: clamped cubic by the named rule of [`FitOptions::knots`] (see `knots`: Eq. 2.10
 //!   literally, or The NURBS Book 9.68-9.69). A and B differ only through their parameters.
 //! - Control nets: least squares per coordinate (`fit`), then for B every border control point
@@ -22,7 +23,7 @@
 use super::basis::{basis_matrix, SparseBasis};
 use super::fit::{faired_net, fitted_grid, least_squares_net, pin_corners};
 use super::knots::{knot_vector, KnotRule};
-use super::param::{grid_params, Parameterisation};
+use super::param::{grid_params_with, ParamReading, Parameterisation};
 use super::surface::BSplineSurface;
 use super::SplineError;
 pub use crate::double_net::TwoViewGrid;
@@ -83,6 +84,8 @@ pub struct FitOptions {
     pub error_a: ErrorA,
     /// Penalised least squares weight (0: the thesis' plain least squares; see `fit::faired_net`).
     pub fairness: f64,
+    /// Eq. 2.8's exponential alpha and Eq. 5.1/5.2's rows (see `param::ParamReading`).
+    pub param: ParamReading,
 }
 
 /// Conventional (A) or improved (B) (in a spec by letter or name, as [`FromStr`] reads it).
@@ -223,7 +226,10 @@ pub fn fit_two_view(
         )));
     }
     let (nx, ny) = (grid.nx, grid.ny);
-    let own = [grid_params(&grid.bottom, nx, ny, param), grid_params(&grid.top, nx, ny, param)];
+    let own = [
+        grid_params_with(&grid.bottom, nx, ny, param, &opts.param),
+        grid_params_with(&grid.top, nx, ny, param, &opts.param),
+    ];
     let params: [(Vec<f64>, Vec<f64>); 2] = match approach {
         Approach::Conventional => own,
         Approach::Improved => {

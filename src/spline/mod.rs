@@ -24,7 +24,7 @@ pub use basis::SparseBasis;
 pub use control_net::{BoxSpec, ControlNetProblem};
 pub use geometry::{DenseGeometry, DENSE_FACTOR};
 pub use knots::KnotRule;
-pub use param::Parameterisation;
+pub use param::{ParamReading, ParamRows, Parameterisation};
 pub use surface::BSplineSurface;
 
 use thiserror::Error;

@@ -1,6 +1,7 @@
 //! Parameterisation of a grid (thesis Eq. 2.7, 2.8 per row and column, averaged by Eq. 5.1, 5.2).
 
 use crate::geom::{self, Point3};
+use serde::{Deserialize, Serialize};
 use std::fmt;
 use std::str::FromStr;
 
@@ -30,12 +31,68 @@ impl Parameterisation {
 
     /// Power factor alpha of Eq. 2.8 (None: uniform, Eq. 2.7).
     pub fn alpha(self) -> Option<f64> {
+        self.alpha_with(EXPONENTIAL_ALPHA)
+    }
+
+    /// Eq. 2.8's alpha with the exponential method's taken as `exponential` (Section 2.3.2 sets it
+    /// to 0.8; a named reading, [`ParamReading::exponential_alpha`]).
+    pub fn alpha_with(self, exponential: f64) -> Option<f64> {
         match self {
             Self::Uniform => None,
             Self::ChordLength => Some(1.0),
             Self::Centripetal => Some(0.5),
-            Self::Exponential => Some(0.8),
+            Self::Exponential => Some(exponential),
         }
+    }
+}
+
+/// Section 2.3.2: "Exponential method was proposed in [88] by setting the power factor, alpha in
+/// Equation 2.8 to 0.8".
+pub const EXPONENTIAL_ALPHA: f64 = 0.8;
+
+/// The range `exponential_alpha` may take, (0, 1]: alpha -> 0 tends to the uniform method (Eq.
+/// 2.7), 1 is chord length.
+pub const EXPONENTIAL_ALPHA_RANGE: (f64, f64) = (0.0, 1.0);
+
+/// Which grid lines give a surface's data parameters (Section 5.2.2.1; a named reading,
+/// docs/readings.md).
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default, Serialize, Deserialize,
+)]
+#[serde(rename_all = "snake_case")]
+pub enum ParamRows {
+    /// Eq. 5.1, 5.2: u is the mean over every column's polyline, v over every row's ("the average
+    /// parameters of each row and column").
+    #[default]
+    All,
+    /// The parameters of the middle column (u) and middle row (v) alone, index ny / 2 and nx / 2.
+    Middle,
+}
+
+impl ParamRows {
+    pub const ALL: [ParamRows; 2] = [ParamRows::All, ParamRows::Middle];
+
+    /// The spec value.
+    pub fn name(self) -> &'static str {
+        match self {
+            ParamRows::All => "all",
+            ParamRows::Middle => "middle",
+        }
+    }
+}
+
+/// The parameterisation's named readings. `Default` is the thesis plan's (Eq. 2.8 with 0.8 for
+/// the exponential method, Eq. 5.1/5.2 over all rows and columns).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ParamReading {
+    /// Eq. 2.8's alpha of the exponential method.
+    pub exponential_alpha: f64,
+    pub rows: ParamRows,
+}
+
+impl Default for ParamReading {
+    fn default() -> Self {
+        ParamReading { exponential_alpha: EXPONENTIAL_ALPHA, rows: ParamRows::All }
     }
 }
 
@@ -68,12 +125,17 @@ impl FromStr for Parameterisation {
 /// Parameters of one polyline: t_0 = 0, t_n = 1, t_k = sum_{i<=k} |Q_i - Q_{i-1}|^alpha / total
 /// (Eq. 2.8), or k/n (Eq. 2.7). A polyline of zero total length falls back to uniform.
 pub fn polyline_params(points: &[Point3], method: Parameterisation) -> Vec<f64> {
+    polyline_params_alpha(points, method.alpha())
+}
+
+/// [`polyline_params`] with Eq. 2.8's alpha given (None: Eq. 2.7).
+pub fn polyline_params_alpha(points: &[Point3], alpha: Option<f64>) -> Vec<f64> {
     let n = points.len();
     if n < 2 {
         return vec![0.0; n];
     }
     let uniform = || (0..n).map(|k| k as f64 / (n - 1) as f64).collect::<Vec<f64>>();
-    let Some(alpha) = method.alpha() else { return uniform() };
+    let Some(alpha) = alpha else { return uniform() };
     let steps: Vec<f64> = points.windows(2).map(|w| geom::dist(w[0], w[1]).powf(alpha)).collect();
     let total: f64 = steps.iter().sum();
     if total.is_nan() || total <= 0.0 {
@@ -99,21 +161,40 @@ pub fn grid_params(
     ny: usize,
     method: Parameterisation,
 ) -> (Vec<f64>, Vec<f64>) {
+    grid_params_with(view, nx, ny, method, &ParamReading::default())
+}
+
+/// [`grid_params`] under the named readings: Eq. 2.8's exponential alpha, and which columns
+/// (rows) give u (v): the mean over all of them (Eq. 5.1, 5.2) or the middle one alone.
+pub fn grid_params_with(
+    view: &[Point3],
+    nx: usize,
+    ny: usize,
+    method: Parameterisation,
+    reading: &ParamReading,
+) -> (Vec<f64>, Vec<f64>) {
+    let alpha = method.alpha_with(reading.exponential_alpha);
+    let (cols, rows) = match reading.rows {
+        ParamRows::All => (0..ny, 0..nx),
+        ParamRows::Middle => (ny / 2..ny / 2 + 1, nx / 2..nx / 2 + 1),
+    };
+    let (n_cols, n_rows) = (cols.len() as f64, rows.len() as f64);
     let mut u = vec![0.0; nx];
-    for j in 0..ny {
+    for j in cols {
         let col: Vec<Point3> = (0..nx).map(|i| view[i * ny + j]).collect();
-        for (acc, t) in u.iter_mut().zip(polyline_params(&col, method)) {
+        for (acc, t) in u.iter_mut().zip(polyline_params_alpha(&col, alpha)) {
             *acc += t;
         }
     }
     let mut v = vec![0.0; ny];
-    for i in 0..nx {
-        for (acc, t) in v.iter_mut().zip(polyline_params(&view[i * ny..(i + 1) * ny], method)) {
+    for i in rows {
+        for (acc, t) in v.iter_mut().zip(polyline_params_alpha(&view[i * ny..(i + 1) * ny], alpha))
+        {
             *acc += t;
         }
     }
-    u.iter_mut().for_each(|x| *x /= ny as f64);
-    v.iter_mut().for_each(|x| *x /= nx as f64);
+    u.iter_mut().for_each(|x| *x /= n_cols);
+    v.iter_mut().for_each(|x| *x /= n_rows);
     (u, v)
 }
 
@@ -157,5 +238,35 @@ mod tests {
         let (u, v) = grid_params(&view, 3, 2, Parameterisation::ChordLength);
         assert!((u[1] - (0.25 + 0.5) / 2.0).abs() < 1e-15, "{u:?}");
         assert_eq!(v, vec![0.0, 1.0]);
+        // The middle column (j = ny / 2 = 1) alone: spacing 1, 1, so u = 0, 0.5, 1.
+        let middle = ParamReading { rows: ParamRows::Middle, ..ParamReading::default() };
+        let (u, v) = grid_params_with(&view, 3, 2, Parameterisation::ChordLength, &middle);
+        assert_eq!((u, v), (vec![0.0, 0.5, 1.0], vec![0.0, 1.0]));
+    }
+
+    /// Eq. 2.8 with alpha = 0.8 on the seed-002 polyline, by hand; alpha 1 and 0.5 are the chord
+    /// length and centripetal methods, and the default reading is bit-identical to `grid_params`.
+    #[test]
+    fn exponential_alpha_reading() {
+        let q = [[0.0, 0.0, 0.0], [1.0, 2.0, 0.0], [3.0, 4.0, 0.0], [4.0, 0.0, 0.0]];
+        let d: Vec<f64> = [5f64, 8.0, 17.0].iter().map(|x| x.sqrt().powf(0.8)).collect();
+        let e = polyline_params(&q, Parameterisation::Exponential);
+        assert!((e[1] - d[0] / (d[0] + d[1] + d[2])).abs() < 1e-15, "{e:?}");
+        let view: Vec<Point3> = (0..12)
+            .map(|k| [(k / 4) as f64, ((k % 4) as f64).powi(2), (k as f64 * 0.7).sin()])
+            .collect();
+        for (alpha, same) in
+            [(1.0, Parameterisation::ChordLength), (0.5, Parameterisation::Centripetal)]
+        {
+            let r = ParamReading { exponential_alpha: alpha, ..ParamReading::default() };
+            assert_eq!(
+                grid_params_with(&view, 3, 4, Parameterisation::Exponential, &r),
+                grid_params(&view, 3, 4, same)
+            );
+        }
+        assert_eq!(
+            grid_params_with(&view, 3, 4, Parameterisation::Exponential, &ParamReading::default()),
+            grid_params(&view, 3, 4, Parameterisation::Exponential)
+        );
     }
 }

@@ -114,7 +114,7 @@ pub fn fit(args: &FitArgs) -> Result<()> {
             args.samples
         );
     }
-    let opts = FitOptions { knots, error_a, fairness: args.fairness };
+    let opts = FitOptions { knots, error_a, fairness: args.fairness, ..FitOptions::default() };
     let shown = args.grid.display().to_string();
     let text = read_text(&args.grid)?;
     let grid = crate::data::grid_csv::parse_two_view_grid(&text).with_context(|| shown.clone())?;

@@ -44,6 +44,13 @@ pub struct FitSpec {
     /// Beyond the thesis: penalised least squares weight (0 = the thesis' plain least squares).
     #[serde(default)]
     pub fairness: f64,
+    /// Reading of Eq. 2.8's power factor for the exponential method (Section 2.3.2: 0.8), in
+    /// (0, 1] (docs/readings.md).
+    #[serde(default = "crate::families::maps::default_exponential_alpha")]
+    pub exponential_alpha: f64,
+    /// Reading of the grid lines Eq. 5.1/5.2 average: `all` or `middle` (docs/readings.md).
+    #[serde(default)]
+    pub param_rows: crate::spline::ParamRows,
 }
 
 impl FitSpec {
@@ -53,6 +60,10 @@ impl FitSpec {
             knots: self.knots,
             error_a: self.error_a,
             fairness: self.fairness,
+            param: crate::spline::ParamReading {
+                exponential_alpha: self.exponential_alpha,
+                rows: self.param_rows,
+            },
         }
     }
 }
@@ -135,6 +146,7 @@ pub(crate) fn limits(c: &Check, s: &FitSpec) -> Result<(), SpecError> {
         c.int("fit.som.iterations", som.iterations, limits::MAX_ITERATIONS)?;
     }
     c.real("fit.fairness", s.fairness, 0.0, true, limits::MAX_FAIRNESS)?;
+    crate::families::maps::check_exponential_alpha(c, "fit", s.exponential_alpha)?;
     c.cells(
         "fit",
         &[s.datasets.len(), s.control_nets.len(), s.parameterisations.len(), s.approaches.len()],

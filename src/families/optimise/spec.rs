@@ -70,6 +70,13 @@ pub struct OptimSpec {
     /// Beyond the thesis: penalised least squares weight of B's start (0 = plain least squares).
     #[serde(default)]
     pub fairness: f64,
+    /// Reading of Eq. 2.8's power factor for the exponential method of B's start (Section 2.3.2:
+    /// 0.8), in (0, 1] (docs/readings.md).
+    #[serde(default = "crate::families::maps::default_exponential_alpha")]
+    pub exponential_alpha: f64,
+    /// Reading of the grid lines Eq. 5.1/5.2 average for B's start: `all` or `middle`.
+    #[serde(default)]
+    pub param_rows: crate::spline::ParamRows,
 }
 
 impl OptimSpec {
@@ -78,6 +85,10 @@ impl OptimSpec {
         crate::spline::FitOptions {
             knots: self.knots,
             fairness: self.fairness,
+            param: crate::spline::ParamReading {
+                exponential_alpha: self.exponential_alpha,
+                rows: self.param_rows,
+            },
             ..Default::default()
         }
     }
@@ -221,6 +232,7 @@ pub(crate) fn limits(c: &Check, o: &OptimSpec) -> Result<(), SpecError> {
     c.list("optim.optimisers", &o.optimisers)?;
     c.optimiser_run("optim", o.repeats, o.generations, o.population)?;
     c.real("optim.fairness", o.fairness, 0.0, true, limits::MAX_FAIRNESS)?;
+    crate::families::maps::check_exponential_alpha(c, "optim", o.exponential_alpha)?;
     c.real("optim.init_range", o.init_range, 0.0, true, limits::MAX_RANGE)?;
     c.real("optim.bounds_margin", o.bounds_margin, 0.0, true, limits::MAX_RANGE)?;
     if let Some(r) = o.search_range {
