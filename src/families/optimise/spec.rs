@@ -262,3 +262,30 @@ impl OptimSpec {
         vec![&self.ga, &self.de, &self.pso, &self.csa, &self.icsa]
     }
 }
+
+#[cfg(test)]
+mod tests {
+    /// The optimisers `[optim]` offers are the registered ones (binary GA aside, seed 004's own),
+    /// and docs/specs.md lists exactly those.
+    #[test]
+    fn offered_optimisers_are_the_registry_and_the_docs_list() {
+        let text = "name = \"t\"\nmaster_seed = 1\n[optim]\ndatasets = [\"sphere\"]\ngrid = \"20x20\"\ncontrol_nets = [\"6x6\"]\nparameterisations = [\"uniform\"]\noptimisers = [\"de\"]\n";
+        let spec = crate::families::Loaded::parse("t.toml", text, None).unwrap();
+        let o: &super::OptimSpec = spec.section().unwrap();
+        let offered = crate::optim::names(&o.offered());
+        let registered: Vec<&str> = crate::optim::REGISTRY
+            .iter()
+            .map(|r| (r.make)().name())
+            .filter(|n| *n != "binary_ga")
+            .collect();
+        assert_eq!(offered, registered);
+        let docs = std::fs::read_to_string(
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/specs.md"),
+        )
+        .unwrap();
+        let row = docs.lines().find(|l| l.starts_with("| `optimisers` |")).unwrap();
+        let listed: Vec<&str> =
+            row.split('|').nth(2).unwrap().split(',').map(|s| s.trim().trim_matches('`')).collect();
+        assert_eq!(listed, offered, "docs/specs.md's optimisers row");
+    }
+}
