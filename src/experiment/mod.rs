@@ -77,12 +77,15 @@ impl RunContext {
     }
 
     /// How `spec`'s data sets load: from this run's data folder, relative paths from the spec's
-    /// own folder, scaled by the spec's `normalise`.
+    /// own folder, scaled by the spec's `normalise`; the spindle as its `[som]` section reads it.
     pub fn loader(&self, spec: &Spec) -> crate::data::registry::Loader {
         crate::data::registry::Loader {
             data_dir: self.data_dir.clone(),
             base: spec.dir().to_path_buf(),
             normalise: spec.file.normalise,
+            spindle: spec
+                .section::<crate::families::som::spec::SomSpec>()
+                .map_or_else(Default::default, |s| (s.spindle_profile, s.spindle_rings)),
         }
     }
 

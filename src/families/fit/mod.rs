@@ -235,7 +235,7 @@ fn recompute_map(
     let (seed, params) = match som {
         Some(s) => (
             s.master_seed.unwrap_or(spec.file.master_seed),
-            SomParams { iterations: s.iterations, alpha0: s.alpha0, sigma0: None },
+            SomParams { iterations: s.iterations, alpha0: s.alpha0, ..SomParams::default() },
         ),
         None => (spec.file.master_seed, SomParams::default()),
     };

@@ -146,7 +146,10 @@ pub fn run_cell(
     master_seed: u64,
 ) -> Result<SomRun> {
     let key = cell.key();
-    let topo = cell.model.topology(cell.grid.nx, cell.grid.ny).map_err(anyhow::Error::msg)?;
+    let topo = cell
+        .model
+        .topology_with(cell.grid.nx, cell.grid.ny, params.som3d_adjacency)
+        .map_err(anyhow::Error::msg)?;
     let mut rng = seeds::cell_rng(master_seed, &key);
     let t0 = runner::thread_cpu_seconds();
     let trained = som::train(topo.as_ref(), data, params, &mut rng)
@@ -183,6 +186,7 @@ pub fn run(spec: &Spec, ctx: &RunContext) -> Result<(Vec<SomRun>, Frames)> {
         iterations: som_spec.iterations,
         alpha0: som_spec.alpha0,
         sigma0: som_spec.sigma0,
+        som3d_adjacency: som_spec.som3d_adjacency,
     };
     let cells = spec::cells(spec);
     for entry in &som_spec.datasets {
@@ -237,7 +241,7 @@ impl crate::experiment::family::Experiment for Som {
         crate::experiment::Definitions(&[
             ("qe", "mean over training iterations of |X(t) - W_c(t)| (Euclidean, before the update) (thesis Eq. 4.15)"),
             ("te", "share of training iterations whose first and second winners are not adjacent (Eq. 4.16)"),
-            ("te_adjacency", "index distance 1: 4-neighbourhood on 2-D maps, 6-neighbourhood in the 3-D lattice and CKSOM surface, 4-neighbourhood on either DNSOM view over class numbers"),
+            ("te_adjacency", "index distance 1: 4-neighbourhood on 2-D maps, 6-neighbourhood in the 3-D lattice (another with som.som3d_adjacency) and CKSOM surface, 4-neighbourhood on either DNSOM view over class numbers"),
             ("qe_final", "mean Euclidean distance of every data point to its best-matching unit after training"),
             ("te_final", "share of data points whose two best units are not adjacent (adjacency as above)"),
             ("cpu_s", "thread CPU seconds of weight initialisation and the T training iterations"),
