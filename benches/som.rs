@@ -44,7 +44,13 @@ fn main() {
         .collect();
     let jobs = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
     let ctx = RunContext { jobs, ..ctx };
-    let data = families::som::load_datasets(spec, &som_spec.datasets, &ctx).expect("data sets");
+    let data = families::som::load_datasets(
+        spec,
+        &som_spec.datasets,
+        &ctx,
+        (som_spec.spindle_profile, som_spec.spindle_rings),
+    )
+    .expect("data sets");
     let t0 = Instant::now();
     let runs = runner::run_cells(
         &cells,

@@ -2,6 +2,7 @@
 //! cylinder of seed 004 and the open surfaces of seed 001.
 
 use crate::geom::Point3;
+use serde::Deserialize;
 use std::collections::HashSet;
 use std::f64::consts::PI;
 
@@ -72,14 +73,67 @@ fn revolution(top: f64, rings: &[(f64, f64)], per_ring: usize, bottom: f64) -> V
     out
 }
 
+/// The spindle's profile, the radius of ring k at t = k/152 (spec key `som.spindle_profile`; the
+/// thesis gives only the point count and, in Table 3.1, the first points, Section 3.2.2).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SpindleProfile {
+    /// r = .5 sin(pi t)^2.
+    #[default]
+    Sin2,
+    /// r = .5 sin(pi t).
+    Sin,
+    /// r = .5 (1 - |1 - 2t|): a double cone in t.
+    Cone,
+}
+
+/// Where the spindle's rings sit along its axis (spec key `som.spindle_rings`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SpindleRings {
+    /// y = .5 + .5 cos(pi t), as the sphere's rings (with `sin` the spindle is the sphere).
+    #[default]
+    Cos,
+    /// y = 1 - t: evenly spaced along the axis (with `sin` a lemon, with `cone` a double cone).
+    Uniform,
+}
+
+impl SpindleProfile {
+    pub const NAMES: [&'static str; 3] = ["sin2", "sin", "cone"];
+
+    fn radius(self, t: f64) -> f64 {
+        match self {
+            SpindleProfile::Sin2 => 0.5 * (PI * t).sin().powi(2),
+            SpindleProfile::Sin => 0.5 * (PI * t).sin(),
+            SpindleProfile::Cone => 0.5 * (1.0 - (1.0 - 2.0 * t).abs()),
+        }
+    }
+}
+
+impl SpindleRings {
+    pub const NAMES: [&'static str; 2] = ["cos", "uniform"];
+
+    fn height(self, t: f64) -> f64 {
+        match self {
+            SpindleRings::Cos => 0.5 + 0.5 * (PI * t).cos(),
+            SpindleRings::Uniform => 1.0 - t,
+        }
+    }
+}
+
 /// Spindle: 151 rings k = 1..151 at t = k/152, y = .5 + .5 cos(pi t), radius .5 sin(pi t)^2, 50
 /// points a ring (7.2-degree steps), plus both poles: 7552 points. (The thesis' exact profile is
 /// unknown; counts and ring layout match, its first points do not.)
 pub fn spindle() -> Vec<Point3> {
+    spindle_with(SpindleProfile::default(), SpindleRings::default())
+}
+
+/// [`spindle`] with another profile or ring placement (the same 151 rings of 50 points).
+pub fn spindle_with(profile: SpindleProfile, rings: SpindleRings) -> Vec<Point3> {
     let rings: Vec<(f64, f64)> = (1..=151)
         .map(|k| {
             let t = k as f64 / 152.0;
-            (0.5 + 0.5 * (PI * t).cos(), 0.5 * (PI * t).sin().powi(2))
+            (rings.height(t), profile.radius(t))
         })
         .collect();
     revolution(1.0, &rings, 50, 0.0)
@@ -172,6 +226,37 @@ mod tests {
         assert_eq!(cylinder().len(), 3876);
         assert_eq!(semi_sphere().len(), 3601);
         assert_eq!(saddle().len(), 3600);
+    }
+
+    #[test]
+    fn spindle_readings_lie_on_their_closed_form_profiles() {
+        let radius = |p: Point3| ((p[0] - 0.5).powi(2) + (p[2] - 0.5).powi(2)).sqrt();
+        let all = |profile, rings| spindle_with(profile, rings);
+        // The default is the parabola r = 2 y (1 - y) (sin^2 = 1 - cos^2 with y = .5 + .5 cos).
+        assert_eq!(spindle(), all(SpindleProfile::Sin2, SpindleRings::Cos));
+        for p in spindle() {
+            assert!((radius(p) - 2.0 * p[1] * (1.0 - p[1])).abs() < 1e-12, "{p:?}");
+        }
+        // sin on cosine rings: the sphere of radius .5 about (.5, .5, .5).
+        for p in all(SpindleProfile::Sin, SpindleRings::Cos) {
+            assert!((radius(p).hypot(p[1] - 0.5) - 0.5).abs() < 1e-12, "{p:?}");
+        }
+        // cone on uniform rings: the double cone r + |y - .5| = .5.
+        for p in all(SpindleProfile::Cone, SpindleRings::Uniform) {
+            assert!((radius(p) + (p[1] - 0.5).abs() - 0.5).abs() < 1e-12, "{p:?}");
+        }
+        // sin on uniform rings: the lemon r = .5 sin(pi (1 - y)).
+        for p in all(SpindleProfile::Sin, SpindleRings::Uniform) {
+            assert!((radius(p) - 0.5 * (PI * (1.0 - p[1])).sin()).abs() < 1e-12, "{p:?}");
+        }
+        for profile in [SpindleProfile::Sin2, SpindleProfile::Sin, SpindleProfile::Cone] {
+            for rings in [SpindleRings::Cos, SpindleRings::Uniform] {
+                let pts = all(profile, rings);
+                assert_eq!(pts.len(), 7552);
+                // Widest ring (t = 76/152 = 1/2) of radius .5: x spans [0, 1] before normalising.
+                assert!(pts.iter().any(|p| (p[0] - 1.0).abs() < 1e-12), "{profile:?} {rings:?}");
+            }
+        }
     }
 
     #[test]

@@ -138,6 +138,8 @@ pub struct Loader {
     pub data_dir: PathBuf,
     pub base: PathBuf,
     pub normalise: Normalise,
+    /// The spindle's profile and ring placement (`som.spindle_profile`, `som.spindle_rings`).
+    pub spindle: (generators::SpindleProfile, generators::SpindleRings),
 }
 
 impl Loader {
@@ -193,7 +195,7 @@ impl Loader {
         match name {
             "cube" => generated(generators::cube()),
             "sphere" => generated(generators::sphere()),
-            "spindle" => generated(generators::spindle()),
+            "spindle" => generated(generators::spindle_with(self.spindle.0, self.spindle.1)),
             "oiltank" => generated(generators::oiltank()),
             "cylinder" => generated(generators::cylinder()),
             "semi_sphere" => generated(generators::semi_sphere()),

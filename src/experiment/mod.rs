@@ -79,12 +79,14 @@ impl RunContext {
     }
 
     /// How `spec`'s data sets load: from this run's data folder, relative paths from the spec's
-    /// own folder, scaled by the spec's `normalise`.
+    /// own folder, scaled by the spec's `normalise`; generated shapes as by default (a family
+    /// with a reading of one sets it on the loader).
     pub fn loader(&self, spec: &Spec) -> crate::data::registry::Loader {
         crate::data::registry::Loader {
             data_dir: self.data_dir.clone(),
             base: spec.dir().to_path_buf(),
             normalise: spec.file.normalise,
+            spindle: Default::default(),
         }
     }
 

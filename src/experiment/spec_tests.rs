@@ -123,6 +123,35 @@ fn overrides_apply_after_the_profile_and_are_validated() {
     assert!(e.contains("colour"), "{e}");
 }
 
+/// The Chapter 4 readings (`som.som3d_adjacency`, `som.spindle_profile`, `som.spindle_rings`):
+/// defaults as before, settable by a reading set, and an unknown value names its key.
+#[test]
+fn som_readings_default_parse_and_name_their_key() {
+    use crate::data::generators::{SpindleProfile, SpindleRings};
+    use crate::som::LatticeAdjacency;
+    let ov = |k: &str, v: &str| Override { key: k.into(), value: v.into() };
+    let som = |s: &L| {
+        let s = s.section::<crate::families::som::spec::SomSpec>().unwrap();
+        (s.som3d_adjacency, s.spindle_profile, s.spindle_rings)
+    };
+    let plain = L::parse("t.toml", SPEC, None).unwrap();
+    assert_eq!(som(&plain), (LatticeAdjacency::N6, SpindleProfile::Sin2, SpindleRings::Cos));
+    let set = [
+        ov("som.som3d_adjacency", "layer"),
+        ov("som.spindle_profile", "cone"),
+        ov("som.spindle_rings", "uniform"),
+    ];
+    let s = L::parse_with("t.toml", SPEC, None, &set).unwrap();
+    assert_eq!(som(&s), (LatticeAdjacency::Layer, SpindleProfile::Cone, SpindleRings::Uniform));
+    for (key, bad) in
+        [("som.som3d_adjacency", "n8"), ("som.spindle_profile", "tan"), ("som.spindle_rings", "z")]
+    {
+        let e = L::parse_with("t.toml", SPEC, None, &[ov(key, bad)]).unwrap_err().to_string();
+        let leaf = key.rsplit('.').next().unwrap();
+        assert!(e.contains(leaf) && e.contains(bad), "{e}");
+    }
+}
+
 #[test]
 fn exactly_one_experiment_section() {
     let none = "name = \"t\"\nmaster_seed = 1\n";

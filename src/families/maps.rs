@@ -253,11 +253,11 @@ fn recompute_map(
     let (seed, params) = match som {
         Some(s) => (
             s.master_seed.unwrap_or(spec.file.master_seed),
-            SomParams { iterations: s.iterations, alpha0: s.alpha0, sigma0: None },
+            SomParams { iterations: s.iterations, alpha0: s.alpha0, ..SomParams::default() },
         ),
         None => (spec.file.master_seed, SomParams::default()),
     };
-    let clouds = som::load_datasets(spec, &[data.to_string()], ctx)?;
+    let clouds = som::load_datasets(spec, &[data.to_string()], ctx, Default::default())?;
     let name = crate::data::registry::name_of(data);
     let cell = SomCell { dataset: name.clone(), model: Model::Dnsom, grid, repeat: 0 };
     som::require_points(data, clouds[&name].points.len(), &cell)?;

@@ -17,6 +17,7 @@ use std::fmt;
 use std::str::FromStr;
 
 pub use lattice::Lattice;
+pub use som3d::LatticeAdjacency;
 pub use train::{final_map_metrics, train, FinalMetrics, OnlineMetrics, SomParams, TrainResult};
 
 /// The four SOM models compared in Chapter 4 (Table 4.1) (in a spec by name, as [`FromStr`]
@@ -55,6 +56,17 @@ impl Model {
 
     /// Build the model's topology for an `nx x ny` grid.
     pub fn topology(self, nx: usize, ny: usize) -> Result<Box<dyn Topology>, String> {
+        self.topology_with(nx, ny, LatticeAdjacency::default())
+    }
+
+    /// [`Model::topology`] with the 3-D lattice's adjacency for the topographic error
+    /// (`som.som3d_adjacency`; the other models ignore it).
+    pub fn topology_with(
+        self,
+        nx: usize,
+        ny: usize,
+        som3d_adjacency: LatticeAdjacency,
+    ) -> Result<Box<dyn Topology>, String> {
         if nx < 2 || ny < 2 {
             return Err(format!("grid {nx}x{ny} is too small: both sides must be at least 2"));
         }
@@ -66,7 +78,7 @@ impl Model {
                         "3-D SOM needs an n x n x n lattice, got grid {nx}x{ny} (use a square grid)"
                     ));
                 }
-                Box::new(som3d::Som3d::new(nx))
+                Box::new(som3d::Som3d::with_adjacency(nx, som3d_adjacency))
             }
             Model::Cksom => Box::new(cksom::Cksom::new(nx, ny)),
             Model::Dnsom => Box::new(dnsom::Dnsom::new(nx, ny)),

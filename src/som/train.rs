@@ -17,11 +17,19 @@ pub struct SomParams {
     pub alpha0: f64,
     /// Initial radius sigma0; `None` = the model's default (half the smaller grid side).
     pub sigma0: Option<f64>,
+    /// Which 3-D SOM units are adjacent for TE (Eq. 4.16): the topology a cell is trained on is
+    /// built with it ([`super::Model::topology_with`]); [`train`] asks the topology.
+    pub som3d_adjacency: super::LatticeAdjacency,
 }
 
 impl Default for SomParams {
     fn default() -> Self {
-        SomParams { iterations: 30_000, alpha0: 0.9, sigma0: None }
+        SomParams {
+            iterations: 30_000,
+            alpha0: 0.9,
+            sigma0: None,
+            som3d_adjacency: super::LatticeAdjacency::N6,
+        }
     }
 }
 
@@ -244,7 +252,7 @@ mod tests {
         // With T = 1 the update is one step: check it against Eq. 4.10-4.11 by hand.
         let data = vec![[0.25, 0.5, 0.75]];
         let topo = Model::Som2d.topology(6, 6).unwrap();
-        let p = SomParams { iterations: 1, alpha0: 0.9, sigma0: None };
+        let p = SomParams { iterations: 1, alpha0: 0.9, ..Default::default() };
         let mut rng = ChaCha8Rng::seed_from_u64(3);
         let r = train(topo.as_ref(), &data, &p, &mut rng).unwrap();
         let mut rng = ChaCha8Rng::seed_from_u64(3);
@@ -275,7 +283,7 @@ mod tests {
         // Apart from step 2's winner, a unit moves iff dist < 4 and K != 2 (Section 4.2.4).
         let topo = Model::Dnsom.topology(6, 6).unwrap();
         let lat = topo.lattice();
-        let p = SomParams { iterations: 2, alpha0: 0.9, sigma0: Some(16.0) };
+        let p = SomParams { iterations: 2, alpha0: 0.9, sigma0: Some(16.0), ..Default::default() };
         let sigma = 4.0;
         let mut saw_blocked = false;
         for seed in 0..40 {

@@ -5,6 +5,7 @@ pub mod pictures;
 pub mod report;
 pub mod spec;
 
+use crate::data::generators::{SpindleProfile, SpindleRings};
 use crate::data::PointCloud;
 use crate::experiment::spec::{Spec, SpecError};
 use crate::experiment::packed::PackedPoints;
@@ -109,11 +110,13 @@ pub fn load_datasets(
     spec: &Spec,
     names: &[String],
     ctx: &RunContext,
+    spindle: (SpindleProfile, SpindleRings),
 ) -> Result<BTreeMap<String, Arc<PointCloud>>> {
+    let loader = crate::data::registry::Loader { spindle, ..ctx.loader(spec) };
     let mut out = BTreeMap::new();
     for name in names {
         if !out.contains_key(&crate::data::registry::name_of(name)) {
-            let cloud = ctx.loader(spec).load(name)?;
+            let cloud = loader.load(name)?;
             out.insert(cloud.name.clone(), Arc::new(cloud));
         }
     }
@@ -146,7 +149,10 @@ pub fn run_cell(
     master_seed: u64,
 ) -> Result<SomRun> {
     let key = cell.key();
-    let topo = cell.model.topology(cell.grid.nx, cell.grid.ny).map_err(anyhow::Error::msg)?;
+    let topo = cell
+        .model
+        .topology_with(cell.grid.nx, cell.grid.ny, params.som3d_adjacency)
+        .map_err(anyhow::Error::msg)?;
     let (trained, cpu_s) =
         runner::on_stream(master_seed, &key, |rng| som::train(topo.as_ref(), data, params, rng));
     let trained = trained.map_err(anyhow::Error::msg).with_context(|| key.clone())?;
@@ -178,11 +184,13 @@ pub fn run(
     som_spec: &spec::SomSpec,
     ctx: &RunContext,
 ) -> Result<(Vec<SomRun>, Frames)> {
-    let data = load_datasets(spec, &som_spec.datasets, ctx)?;
+    let spindle = (som_spec.spindle_profile, som_spec.spindle_rings);
+    let data = load_datasets(spec, &som_spec.datasets, ctx, spindle)?;
     let params = SomParams {
         iterations: som_spec.iterations,
         alpha0: som_spec.alpha0,
         sigma0: som_spec.sigma0,
+        som3d_adjacency: som_spec.som3d_adjacency,
     };
     let cells = spec::cells(som_spec);
     for entry in &som_spec.datasets {
@@ -240,7 +248,7 @@ impl crate::experiment::family::Experiment for Som {
         crate::experiment::Definitions(&[
             ("qe", "mean over training iterations of |X(t) - W_c(t)| (Euclidean, before the update) (thesis Eq. 4.15)"),
             ("te", "share of training iterations whose first and second winners are not adjacent (Eq. 4.16)"),
-            ("te_adjacency", "index distance 1: 4-neighbourhood on 2-D maps, 6-neighbourhood in the 3-D lattice and CKSOM surface, 4-neighbourhood on either DNSOM view over class numbers"),
+            ("te_adjacency", "index distance 1: 4-neighbourhood on 2-D maps, 6-neighbourhood in the 3-D lattice (another with som.som3d_adjacency) and CKSOM surface, 4-neighbourhood on either DNSOM view over class numbers"),
             ("qe_final", "mean Euclidean distance of every data point to its best-matching unit after training"),
             ("te_final", "share of data points whose two best units are not adjacent (adjacency as above)"),
             ("cpu_s", "thread CPU seconds of weight initialisation and the T training iterations"),

@@ -35,6 +35,17 @@ pub struct SomSpec {
     /// One PNG per cell and the overview pictures.
     #[serde(default = "crate::experiment::defaults::yes")]
     pub pictures: bool,
+    /// Which 3-D SOM units are adjacent for TE (Eq. 4.16): `n6` (index distance 1), `n18`, `n26`,
+    /// `layer` (within one k layer), `shell` (along the lattice's outer faces).
+    #[serde(default)]
+    pub som3d_adjacency: crate::som::LatticeAdjacency,
+    /// The spindle's radius at ring parameter t (Section 3.2.2 gives no curve): `sin2`, `sin`,
+    /// `cone`.
+    #[serde(default)]
+    pub spindle_profile: crate::data::generators::SpindleProfile,
+    /// Where the spindle's rings sit along its axis: `cos` (y = .5 + .5 cos(pi t)), `uniform`.
+    #[serde(default)]
+    pub spindle_rings: crate::data::generators::SpindleRings,
 }
 
 #[derive(Debug, Clone, Deserialize)]
