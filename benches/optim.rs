@@ -9,8 +9,8 @@ use somnurbs::families;
 use somnurbs::families::som::spec::SomCell;
 use somnurbs::geom::Point3;
 use somnurbs::optim::{default_optimiser, Budget, ExactOptions, Problem};
+use somnurbs::simd::Isa;
 use somnurbs::som::{Model, SomParams};
-use somnurbs::spline::control_net::Isa;
 use somnurbs::spline::{fit_two_view, Approach, Parameterisation};
 use somnurbs::spline::{BoxSpec, ControlNetProblem};
 use std::time::Instant;
@@ -124,7 +124,8 @@ fn main() {
             sum / bound
         );
     }
-    for isa in Isa::ALL {
+    // The fitness has a baseline and an AVX2 copy (under `Avx512Vl` it runs the AVX2 one).
+    for isa in [Isa::Baseline, Isa::Avx2] {
         let q = problem.clone().with_isa(isa);
         if q.isa() != isa {
             println!("fitness, {isa:?} copy: not run (this CPU lacks it)");
@@ -136,7 +137,10 @@ fn main() {
     }
     // The optimisers' own kernels, every compiled copy (all in L1: the floor of their overhead).
     #[cfg(target_arch = "x86_64")]
-    for line in somnurbs::optim::kernels::timing::report() {
+    for line in somnurbs::simd::moves::timing::report()
+        .into_iter()
+        .chain(somnurbs::simd::levy::timing::report())
+    {
         println!("{line}");
     }
     if std::env::var("BENCH_SCALING").is_ok_and(|v| v != "0") {

@@ -1,6 +1,7 @@
 //! somnurbs: reproduce, from seeds, SOM + cubic B-spline surface reconstruction experiments.
 //!
-//! Pure algorithms (`data`, `som`, `spline`, `optim`, `stats`) know nothing of files or the CLI;
+//! Pure algorithms (`data`, `som`, `spline`, `optim`, `stats`, and `simd`, the home of every fast
+//! path) know nothing of files or the CLI;
 //! `experiment` (the engine: spec, runner, seeds), `report` (the toolkit: tables, PNG, Markdown)
 //! and `io` serve the experiment `families`, one folder each, listed once in `families/mod.rs`.
 // Loops over coordinates (0..3), SIMD lanes and table columns index several arrays at once and
@@ -16,6 +17,7 @@ pub mod geom;
 pub mod io;
 pub mod optim;
 pub mod report;
+pub mod simd;
 pub mod som;
 pub mod spline;
 pub mod stats;

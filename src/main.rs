@@ -36,7 +36,7 @@ fn jobs(flag: Option<usize>) -> anyhow::Result<usize> {
 }
 
 fn run(cli: Cli) -> anyhow::Result<ExitCode> {
-    somnurbs::optim::kernels::simd()?;
+    somnurbs::simd::simd()?;
     match cli.command {
         Command::Run(args) => run_spec(&args),
         Command::Drift(args) => drift(&args),

@@ -1,5 +1,5 @@
 //! The AVX2 fitness' two building blocks, each run alone with its data in L1 and nothing around
-//! it (the kernel's own code, `control_net::building_blocks`): what the kernel's data flow costs
+//! it (the kernel's own code, `simd::fitness::building_blocks`): what the kernel's data flow costs
 //! on this core before any set-up, chunk change or interaction between the passes. Their sum over
 //! one evaluation is a floor of that data flow, measured (the FMA bound counts only the
 //! multiply-adds).
@@ -34,7 +34,7 @@ pub fn measure(mhz: f64) -> Option<Blocks> {
     #[cfg(target_arch = "x86_64")]
     {
         use crate::best_ns_per;
-        use somnurbs::spline::control_net::building_blocks::{first_pass, second_pass};
+        use somnurbs::simd::fitness::building_blocks::{first_pass, second_pass};
         let rows: Vec<f64> = (0..5 * K).map(|k| 1.0 + k as f64 * 1e-3).collect();
         let w = [
             [0.1, 0.6, 0.25, 0.05],

@@ -24,7 +24,7 @@
 //! The Levy factors u psi / |v|^(1/beta) (3 normals per coordinate and nest) are drawn in bulk
 //! by [`super::levy`] from a quantile table of their law built once per beta (one 32-bit uniform
 //! and one table look-up per coordinate, one vectorised pass per nest); the
-//! discovery's per-coordinate choices are DE's vectorised trial ([`super::kernels::de_trial`]),
+//! discovery's per-coordinate choices are DE's vectorised trial ([`crate::simd::moves::de_trial`]),
 //! each coordinate rebuilt with probability pa (a 32-bit uniform below floor(pa 2^32)). Both draw
 //! from four xoshiro256++ lanes seeded from the run's ChaCha8 stream, which gives the rest (the
 //! permutations and r).
@@ -33,11 +33,12 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::aligned::Aligned;
-use super::kernels::{de_trial, DeSources};
-use super::levy::{levy_flight, FlightLaw, FlightSources, LevyScratch, LevyTable};
+use super::levy::LevyTable;
 use super::problem::{check_problem, Budget, Evaluator, Optimiser, Population, Problem, RunResult};
 use super::sampling::{bernoulli_threshold_32, index, mantegna_sigma_u, unit, DeLanes};
 use super::{check_range, OptimError};
+use crate::simd::levy::{levy_flight, FlightLaw, FlightSources, LevyScratch};
+use crate::simd::moves::{de_trial, DeSources};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
@@ -327,7 +328,7 @@ mod tests {
     /// the factors are symmetric.
     #[test]
     fn levy_factors_have_the_right_tail() {
-        use super::super::levy::levy_fill;
+        use crate::simd::levy::levy_fill;
         let mut lanes = DeLanes::from_rng(&mut ChaCha8Rng::seed_from_u64(3));
         let n = 400_000;
         let mut s = vec![0.0; n];

@@ -14,13 +14,13 @@
 //! floor(CR 2^32) (probability within 2^-32 of CR), drawn from four xoshiro256++ lanes seeded
 //! from the run's stream ([`super::sampling::DeLanes`]; one step of the four gives the halves
 //! for eight genes), so the mutant, the choices and the trial are one vectorised pass over the
-//! genes ([`super::kernels::de_trial`]); j_rand is drawn from the run's stream.
+//! genes ([`crate::simd::moves::de_trial`]); j_rand is drawn from the run's stream.
 
 use super::aligned::Aligned;
-use super::kernels::{de_mutant_gene, de_trial, DeSources};
 use super::problem::{check_problem, Budget, Evaluator, Optimiser, Population, Problem, RunResult};
 use super::sampling::{bernoulli_threshold_32, index, DeLanes};
 use super::{check_range, OptimError};
+use crate::simd::moves::{de_mutant_gene, de_trial, DeSources};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 

@@ -11,7 +11,6 @@ pub mod de;
 pub mod exact;
 pub mod ga;
 pub mod ioh;
-pub mod kernels;
 pub mod levy;
 pub mod problem;
 pub mod pso;
@@ -43,6 +42,12 @@ pub enum OptimError {
 impl OptimError {
     pub(crate) fn param(key: &str, message: String) -> OptimError {
         OptimError::InvalidParameter { key: key.to_string(), message }
+    }
+}
+
+impl From<crate::simd::SimdError> for OptimError {
+    fn from(e: crate::simd::SimdError) -> OptimError {
+        OptimError::param(crate::simd::SIMD_ENV, e.message)
     }
 }
 

@@ -133,7 +133,7 @@ pub struct RunResult {
 
 /// Check a problem's shapes and box before a run.
 pub fn check_problem(problem: &dyn Problem) -> Result<(), OptimError> {
-    super::kernels::simd()?;
+    crate::simd::simd()?;
     let d = problem.dim();
     if d == 0 {
         return Err(OptimError::Problem("dimension is 0".into()));

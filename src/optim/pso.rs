@@ -16,10 +16,10 @@
 //! in the vectorised move loop.
 
 use super::aligned::Aligned;
-use super::kernels::{pso_move, PsoBounds, PsoCoefficients};
 use super::problem::{check_problem, Budget, Evaluator, Optimiser, Population, Problem, RunResult};
 use super::sampling::PsoLanes;
 use super::{check_range, OptimError};
+use crate::simd::moves::{pso_move, PsoBounds, PsoCoefficients};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 use std::borrow::Cow;
@@ -276,8 +276,8 @@ mod tests {
     /// [-4, 4] and [-1, 1] (data, widened to hold the box).
     #[test]
     fn velocity_and_position_ranges_clamp_as_computed_by_hand() {
-        use crate::optim::kernels::pso_move;
         use crate::optim::problem::tests::Sphere;
+        use crate::simd::moves::pso_move;
         use rand::SeedableRng;
         let mut inner = Sphere::new(2);
         (inner.lo, inner.hi) = (vec![-1.0; 2], vec![1.0; 2]);

@@ -4,7 +4,7 @@
 //! likewise.
 
 use crate::common::*;
-use somnurbs::spline::control_net::Isa;
+use somnurbs::simd::Isa;
 
 /// Every optimiser (so every kernel) on two nets, one of them with padded lanes.
 const ALL_KERNELS: &str = r#"
@@ -96,7 +96,7 @@ fn malformed_simd_value_is_refused() {
 
 #[test]
 fn simd_values_are_parsed_and_checked_against_the_cpu() {
-    use somnurbs::optim::kernels::parse_simd;
+    use somnurbs::simd::parse_simd;
     for v in [None, Some(""), Some("auto"), Some(" auto ")] {
         assert_eq!(parse_simd(v).unwrap(), Isa::fastest());
     }

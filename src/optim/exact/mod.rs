@@ -59,6 +59,7 @@ mod refine;
 
 use super::OptimError;
 use crate::geom::Point3;
+use crate::simd::envelope::{cholesky, dot};
 
 /// One term |a_k^T (x) I_3 x - d_k|: the points it combines, their coefficients, its data.
 #[derive(Debug, Clone, Copy)]
@@ -208,63 +209,6 @@ struct Envelope {
     val: Vec<f64>,
 }
 
-/// Dot product with eight interleaved accumulators summed in a fixed order (vectorises; the
-/// same result on every instruction set).
-#[inline(always)]
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    let n = a.len();
-    let b = &b[..n];
-    let mut acc = [0.0; 8];
-    let chunks = n / 8;
-    for i in 0..chunks {
-        let (x, y) = (&a[8 * i..8 * i + 8], &b[8 * i..8 * i + 8]);
-        for l in 0..8 {
-            acc[l] += x[l] * y[l];
-        }
-    }
-    for i in 8 * chunks..n {
-        acc[i - 8 * chunks] += a[i] * b[i];
-    }
-    ((acc[0] + acc[4]) + (acc[2] + acc[6])) + ((acc[1] + acc[5]) + (acc[3] + acc[7]))
-}
-
-/// In-place Cholesky L L^T of an envelope matrix; Err(row) at a non-positive pivot.
-#[inline(always)]
-fn cholesky_generic(first: &[usize], start: &[usize], val: &mut [f64]) -> Result<(), usize> {
-    let n = first.len();
-    for r in 0..n {
-        let fr = first[r];
-        let (done, rest) = val.split_at_mut(start[r]);
-        let row = &mut rest[..r - fr + 1];
-        for c in fr..r {
-            let fc = first[c];
-            let k0 = fr.max(fc);
-            let lc = &done[start[c]..start[c] + (c - fc + 1)];
-            let s = row[c - fr] - dot(&row[k0 - fr..c - fr], &lc[k0 - fc..c - fc]);
-            row[c - fr] = s / lc[c - fc];
-        }
-        let (off, diag) = row.split_at_mut(r - fr);
-        let d = diag[0] - dot(off, off);
-        if !(d > 0.0 && d.is_finite()) {
-            return Err(r);
-        }
-        diag[0] = d.sqrt();
-    }
-    Ok(())
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn cholesky_avx2(first: &[usize], start: &[usize], val: &mut [f64]) -> Result<(), usize> {
-    cholesky_generic(first, start, val)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
-fn cholesky_avx512(first: &[usize], start: &[usize], val: &mut [f64]) -> Result<(), usize> {
-    cholesky_generic(first, start, val)
-}
-
 impl Envelope {
     fn new(first: Vec<usize>) -> Envelope {
         let mut start = Vec::with_capacity(first.len());
@@ -287,18 +231,7 @@ impl Envelope {
     }
 
     fn factorise(&mut self) -> Result<(), usize> {
-        #[cfg(target_arch = "x86_64")]
-        {
-            if std::arch::is_x86_feature_detected!("avx512f") {
-                // SAFETY: the CPU reports AVX-512F.
-                return unsafe { cholesky_avx512(&self.first, &self.start, &mut self.val) };
-            }
-            if std::arch::is_x86_feature_detected!("avx2") {
-                // SAFETY: the CPU reports AVX2.
-                return unsafe { cholesky_avx2(&self.first, &self.start, &mut self.val) };
-            }
-        }
-        cholesky_generic(&self.first, &self.start, &mut self.val)
+        cholesky(&self.first, &self.start, &mut self.val)
     }
 
     /// Solve L L^T x = b in place.

@@ -20,7 +20,7 @@ use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 
-mod fast;
+use crate::simd::bezier as fast;
 
 /// The n+1 Bernstein polynomials of degree n at t (de Casteljau-style recurrence).
 pub fn bernstein(n: usize, t: f64) -> Vec<f64> {
@@ -156,12 +156,12 @@ fn column_basis(deg: usize, t: &[f64]) -> DMatrix<f64> {
 #[derive(Debug, Clone)]
 pub struct GridData {
     coords: [DMatrix<f64>; 3],
-    norm2: f64,
-    nu: usize,
-    nv: usize,
+    pub(crate) norm2: f64,
+    pub(crate) nu: usize,
+    pub(crate) nv: usize,
     /// Row i = coordinate c of points (i, 0..nv) at c lv + j, lv = `fast::padded(nv)`, zero
     /// padded; rows 3 lv long: the fast path's layout.
-    rows: Vec<f64>,
+    pub(crate) rows: Vec<f64>,
 }
 
 impl GridData {

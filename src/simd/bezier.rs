@@ -13,15 +13,16 @@
 //! Determinism: every sum has a fixed order written in the code: the long dot products keep 4
 //! partial sums (entry k into lane k mod 4, each a chain of fused multiply-adds `f64::mul_add`,
 //! one rounding in every copy) combined as (s0 + s2) + (s1 + s3); the Householder steps' dot
-//! products keep 8 ([`dot8`]); [`gemm_tn`]'s sums are one chain each. The AVX2 + FMA and AVX-512VL
-//! copies are the same Rust compiled with `target_feature` (wider vectors and hardware FMA only;
-//! rustc never reassociates), so all copies give the same bits; `SOMNURBS_SIMD=scalar` forces the
+//! products keep 8 ([`dot8`]); [`gemm_tn`]'s sums are one chain each. The AVX2 + FMA copy is the
+//! same Rust compiled with `target_feature` (wider vectors and hardware FMA only; rustc never
+//! reassociates) plus a few hand-written AVX2 kernels, so all copies give the same bits (an
+//! AVX-512VL compilation gained under 5% and was removed: docs/speed.md); `SOMNURBS_SIMD=scalar` forces the
 //! baseline copy (whose `mul_add` is the C library's correctly rounded `fma`, slow but identical).
 
-use super::GridData;
-use crate::geom::Point3;
 #[cfg(target_arch = "x86_64")]
-use crate::optim::kernels::Isa;
+use super::Isa;
+use crate::geom::Point3;
+use crate::spline::bezier::GridData;
 use std::cell::RefCell;
 use std::mem::MaybeUninit;
 
@@ -43,7 +44,7 @@ const CANCEL_REL: f64 = 1e-6;
 
 /// Reused buffers of one thread (no allocation per evaluation once grown).
 #[derive(Default)]
-pub(super) struct Scratch {
+pub(crate) struct Scratch {
     /// The clamped (and, for grids, sorted) decision vector.
     pub x: Vec<f64>,
     bu: Vec<f64>,
@@ -69,7 +70,7 @@ thread_local! {
 }
 
 /// Run `f` with this thread's scratch buffers.
-pub(super) fn with_scratch<R>(f: impl FnOnce(&mut Scratch) -> R) -> R {
+pub(crate) fn with_scratch<R>(f: impl FnOnce(&mut Scratch) -> R) -> R {
     SCRATCH.with(|s| f(&mut s.borrow_mut()))
 }
 
@@ -87,7 +88,7 @@ fn align64(v: &mut Vec<f64>, n: usize) -> usize {
 }
 
 /// The length of a padded row or column of n entries (the next multiple of [`LANES`]).
-pub(super) fn padded(n: usize) -> usize {
+pub(crate) fn padded(n: usize) -> usize {
     n.div_ceil(LANES) * LANES
 }
 
@@ -761,14 +762,14 @@ fn gemm_nt_acc_scalar(a: &[f64], ra: usize, b: &[f64], rb: usize, len: usize, ac
 /// [`moments`]' layout (per block of [`BLK`] points the x, y and z rows, [`BLK`] apart, zero past
 /// the last point; laid out once per problem instead of once per evaluation) and sum_k |P_k|^2.
 #[derive(Debug, Clone)]
-pub(super) struct ScatteredData {
+pub(crate) struct ScatteredData {
     len: usize,
     blocks: Vec<f64>,
     norm2: f64,
 }
 
 impl ScatteredData {
-    pub(super) fn new(pts: &[Point3]) -> ScatteredData {
+    pub(crate) fn new(pts: &[Point3]) -> ScatteredData {
         let mut blocks = vec![0.0; pts.len().div_ceil(BLK) * 3 * BLK];
         for (k, p) in pts.iter().enumerate() {
             for co in 0..3 {
@@ -799,7 +800,7 @@ impl ScatteredData {
 /// z = U^-T g, Y = |P|^2 - 2 g.c + c^T G c = |P|^2 - |z|^2 (the back substitution for c is
 /// skipped); below 1e-6 |P|^2 c is solved for, refined once and Y summed from the residuals.
 /// `None` if a Cholesky pivot is below [`PIVOT_REL`].
-pub(super) fn scattered_sse(
+pub(crate) fn scattered_sse(
     du: usize,
     dv: usize,
     x: &[f64],
@@ -810,10 +811,9 @@ pub(super) fn scattered_sse(
         return None;
     }
     #[cfg(target_arch = "x86_64")]
-    match crate::optim::kernels::chosen() {
+    match super::chosen() {
         // SAFETY: the dispatcher checked that the CPU has the copy's features.
-        Isa::Avx512Vl => return unsafe { scattered_sse_avx512(du, dv, x, data, s) },
-        Isa::Avx2 => return unsafe { scattered_sse_avx2(du, dv, x, data, s) },
+        Isa::Avx2 | Isa::Avx512Vl => return unsafe { scattered_sse_avx2(du, dv, x, data, s) },
         Isa::Baseline => {}
     }
     scattered_sse_body::<false>(du, dv, x, data, s)
@@ -823,19 +823,6 @@ pub(super) fn scattered_sse(
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 fn scattered_sse_avx2(
-    du: usize,
-    dv: usize,
-    x: &[f64],
-    data: &ScatteredData,
-    s: &mut Scratch,
-) -> Option<f64> {
-    scattered_sse_body::<true>(du, dv, x, data, s)
-}
-
-/// [`scattered_sse_body`] compiled for AVX-512VL (256-bit vectors, 32 registers).
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma,avx512f,avx512vl")]
-fn scattered_sse_avx512(
     du: usize,
     dv: usize,
     x: &[f64],
@@ -1075,8 +1062,8 @@ fn refined_residual(
         let mut y = 0.0;
         let (mut bu, mut bv) = ([0.0; MAXB], [0.0; MAXB]);
         for (k, uv) in x.chunks_exact(2).enumerate() {
-            super::bernstein_into(du, uv[0], &mut bu[..ku]);
-            super::bernstein_into(dv, uv[1], &mut bv[..kv]);
+            crate::spline::bezier::bernstein_into(du, uv[0], &mut bu[..ku]);
+            crate::spline::bezier::bernstein_into(dv, uv[1], &mut bv[..kv]);
             let mut e = data.point(k);
             for a in 0..ku {
                 for b in 0..kv {
@@ -1305,9 +1292,9 @@ const RANK_MAX: usize = 128;
 /// The AVX2 copy ranks every entry by comparisons against all others instead of the std sort
 /// (about 0.7 us for 41 values on Zen 3); keys equal under `total_cmp` are equal bits, so every
 /// correct sort gives the same slice, bit for bit.
-pub(super) fn sort_params(t: &mut [f64]) {
+pub(crate) fn sort_params(t: &mut [f64]) {
     #[cfg(target_arch = "x86_64")]
-    if t.len() <= RANK_MAX && crate::optim::kernels::use_avx2() {
+    if t.len() <= RANK_MAX && super::use_avx2() {
         // SAFETY: `use_avx2` is true only when this CPU has AVX2 + FMA; the length is checked.
         unsafe { rank_sort_avx2(t) };
         return;
@@ -1500,10 +1487,10 @@ fn axpy(f: f64, v: &[f64], x: &mut [f64]) {
 }
 
 /// Y of the grid fit by the separable projection Y = |D|^2 - sum_c |Qu^T D_c Qv|^2 (see
-/// [`super::grid_sse`]) with the thin Qs from [`thin_q`]; `None` when a collocation matrix is
+/// [`crate::spline::bezier::grid_sse`]) with the thin Qs from [`thin_q`]; `None` when a collocation matrix is
 /// (nearly) rank deficient or a grid side exceeds 128. Below 1e-6 |D|^2 the residual
 /// D_c - Qu C_c Qv^T is summed instead.
-pub(super) fn grid_sse(
+pub(crate) fn grid_sse(
     du: usize,
     dv: usize,
     u: &[f64],
@@ -1512,10 +1499,9 @@ pub(super) fn grid_sse(
     s: &mut Scratch,
 ) -> Option<f64> {
     #[cfg(target_arch = "x86_64")]
-    match crate::optim::kernels::chosen() {
+    match super::chosen() {
         // SAFETY: the dispatcher checked that the CPU has the copy's features.
-        Isa::Avx512Vl => return unsafe { grid_sse_avx512(du, dv, u, v, data, s) },
-        Isa::Avx2 => return unsafe { grid_sse_avx2(du, dv, u, v, data, s) },
+        Isa::Avx2 | Isa::Avx512Vl => return unsafe { grid_sse_avx2(du, dv, u, v, data, s) },
         Isa::Baseline => {}
     }
     grid_sse_body::<false>(du, dv, u, v, data, s)
@@ -1525,20 +1511,6 @@ pub(super) fn grid_sse(
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 fn grid_sse_avx2(
-    du: usize,
-    dv: usize,
-    u: &[f64],
-    v: &[f64],
-    data: &GridData,
-    s: &mut Scratch,
-) -> Option<f64> {
-    grid_sse_body::<true>(du, dv, u, v, data, s)
-}
-
-/// [`grid_sse_body`] compiled for AVX-512VL (256-bit vectors, 32 registers).
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma,avx512f,avx512vl")]
-fn grid_sse_avx512(
     du: usize,
     dv: usize,
     u: &[f64],
@@ -1617,9 +1589,9 @@ fn grid_residual(ku: usize, kv: usize, data: &GridData, s: &mut Scratch) -> f64 
 
 #[cfg(test)]
 mod tests {
-    use super::super::{add_noise, example3, fit_poles, grid_sse_qr, BezierSurface};
     use super::*;
     use crate::optim::Problem;
+    use crate::spline::bezier::{add_noise, example3, fit_poles, grid_sse_qr, BezierSurface};
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
@@ -1684,7 +1656,7 @@ mod tests {
                 }
             }
             #[cfg(target_arch = "x86_64")]
-            if crate::optim::kernels::avx2_fma() {
+            if super::super::avx2_fma() {
                 let mut o2 = vec![f64::NAN; ra * rb];
                 unsafe { gemm_nt_avx2(&a, ra, &b, rb, len, &mut o2, rb) };
                 let bits = |o: &[f64]| o.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
@@ -1715,7 +1687,7 @@ mod tests {
                 }
             }
             #[cfg(target_arch = "x86_64")]
-            if crate::optim::kernels::avx2_fma() {
+            if super::super::avx2_fma() {
                 let mut o2 = vec![f64::NAN; k * w];
                 unsafe { gemm_tn_avx2(&q, lq, k, &r, n, w, &mut o2) };
                 let bits = |o: &[f64]| o.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
@@ -1743,7 +1715,7 @@ mod tests {
                 }
             }
             #[cfg(target_arch = "x86_64")]
-            if crate::optim::kernels::avx2_fma() {
+            if super::super::avx2_fma() {
                 let mut x2 = x.clone();
                 unsafe { reflect_cols_avx2(&v, beta, &mut x2, lp) };
                 let bits = |o: &[f64]| o.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
@@ -1773,7 +1745,7 @@ mod tests {
                 let o = run(false);
                 let mut b = [0.0; MAXB];
                 for (k, &tk) in t.iter().enumerate() {
-                    super::super::bernstein_into(n, tk, &mut b[..=n]);
+                    crate::spline::bezier::bernstein_into(n, tk, &mut b[..=n]);
                     for i in 0..=n {
                         assert!((o[i * stride + k] - b[i]).abs() <= 1e-14, "n={n} k={k}");
                     }
@@ -1782,7 +1754,7 @@ mod tests {
                     assert!(o[i * stride + np..(i + 1) * stride].iter().all(|&x| x == 0.0));
                 }
                 #[cfg(target_arch = "x86_64")]
-                if crate::optim::kernels::avx2_fma() {
+                if super::super::avx2_fma() {
                     let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
                     assert_eq!(bits(&run(true)), bits(&o), "n={n} np={np}");
                 }
@@ -1812,7 +1784,7 @@ mod tests {
                 };
                 let (o, o2) = run(false);
                 #[cfg(target_arch = "x86_64")]
-                if crate::optim::kernels::avx2_fma() {
+                if super::super::avx2_fma() {
                     let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
                     let (p, p2) = run(true);
                     assert_eq!((bits(&p), bits(&p2)), (bits(&o), bits(&o2)), "n={n} np={np}");
@@ -1854,7 +1826,7 @@ mod tests {
                 }
             }
             #[cfg(target_arch = "x86_64")]
-            if crate::optim::kernels::avx2_fma() {
+            if super::super::avx2_fma() {
                 let mut u2 = g.clone();
                 assert!(unsafe { cholesky_avx2_for_test(&mut u2, n) });
                 let upper = |u: &[f64]| {
@@ -1910,7 +1882,7 @@ mod tests {
             let bits: Vec<u64> = whole.iter().map(|x| x.to_bits()).collect();
             assert_eq!(blocked(false), bits, "({ra},{rb},{len})");
             #[cfg(target_arch = "x86_64")]
-            if crate::optim::kernels::avx2_fma() {
+            if super::super::avx2_fma() {
                 assert_eq!(blocked(true), bits, "AVX2 ({ra},{rb},{len})");
             }
         }
@@ -1942,14 +1914,10 @@ mod tests {
                 assert!((y - y_svd).abs() <= 1e-10 * y_svd, "({du},{dv}): {y} vs {y_svd}");
                 #[cfg(target_arch = "x86_64")]
                 {
-                    use crate::optim::kernels::{avx2_fma, avx512vl};
+                    use crate::simd::avx2_fma;
                     if avx2_fma() {
                         let y2 = unsafe { scattered_sse_avx2(du, dv, &x, &data, &mut s) };
                         assert_eq!(y2.map(f64::to_bits), Some(y.to_bits()), "AVX2 ({du},{dv})");
-                    }
-                    if avx512vl() {
-                        let y3 = unsafe { scattered_sse_avx512(du, dv, &x, &data, &mut s) };
-                        assert_eq!(y3.map(f64::to_bits), Some(y.to_bits()), "AVX-512 ({du},{dv})");
                     }
                 }
             }
@@ -1996,10 +1964,10 @@ mod tests {
             .collect();
         let mut s = Scratch::default();
         assert!(scattered_sse_body::<false>(5, 5, &x, &ScatteredData::new(&pts), &mut s).is_none());
-        let prob = super::super::BezierParamProblem::new(
+        let prob = crate::spline::bezier::BezierParamProblem::new(
             5,
             5,
-            super::super::Layout::Scattered,
+            crate::spline::bezier::Layout::Scattered,
             pts.clone(),
             x.clone(),
         )
@@ -2013,7 +1981,8 @@ mod tests {
     fn grid_fast_equals_qr_and_refuses_rank_deficiency() {
         let mut rng = ChaCha8Rng::seed_from_u64(34);
         for (n, d) in [(29, 5), (41, 9), (13, 5)] {
-            let mut pts = super::super::height_grid(super::super::peaks, n, -3.0, 3.0);
+            let mut pts =
+                crate::spline::bezier::height_grid(crate::spline::bezier::peaks, n, -3.0, 3.0);
             add_noise(&mut pts, 12.5, &mut rng);
             let data = GridData::new(&pts, n, n);
             for _ in 0..4 {
@@ -2027,14 +1996,10 @@ mod tests {
                 assert!((y - y_qr).abs() <= 1e-10 * y_qr, "n={n}: {y} vs {y_qr}");
                 #[cfg(target_arch = "x86_64")]
                 {
-                    use crate::optim::kernels::{avx2_fma, avx512vl};
+                    use crate::simd::avx2_fma;
                     if avx2_fma() {
                         let y2 = unsafe { grid_sse_avx2(d, d, &u, &v, &data, &mut s) };
                         assert_eq!(y2.map(f64::to_bits), Some(y.to_bits()), "AVX2 n={n}");
-                    }
-                    if avx512vl() {
-                        let y3 = unsafe { grid_sse_avx512(d, d, &u, &v, &data, &mut s) };
-                        assert_eq!(y3.map(f64::to_bits), Some(y.to_bits()), "AVX-512 n={n}");
                     }
                 }
             }

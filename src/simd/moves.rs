@@ -1,198 +1,15 @@
-//! The optimisers' per-coordinate loops (DE's trial, PSO's move), each compiled as a baseline
-//! copy and hand-written in 256-bit AVX2 and AVX-512VL instructions (one macro body for both),
-//! picked at run time. Results are bit-identical between the copies: every operation is an IEEE
-//! multiply, add, fused multiply-add (`f64::mul_add`, one rounding in every copy: a hardware
-//! instruction in the vector copies, the C library's `fma` in the baseline one) or compare in the
-//! same order, or exact integer arithmetic; only the vector width differs.
-//!
-//! Clamping is written as `if v < lo { lo } else { v }` then `if v > hi { hi } else { v }`: the
-//! same value as `max(lo).min(hi)` for every number (and NaN passes through), but it compiles to
-//! one vector max and one vector min instead of NaN-aware blends.
+//! The optimisers' per-coordinate loops (DE's trial, PSO's move, the words of DE's four lanes
+//! for cuckoo search), each a portable copy beside its copies hand-written in 256-bit vector
+//! instructions (one macro body per ISA), picked at run time. Results are bit-identical between
+//! the copies: every operation is an IEEE multiply, add, fused multiply-add (`f64::mul_add`, one
+//! rounding in every copy: a hardware instruction in the vector copies, the C library's `fma` in
+//! the baseline one) or compare in the same order, or exact integer arithmetic; only the vector
+//! width differs. Clamping is [`super::clamp`].
 
-use super::sampling::{two_units_plus_one, DeLanes, PsoLanes, DE_LANES, PSO_LANES};
-use super::OptimError;
-
-/// Which compiled copy of the fitness kernel runs. (The AVX-512VL copy is hand-written with
-/// 256-bit vectors: compiler-vectorised AVX-512 code picks 512-bit vectors, which the development
-/// machine, an AMD Zen 4 (family 25), runs in two halves, and turns the transpose into scatters.)
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Isa {
-    Baseline,
-    /// AVX2 with FMA.
-    Avx2,
-    /// AVX-512VL (256-bit vectors, 32 registers): the first pass fused with the transpose.
-    Avx512Vl,
-}
-
-impl Isa {
-    /// Every copy, slowest first.
-    pub const ALL: [Isa; 3] = [Isa::Baseline, Isa::Avx2, Isa::Avx512Vl];
-
-    /// The fastest copy this CPU supports.
-    pub fn fastest() -> Isa {
-        Isa::ALL.into_iter().rev().find(|isa| isa.supported()).unwrap_or(Isa::Baseline)
-    }
-
-    /// Whether this CPU runs this copy.
-    pub fn supported(self) -> bool {
-        match self {
-            Isa::Baseline => true,
-            #[cfg(target_arch = "x86_64")]
-            Isa::Avx2 => avx2_fma(),
-            #[cfg(target_arch = "x86_64")]
-            Isa::Avx512Vl => avx512vl(),
-            #[cfg(not(target_arch = "x86_64"))]
-            Isa::Avx2 | Isa::Avx512Vl => false,
-        }
-    }
-}
-
-#[inline(always)]
-pub(crate) fn clamp(v: f64, lo: f64, hi: f64) -> f64 {
-    let v = if v < lo { lo } else { v };
-    if v > hi {
-        hi
-    } else {
-        v
-    }
-}
-
-/// Whether this CPU runs the AVX2 + FMA copies.
+use super::clamp;
 #[cfg(target_arch = "x86_64")]
-#[inline]
-pub fn avx2_fma() -> bool {
-    std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
-}
-
-/// Whether this CPU runs the AVX-512VL copies (256-bit vectors, 32 registers; compiled with
-/// AVX2, FMA, AVX-512F and AVX-512VL).
-#[cfg(target_arch = "x86_64")]
-pub fn avx512vl() -> bool {
-    avx2_fma()
-        && std::arch::is_x86_feature_detected!("avx512f")
-        && std::arch::is_x86_feature_detected!("avx512vl")
-}
-
-/// The environment variable that forces one compiled copy of every SIMD kernel (the fitness,
-/// DE's trial, PSO's move, cuckoo search's Levy steps): `scalar`, `avx2` or `avx512` (the
-/// AVX-512VL copies); unset, empty or `auto` runs the fastest copy this CPU has. All copies give
-/// the same bits, so this only changes the speed; a copy the CPU lacks is refused with an error.
-pub const SIMD_ENV: &str = "SOMNURBS_SIMD";
-
-/// The copy `value` (the variable's value, if set) asks for, checked against this CPU.
-pub fn parse_simd(value: Option<&str>) -> Result<Isa, OptimError> {
-    let isa = match value.map(str::trim) {
-        None | Some("") | Some("auto") => return Ok(Isa::fastest()),
-        Some("scalar") => Isa::Baseline,
-        Some("avx2") => Isa::Avx2,
-        Some("avx512") => Isa::Avx512Vl,
-        Some(other) => {
-            return Err(OptimError::param(
-                SIMD_ENV,
-                format!("must be scalar, avx2, avx512 or auto, got '{other}'"),
-            ))
-        }
-    };
-    if !isa.supported() {
-        let needs =
-            if isa == Isa::Avx2 { "AVX2 and FMA" } else { "AVX2, FMA, AVX-512F and AVX-512VL" };
-        return Err(OptimError::param(
-            SIMD_ENV,
-            format!("asks for the {} copy, which needs {needs}, but this CPU lacks them (the fastest copy here is {:?})", value.unwrap_or_default().trim(), Isa::fastest()),
-        ));
-    }
-    Ok(isa)
-}
-
-/// The copy this process runs: [`SIMD_ENV`] if set (read once), else the fastest this CPU has.
-/// Every optimiser run and every control-net problem checks it first, so a bad value is an
-/// error before any work.
-pub fn simd() -> Result<Isa, OptimError> {
-    choice().clone()
-}
-
-/// [`SIMD_ENV`] parsed once for the process.
-fn choice() -> &'static Result<Isa, OptimError> {
-    static CHOICE: std::sync::OnceLock<Result<Isa, OptimError>> = std::sync::OnceLock::new();
-    CHOICE.get_or_init(|| parse_simd(std::env::var(SIMD_ENV).ok().as_deref()))
-}
-
-/// The copy the dispatchers run ([`simd`]; the fastest copy if the variable is malformed, which
-/// the runs have already refused). Read by reference: the dispatchers ask for every chunk of a
-/// move, and cloning [`simd`]'s result each time took about 1% of a cuckoo-search run.
-#[inline]
-pub(crate) fn chosen() -> Isa {
-    match choice() {
-        Ok(isa) => *isa,
-        Err(_) => Isa::fastest(),
-    }
-}
-
-/// Whether the AVX2 (or AVX-512VL) copies run.
-#[inline]
-pub fn use_avx2() -> bool {
-    matches!(chosen(), Isa::Avx2 | Isa::Avx512Vl)
-}
-
-/// Whether the AVX-512VL copies run.
-#[inline]
-pub fn use_avx512() -> bool {
-    chosen() == Isa::Avx512Vl
-}
-
-/// The few operations whose AVX2 and AVX-512VL forms differ, so that each hand-written kernel
-/// is one body for both (`simd!(avx2, ..)` or `simd!(avx512vl, ..)`): AVX-512VL has native 64-bit
-/// rotates, three-input logic and unsigned compares into mask registers; AVX2 builds them from
-/// shifts, two-input logic and signed compares (exact here: the compared values are below 2^33).
-#[cfg(target_arch = "x86_64")]
-macro_rules! simd {
-    (avx512vl, rol, $x:expr, $k:literal) => {
-        _mm256_rol_epi64::<$k>($x)
-    };
-    (avx2, rol, $x:expr, $k:literal) => {{
-        let x = $x;
-        _mm256_or_si256(_mm256_slli_epi64::<$k>(x), _mm256_srli_epi64::<{ 64 - $k }>(x))
-    }};
-    // a ^ b ^ c
-    (avx512vl, xor3, $a:expr, $b:expr, $c:expr) => {
-        _mm256_ternarylogic_epi64::<0x96>($a, $b, $c)
-    };
-    (avx2, xor3, $a:expr, $b:expr, $c:expr) => {
-        _mm256_xor_si256(_mm256_xor_si256($a, $b), $c)
-    };
-    // (a & b) | c
-    (avx512vl, and_or, $a:expr, $b:expr, $c:expr) => {
-        _mm256_ternarylogic_epi64::<0xEA>($a, $b, $c)
-    };
-    (avx2, and_or, $a:expr, $b:expr, $c:expr) => {
-        _mm256_or_si256(_mm256_and_si256($a, $b), $c)
-    };
-    // Per 64-bit lane: h < threshold (both below 2^33) ? m : x.
-    (avx512vl, choose, $h:expr, $thr:expr, $x:expr, $m:expr) => {
-        _mm256_mask_blend_pd(_mm256_cmplt_epu64_mask($h, $thr), $x, $m)
-    };
-    (avx2, choose, $h:expr, $thr:expr, $x:expr, $m:expr) => {
-        _mm256_blendv_pd($x, $m, _mm256_castsi256_pd(_mm256_cmpgt_epi64($thr, $h)))
-    };
-}
-
-/// One xoshiro256++ step of four lanes in 256-bit instructions: `$s` is the four state rows, one
-/// register each; evaluates to the four words.
-#[cfg(target_arch = "x86_64")]
-macro_rules! xoshiro4 {
-    ($isa:ident, $s:ident) => {{
-        let [a0, a1, a2, a3] = $s;
-        let word = _mm256_add_epi64(simd!($isa, rol, _mm256_add_epi64(a0, a3), 23), a0);
-        let t = _mm256_slli_epi64::<17>(a1);
-        $s = [
-            simd!($isa, xor3, a0, a3, a1),
-            simd!($isa, xor3, a1, a2, a0),
-            simd!($isa, xor3, a2, a0, t),
-            simd!($isa, rol, _mm256_xor_si256(a3, a1), 45),
-        ];
-        word
-    }};
-}
+use super::{avx2_fma, avx512vl, use_avx2, use_avx512};
+use crate::optim::sampling::{two_units_plus_one, DeLanes, PsoLanes, DE_LANES, PSO_LANES};
 
 /// One gene of the DE/rand/1 mutant, clamp(a + f (b - c)), a + f (b - c) fused.
 #[inline(always)]
@@ -327,7 +144,7 @@ fn de_trial_avx512vl(t: &mut [f64], src: DeSources, f: f64, rng: &mut DeLanes, t
 }
 
 /// The DE/rand/1/bin trial before its forced gene: t_j = clamp(a_j + F (b_j - c_j)) (fused)
-/// where gene j's 32-bit uniform h_j < `threshold` ([`super::sampling::bernoulli_threshold_32`]
+/// where gene j's 32-bit uniform h_j < `threshold` ([`crate::optim::sampling::bernoulli_threshold_32`]
 /// of CR), else x_j; one pass, the uniforms drawn from `rng` as in `de_trial_scalar`.
 pub fn de_trial(t: &mut [f64], src: DeSources, f: f64, rng: &mut DeLanes, threshold: u64) {
     #[cfg(target_arch = "x86_64")]
@@ -633,14 +450,6 @@ mod tests {
     use crate::optim::sampling::{bernoulli_threshold_32, two_units, xoshiro_step};
     use rand::{RngCore, SeedableRng};
     use rand_chacha::ChaCha8Rng;
-
-    #[test]
-    fn clamp_matches_max_min_and_keeps_nan() {
-        for v in [-3.0, -1.0, 0.0, 0.5, 1.0, 7.0, f64::INFINITY, f64::NEG_INFINITY] {
-            assert_eq!(clamp(v, -1.0, 1.0), v.clamp(-1.0, 1.0));
-        }
-        assert!(clamp(f64::NAN, -1.0, 1.0).is_nan());
-    }
 
     #[test]
     fn dispatched_copies_are_bit_identical_and_follow_the_formulas() {
