@@ -521,13 +521,14 @@ mod tests {
 
     #[test]
     fn foot_distance_closed_forms() {
-        // Order 2 closes the polygon of its control points: the square (+-1, +-1).
+        // Order 2 closes the polygon of its control points: the square (+-1, +-1), with P_3 at
+        // u = 0, P_0 = (1, -1) at u = 1, P_1 = (1, 1) at u = 2 and P_2 = (-1, 1) at u = 3.
         let sq = [1.0, -1.0, 1.0, 1.0, -1.0, 1.0, -1.0, -1.0];
-        // Above the edge (1,1)-(-1,1) by 0.2: distance 0.2, from a start a third of a span off.
+        // Above the edge P_1 P_2 by 0.2: distance 0.2, from a start on the next edge down.
         let d = foot_distance_sq(&sq, 4, 2, [0.3, 1.2], 1.0);
         assert!((d - 0.04).abs() < 1e-12, "{d}");
-        // Inside, 0.1 from the edge x = 1.
-        let d = foot_distance_sq(&sq, 4, 2, [0.9, 0.0], 0.2);
+        // Inside, 0.1 from the edge P_0 P_1 (x = 1), from a start on it.
+        let d = foot_distance_sq(&sq, 4, 2, [0.9, 0.0], 1.3);
         assert!((d - 0.01).abs() < 1e-12, "{d}");
         // A point of a quadratic closed curve is found at distance 0 from a start 0.3 away.
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);

@@ -359,6 +359,6 @@ mod tests {
         assert_eq!(ra.analytical_rms, problem(sa, &d, 7).unwrap().analytical().rms);
         assert_eq!(rf.analytical_rms, problem(sf, &d, 7).unwrap().analytical_rms());
         assert!(rf.analytical_rms < ra.analytical_rms, "{} {}", rf.analytical_rms, ra.analytical_rms);
-        assert!(spec_with("error = \"max\"").unwrap_err().to_string().contains("error"));
+        assert!(spec_with("error = \"max\"").unwrap_err().to_string().contains("unknown variant `max`"));
     }
 }

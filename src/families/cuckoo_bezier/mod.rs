@@ -492,6 +492,6 @@ mod tests {
             let e = spec_with(bad).unwrap_err().to_string();
             assert!(e.contains("seed003.start_spread"), "{e}");
         }
-        assert!(spec_with("start = \"somewhere\"").unwrap_err().to_string().contains("start"));
+        assert!(spec_with("start = \"somewhere\"").unwrap_err().to_string().contains("unknown variant `somewhere`"));
     }
 }
