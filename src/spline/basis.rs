@@ -31,10 +31,28 @@ pub fn basis_funs(span: usize, u: f64, p: usize, knots: &[f64]) -> Vec<f64> {
     let mut n = vec![0.0; p + 1];
     let mut left = vec![0.0; p + 1];
     let mut right = vec![0.0; p + 1];
+    basis_funs_into(
+        p,
+        |j| u - knots[span + 1 - j],
+        |j| knots[span + j] - u,
+        (&mut n, &mut left, &mut right),
+    );
+    n
+}
+
+/// A2.2's recurrence into `n` (the p + 1 values) with the scratch `left`, `right` (each at least
+/// p + 1 long), from the knot distances `below(j)` = u - t_{span+1-j} and `above(j)` =
+/// t_{span+j} - u, j = 1..p (no allocation).
+pub fn basis_funs_into(
+    p: usize,
+    below: impl Fn(usize) -> f64,
+    above: impl Fn(usize) -> f64,
+    (n, left, right): (&mut [f64], &mut [f64], &mut [f64]),
+) {
     n[0] = 1.0;
     for j in 1..=p {
-        left[j] = u - knots[span + 1 - j];
-        right[j] = knots[span + j] - u;
+        left[j] = below(j);
+        right[j] = above(j);
         let mut saved = 0.0;
         for r in 0..j {
             let temp = n[r] / (right[r + 1] + left[j - r]);
@@ -43,7 +61,6 @@ pub fn basis_funs(span: usize, u: f64, p: usize, knots: &[f64]) -> Vec<f64> {
         }
         n[j] = saved;
     }
-    n
 }
 
 /// Cubic basis in sparse form: for each parameter, the index of the first of its four non-zero

@@ -22,6 +22,7 @@ use super::SplineError;
 use crate::geom::Point3;
 use crate::optim::Problem;
 use nalgebra::DMatrix;
+use serde::{Deserialize, Serialize};
 
 /// The `order` non-zero closed basis functions at u (taken mod n): (first control index, values);
 /// the l-th value belongs to control point (first + l) mod n.
@@ -181,6 +182,85 @@ pub fn fit_closed_at(
     Ok(ClosedFit { surface, uv, rms })
 }
 
+/// How the GA's RMS error measures a data point's distance to the surface (seed 004's Eq. 9
+/// against its "RMS values of modelled curve and data points", Table II).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PointError {
+    /// At the point's own chord-length parameters (Eq. 9 as written: the least-squares net is
+    /// its exact minimum).
+    #[default]
+    AtParameters,
+    /// At the point's foot on the surface: its (x, y) distance to the closed curve of the
+    /// columns' (x, y), u re-found by Gauss-Newton from its chord-length u; z at its parameters.
+    ClosestPoint,
+}
+
+/// The `p + 1` uniform B-splines of degree p non-zero on a unit span, at t in [0, 1) of it
+/// (A2.2 on the integer knots, without allocation; p <= 7).
+fn uniform_span_basis(p: usize, t: f64) -> [f64; 8] {
+    debug_assert!(p <= 7, "degree {p} above 7");
+    let (mut out, mut left, mut right) = ([0.0; 8], [0.0; 8], [0.0; 8]);
+    // The span [0, 1) of the knots ..., -1, 0, 1, 2, ...: u - t_{1-j} = t + j - 1, t_j - u = j - t.
+    super::basis::basis_funs_into(
+        p,
+        |j| t + (j - 1) as f64,
+        |j| j as f64 - t,
+        (&mut out, &mut left, &mut right),
+    );
+    out
+}
+
+/// The point of the closed curve of `xy` = (x_0, y_0, x_1, y_1, ...) at u and its derivative.
+fn curve_and_tangent(xy: &[f64], n: usize, order: usize, u: f64) -> ([f64; 2], [f64; 2]) {
+    let nf = n as f64;
+    let mut w = u.rem_euclid(nf);
+    if w >= nf {
+        w = 0.0;
+    }
+    let s = (w.floor() as usize).min(n - 1);
+    let (p, t) = (order - 1, w - s as f64);
+    // The l-th value of degree p belongs to control point s - p + l (as in `periodic_basis`).
+    let b = uniform_span_basis(p, t);
+    let mut c = [0.0; 2];
+    for (l, a) in b.iter().take(p + 1).enumerate() {
+        let i = (s + l + n - p % n) % n;
+        c[0] += a * xy[2 * i];
+        c[1] += a * xy[2 * i + 1];
+    }
+    // Uniform knots: B'_{j,k} = B_{j,k-1} - B_{j+1,k-1}, so C' = sum_j B_{j,k-1} (P_j - P_{j-1}),
+    // the degree p - 1 functions on the span belonging to s - p + 1 + l.
+    let b1 = uniform_span_basis(p - 1, t);
+    let mut d = [0.0; 2];
+    for (l, a) in b1.iter().take(p).enumerate() {
+        let i = (s + 1 + l + 2 * n - p % n) % n;
+        let h = (i + n - 1) % n;
+        d[0] += a * (xy[2 * i] - xy[2 * h]);
+        d[1] += a * (xy[2 * i + 1] - xy[2 * h + 1]);
+    }
+    (c, d)
+}
+
+/// The squared distance from `p` to the closed curve of `xy` (order `order`, `n` points) at the
+/// foot point nearest u0: Gauss-Newton on |C(u) - p|^2 from u0, steps at most half a span.
+pub fn foot_distance_sq(xy: &[f64], n: usize, order: usize, p: [f64; 2], u0: f64) -> f64 {
+    let mut u = u0;
+    for _ in 0..12 {
+        let (c, d) = curve_and_tangent(xy, n, order, u);
+        let dd = d[0] * d[0] + d[1] * d[1];
+        if dd <= 0.0 {
+            break;
+        }
+        let step = (((c[0] - p[0]) * d[0] + (c[1] - p[1]) * d[1]) / dd).clamp(-0.5, 0.5);
+        u -= step;
+        if step.abs() < 1e-13 {
+            break;
+        }
+    }
+    let (c, _) = curve_and_tangent(xy, n, order, u);
+    (c[0] - p[0]).powi(2) + (c[1] - p[1]).powi(2)
+}
+
 /// The GA's problem: decision vector (x_0, y_0, ..., x_{N-1}, y_{N-1}), the (x, y) of every column
 /// of the net (all its rows share them), z of the net fixed at the analytical fit's; box: the
 /// analytical column's (x, y) (averaged over its rows) +- `search_range`; fitness = RMS error.
@@ -196,6 +276,10 @@ pub struct RingNetProblem {
     x0: Vec<f64>,
     lo: Vec<f64>,
     hi: Vec<f64>,
+    measure: PointError,
+    /// For `ClosestPoint`: the distinct ((x, y), chord-length u) of the data and their counts
+    /// (the lattice repeats its rings level by level).
+    feet: Vec<([f64; 2], f64, f64)>,
 }
 
 impl RingNetProblem {
@@ -222,7 +306,44 @@ impl RingNetProblem {
         }
         let lo = x0.iter().map(|v| v - search_range).collect();
         let hi = x0.iter().map(|v| v + search_range).collect();
-        RingNetProblem { fit, w, at, target, z_sse, x0, lo, hi }
+        RingNetProblem {
+            fit,
+            w,
+            at,
+            target,
+            z_sse,
+            x0,
+            lo,
+            hi,
+            measure: PointError::AtParameters,
+            feet: Vec::new(),
+        }
+    }
+
+    /// The same problem with its fitness measured by `measure`.
+    pub fn with_measure(mut self, measure: PointError) -> RingNetProblem {
+        self.measure = measure;
+        self.feet.clear();
+        if measure == PointError::ClosestPoint {
+            let mut seen = std::collections::HashMap::new();
+            for (t, &(u, _)) in self.target.iter().zip(&self.fit.uv) {
+                let key = (t[0].to_bits(), t[1].to_bits(), u.to_bits());
+                let k = *seen.entry(key).or_insert(self.feet.len());
+                if k == self.feet.len() {
+                    self.feet.push((*t, u, 0.0));
+                }
+                self.feet[k].2 += 1.0;
+            }
+        }
+        self
+    }
+
+    /// The analytical net's RMS error in the problem's measure (its columns' (x, y)).
+    pub fn analytical_rms(&self) -> f64 {
+        match self.measure {
+            PointError::AtParameters => self.fit.rms,
+            PointError::ClosestPoint => self.fitness(&self.x0),
+        }
     }
 
     pub fn n_points(&self) -> usize {
@@ -259,6 +380,13 @@ impl Problem for RingNetProblem {
     fn fitness(&self, x: &[f64]) -> f64 {
         let k = self.fit.surface.order_around;
         let mut sse = self.z_sse;
+        if self.measure == PointError::ClosestPoint {
+            let n = self.fit.surface.n_around;
+            for &(t, u, count) in &self.feet {
+                sse += count * foot_distance_sq(x, n, k, t, u);
+            }
+            return (sse / self.target.len() as f64).sqrt();
+        }
         for ((t, w), at) in
             self.target.iter().zip(self.w.chunks_exact(k)).zip(self.at.chunks_exact(k))
         {
@@ -354,6 +482,92 @@ mod tests {
                     assert!((a[c] - b[c]).abs() < 1e-10, "{a:?} {b:?}");
                 }
             }
+        }
+    }
+
+    #[test]
+    fn uniform_span_basis_is_the_periodic_one() {
+        for (n, k) in [(5, 2), (7, 3), (8, 4), (9, 8)] {
+            for s in 0..=300 {
+                let u = s as f64 * n as f64 / 301.0;
+                let (_, want) = periodic_basis(n, k, u);
+                let got = uniform_span_basis(k - 1, u - u.floor());
+                for (a, b) in got.iter().zip(&want) {
+                    assert!((a - b).abs() < 1e-13, "n {n} k {k} u {u}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn curve_tangent_matches_finite_differences() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+        for (n, k) in [(5, 2), (7, 3), (8, 4)] {
+            let xy: Vec<f64> = (0..2 * n).map(|_| rng.gen::<f64>()).collect();
+            for s in 0..50 {
+                // Off the knots, where the curve is smooth.
+                let u = (s as f64 + 0.37) * n as f64 / 50.0;
+                let (_, d) = curve_and_tangent(&xy, n, k, u);
+                let h = 1e-6;
+                let (a, _) = curve_and_tangent(&xy, n, k, u + h);
+                let (b, _) = curve_and_tangent(&xy, n, k, u - h);
+                for c in 0..2 {
+                    let fd = (a[c] - b[c]) / (2.0 * h);
+                    assert!((d[c] - fd).abs() < 1e-6, "n {n} k {k} u {u}: {} vs {fd}", d[c]);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn foot_distance_closed_forms() {
+        // Order 2 closes the polygon of its control points: the square (+-1, +-1), with P_3 at
+        // u = 0, P_0 = (1, -1) at u = 1, P_1 = (1, 1) at u = 2 and P_2 = (-1, 1) at u = 3.
+        let sq = [1.0, -1.0, 1.0, 1.0, -1.0, 1.0, -1.0, -1.0];
+        // Above the edge P_1 P_2 by 0.2: distance 0.2, from a start on the next edge down.
+        let d = foot_distance_sq(&sq, 4, 2, [0.3, 1.2], 1.0);
+        assert!((d - 0.04).abs() < 1e-12, "{d}");
+        // Inside, 0.1 from the edge P_0 P_1 (x = 1), from a start on it.
+        let d = foot_distance_sq(&sq, 4, 2, [0.9, 0.0], 1.3);
+        assert!((d - 0.01).abs() < 1e-12, "{d}");
+        // A point of a quadratic closed curve is found at distance 0 from a start 0.3 away.
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let xy: Vec<f64> = (0..7)
+            .flat_map(|i| {
+                let t = i as f64 * std::f64::consts::TAU / 7.0;
+                [5.0 * t.cos(), 5.0 * t.sin()]
+            })
+            .collect();
+        for _ in 0..20 {
+            let u = rng.gen::<f64>() * 7.0;
+            let (c, _) = curve_and_tangent(&xy, 7, 3, u);
+            assert!(foot_distance_sq(&xy, 7, 3, c, u + 0.3) < 1e-20);
+        }
+    }
+
+    /// The foot-point measure is never above the at-parameter one (the foot is the nearest
+    /// point, the parameter's point one of the candidates) and is below it on the lattice.
+    #[test]
+    fn closest_point_measure_is_at_most_the_parameter_one() {
+        let data = crate::data::cylinder::sort_into_rings(
+            &crate::data::cylinder::lattice_cylinder(5.0, 5.0, 0.1, 0.1),
+            1e-4,
+        );
+        let shape = ClosedNetShape { order_around: 3, order_up: 2, n_around: 7, rows: 2 };
+        let fit = fit_closed(&data, shape).unwrap();
+        let at = RingNetProblem::new(&data, fit.clone(), 0.25);
+        let foot =
+            RingNetProblem::new(&data, fit.clone(), 0.25).with_measure(PointError::ClosestPoint);
+        assert_eq!(at.analytical_rms(), fit.rms);
+        assert!(foot.analytical_rms() < 0.9 * fit.rms, "{} {}", foot.analytical_rms(), fit.rms);
+        for j in 0..10 {
+            let x: Vec<f64> = at
+                .initial_point()
+                .iter()
+                .enumerate()
+                .map(|(i, v)| v + 0.02 * ((i * j) as f64).sin())
+                .collect();
+            assert!(foot.fitness(&x) <= at.fitness(&x) + 1e-12);
         }
     }
 

@@ -117,7 +117,7 @@ pub fn shape(s: &Seed004Spec, control_points: usize) -> ClosedNetShape {
 pub fn problem(s: &Seed004Spec, data: &RingData, control_points: usize) -> Result<RingNetProblem> {
     let fit = fit_closed(data, shape(s, control_points))
         .with_context(|| format!("seed004, {control_points} control points"))?;
-    Ok(RingNetProblem::new(data, fit, s.search_range))
+    Ok(RingNetProblem::new(data, fit, s.search_range).with_measure(s.error))
 }
 
 /// Run one cell (alone it gives the same numbers as inside the full run).
@@ -138,7 +138,7 @@ fn run_cell_on(spec: &Spec, s: &Seed004Spec, problem: &RingNetProblem, cell: &Ce
         s.ga.run_with_history(problem, &budget, rng)
     });
     let r = r.with_context(|| key.clone())?;
-    let analytical = problem.analytical().rms;
+    let analytical = problem.analytical_rms();
     let row = Row {
         cell: key.clone(),
         control_points: cell.control_points,
@@ -209,16 +209,7 @@ pub fn analytical_sweep(s: &Seed004Spec, data: &RingData) -> Result<Vec<(usize, 
         s.control_points.iter().min().copied().unwrap_or(0),
         s.control_points.iter().max().copied().unwrap_or(0),
     );
-    (lo..=hi)
-        .map(|n| {
-            Ok((
-                n,
-                fit_closed(data, shape(s, n))
-                    .with_context(|| format!("seed004, {n} control points"))?
-                    .rms,
-            ))
-        })
-        .collect()
+    (lo..=hi).map(|n| Ok((n, problem(s, data, n)?.analytical_rms()))).collect()
 }
 
 /// RMS distance of the data to the exact cylinder (sqrt(x^2 + y^2) - radius): a floor under
@@ -334,5 +325,38 @@ impl crate::experiment::family::Experiment for Seed004 {
             cpu_s: runs.iter().map(|r| r.row.cpu_s).sum(),
             cells: runs.len(),
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn spec_with(extra: &str) -> Result<crate::families::Loaded, SpecError> {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/experiments/seed004_cylinder.toml");
+        let text = std::fs::read_to_string(path).unwrap();
+        let text = text.replacen("[seed004]\n", &format!("[seed004]\n{extra}\n"), 1);
+        crate::families::Loaded::parse(path, &text, Some("quick"))
+    }
+
+    /// `error` defaults to Eq. 9 at the parameters; `closest_point` measures the analytical net
+    /// and the GA alike by foot points (below the at-parameter figure on the lattice).
+    #[test]
+    fn error_readings() {
+        let at = spec_with("").unwrap();
+        let foot = spec_with("error = \"closest_point\"").unwrap();
+        let (sa, sf): (&Seed004Spec, &Seed004Spec) =
+            (at.section().unwrap(), foot.section().unwrap());
+        assert_eq!(sa.error, crate::spline::closed::PointError::AtParameters);
+        let d = data(sa);
+        let cell = Cell { control_points: 7, repeat: 0 };
+        let (ra, rf) = (
+            run_cell(&at.spec, sa, &d, &cell).unwrap().row,
+            run_cell(&foot.spec, sf, &d, &cell).unwrap().row,
+        );
+        assert_eq!(ra.analytical_rms, problem(sa, &d, 7).unwrap().analytical().rms);
+        assert_eq!(rf.analytical_rms, problem(sf, &d, 7).unwrap().analytical_rms());
+        assert!(rf.analytical_rms < ra.analytical_rms, "{} {}", rf.analytical_rms, ra.analytical_rms);
+        assert!(spec_with("error = \"max\"").unwrap_err().to_string().contains("unknown variant `max`"));
     }
 }

@@ -73,6 +73,10 @@ pub struct Seed004Spec {
     /// GA box: the analytical (x, y) of each control column +- this (data units).
     #[serde(default = "default_s4_search_range")]
     pub search_range: f64,
+    /// What the GA's RMS measures (docs/readings.md): `at_parameters` (Eq. 9 at the chord-length
+    /// parameters) or `closest_point` (Table II's "modelled curve and data points": foot points).
+    #[serde(default)]
+    pub error: crate::spline::closed::PointError,
     #[serde(default)]
     pub ga: crate::optim::binary_ga::BinaryGa,
 }

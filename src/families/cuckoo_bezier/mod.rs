@@ -39,6 +39,47 @@ pub struct ExampleSpec {
     pub generations: usize,
 }
 
+/// Where CSA/ICSA's start population lies (docs/readings.md).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Start {
+    /// Section 5.2: "All data parameters are initialized with random numbers within the
+    /// hypercube [0,1]^m x [0,1]^n": U[0, 1] per parameter.
+    #[default]
+    Random,
+    /// Section 4.3's per-component bounds low_j^k, up_j^k read as a box around a classical
+    /// parameterisation (Eqs. 11-13): that parameterisation +- `start_spread`, clamped to [0, 1].
+    UniformParam,
+    Chordal,
+    Centripetal,
+}
+
+impl Start {
+    /// The classical parameterisation the start is centred on (None: the random start).
+    pub fn classical(self) -> Option<Parameterisation> {
+        match self {
+            Start::Random => None,
+            Start::UniformParam => Some(Parameterisation::Uniform),
+            Start::Chordal => Some(Parameterisation::ChordLength),
+            Start::Centripetal => Some(Parameterisation::Centripetal),
+        }
+    }
+
+    /// The spec value.
+    pub fn key(self) -> &'static str {
+        match self {
+            Start::Random => "random",
+            Start::UniformParam => "uniform_param",
+            Start::Chordal => "chordal",
+            Start::Centripetal => "centripetal",
+        }
+    }
+}
+
+fn default_start_spread() -> f64 {
+    0.05
+}
+
 /// The `[seed003]` section.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -58,6 +99,13 @@ pub struct Seed003Spec {
     pub example1: ExampleSpec,
     pub example2: ExampleSpec,
     pub example3: ExampleSpec,
+    /// CSA/ICSA start: `random` (Section 5.2, the default) or centred on a classical
+    /// parameterisation (`uniform_param`, `chordal`, `centripetal`) +- `start_spread`.
+    #[serde(default)]
+    pub start: Start,
+    /// Half-width of the centred start box, in (0, 0.5] (unused by `random`).
+    #[serde(default = "default_start_spread")]
+    pub start_spread: f64,
     #[serde(default)]
     pub csa: Csa,
     #[serde(default)]
@@ -108,6 +156,9 @@ impl Seed003Spec {
         }
         if !(self.alpha > 0.0 && self.alpha < 1.0) {
             return bad("alpha", format!("must be in (0, 1), got {}", self.alpha));
+        }
+        if !(self.start_spread > 0.0 && self.start_spread <= 0.5) {
+            return bad("start_spread", format!("must be in (0, 0.5], got {}", self.start_spread));
         }
         for name in EXAMPLES {
             let e = self.example(name).expect("known example");
@@ -267,13 +318,13 @@ pub fn classical_start(d: &Data, p: Parameterisation) -> Vec<f64> {
 }
 
 /// The CSA/ICSA budget of an example: N nests, G iterations; the start population is uniform on
-/// [0, 1]^dim (centre 0.5, half-width 0.5), one trace point every `trace_every` iterations (2N
-/// evaluations per iteration).
+/// [0, 1]^dim (centre 0.5, half-width 0.5) under `start = "random"`, else the centre +-
+/// `start_spread`; one trace point every `trace_every` iterations (2N evaluations per iteration).
 pub fn budget(s: &Seed003Spec, e: &ExampleSpec) -> Budget {
     Budget {
         generations: e.generations as u64,
         population: s.nests,
-        init_range: 0.5,
+        init_range: if s.start == Start::Random { 0.5 } else { s.start_spread },
         trace_every_evals: (2 * s.nests * s.trace_every) as u64,
     }
 }
@@ -296,13 +347,17 @@ pub fn run_cell(spec: &Spec, s: &Seed003Spec, cell: &Cell) -> Result<Run> {
         let (y, cpu_s) = runner::timed(|| prob.fitness(&x));
         ((y, y, 1, 0, Vec::new(), prob.dim()), cpu_s)
     } else {
-        let centre = vec![
-            0.5;
-            match d.layout {
-                Layout::Grid { nu, nv } => nu + nv,
-                Layout::Scattered => 2 * n,
-            }
-        ];
+        // The start population's centre: [0, 1]^dim's, or a classical parameterisation's.
+        let centre = match s.start.classical() {
+            None => vec![
+                0.5;
+                match d.layout {
+                    Layout::Grid { nu, nv } => nu + nv,
+                    Layout::Scattered => 2 * n,
+                }
+            ],
+            Some(p) => classical_start(&d, p),
+        };
         let prob = BezierParamProblem::new(e.degree, e.degree, d.layout, d.points, centre)
             .map_err(|err| anyhow::anyhow!("{key}: {err}"))?;
         let Some(opt) = crate::optim::pick(&s.offered(), &cell.method) else {
@@ -388,5 +443,50 @@ impl Seed003Spec {
     /// The optimisers this section offers, each with its parameter table (`csa`, ...).
     pub fn offered(&self) -> Vec<&dyn crate::optim::Optimiser> {
         vec![&self.csa, &self.icsa]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn spec_with(extra: &str) -> Result<crate::families::Loaded, SpecError> {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/experiments/seed003_cuckoo_bezier.toml");
+        let text = std::fs::read_to_string(path).unwrap();
+        let text = text.replacen("[seed003]\n", &format!("[seed003]\n{extra}\n"), 1);
+        crate::families::Loaded::parse(path, &text, Some("quick"))
+    }
+
+    fn csa_example3(spec: &crate::families::Loaded) -> Row {
+        let cell = Cell { example: "example3".into(), method: "csa".into(), run: 0 };
+        run_cell(&spec.spec, spec.section().unwrap(), &cell).unwrap().row
+    }
+
+    /// The default start is Section 5.2's U[0,1]; a centred start begins next to its classical
+    /// parameterisation (centripetal Y within 2x) and far below the random start.
+    #[test]
+    fn start_readings() {
+        let random = spec_with("").unwrap();
+        let s = random.section::<Seed003Spec>().unwrap();
+        assert_eq!((s.start, budget(s, &s.example3).init_range), (Start::Random, 0.5));
+        let centred = spec_with("start = \"centripetal\"\nstart_spread = 0.01").unwrap();
+        let c = centred.section::<Seed003Spec>().unwrap();
+        assert_eq!(budget(c, &c.example3).init_range, 0.01);
+        let classical = run_cell(
+            &random.spec,
+            s,
+            &Cell { example: "example3".into(), method: "centripetal".into(), run: 0 },
+        )
+        .unwrap()
+        .row
+        .y;
+        let (r, k) = (csa_example3(&random), csa_example3(&centred));
+        assert!(k.initial_best_y < 2.0 * classical, "{} vs {classical}", k.initial_best_y);
+        assert!(k.initial_best_y < 0.5 * r.initial_best_y, "{} {}", k.initial_best_y, r.initial_best_y);
+        for bad in ["start_spread = 0.0", "start_spread = 0.6"] {
+            let e = spec_with(bad).unwrap_err().to_string();
+            assert!(e.contains("seed003.start_spread"), "{e}");
+        }
+        assert!(spec_with("start = \"somewhere\"").unwrap_err().to_string().contains("unknown variant `somewhere`"));
     }
 }

@@ -117,6 +117,18 @@ fn write_csv(out: &Path, name: &str, header: &[&str], rows: &[Vec<String>]) -> R
     crate::io::write_atomic(&out.join(name), crate::io::csv_records(&header, rows)?.as_bytes())
 }
 
+/// Where the CSA/ICSA start population lies under the spec's `start` reading.
+fn start_text(s: &Seed003Spec) -> String {
+    if s.start.classical().is_none() {
+        return "uniform on [0,1]^dim".into();
+    }
+    format!(
+        "uniform in the parameterisation `start = \"{}\"` +- {} (clamped to [0,1])",
+        s.start.key(),
+        s.start_spread
+    )
+}
+
 /// Write runs.csv, the tables and the pictures; return the REPORT.md section.
 pub fn write(spec_name: &str, s: &Seed003Spec, runs: &[Run], out: &Path) -> Result<String> {
     let rows: Vec<_> = runs.iter().map(|r| r.row.clone()).collect();
@@ -136,8 +148,8 @@ pub fn write(spec_name: &str, s: &Seed003Spec, runs: &[Run], out: &Path) -> Resu
         md,
         "## Seed 003: cuckoo search for Bezier surface approximation (Iglesias et al.)\n"
     );
-    let _ = writeln!(md, "Data (stated choices, see the spec's header): Example I = Franke's function on a {0}x{0} grid of [0,1]^2, degree ({1},{1}), SNR {2} dB; Example II = MATLAB's peaks on a {3}x{3} grid of [-3,3]^2, degree ({4},{4}), SNR {5} dB; Example III = {6} points at uniform random parameters of a degree-(5,5) Bezier surface with random poles in [-1,1]^3 whose four corner poles coincide (fixed stream), fitted at degree ({7},{7}), SNR {8} dB. Noise: i.i.d. Gaussian on x, y and z, redrawn for every run and shared by the five methods in that run (so runs pair by index). Classical methods: the paper's Eqs. 11-13 on the grid rows and columns; for the unorganised Example III along the order of the points on the cloud's two principal axes. CSA/ICSA: {9} nests, start population uniform on [0,1]^dim, iterations per example {10}/{11}/{12}; pa = {13} (CSA), pa from {14} to {15} (ICSA). {16} runs per (example, method). Y = sum of squared 3-D distances (Eq. 4/5), RMSE = sqrt(Y / points) (Eq. 14/15). The paper's absolute Y depends on its unpublished surfaces and noise scale, so compare orders and directions, not digits.\n",
-        s.example1.size, s.example1.degree, s.example1.snr_db, s.example2.size, s.example2.degree, s.example2.snr_db, s.example3.size, s.example3.degree, s.example3.snr_db, s.nests, s.example1.generations, s.example2.generations, s.example3.generations, s.csa.pa, s.icsa.pa_max, s.icsa.pa_min, s.runs);
+    let _ = writeln!(md, "Data (stated choices, see the spec's header): Example I = Franke's function on a {0}x{0} grid of [0,1]^2, degree ({1},{1}), SNR {2} dB; Example II = MATLAB's peaks on a {3}x{3} grid of [-3,3]^2, degree ({4},{4}), SNR {5} dB; Example III = {6} points at uniform random parameters of a degree-(5,5) Bezier surface with random poles in [-1,1]^3 whose four corner poles coincide (fixed stream), fitted at degree ({7},{7}), SNR {8} dB. Noise: i.i.d. Gaussian on x, y and z, redrawn for every run and shared by the five methods in that run (so runs pair by index). Classical methods: the paper's Eqs. 11-13 on the grid rows and columns; for the unorganised Example III along the order of the points on the cloud's two principal axes. CSA/ICSA: {9} nests, start population {17}, iterations per example {10}/{11}/{12}; pa = {13} (CSA), pa from {14} to {15} (ICSA). {16} runs per (example, method). Y = sum of squared 3-D distances (Eq. 4/5), RMSE = sqrt(Y / points) (Eq. 14/15). The paper's absolute Y depends on its unpublished surfaces and noise scale, so compare orders and directions, not digits.\n",
+        s.example1.size, s.example1.degree, s.example1.snr_db, s.example2.size, s.example2.degree, s.example2.snr_db, s.example3.size, s.example3.degree, s.example3.snr_db, s.nests, s.example1.generations, s.example2.generations, s.example3.generations, s.csa.pa, s.icsa.pa_max, s.icsa.pa_min, s.runs, start_text(s));
 
     // Table 3: CSA's statistics, examples in columns.
     if methods.contains(&"csa") {
