@@ -90,6 +90,9 @@ pub trait Family<F>: Sync {
     /// The published tables the family reproduces (the readings score compares every CSV of its
     /// folders named like one).
     fn published(&self) -> Published;
+    /// The part of the sources the family reproduces (`Chapter 6`, `Seed 003`), for the readings
+    /// score's totals.
+    fn title(&self) -> &'static str;
 }
 
 /// A finished plan as one family sees it, for the parts of the combined report that need more
@@ -236,6 +239,8 @@ pub trait Experiment: Sync + 'static {
     fn published(&self) -> Published {
         &[]
     }
+    /// See [`Family::title`].
+    fn title(&self) -> &'static str;
 }
 
 /// The message for a section handed to a family it does not belong to (the engine asks each
@@ -300,6 +305,9 @@ impl<F: Holds<E::Section>, E: Experiment> Family<F> for E {
     }
     fn published(&self) -> Published {
         Experiment::published(self)
+    }
+    fn title(&self) -> &'static str {
+        Experiment::title(self)
     }
 }
 

@@ -14,6 +14,7 @@ use crate::io::{csv_records, write_atomic};
 use crate::report::claims::{self, Claim};
 use anyhow::{Context, Result};
 use serde::Deserialize;
+use std::collections::BTreeMap;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -364,7 +365,12 @@ pub fn reproduce<F: Families>(
             report.extend(part.readings.iter().map(String::as_str));
         }
     }
-    report.push_str(&readings_score::<F>(&ctx.out, &plan)?);
+    let titles: BTreeMap<String, &'static str> = specs
+        .iter()
+        .chain(reading_specs.iter().flat_map(|(_, r)| r))
+        .map(|s| (s.spec.file.name.clone(), s.family().title()))
+        .collect();
+    report.push_str(&readings_score::<F>(&ctx.out, &plan, &titles)?);
     let path = ctx.out.join("REPORT.md");
     write_atomic(&path, report.as_bytes())?;
     crate::report::html::write(&ctx.out)?;
@@ -662,7 +668,11 @@ fn render_readings(out: &Path, plan: &Plan, rows: &[ReadingClaim]) -> Result<Str
 /// `readings_score.csv` and its REPORT.md section: per spec folder and reading, the published
 /// table cells whose ratio ours/published lies in the band and the claims that agree with the
 /// source's own count ([`crate::report::score`]); totals over the specs every reading ran.
-fn readings_score<F: Families>(out: &Path, plan: &Plan) -> Result<String> {
+fn readings_score<F: Families>(
+    out: &Path,
+    plan: &Plan,
+    titles: &BTreeMap<String, &'static str>,
+) -> Result<String> {
     use crate::report::score::{folder_score, Score, BAND};
     let mut readings: Vec<(String, Vec<(String, PathBuf)>)> =
         vec![(plan.reading.clone(), plan.specs.iter().map(|s| (s.clone(), out.join(s))).collect())];
@@ -689,6 +699,7 @@ fn readings_score<F: Families>(out: &Path, plan: &Plan) -> Result<String> {
             };
             rows.push(vec![
                 reading.clone(),
+                titles.get(spec).copied().unwrap_or_default().to_string(),
                 spec.clone(),
                 sc.cells.to_string(),
                 sc.within.to_string(),
@@ -704,6 +715,7 @@ fn readings_score<F: Families>(out: &Path, plan: &Plan) -> Result<String> {
     }
     let header: Vec<String> = [
         "reading",
+        "chapter",
         "spec",
         "published_cells",
         "within_band",
@@ -737,6 +749,7 @@ fn readings_score<F: Families>(out: &Path, plan: &Plan) -> Result<String> {
             std::iter::once(s.to_string()).chain(names.iter().map(|r| cell(find(r, s)))).collect()
         })
         .collect();
+    md_rows.extend(chapter_totals(&names, &specs, titles, &find, &cell));
     // Comparable totals: over the specs every reading ran.
     let common: Vec<&&String> =
         specs.iter().filter(|s| names.iter().all(|r| find(r, s).is_some())).collect();
@@ -751,9 +764,50 @@ fn readings_score<F: Families>(out: &Path, plan: &Plan) -> Result<String> {
         row.extend(names.iter().map(|r| cell(Some(&total(r)))));
         md_rows.push(row);
     }
-    let mut s = format!("\n---\n\n# Readings score\n\nFor each reading and spec: the share of the published tables' value cells (Appendices B-F, K, L and the seeds' tables; CPU seconds left out) whose ratio ours/published lies in [{}, {}], and how many of the claims with the source's own count agree with it (`readings_score.csv`). The reading that reproduces the published numbers best has the highest shares.\n\n", BAND.0, BAND.1);
+    let mut s = format!("\n---\n\n# Readings score\n\nFor each reading and spec, and in total per chapter or seed (over the specs every reading that ran one of them ran): the share of the published tables' value cells (Appendices B-F, K, L and the seeds' tables; CPU seconds left out) whose ratio ours/published lies in [{}, {}], and how many of the claims with the source's own count agree with it (`readings_score.csv`). The reading that reproduces the published numbers best has the highest shares.\n\n", BAND.0, BAND.1);
     s.push_str(&crate::report::markdown::table(&h, &md_rows));
     Ok(s)
+}
+
+/// The readings score's total per chapter or seed (rows of the Markdown table): for each chapter
+/// with a spec that more than one reading ran, each reading's sum over the chapter's specs that
+/// every reading running one of them ran ("-" for a reading that ran none).
+fn chapter_totals<'s>(
+    names: &[&String],
+    specs: &[&String],
+    titles: &BTreeMap<String, &'static str>,
+    find: &dyn Fn(&str, &str) -> Option<&'s crate::report::score::Score>,
+    cell: &dyn Fn(Option<&crate::report::score::Score>) -> String,
+) -> Vec<Vec<String>> {
+    use crate::report::score::Score;
+    let chapters: Vec<&str> =
+        crate::report::ordered(specs.iter().filter_map(|s| titles.get(s.as_str()).copied()));
+    let mut rows = Vec::new();
+    for chapter in chapters {
+        let own: Vec<&&String> =
+            specs.iter().filter(|s| titles.get(s.as_str()) == Some(&chapter)).collect();
+        let ran: Vec<&&String> =
+            names.iter().filter(|r| own.iter().any(|s| find(r, s).is_some())).collect();
+        let common: Vec<&&&String> =
+            own.iter().filter(|s| ran.iter().all(|r| find(r, s).is_some())).collect();
+        if ran.len() < 2 || common.is_empty() {
+            continue;
+        }
+        let mut row = vec![format!(
+            "**{chapter}: {}**",
+            common.iter().map(|s| s.as_str()).collect::<Vec<_>>().join(", ")
+        )];
+        row.extend(names.iter().map(|r| {
+            if !ran.contains(&r) {
+                return "-".to_string();
+            }
+            let total =
+                common.iter().filter_map(|s| find(r, s)).fold(Score::default(), |a, b| a + *b);
+            cell(Some(&total))
+        }));
+        rows.push(row);
+    }
+    rows
 }
 
 /// The combined REPORT.md: header, claims, Tables 6.8/6.9, then each chapter's report with its

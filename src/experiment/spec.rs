@@ -338,7 +338,8 @@ impl Spec {
     }
 
     /// The checks every optimisation section shares: its optimiser names (from those `offered`),
-    /// repeats, generations, and a population each optimiser the section runs can work with,
+    /// repeats, generations, a population each optimiser the section runs can work with, and every
+    /// offered parameter table ([`Spec::validate_optimiser_params`]),
     /// each error naming `<section>.<key>` (the optimiser's own key where one sets the minimum).
     pub(crate) fn validate_runs(
         &self,
@@ -373,7 +374,6 @@ impl Spec {
         if generations == 0 {
             return Err(self.err(&key("generations"), "must be at least 1"));
         }
-        self.validate_optimiser_params(section, offered)?;
         for name in optimisers {
             let Some(opt) = crate::optim::pick(offered, name) else { continue };
             let need = opt.min_population();
@@ -399,7 +399,7 @@ impl Spec {
                 ),
             });
         }
-        Ok(())
+        self.validate_optimiser_params(section, offered)
     }
 
     /// The parameter tables of the optimisers a section offers ([`crate::optim::Optimiser::validate`]),

@@ -115,7 +115,7 @@ fn bad_specs_fail_on_one_line_naming_line_and_key() {
     c.write("unknown.toml", &TINY.replace("iterations = 400", "iteration = 400"));
     c.fails(&["run", "unknown.toml"], &["unknown.toml:6:1", "iteration"]);
     c.write("model.toml", &TINY.replace("\"som2d\", \"som3d\"", "\"som2d\", \"som4d\""));
-    c.fails(&["run", "model.toml"], &["som.group[0].models", "som4d"]);
+    c.fails(&["run", "model.toml"], &["model.toml:", "unknown SOM model `som4d`"]);
     c.fails(&["run", "missing.toml"], &["missing.toml"]);
     c.fails(&["run", "unknown.toml", "--profile", "quick"], &["unknown.toml"]);
 }

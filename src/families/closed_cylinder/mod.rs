@@ -288,6 +288,9 @@ impl crate::experiment::family::Section for self::spec::Seed004Spec {
 }
 
 impl crate::experiment::family::Experiment for Seed004 {
+    fn title(&self) -> &'static str {
+        "Seed 004"
+    }
     fn published(&self) -> crate::report::reference::Published {
         self::report::PUBLISHED
     }

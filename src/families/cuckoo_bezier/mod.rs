@@ -415,6 +415,9 @@ impl crate::experiment::family::Section for Seed003Spec {
 }
 
 impl crate::experiment::family::Experiment for Seed003 {
+    fn title(&self) -> &'static str {
+        "Seed 003"
+    }
     fn published(&self) -> crate::report::reference::Published {
         self::report::PUBLISHED
     }

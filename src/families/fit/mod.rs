@@ -156,6 +156,9 @@ impl crate::experiment::family::Section for self::spec::FitSpec {
 }
 
 impl crate::experiment::family::Experiment for Fit {
+    fn title(&self) -> &'static str {
+        "Chapter 5"
+    }
     fn published(&self) -> crate::report::reference::Published {
         self::report::PUBLISHED
     }

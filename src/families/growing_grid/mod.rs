@@ -257,6 +257,9 @@ impl crate::experiment::family::Section for self::spec::GrowingGridSpec {
 }
 
 impl crate::experiment::family::Experiment for Seed001 {
+    fn title(&self) -> &'static str {
+        "Seed 001"
+    }
     type Section = self::spec::GrowingGridSpec;
     fn logged_keys(&self, _spec: &Spec, g: &GrowingGridSpec) -> Vec<String> {
         cells(g).iter().map(|c| c.key()).collect()

@@ -376,6 +376,9 @@ impl crate::experiment::family::Section for self::spec::OptimSpec {
 }
 
 impl crate::experiment::family::Experiment for Optim {
+    fn title(&self) -> &'static str {
+        "Chapter 6"
+    }
     fn published(&self) -> crate::report::reference::Published {
         self::report::PUBLISHED
     }

@@ -285,6 +285,9 @@ impl crate::experiment::family::Section for self::spec::Seed002Spec {
 }
 
 impl crate::experiment::family::Experiment for Seed002 {
+    fn title(&self) -> &'static str {
+        "Seed 002"
+    }
     type Section = self::spec::Seed002Spec;
     fn logged_keys(&self, _spec: &Spec, s: &Seed002Spec) -> Vec<String> {
         cells(s).iter().map(|c| c.key()).collect()

@@ -240,6 +240,9 @@ impl crate::experiment::family::Section for self::spec::SomSpec {
 }
 
 impl crate::experiment::family::Experiment for Som {
+    fn title(&self) -> &'static str {
+        "Chapter 4"
+    }
     fn published(&self) -> crate::report::reference::Published {
         self::report::PUBLISHED
     }
