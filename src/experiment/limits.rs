@@ -35,9 +35,9 @@ pub const MAX_RANGE: f64 = 10.0;
 pub const MAX_TRACE_EVERY: u64 = 1_000_000_000_000;
 /// Newton steps of the exact solver.
 pub const MAX_NEWTON_STEPS: u64 = 100_000;
-/// Data-unit lengths of the seed 004 cylinder (radius, height, step, accuracy, search range).
+/// Lengths in data units (a generated shape's radius or height, a step, an accuracy, a search range).
 pub const MAX_LENGTH: f64 = 1e6;
-/// Points or samples per side of a generated data set (seed 002 grid, seed 003 examples).
+/// Points or samples per side of a generated data set.
 pub const MAX_SAMPLES: u64 = 100_000;
 
 /// Worker threads per available CPU at most (`--jobs`).

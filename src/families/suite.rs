@@ -142,7 +142,7 @@ pub fn load(
     let ctx = RunContext::new(work.to_path_buf(), 1, data_dir);
     let o = match &section {
         Section::Optim(o) => o,
-        Section::Seed001(g) => return open_surfaces(&spec, g, &ctx, profile),
+        Section::GrowingGrid(g) => return open_surfaces(&spec, g, &ctx, profile),
         _ => anyhow::bail!(
             "{}: a suite is made of an [optim] or a [growing_grid] spec's problems",
             spec.path

@@ -13,7 +13,7 @@ use crate::optim::{Budget, Problem};
 use crate::spline::closed::{fit_closed, ClosedNetShape, RingData, RingNetProblem};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
-use spec::Seed004Spec;
+use spec::ClosedCylinderSpec;
 
 /// One (number of control points around, repeat).
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -87,7 +87,7 @@ impl runner::Logged for Run {
 }
 
 /// The flat list of cells.
-pub fn cells(s: &Seed004Spec) -> Vec<Cell> {
+pub fn cells(s: &ClosedCylinderSpec) -> Vec<Cell> {
     s.control_points
         .iter()
         .flat_map(|&control_points| {
@@ -97,14 +97,14 @@ pub fn cells(s: &Seed004Spec) -> Vec<Cell> {
 }
 
 /// The paper's data: lattice cylinder sorted into rings.
-pub fn data(s: &Seed004Spec) -> RingData {
+pub fn data(s: &ClosedCylinderSpec) -> RingData {
     sort_into_rings(
         &lattice_cylinder(s.radius, s.height, s.grid_step, s.accuracy),
         s.grid_step * 1e-3,
     )
 }
 
-pub fn shape(s: &Seed004Spec, control_points: usize) -> ClosedNetShape {
+pub fn shape(s: &ClosedCylinderSpec, control_points: usize) -> ClosedNetShape {
     ClosedNetShape {
         order_around: s.order_around,
         order_up: s.order_vertical,
@@ -114,19 +114,19 @@ pub fn shape(s: &Seed004Spec, control_points: usize) -> ClosedNetShape {
 }
 
 /// The GA problem (and analytical fit) for a number of control points.
-pub fn problem(s: &Seed004Spec, data: &RingData, control_points: usize) -> Result<RingNetProblem> {
+pub fn problem(s: &ClosedCylinderSpec, data: &RingData, control_points: usize) -> Result<RingNetProblem> {
     let fit = fit_closed(data, shape(s, control_points))
         .with_context(|| format!("seed004, {control_points} control points"))?;
     Ok(RingNetProblem::new(data, fit, s.search_range).with_measure(s.error))
 }
 
 /// Run one cell (alone it gives the same numbers as inside the full run).
-pub fn run_cell(spec: &Spec, s: &Seed004Spec, data: &RingData, cell: &Cell) -> Result<Run> {
+pub fn run_cell(spec: &Spec, s: &ClosedCylinderSpec, data: &RingData, cell: &Cell) -> Result<Run> {
     run_cell_on(spec, s, &problem(s, data, cell.control_points)?, cell)
 }
 
 /// Run one cell on its number of control points' problem (built once for all its repeats).
-fn run_cell_on(spec: &Spec, s: &Seed004Spec, problem: &RingNetProblem, cell: &Cell) -> Result<Run> {
+fn run_cell_on(spec: &Spec, s: &ClosedCylinderSpec, problem: &RingNetProblem, cell: &Cell) -> Result<Run> {
     let budget = Budget {
         generations: s.generations as u64,
         population: s.population,
@@ -170,7 +170,7 @@ fn run_cell_on(spec: &Spec, s: &Seed004Spec, problem: &RingNetProblem, cell: &Ce
 
 /// Run every cell of the spec on `data` (the analytical fit of each number of control points
 /// once, on the worker threads).
-pub fn run(spec: &Spec, s: &Seed004Spec, ctx: &RunContext, data: &RingData) -> Result<Vec<Run>> {
+pub fn run(spec: &Spec, s: &ClosedCylinderSpec, ctx: &RunContext, data: &RingData) -> Result<Vec<Run>> {
     let cps: Vec<usize> = crate::report::ordered(s.control_points.iter().copied());
     let problems = runner::run_cells(
         &cps,
@@ -204,7 +204,7 @@ pub fn run(spec: &Spec, s: &Seed004Spec, ctx: &RunContext, data: &RingData) -> R
 
 /// The analytical method alone at every number of control points from the smallest to the
 /// largest of the spec's list (deterministic and cheap: not logged): (control points, RMS).
-pub fn analytical_sweep(s: &Seed004Spec, data: &RingData) -> Result<Vec<(usize, f64)>> {
+pub fn analytical_sweep(s: &ClosedCylinderSpec, data: &RingData) -> Result<Vec<(usize, f64)>> {
     let (lo, hi) = (
         s.control_points.iter().min().copied().unwrap_or(0),
         s.control_points.iter().max().copied().unwrap_or(0),
@@ -214,7 +214,7 @@ pub fn analytical_sweep(s: &Seed004Spec, data: &RingData) -> Result<Vec<(usize, 
 
 /// RMS distance of the data to the exact cylinder (sqrt(x^2 + y^2) - radius): a floor under
 /// every fit's RMS error at the data's own radial scatter.
-pub fn data_floor(s: &Seed004Spec, data: &RingData) -> f64 {
+pub fn data_floor(s: &ClosedCylinderSpec, data: &RingData) -> f64 {
     let sse: f64 =
         data.points().map(|p| ((p[0] * p[0] + p[1] * p[1]).sqrt() - s.radius).powi(2)).sum();
     (sse / data.n_points().max(1) as f64).sqrt()
@@ -236,7 +236,7 @@ pub struct TopView {
 
 /// The top view of the lowest-RMS run at `control_points` (None if there is no such run).
 pub fn top_view(
-    s: &Seed004Spec,
+    s: &ClosedCylinderSpec,
     data: &RingData,
     runs: &[Run],
     control_points: usize,
@@ -276,9 +276,9 @@ pub fn top_view(
 }
 
 /// Seed 004's family: the `[seed004]` section.
-pub struct Seed004;
+pub struct ClosedCylinder;
 
-impl crate::experiment::family::Section for self::spec::Seed004Spec {
+impl crate::experiment::family::Section for self::spec::ClosedCylinderSpec {
     fn limits(&self, c: &crate::experiment::limits::Check) -> Result<(), SpecError> {
         self::spec::limits(c, self)
     }
@@ -287,21 +287,21 @@ impl crate::experiment::family::Section for self::spec::Seed004Spec {
     }
 }
 
-impl crate::experiment::family::Experiment for Seed004 {
+impl crate::experiment::family::Experiment for ClosedCylinder {
     fn title(&self) -> &'static str {
         "Seed 004"
     }
     fn published(&self) -> crate::report::reference::Published {
         self::report::PUBLISHED
     }
-    type Section = self::spec::Seed004Spec;
-    fn logged_keys(&self, _spec: &Spec, s: &Seed004Spec) -> Vec<String> {
+    type Section = self::spec::ClosedCylinderSpec;
+    fn logged_keys(&self, _spec: &Spec, s: &ClosedCylinderSpec) -> Vec<String> {
         cells(s).iter().map(|c| c.key()).collect()
     }
     fn run(
         &self,
         spec: &Spec,
-        s4: &Seed004Spec,
+        s4: &ClosedCylinderSpec,
         ctx: &RunContext,
         tables: bool,
     ) -> Result<crate::experiment::family::Outcome> {
@@ -348,7 +348,7 @@ mod tests {
     fn error_readings() {
         let at = spec_with("").unwrap();
         let foot = spec_with("error = \"closest_point\"").unwrap();
-        let (sa, sf): (&Seed004Spec, &Seed004Spec) =
+        let (sa, sf): (&ClosedCylinderSpec, &ClosedCylinderSpec) =
             (at.section().unwrap(), foot.section().unwrap());
         assert_eq!(sa.error, crate::spline::closed::PointError::AtParameters);
         let d = data(sa);

@@ -3,7 +3,7 @@
 //! paper's transcribed numbers (`experiments/reference/seed004_table{2,3}.csv`), the paper's
 //! claims checked on the runs (verdicts computed), and the Fig. 2(a), 3 and 5 analogues.
 
-use super::spec::Seed004Spec;
+use super::spec::ClosedCylinderSpec;
 use super::{Run, TopView};
 use crate::report::markdown::{num, table};
 use crate::report::plots::boxplot::quantile_type7;
@@ -65,7 +65,7 @@ fn header(cols: &[&str]) -> Vec<String> {
 }
 
 /// The data, the surface, the GA and the scatter floor, in one paragraph.
-fn intro(s4: &Seed004Spec, runs: &[Run], floor: f64, p3: &RefTable) -> String {
+fn intro(s4: &ClosedCylinderSpec, runs: &[Run], floor: f64, p3: &RefTable) -> String {
     let mut s = String::new();
     let n_points = runs.first().map(|r| r.row.n_points).unwrap_or(0);
     let paper_min_ratio = p3
@@ -182,7 +182,7 @@ fn render_table_3(
 
 /// What the fitness measures under the spec's `error` reading (both the GA's and the analytical
 /// net's figures).
-fn measure(s4: &Seed004Spec) -> &'static str {
+fn measure(s4: &ClosedCylinderSpec) -> &'static str {
     match s4.error {
         PointError::AtParameters => "RMS distance of the data to the surface at their parameters",
         PointError::ClosestPoint => "RMS distance of the data to their foot points on the surface (reading `error = \"closest_point\"`; the analytical figures in the same measure)",
@@ -190,7 +190,7 @@ fn measure(s4: &Seed004Spec) -> &'static str {
 }
 
 /// Why the GA's error has a minimum over N, and why it cannot beat the analytical net.
-fn explanations(s4: &Seed004Spec) -> String {
+fn explanations(s4: &ClosedCylinderSpec) -> String {
     let mut s = String::new();
     if s4.error == PointError::ClosestPoint {
         let _ = writeln!(
@@ -214,7 +214,7 @@ fn explanations(s4: &Seed004Spec) -> String {
 /// The convergence, fitness and top-view charts, linked into the section.
 #[allow(clippy::too_many_arguments)]
 fn render_pictures(
-    s4: &Seed004Spec,
+    s4: &ClosedCylinderSpec,
     runs: &[Run],
     cps: &[usize],
     p2: &RefTable,
@@ -249,7 +249,7 @@ fn render_pictures(
 /// Write the tables and charts; return the REPORT.md section.
 pub fn write(
     spec_name: &str,
-    s4: &Seed004Spec,
+    s4: &ClosedCylinderSpec,
     runs: &[Run],
     sweep: &[(usize, f64)],
     floor: f64,
@@ -312,7 +312,7 @@ fn of(runs: &[Run], cp: usize) -> Vec<&Run> {
 
 /// Table II: per followed number of control points and generation, the CSV rows and the markdown
 /// rows beside the paper's best RMS.
-fn table_2(s4: &Seed004Spec, runs: &[Run], cps: &[usize], p2: &RefTable) -> (Rows, Rows) {
+fn table_2(s4: &ClosedCylinderSpec, runs: &[Run], cps: &[usize], p2: &RefTable) -> (Rows, Rows) {
     let mut t2 = Vec::new();
     let mut md2 = Vec::new();
     for &cp in s4.table2_control_points.iter().filter(|cp| cps.contains(cp)) {
@@ -452,7 +452,7 @@ fn claims(
 /// Fig. 3 analogue: best RMS so far against generation (median and quartiles over the repeats)
 /// per followed number of control points, with the analytical RMS and the paper's Table II.
 fn convergence_chart(
-    s4: &Seed004Spec,
+    s4: &ClosedCylinderSpec,
     runs: &[Run],
     cps: &[usize],
     p2: &RefTable,

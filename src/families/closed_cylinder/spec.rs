@@ -38,7 +38,7 @@ fn default_s4_search_range() -> f64 {
 /// stated readings of experiments/seed004_cylinder.toml.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct Seed004Spec {
+pub struct ClosedCylinderSpec {
     /// Control points around (Table III's list); each is one family of `repeats` GA runs.
     #[serde(default = "default_s4_control_points")]
     pub control_points: Vec<usize>,
@@ -82,7 +82,7 @@ pub struct Seed004Spec {
 }
 
 /// Every value of the `[seed004]` section (after the limits).
-pub(crate) fn validate(spec: &Spec, s: &Seed004Spec) -> Result<(), SpecError> {
+pub(crate) fn validate(spec: &Spec, s: &ClosedCylinderSpec) -> Result<(), SpecError> {
     if s.control_points.is_empty() {
         return Err(spec.err("seed004.control_points", "is empty"));
     }
@@ -156,7 +156,7 @@ pub(crate) fn validate(spec: &Spec, s: &Seed004Spec) -> Result<(), SpecError> {
 }
 
 /// The bounds of the `[seed004]` section's sizes and counts (docs/specs.md, "Spec limits").
-pub(crate) fn limits(c: &Check, s: &Seed004Spec) -> Result<(), SpecError> {
+pub(crate) fn limits(c: &Check, s: &ClosedCylinderSpec) -> Result<(), SpecError> {
     c.list("seed004.control_points", &s.control_points)?;
     c.list("seed004.table2_control_points", &s.table2_control_points)?;
     c.list("seed004.table2_generations", &s.table2_generations)?;

@@ -83,7 +83,7 @@ fn default_start_spread() -> f64 {
 /// The `[seed003]` section.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct Seed003Spec {
+pub struct CuckooBezierSpec {
     /// example1 (Franke), example2 (peaks), example3 (self-intersecting Bezier surface).
     pub examples: Vec<String>,
     /// uniform, chordal, centripetal, csa, icsa.
@@ -112,7 +112,7 @@ pub struct Seed003Spec {
     pub icsa: Icsa,
 }
 
-impl Seed003Spec {
+impl CuckooBezierSpec {
     pub fn example(&self, name: &str) -> Option<&ExampleSpec> {
         match name {
             "example1" => Some(&self.example1),
@@ -254,7 +254,7 @@ impl runner::Logged for Run {
 }
 
 /// The flat list of cells: examples x methods x runs.
-pub fn cells(s: &Seed003Spec) -> Vec<Cell> {
+pub fn cells(s: &CuckooBezierSpec) -> Vec<Cell> {
     runner::product_cells(&s.examples, &s.methods, s.runs, |e, m, run| Cell {
         example: e.clone(),
         method: m.clone(),
@@ -320,7 +320,7 @@ pub fn classical_start(d: &Data, p: Parameterisation) -> Vec<f64> {
 /// The CSA/ICSA budget of an example: N nests, G iterations; the start population is uniform on
 /// [0, 1]^dim (centre 0.5, half-width 0.5) under `start = "random"`, else the centre +-
 /// `start_spread`; one trace point every `trace_every` iterations (2N evaluations per iteration).
-pub fn budget(s: &Seed003Spec, e: &ExampleSpec) -> Budget {
+pub fn budget(s: &CuckooBezierSpec, e: &ExampleSpec) -> Budget {
     Budget {
         generations: e.generations as u64,
         population: s.nests,
@@ -330,7 +330,7 @@ pub fn budget(s: &Seed003Spec, e: &ExampleSpec) -> Budget {
 }
 
 /// Run one cell (alone it gives the same numbers as inside the full run).
-pub fn run_cell(spec: &Spec, s: &Seed003Spec, cell: &Cell) -> Result<Run> {
+pub fn run_cell(spec: &Spec, s: &CuckooBezierSpec, cell: &Cell) -> Result<Run> {
     let e = s
         .example(&cell.example)
         .with_context(|| format!("seed003.examples: unknown example `{}`", cell.example))?;
@@ -390,7 +390,7 @@ pub fn run_cell(spec: &Spec, s: &Seed003Spec, cell: &Cell) -> Result<Run> {
 }
 
 /// Run every cell of the spec.
-pub fn run(spec: &Spec, s: &Seed003Spec, ctx: &RunContext) -> Result<Vec<Run>> {
+pub fn run(spec: &Spec, s: &CuckooBezierSpec, ctx: &RunContext) -> Result<Vec<Run>> {
     let cells = cells(s);
     runner::run_logged(
         &cells,
@@ -402,9 +402,9 @@ pub fn run(spec: &Spec, s: &Seed003Spec, ctx: &RunContext) -> Result<Vec<Run>> {
 }
 
 /// Seed 003's family: the `[seed003]` section.
-pub struct Seed003;
+pub struct CuckooBezier;
 
-impl crate::experiment::family::Section for Seed003Spec {
+impl crate::experiment::family::Section for CuckooBezierSpec {
     fn limits(&self, c: &crate::experiment::limits::Check) -> Result<(), SpecError> {
         self::spec::limits(c, self)
     }
@@ -414,21 +414,21 @@ impl crate::experiment::family::Section for Seed003Spec {
     }
 }
 
-impl crate::experiment::family::Experiment for Seed003 {
+impl crate::experiment::family::Experiment for CuckooBezier {
     fn title(&self) -> &'static str {
         "Seed 003"
     }
     fn published(&self) -> crate::report::reference::Published {
         self::report::PUBLISHED
     }
-    type Section = Seed003Spec;
-    fn logged_keys(&self, _spec: &Spec, s: &Seed003Spec) -> Vec<String> {
+    type Section = CuckooBezierSpec;
+    fn logged_keys(&self, _spec: &Spec, s: &CuckooBezierSpec) -> Vec<String> {
         cells(s).iter().map(|c| c.key()).collect()
     }
     fn run(
         &self,
         spec: &Spec,
-        s3: &Seed003Spec,
+        s3: &CuckooBezierSpec,
         ctx: &RunContext,
         tables: bool,
     ) -> Result<crate::experiment::family::Outcome> {
@@ -442,7 +442,7 @@ impl crate::experiment::family::Experiment for Seed003 {
     }
 }
 
-impl Seed003Spec {
+impl CuckooBezierSpec {
     /// The optimisers this section offers, each with its parameter table (`csa`, ...).
     pub fn offered(&self) -> Vec<&dyn crate::optim::Optimiser> {
         vec![&self.csa, &self.icsa]
@@ -470,10 +470,10 @@ mod tests {
     #[test]
     fn start_readings() {
         let random = spec_with("").unwrap();
-        let s = random.section::<Seed003Spec>().unwrap();
+        let s = random.section::<CuckooBezierSpec>().unwrap();
         assert_eq!((s.start, budget(s, &s.example3).init_range), (Start::Random, 0.5));
         let centred = spec_with("start = \"centripetal\"\nstart_spread = 0.01").unwrap();
-        let c = centred.section::<Seed003Spec>().unwrap();
+        let c = centred.section::<CuckooBezierSpec>().unwrap();
         assert_eq!(budget(c, &c.example3).init_range, 0.01);
         let classical = run_cell(
             &random.spec,

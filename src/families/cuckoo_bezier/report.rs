@@ -5,7 +5,7 @@
 //! both tables), and the convergence diagrams (best Y against iterations, median and quartiles
 //! over the runs).
 
-use super::{Run, Seed003Spec, EXAMPLES, METHODS};
+use super::{Run, CuckooBezierSpec, EXAMPLES, METHODS};
 use crate::report::plots::{self, boxplot::quantile_type7, style, Series};
 use crate::report::reference::RefTable;
 use crate::stats::{rank_sum::rank_sum, wilcoxon::signed_rank, Alternative};
@@ -118,7 +118,7 @@ fn write_csv(out: &Path, name: &str, header: &[&str], rows: &[Vec<String>]) -> R
 }
 
 /// Where the CSA/ICSA start population lies under the spec's `start` reading.
-fn start_text(s: &Seed003Spec) -> String {
+fn start_text(s: &CuckooBezierSpec) -> String {
     if s.start.classical().is_none() {
         return "uniform on [0,1]^dim".into();
     }
@@ -130,7 +130,7 @@ fn start_text(s: &Seed003Spec) -> String {
 }
 
 /// Write runs.csv, the tables and the pictures; return the REPORT.md section.
-pub fn write(spec_name: &str, s: &Seed003Spec, runs: &[Run], out: &Path) -> Result<String> {
+pub fn write(spec_name: &str, s: &CuckooBezierSpec, runs: &[Run], out: &Path) -> Result<String> {
     let rows: Vec<_> = runs.iter().map(|r| r.row.clone()).collect();
     crate::io::write_atomic(&out.join("runs.csv"), crate::io::csv_text(&rows)?.as_bytes())?;
     let examples: Vec<&str> =
@@ -235,7 +235,7 @@ type Comparison = (String, String, Vec<[f64; 6]>);
 /// Table 5 (`seed003_table5.csv`) and its Markdown: each method against CSA, paired by run.
 #[allow(clippy::too_many_arguments)]
 fn table5(
-    s: &Seed003Spec,
+    s: &CuckooBezierSpec,
     runs: &[Run],
     examples: &[&str],
     others: &[&str],
@@ -298,7 +298,7 @@ fn table5(
 /// the better method and the tests' h, ours beside the paper's. Returns its rows.
 #[allow(clippy::too_many_arguments)]
 fn agreement(
-    s: &Seed003Spec,
+    s: &CuckooBezierSpec,
     examples: &[&str],
     results: &[Comparison],
     ref4: Option<&RefTable>,
@@ -422,7 +422,7 @@ fn agreement_claims(
 #[allow(clippy::too_many_arguments)]
 fn write_tests(
     spec_name: &str,
-    s: &Seed003Spec,
+    s: &CuckooBezierSpec,
     runs: &[Run],
     examples: &[&str],
     others: &[&str],
@@ -442,7 +442,7 @@ fn write_tests(
 /// best Y against iterations (evaluations - N over 2N), with the classical methods' mean Y as
 /// flat lines; and the traces as CSV.
 fn convergence(
-    s: &Seed003Spec,
+    s: &CuckooBezierSpec,
     runs: &[Run],
     examples: &[&str],
     methods: &[&str],

@@ -1,12 +1,12 @@
-//! The bounds of the `[seed003]` section. Its settings, defaults and checks are `Seed003Spec` in
+//! The bounds of the `[seed003]` section. Its settings, defaults and checks are `CuckooBezierSpec` in
 //! the family's `mod.rs`.
 
-use super::Seed003Spec;
+use super::CuckooBezierSpec;
 use crate::experiment::limits::{self, Check};
 use crate::experiment::spec::SpecError;
 
 /// The bounds of the `[seed003]` section's sizes and counts (docs/specs.md, "Spec limits").
-pub(crate) fn limits(c: &Check, s: &Seed003Spec) -> Result<(), SpecError> {
+pub(crate) fn limits(c: &Check, s: &CuckooBezierSpec) -> Result<(), SpecError> {
     c.list("seed003.examples", &s.examples)?;
     c.list("seed003.methods", &s.methods)?;
     c.int("seed003.runs", s.runs, limits::MAX_REPEATS)?;

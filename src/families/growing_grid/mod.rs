@@ -10,7 +10,7 @@ use crate::experiment::spec::{GridSize, Spec, SpecError};
 use crate::experiment::{runner, seeds, RunContext};
 use crate::geom::Point3;
 use crate::optim::{Budget, Optimiser, Problem};
-use crate::som::growing_grid::{grow, GrowingGrid};
+use crate::som::growing_grid::{self as grown, grow};
 use crate::spline::open_surface::OpenSurfaceProblem;
 use crate::spline::Parameterisation;
 use anyhow::{Context, Result};
@@ -23,7 +23,7 @@ use std::collections::BTreeMap;
 pub struct MapRun {
     pub dataset: String,
     pub points: usize,
-    pub map: GrowingGrid,
+    pub map: grown::GrowingGrid,
     pub qe: f64,
     pub te: f64,
     pub cpu_s: f64,
@@ -242,7 +242,7 @@ pub fn run(
 }
 
 /// Seed 001's family: the `[growing_grid]` section.
-pub struct Seed001;
+pub struct GrowingGrid;
 
 impl crate::experiment::family::Section for self::spec::GrowingGridSpec {
     fn limits(&self, c: &crate::experiment::limits::Check) -> Result<(), SpecError> {
@@ -256,7 +256,7 @@ impl crate::experiment::family::Section for self::spec::GrowingGridSpec {
     }
 }
 
-impl crate::experiment::family::Experiment for Seed001 {
+impl crate::experiment::family::Experiment for GrowingGrid {
     fn title(&self) -> &'static str {
         "Seed 001"
     }

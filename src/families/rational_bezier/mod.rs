@@ -12,7 +12,7 @@ use crate::spline::conic::{self, ConicProblem, P2};
 use crate::spline::rational_bezier::{SurfaceSse, TestSurface};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
-use spec::Seed002Spec;
+use spec::RationalBezierSpec;
 
 /// One (surface, optimiser, repeat).
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -74,7 +74,7 @@ impl runner::Logged for Run {
 }
 
 /// The flat list of cells.
-pub fn cells(s: &Seed002Spec) -> Vec<Cell> {
+pub fn cells(s: &RationalBezierSpec) -> Vec<Cell> {
     runner::product_cells(&s.surfaces, &s.optimisers, s.repeats, |sf, o, repeat| Cell {
         surface: sf.clone(),
         optimiser: o.clone(),
@@ -83,19 +83,19 @@ pub fn cells(s: &Seed002Spec) -> Vec<Cell> {
 }
 
 /// The SSE problem of a surface with the spec's grid and box.
-pub fn problem(s: &Seed002Spec, surface: &str) -> Result<SurfaceSse> {
+pub fn problem(s: &RationalBezierSpec, surface: &str) -> Result<SurfaceSse> {
     let ts = TestSurface::by_name(surface)
         .with_context(|| format!("seed002.surfaces: unknown surface `{surface}`"))?;
     Ok(SurfaceSse::new(ts.grid(s.grid), s.bounds_margin, s.w_min))
 }
 
-fn optimiser<'a>(s: &'a Seed002Spec, name: &str) -> Result<&'a dyn Optimiser> {
+fn optimiser<'a>(s: &'a RationalBezierSpec, name: &str) -> Result<&'a dyn Optimiser> {
     crate::optim::pick(&s.offered(), name)
         .with_context(|| format!("seed002.optimisers: unknown optimiser `{name}`"))
 }
 
 /// Run one cell (alone it gives the same numbers as inside the full run).
-pub fn run_cell(spec: &Spec, s: &Seed002Spec, cell: &Cell) -> Result<Run> {
+pub fn run_cell(spec: &Spec, s: &RationalBezierSpec, cell: &Cell) -> Result<Run> {
     let problem = problem(s, &cell.surface)?;
     let opt = optimiser(s, &cell.optimiser)?;
     // init_range is a share of the data's largest bounding-box extent (the domains differ in scale).
@@ -137,7 +137,7 @@ pub fn run_cell(spec: &Spec, s: &Seed002Spec, cell: &Cell) -> Result<Run> {
 }
 
 /// Run every cell of the spec.
-pub fn run(spec: &Spec, s: &Seed002Spec, ctx: &RunContext) -> Result<Vec<Run>> {
+pub fn run(spec: &Spec, s: &RationalBezierSpec, ctx: &RunContext) -> Result<Vec<Run>> {
     let cells = cells(s);
     runner::run_logged(
         &cells,
@@ -193,7 +193,7 @@ pub struct CurveRun {
     pub conics: Vec<([P2; 3], f64)>,
 }
 
-pub fn curve_cells(s: &Seed002Spec) -> Vec<CurveCell> {
+pub fn curve_cells(s: &RationalBezierSpec) -> Vec<CurveCell> {
     runner::product_cells(&s.outlines, &s.optimisers, s.repeats, |ol, o, repeat| CurveCell {
         outline: ol.clone(),
         optimiser: o.clone(),
@@ -203,7 +203,7 @@ pub fn curve_cells(s: &Seed002Spec) -> Vec<CurveCell> {
 
 /// Sample the outline, detect its corners (SAM06), cut it into conic runs and fit each run's
 /// conic with the cell's optimiser, all on the cell's stream in run order.
-pub fn run_curve_cell(spec: &Spec, s: &Seed002Spec, cell: &CurveCell) -> Result<CurveRun> {
+pub fn run_curve_cell(spec: &Spec, s: &RationalBezierSpec, cell: &CurveCell) -> Result<CurveRun> {
     let (pieces, truth) = conic::outline(&cell.outline)
         .with_context(|| format!("seed002.outlines: unknown outline `{}`", cell.outline))?;
     let points = conic::sample_closed(&pieces, s.outline_spacing);
@@ -261,7 +261,7 @@ pub fn run_curve_cell(spec: &Spec, s: &Seed002Spec, cell: &CurveCell) -> Result<
 
 /// The curve cells (a fraction of a second in all; not logged: a resumed run or a merge runs
 /// them again, deterministically).
-pub fn run_curves(spec: &Spec, s: &Seed002Spec, ctx: &RunContext) -> Result<Vec<CurveRun>> {
+pub fn run_curves(spec: &Spec, s: &RationalBezierSpec, ctx: &RunContext) -> Result<Vec<CurveRun>> {
     let cells = curve_cells(s);
     runner::run_cells(
         &cells,
@@ -273,9 +273,9 @@ pub fn run_curves(spec: &Spec, s: &Seed002Spec, ctx: &RunContext) -> Result<Vec<
 }
 
 /// Seed 002's family: the `[seed002]` section (surface cells logged, curve cells not).
-pub struct Seed002;
+pub struct RationalBezier;
 
-impl crate::experiment::family::Section for self::spec::Seed002Spec {
+impl crate::experiment::family::Section for self::spec::RationalBezierSpec {
     fn limits(&self, c: &crate::experiment::limits::Check) -> Result<(), SpecError> {
         self::spec::limits(c, self)
     }
@@ -284,21 +284,21 @@ impl crate::experiment::family::Section for self::spec::Seed002Spec {
     }
 }
 
-impl crate::experiment::family::Experiment for Seed002 {
+impl crate::experiment::family::Experiment for RationalBezier {
     fn title(&self) -> &'static str {
         "Seed 002"
     }
-    type Section = self::spec::Seed002Spec;
-    fn logged_keys(&self, _spec: &Spec, s: &Seed002Spec) -> Vec<String> {
+    type Section = self::spec::RationalBezierSpec;
+    fn logged_keys(&self, _spec: &Spec, s: &RationalBezierSpec) -> Vec<String> {
         cells(s).iter().map(|c| c.key()).collect()
     }
-    fn unlogged_keys(&self, _spec: &Spec, s: &Seed002Spec) -> Vec<String> {
+    fn unlogged_keys(&self, _spec: &Spec, s: &RationalBezierSpec) -> Vec<String> {
         curve_cells(s).iter().map(|c| c.key()).collect()
     }
     fn run(
         &self,
         spec: &Spec,
-        s: &Seed002Spec,
+        s: &RationalBezierSpec,
         ctx: &RunContext,
         tables: bool,
     ) -> Result<crate::experiment::family::Outcome> {

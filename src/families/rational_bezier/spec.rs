@@ -51,7 +51,7 @@ fn default_s2_curve_generations() -> usize {
 /// in the seed text, so the defaults are stated choices (see experiments/seed002_rational.toml).
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct Seed002Spec {
+pub struct RationalBezierSpec {
     /// surface1..surface4 (SPEC 7; domains fixed in `rational_bezier::TestSurface`).
     #[serde(default = "default_s2_surfaces")]
     pub surfaces: Vec<String>,
@@ -107,7 +107,7 @@ pub struct Seed002Spec {
 }
 
 /// Every value of the `[seed002]` section (after the limits).
-pub(crate) fn validate(spec: &Spec, s: &Seed002Spec) -> Result<(), SpecError> {
+pub(crate) fn validate(spec: &Spec, s: &RationalBezierSpec) -> Result<(), SpecError> {
     if s.surfaces.is_empty() {
         return Err(spec.err("seed002.surfaces", "is empty"));
     }
@@ -179,7 +179,7 @@ pub(crate) fn validate(spec: &Spec, s: &Seed002Spec) -> Result<(), SpecError> {
 }
 
 /// The bounds of the `[seed002]` section's sizes and counts (docs/specs.md, "Spec limits").
-pub(crate) fn limits(c: &Check, s: &Seed002Spec) -> Result<(), SpecError> {
+pub(crate) fn limits(c: &Check, s: &RationalBezierSpec) -> Result<(), SpecError> {
     c.list("seed002.surfaces", &s.surfaces)?;
     c.list("seed002.optimisers", &s.optimisers)?;
     c.list("seed002.outlines", &s.outlines)?;
@@ -198,7 +198,7 @@ pub(crate) fn limits(c: &Check, s: &Seed002Spec) -> Result<(), SpecError> {
     Ok(())
 }
 
-impl Seed002Spec {
+impl RationalBezierSpec {
     /// The optimisers this section offers, each with its parameter table (`ga`, ...).
     pub fn offered(&self) -> Vec<&dyn crate::optim::Optimiser> {
         vec![&self.ga, &self.de, &self.pso]
