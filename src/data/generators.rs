@@ -79,9 +79,9 @@ fn revolution(top: f64, rings: &[(f64, f64)], per_ring: usize, bottom: f64) -> V
 #[serde(rename_all = "snake_case")]
 pub enum SpindleProfile {
     /// r = .5 sin(pi t)^2.
-    #[default]
     Sin2,
-    /// r = .5 sin(pi t).
+    /// r = .5 sin(pi t): Table 3.1's rounded pole; Appendix B's QE (docs/readings.md).
+    #[default]
     Sin,
     /// r = .5 (1 - |1 - 2t|): a double cone in t.
     Cone,
@@ -233,7 +233,7 @@ mod tests {
         let radius = |p: Point3| ((p[0] - 0.5).powi(2) + (p[2] - 0.5).powi(2)).sqrt();
         let all = |profile, rings| spindle_with(profile, rings);
         // The default is the parabola r = 2 y (1 - y) (sin^2 = 1 - cos^2 with y = .5 + .5 cos).
-        assert_eq!(spindle(), all(SpindleProfile::Sin2, SpindleRings::Cos));
+        assert_eq!(spindle(), all(SpindleProfile::Sin, SpindleRings::Cos));
         for p in spindle() {
             assert!((radius(p) - 2.0 * p[1] * (1.0 - p[1])).abs() < 1e-12, "{p:?}");
         }

@@ -135,7 +135,7 @@ fn som_readings_default_parse_and_name_their_key() {
         (s.som3d_adjacency, s.spindle_profile, s.spindle_rings)
     };
     let plain = L::parse("t.toml", SPEC, None).unwrap();
-    assert_eq!(som(&plain), (LatticeAdjacency::N6, SpindleProfile::Sin2, SpindleRings::Cos));
+    assert_eq!(som(&plain), (LatticeAdjacency::N6, SpindleProfile::Sin, SpindleRings::Cos));
     let set = [
         ov("som.som3d_adjacency", "layer"),
         ov("som.spindle_profile", "cone"),
