@@ -6,9 +6,9 @@ The keys go into the file, not through `run --set`, which would change every cel
 copy keeps the spec's seeds, so its PSO runs are the ones a full run under those keys makes.
 The maps path is made absolute (recomputed from [optim.som] if missing, as in the spec).
 
-    python3 scripts/readings_ch6_pso_spec.py experiments/ch6_same.toml /tmp/r38/v25_same.toml \\
-        vmax_fraction=0.25
-    somnurbs run /tmp/r38/v25_same.toml --jobs 1 --out /tmp/r38/v25/ch6_same
+    python3 scripts/readings_ch6_pso_spec.py experiments/ch6_same.toml /tmp/r38/v50_same.toml \\
+        vmax_fraction=0.5
+    somnurbs run /tmp/r38/v50_same.toml --jobs 1 --out /tmp/r38/v50/ch6_same
 """
 
 import sys
@@ -29,10 +29,20 @@ def main():
         if old not in s:
             sys.exit(f"{spec}: no line {old!r}")
         s = s.replace(old, new, 1)
-    header = s.index("[optim.pso]")
-    line_end = s.index("\n", header) + 1
-    keys = "".join(f"{k} = {v}\n" for k, v in (p.split("=", 1) for p in pairs))
-    Path(out).write_text(s[:line_end] + keys + s[line_end:])
+    lines = s.splitlines(keepends=True)
+    start = next(i for i, l in enumerate(lines) if l.startswith("[optim.pso]")) + 1
+    end = next((i for i in range(start, len(lines)) if lines[i].startswith("[")), len(lines))
+    for k, v in (p.split("=", 1) for p in pairs):
+        k = k.strip()
+        line = f"{k} = {v.strip()}\n"
+        # A key the spec sets already is replaced (TOML forbids it twice), a new one added.
+        at = [i for i in range(start, end) if lines[i].split("=", 1)[0].strip() == k]
+        if at:
+            lines[at[0]] = line
+        else:
+            lines.insert(start, line)
+            end += 1
+    Path(out).write_text("".join(lines))
 
 
 if __name__ == "__main__":

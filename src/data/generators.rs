@@ -232,13 +232,13 @@ mod tests {
     fn spindle_readings_lie_on_their_closed_form_profiles() {
         let radius = |p: Point3| ((p[0] - 0.5).powi(2) + (p[2] - 0.5).powi(2)).sqrt();
         let all = |profile, rings| spindle_with(profile, rings);
-        // The default is the parabola r = 2 y (1 - y) (sin^2 = 1 - cos^2 with y = .5 + .5 cos).
-        assert_eq!(spindle(), all(SpindleProfile::Sin, SpindleRings::Cos));
-        for p in spindle() {
+        // sin2 on cosine rings: the parabola r = 2 y (1 - y) (sin^2 = 1 - cos^2, y = .5 + .5 cos).
+        for p in all(SpindleProfile::Sin2, SpindleRings::Cos) {
             assert!((radius(p) - 2.0 * p[1] * (1.0 - p[1])).abs() < 1e-12, "{p:?}");
         }
-        // sin on cosine rings: the sphere of radius .5 about (.5, .5, .5).
-        for p in all(SpindleProfile::Sin, SpindleRings::Cos) {
+        // The default, sin on cosine rings: the sphere of radius .5 about (.5, .5, .5).
+        assert_eq!(spindle(), all(SpindleProfile::Sin, SpindleRings::Cos));
+        for p in spindle() {
             assert!((radius(p).hypot(p[1] - 0.5) - 0.5).abs() < 1e-12, "{p:?}");
         }
         // cone on uniform rings: the double cone r + |y - .5| = .5.

@@ -86,7 +86,9 @@ pub fn describe(name: &str) -> Option<&'static str> {
     Some(match name {
         "cube" => "7352 points, unit-cube surface lattice (generated)",
         "sphere" => "7082 points, sphere rings at 3-degree steps (generated)",
-        "spindle" => "7552 points, spindle of revolution, 151 rings x 50 (generated)",
+        "spindle" => {
+            "7552 points, surface of revolution, 151 rings x 50 (generated; som.spindle_profile)"
+        }
         "oiltank" => "5942 points, capsule with spherical-cap domes, 99 rings x 60 (generated)",
         "talus" => "5253 points sampled on talus_r.stl (TLEM 2.0 talus bone; data file)",
         "bunny" => "35947 vertices of bun_zipper.ply (Stanford bunny; data file)",
