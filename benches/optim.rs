@@ -4,9 +4,9 @@
 //! the thesis 48 s), and GA, PSO and cuckoo-search runs. The Python peers (numpy, scipy) are
 //! measured on the same problem in the same run by `scripts/bench_peers.sh`.
 
-use somnurbs::experiment::{runner, spec::GridSize};
+use somnurbs::experiment::{self, GridSize};
 use somnurbs::families;
-use somnurbs::families::som::spec::SomCell;
+use somnurbs::families::som::SomCell;
 use somnurbs::geom::Point3;
 use somnurbs::optim::{default_optimiser, Budget, ExactOptions, Problem};
 use somnurbs::simd::Isa;
@@ -20,8 +20,7 @@ mod floor;
 
 fn main() {
     let spindle =
-        somnurbs::data::registry::load_dataset("spindle", &somnurbs::experiment::data_dir(None))
-            .unwrap();
+        somnurbs::data::load_dataset("spindle", &somnurbs::experiment::data_dir(None)).unwrap();
     let cell = SomCell {
         dataset: "spindle".into(),
         model: Model::Dnsom,
@@ -67,7 +66,7 @@ fn main() {
         std::env::var("BENCH_ROUNDS").ok().and_then(|v| v.parse().ok()).unwrap_or(5);
     let mut xs = x0.clone();
     let mut round = |with_fitness: bool| {
-        let t = runner::thread_cpu_seconds();
+        let t = experiment::thread_cpu_seconds();
         let mut acc = 0.0;
         for k in 0..reps {
             let j = k % x0.len();
@@ -79,7 +78,7 @@ fn main() {
             std::hint::black_box(&xs);
         }
         std::hint::black_box(acc);
-        runner::thread_cpu_seconds() - t
+        experiment::thread_cpu_seconds() - t
     };
     let per =
         (0..rounds).map(|_| round(true) - round(false)).fold(f64::INFINITY, f64::min) / reps as f64;
@@ -137,9 +136,9 @@ fn main() {
     }
     // The optimisers' own kernels, every compiled copy (all in L1: the floor of their overhead).
     #[cfg(target_arch = "x86_64")]
-    for line in somnurbs::simd::moves::timing::report()
+    for line in somnurbs::simd::moves_timing::report()
         .into_iter()
-        .chain(somnurbs::simd::levy::timing::report())
+        .chain(somnurbs::simd::levy_timing::report())
     {
         println!("{line}");
     }
@@ -186,10 +185,10 @@ fn main() {
         .filter(|n| only.as_ref().is_none_or(|o| o.iter().any(|x| x == n)))
     {
         let opt = default_optimiser(name).unwrap();
-        let mut rng = somnurbs::experiment::seeds::cell_rng(1, "bench");
-        let t = runner::thread_cpu_seconds();
+        let mut rng = somnurbs::experiment::cell_rng(1, "bench");
+        let t = experiment::thread_cpu_seconds();
         let r = opt.run(&problem, &budget, &mut rng).unwrap();
-        let s = runner::thread_cpu_seconds() - t;
+        let s = experiment::thread_cpu_seconds() - t;
         let per_eval = s / r.evaluations as f64;
         let target = if name == "de" {
             format!(" (target 0.2 s; thesis 48 s: {:.0}x)", 48.0 / s)
@@ -283,9 +282,9 @@ struct Peak {
 fn best_ns_per(n: usize, f: impl Fn(usize) -> f64) -> f64 {
     (0..5)
         .map(|_| {
-            let t = runner::thread_cpu_seconds();
+            let t = experiment::thread_cpu_seconds();
             std::hint::black_box(f(n));
-            (runner::thread_cpu_seconds() - t) / n as f64 * 1e9
+            (experiment::thread_cpu_seconds() - t) / n as f64 * 1e9
         })
         .fold(f64::INFINITY, f64::min)
 }
@@ -367,13 +366,13 @@ fn best_fitness_ns(problem: &ControlNetProblem, x0: &[f64], rounds: usize) -> f6
     let n = 20_000;
     (0..rounds.max(1))
         .map(|_| {
-            let t = runner::thread_cpu_seconds();
+            let t = experiment::thread_cpu_seconds();
             let mut acc = 0.0;
             for _ in 0..n {
                 acc += problem.fitness(std::hint::black_box(x0));
             }
             std::hint::black_box(acc);
-            (runner::thread_cpu_seconds() - t) / n as f64 * 1e9
+            (experiment::thread_cpu_seconds() - t) / n as f64 * 1e9
         })
         .fold(f64::INFINITY, f64::min)
 }
@@ -388,7 +387,7 @@ fn scaling(points: &[Point3], mhz: f64) {
     println!("|---|---|---|---|---|---|---|---|---|");
     // A net needs at most as many control points as the map has neurons per side.
     let cases = [(20, 6), (20, 12), (20, 18), (30, 6), (30, 18), (30, 28), (40, 18), (40, 28)];
-    let mut maps: Vec<(usize, somnurbs::spline::TwoViewGrid)> = Vec::new();
+    let mut maps: Vec<(usize, somnurbs::double_net::TwoViewGrid)> = Vec::new();
     for (m, cn) in cases {
         if !maps.iter().any(|(k, _)| *k == m) {
             let cell = SomCell {
@@ -424,10 +423,10 @@ fn scaling(points: &[Point3], mhz: f64) {
         let bound = fma_lower_bound_cycles(m, m, cn);
         let budget =
             Budget { generations, population: 40, init_range: 5e-6, trace_every_evals: 400 };
-        let mut rng = somnurbs::experiment::seeds::cell_rng(1, "bench");
-        let t = runner::thread_cpu_seconds();
+        let mut rng = somnurbs::experiment::cell_rng(1, "bench");
+        let t = experiment::thread_cpu_seconds();
         let r = default_optimiser("de").unwrap().run(&pb, &budget, &mut rng).unwrap();
-        let s = runner::thread_cpu_seconds() - t;
+        let s = experiment::thread_cpu_seconds() - t;
         println!(
             "| {m}x{m} | {cn}x{cn} | {} | {ns:.0} | {:.0} | {bound:.0} | {:.2} | {s:.3} | {:.3} |",
             pb.dim(),
@@ -469,7 +468,7 @@ fn counted(what: &str, problem: &ControlNetProblem, budget: &Budget) -> (u64, f6
         return (n, acc);
     }
     let opt = default_optimiser(what).unwrap_or_else(|| panic!("BENCH_COUNT: unknown '{what}'"));
-    let mut rng = somnurbs::experiment::seeds::cell_rng(1, "bench");
+    let mut rng = somnurbs::experiment::cell_rng(1, "bench");
     let r = opt.run(problem, budget, &mut rng).unwrap();
     (r.evaluations, r.best_fitness)
 }

@@ -6,13 +6,14 @@
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use somnurbs::experiment::{runner, seeds};
+use somnurbs::double_net::TwoViewGrid;
+use somnurbs::experiment;
 use somnurbs::families;
-use somnurbs::families::som::spec::SomCell;
+use somnurbs::families::som::SomCell;
 use somnurbs::optim::Problem;
 use somnurbs::som::{Model, SomParams};
-use somnurbs::spline::bezier::{example3, franke, height_grid, peaks, BezierParamProblem, Layout};
-use somnurbs::spline::{fit_two_view, Approach, Parameterisation, TwoViewGrid};
+use somnurbs::spline::{example3, franke, height_grid, peaks, BezierParamProblem, Layout};
+use somnurbs::spline::{fit_two_view, Approach, Parameterisation};
 use std::time::Instant;
 
 fn maps(grid: (usize, usize)) -> Vec<TwoViewGrid> {
@@ -24,7 +25,7 @@ fn maps(grid: (usize, usize)) -> Vec<TwoViewGrid> {
         .map(|n| {
             (
                 n.clone(),
-                somnurbs::data::registry::load_dataset(n, &dir)
+                somnurbs::data::load_dataset(n, &dir)
                     .expect("data sets (talus needs SOMNURBS_DATA)"),
             )
         })
@@ -32,7 +33,7 @@ fn maps(grid: (usize, usize)) -> Vec<TwoViewGrid> {
     names
         .iter()
         .map(|d| {
-            let g = somnurbs::experiment::spec::GridSize { nx: grid.0, ny: grid.1 };
+            let g = somnurbs::experiment::GridSize { nx: grid.0, ny: grid.1 };
             let cell = SomCell { dataset: d.clone(), model: Model::Dnsom, grid: g, repeat: 0 };
             let run = families::som::run_cell(&cell, &data[d].points, &SomParams::default(), 2023)
                 .unwrap();
@@ -43,7 +44,7 @@ fn maps(grid: (usize, usize)) -> Vec<TwoViewGrid> {
 }
 
 fn main() {
-    let _ = seeds::seed_hex(0, "");
+    let _ = experiment::seed_hex(0, "");
     if std::env::args().any(|a| a == "bezier") {
         bezier_fitness(); // `cargo bench --bench spline -- bezier`: seed 003's part only
         return;
@@ -54,7 +55,7 @@ fn main() {
     let nets_diff: Vec<(usize, usize)> = (0..7).map(|k| (4 + 2 * k, 16 + 2 * k)).collect();
     let mut best = f64::INFINITY;
     for _ in 0..5 {
-        let t0 = runner::thread_cpu_seconds();
+        let t0 = experiment::thread_cpu_seconds();
         let mut n = 0;
         for (grids, nets) in [(&same, &nets_same), (&diff, &nets_diff)] {
             for g in grids.iter() {
@@ -71,7 +72,7 @@ fn main() {
             }
         }
         assert_eq!(n, 560);
-        best = best.min(runner::thread_cpu_seconds() - t0);
+        best = best.min(experiment::thread_cpu_seconds() - t0);
     }
     println!("Appendices E+F: 280 cells (data x parameterisation x net x grid), 560 two-surface fits (A and B), one core: {best:.4} s ({:.3} ms per fit; target < 0.5 s)", best / 560.0 * 1e3);
     let t0 = Instant::now();
@@ -127,7 +128,7 @@ fn bezier_fitness() {
             (0..64).map(|_| (0..dim).map(|_| rng.gen_range(0.0..1.0)).collect()).collect();
         let prob = BezierParamProblem::new(d, d, layout, pts, xs[0].clone()).unwrap();
         let t = Instant::now();
-        let c0 = runner::thread_cpu_seconds();
+        let c0 = experiment::thread_cpu_seconds();
         let mut n = 0u64;
         let mut acc = 0.0;
         // BENCH_EVALS=n: exactly n evaluations (for instruction counts under callgrind)
@@ -137,7 +138,7 @@ fn bezier_fitness() {
             n += 1;
         }
         let secs = t.elapsed().as_secs_f64();
-        let cpu = runner::thread_cpu_seconds() - c0;
+        let cpu = experiment::thread_cpu_seconds() - c0;
         println!(
             "{name}: {:.0} evaluations/s ({:.1} us each, {:.1} us CPU; checksum {acc:.3e})",
             n as f64 / secs,

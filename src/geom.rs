@@ -4,50 +4,50 @@
 pub type Point3 = [f64; 3];
 
 #[inline]
-pub fn sub(a: Point3, b: Point3) -> Point3 {
+pub(crate) fn sub(a: Point3, b: Point3) -> Point3 {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
 #[inline]
-pub fn add(a: Point3, b: Point3) -> Point3 {
+pub(crate) fn add(a: Point3, b: Point3) -> Point3 {
     [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
 
 #[inline]
-pub fn scale(a: Point3, s: f64) -> Point3 {
+pub(crate) fn scale(a: Point3, s: f64) -> Point3 {
     [a[0] * s, a[1] * s, a[2] * s]
 }
 
 #[inline]
-pub fn dot(a: Point3, b: Point3) -> f64 {
+pub(crate) fn dot(a: Point3, b: Point3) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 #[inline]
-pub fn cross(a: Point3, b: Point3) -> Point3 {
+pub(crate) fn cross(a: Point3, b: Point3) -> Point3 {
     [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }
 
 #[inline]
-pub fn norm(a: Point3) -> f64 {
+pub(crate) fn norm(a: Point3) -> f64 {
     dot(a, a).sqrt()
 }
 
 /// Squared Euclidean distance.
 #[inline]
-pub fn dist2(a: Point3, b: Point3) -> f64 {
+pub(crate) fn dist2(a: Point3, b: Point3) -> f64 {
     let d = sub(a, b);
     dot(d, d)
 }
 
 /// Euclidean distance.
 #[inline]
-pub fn dist(a: Point3, b: Point3) -> f64 {
+pub(crate) fn dist(a: Point3, b: Point3) -> f64 {
     dist2(a, b).sqrt()
 }
 
 /// Per-axis minimum and maximum of a point set (None when empty).
-pub fn bounding_box(points: &[Point3]) -> Option<(Point3, Point3)> {
+pub(crate) fn bounding_box(points: &[Point3]) -> Option<(Point3, Point3)> {
     let first = *points.first()?;
     let mut lo = first;
     let mut hi = first;

@@ -34,7 +34,7 @@ pub fn measure(mhz: f64) -> Option<Blocks> {
     #[cfg(target_arch = "x86_64")]
     {
         use crate::best_ns_per;
-        use somnurbs::simd::fitness::building_blocks::{first_pass, second_pass};
+        use somnurbs::simd::building_blocks::{first_pass, second_pass};
         let rows: Vec<f64> = (0..5 * K).map(|k| 1.0 + k as f64 * 1e-3).collect();
         let w = [
             [0.1, 0.6, 0.25, 0.05],

@@ -8,8 +8,8 @@ use pyo3::exceptions::{PyNotImplementedError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use somnurbs::families::suite::{self, Fitness, Suite, SuiteProblem};
-use somnurbs::optim::exact::ExactResult;
 use somnurbs::optim::ExactOptions;
+use somnurbs::optim::ExactResult;
 use std::sync::{Arc, OnceLock};
 
 /// What every problem of one `problems()` call shares.

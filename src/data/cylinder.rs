@@ -15,22 +15,22 @@ use crate::geom::Point3;
 
 /// Ring-organised data: rings bottom to top, each in angular order (see [`sort_into_rings`]); the closed fit of `spline::closed` reads it.
 #[derive(Debug, Clone, PartialEq)]
-pub struct RingData {
-    pub rings: Vec<Vec<Point3>>,
+pub(crate) struct RingData {
+    pub(crate) rings: Vec<Vec<Point3>>,
 }
 
 impl RingData {
-    pub fn n_points(&self) -> usize {
+    pub(crate) fn n_points(&self) -> usize {
         self.rings.iter().map(|r| r.len()).sum()
     }
 
-    pub fn points(&self) -> impl Iterator<Item = &Point3> {
+    pub(crate) fn points(&self) -> impl Iterator<Item = &Point3> {
         self.rings.iter().flatten()
     }
 
     /// Eq. 8 on a closed ring: cumulative chord over the perimeter (closing chord included) times
     /// `n_around`, so u runs over [0, n_around).
-    pub fn ring_parameters(ring: &[Point3], n_around: usize) -> Vec<f64> {
+    pub(crate) fn ring_parameters(ring: &[Point3], n_around: usize) -> Vec<f64> {
         let m = ring.len();
         let chord = |a: usize, b: usize| crate::geom::dist(ring[a], ring[b]);
         let total: f64 = (0..m).map(|g| chord(g, (g + 1) % m)).sum();
@@ -46,7 +46,7 @@ impl RingData {
     }
 
     /// Eq. 8 along the rings (chords between ring centroids), in [0, 1].
-    pub fn row_parameters(&self) -> Vec<f64> {
+    pub(crate) fn row_parameters(&self) -> Vec<f64> {
         let centroid = |r: &[Point3]| {
             let n = r.len().max(1) as f64;
             let s = r.iter().fold([0.0; 3], |a, p| crate::geom::add(a, *p));
@@ -65,7 +65,7 @@ impl RingData {
 /// Lattice points of step `step` with |x^2 + y^2 - radius^2| <= accuracy and 0 <= z <= height,
 /// level by level from z = 0, each level in lattice order (x, then y). Integer lattice indices
 /// keep the test exact up to rounding of the inputs.
-pub fn lattice_cylinder(radius: f64, height: f64, step: f64, accuracy: f64) -> Vec<Point3> {
+pub(crate) fn lattice_cylinder(radius: f64, height: f64, step: f64, accuracy: f64) -> Vec<Point3> {
     let reach = ((radius + accuracy.sqrt() + step) / step).ceil() as i64;
     let levels = (height / step + 1e-9).floor() as i64;
     let mut ring = Vec::new();
@@ -82,7 +82,7 @@ pub fn lattice_cylinder(radius: f64, height: f64, step: f64, accuracy: f64) -> V
 
 /// Sort points into rings of equal height (heights equal to within `tol`), bottom to top, each
 /// ring in increasing angle about the z axis (from the positive x axis, in [0, 2 pi)).
-pub fn sort_into_rings(points: &[Point3], tol: f64) -> RingData {
+pub(crate) fn sort_into_rings(points: &[Point3], tol: f64) -> RingData {
     let mut pts = points.to_vec();
     pts.sort_by(|a, b| a[2].total_cmp(&b[2]));
     let mut rings: Vec<Vec<Point3>> = Vec::new();

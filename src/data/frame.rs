@@ -24,7 +24,7 @@ pub struct Frame {
 }
 
 /// The `source` of a generated data set.
-pub const GENERATED: &str = "generated";
+pub(crate) const GENERATED: &str = "generated";
 
 impl Frame {
     /// The frame `normalise` will apply to `points` (the same bounding box and ranges as
@@ -89,7 +89,7 @@ impl Frame {
 }
 
 /// The frame file beside a map: `X.csv` -> `X.frame.toml` (any other name: `.frame.toml` added).
-pub fn sidecar(map: &std::path::Path) -> std::path::PathBuf {
+pub(crate) fn sidecar(map: &std::path::Path) -> std::path::PathBuf {
     let name = map.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
     let stem = name.strip_suffix(".csv").unwrap_or(&name);
     map.with_file_name(format!("{stem}.frame.toml"))

@@ -10,7 +10,7 @@ use std::f64::consts::PI;
 /// and corner points once: 6*36^2 - 12*36 + 8 = 7352 points. Each face is walked quad by quad
 /// (rows from the top, corners (a, b+1), (a, b), (a+1, b), (a+1, b+1)), which reproduces the
 /// thesis' first points (0,0,1), (0,0,0.97143), (0.02858,0,0.97143), (0.02858,0,1), (0.05715,0,0.97143).
-pub fn cube() -> Vec<Point3> {
+pub(crate) fn cube() -> Vec<Point3> {
     const N: i32 = 35;
     let mut seen = HashSet::new();
     let mut out = Vec::with_capacity(7352);
@@ -45,7 +45,7 @@ pub fn cube() -> Vec<Point3> {
 /// Sphere: centre (.5,.5,.5), radius .5: the pole (.5,1,.5), 59 rings at 3-degree polar steps of
 /// 120 points at 3-degree azimuth steps (x = .5 - r sin phi, z = .5 - r cos phi), the pole (.5,0,.5):
 /// 7082 points; the thesis' first points (0.5, 0.999315, 0.473830), (0.498630, 0.999315, 0.473865).
-pub fn sphere() -> Vec<Point3> {
+pub(crate) fn sphere() -> Vec<Point3> {
     let mut out = vec![[0.5, 1.0, 0.5]];
     for k in 1..60 {
         let theta = (3.0 * k as f64).to_radians();
@@ -124,12 +124,13 @@ impl SpindleRings {
 /// Spindle: 151 rings k = 1..151 at t = k/152, y = .5 + .5 cos(pi t), radius .5 sin(pi t)^2, 50
 /// points a ring (7.2-degree steps), plus both poles: 7552 points. (The thesis' exact profile is
 /// unknown; counts and ring layout match, its first points do not.)
-pub fn spindle() -> Vec<Point3> {
+#[cfg(test)]
+pub(crate) fn spindle() -> Vec<Point3> {
     spindle_with(SpindleProfile::default(), SpindleRings::default())
 }
 
 /// [`spindle`] with another profile or ring placement (the same 151 rings of 50 points).
-pub fn spindle_with(profile: SpindleProfile, rings: SpindleRings) -> Vec<Point3> {
+pub(crate) fn spindle_with(profile: SpindleProfile, rings: SpindleRings) -> Vec<Point3> {
     let rings: Vec<(f64, f64)> = (1..=151)
         .map(|k| {
             let t = k as f64 / 152.0;
@@ -141,13 +142,13 @@ pub fn spindle_with(profile: SpindleProfile, rings: SpindleRings) -> Vec<Point3>
 
 /// Cylinder length of the oil tank: chosen so that, after normalisation, the first dome ring lies
 /// at y = 0.999462 as in the thesis' Table 3.1.
-pub const OILTANK_CYLINDER_LENGTH: f64 = 0.611;
+pub(crate) const OILTANK_CYLINDER_LENGTH: f64 = 0.611;
 
 /// Oil tank: a capsule of a cylinder of radius .5 and two spherical-cap domes of sphere radius .78;
 /// each dome has 19 rings at polar angles k asin(.5/.78)/19, k = 1..19; 61 cylinder rings evenly
 /// spaced strictly between the two dome-edge rings; 60 points a ring (6-degree steps); plus both
 /// poles: 99*60 + 2 = 5942 points.
-pub fn oiltank() -> Vec<Point3> {
+pub(crate) fn oiltank() -> Vec<Point3> {
     const R: f64 = 0.78;
     let edge = (0.5 / R).asin();
     let cap = R * (1.0 - edge.cos());
@@ -171,7 +172,7 @@ pub fn oiltank() -> Vec<Point3> {
 }
 
 /// Cylinder of seed 004: radius 5, height 5, 51 rings z = 0, 0.1, ..., 5 of 76 points: 3876 points.
-pub fn cylinder() -> Vec<Point3> {
+pub(crate) fn cylinder() -> Vec<Point3> {
     let mut out = Vec::with_capacity(51 * 76);
     for k in 0..=50 {
         let z = k as f64 * 0.1;
@@ -185,7 +186,7 @@ pub fn cylinder() -> Vec<Point3> {
 
 /// Upper unit hemisphere (open surface, seed 001): the pole and 30 rings at 3-degree polar steps
 /// down to the equator, 120 points a ring: 3601 points.
-pub fn semi_sphere() -> Vec<Point3> {
+pub(crate) fn semi_sphere() -> Vec<Point3> {
     let mut out = vec![[0.0, 0.0, 1.0]];
     for k in 1..=30 {
         let theta = (3.0 * k as f64).to_radians();
@@ -198,7 +199,7 @@ pub fn semi_sphere() -> Vec<Point3> {
 }
 
 /// Saddle z = x^2 - y^2 on a 60 x 60 lattice over [-1, 1]^2 (open surface, seed 001): 3600 points.
-pub fn saddle() -> Vec<Point3> {
+pub(crate) fn saddle() -> Vec<Point3> {
     let mut out = Vec::with_capacity(3600);
     for i in 0..60 {
         for j in 0..60 {

@@ -6,7 +6,7 @@ use crate::double_net::TwoViewGrid;
 use crate::geom::Point3;
 
 /// Parse the grid CSV (sizes from the largest i and j; every position of both views exactly once).
-pub fn parse_two_view_grid(text: &str) -> Result<TwoViewGrid, DataError> {
+pub(crate) fn parse_two_view_grid(text: &str) -> Result<TwoViewGrid, DataError> {
     let mut r = csv::ReaderBuilder::new().trim(csv::Trim::All).from_reader(text.as_bytes());
     let header: Vec<String> = r
         .headers()

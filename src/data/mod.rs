@@ -2,18 +2,19 @@
 //! (PLY, STL, OFF, OBJ, XYZ/CSV), the thesis' per-axis min-max normalisation and the frame that
 //! undoes it. Pure apart from `registry`, the one place that reads files.
 
-pub mod cylinder;
-pub mod frame;
-pub mod generators;
-pub mod grid_csv;
+pub(crate) mod cylinder;
+pub(crate) mod frame;
+pub(crate) mod generators;
+pub(crate) mod grid_csv;
 pub mod obj;
 pub mod off;
 pub mod ply;
-pub mod registry;
+pub(crate) mod registry;
 pub mod stl;
 pub mod xyz;
 
 use crate::geom::Point3;
+pub use registry::{clone_data_dir, load_dataset};
 use thiserror::Error;
 
 /// A named point cloud.
@@ -103,7 +104,7 @@ impl Normalise {
 
 /// Uniform min-max normalisation: every axis shifted to start at 0 and divided by the largest
 /// axis range, so the longest axis spans [0, 1] and the shape's proportions are kept.
-pub fn normalise_uniform(points: &mut [Point3]) {
+pub(crate) fn normalise_uniform(points: &mut [Point3]) {
     let Some((lo, hi)) = crate::geom::bounding_box(points) else { return };
     let range = (0..3).map(|a| hi[a] - lo[a]).fold(0.0, f64::max);
     for p in points.iter_mut() {
@@ -114,7 +115,7 @@ pub fn normalise_uniform(points: &mut [Point3]) {
 }
 
 /// Per-axis min-max normalisation to [0, 1], as the thesis did; an axis with zero range maps to 0.
-pub fn normalise_min_max(points: &mut [Point3]) {
+pub(crate) fn normalise_min_max(points: &mut [Point3]) {
     let Some((lo, hi)) = crate::geom::bounding_box(points) else { return };
     for p in points.iter_mut() {
         for a in 0..3 {
@@ -127,10 +128,10 @@ pub fn normalise_min_max(points: &mut [Point3]) {
 /// Largest coordinate magnitude of a point file: beyond it the squared distances of the
 /// parameterisation and the least-squares fit lose the data's own scale (1e300 made the normal
 /// equations singular), so such a file is refused when it is read (docs/specs.md, "Own data").
-pub const MAX_COORDINATE: f64 = 1e15;
+pub(crate) const MAX_COORDINATE: f64 = 1e15;
 
 /// Why a coordinate read from a file is refused (non-finite, or beyond [`MAX_COORDINATE`]).
-pub fn coordinate_problem(axis: &str, v: f64) -> Option<String> {
+pub(crate) fn coordinate_problem(axis: &str, v: f64) -> Option<String> {
     if !v.is_finite() {
         Some(format!("a non-finite {axis} ({v})"))
     } else if v.abs() > MAX_COORDINATE {
@@ -142,7 +143,7 @@ pub fn coordinate_problem(axis: &str, v: f64) -> Option<String> {
 
 /// Refuse non-finite coordinates and coordinates beyond [`MAX_COORDINATE`] (naming the point and
 /// axis) and clouds of fewer than `min_points`.
-pub fn validate(points: &[Point3], min_points: usize) -> Result<(), DataError> {
+pub(crate) fn validate(points: &[Point3], min_points: usize) -> Result<(), DataError> {
     for (k, p) in points.iter().enumerate() {
         for (a, axis) in ["x", "y", "z"].iter().enumerate() {
             if let Some(why) = coordinate_problem(axis, p[a]) {
@@ -162,7 +163,7 @@ pub fn validate(points: &[Point3], min_points: usize) -> Result<(), DataError> {
 /// Refuse a cloud of fewer points than the map trained on it has neurons: units would be left
 /// with no data of their own, so the map could not organise over the surface. `entry` names the
 /// data set as the spec wrote it (its file).
-pub fn require_points(
+pub(crate) fn require_points(
     entry: &str,
     points: usize,
     neurons: usize,

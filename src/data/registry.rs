@@ -7,7 +7,7 @@ use rand::SeedableRng;
 use std::path::{Path, PathBuf};
 
 /// Built-in data-set names.
-pub const BUILTIN: &[&str] = &[
+pub(crate) const BUILTIN: &[&str] = &[
     "cube",
     "sphere",
     "spindle",
@@ -20,18 +20,18 @@ pub const BUILTIN: &[&str] = &[
 ];
 
 /// Number of points sampled on the talus mesh (the thesis' talus has 5253 points).
-pub const TALUS_POINTS: usize = 5253;
+pub(crate) const TALUS_POINTS: usize = 5253;
 /// Seed of the talus sample (the thesis' own scan points are not public).
-pub const TALUS_SAMPLE_SEED: u64 = 5253;
+pub(crate) const TALUS_SAMPLE_SEED: u64 = 5253;
 /// Points sampled from a user's STL file unless `path.stl:N` says otherwise.
-pub const DEFAULT_STL_POINTS: usize = 5000;
+pub(crate) const DEFAULT_STL_POINTS: usize = 5000;
 /// The most points `path.stl:N` may ask for.
-pub const MAX_STL_POINTS: usize = 10_000_000;
+pub(crate) const MAX_STL_POINTS: usize = 10_000_000;
 /// File types a data-set path may have.
-pub const EXTENSIONS: [&str; 7] = [".ply", ".stl", ".off", ".obj", ".xyz", ".csv", ".txt"];
+pub(crate) const EXTENSIONS: [&str; 7] = [".ply", ".stl", ".off", ".obj", ".xyz", ".csv", ".txt"];
 
 /// [`dataset_name`] of an entry validation has passed (the entry itself if it would not).
-pub fn name_of(entry: &str) -> String {
+pub(crate) fn name_of(entry: &str) -> String {
     dataset_name(entry).unwrap_or_else(|_| entry.to_string())
 }
 
@@ -57,7 +57,7 @@ fn split_count(entry: &str) -> Result<(&str, Option<usize>), DataError> {
 /// a file's stem (`scans/part.xyz` and `/abs/part.xyz` are both `part`, so a result does not
 /// depend on where its file lives). Refuses an entry that is neither a built-in nor a point file,
 /// and a name that could not be a file name (empty, `.`, `..`).
-pub fn dataset_name(entry: &str) -> Result<String, DataError> {
+pub(crate) fn dataset_name(entry: &str) -> Result<String, DataError> {
     if BUILTIN.contains(&entry) {
         return Ok(entry.to_string());
     }
@@ -78,11 +78,11 @@ pub fn dataset_name(entry: &str) -> Result<String, DataError> {
     Ok(stem.to_string())
 }
 
-pub const BUNNY_FILE: &str = "bun_zipper.ply";
-pub const TALUS_FILE: &str = "talus_r.stl";
+pub(crate) const BUNNY_FILE: &str = "bun_zipper.ply";
+pub(crate) const TALUS_FILE: &str = "talus_r.stl";
 
 /// One line about a built-in data set.
-pub fn describe(name: &str) -> Option<&'static str> {
+pub(crate) fn describe(name: &str) -> Option<&'static str> {
     Some(match name {
         "cube" => "7352 points, unit-cube surface lattice (generated)",
         "sphere" => "7082 points, sphere rings at 3-degree steps (generated)",
@@ -127,7 +127,7 @@ fn sample_stl(bytes: &[u8], n: usize, seed: u64, shown: &str) -> Result<Vec<Poin
     stl::sample_surface(&tris, n, &mut rng).map_err(|e| e.in_file(shown))
 }
 
-/// Load a data set by name or path ([`Loader::load`]): paths relative to the working folder,
+/// Load a data set by name or path (`Loader::load`): paths relative to the working folder,
 /// normalised per axis (the thesis).
 pub fn load_dataset(name: &str, data_dir: &Path) -> Result<PointCloud, DataError> {
     Loader { data_dir: data_dir.to_path_buf(), ..Loader::default() }.load(name)
@@ -270,12 +270,12 @@ fn note_once(key: &str, message: &str) {
 
 /// The top of the clone this crate was built from (`CARGO_MANIFEST_DIR`): where the tests find
 /// the data, and where `reproduce` finds its plans when run from another folder without `--specs`.
-pub const CLONE_DIR: &str = env!("CARGO_MANIFEST_DIR");
+pub(crate) const CLONE_DIR: &str = env!("CARGO_MANIFEST_DIR");
 
 /// The folder of the data files (bunny, talus), the one rule for the main job and the tests:
 /// `flag` (`--data-dir`), else `SOMNURBS_DATA`, else `data` in `top` (the working folder for the
 /// binary, the top of the clone for the tests: [`clone_data_dir`]).
-pub fn data_folder(flag: Option<&Path>, top: &Path) -> PathBuf {
+pub(crate) fn data_folder(flag: Option<&Path>, top: &Path) -> PathBuf {
     if let Some(p) = flag {
         return p.to_path_buf();
     }
@@ -285,7 +285,7 @@ pub fn data_folder(flag: Option<&Path>, top: &Path) -> PathBuf {
     }
 }
 
-/// The data folder the tests use: [`data_folder`] at the top of the clone, i.e. what a user's
+/// The data folder the tests use: `data_folder` at the top of the clone, i.e. what a user's
 /// main job uses when run from there (`SOMNURBS_DATA` if set, else `<clone>/data`).
 pub fn clone_data_dir() -> PathBuf {
     data_folder(None, Path::new(CLONE_DIR))

@@ -6,7 +6,7 @@ use anyhow::Result;
 use std::fmt::Write;
 use std::path::Path;
 
-pub fn datasets(action: DatasetsAction, data_dir: &Path) -> Result<()> {
+pub(crate) fn datasets(action: DatasetsAction, data_dir: &Path) -> Result<()> {
     match action {
         DatasetsAction::List => {
             for name in registry::BUILTIN {

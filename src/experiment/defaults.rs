@@ -3,41 +3,41 @@
 //! seeds' families reuse), the SOM settings of Chapter 4 (`SomParams::default()`), and `true`.
 
 /// Repeats per cell, and other counts that default to ten (Table 6.1: 10 runs).
-pub fn ten() -> usize {
+pub(crate) fn ten() -> usize {
     10
 }
 
 /// Generations of one optimiser run (Table 6.1).
-pub fn generations() -> usize {
+pub(crate) fn generations() -> usize {
     2000
 }
 
 /// Individuals of one optimiser run (Table 6.1).
-pub fn population() -> usize {
+pub(crate) fn population() -> usize {
     40
 }
 
 /// Half-width of the start around the least-squares net (Table 6.1's range, +-5e-6).
-pub fn init_range() -> f64 {
+pub(crate) fn init_range() -> f64 {
     5e-6
 }
 
 /// Evaluations between two points of a convergence trace.
-pub fn trace_every() -> u64 {
+pub(crate) fn trace_every() -> u64 {
     400
 }
 
 /// SOM training iterations T (Chapter 4; `SomParams::default()`).
-pub fn som_iterations() -> usize {
+pub(crate) fn som_iterations() -> usize {
     crate::som::SomParams::default().iterations
 }
 
 /// SOM initial learning rate alpha0 (Chapter 4; `SomParams::default()`).
-pub fn som_alpha0() -> f64 {
+pub(crate) fn som_alpha0() -> f64 {
     crate::som::SomParams::default().alpha0
 }
 
 /// A switch that is on unless the spec turns it off.
-pub fn yes() -> bool {
+pub(crate) fn yes() -> bool {
     true
 }

@@ -312,11 +312,11 @@ impl<F: Holds<E::Section>, E: Experiment> Family<F> for E {
 }
 
 /// The published table `name`, from whichever family of `F` compiles it in.
-pub fn published<F: Families>(name: &str) -> Option<RefTable> {
+pub(crate) fn published<F: Families>(name: &str) -> Option<RefTable> {
     F::all().iter().find_map(|f| crate::report::reference::lookup(f.published(), name))
 }
 
 /// The section names, as `[som], [fit], ...`, for messages.
-pub fn section_list<F: Families>() -> String {
+pub(crate) fn section_list<F: Families>() -> String {
     F::all().iter().map(|f| format!("[{}]", f.section())).collect::<Vec<_>>().join(", ")
 }

@@ -6,7 +6,7 @@ use serde::ser::{self, Serialize};
 use std::fmt;
 
 /// The path and value of the first non-finite float in `value`, if any.
-pub fn first_non_finite<T: Serialize + ?Sized>(value: &T) -> Option<String> {
+pub(crate) fn first_non_finite<T: Serialize + ?Sized>(value: &T) -> Option<String> {
     let mut f = Finder { path: Vec::new() };
     match value.serialize(&mut f) {
         Err(Stop::Found(s)) => Some(s),

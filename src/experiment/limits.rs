@@ -10,42 +10,42 @@ use std::collections::HashSet;
 use std::fmt::Display;
 
 /// Largest side of any SOM grid or control net.
-pub const MAX_GRID_SIDE: usize = 256;
+pub(crate) const MAX_GRID_SIDE: usize = 256;
 /// SOM iterations T (Chapter 4 and the map recomputation of Chapters 5 and 6).
-pub const MAX_ITERATIONS: u64 = 10_000_000;
+pub(crate) const MAX_ITERATIONS: u64 = 10_000_000;
 /// Largest initial SOM radius sigma0 (the neighbourhood is tabulated per iteration).
-pub const MAX_SIGMA0: f64 = 256.0;
+pub(crate) const MAX_SIGMA0: f64 = 256.0;
 /// Repeats (runs) per cell.
-pub const MAX_REPEATS: u64 = 10_000;
+pub(crate) const MAX_REPEATS: u64 = 10_000;
 /// Generations (iterations) of one optimiser run.
-pub const MAX_GENERATIONS: u64 = 1_000_000;
+pub(crate) const MAX_GENERATIONS: u64 = 1_000_000;
 /// Individuals (nests, particles) of one optimiser run.
-pub const MAX_POPULATION: u64 = 10_000;
+pub(crate) const MAX_POPULATION: u64 = 10_000;
 /// Cells of one spec (all its `--sweep` variants together).
-pub const MAX_CELLS: u64 = 100_000;
+pub(crate) const MAX_CELLS: u64 = 100_000;
 /// Variants of one run: the product of the `--sweep` value counts.
-pub const MAX_VARIANTS: u64 = 1_000;
+pub(crate) const MAX_VARIANTS: u64 = 1_000;
 /// Cells of one `reproduce` plan: its specs and its reading sets' runs together.
-pub const MAX_PLAN_CELLS: u64 = 1_000_000;
+pub(crate) const MAX_PLAN_CELLS: u64 = 1_000_000;
 /// Entries of one list.
-pub const MAX_LIST: usize = 1_000;
+pub(crate) const MAX_LIST: usize = 1_000;
 /// Initial range, search range and box margin, in units of the (normalised) data's extent.
-pub const MAX_RANGE: f64 = 10.0;
+pub(crate) const MAX_RANGE: f64 = 10.0;
 /// Trace checkpoint spacing in evaluations.
-pub const MAX_TRACE_EVERY: u64 = 1_000_000_000_000;
+pub(crate) const MAX_TRACE_EVERY: u64 = 1_000_000_000_000;
 /// Newton steps of the exact solver.
-pub const MAX_NEWTON_STEPS: u64 = 100_000;
+pub(crate) const MAX_NEWTON_STEPS: u64 = 100_000;
 /// Lengths in data units (a generated shape's radius or height, a step, an accuracy, a search range).
-pub const MAX_LENGTH: f64 = 1e6;
+pub(crate) const MAX_LENGTH: f64 = 1e6;
 /// Points or samples per side of a generated data set.
-pub const MAX_SAMPLES: u64 = 100_000;
+pub(crate) const MAX_SAMPLES: u64 = 100_000;
 
 /// Worker threads per available CPU at most (`--jobs`).
-pub const MAX_JOBS_PER_CPU: usize = 4;
+pub(crate) const MAX_JOBS_PER_CPU: usize = 4;
 
 /// The worker threads of `--jobs` (`flag`; default: `cpus`): at least 1 (0 is an error), at most
 /// [`MAX_JOBS_PER_CPU`] x `cpus` (a larger flag is cut down, with the note to print).
-pub fn jobs(flag: Option<usize>, cpus: usize) -> anyhow::Result<(usize, Option<String>)> {
+pub(crate) fn jobs(flag: Option<usize>, cpus: usize) -> anyhow::Result<(usize, Option<String>)> {
     let cpus = cpus.max(1);
     let cap = MAX_JOBS_PER_CPU.saturating_mul(cpus);
     match flag {
@@ -175,15 +175,15 @@ impl Check<'_> {
 }
 
 /// The data-set entries of a spec's section (as written: names or paths).
-pub fn dataset_entries<F: Families>(spec: &Loaded<F>) -> Vec<&String> {
+pub(crate) fn dataset_entries<F: Families>(spec: &Loaded<F>) -> Vec<&String> {
     spec.family().datasets(&spec.section)
 }
 
 /// The penalised least squares weight (`fairness`): at most 10^6.
-pub const MAX_FAIRNESS: f64 = 1e6;
+pub(crate) const MAX_FAIRNESS: f64 = 1e6;
 
 /// A usable experiment or file name: not empty, no path separator or NUL, not `.` or `..`.
-pub fn check_name(name: &str) -> Result<(), String> {
+pub(crate) fn check_name(name: &str) -> Result<(), String> {
     if name.trim().is_empty() || name.contains(['/', '\\', '\0']) || name == "." || name == ".." {
         return Err(format!("`{name}` must be a non-empty name without slashes, not `.` or `..`"));
     }
@@ -191,7 +191,7 @@ pub fn check_name(name: &str) -> Result<(), String> {
 }
 
 /// Every bound of a spec and its section (see the module doc), before any other check.
-pub fn check<F: Families>(spec: &Spec, section: &F) -> Result<(), SpecError> {
+pub(crate) fn check<F: Families>(spec: &Spec, section: &F) -> Result<(), SpecError> {
     let c = Check { spec, counted: Default::default() };
     check_name(&spec.file.name).map_err(|e| c.err("name", e))?;
     section.family().check_limits(&c, section)
@@ -199,7 +199,7 @@ pub fn check<F: Families>(spec: &Spec, section: &F) -> Result<(), SpecError> {
 
 /// The cells of a spec as its limit counts them (the product of its section's sizes), without
 /// making them; 0 when a limit fails (a spec that passed validation has passed them).
-pub fn cell_count<F: Families>(spec: &Loaded<F>) -> u64 {
+pub(crate) fn cell_count<F: Families>(spec: &Loaded<F>) -> u64 {
     let c = Check { spec: &spec.spec, counted: Default::default() };
     match spec.family().check_limits(&c, &spec.section) {
         Ok(()) => c.counted.get(),

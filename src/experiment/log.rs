@@ -14,7 +14,7 @@ use std::fs::{File, OpenOptions};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-pub use crate::io::outdir::{FINGERPRINT_FILE, LOG_FILE, LOG_GZ};
+pub(crate) use crate::io::outdir::{FINGERPRINT_FILE, LOG_FILE, LOG_GZ};
 
 /// The `I`-th of `N` deterministic slices of a spec's cells (1-based): cell number k belongs to
 /// shard (k mod N) + 1, so every shard gets a mix of small and large cells.
@@ -47,7 +47,7 @@ impl Shard {
 
 /// `merge`'s output folder must not be one of the shard folders it reads (compared as canonical
 /// paths, so `s1`, `./s1/` and a link to it are one folder).
-pub fn out_is_no_shard(shards: &[PathBuf], out: &Path) -> Result<()> {
+pub(crate) fn out_is_no_shard(shards: &[PathBuf], out: &Path) -> Result<()> {
     let Ok(target) = out.canonicalize() else { return Ok(()) };
     for dir in shards {
         if dir.canonicalize().is_ok_and(|d| d == target) {
@@ -70,29 +70,29 @@ impl std::fmt::Display for Shard {
 /// What makes two runs the same run: the spec (text after which profile), the seed, the shard.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct Fingerprint {
-    pub spec_name: String,
-    pub spec_path: String,
-    pub spec_sha256: String,
-    pub profile: String,
-    pub master_seed: u64,
+pub(crate) struct Fingerprint {
+    pub(crate) spec_name: String,
+    pub(crate) spec_path: String,
+    pub(crate) spec_sha256: String,
+    pub(crate) profile: String,
+    pub(crate) master_seed: u64,
     /// Cells in the whole spec (all shards).
-    pub cells: usize,
+    pub(crate) cells: usize,
     /// `I/N` when the folder holds one shard.
     #[serde(default)]
-    pub shard: Option<String>,
+    pub(crate) shard: Option<String>,
     /// The spec's text, so that a merge can re-read it.
-    pub spec_text: String,
+    pub(crate) spec_text: String,
     /// The command line's `--set KEY=VALUE` and `--sweep KEY=V1,V2` (absent for a plain run).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub set: Vec<String>,
+    pub(crate) set: Vec<String>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub sweep: Vec<String>,
+    pub(crate) sweep: Vec<String>,
 }
 
 impl Fingerprint {
     /// The first field in which `other` differs, as `name: ours vs theirs` (None if equal).
-    pub fn difference(&self, other: &Fingerprint) -> Option<String> {
+    pub(crate) fn difference(&self, other: &Fingerprint) -> Option<String> {
         let pairs = [
             ("spec name", self.spec_name.clone(), other.spec_name.clone()),
             ("master seed", self.master_seed.to_string(), other.master_seed.to_string()),
@@ -111,11 +111,11 @@ impl Fingerprint {
     }
 
     /// The command line's changes, as a spec reads them back (merge).
-    pub fn overrides(&self) -> super::spec::CliOverrides {
+    pub(crate) fn overrides(&self) -> super::spec::CliOverrides {
         super::spec::CliOverrides { set: self.set.clone(), sweep: self.sweep.clone() }
     }
 
-    pub fn read(dir: &Path) -> Result<Option<Fingerprint>> {
+    pub(crate) fn read(dir: &Path) -> Result<Option<Fingerprint>> {
         let path = dir.join(FINGERPRINT_FILE);
         if !path.exists() {
             return Ok(None);
@@ -124,7 +124,7 @@ impl Fingerprint {
         Ok(Some(fp))
     }
 
-    pub fn write(&self, dir: &Path) -> Result<()> {
+    pub(crate) fn write(&self, dir: &Path) -> Result<()> {
         let text = toml::to_string(self).context("cannot serialise the fingerprint")?;
         crate::io::write_atomic(&dir.join(FINGERPRINT_FILE), text.as_bytes())
     }
@@ -152,7 +152,7 @@ struct Line<T> {
 /// last line of the plain log (no newline: the write was cut short) is dropped and cut off the
 /// file; any other malformed line is an error naming the file and line, and so is a line whose
 /// seed is not the cell's seed under `master_seed` (a log that mixes runs).
-pub fn read_records<T: DeserializeOwned>(
+pub(crate) fn read_records<T: DeserializeOwned>(
     dir: &Path,
     master_seed: u64,
 ) -> Result<BTreeMap<String, T>> {
@@ -239,7 +239,7 @@ pub fn log_text(dir: &Path) -> Result<String> {
 /// Compress a finished run's log: the plain log's complete lines are added to `cells.jsonl.gz`
 /// (written whole, atomically), then the plain log is removed. Interrupted at any point, the
 /// folder still holds every line once: [`read_records`] reads both files.
-pub fn compress(dir: &Path) -> Result<()> {
+pub(crate) fn compress(dir: &Path) -> Result<()> {
     use std::io::Write as _;
     let plain = dir.join(LOG_FILE);
     if !plain.exists() {
@@ -255,7 +255,7 @@ pub fn compress(dir: &Path) -> Result<()> {
 }
 
 /// Appends one line per finished cell, flushed at once.
-pub struct CellLog {
+pub(crate) struct CellLog {
     file: File,
     path: PathBuf,
     master_seed: u64,
@@ -264,7 +264,7 @@ pub struct CellLog {
 impl CellLog {
     /// Open the folder's log: appending to it when resuming, else starting it empty. A run
     /// opens it once, empty or not, and every cell family of the spec appends (`append`).
-    pub fn open(dir: &Path, resume: bool, master_seed: u64) -> Result<CellLog> {
+    pub(crate) fn open(dir: &Path, resume: bool, master_seed: u64) -> Result<CellLog> {
         let path = dir.join(LOG_FILE);
         let file = if resume {
             OpenOptions::new().create(true).append(true).open(&path)
@@ -276,11 +276,11 @@ impl CellLog {
     }
 
     /// Append to the folder's log (created if missing).
-    pub fn append(dir: &Path, master_seed: u64) -> Result<CellLog> {
+    pub(crate) fn append(dir: &Path, master_seed: u64) -> Result<CellLog> {
         CellLog::open(dir, true, master_seed)
     }
 
-    pub fn push<T: Serialize>(&mut self, key: &str, record: &T) -> Result<()> {
+    pub(crate) fn push<T: Serialize>(&mut self, key: &str, record: &T) -> Result<()> {
         let seed = Some(super::seeds::seed_hex(self.master_seed, key));
         let mut line = serde_json::to_string(&Line { key: key.to_string(), seed, record })
             .context("cannot serialise a cell record")?;

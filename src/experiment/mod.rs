@@ -1,21 +1,26 @@
 //! Experiments: spec -> cells -> runs (on per-cell random streams) -> report files and manifest.
 
-pub mod datasets;
-pub mod defaults;
-pub mod family;
-pub mod finite;
-pub mod grid_size;
-pub mod limits;
-pub mod log;
-pub mod overrides;
-pub mod packed;
-pub mod reproduce;
-pub mod runner;
-pub mod seeds;
-pub mod spec;
+pub(crate) mod datasets;
+pub(crate) mod defaults;
+pub(crate) mod family;
+pub(crate) mod finite;
+pub(crate) mod grid_size;
+pub(crate) mod limits;
+pub(crate) mod log;
+pub(crate) mod overrides;
+pub(crate) mod packed;
+pub(crate) mod reproduce;
+pub(crate) mod runner;
+pub(crate) mod seeds;
+pub(crate) mod spec;
 
 use anyhow::{Context, Result};
 use family::Families;
+pub use grid_size::GridSize;
+pub use log::log_text;
+pub use overrides::Override;
+pub use runner::{run_cells, thread_cpu_seconds};
+pub use seeds::{cell_rng, seed_hex};
 use serde::Serialize;
 use spec::{Loaded, Spec};
 use std::collections::BTreeMap;
@@ -65,7 +70,7 @@ impl RunContext {
 
     /// Make the folder this run's: called by the runner when the first cell is about to run,
     /// i.e. after every input (spec, data, maps) has loaded, and before anything is written. The
-    /// folder is empty or holds this run unfinished ([`claim`]); the first call writes the
+    /// folder is empty or holds this run unfinished (`claim`); the first call writes the
     /// fingerprint and starts the cell log (kept when resuming); later calls do nothing.
     pub fn begin(&self) -> Result<()> {
         let Some(session) = &self.session else { return Ok(()) };
@@ -116,7 +121,7 @@ pub fn dry_run_listing<F: Families>(spec: &Loaded<F>) -> Vec<(String, String)> {
 }
 
 /// The keys of every cell of a spec that goes through the cell log (what a merge must find).
-pub fn logged_cell_keys<F: Families>(spec: &Loaded<F>) -> Vec<String> {
+pub(crate) fn logged_cell_keys<F: Families>(spec: &Loaded<F>) -> Vec<String> {
     spec.family().logged_keys(&spec.spec, &spec.section)
 }
 
@@ -127,34 +132,34 @@ fn logged_variant_keys<F: Families>(variants: &[Loaded<F>]) -> Vec<String> {
 
 /// The manifest: enough to re-run exactly.
 #[derive(Debug, Serialize)]
-pub struct Manifest {
-    pub spec_name: String,
-    pub spec_path: String,
-    pub spec_sha256: String,
-    pub profile: String,
-    pub master_seed: u64,
+pub(crate) struct Manifest {
+    pub(crate) spec_name: String,
+    pub(crate) spec_path: String,
+    pub(crate) spec_sha256: String,
+    pub(crate) profile: String,
+    pub(crate) master_seed: u64,
     /// `I/N` when this folder holds one shard of the cells (no tables).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub shard: Option<String>,
+    pub(crate) shard: Option<String>,
     /// The command line's `--set KEY=VALUE` and `--sweep KEY=V1,V2` (absent for a plain run).
     #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub set: Vec<String>,
+    pub(crate) set: Vec<String>,
     #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub sweep: Vec<String>,
-    pub crate_version: String,
-    pub git_commit: String,
-    pub git_dirty: bool,
-    pub rustc: String,
-    pub host: String,
-    pub jobs: usize,
-    pub cells: usize,
-    pub started_unix: u64,
-    pub wall_seconds: f64,
-    pub cpu_seconds_cells: f64,
+    pub(crate) sweep: Vec<String>,
+    pub(crate) crate_version: String,
+    pub(crate) git_commit: String,
+    pub(crate) git_dirty: bool,
+    pub(crate) rustc: String,
+    pub(crate) host: String,
+    pub(crate) jobs: usize,
+    pub(crate) cells: usize,
+    pub(crate) started_unix: u64,
+    pub(crate) wall_seconds: f64,
+    pub(crate) cpu_seconds_cells: f64,
     /// The family's metric definitions (none: no table).
     #[serde(skip_serializing_if = "Definitions::is_empty")]
-    pub definitions: Definitions,
-    pub spec_text: String,
+    pub(crate) definitions: Definitions,
+    pub(crate) spec_text: String,
 }
 
 /// The exact definitions of the metrics a family reports (libraries disagree on them), in its
@@ -176,7 +181,7 @@ impl Serialize for Definitions {
 
 /// The fingerprint of a run of a spec's variants (one for a plain run) in a folder (what
 /// `--resume` and `merge` compare).
-pub fn fingerprint<F: Families>(
+pub(crate) fn fingerprint<F: Families>(
     variants: &[Loaded<F>],
     shard: Option<log::Shard>,
 ) -> log::Fingerprint {
@@ -203,13 +208,16 @@ pub fn fingerprint<F: Families>(
 /// writes them). With `resume`, the cells in the folder's log are kept if the folder's
 /// fingerprint and every logged seed match, else the run is refused before anything is touched;
 /// a folder that already holds this run finished is left as it is.
-pub fn run_spec<F: Families>(spec: &Loaded<F>, ctx: &RunContext) -> Result<PathBuf> {
+pub(crate) fn run_spec<F: Families>(spec: &Loaded<F>, ctx: &RunContext) -> Result<PathBuf> {
     run_variants(std::slice::from_ref(spec), ctx)
 }
 
 /// [`run_spec`] of the variants of one spec (`--set`/`--sweep`: [`spec::CliOverrides`]) into one
 /// folder: one cell log, one fingerprint and manifest, the family's tables over every variant.
-pub fn run_variants<F: Families>(variants: &[Loaded<F>], ctx: &RunContext) -> Result<PathBuf> {
+pub(crate) fn run_variants<F: Families>(
+    variants: &[Loaded<F>],
+    ctx: &RunContext,
+) -> Result<PathBuf> {
     let first = variants.first().context("no spec to run")?;
     let spec = &first.spec;
     // A data file the spec names that is not there or does not load: refused before the folder
@@ -345,7 +353,7 @@ fn run_spec_locked<F: Families>(variants: &[Loaded<F>], ctx: &RunContext) -> Res
 
 /// The `somnurbs run` command that makes the folder `out` again: the spec, its profile, `--out`
 /// unless it is the spec's default folder, and every `--set` and `--sweep`.
-pub fn run_command(spec: &Spec, m: &Manifest, out: &Path) -> String {
+pub(crate) fn run_command(spec: &Spec, m: &Manifest, out: &Path) -> String {
     let mut s = format!("somnurbs run {}", m.spec_path);
     if m.profile != "default" {
         let _ = write!(s, " --profile {}", m.profile);
@@ -364,7 +372,7 @@ pub fn run_command(spec: &Spec, m: &Manifest, out: &Path) -> String {
 
 /// REPORT.md: a header naming the run and the command that makes it again (`rerun`), then the
 /// chapters' sections.
-pub fn report_md<F: Families>(
+pub(crate) fn report_md<F: Families>(
     loaded: &Loaded<F>,
     m: &Manifest,
     rerun: &str,
@@ -415,7 +423,7 @@ pub fn report_md<F: Families>(
 
 /// What the profile changed from the spec as written and, for a reduced profile, the caveat that
 /// its counts are no evidence (empty for the spec as written).
-pub fn profile_note(spec: &Spec) -> String {
+pub(crate) fn profile_note(spec: &Spec) -> String {
     let changes = spec.profile_changes();
     let Some(profile) = spec.profile.as_deref().filter(|_| !changes.is_empty()) else {
         return String::new();
@@ -430,17 +438,17 @@ pub fn profile_note(spec: &Spec) -> String {
 }
 
 /// The note of a run drawn without pictures.
-pub const NO_PICTURES: &str = "\nNo pictures, 3-D views or IOHprofiler export are written in this folder: it is a reading variant of a plan, whose tables and claims the plan's readings matrix compares. Run the spec with the variant's keys (`somnurbs run SPEC --set KEY=VALUE ...`) to have them.\n";
+pub(crate) const NO_PICTURES: &str = "\nNo pictures, 3-D views or IOHprofiler export are written in this folder: it is a reading variant of a plan, whose tables and claims the plan's readings matrix compares. Run the spec with the variant's keys (`somnurbs run SPEC --set KEY=VALUE ...`) to have them.\n";
 
 /// The caveat a reduced run carries at the top of its report.
-pub const NOT_EVIDENCE: &str = "> **Not evidence.** This is a reduced run (fewer cells, repeats or iterations than the spec as written), for checking the harness and the pipeline. Its counts are too few to support or refute a claim, and its verdicts are mostly *undecided* for that reason; cite only a run of the spec as written.\n\n";
+pub(crate) const NOT_EVIDENCE: &str = "> **Not evidence.** This is a reduced run (fewer cells, repeats or iterations than the spec as written), for checking the harness and the pipeline. Its counts are too few to support or refute a claim, and its verdicts are mostly *undecided* for that reason; cite only a run of the spec as written.\n\n";
 
 /// Combine shard folders of one spec into `out` and write its tables: the shards' fingerprints
 /// must agree (apart from the shard) and cover 1..N once, each shard finished, its logged seeds
 /// the spec's, and their cell logs together hold exactly the spec's cells; the logs are joined and
 /// the spec is run in `out` (locked, and empty) with every cell restored from the log, so the
 /// tables equal a one-machine run's.
-pub fn merge<F: Families>(shards: &[PathBuf], ctx: &RunContext) -> Result<PathBuf> {
+pub(crate) fn merge<F: Families>(shards: &[PathBuf], ctx: &RunContext) -> Result<PathBuf> {
     if shards.is_empty() {
         anyhow::bail!("merge: no shard folders given");
     }
@@ -536,7 +544,7 @@ pub fn merge<F: Families>(shards: &[PathBuf], ctx: &RunContext) -> Result<PathBu
 }
 
 /// Resolve the data directory: flag, else `SOMNURBS_DATA`, else `./data` (in the working folder;
-/// [`crate::data::registry::data_folder`] is the rule).
+/// `crate::data::registry::data_folder` is the rule).
 pub fn data_dir(flag: Option<&Path>) -> PathBuf {
     crate::data::registry::data_folder(flag, Path::new(""))
 }

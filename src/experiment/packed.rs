@@ -11,19 +11,20 @@ const ALPHABET: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwx
 /// a non-finite coordinate is written as a plain number array instead, so the record's
 /// finiteness check ([`super::finite`]) finds it by path.
 #[derive(Debug, Clone, PartialEq, Default)]
-pub struct PackedPoints {
-    pub points: Vec<[f64; 3]>,
-    pub single: bool,
+pub(crate) struct PackedPoints {
+    pub(crate) points: Vec<[f64; 3]>,
+    pub(crate) single: bool,
 }
 
 impl PackedPoints {
     /// Every value exactly (f64).
-    pub fn exact(points: Vec<[f64; 3]>) -> Self {
+    #[cfg(test)]
+    pub(crate) fn exact(points: Vec<[f64; 3]>) -> Self {
         PackedPoints { points, single: false }
     }
 
     /// Every value rounded to the nearest f32 (as an f64), written as f32.
-    pub fn single(points: &[[f64; 3]]) -> Self {
+    pub(crate) fn single(points: &[[f64; 3]]) -> Self {
         let r = |v: f64| f64::from(v as f32);
         PackedPoints {
             points: points.iter().map(|p| [r(p[0]), r(p[1]), r(p[2])]).collect(),

@@ -22,35 +22,35 @@ use std::time::Instant;
 /// A plan: `experiments/thesis.toml` (Chapters 4-6), `seeds.toml`, `all.toml`.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct Plan {
+pub(crate) struct Plan {
     /// The combined report's title.
     #[serde(default = "default_title")]
-    pub title: String,
+    pub(crate) title: String,
     /// Spec names (files `<name>.toml` beside the plan), run in this order.
-    pub specs: Vec<String>,
+    pub(crate) specs: Vec<String>,
     /// The spec whose `maps/` folder the later specs read (plans with Chapters 5 or 6).
     #[serde(default)]
-    pub maps_from: Option<String>,
+    pub(crate) maps_from: Option<String>,
     /// The name of the readings the specs make as written (a row label of the readings matrix).
     #[serde(default = "default_reading")]
-    pub reading: String,
+    pub(crate) reading: String,
     /// Other reading sets: each runs the specs it names again with its overrides, into
     /// `readings/<name>/`, and the report sets every claim under every reading side by side.
     #[serde(default)]
-    pub readings: Vec<ReadingSet>,
+    pub(crate) readings: Vec<ReadingSet>,
 }
 
 /// A named set of readings (docs/readings.md): dotted spec keys and the values to use.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct ReadingSet {
-    pub name: String,
+pub(crate) struct ReadingSet {
+    pub(crate) name: String,
     #[serde(default)]
-    pub description: String,
+    pub(crate) description: String,
     /// E.g. `"fit.knots" = "nurbs_book"`; a key is applied to the specs that have its section.
-    pub set: std::collections::BTreeMap<String, toml::Value>,
+    pub(crate) set: std::collections::BTreeMap<String, toml::Value>,
     /// Which of the plan's specs run under this set.
-    pub specs: Vec<String>,
+    pub(crate) specs: Vec<String>,
 }
 
 impl ReadingSet {
@@ -74,7 +74,7 @@ fn default_title() -> String {
 }
 
 impl Plan {
-    pub fn load(path: &Path) -> Result<Plan> {
+    pub(crate) fn load(path: &Path) -> Result<Plan> {
         let plan: Plan = crate::io::read_toml(path)?;
         if plan.specs.is_empty() {
             anyhow::bail!("{}: specs: is empty", path.display());
@@ -209,10 +209,10 @@ fn has_profile(path: &Path, profile: &str) -> bool {
 }
 
 /// The folder `--specs` names when it is not given.
-pub const DEFAULT_SPECS: &str = "experiments";
+pub(crate) const DEFAULT_SPECS: &str = "experiments";
 
 /// The default output folder of a plan: `results/<plan>`, or `results/<plan>_quick`.
-pub fn default_out(plan: &str, profile: &str) -> PathBuf {
+pub(crate) fn default_out(plan: &str, profile: &str) -> PathBuf {
     if profile == "quick" {
         format!("results/{plan}_quick").into()
     } else {
@@ -223,7 +223,7 @@ pub fn default_out(plan: &str, profile: &str) -> PathBuf {
 /// The folder of the plans and specs: `--specs`, else `experiments` in the working folder, else,
 /// run from a folder that has no `experiments` (and no `--specs`), the one in the clone somnurbs
 /// was built from (said on stderr). An error names the folders tried and hints `--specs DIR`.
-pub fn specs_dir(flag: Option<&Path>, plan: &str) -> Result<PathBuf> {
+pub(crate) fn specs_dir(flag: Option<&Path>, plan: &str) -> Result<PathBuf> {
     if let Some(d) = flag {
         return Ok(d.to_path_buf());
     }
@@ -260,7 +260,7 @@ fn reproduce_command(specs_dir: &Path, plan: &str, profile: &str, out: &Path) ->
 }
 
 /// Run the plan into `ctx.out` and write the combined REPORT.md; returns its path.
-pub fn reproduce<F: Families>(
+pub(crate) fn reproduce<F: Families>(
     specs_dir: &Path,
     plan_name: &str,
     profile: &str,
@@ -533,7 +533,7 @@ fn combine<F: Families>(out: &Path, plan: &Plan, specs: &[Loaded<F>]) -> Result<
 }
 
 /// Where the reading sets' runs go, inside the plan's output folder.
-pub const READINGS_DIR: &str = "readings";
+pub(crate) const READINGS_DIR: &str = "readings";
 
 /// One claim under one reading.
 struct ReadingClaim {

@@ -9,8 +9,8 @@ use std::collections::BTreeMap;
 
 /// Seconds between the plain progress lines of a run whose stderr is not a terminal (a log),
 /// unless the environment variable [`PROGRESS_ENV`] gives another (e.g. `0.2` in tests).
-pub const PROGRESS_SECS: f64 = 15.0;
-pub const PROGRESS_ENV: &str = "SOMNURBS_PROGRESS_SECS";
+pub(crate) const PROGRESS_SECS: f64 = 15.0;
+pub(crate) const PROGRESS_ENV: &str = "SOMNURBS_PROGRESS_SECS";
 
 /// The interval of the plain progress lines: [`PROGRESS_ENV`] if it holds a positive number of
 /// seconds, else [`PROGRESS_SECS`].
@@ -34,7 +34,7 @@ fn clock(d: std::time::Duration) -> String {
 }
 
 /// One plain progress line: `somnurbs: progress LABEL: DONE/TOTAL cells, elapsed E, eta T`.
-pub fn progress_line(
+pub(crate) fn progress_line(
     label: &str,
     done: usize,
     total: usize,
@@ -54,8 +54,8 @@ pub fn progress_line(
 }
 
 /// Run `work` over `cells` on `jobs` threads. On a terminal a progress bar shows; otherwise (a
-/// log: SLURM, nohup, CI) a plain [`progress_line`] is printed to stderr when the cells start, every
-/// [`progress_interval`] and when they end.
+/// log: SLURM, nohup, CI) a plain `progress_line` is printed to stderr when the cells start, every
+/// `progress_interval` and when they end.
 pub fn run_cells<C, R>(
     cells: &[C],
     jobs: usize,
@@ -139,7 +139,7 @@ where
 
 /// The cells of a two-list x repeats design in the specs' fixed order (a outer, b, then the
 /// repeat 0..repeats inner), built by `make`.
-pub fn product_cells<A, B, C>(
+pub(crate) fn product_cells<A, B, C>(
     a: &[A],
     b: &[B],
     repeats: usize,
@@ -157,13 +157,13 @@ pub fn product_cells<A, B, C>(
 }
 
 /// A cell of a spec: its stable key names its random stream and its line in the cell log.
-pub trait Cell: Sync {
+pub(crate) trait Cell: Sync {
     fn key(&self) -> String;
 }
 
 /// A cell's result as the cell log keeps it: `record` is what a resumed run or a merge reads
 /// back instead of recomputing the cell.
-pub trait Logged: Send + Sized {
+pub(crate) trait Logged: Send + Sized {
     type Record: Serialize + DeserializeOwned;
     fn record(&self) -> Self::Record;
 }
@@ -172,7 +172,7 @@ pub trait Logged: Send + Sized {
 /// order. Each finished cell is appended to the folder's cell log at once; with `ctx.resume`,
 /// cells already in the log are not run again but rebuilt by `restore` from their record, so a
 /// resumed run gives the results of an uninterrupted one.
-pub fn run_logged<C, R>(
+pub(crate) fn run_logged<C, R>(
     cells: &[C],
     ctx: &super::RunContext,
     label: &str,
@@ -248,7 +248,7 @@ where
 /// The run protocol every cell follows: `work` on the cell's own stream (from the master seed and
 /// the cell's key, [`super::seeds::cell_rng`]), timed in the thread's CPU seconds (the rows'
 /// `cpu_s`).
-pub fn on_stream<T>(
+pub(crate) fn on_stream<T>(
     master_seed: u64,
     key: &str,
     work: impl FnOnce(&mut rand_chacha::ChaCha8Rng) -> T,
@@ -258,14 +258,14 @@ pub fn on_stream<T>(
 }
 
 /// The same for a cell that draws no random number (a deterministic fit).
-pub fn timed<T>(work: impl FnOnce() -> T) -> (T, f64) {
+pub(crate) fn timed<T>(work: impl FnOnce() -> T) -> (T, f64) {
     let t0 = thread_cpu_seconds();
     let out = work();
     (out, thread_cpu_seconds() - t0)
 }
 
 /// One optimiser run of a cell through [`on_stream`]; an error names the cell.
-pub fn optimise(
+pub(crate) fn optimise(
     opt: &dyn crate::optim::Optimiser,
     problem: &dyn crate::optim::Problem,
     budget: &crate::optim::Budget,

@@ -7,7 +7,7 @@ use rand_chacha::ChaCha8Rng;
 use sha2::{Digest, Sha256};
 
 /// The 32-byte seed of a cell's stream.
-pub fn cell_seed(master_seed: u64, cell_key: &str) -> [u8; 32] {
+pub(crate) fn cell_seed(master_seed: u64, cell_key: &str) -> [u8; 32] {
     let mut h = Sha256::new();
     h.update(b"somnurbs/seed/v1\0");
     h.update(master_seed.to_le_bytes());

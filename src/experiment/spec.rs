@@ -5,9 +5,9 @@
 //! Errors are one line and name the file, the line and column, and the key at fault.
 
 use super::family::{Families, Family, Holds};
-pub use super::grid_size::GridSize;
+pub(crate) use super::grid_size::GridSize;
 use super::overrides::apply_override;
-pub use super::overrides::{CliOverrides, Override, Variant};
+pub(crate) use super::overrides::{CliOverrides, Override, Variant};
 use std::fmt;
 use std::path::Path;
 

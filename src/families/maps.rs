@@ -115,28 +115,28 @@ pub(crate) fn validate_map_som(
 
 /// Where a map came from.
 #[derive(Debug, Clone)]
-pub struct MapSource {
-    pub grid: TwoViewGrid,
-    pub origin: String,
+pub(crate) struct MapSource {
+    pub(crate) grid: TwoViewGrid,
+    pub(crate) origin: String,
     /// The data set's frame (the map file's sidecar, or the recomputation's cloud); None: a map
     /// saved without one.
-    pub frame: Option<crate::data::frame::Frame>,
+    pub(crate) frame: Option<crate::data::frame::Frame>,
 }
 
 /// The map file name Chapter 4 writes and Chapter 5 reads.
-pub fn map_file_name(dataset: &str, grid: GridSize) -> String {
+pub(crate) fn map_file_name(dataset: &str, grid: GridSize) -> String {
     format!("dnsom_{dataset}_{grid}.csv")
 }
 
 /// Where a section's maps come from: its `maps` key as written (relative to the spec's folder),
 /// what a named folder or map that is not there means, and how a map is recomputed.
 #[derive(Debug, Clone, Copy)]
-pub struct MapsFrom<'a> {
+pub(crate) struct MapsFrom<'a> {
     /// `fit` or `optim`, for messages.
-    pub section: &'static str,
-    pub dir: Option<&'a str>,
-    pub missing: MapsMissing,
-    pub som: Option<&'a MapSom>,
+    pub(crate) section: &'static str,
+    pub(crate) dir: Option<&'a str>,
+    pub(crate) missing: MapsMissing,
+    pub(crate) som: Option<&'a MapSom>,
 }
 
 /// Each data set's entry, name and map file in the folder `from.dir` names (resolved against the
@@ -162,7 +162,7 @@ fn map_files<'a>(
 /// Whether the maps a section names are there: an error naming the missing folder or map, unless
 /// `maps_missing = "recompute"`, then the line that says what is recomputed (None: nothing is
 /// missing, or no folder is named and every map is recomputed as the spec says).
-pub fn require_maps(
+pub(crate) fn require_maps(
     spec: &Spec,
     datasets: &[String],
     grid: GridSize,
@@ -197,7 +197,7 @@ pub fn require_maps(
 /// spec's folder), recomputed with `from.som` when the spec names no folder. A named folder or map
 /// that is not there is an error naming it, unless `maps_missing = "recompute"`, in which case
 /// one stderr line says what is recomputed ([`require_maps`]).
-pub fn maps_for(
+pub(crate) fn maps_for(
     spec: &Spec,
     ctx: &RunContext,
     datasets: &[String],

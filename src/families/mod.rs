@@ -1,7 +1,7 @@
-//! The experiment families, one folder each: `mod.rs` implements [`Experiment`] for the family's
-//! spec section, `report.rs` writes its tables, pictures and REPORT.md section. This file holds
-//! the only list of families (the macro declares their modules too): a new one is its folder plus
-//! one line here.
+//! The experiment families, one folder each: `mod.rs` implements `experiment::family::Experiment`
+//! for the family's spec section, `report.rs` writes its tables, pictures and REPORT.md section.
+//! This file holds the only list of families (the macro declares their modules too): a new one is
+//! its folder plus one line here.
 
 crate::experiment::spec::families! {
     /// Chapter 4: SOM models.
@@ -20,5 +20,5 @@ crate::experiment::spec::families! {
     seed004: closed_cylinder::spec::ClosedCylinderSpec => closed_cylinder::ClosedCylinder,
 }
 
-pub mod maps;
+pub(crate) mod maps;
 pub mod suite;

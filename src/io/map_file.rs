@@ -9,7 +9,7 @@ use std::path::Path;
 
 /// A two-view grid as CSV: i, j, view, class (1-based class number), x, y, z; one row per
 /// position of both views (NON rows), bottom view first. Chapter 5 and `somnurbs fit` read it back.
-pub fn text(grid: &TwoViewGrid) -> Result<String> {
+pub(crate) fn text(grid: &TwoViewGrid) -> Result<String> {
     let net = DoubleNet::new(grid.nx, grid.ny)
         .ok_or_else(|| anyhow::anyhow!("grid {}x{} is too small", grid.nx, grid.ny))?;
     let mut rows = Vec::with_capacity(net.non());
@@ -39,7 +39,7 @@ pub fn text(grid: &TwoViewGrid) -> Result<String> {
 }
 
 /// Write `frame` beside the map file `map` ([`crate::data::frame::sidecar`]).
-pub fn write_frame(map: &Path, frame: &Frame) -> Result<()> {
+pub(crate) fn write_frame(map: &Path, frame: &Frame) -> Result<()> {
     let name = map.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
     let text = frame.to_toml(&name)?;
     write_atomic(&crate::data::frame::sidecar(map), text.as_bytes())
@@ -47,7 +47,7 @@ pub fn write_frame(map: &Path, frame: &Frame) -> Result<()> {
 
 /// The frame saved beside a map (`X.frame.toml` beside `X.csv`), None when there is none; a frame
 /// file that is there but cannot be read is an error naming it.
-pub fn read_frame(map: &Path) -> Result<Option<Frame>> {
+pub(crate) fn read_frame(map: &Path) -> Result<Option<Frame>> {
     let file = crate::data::frame::sidecar(map);
     if !file.exists() {
         return Ok(None);

@@ -3,8 +3,8 @@
 //! so a reader never sees half a file and two writers never share a temporary file (the rest of
 //! the output-folder contract is in [`crate::io::outdir`]).
 
-pub mod map_file;
-pub mod outdir;
+pub(crate) mod map_file;
+pub(crate) mod outdir;
 
 use anyhow::{Context, Result};
 use std::fs::{self, File};
@@ -12,13 +12,13 @@ use std::io::Write;
 use std::path::Path;
 
 /// Create a folder (and parents), naming it on failure.
-pub fn ensure_dir(dir: &Path) -> Result<()> {
+pub(crate) fn ensure_dir(dir: &Path) -> Result<()> {
     fs::create_dir_all(dir).with_context(|| format!("cannot create folder {}", dir.display()))
 }
 
 /// Refuse to replace anything but a regular file: a rename would put a plain file in place of a
 /// device, a pipe, a socket, a folder or a link (a link's target would not be written).
-pub fn require_regular_or_absent(path: &Path) -> Result<()> {
+pub(crate) fn require_regular_or_absent(path: &Path) -> Result<()> {
     let Ok(meta) = fs::symlink_metadata(path) else { return Ok(()) };
     let ty = meta.file_type();
     if ty.is_file() {
@@ -48,7 +48,7 @@ pub fn require_regular_or_absent(path: &Path) -> Result<()> {
 
 /// Write `bytes` to `path` atomically (temporary file + rename); `path` must be a regular file or
 /// absent ([`require_regular_or_absent`]).
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     require_regular_or_absent(path)?;
     if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
         ensure_dir(parent)?;
@@ -68,7 +68,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
 }
 
 /// Read a whole file as text, naming it on failure (a UTF-16 or binary file: [`utf8_text`]).
-pub fn read_text(path: &Path) -> Result<String> {
+pub(crate) fn read_text(path: &Path) -> Result<String> {
     let bytes = fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
     utf8_text(&path.display().to_string(), bytes).map_err(anyhow::Error::msg)
 }
@@ -76,7 +76,7 @@ pub fn read_text(path: &Path) -> Result<String> {
 /// An error chain as one printable line: line breaks become spaces and every other control
 /// character its escape (`\0`, `\u{1b}`), so no input echoed into a message can break the line or
 /// drive the terminal.
-pub fn one_line(msg: &str) -> String {
+pub(crate) fn one_line(msg: &str) -> String {
     msg.chars()
         .map(|c| match c {
             '\n' | '\r' => " ".to_string(),
@@ -88,7 +88,7 @@ pub fn one_line(msg: &str) -> String {
 
 /// Refuse UTF-16 text (a byte-order mark FF FE or FE FF) and bytes with NUL in them, naming
 /// `shown`: what a parser would otherwise echo into a message.
-pub fn not_utf16(shown: &str, bytes: &[u8]) -> std::result::Result<(), String> {
+pub(crate) fn not_utf16(shown: &str, bytes: &[u8]) -> std::result::Result<(), String> {
     if bytes.starts_with(&[0xFF, 0xFE]) || bytes.starts_with(&[0xFE, 0xFF]) || bytes.contains(&0) {
         return Err(format!("{shown}: UTF-16 text (or binary with NUL bytes); save it as UTF-8"));
     }
@@ -97,7 +97,7 @@ pub fn not_utf16(shown: &str, bytes: &[u8]) -> std::result::Result<(), String> {
 
 /// A file's bytes as UTF-8 text, or a one-line error naming `shown`: UTF-16 (a byte-order mark
 /// FF FE or FE FF) and NUL bytes are named as such, so no NUL byte reaches a parser's message.
-pub fn utf8_text(shown: &str, bytes: Vec<u8>) -> std::result::Result<String, String> {
+pub(crate) fn utf8_text(shown: &str, bytes: Vec<u8>) -> std::result::Result<String, String> {
     not_utf16(shown, &bytes)?;
     String::from_utf8(bytes).map_err(|e| {
         format!(
@@ -109,7 +109,7 @@ pub fn utf8_text(shown: &str, bytes: Vec<u8>) -> std::result::Result<String, Str
 
 /// A TOML parse error on one line, `path:line:col: message` (toml's own Display spans several
 /// lines with a snippet of the file).
-pub fn toml_message(path: &str, text: &str, e: &toml::de::Error) -> String {
+pub(crate) fn toml_message(path: &str, text: &str, e: &toml::de::Error) -> String {
     let msg = e.message().trim().replace('\n', " ");
     match e.span() {
         Some(span) => {
@@ -123,14 +123,14 @@ pub fn toml_message(path: &str, text: &str, e: &toml::de::Error) -> String {
 }
 
 /// Read and parse a TOML file; an error names the file, and the line and column where it can.
-pub fn read_toml<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T> {
+pub(crate) fn read_toml<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T> {
     let text = read_text(path)?;
     toml::from_str(&text)
         .map_err(|e| anyhow::Error::msg(toml_message(&path.display().to_string(), &text, &e)))
 }
 
 /// Typed rows of a CSV file (extra columns ignored); errors name the file and line.
-pub fn read_rows<T: serde::de::DeserializeOwned>(path: &Path) -> Result<Vec<T>> {
+pub(crate) fn read_rows<T: serde::de::DeserializeOwned>(path: &Path) -> Result<Vec<T>> {
     let text = read_text(path)?;
     let mut rd = csv::Reader::from_reader(text.as_bytes());
     rd.deserialize()
@@ -153,7 +153,7 @@ fn no_negative_zero(field: &str) -> &str {
 }
 
 /// Serialise rows to CSV text (header from the struct's field names), with no negative zero.
-pub fn csv_text<T: serde::Serialize>(rows: &[T]) -> Result<String> {
+pub(crate) fn csv_text<T: serde::Serialize>(rows: &[T]) -> Result<String> {
     let mut w = csv::Writer::from_writer(Vec::new());
     for r in rows {
         w.serialize(r)?;
@@ -168,7 +168,7 @@ pub fn csv_text<T: serde::Serialize>(rows: &[T]) -> Result<String> {
 }
 
 /// CSV text from a header and string records, with no negative zero.
-pub fn csv_records(header: &[String], rows: &[Vec<String>]) -> Result<String> {
+pub(crate) fn csv_records(header: &[String], rows: &[Vec<String>]) -> Result<String> {
     let mut w = csv::Writer::from_writer(Vec::new());
     w.write_record(header)?;
     for r in rows {
@@ -179,7 +179,7 @@ pub fn csv_records(header: &[String], rows: &[Vec<String>]) -> Result<String> {
 
 /// A path as messages and reports show it: `.` and `dir/..` dropped (lexically; the path opened
 /// is unchanged), and relative to the working folder when it lies inside it.
-pub fn shown(path: &Path) -> String {
+pub(crate) fn shown(path: &Path) -> String {
     use std::path::{Component, PathBuf};
     let mut parts: Vec<Component> = Vec::new();
     for c in path.components() {

@@ -36,28 +36,28 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
-pub const LOCK_FILE: &str = ".somnurbs.lock";
-pub const MANIFEST: &str = "manifest.toml";
+pub(crate) const LOCK_FILE: &str = ".somnurbs.lock";
+pub(crate) const MANIFEST: &str = "manifest.toml";
 /// The cell log of a run (one JSON record per finished cell; see `experiment::log`).
-pub const LOG_FILE: &str = "cells.jsonl";
+pub(crate) const LOG_FILE: &str = "cells.jsonl";
 /// The cell log of a finished run, gzip-compressed (see `experiment::log::compress`).
-pub const LOG_GZ: &str = "cells.jsonl.gz";
+pub(crate) const LOG_GZ: &str = "cells.jsonl.gz";
 /// The fingerprint of the run a folder holds (what `--resume` and `merge` compare).
-pub const FINGERPRINT_FILE: &str = "fingerprint.toml";
+pub(crate) const FINGERPRINT_FILE: &str = "fingerprint.toml";
 /// Present in a `reproduce` folder from the moment its inputs have loaded until its REPORT.md.
-pub const INCOMPLETE: &str = ".somnurbs-incomplete";
+pub(crate) const INCOMPLETE: &str = ".somnurbs-incomplete";
 /// The record of the plan a `reproduce` folder holds (what `reproduce --resume` compares).
-pub const PLAN_FILE: &str = "plan_fingerprint.toml";
+pub(crate) const PLAN_FILE: &str = "plan_fingerprint.toml";
 /// The files that make a folder a result folder (a run, a shard, a plan or a `fit`).
 const MARKERS: [&str; 7] =
     [MANIFEST, FINGERPRINT_FILE, LOG_FILE, LOG_GZ, INCOMPLETE, PLAN_FILE, LOCK_FILE];
 /// How often a lock holder refreshes its record.
-pub const HEARTBEAT: Duration = Duration::from_secs(20);
+pub(crate) const HEARTBEAT: Duration = Duration::from_secs(20);
 /// A record of another host older than this is taken to be left by a dead writer.
-pub const STALE_AFTER: Duration = Duration::from_secs(120);
+pub(crate) const STALE_AFTER: Duration = Duration::from_secs(120);
 
 /// A unique name for a temporary sibling of `path`: `.NAME.PID.N.tmp`.
-pub fn temp_name(path: &Path, what: &str) -> PathBuf {
+pub(crate) fn temp_name(path: &Path, what: &str) -> PathBuf {
     static COUNTER: AtomicU64 = AtomicU64::new(0);
     let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
     let n = COUNTER.fetch_add(1, Ordering::Relaxed);
@@ -81,7 +81,7 @@ fn is_temp_name(name: &str) -> bool {
 /// Remove the temporary files and folders that an interrupted writer left anywhere under `dir`
 /// (names made by [`temp_name`]); call it only while holding the folder's [`lock`]. Returns how
 /// many were removed.
-pub fn remove_leftovers(dir: &Path) -> Result<usize> {
+pub(crate) fn remove_leftovers(dir: &Path) -> Result<usize> {
     let (files, dirs) = walk(dir)?;
     let mut gone: Vec<PathBuf> = Vec::new();
     for rel in dirs.iter().chain(&files) {
@@ -103,7 +103,7 @@ pub fn remove_leftovers(dir: &Path) -> Result<usize> {
 
 /// The entries of `dir` other than its lock file, sorted, folders with a trailing `/` (none when
 /// `dir` does not exist).
-pub fn entries(dir: &Path) -> Result<Vec<String>> {
+pub(crate) fn entries(dir: &Path) -> Result<Vec<String>> {
     let rd = match fs::read_dir(dir) {
         Ok(rd) => rd,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
@@ -174,7 +174,7 @@ fn describe(dir: &Path, entries: &[String]) -> String {
 
 /// Refuse to start a new result in `dir` unless it is missing or empty (its lock file aside): a
 /// result folder holds one run and the files that run wrote, and a finished one is never changed.
-pub fn require_empty(dir: &Path) -> Result<()> {
+pub(crate) fn require_empty(dir: &Path) -> Result<()> {
     let found = entries(dir)?;
     if found.is_empty() {
         return Ok(());
@@ -189,7 +189,7 @@ pub fn require_empty(dir: &Path) -> Result<()> {
 /// The result folder (a run, shard, plan or `fit` folder: one holding a manifest, fingerprint,
 /// cell log, plan record or lock file) that `path` would be written into, if any: `path`'s
 /// folder or one of its parents.
-pub fn result_folder_of(path: &Path) -> Option<PathBuf> {
+pub(crate) fn result_folder_of(path: &Path) -> Option<PathBuf> {
     let parent = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
     let start = fs::canonicalize(parent).ok()?;
     start.ancestors().find(|d| MARKERS.iter().any(|m| d.join(m).exists())).map(Path::to_path_buf)
@@ -197,7 +197,7 @@ pub fn result_folder_of(path: &Path) -> Option<PathBuf> {
 
 /// Refuse to write the single file `path` (e.g. `datasets export`, `drift`'s CSV) inside a result
 /// folder: results are never changed after the fact.
-pub fn require_outside_results(path: &Path, option: &str) -> Result<()> {
+pub(crate) fn require_outside_results(path: &Path, option: &str) -> Result<()> {
     if let Some(folder) = result_folder_of(path) {
         bail!(
             "{} is inside the result folder {}, which holds one run and nothing else; write it elsewhere ({option})",
@@ -209,14 +209,14 @@ pub fn require_outside_results(path: &Path, option: &str) -> Result<()> {
 }
 
 /// `fsync` a folder, so that renames and creations in it are durable.
-pub fn sync_dir(dir: &Path) -> Result<()> {
+pub(crate) fn sync_dir(dir: &Path) -> Result<()> {
     let dir = if dir.as_os_str().is_empty() { Path::new(".") } else { dir };
     File::open(dir)
         .and_then(|f| f.sync_all())
         .with_context(|| format!("cannot sync folder {}", dir.display()))
 }
 
-pub fn host_name() -> String {
+pub(crate) fn host_name() -> String {
     std::fs::read_to_string("/proc/sys/kernel/hostname")
         .map(|s| s.trim().to_string())
         .or_else(|_| std::env::var("HOSTNAME"))
@@ -329,7 +329,7 @@ fn live_record(holder: &Holder, file: &File, flock_held: bool) -> Option<String>
 }
 
 /// The exclusive hold on an output folder; released (record cleared, flock dropped) on drop.
-pub struct Lock {
+pub(crate) struct Lock {
     file: File,
     path: PathBuf,
     stop: Arc<AtomicBool>,
@@ -344,7 +344,7 @@ impl std::fmt::Debug for Lock {
 
 /// Take the one-writer lock of `dir` (created if missing) for `command` (shown to a refused
 /// writer, e.g. `run spec.toml`).
-pub fn lock(dir: &Path, command: &str) -> Result<Lock> {
+pub(crate) fn lock(dir: &Path, command: &str) -> Result<Lock> {
     if dir.exists() && !dir.is_dir() {
         bail!("output folder {} is not a folder (a file is there); choose another", dir.display());
     }
@@ -426,7 +426,7 @@ impl Drop for Lock {
 }
 
 /// Refuse to read a folder a live writer holds (a shared flock that would wait, or a live record).
-pub fn require_not_being_written(dir: &Path) -> Result<()> {
+pub(crate) fn require_not_being_written(dir: &Path) -> Result<()> {
     let path = dir.join(LOCK_FILE);
     let Ok(mut file) = File::open(&path) else { return Ok(()) };
     let held = match try_flock(&file, libc::LOCK_SH)
@@ -449,7 +449,7 @@ pub fn require_not_being_written(dir: &Path) -> Result<()> {
 
 /// Every file and folder under `dir` (relative paths, sorted), not following links to folders (a
 /// link loop cannot hang a walk); links to files are listed when they point at a regular file.
-pub fn walk(dir: &Path) -> Result<(Vec<PathBuf>, Vec<PathBuf>)> {
+pub(crate) fn walk(dir: &Path) -> Result<(Vec<PathBuf>, Vec<PathBuf>)> {
     const MAX_DEPTH: usize = 32;
     let (mut files, mut dirs) = (Vec::new(), vec![PathBuf::new()]);
     let mut stack = vec![(PathBuf::new(), 0usize)];
@@ -494,7 +494,7 @@ struct ManifestShard {
 /// `fingerprint.toml`, `cells.jsonl` or `manifest.toml`) without `manifest.toml`, a shard's
 /// folder, a `reproduce` folder still marked incomplete, or one a live writer holds. `role`
 /// names the folder in messages (e.g. "the current folder").
-pub fn require_finished(dir: &Path, role: &str) -> Result<()> {
+pub(crate) fn require_finished(dir: &Path, role: &str) -> Result<()> {
     if !dir.is_dir() {
         bail!("{role} {} is not a folder", dir.display());
     }
@@ -525,7 +525,7 @@ pub fn require_finished(dir: &Path, role: &str) -> Result<()> {
 /// Replace the folder `target` by one built by `build` in a sibling temporary folder, swapped in
 /// with one atomic rename (`renameat2(RENAME_EXCHANGE)`; where the file system lacks it, two
 /// renames). A failure before the swap removes the temporary folder and leaves `target` as it was.
-pub fn replace_dir(target: &Path, build: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
+pub(crate) fn replace_dir(target: &Path, build: impl FnOnce(&Path) -> Result<()>) -> Result<()> {
     let parent = target.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
     let staged = temp_name(target, "staged");
     fs::create_dir(&staged).with_context(|| format!("cannot create {}", staged.display()))?;

@@ -26,32 +26,32 @@ use std::fmt::Write;
 
 /// The `version` written: the `ioh` logger version whose output this layout was checked against
 /// (IOHanalyzer needs at least 0.3.3 to read the JSON form).
-pub const FORMAT_VERSION: &str = "0.3.22";
+pub(crate) const FORMAT_VERSION: &str = "0.3.22";
 
 /// The `.dat` header (the JSON's `attributes`).
-pub const ATTRIBUTES: [&str; 2] = ["evaluations", "raw_y"];
+pub(crate) const ATTRIBUTES: [&str; 2] = ["evaluations", "raw_y"];
 
 /// What the meta-data file says about the runs.
 #[derive(Debug, Clone, PartialEq)]
-pub struct IohMeta {
-    pub suite: String,
-    pub function_id: u32,
+pub(crate) struct IohMeta {
+    pub(crate) suite: String,
+    pub(crate) function_id: u32,
     /// A name without spaces or slashes (e.g. "spindle_20x20_18x18_chord_length"); used in file
     /// names.
-    pub function_name: String,
-    pub algorithm: String,
-    pub algorithm_info: String,
-    pub dimension: usize,
+    pub(crate) function_name: String,
+    pub(crate) algorithm: String,
+    pub(crate) algorithm_info: String,
+    pub(crate) dimension: usize,
 }
 
 impl IohMeta {
     /// The meta-data file name.
-    pub fn json_file_name(&self) -> String {
+    pub(crate) fn json_file_name(&self) -> String {
         format!("IOHprofiler_f{}_{}.json", self.function_id, self.function_name)
     }
 
     /// The raw-data file, relative to the meta-data file.
-    pub fn dat_path(&self) -> String {
+    pub(crate) fn dat_path(&self) -> String {
         format!(
             "data_f{}_{}/IOHprofiler_f{}_DIM{}.dat",
             self.function_id, self.function_name, self.function_id, self.dimension
@@ -61,18 +61,18 @@ impl IohMeta {
 
 /// One run as the exporter sees it.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct IohRun<'a> {
+pub(crate) struct IohRun<'a> {
     /// Evaluations the run made.
-    pub evaluations: u64,
+    pub(crate) evaluations: u64,
     /// (evaluation, fitness) at every strict improvement, the first at evaluation 1.
-    pub improvements: &'a [(u64, f64)],
+    pub(crate) improvements: &'a [(u64, f64)],
     /// The best point, when known (empty: written as `[]`).
-    pub best_x: &'a [f64],
+    pub(crate) best_x: &'a [f64],
 }
 
 impl IohRun<'_> {
     /// The best value and the evaluation that found it (+inf at 0 for a run with no finite value).
-    pub fn best(&self) -> (u64, f64) {
+    pub(crate) fn best(&self) -> (u64, f64) {
         self.improvements.last().copied().unwrap_or((0, f64::INFINITY))
     }
 }
@@ -104,7 +104,7 @@ fn json_str(s: &str) -> String {
 }
 
 /// The raw-data (.dat) text of several runs of one algorithm on one problem.
-pub fn dat_text(runs: &[IohRun]) -> String {
+pub(crate) fn dat_text(runs: &[IohRun]) -> String {
     let mut out = String::new();
     for run in runs {
         out.push_str(&ATTRIBUTES.join(" "));
@@ -125,7 +125,7 @@ pub fn dat_text(runs: &[IohRun]) -> String {
 }
 
 /// The `.json` meta-data text.
-pub fn json_text(meta: &IohMeta, runs: &[IohRun]) -> String {
+pub(crate) fn json_text(meta: &IohMeta, runs: &[IohRun]) -> String {
     let mut out = String::new();
     let _ = writeln!(out, "{{");
     let _ = writeln!(out, "  \"version\": {},", json_str(FORMAT_VERSION));
@@ -168,7 +168,7 @@ pub fn json_text(meta: &IohMeta, runs: &[IohRun]) -> String {
 
 /// Parse a `.dat` text back into runs of (evaluation, value) rows (a header line starts a run).
 /// Errors name the 1-based line; a value that is not finite (`nan`, `Inf`) is one.
-pub fn parse_dat(text: &str) -> Result<Vec<Vec<(u64, f64)>>, String> {
+pub(crate) fn parse_dat(text: &str) -> Result<Vec<Vec<(u64, f64)>>, String> {
     let mut runs: Vec<Vec<(u64, f64)>> = Vec::new();
     for (n, line) in text.lines().enumerate() {
         let line = line.trim();

@@ -33,7 +33,7 @@
 use std::sync::{Arc, Mutex};
 
 /// Coordinates per chunk of words (a whole chunk of words is drawn even when fewer are needed).
-pub const CHUNK: usize = 128;
+pub(crate) const CHUNK: usize = 128;
 pub(crate) const HALF: usize = CHUNK / 2;
 
 pub(crate) const ONE: u64 = 0x3ff0_0000_0000_0000;
@@ -68,7 +68,7 @@ const LN_T_MIN: f64 = -32.0;
 /// The s nodes of [`product_cdf`]: cosh s_k, the trapezoid weights (1 or 2) sech s_k and the
 /// sums of the weights from k on (s_k = k H_S up to 700).
 #[derive(Debug, Clone)]
-pub struct SechNodes {
+pub(crate) struct SechNodes {
     cosh: Vec<f64>,
     weight: Vec<f64>,
     suffix: Vec<f64>,
@@ -76,7 +76,7 @@ pub struct SechNodes {
 
 impl SechNodes {
     /// The nodes up to s = 700.
-    pub fn new() -> SechNodes {
+    pub(crate) fn new() -> SechNodes {
         let n = (700.0 / H_S) as usize;
         let cosh: Vec<f64> = (0..=n).map(|k| (k as f64 * H_S).cosh()).collect();
         let weight: Vec<f64> =
@@ -93,7 +93,7 @@ impl SechNodes {
     /// complement with 1 - exp(-c cosh s) (-expm1 below 1/4), by the trapezoid rule; once
     /// c cosh s > c + 40 the upper terms are below 4e-18 of the first and the lower terms are
     /// the weights, summed ahead.
-    pub fn product_cdf(&self, c: f64) -> (f64, f64) {
+    pub(crate) fn product_cdf(&self, c: f64) -> (f64, f64) {
         if c <= 0.0 {
             return (0.0, 1.0);
         }
@@ -124,7 +124,8 @@ impl Default for SechNodes {
 
 /// (P(|u psi| <= c), P(|u psi| > c)) for independent standard normals ([`SechNodes::product_cdf`]
 /// on fresh nodes).
-pub fn product_cdf(c: f64) -> (f64, f64) {
+#[cfg(test)]
+pub(crate) fn product_cdf(c: f64) -> (f64, f64) {
     SechNodes::new().product_cdf(c)
 }
 
@@ -136,7 +137,7 @@ fn y_min(beta: f64) -> f64 {
 }
 
 /// Density of y = ln|v| for v ~ N(0, 1): sqrt(2/pi) exp(y - e^(2y)/2).
-pub fn ln_abs_normal_density(y: f64) -> f64 {
+pub(crate) fn ln_abs_normal_density(y: f64) -> f64 {
     (2.0 / std::f64::consts::PI).sqrt() * (y - 0.5 * (2.0 * y).exp()).exp()
 }
 
@@ -149,7 +150,8 @@ fn y_nodes(beta: f64) -> impl Iterator<Item = f64> {
 
 /// (G(t), 1 - G(t)) of |T| = |u psi| / |v|^(1/beta) computed directly:
 /// G(t) = int p(y) P(|u psi| <= t e^(y/beta)) dy (p the density of ln|v|), trapezoid in y.
-pub fn levy_cdf(t: f64, beta: f64) -> (f64, f64) {
+#[cfg(test)]
+pub(crate) fn levy_cdf(t: f64, beta: f64) -> (f64, f64) {
     let (mut lower, mut upper) = (0.0, 0.0);
     let nodes = SechNodes::new();
     for y in y_nodes(beta) {
@@ -164,7 +166,7 @@ pub fn levy_cdf(t: f64, beta: f64) -> (f64, f64) {
 /// ln G(t_m) and ln(1 - G(t_m)) on the grid ln t_m = LN_T_MIN + m H_Y / beta (the convolution
 /// of [`levy_cdf`]'s sums, every c on one log grid).
 #[derive(Debug, Clone)]
-pub struct CdfGrid {
+pub(crate) struct CdfGrid {
     step: f64,
     ln_lower: Vec<f64>,
     ln_upper: Vec<f64>,
@@ -172,7 +174,7 @@ pub struct CdfGrid {
 
 impl CdfGrid {
     /// The grid for exponent beta.
-    pub fn new(beta: f64) -> CdfGrid {
+    pub(crate) fn new(beta: f64) -> CdfGrid {
         let step = H_Y / beta;
         let m = ((30.0 / beta + 3.0 - LN_T_MIN) / step).ceil() as usize + 1;
         let dens: Vec<f64> = y_nodes(beta).map(ln_abs_normal_density).collect();
@@ -195,7 +197,7 @@ impl CdfGrid {
 
     /// The t with P(|T| <= t) = r (`upper` false) or P(|T| > t) = r (`upper` true), r <= 1/2:
     /// six-point Lagrange interpolation of ln t against ln r on the grid.
-    pub fn quantile(&self, upper: bool, r: f64) -> f64 {
+    pub(crate) fn quantile(&self, upper: bool, r: f64) -> f64 {
         let target = if upper { -r.ln() } else { r.ln() };
         let psi = |i: usize| if upper { -self.ln_upper[i] } else { self.ln_lower[i] };
         let n = self.ln_lower.len();
@@ -255,7 +257,7 @@ fn cubic_through(f: [f64; 4], v: [f64; 4]) -> [f64; 4] {
 
 /// The quantile table of |T| for one beta (see the module).
 #[derive(Debug, Clone)]
-pub struct LevyTable {
+pub(crate) struct LevyTable {
     beta: f64,
     pub(crate) coef: Box<[[f64; 4]; TABLE_LEN]>,
 }
@@ -266,7 +268,7 @@ static TABLES: Mutex<Vec<Arc<LevyTable>>> = Mutex::new(Vec::new());
 impl LevyTable {
     /// Build the table for exponent beta in (0, 2): the exact quantiles at each segment's four
     /// Chebyshev points and the cubic through them.
-    pub fn new(beta: f64) -> LevyTable {
+    pub(crate) fn new(beta: f64) -> LevyTable {
         let grid = CdfGrid::new(beta);
         let mut coef = Box::new([[0.0; 4]; TABLE_LEN]);
         let nodes = cheb_nodes();
@@ -286,7 +288,7 @@ impl LevyTable {
     }
 
     /// The table for beta, built at the first call in the process and shared after.
-    pub fn shared(beta: f64) -> Arc<LevyTable> {
+    pub(crate) fn shared(beta: f64) -> Arc<LevyTable> {
         let mut tables = TABLES.lock().unwrap_or_else(|e| e.into_inner());
         if let Some(t) = tables.iter().find(|t| t.beta.to_bits() == beta.to_bits()) {
             return t.clone();
@@ -294,11 +296,6 @@ impl LevyTable {
         let t = Arc::new(LevyTable::new(beta));
         tables.push(t.clone());
         t
-    }
-
-    /// The exponent beta the table is for.
-    pub fn beta(&self) -> f64 {
-        self.beta
     }
 
     /// |T| at r' in (0, 1) (tail probability r'/2) of the lower (`upper` false) or upper side:

@@ -4,25 +4,26 @@
 //! is convex, so how far each metaheuristic stops from the true optimum can be stated, not
 //! guessed. Pure code: no file or terminal I/O (the IOHprofiler export returns text).
 
-pub mod aligned;
-pub mod binary_ga;
-pub mod cuckoo;
-pub mod de;
-pub mod exact;
-pub mod ga;
-pub mod ioh;
-pub mod levy;
-pub mod problem;
-pub mod pso;
-pub mod sampling;
+pub(crate) mod aligned;
+pub(crate) mod binary_ga;
+pub(crate) mod cuckoo;
+pub(crate) mod de;
+pub(crate) mod exact;
+pub(crate) mod ga;
+pub(crate) mod ioh;
+pub(crate) mod levy;
+pub(crate) mod problem;
+pub(crate) mod pso;
+pub(crate) mod sampling;
 
-pub use aligned::Aligned;
-pub use binary_ga::BinaryGa;
-pub use cuckoo::{Csa, Icsa};
+pub(crate) use binary_ga::BinaryGa;
+pub use cuckoo::Csa;
+pub(crate) use cuckoo::Icsa;
 pub use de::De;
-pub use exact::{certify, solve_exact, ExactOptions, ExactResult, SumOfNorms};
-pub use ga::Ga;
-pub use problem::{Budget, Evaluator, MinPopulation, Optimiser, Problem, RunResult};
+pub use exact::{certify_dual, ExactOptions, ExactResult};
+pub(crate) use ga::Ga;
+pub use problem::{Budget, Problem};
+pub(crate) use problem::{Optimiser, RunResult};
 pub use pso::Pso;
 
 /// What can go wrong before an optimisation starts.
@@ -62,15 +63,15 @@ pub(crate) fn check_range(key: &str, value: f64, lo: f64, hi: f64) -> Result<(),
 
 /// One optimiser the harness knows: how to make it with its default parameters (thesis Table
 /// 6.1, seed 003, seed 004) and its colour in every chart (Okabe-Ito, as RGB).
-pub struct Registered {
-    pub make: fn() -> Box<dyn Optimiser>,
-    pub colour: [u8; 3],
+pub(crate) struct Registered {
+    pub(crate) make: fn() -> Box<dyn Optimiser>,
+    pub(crate) colour: [u8; 3],
 }
 
 /// Every optimiser the harness knows: a new one is its own file implementing [`Optimiser`] (its
 /// parameter table is checked by [`Optimiser::validate`]) plus one line here, and a parameter
 /// table in each spec section that offers it (the section's `offered`).
-pub static REGISTRY: &[Registered] = &[
+pub(crate) static REGISTRY: &[Registered] = &[
     Registered { make: || Box::new(Ga::default()), colour: [230, 159, 0] },
     Registered { make: || Box::new(De::default()), colour: [0, 114, 178] },
     Registered { make: || Box::new(Pso::default()), colour: [0, 158, 115] },
@@ -80,7 +81,7 @@ pub static REGISTRY: &[Registered] = &[
 ];
 
 /// The registered optimiser named `name`.
-pub fn registered(name: &str) -> Option<&'static Registered> {
+pub(crate) fn registered(name: &str) -> Option<&'static Registered> {
     REGISTRY.iter().find(|r| (r.make)().name() == name)
 }
 
@@ -91,12 +92,12 @@ pub fn default_optimiser(name: &str) -> Option<Box<dyn Optimiser>> {
 
 /// The optimiser named `name` among those a spec section offers (each with the section's
 /// parameters, e.g. `[optim.de]`).
-pub fn pick<'a>(offered: &[&'a dyn Optimiser], name: &str) -> Option<&'a dyn Optimiser> {
+pub(crate) fn pick<'a>(offered: &[&'a dyn Optimiser], name: &str) -> Option<&'a dyn Optimiser> {
     offered.iter().copied().find(|o| o.name() == name)
 }
 
 /// The names of the optimisers a section offers, for its checks and messages.
-pub fn names(offered: &[&dyn Optimiser]) -> Vec<&'static str> {
+pub(crate) fn names(offered: &[&dyn Optimiser]) -> Vec<&'static str> {
     offered.iter().map(|o| o.name()).collect()
 }
 
@@ -109,7 +110,7 @@ pub(crate) mod optimiser_tests {
     use rand_chacha::ChaCha8Rng;
 
     /// A box that cuts through the sphere's optimum, so clamping is exercised.
-    pub fn boxed_sphere(dim: usize) -> Sphere {
+    pub(crate) fn boxed_sphere(dim: usize) -> Sphere {
         let mut p = Sphere::new(dim);
         for j in 0..dim {
             p.lo[j] = -0.1;
@@ -121,7 +122,7 @@ pub(crate) mod optimiser_tests {
 
     /// Determinism, exact evaluation count, bounds, best not worse than the initial best,
     /// best_fitness = f(best_x), a monotone trace on the fixed checkpoints, improvement.
-    pub fn check(opt: &dyn Optimiser, expected_evals: impl Fn(&Budget) -> u64) {
+    pub(crate) fn check(opt: &dyn Optimiser, expected_evals: impl Fn(&Budget) -> u64) {
         let p = boxed_sphere(25);
         let budget =
             Budget { generations: 150, population: 12, init_range: 0.1, trace_every_evals: 50 };

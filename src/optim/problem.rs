@@ -132,7 +132,7 @@ pub struct RunResult {
 }
 
 /// Check a problem's shapes and box before a run.
-pub fn check_problem(problem: &dyn Problem) -> Result<(), OptimError> {
+pub(crate) fn check_problem(problem: &dyn Problem) -> Result<(), OptimError> {
     crate::simd::simd()?;
     let d = problem.dim();
     if d == 0 {
@@ -165,7 +165,7 @@ pub fn check_problem(problem: &dyn Problem) -> Result<(), OptimError> {
 
 /// Counts evaluations, keeps the best value, and records the trace (the argmin-style counting
 /// wrapper). A NaN fitness is recorded as +inf so that it never wins a comparison.
-pub struct Evaluator<'a> {
+pub(crate) struct Evaluator<'a> {
     problem: &'a dyn Problem,
     evaluations: u64,
     best: f64,
@@ -194,7 +194,7 @@ fn mark_after(e: u64) -> u64 {
 }
 
 impl<'a> Evaluator<'a> {
-    pub fn new(problem: &'a dyn Problem, budget: &Budget) -> Evaluator<'a> {
+    pub(crate) fn new(problem: &'a dyn Problem, budget: &Budget) -> Evaluator<'a> {
         Evaluator {
             problem,
             evaluations: 0,
@@ -209,7 +209,7 @@ impl<'a> Evaluator<'a> {
 
     /// Evaluate `x`, counting it and updating the best and the trace.
     #[inline]
-    pub fn eval(&mut self, x: &[f64]) -> f64 {
+    pub(crate) fn eval(&mut self, x: &[f64]) -> f64 {
         let f = self.problem.fitness(x);
         let f = if f.is_nan() { f64::INFINITY } else { f };
         self.evaluations += 1;
@@ -229,17 +229,17 @@ impl<'a> Evaluator<'a> {
         f
     }
 
-    pub fn evaluations(&self) -> u64 {
-        self.evaluations
-    }
-
-    pub fn best(&self) -> f64 {
+    pub(crate) fn best(&self) -> f64 {
         self.best
     }
 
     /// Close the run: `best_x` is the optimiser's best individual (whose fitness is the best
     /// value seen, since every optimiser here keeps its best).
-    pub fn finish(mut self, best_x: impl Into<Vec<f64>>, initial_best_fitness: f64) -> RunResult {
+    pub(crate) fn finish(
+        mut self,
+        best_x: impl Into<Vec<f64>>,
+        initial_best_fitness: f64,
+    ) -> RunResult {
         let best_x = best_x.into();
         if self.trace.last().map(|t| t.0) != Some(self.evaluations) {
             self.trace.push((self.evaluations, self.best));
@@ -258,7 +258,7 @@ impl<'a> Evaluator<'a> {
 
 /// Clamp every coordinate into the box.
 #[inline]
-pub fn clamp_into(x: &mut [f64], lo: &[f64], hi: &[f64]) {
+pub(crate) fn clamp_into(x: &mut [f64], lo: &[f64], hi: &[f64]) {
     let n = x.len();
     let (lo, hi) = (&lo[..n], &hi[..n]);
     for j in 0..n {
@@ -267,15 +267,15 @@ pub fn clamp_into(x: &mut [f64], lo: &[f64], hi: &[f64]) {
 }
 
 /// A population: one vector per individual and its fitness.
-pub struct Population {
-    pub x: Vec<Aligned>,
-    pub f: Vec<f64>,
+pub(crate) struct Population {
+    pub(crate) x: Vec<Aligned>,
+    pub(crate) f: Vec<f64>,
 }
 
 impl Population {
     /// The thesis' initialisation (6.2.4.1 step 1): x0 + U[-r, r] per coordinate, clamped to the
     /// bounds, each individual evaluated once.
-    pub fn initial(
+    pub(crate) fn initial(
         problem: &dyn Problem,
         budget: &Budget,
         eval: &mut Evaluator,
@@ -303,7 +303,7 @@ impl Population {
     }
 
     /// Index of the best individual (the first one on ties).
-    pub fn best(&self) -> usize {
+    pub(crate) fn best(&self) -> usize {
         let mut b = 0;
         for i in 1..self.f.len() {
             if self.f[i] < self.f[b] {
@@ -313,7 +313,7 @@ impl Population {
         b
     }
 
-    pub fn best_fitness(&self) -> f64 {
+    pub(crate) fn best_fitness(&self) -> f64 {
         self.f[self.best()]
     }
 }
@@ -323,15 +323,15 @@ pub(crate) mod tests {
     use super::*;
 
     /// The sphere function sum (x_j - c_j)^2 in a box: a known convex problem with optimum 0.
-    pub struct Sphere {
-        pub centre: Vec<f64>,
-        pub x0: Vec<f64>,
-        pub lo: Vec<f64>,
-        pub hi: Vec<f64>,
+    pub(crate) struct Sphere {
+        pub(crate) centre: Vec<f64>,
+        pub(crate) x0: Vec<f64>,
+        pub(crate) lo: Vec<f64>,
+        pub(crate) hi: Vec<f64>,
     }
 
     impl Sphere {
-        pub fn new(dim: usize) -> Sphere {
+        pub(crate) fn new(dim: usize) -> Sphere {
             Sphere {
                 centre: (0..dim).map(|k| 0.05 * (k % 13) as f64 - 0.3).collect(),
                 x0: vec![0.5; dim],

@@ -8,47 +8,32 @@
 //! skip itself mostly costs 12 random bits and a table look-up instead of a 53-bit uniform and a
 //! logarithm, with exactly the distribution of the logarithm formula (see [`Geometric`]).
 
-use rand::{RngCore, SeedableRng};
+use rand::RngCore;
 use rand_chacha::ChaCha8Rng;
-use rand_xoshiro::Xoshiro256PlusPlus;
-
-/// The generator of an optimiser's scalar bulk draws (cuckoo search's normals; the vectorised
-/// loops use [`BulkLanes`]): xoshiro256++ seeded from 256 bits of the run's ChaCha8 stream, so a
-/// run stays a pure function of its (cell, repeat) stream. ChaCha8 is the stream the runner hands
-/// out because its streams are independent by construction; xoshiro256++ (Blackman & Vigna 2021;
-/// passes BigCrush) makes the millions of draws of one run about four times cheaper.
-pub type Bulk = Xoshiro256PlusPlus;
-
-/// A bulk generator seeded from the run's stream.
-pub fn bulk_from(rng: &mut ChaCha8Rng) -> Bulk {
-    let mut seed = [0u8; 32];
-    rng.fill_bytes(&mut seed);
-    Xoshiro256PlusPlus::from_seed(seed)
-}
 
 const TWO_POW_M53: f64 = 1.0 / (1u64 << 53) as f64;
 
 /// A uniform in [0, 1) with 53 random bits.
 #[inline]
-pub fn unit(rng: &mut ChaCha8Rng) -> f64 {
+pub(crate) fn unit(rng: &mut ChaCha8Rng) -> f64 {
     unit_from(rng.next_u64())
 }
 
 /// The uniform in [0, 1) of [`unit`] from its 64-bit draw `w`: (w >> 11) 2^-53.
 #[inline(always)]
-pub fn unit_from(w: u64) -> f64 {
+pub(crate) fn unit_from(w: u64) -> f64 {
     (w >> 11) as f64 * TWO_POW_M53
 }
 
 /// A uniform in [-r, r) around 0 (53 random bits).
 #[inline]
-pub fn symmetric(rng: &mut ChaCha8Rng, r: f64) -> f64 {
+pub(crate) fn symmetric(rng: &mut ChaCha8Rng, r: f64) -> f64 {
     symmetric_from(rng.next_u64(), r)
 }
 
 /// The uniform of [`symmetric`] from its 64-bit draw `w`: r (2 u - 1), u = [`unit_from`] w.
 #[inline(always)]
-pub fn symmetric_from(w: u64, r: f64) -> f64 {
+pub(crate) fn symmetric_from(w: u64, r: f64) -> f64 {
     r * (2.0 * unit_from(w) - 1.0)
 }
 
@@ -59,7 +44,7 @@ pub fn symmetric_from(w: u64, r: f64) -> f64 {
 /// (`h as f64 * 2^-32`, tested), so a caller may fold it into a fused multiply-add:
 /// c u - c = c (u - 1) in one rounding.
 #[inline(always)]
-pub fn two_units_plus_one(word: u64) -> (f64, f64) {
+pub(crate) fn two_units_plus_one(word: u64) -> (f64, f64) {
     const ONE: u64 = 0x3ff0_0000_0000_0000;
     const MANTISSA_TOP32: u64 = 0x000f_ffff_fff0_0000;
     (
@@ -70,16 +55,16 @@ pub fn two_units_plus_one(word: u64) -> (f64, f64) {
 
 /// The uniforms in [0, 1) themselves (the tests' reference for the folded form).
 #[cfg(test)]
-pub fn two_units(word: u64) -> (f64, f64) {
+pub(crate) fn two_units(word: u64) -> (f64, f64) {
     let (hi, lo) = two_units_plus_one(word);
     (hi - 1.0, lo - 1.0)
 }
 
 /// Lanes of PSO's generators ([`PsoLanes`]): coordinate j of a move draws from lane j % 8.
-pub const PSO_LANES: usize = 8;
+pub(crate) const PSO_LANES: usize = 8;
 /// Lanes of DE's crossover generators ([`DeLanes`]): one step of the four lanes decides eight
 /// genes.
-pub const DE_LANES: usize = 4;
+pub(crate) const DE_LANES: usize = 4;
 
 /// `L` independent xoshiro256++ generators, each seeded from 256 bits of the run's ChaCha8
 /// stream, for the per-coordinate words of the vectorised loops (PSO's r1 and r2, DE's crossover
@@ -89,19 +74,19 @@ pub const DE_LANES: usize = 4;
 /// holds each row in one or two registers for a whole pass over a vector and stores it once at
 /// the end. Each lane is exactly `Xoshiro256PlusPlus` from its seed.
 #[derive(Debug, Clone, PartialEq)]
-pub struct BulkLanes<const L: usize> {
+pub(crate) struct BulkLanes<const L: usize> {
     s: [[u64; L]; 4],
 }
 
 /// PSO's generators: eight lanes, two 256-bit registers per state row.
-pub type PsoLanes = BulkLanes<PSO_LANES>;
+pub(crate) type PsoLanes = BulkLanes<PSO_LANES>;
 /// DE's crossover generators: four lanes, one 256-bit register per state row.
-pub type DeLanes = BulkLanes<DE_LANES>;
+pub(crate) type DeLanes = BulkLanes<DE_LANES>;
 
 impl<const L: usize> BulkLanes<L> {
     /// Lane l takes the l-th 4 words of the stream as its state (an all-zero state, probability
     /// 2^-256, would stay zero forever, so it is replaced by one word 1).
-    pub fn from_rng(rng: &mut ChaCha8Rng) -> BulkLanes<L> {
+    pub(crate) fn from_rng(rng: &mut ChaCha8Rng) -> BulkLanes<L> {
         let mut s = [[0u64; L]; 4];
         for l in 0..L {
             for row in s.iter_mut() {
@@ -116,13 +101,13 @@ impl<const L: usize> BulkLanes<L> {
 
     /// The four state rows over the lanes.
     #[inline(always)]
-    pub fn state_mut(&mut self) -> &mut [[u64; L]; 4] {
+    pub(crate) fn state_mut(&mut self) -> &mut [[u64; L]; 4] {
         &mut self.s
     }
 
     /// The next word of lane `l`.
     #[inline(always)]
-    pub fn next_word(&mut self, l: usize) -> u64 {
+    pub(crate) fn next_word(&mut self, l: usize) -> u64 {
         let (word, [a, b, c, d]) =
             xoshiro_next([self.s[0][l], self.s[1][l], self.s[2][l], self.s[3][l]]);
         (self.s[0][l], self.s[1][l], self.s[2][l], self.s[3][l]) = (a, b, c, d);
@@ -131,14 +116,14 @@ impl<const L: usize> BulkLanes<L> {
 
     /// The next word of every lane (lane l's word at index l).
     #[inline(always)]
-    pub fn next_words(&mut self) -> [u64; L] {
+    pub(crate) fn next_words(&mut self) -> [u64; L] {
         std::array::from_fn(|l| self.next_word(l))
     }
 }
 
 /// The 32-bit threshold of a Bernoulli(p) choice made by one 32-bit uniform h: h < threshold
 /// with probability floor(p 2^32) / 2^32, within 2^-32 of p (exactly 0 and 1 at p = 0 and 1).
-pub fn bernoulli_threshold_32(p: f64) -> u64 {
+pub(crate) fn bernoulli_threshold_32(p: f64) -> u64 {
     let p = if p.is_nan() { 0.0 } else { p.clamp(0.0, 1.0) };
     (p * 4_294_967_296.0).floor() as u64
 }
@@ -146,7 +131,7 @@ pub fn bernoulli_threshold_32(p: f64) -> u64 {
 /// One xoshiro256++ output and state step of one lane, in the shape of Blackman & Vigna's
 /// reference `next` (the tests' reference for [`xoshiro_next`]).
 #[cfg(test)]
-pub fn xoshiro_step(s0: &mut u64, s1: &mut u64, s2: &mut u64, s3: &mut u64) -> u64 {
+pub(crate) fn xoshiro_step(s0: &mut u64, s1: &mut u64, s2: &mut u64, s3: &mut u64) -> u64 {
     let (out, [a, b, c, d]) = xoshiro_next([*s0, *s1, *s2, *s3]);
     (*s0, *s1, *s2, *s3) = (a, b, c, d);
     out
@@ -156,7 +141,7 @@ pub fn xoshiro_step(s0: &mut u64, s1: &mut u64, s2: &mut u64, s3: &mut u64) -> u
 /// calls this and stores the four results keeps the state in registers (through `&mut` the
 /// compiler reloads each word after every store).
 #[inline(always)]
-pub fn xoshiro_next(s: [u64; 4]) -> (u64, [u64; 4]) {
+pub(crate) fn xoshiro_next(s: [u64; 4]) -> (u64, [u64; 4]) {
     let out = s[0].wrapping_add(s[3]).rotate_left(23).wrapping_add(s[0]);
     let t = s[1] << 17;
     let s2 = s[2] ^ s[0];
@@ -168,7 +153,7 @@ pub fn xoshiro_next(s: [u64; 4]) -> (u64, [u64; 4]) {
 
 /// A uniform index in 0..n (n >= 1), unbiased (Lemire's multiply-and-reject).
 #[inline]
-pub fn index(rng: &mut ChaCha8Rng, n: usize) -> usize {
+pub(crate) fn index(rng: &mut ChaCha8Rng, n: usize) -> usize {
     debug_assert!(n >= 1);
     let n64 = n as u64;
     let threshold = n64.wrapping_neg() % n64;
@@ -183,19 +168,19 @@ pub fn index(rng: &mut ChaCha8Rng, n: usize) -> usize {
 /// Random bits handed out a few at a time from 64-bit draws (leftover bits of a word that
 /// cannot serve a request are discarded, so the stream stays a pure function of the seed).
 #[derive(Debug, Clone, Default, PartialEq)]
-pub struct BitPool {
+pub(crate) struct BitPool {
     word: u64,
     left: u32,
 }
 
 impl BitPool {
-    pub fn new() -> BitPool {
+    pub(crate) fn new() -> BitPool {
         BitPool::default()
     }
 
     /// `n` (1..=32) fresh random bits as the low bits of the result.
     #[inline(always)]
-    pub fn take(&mut self, n: u32, rng: &mut ChaCha8Rng) -> u64 {
+    pub(crate) fn take(&mut self, n: u32, rng: &mut ChaCha8Rng) -> u64 {
         debug_assert!((1..=32).contains(&n));
         if self.left < n {
             self.word = rng.next_u64();
@@ -205,12 +190,6 @@ impl BitPool {
         self.word >>= n;
         self.left -= n;
         v
-    }
-
-    /// One fair random bit.
-    #[inline]
-    pub fn bit(&mut self, rng: &mut ChaCha8Rng) -> bool {
-        self.take(1, rng) == 1
     }
 }
 
@@ -232,7 +211,7 @@ const MIXED: u16 = u16::MAX;
 /// formula evaluated. The result is the formula's value for a uniformly drawn 53-bit U either way,
 /// so the distribution is exactly that of the formula; only the bit consumption differs.
 #[derive(Debug, Clone)]
-pub struct Geometric {
+pub(crate) struct Geometric {
     p: f64,
     inv_ln_q: f64,
     table: Option<Box<[u16]>>,
@@ -240,7 +219,7 @@ pub struct Geometric {
 
 impl Geometric {
     /// Skips for success probability `p` (clamped into [0, 1]).
-    pub fn new(p: f64) -> Geometric {
+    pub(crate) fn new(p: f64) -> Geometric {
         let p = if p.is_nan() { 0.0 } else { p.clamp(0.0, 1.0) };
         let inv_ln_q = if p > 0.0 && p < 1.0 { 1.0 / (-p).ln_1p() } else { 0.0 };
         let mut g = Geometric { p, inv_ln_q, table: None };
@@ -262,10 +241,6 @@ impl Geometric {
         g
     }
 
-    pub fn p(&self) -> f64 {
-        self.p
-    }
-
     /// G for the 53-bit integer k (U = (k + 1) 2^-53).
     #[inline(never)]
     fn formula(&self, k: u64) -> usize {
@@ -280,7 +255,7 @@ impl Geometric {
 
     /// One skip; `usize::MAX` when p = 0 (no coordinate is ever visited).
     #[inline(always)]
-    pub fn skip(&self, pool: &mut BitPool, rng: &mut ChaCha8Rng) -> usize {
+    pub(crate) fn skip(&self, pool: &mut BitPool, rng: &mut ChaCha8Rng) -> usize {
         if self.p <= 0.0 {
             return usize::MAX;
         }
@@ -304,7 +279,7 @@ impl Geometric {
 
     /// The next visited position after `pos` (walk: `j = skip(); while j < n { ..; j = next_after(j) }`).
     #[inline(always)]
-    pub fn next_after(&self, pos: usize, pool: &mut BitPool, rng: &mut ChaCha8Rng) -> usize {
+    pub(crate) fn next_after(&self, pos: usize, pool: &mut BitPool, rng: &mut ChaCha8Rng) -> usize {
         pos.saturating_add(1).saturating_add(self.skip(pool, rng))
     }
 
@@ -312,7 +287,7 @@ impl Geometric {
     /// positions and the random bits drawn are exactly those of the walk with `skip` and
     /// `next_after`, with the table's checks hoisted out of the loop.
     #[inline]
-    pub fn for_each<F: FnMut(usize)>(
+    pub(crate) fn for_each<F: FnMut(usize)>(
         &self,
         n: usize,
         pool: &mut BitPool,
@@ -356,7 +331,7 @@ impl Geometric {
 
 /// Mantegna's sigma_u for Levy exponent beta (seed 003 Eq. 8):
 /// [Gamma(1+b) sin(pi b/2) / (Gamma((1+b)/2) b 2^((b-1)/2))]^(1/b).
-pub fn mantegna_sigma_u(beta: f64) -> f64 {
+pub(crate) fn mantegna_sigma_u(beta: f64) -> f64 {
     use statrs::function::gamma::gamma;
     let num = gamma(1.0 + beta) * (std::f64::consts::PI * beta / 2.0).sin();
     let den = gamma((1.0 + beta) / 2.0) * beta * 2f64.powf((beta - 1.0) / 2.0);
@@ -367,7 +342,8 @@ pub fn mantegna_sigma_u(beta: f64) -> f64 {
 /// squared): the Mantegna denominator |v|^(1/beta) for beta = 1.5, in pure IEEE arithmetic so it
 /// is the same on every platform. Relative error < 1e-14; 0 and subnormals give +inf.
 #[inline]
-pub fn inv_abs_pow_two_thirds(v: f64) -> f64 {
+#[cfg(test)]
+pub(crate) fn inv_abs_pow_two_thirds(v: f64) -> f64 {
     let a = v.abs();
     if a.is_nan() {
         return f64::NAN;
@@ -393,6 +369,7 @@ pub fn inv_abs_pow_two_thirds(v: f64) -> f64 {
 mod tests {
     use super::*;
     use rand::SeedableRng;
+    use rand_xoshiro::Xoshiro256PlusPlus;
 
     #[test]
     fn table_agrees_with_the_formula_inside_every_pure_bucket() {

@@ -161,7 +161,7 @@ impl Claim {
 /// The columns of `claims.csv`, which every chapter's report writes (and `reproduce` collects):
 /// one row per (spec, grid, claim). `low_95`/`high_95` bound the judged share (empty for an
 /// every-case claim); `best_rival_here` is filled for best-of-several claims only.
-pub const CSV_HEADER: [&str; 15] = [
+pub(crate) const CSV_HEADER: [&str; 15] = [
     "spec",
     "chapter",
     "grid",
@@ -204,7 +204,7 @@ fn csv_row(c: &Claim) -> Vec<String> {
 
 /// Write `claims.csv` into `out` (the claims checked in at least one case, each without a spec
 /// named taking `spec`) and return their markdown table (`with_spec`: a spec column).
-pub fn write(
+pub(crate) fn write(
     out: &std::path::Path,
     spec: &str,
     claims: &[Claim],
@@ -228,7 +228,7 @@ pub fn write(
 }
 
 /// Claims read back from a `claims.csv` (for the combined report of `reproduce`).
-pub fn read(path: &std::path::Path) -> anyhow::Result<Vec<Claim>> {
+pub(crate) fn read(path: &std::path::Path) -> anyhow::Result<Vec<Claim>> {
     let mut rd = csv::Reader::from_path(path).with_context(|| format!("{}", path.display()))?;
     let header = rd.headers().with_context(|| format!("{}", path.display()))?.clone();
     if header.iter().ne(CSV_HEADER.iter().copied()) {
@@ -278,10 +278,10 @@ pub fn read(path: &std::path::Path) -> anyhow::Result<Vec<Claim>> {
 }
 
 /// The verdict rule in one paragraph, for the reports that show claims.
-pub const RULE: &str = "Verdicts (docs/statistics.md, \"Verdicts\"): a claim of kind *every* (soundness checks, and what a source states for every case) holds only in every case; a claim of kind *most* holds when the Wilson 95% interval of its share lies above 1/2, does not hold when it lies below, and is *undecided* otherwise; a *best*-of-several claim is judged the same way on its cases against its best rival's. *Agreement* with the source's own count (over the same cells) is Newcombe's 95% interval of the difference of the two shares holding 0.";
+pub(crate) const RULE: &str = "Verdicts (docs/statistics.md, \"Verdicts\"): a claim of kind *every* (soundness checks, and what a source states for every case) holds only in every case; a claim of kind *most* holds when the Wilson 95% interval of its share lies above 1/2, does not hold when it lies below, and is *undecided* otherwise; a *best*-of-several claim is judged the same way on its cases against its best rival's. *Agreement* with the source's own count (over the same cells) is Newcombe's 95% interval of the difference of the two shares holding 0.";
 
 /// Markdown table of claims, after the rule (empty without claims).
-pub fn markdown(claims: &[Claim], with_spec: bool) -> String {
+pub(crate) fn markdown(claims: &[Claim], with_spec: bool) -> String {
     let mut s = String::new();
     if claims.is_empty() {
         return s;

@@ -20,9 +20,9 @@ use std::path::{Path, PathBuf};
 /// Equality of two numbers: |a - b| <= abs + rel * max(|a|, |b|).
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct Tolerance {
-    pub abs: f64,
-    pub rel: f64,
+pub(crate) struct Tolerance {
+    pub(crate) abs: f64,
+    pub(crate) rel: f64,
 }
 
 impl Default for Tolerance {
@@ -32,7 +32,7 @@ impl Default for Tolerance {
 }
 
 impl Tolerance {
-    pub fn equal(&self, a: f64, b: f64) -> bool {
+    pub(crate) fn equal(&self, a: f64, b: f64) -> bool {
         if a.is_nan() || b.is_nan() {
             return a.is_nan() && b.is_nan();
         }
@@ -50,35 +50,35 @@ impl Tolerance {
 /// `drift.toml` in a baseline folder: what is timing-dependent and per-column tolerances.
 #[derive(Debug, Clone, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct DriftConfig {
+pub(crate) struct DriftConfig {
     /// Tables (glob over the relative path, `*` any run of characters) whose every cell is
     /// timing-dependent (e.g. win counts of CPU time).
     #[serde(default)]
-    pub timing_tables: Vec<String>,
+    pub(crate) timing_tables: Vec<String>,
     /// Rows holding any of these strings in a cell are timing-dependent (e.g. claims about speed).
     #[serde(default)]
-    pub timing_rows: Vec<String>,
+    pub(crate) timing_rows: Vec<String>,
     /// Per-column tolerances (`column` is a glob over column names).
     #[serde(default)]
-    pub tolerance: Vec<ColumnTolerance>,
+    pub(crate) tolerance: Vec<ColumnTolerance>,
 }
 
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct ColumnTolerance {
-    pub column: String,
-    pub abs: f64,
+pub(crate) struct ColumnTolerance {
+    pub(crate) column: String,
+    pub(crate) abs: f64,
     #[serde(default)]
-    pub rel: f64,
+    pub(crate) rel: f64,
 }
 
 /// How to compare.
 #[derive(Debug, Clone, Default)]
-pub struct DriftOptions {
-    pub default: Tolerance,
+pub(crate) struct DriftOptions {
+    pub(crate) default: Tolerance,
     /// Per-column tolerances (globs); the first match wins; command-line ones come first.
-    pub columns: Vec<(String, Tolerance)>,
-    pub config: DriftConfig,
+    pub(crate) columns: Vec<(String, Tolerance)>,
+    pub(crate) config: DriftConfig,
 }
 
 impl DriftOptions {
@@ -88,7 +88,7 @@ impl DriftOptions {
 }
 
 /// Parse `--tol COLUMN=ABS[,REL]`.
-pub fn parse_tol(s: &str) -> Result<(String, Tolerance)> {
+pub(crate) fn parse_tol(s: &str) -> Result<(String, Tolerance)> {
     let (col, v) =
         s.split_once('=').with_context(|| format!("--tol `{s}`: expected COLUMN=ABS[,REL]"))?;
     let mut it = v.split(',');
@@ -107,7 +107,7 @@ pub fn parse_tol(s: &str) -> Result<(String, Tolerance)> {
 }
 
 /// `*` matches any run of characters; everything else literally.
-pub fn glob(pattern: &str, s: &str) -> bool {
+pub(crate) fn glob(pattern: &str, s: &str) -> bool {
     let parts: Vec<&str> = pattern.split('*').collect();
     if parts.len() == 1 {
         return pattern == s;
@@ -130,7 +130,7 @@ pub fn glob(pattern: &str, s: &str) -> bool {
 }
 
 /// Columns that hold measured time: reported, never judged.
-pub fn is_timing_column(name: &str) -> bool {
+pub(crate) fn is_timing_column(name: &str) -> bool {
     name.ends_with("_s")
         || name.contains("cpu")
         || name.contains("seconds")
@@ -143,7 +143,7 @@ const IDENTITY: [&str; 9] =
 
 /// One difference.
 #[derive(Debug, Clone, PartialEq)]
-pub enum Finding {
+pub(crate) enum Finding {
     MissingTable {
         table: String,
     },
@@ -190,7 +190,7 @@ pub enum Finding {
 
 impl Finding {
     /// Whether it counts as drift (an extra table or a timing cell does not).
-    pub fn drifted(&self) -> bool {
+    pub(crate) fn drifted(&self) -> bool {
         match self {
             Finding::ExtraTable { .. }
             | Finding::ExtraColumn { .. }
@@ -229,19 +229,19 @@ impl Finding {
 
 /// The outcome of a comparison.
 #[derive(Debug, Clone, Default)]
-pub struct DriftReport {
-    pub tables: usize,
-    pub cells: usize,
-    pub findings: Vec<Finding>,
+pub(crate) struct DriftReport {
+    pub(crate) tables: usize,
+    pub(crate) cells: usize,
+    pub(crate) findings: Vec<Finding>,
 }
 
 impl DriftReport {
-    pub fn drifted(&self) -> bool {
+    pub(crate) fn drifted(&self) -> bool {
         self.findings.iter().any(Finding::drifted)
     }
 
     /// The summary printed by `somnurbs drift`.
-    pub fn summary(&self, most: usize) -> String {
+    pub(crate) fn summary(&self, most: usize) -> String {
         let drifted: Vec<&Finding> = self.findings.iter().filter(|f| f.drifted()).collect();
         let mut s = format!("compared {} tables, {} cells: ", self.tables, self.cells);
         if drifted.is_empty() {
@@ -301,7 +301,7 @@ impl DriftReport {
     }
 
     /// The per-cell diff CSV.
-    pub fn csv(&self) -> Result<String> {
+    pub(crate) fn csv(&self) -> Result<String> {
         let header: Vec<String> = [
             "table", "row", "column", "baseline", "current", "abs_diff", "rel_diff", "judged",
             "drifted", "what",
@@ -363,13 +363,13 @@ fn yes(b: bool) -> String {
 
 /// A parsed CSV table.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Table {
-    pub header: Vec<String>,
-    pub rows: Vec<Vec<String>>,
+pub(crate) struct Table {
+    pub(crate) header: Vec<String>,
+    pub(crate) rows: Vec<Vec<String>>,
 }
 
 impl Table {
-    pub fn parse(name: &str, text: &str) -> Result<Table> {
+    pub(crate) fn parse(name: &str, text: &str) -> Result<Table> {
         let mut rd = csv::ReaderBuilder::new().has_headers(true).from_reader(text.as_bytes());
         let header: Vec<String> = rd
             .headers()
@@ -390,7 +390,7 @@ impl Table {
 }
 
 /// Compare one table (pure).
-pub fn compare_table(
+pub(crate) fn compare_table(
     name: &str,
     base: &Table,
     cur: &Table,
@@ -527,7 +527,7 @@ fn compare_cell(
 
 /// The tables of a folder: relative paths of its CSVs outside `png/`, `ioh/` and `maps/` (links
 /// to folders are not followed).
-pub fn tables(dir: &Path) -> Result<Vec<PathBuf>> {
+pub(crate) fn tables(dir: &Path) -> Result<Vec<PathBuf>> {
     if !dir.is_dir() {
         bail!("{} is not a folder", dir.display());
     }
@@ -570,7 +570,7 @@ fn identities(dir: &Path) -> Result<BTreeMap<PathBuf, (String, String, String)>>
 }
 
 /// Read `drift.toml` of a baseline folder (absent: defaults).
-pub fn read_config(baseline: &Path) -> Result<DriftConfig> {
+pub(crate) fn read_config(baseline: &Path) -> Result<DriftConfig> {
     let p = baseline.join("drift.toml");
     if !p.exists() {
         return Ok(DriftConfig::default());
@@ -579,7 +579,7 @@ pub fn read_config(baseline: &Path) -> Result<DriftConfig> {
 }
 
 /// Compare two folders. `allow_spec_change`: runs of other specs are compared anyway.
-pub fn compare_dirs(
+pub(crate) fn compare_dirs(
     baseline: &Path,
     current: &Path,
     opts: &DriftOptions,
@@ -640,7 +640,7 @@ pub fn compare_dirs(
 /// finished, whole run. The new baseline is built beside the old one and swapped in whole
 /// ([`crate::io::outdir::replace_dir`]) under the baseline's lock: a failure leaves the old baseline
 /// as it was. Returns one line per file changed.
-pub fn accept(baseline: &Path, current: &Path) -> Result<Vec<String>> {
+pub(crate) fn accept(baseline: &Path, current: &Path) -> Result<Vec<String>> {
     crate::io::outdir::require_finished(current, "the current folder")?;
     let tc = tables(current)?;
     if tc.is_empty() {

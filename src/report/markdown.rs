@@ -3,7 +3,7 @@
 use std::fmt::Write;
 
 /// A Markdown table from a header and rows of cells.
-pub fn table(header: &[String], rows: &[Vec<String>]) -> String {
+pub(crate) fn table(header: &[String], rows: &[Vec<String>]) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "| {} |", header.join(" | "));
     let _ = writeln!(s, "|{}", "---|".repeat(header.len()));
@@ -14,7 +14,7 @@ pub fn table(header: &[String], rows: &[Vec<String>]) -> String {
 }
 
 /// A number with `d` decimals, or "-" when absent.
-pub fn num(v: Option<f64>, d: usize) -> String {
+pub(crate) fn num(v: Option<f64>, d: usize) -> String {
     match v {
         Some(x) if x.is_finite() => format!("{x:.d$}"),
         _ => "-".into(),
@@ -22,7 +22,7 @@ pub fn num(v: Option<f64>, d: usize) -> String {
 }
 
 /// "ours (thesis)" for side-by-side cells.
-pub fn beside(ours: Option<f64>, thesis: Option<f64>, d: usize) -> String {
+pub(crate) fn beside(ours: Option<f64>, thesis: Option<f64>, d: usize) -> String {
     match thesis {
         Some(_) => format!("{} ({})", num(ours, d), num(thesis, d)),
         None => num(ours, d),
@@ -30,7 +30,7 @@ pub fn beside(ours: Option<f64>, thesis: Option<f64>, d: usize) -> String {
 }
 
 /// Median of the finite values (None when there are none).
-pub fn median(values: &[f64]) -> Option<f64> {
+pub(crate) fn median(values: &[f64]) -> Option<f64> {
     let mut v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
     if v.is_empty() {
         return None;
@@ -41,7 +41,7 @@ pub fn median(values: &[f64]) -> Option<f64> {
 }
 
 /// Geometric mean of positive values (None when empty).
-pub fn geometric_mean(values: &[f64]) -> Option<f64> {
+pub(crate) fn geometric_mean(values: &[f64]) -> Option<f64> {
     let v: Vec<f64> = values.iter().copied().filter(|x| *x > 0.0 && x.is_finite()).collect();
     if v.is_empty() {
         return None;

@@ -38,7 +38,7 @@ impl RefTable {
 
 /// A family's published tables, (name, CSV text), compiled in by the family that reproduces
 /// them so that a report can always set a reproduction beside them (the toolkit lists none).
-pub type Published = &'static [(&'static str, &'static str)];
+pub(crate) type Published = &'static [(&'static str, &'static str)];
 
 /// The table `name` of `published`.
 pub fn lookup(published: Published, name: &str) -> Option<RefTable> {
@@ -47,7 +47,7 @@ pub fn lookup(published: Published, name: &str) -> Option<RefTable> {
 
 /// Several tables of `published` with the same columns read as one (e.g. Appendix B and the
 /// bunny figures of Section 4.3's text); None when none of them is there.
-pub fn joined(published: Published, names: &[&str]) -> Option<RefTable> {
+pub(crate) fn joined(published: Published, names: &[&str]) -> Option<RefTable> {
     let mut parts = names.iter().filter_map(|n| lookup(published, n));
     let mut first = parts.next()?;
     for t in parts {

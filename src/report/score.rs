@@ -8,7 +8,7 @@ use anyhow::{Context, Result};
 use std::path::Path;
 
 /// A ratio ours/published inside this band counts as reproduced.
-pub const BAND: (f64, f64) = (0.8, 1.25);
+pub(crate) const BAND: (f64, f64) = (0.8, 1.25);
 
 /// Columns that name a row of a published table (the rest are values).
 const KEYS: [&str; 9] =
@@ -22,15 +22,15 @@ fn scored(column: &str) -> bool {
 
 /// One folder's score.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct Score {
+pub(crate) struct Score {
     /// Published value cells this folder's tables also hold (both finite, the published non-zero).
-    pub cells: usize,
+    pub(crate) cells: usize,
     /// Of those, the cells whose ratio ours/published lies in [`BAND`].
-    pub within: usize,
+    pub(crate) within: usize,
     /// Claims with the source's own count over the same cells.
-    pub claims: usize,
+    pub(crate) claims: usize,
     /// Of those, the claims whose share agrees with the source's (`Claim::agreement`).
-    pub agree: usize,
+    pub(crate) agree: usize,
 }
 
 impl std::ops::Add for Score {
@@ -46,7 +46,7 @@ impl std::ops::Add for Score {
 }
 
 /// (cells compared, cells within the band) of one of our tables against the published one.
-pub fn table_score(ours: &RefTable, published: &RefTable) -> (usize, usize) {
+pub(crate) fn table_score(ours: &RefTable, published: &RefTable) -> (usize, usize) {
     let keys: Vec<&str> =
         published.header.iter().map(String::as_str).filter(|c| KEYS.contains(c)).collect();
     let values: Vec<&str> = published
@@ -76,7 +76,10 @@ pub fn table_score(ours: &RefTable, published: &RefTable) -> (usize, usize) {
 
 /// The score of a run folder: every CSV named like a table `published` finds, and its
 /// `claims.csv`.
-pub fn folder_score(folder: &Path, published: &dyn Fn(&str) -> Option<RefTable>) -> Result<Score> {
+pub(crate) fn folder_score(
+    folder: &Path,
+    published: &dyn Fn(&str) -> Option<RefTable>,
+) -> Result<Score> {
     let mut score = Score::default();
     let entries =
         std::fs::read_dir(folder).with_context(|| format!("cannot list {}", folder.display()))?;

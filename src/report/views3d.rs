@@ -14,19 +14,19 @@ use std::fmt::Write;
 use std::path::Path;
 
 /// The file a run writes beside its REPORT.md.
-pub const FILE: &str = "views3d.js";
+pub(crate) const FILE: &str = "views3d.js";
 
 /// The most rows (or columns) of a surface grid written out.
-pub const MAX_SIDE: usize = 30;
+pub(crate) const MAX_SIDE: usize = 30;
 
 /// A colour as `#rrggbb`.
-pub fn hex(c: plotters::style::RGBColor) -> String {
+pub(crate) fn hex(c: plotters::style::RGBColor) -> String {
     format!("#{:02x}{:02x}{:02x}", c.0, c.1, c.2)
 }
 
 /// One drawable: a point set (optionally joined into polylines) or a surface on a grid.
 #[derive(Debug, Clone)]
-pub enum Trace {
+pub(crate) enum Trace {
     /// Markers at `points`; each of `lines` (indices into `points`) is drawn as a polyline.
     Points { label: String, colour: String, points: Vec<Point3>, lines: Vec<Vec<usize>> },
     /// A surface through `points`, row-major with `rows` x `cols`.
@@ -35,9 +35,9 @@ pub enum Trace {
 
 /// One view: a title and what it draws.
 #[derive(Debug, Clone)]
-pub struct View {
-    pub title: String,
-    pub traces: Vec<Trace>,
+pub(crate) struct View {
+    pub(crate) title: String,
+    pub(crate) traces: Vec<Trace>,
 }
 
 /// A number with 6 significant digits, as a JavaScript literal (`null` if not finite).
@@ -58,7 +58,7 @@ fn string(s: &str) -> String {
 }
 
 /// Indices 0..n thinned to at most `max`, keeping the first and the last.
-pub fn thin(n: usize, max: usize) -> Vec<usize> {
+pub(crate) fn thin(n: usize, max: usize) -> Vec<usize> {
     if n <= max || max < 2 {
         return (0..n).collect();
     }
@@ -69,7 +69,7 @@ pub fn thin(n: usize, max: usize) -> Vec<usize> {
 
 /// A row-major `rows x cols` grid thinned to at most `side` rows and columns (first and last
 /// kept), for views shown in numbers: (points, rows, cols).
-pub fn coarse(
+pub(crate) fn coarse(
     points: &[Point3],
     rows: usize,
     cols: usize,
@@ -141,7 +141,7 @@ fn trace_js(t: &Trace) -> String {
 
 /// The script text: it appends this folder's views to `window.somnurbsViews`, tagged with the
 /// `data-folder` of the script element that loaded it.
-pub fn script(views: &[View]) -> String {
+pub(crate) fn script(views: &[View]) -> String {
     let mut s = String::from("// somnurbs 3-D views (report.html draws them)\n(window.somnurbsViews = window.somnurbsViews || []).push({folder: document.currentScript ? document.currentScript.getAttribute(\"data-folder\") : \"\", views: [\n");
     for (k, v) in views.iter().enumerate() {
         let traces: Vec<String> = v.traces.iter().map(trace_js).collect();
@@ -158,7 +158,7 @@ pub fn script(views: &[View]) -> String {
 }
 
 /// Write `views3d.js` into `out` (nothing when there are no views).
-pub fn write(out: &Path, views: &[View]) -> Result<()> {
+pub(crate) fn write(out: &Path, views: &[View]) -> Result<()> {
     if views.is_empty() {
         return Ok(());
     }

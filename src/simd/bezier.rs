@@ -46,7 +46,7 @@ const CANCEL_REL: f64 = 1e-6;
 #[derive(Default)]
 pub(crate) struct Scratch {
     /// The clamped (and, for grids, sorted) decision vector.
-    pub x: Vec<f64>,
+    pub(crate) x: Vec<f64>,
     bu: Vec<f64>,
     bv: Vec<f64>,
     bu2: Vec<f64>,

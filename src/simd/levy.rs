@@ -119,6 +119,7 @@ fn chunk(out: &mut [f64; CHUNK], words: &[u64; HALF], table: &LevyTable, sigma: 
 
 /// `out[j]` = sigma_u T_j for every j, chunk by chunk from `rng` (see the module), in the scalar
 /// (`avx2` false) or the AVX2 copy.
+#[cfg(test)]
 fn fill_with(out: &mut [f64], sigma: f64, table: &LevyTable, rng: &mut DeLanes, avx2: bool) {
     let mut words = [0u64; HALF];
     let mut buf = [0.0f64; CHUNK];
@@ -131,17 +132,17 @@ fn fill_with(out: &mut [f64], sigma: f64, table: &LevyTable, rng: &mut DeLanes, 
 
 /// The vectors of one Levy flight: the nest `x`, the best nest `b` and the box.
 #[derive(Debug, Clone, Copy)]
-pub struct FlightSources<'a> {
-    pub x: &'a [f64],
-    pub b: &'a [f64],
-    pub lo: &'a [f64],
-    pub hi: &'a [f64],
+pub(crate) struct FlightSources<'a> {
+    pub(crate) x: &'a [f64],
+    pub(crate) b: &'a [f64],
+    pub(crate) lo: &'a [f64],
+    pub(crate) hi: &'a [f64],
 }
 
 /// One flight's words and factors, chunk by chunk (kept by the caller across flights, so that
 /// nothing is allocated or cleared per flight).
 #[derive(Debug, Clone)]
-pub struct LevyScratch {
+pub(crate) struct LevyScratch {
     words: [u64; HALF],
     factors: [f64; CHUNK],
 }
@@ -155,7 +156,7 @@ impl Default for LevyScratch {
 /// One coordinate of a Levy flight: x + alpha L (x - b) clamped to [lo, hi] (x itself if that
 /// is NaN, from 0 * inf).
 #[inline(always)]
-pub fn flight_coordinate(x: f64, b: f64, lo: f64, hi: f64, alpha: f64, l: f64) -> f64 {
+pub(crate) fn flight_coordinate(x: f64, b: f64, lo: f64, hi: f64, alpha: f64, l: f64) -> f64 {
     let nj = x + alpha * l * (x - b);
     if nj.is_nan() {
         x
@@ -166,10 +167,10 @@ pub fn flight_coordinate(x: f64, b: f64, lo: f64, hi: f64, alpha: f64, l: f64) -
 
 /// The parameters of one flight's factors: the table, sigma_u and the step alpha.
 #[derive(Debug, Clone, Copy)]
-pub struct FlightLaw<'a> {
-    pub table: &'a LevyTable,
-    pub sigma_u: f64,
-    pub alpha: f64,
+pub(crate) struct FlightLaw<'a> {
+    pub(crate) table: &'a LevyTable,
+    pub(crate) sigma_u: f64,
+    pub(crate) alpha: f64,
 }
 
 /// [`levy_flight`] in one pass: each chunk's factors go straight into its coordinates' flight,
@@ -225,7 +226,7 @@ fn flight_avx2(
 /// One Levy flight of a nest into `c` (of the nest's length): coordinate j is
 /// [`flight_coordinate`] of the factor sigma_u T that [`levy_fill`] would draw for it from `rng`
 /// (the same words and the same bits), in the copy the run's SIMD choice names.
-pub fn levy_flight(
+pub(crate) fn levy_flight(
     c: &mut [f64],
     src: FlightSources,
     law: FlightLaw,
@@ -244,13 +245,19 @@ pub fn levy_flight(
 
 /// Fill `out` with Levy factors sigma_u T (T = u psi / |v|^(1/beta), beta the table's), in the
 /// copy the run's SIMD choice ([`super::simd`]) names; the same bits from every copy.
-pub fn levy_fill(out: &mut [f64], sigma_u: f64, table: &LevyTable, rng: &mut DeLanes) {
+#[cfg(test)]
+pub(crate) fn levy_fill(out: &mut [f64], sigma_u: f64, table: &LevyTable, rng: &mut DeLanes) {
     fill_with(out, sigma_u, table, rng, super::use_avx2())
 }
 
 /// The baseline copy (the tests' reference for the dispatched one).
 #[cfg(test)]
-pub fn levy_fill_baseline(out: &mut [f64], sigma_u: f64, table: &LevyTable, rng: &mut DeLanes) {
+pub(crate) fn levy_fill_baseline(
+    out: &mut [f64],
+    sigma_u: f64,
+    table: &LevyTable,
+    rng: &mut DeLanes,
+) {
     fill_with(out, sigma_u, table, rng, false)
 }
 

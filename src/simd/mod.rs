@@ -3,11 +3,11 @@
 //! kernel group, each holding the portable copy beside its ISA copies and the tests that they
 //! give the same bits:
 //!
-//! - [`fitness`]: the control-net fitness (Eq. 6.2), portable and AVX2;
-//! - [`moves`]: the optimisers' per-coordinate loops (DE's trial, PSO's move, the lanes' words);
-//! - [`levy`]: cuckoo search's Levy factors and flights;
-//! - [`bezier`]: seed 003's allocation-free least squares;
-//! - [`envelope`]: the exact solver's envelope Cholesky.
+//! - `fitness`: the control-net fitness (Eq. 6.2), portable and AVX2;
+//! - `moves`: the optimisers' per-coordinate loops (DE's trial, PSO's move, the lanes' words);
+//! - `levy`: cuckoo search's Levy factors and flights;
+//! - `bezier`: seed 003's allocation-free least squares;
+//! - `envelope`: the exact solver's envelope Cholesky.
 //!
 //! Determinism: results never depend on the instruction set. Every copy performs the same IEEE
 //! operations (multiply, add, fused multiply-add `f64::mul_add` with one rounding in every copy,
@@ -58,14 +58,14 @@ impl Isa {
 /// Whether this CPU runs the AVX2 + FMA copies.
 #[cfg(target_arch = "x86_64")]
 #[inline]
-pub fn avx2_fma() -> bool {
+pub(crate) fn avx2_fma() -> bool {
     std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
 }
 
 /// Whether this CPU runs the AVX-512VL copies (256-bit vectors, 32 registers; compiled with
 /// AVX2, FMA, AVX-512F and AVX-512VL).
 #[cfg(target_arch = "x86_64")]
-pub fn avx512vl() -> bool {
+pub(crate) fn avx512vl() -> bool {
     avx2_fma()
         && std::arch::is_x86_feature_detected!("avx512f")
         && std::arch::is_x86_feature_detected!("avx512vl")
@@ -76,9 +76,9 @@ pub fn avx512vl() -> bool {
 /// one); unset, empty or `auto` runs the fastest copy this CPU has. All copies
 /// give the same bits, so this only changes the speed; a copy the CPU lacks is refused with an
 /// error.
-pub const SIMD_ENV: &str = "SOMNURBS_SIMD";
+pub(crate) const SIMD_ENV: &str = "SOMNURBS_SIMD";
 
-/// A value of [`SIMD_ENV`] that names no copy, or one this CPU lacks; displayed as
+/// A value of `SIMD_ENV` that names no copy, or one this CPU lacks; displayed as
 /// `SOMNURBS_SIMD <message>`.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct SimdError {
@@ -119,7 +119,7 @@ pub fn parse_simd(value: Option<&str>) -> Result<Isa, SimdError> {
 /// The copy this process runs: [`SIMD_ENV`] if set (read once), else the fastest this CPU has.
 /// Every optimiser run and every control-net problem checks it first, so a bad value is an
 /// error before any work.
-pub fn simd() -> Result<Isa, SimdError> {
+pub(crate) fn simd() -> Result<Isa, SimdError> {
     choice().clone()
 }
 
@@ -220,11 +220,14 @@ macro_rules! xoshiro4 {
     }};
 }
 
-pub mod bezier;
-pub mod envelope;
-pub mod fitness;
-pub mod levy;
-pub mod moves;
+pub(crate) mod bezier;
+pub(crate) mod envelope;
+pub(crate) mod fitness;
+pub(crate) mod levy;
+pub(crate) mod moves;
+pub use fitness::building_blocks;
+pub use levy::timing as levy_timing;
+pub use moves::timing as moves_timing;
 
 #[cfg(test)]
 mod tests {

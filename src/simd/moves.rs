@@ -13,7 +13,7 @@ use crate::optim::sampling::{two_units_plus_one, DeLanes, PsoLanes, DE_LANES, PS
 
 /// One gene of the DE/rand/1 mutant, clamp(a + f (b - c)), a + f (b - c) fused.
 #[inline(always)]
-pub fn de_mutant_gene(a: f64, b: f64, c: f64, f: f64, lo: f64, hi: f64) -> f64 {
+pub(crate) fn de_mutant_gene(a: f64, b: f64, c: f64, f: f64, lo: f64, hi: f64) -> f64 {
     clamp(f.mul_add(b - c, a), lo, hi)
 }
 
@@ -51,13 +51,13 @@ fn de_trial_scalar(
 
 /// The vectors a trial is built from: donors a, b, c (mutant a + F (b - c)), target x, box.
 #[derive(Debug, Clone, Copy)]
-pub struct DeSources<'a> {
-    pub a: &'a [f64],
-    pub b: &'a [f64],
-    pub c: &'a [f64],
-    pub x: &'a [f64],
-    pub lo: &'a [f64],
-    pub hi: &'a [f64],
+pub(crate) struct DeSources<'a> {
+    pub(crate) a: &'a [f64],
+    pub(crate) b: &'a [f64],
+    pub(crate) c: &'a [f64],
+    pub(crate) x: &'a [f64],
+    pub(crate) lo: &'a [f64],
+    pub(crate) hi: &'a [f64],
 }
 
 impl<'a> DeSources<'a> {
@@ -146,7 +146,7 @@ fn de_trial_avx512vl(t: &mut [f64], src: DeSources, f: f64, rng: &mut DeLanes, t
 /// The DE/rand/1/bin trial before its forced gene: t_j = clamp(a_j + F (b_j - c_j)) (fused)
 /// where gene j's 32-bit uniform h_j < `threshold` ([`crate::optim::sampling::bernoulli_threshold_32`]
 /// of CR), else x_j; one pass, the uniforms drawn from `rng` as in `de_trial_scalar`.
-pub fn de_trial(t: &mut [f64], src: DeSources, f: f64, rng: &mut DeLanes, threshold: u64) {
+pub(crate) fn de_trial(t: &mut [f64], src: DeSources, f: f64, rng: &mut DeLanes, threshold: u64) {
     #[cfg(target_arch = "x86_64")]
     {
         if use_avx512() {
@@ -164,7 +164,7 @@ pub fn de_trial(t: &mut [f64], src: DeSources, f: f64, rng: &mut DeLanes, thresh
 /// Fill `words` (a multiple of 4 long) with the next words of DE's four lanes: word m from lane
 /// m % 4 at step m / 4 (cuckoo search's bulk Levy draws). The AVX2 copy keeps the state in four
 /// registers (the same integer operations, so the same words).
-pub fn lanes_fill(words: &mut [u64], rng: &mut DeLanes) {
+pub(crate) fn lanes_fill(words: &mut [u64], rng: &mut DeLanes) {
     assert_eq!(words.len() % DE_LANES, 0, "whole steps of the four lanes");
     #[cfg(target_arch = "x86_64")]
     {
@@ -199,10 +199,10 @@ fn lanes_fill_avx2(words: &mut [u64], rng: &mut DeLanes) {
 
 /// PSO constants of one move.
 #[derive(Debug, Clone, Copy)]
-pub struct PsoCoefficients {
-    pub k: f64,
-    pub c1: f64,
-    pub c2: f64,
+pub(crate) struct PsoCoefficients {
+    pub(crate) k: f64,
+    pub(crate) c1: f64,
+    pub(crate) c2: f64,
 }
 
 /// The box of a PSO run per coordinate: positions in [lo, hi], velocities in [-vmax, vmax] with
@@ -211,17 +211,17 @@ pub struct PsoCoefficients {
 /// (the search box) or the data set's range (`Pso::vmax_range`); when they are the same slices
 /// the move reads the same cache lines twice.
 #[derive(Debug, Clone, Copy)]
-pub struct PsoBounds<'a> {
-    pub lo: &'a [f64],
-    pub hi: &'a [f64],
-    pub vlo: &'a [f64],
-    pub vhi: &'a [f64],
-    pub vmax_fraction: f64,
+pub(crate) struct PsoBounds<'a> {
+    pub(crate) lo: &'a [f64],
+    pub(crate) hi: &'a [f64],
+    pub(crate) vlo: &'a [f64],
+    pub(crate) vhi: &'a [f64],
+    pub(crate) vmax_fraction: f64,
 }
 
 impl<'a> PsoBounds<'a> {
     /// Positions in [lo, hi] and the clamp a fraction of that box's width.
-    pub fn search_box(lo: &'a [f64], hi: &'a [f64], vmax_fraction: f64) -> PsoBounds<'a> {
+    pub(crate) fn search_box(lo: &'a [f64], hi: &'a [f64], vmax_fraction: f64) -> PsoBounds<'a> {
         PsoBounds { lo, hi, vlo: lo, vhi: hi, vmax_fraction }
     }
 }
@@ -420,7 +420,7 @@ fn pso_move_avx512vl(
 /// so that the caller can keep a particle's position and personal best in one buffer while they
 /// are equal, and swap buffers instead of copying when the personal best moves.
 #[allow(clippy::too_many_arguments)] // the move's vectors, generators, constants and box
-pub fn pso_move(
+pub(crate) fn pso_move(
     out: &mut [f64],
     x: &[f64],
     v: &mut [f64],

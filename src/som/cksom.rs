@@ -10,14 +10,14 @@
 use super::{EdgeGroup, Lattice, Model, NeuronCounts, Topology};
 use std::collections::HashMap;
 
-pub struct Cksom {
+pub(crate) struct Cksom {
     nx: usize,
     ny: usize,
     lattice: Lattice,
 }
 
 impl Cksom {
-    pub fn new(nx: usize, ny: usize) -> Cksom {
+    pub(crate) fn new(nx: usize, ny: usize) -> Cksom {
         let l = nx.max(ny) as i32 - 1;
         let mut seen: HashMap<[i32; 3], usize> = HashMap::new();
         let mut index = Vec::new();

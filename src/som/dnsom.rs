@@ -11,7 +11,7 @@
 use super::{EdgeGroup, Lattice, Model, NeuronCounts, Topology};
 use crate::double_net::{DoubleNet, View};
 
-pub struct Dnsom {
+pub(crate) struct Dnsom {
     net: DoubleNet,
     lattice: Lattice,
     /// Sorted 4-neighbourhood of every unit over both views.
@@ -19,7 +19,7 @@ pub struct Dnsom {
 }
 
 impl Dnsom {
-    pub fn new(nx: usize, ny: usize) -> Dnsom {
+    pub(crate) fn new(nx: usize, ny: usize) -> Dnsom {
         let net = DoubleNet::new(nx, ny).expect("DNSOM grid sides are at least 2");
         let index: Vec<[i32; 3]> = (0..net.nov())
             .map(|c| {
@@ -41,11 +41,6 @@ impl Dnsom {
             list.dedup();
         }
         Dnsom { lattice: Lattice::new([nx, ny, 3], index), net, adjacency }
-    }
-
-    /// The class-number layout of the two views.
-    pub fn net(&self) -> &DoubleNet {
-        &self.net
     }
 }
 

@@ -75,20 +75,20 @@ impl Default for GrowingGridParams {
 
 /// A grown map: `nx x ny` weights, row-major (unit (i, j) at `i * ny + j`).
 #[derive(Debug, Clone, PartialEq)]
-pub struct GrowingGrid {
-    pub nx: usize,
-    pub ny: usize,
-    pub weights: Vec<Point3>,
+pub(crate) struct GrowingGrid {
+    pub(crate) nx: usize,
+    pub(crate) ny: usize,
+    pub(crate) weights: Vec<Point3>,
     /// Rows and columns inserted.
-    pub insertions: usize,
+    pub(crate) insertions: usize,
     /// Adaptation steps of the growth and fine-tuning phases.
-    pub growth_steps: usize,
-    pub fine_steps: usize,
+    pub(crate) growth_steps: usize,
+    pub(crate) fine_steps: usize,
 }
 
 impl GrowingGrid {
     /// QE and TE over the data with the shared 2-D SOM definitions.
-    pub fn metrics(&self, data: &[Point3]) -> FinalMetrics {
+    pub(crate) fn metrics(&self, data: &[Point3]) -> FinalMetrics {
         final_map_metrics(&Som2d::new(self.nx, self.ny), &self.weights, data)
     }
 }
@@ -199,7 +199,7 @@ impl State {
 }
 
 /// Grow a grid over `data` (at least one point) with the stream `rng`.
-pub fn grow(
+pub(crate) fn grow(
     data: &[Point3],
     p: &GrowingGridParams,
     rng: &mut ChaCha8Rng,

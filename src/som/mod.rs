@@ -5,20 +5,21 @@
 //! winner may update, which units count as adjacent (for the topographic error) and how the units
 //! are drawn. The shared loop in [`train`] does the rest, so a new model is one file.
 
-pub mod cksom;
-pub mod dnsom;
-pub mod growing_grid;
-pub mod lattice;
-pub mod som2d;
-pub mod som3d;
-pub mod train;
+pub(crate) mod cksom;
+pub(crate) mod dnsom;
+pub(crate) mod growing_grid;
+pub(crate) mod lattice;
+pub(crate) mod som2d;
+pub(crate) mod som3d;
+pub(crate) mod train;
 
 use std::fmt;
 use std::str::FromStr;
 
-pub use lattice::Lattice;
-pub use som3d::LatticeAdjacency;
-pub use train::{final_map_metrics, train, FinalMetrics, OnlineMetrics, SomParams, TrainResult};
+pub(crate) use lattice::Lattice;
+pub(crate) use som3d::LatticeAdjacency;
+pub(crate) use train::{final_map_metrics, FinalMetrics, OnlineMetrics};
+pub use train::{train, SomParams};
 
 /// The four SOM models compared in Chapter 4 (Table 4.1) (in a spec by name, as [`FromStr`]
 /// reads it).

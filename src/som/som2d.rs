@@ -2,14 +2,14 @@
 
 use super::{EdgeGroup, Lattice, Model, NeuronCounts, Topology};
 
-pub struct Som2d {
+pub(crate) struct Som2d {
     nx: usize,
     ny: usize,
     lattice: Lattice,
 }
 
 impl Som2d {
-    pub fn new(nx: usize, ny: usize) -> Som2d {
+    pub(crate) fn new(nx: usize, ny: usize) -> Som2d {
         let mut index = Vec::with_capacity(nx * ny);
         for i in 0..nx {
             for j in 0..ny {

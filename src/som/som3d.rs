@@ -45,19 +45,20 @@ impl LatticeAdjacency {
     }
 }
 
-pub struct Som3d {
+pub(crate) struct Som3d {
     n: usize,
     lattice: Lattice,
     adjacency: LatticeAdjacency,
 }
 
 impl Som3d {
-    pub fn new(n: usize) -> Som3d {
+    #[cfg(test)]
+    pub(crate) fn new(n: usize) -> Som3d {
         Som3d::with_adjacency(n, LatticeAdjacency::default())
     }
 
     /// The lattice with the topographic error's adjacency `adjacency`.
-    pub fn with_adjacency(n: usize, adjacency: LatticeAdjacency) -> Som3d {
+    pub(crate) fn with_adjacency(n: usize, adjacency: LatticeAdjacency) -> Som3d {
         let mut index = Vec::with_capacity(n * n * n);
         for i in 0..n {
             for j in 0..n {

@@ -50,9 +50,9 @@ pub struct OnlineMetrics {
 /// Euclidean distance to the best-matching unit; TE: share of points whose two best units are not
 /// adjacent, with the model's own adjacency).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct FinalMetrics {
-    pub qe: f64,
-    pub te: f64,
+pub(crate) struct FinalMetrics {
+    pub(crate) qe: f64,
+    pub(crate) te: f64,
 }
 
 #[derive(Debug, Clone)]
@@ -183,7 +183,7 @@ pub fn train(
 }
 
 /// QE and TE of a trained map over every data point.
-pub fn final_map_metrics(
+pub(crate) fn final_map_metrics(
     topology: &dyn Topology,
     weights: &[Point3],
     data: &[Point3],

@@ -26,7 +26,7 @@ use super::knots::{knot_vector, KnotRule};
 use super::param::{grid_params_with, ParamReading, Parameterisation};
 use super::surface::BSplineSurface;
 use super::SplineError;
-pub use crate::double_net::TwoViewGrid;
+pub(crate) use crate::double_net::TwoViewGrid;
 use crate::double_net::{DoubleNet, View};
 use crate::geom::{self, Point3};
 use serde::{Deserialize, Serialize};
@@ -315,7 +315,7 @@ pub fn fit_two_view(
 }
 
 /// Eq. 5.13: sum over the NOV grid classes of |D - D^G| at each class's first allocation.
-pub fn surface_error(
+pub(crate) fn surface_error(
     grid: &TwoViewGrid,
     net: &DoubleNet,
     fitted_bottom: &[Point3],
@@ -334,7 +334,7 @@ pub fn surface_error(
 }
 
 /// Approach A's error under `per_surface`: sum of |D - D^G| over every position of both views.
-pub fn per_surface_error(
+pub(crate) fn per_surface_error(
     grid: &TwoViewGrid,
     fitted_bottom: &[Point3],
     fitted_top: &[Point3],
@@ -346,7 +346,7 @@ pub fn per_surface_error(
 }
 
 /// Largest distance between the fitted surfaces over the shared border positions.
-pub fn border_gap(net: &DoubleNet, fitted_bottom: &[Point3], fitted_top: &[Point3]) -> f64 {
+pub(crate) fn border_gap(net: &DoubleNet, fitted_bottom: &[Point3], fitted_top: &[Point3]) -> f64 {
     let mut gap = 0.0f64;
     for i in 0..net.nx {
         for j in 0..net.ny {
@@ -522,11 +522,11 @@ impl ControlNetParts {
 }
 
 #[cfg(test)]
-pub mod tests {
+pub(crate) mod tests {
     use super::*;
 
     /// A lumpy closed two-view grid: a noisy sphere cut at the equator, built on the shared border.
-    pub fn test_grid(nx: usize, ny: usize, noise: f64) -> TwoViewGrid {
+    pub(crate) fn test_grid(nx: usize, ny: usize, noise: f64) -> TwoViewGrid {
         let net = DoubleNet::new(nx, ny).unwrap();
         let mut bottom = vec![[0.0; 3]; nx * ny];
         let mut top = vec![[0.0; 3]; nx * ny];

@@ -5,7 +5,7 @@ use nalgebra::DMatrix;
 
 /// Knot span index of `u` for `n_ctrl` control points of degree `p` (A2.1); `u = 1` (the last knot)
 /// belongs to the last non-empty span, so that the clamped curve reaches its last control point.
-pub fn find_span(n_ctrl: usize, p: usize, u: f64, knots: &[f64]) -> usize {
+pub(crate) fn find_span(n_ctrl: usize, p: usize, u: f64, knots: &[f64]) -> usize {
     let n = n_ctrl - 1;
     if u >= knots[n + 1] {
         return n;
@@ -27,7 +27,7 @@ pub fn find_span(n_ctrl: usize, p: usize, u: f64, knots: &[f64]) -> usize {
 }
 
 /// The p + 1 non-zero basis functions N_{span-p..span, p}(u) (A2.2).
-pub fn basis_funs(span: usize, u: f64, p: usize, knots: &[f64]) -> Vec<f64> {
+pub(crate) fn basis_funs(span: usize, u: f64, p: usize, knots: &[f64]) -> Vec<f64> {
     let mut n = vec![0.0; p + 1];
     let mut left = vec![0.0; p + 1];
     let mut right = vec![0.0; p + 1];
@@ -43,7 +43,7 @@ pub fn basis_funs(span: usize, u: f64, p: usize, knots: &[f64]) -> Vec<f64> {
 /// A2.2's recurrence into `n` (the p + 1 values) with the scratch `left`, `right` (each at least
 /// p + 1 long), from the knot distances `below(j)` = u - t_{span+1-j} and `above(j)` =
 /// t_{span+j} - u, j = 1..p (no allocation).
-pub fn basis_funs_into(
+pub(crate) fn basis_funs_into(
     p: usize,
     below: impl Fn(usize) -> f64,
     above: impl Fn(usize) -> f64,
@@ -98,7 +98,7 @@ impl SparseBasis {
 }
 
 /// Dense basis matrix of degree `p` (rows: parameters, columns: the `n_ctrl` basis functions).
-pub fn basis_matrix(params: &[f64], knots: &[f64], p: usize, n_ctrl: usize) -> DMatrix<f64> {
+pub(crate) fn basis_matrix(params: &[f64], knots: &[f64], p: usize, n_ctrl: usize) -> DMatrix<f64> {
     let mut m = DMatrix::zeros(params.len(), n_ctrl);
     for (r, &u) in params.iter().enumerate() {
         let span = find_span(n_ctrl, p, u, knots);

@@ -26,7 +26,7 @@ use serde::{Deserialize, Serialize};
 
 /// The `order` non-zero closed basis functions at u (taken mod n): (first control index, values);
 /// the l-th value belongs to control point (first + l) mod n.
-pub fn periodic_basis(n: usize, order: usize, u: f64) -> (usize, Vec<f64>) {
+pub(crate) fn periodic_basis(n: usize, order: usize, u: f64) -> (usize, Vec<f64>) {
     let p = order - 1;
     let nf = n as f64;
     let mut w = u.rem_euclid(nf);
@@ -42,17 +42,17 @@ pub fn periodic_basis(n: usize, order: usize, u: f64) -> (usize, Vec<f64>) {
 
 /// The surface: `n_around` x `rows` control points, P(i around, j up) at `i * rows + j`.
 #[derive(Debug, Clone, PartialEq)]
-pub struct ClosedSurface {
-    pub order_around: usize,
-    pub order_up: usize,
-    pub n_around: usize,
-    pub rows: usize,
-    pub knots_v: Vec<f64>,
-    pub control: Vec<Point3>,
+pub(crate) struct ClosedSurface {
+    pub(crate) order_around: usize,
+    pub(crate) order_up: usize,
+    pub(crate) n_around: usize,
+    pub(crate) rows: usize,
+    pub(crate) knots_v: Vec<f64>,
+    pub(crate) control: Vec<Point3>,
 }
 
 impl ClosedSurface {
-    pub fn eval(&self, u: f64, v: f64) -> Point3 {
+    pub(crate) fn eval(&self, u: f64, v: f64) -> Point3 {
         let (first, bu) = periodic_basis(self.n_around, self.order_around, u);
         let q = self.order_up - 1;
         let sv = find_span(self.rows, q, v, &self.knots_v);
@@ -71,19 +71,19 @@ impl ClosedSurface {
     }
 }
 
-pub use crate::data::cylinder::RingData;
+pub(crate) use crate::data::cylinder::RingData;
 
 /// The shape of a fit: orders and net size.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ClosedNetShape {
-    pub order_around: usize,
-    pub order_up: usize,
-    pub n_around: usize,
-    pub rows: usize,
+pub(crate) struct ClosedNetShape {
+    pub(crate) order_around: usize,
+    pub(crate) order_up: usize,
+    pub(crate) n_around: usize,
+    pub(crate) rows: usize,
 }
 
 impl ClosedNetShape {
-    pub fn check(&self, data: &RingData) -> Result<(), SplineError> {
+    pub(crate) fn check(&self, data: &RingData) -> Result<(), SplineError> {
         if self.order_around < 2 || self.n_around < self.order_around {
             return Err(SplineError::ControlNet(format!("{} control points around are too few for order {} (at least the order, and order >= 2)", self.n_around, self.order_around)));
         }
@@ -113,14 +113,14 @@ impl ClosedNetShape {
 
 /// The analytical fit: the surface, each point's (u, v), and its RMS error.
 #[derive(Debug, Clone)]
-pub struct ClosedFit {
-    pub surface: ClosedSurface,
-    pub uv: Vec<(f64, f64)>,
-    pub rms: f64,
+pub(crate) struct ClosedFit {
+    pub(crate) surface: ClosedSurface,
+    pub(crate) uv: Vec<(f64, f64)>,
+    pub(crate) rms: f64,
 }
 
 /// Chord-length parameters and the SVD least-squares net (the paper's analytical method).
-pub fn fit_closed(data: &RingData, shape: ClosedNetShape) -> Result<ClosedFit, SplineError> {
+pub(crate) fn fit_closed(data: &RingData, shape: ClosedNetShape) -> Result<ClosedFit, SplineError> {
     shape.check(data)?;
     let vs = data.row_parameters();
     let knots_v = knot_vector(&vs, shape.rows, shape.order_up - 1, KnotRule::NurbsBook)
@@ -135,7 +135,7 @@ pub fn fit_closed(data: &RingData, shape: ClosedNetShape) -> Result<ClosedFit, S
 
 /// The SVD least-squares net (Eq. 11-13, minimum-norm if rank deficient) for points with given
 /// parameters and knots up.
-pub fn fit_closed_at(
+pub(crate) fn fit_closed_at(
     points: &[Point3],
     uv: Vec<(f64, f64)>,
     shape: ClosedNetShape,
@@ -243,7 +243,7 @@ fn curve_and_tangent(xy: &[f64], n: usize, order: usize, u: f64) -> ([f64; 2], [
 
 /// The squared distance from `p` to the closed curve of `xy` (order `order`, `n` points) at the
 /// foot point nearest u0: Gauss-Newton on |C(u) - p|^2 from u0, steps at most half a span.
-pub fn foot_distance_sq(xy: &[f64], n: usize, order: usize, p: [f64; 2], u0: f64) -> f64 {
+pub(crate) fn foot_distance_sq(xy: &[f64], n: usize, order: usize, p: [f64; 2], u0: f64) -> f64 {
     let mut u = u0;
     for _ in 0..12 {
         let (c, d) = curve_and_tangent(xy, n, order, u);
@@ -264,7 +264,7 @@ pub fn foot_distance_sq(xy: &[f64], n: usize, order: usize, p: [f64; 2], u0: f64
 /// The GA's problem: decision vector (x_0, y_0, ..., x_{N-1}, y_{N-1}), the (x, y) of every column
 /// of the net (all its rows share them), z of the net fixed at the analytical fit's; box: the
 /// analytical column's (x, y) (averaged over its rows) +- `search_range`; fitness = RMS error.
-pub struct RingNetProblem {
+pub(crate) struct RingNetProblem {
     fit: ClosedFit,
     /// Per point: the `order_around` non-zero basis values and the positions 2 i of their
     /// control columns' x in the decision vector (wrapped around once, here).
@@ -283,7 +283,7 @@ pub struct RingNetProblem {
 }
 
 impl RingNetProblem {
-    pub fn new(data: &RingData, fit: ClosedFit, search_range: f64) -> RingNetProblem {
+    pub(crate) fn new(data: &RingData, fit: ClosedFit, search_range: f64) -> RingNetProblem {
         let s = &fit.surface;
         let (n, rows, k) = (s.n_around, s.rows, s.order_around);
         let x0: Vec<f64> = (0..n)
@@ -321,7 +321,7 @@ impl RingNetProblem {
     }
 
     /// The same problem with its fitness measured by `measure`.
-    pub fn with_measure(mut self, measure: PointError) -> RingNetProblem {
+    pub(crate) fn with_measure(mut self, measure: PointError) -> RingNetProblem {
         self.measure = measure;
         self.feet.clear();
         if measure == PointError::ClosestPoint {
@@ -339,24 +339,24 @@ impl RingNetProblem {
     }
 
     /// The analytical net's RMS error in the problem's measure (its columns' (x, y)).
-    pub fn analytical_rms(&self) -> f64 {
+    pub(crate) fn analytical_rms(&self) -> f64 {
         match self.measure {
             PointError::AtParameters => self.fit.rms,
             PointError::ClosestPoint => self.fitness(&self.x0),
         }
     }
 
-    pub fn n_points(&self) -> usize {
+    pub(crate) fn n_points(&self) -> usize {
         self.target.len()
     }
 
     /// The analytical fit the problem was built on.
-    pub fn analytical(&self) -> &ClosedFit {
+    pub(crate) fn analytical(&self) -> &ClosedFit {
         &self.fit
     }
 
     /// The surface of a decision vector.
-    pub fn surface(&self, x: &[f64]) -> ClosedSurface {
+    pub(crate) fn surface(&self, x: &[f64]) -> ClosedSurface {
         let mut s = self.fit.surface.clone();
         for (k, c) in s.control.iter_mut().enumerate() {
             let i = k / s.rows;

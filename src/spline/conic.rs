@@ -11,11 +11,11 @@
 use super::rational_bezier::conic_point;
 use crate::optim::Problem;
 
-pub type P2 = [f64; 2];
+pub(crate) type P2 = [f64; 2];
 
 /// Walk a closed path of pieces, sampling one point every `spacing` of arc length.
 #[derive(Debug, Clone, Copy)]
-pub enum Piece {
+pub(crate) enum Piece {
     Line {
         from: P2,
         to: P2,
@@ -54,7 +54,7 @@ impl Piece {
 
 /// Sample a closed path at arc-length steps of (about) `spacing`: the total length is divided
 /// into round(length / spacing) equal steps; the first point is the start of the first piece.
-pub fn sample_closed(pieces: &[Piece], spacing: f64) -> Vec<P2> {
+pub(crate) fn sample_closed(pieces: &[Piece], spacing: f64) -> Vec<P2> {
     let total: f64 = pieces.iter().map(Piece::length).sum();
     let n = (total / spacing).round().max(3.0) as usize;
     let h = total / n as f64;
@@ -72,7 +72,7 @@ pub fn sample_closed(pieces: &[Piece], spacing: f64) -> Vec<P2> {
 }
 
 /// The generated outlines: name, pieces, and the true corner positions.
-pub fn outline(name: &str) -> Option<(Vec<Piece>, Vec<P2>)> {
+pub(crate) fn outline(name: &str) -> Option<(Vec<Piece>, Vec<P2>)> {
     let line = |a: P2, b: P2| Piece::Line { from: a, to: b };
     Some(match name {
         // A 60 x 60 square, counter-clockwise from (0,0).
@@ -118,7 +118,7 @@ pub fn outline(name: &str) -> Option<(Vec<Piece>, Vec<P2>)> {
     })
 }
 
-pub const OUTLINES: [&str; 3] = ["square", "letter_d", "letter_p"];
+pub(crate) const OUTLINES: [&str; 3] = ["square", "letter_d", "letter_p"];
 
 /// Perpendicular distance of p from the straight line through a and b.
 fn line_distance(p: P2, a: P2, b: P2) -> f64 {
@@ -135,7 +135,7 @@ fn line_distance(p: P2, a: P2, b: P2) -> f64 {
 /// exceeds `d`, keeping its largest distance; second pass, a candidate survives when no other
 /// candidate within `r` points on either side has a larger distance (ties: the lower index
 /// wins). Returns the corner indices in increasing order.
-pub fn sam06(points: &[P2], l: usize, d: f64, r: usize) -> Vec<usize> {
+pub(crate) fn sam06(points: &[P2], l: usize, d: f64, r: usize) -> Vec<usize> {
     let n = points.len();
     if n < 3 || l < 2 {
         return Vec::new();
@@ -173,7 +173,7 @@ pub fn sam06(points: &[P2], l: usize, d: f64, r: usize) -> Vec<usize> {
 }
 
 /// Chord-length parameters t_0 = 0, t_k = (sum of chords up to k) / total, t_n = 1.
-pub fn chord_length_params(points: &[P2]) -> Vec<f64> {
+pub(crate) fn chord_length_params(points: &[P2]) -> Vec<f64> {
     let mut t = vec![0.0; points.len()];
     for k in 1..points.len() {
         t[k] = t[k - 1]
@@ -193,7 +193,7 @@ pub fn chord_length_params(points: &[P2]) -> Vec<f64> {
 /// The pieces of a closed contour between consecutive corners, each split at its middle data
 /// point into two runs of points (both ends included). With no corner the contour is cut at
 /// point 0.
-pub fn conic_runs(points: &[P2], corners: &[usize]) -> Vec<Vec<P2>> {
+pub(crate) fn conic_runs(points: &[P2], corners: &[usize]) -> Vec<Vec<P2>> {
     let n = points.len();
     let cuts: Vec<usize> = if corners.is_empty() { vec![0] } else { corners.to_vec() };
     let mut out = Vec::new();
@@ -213,9 +213,9 @@ pub fn conic_runs(points: &[P2], corners: &[usize]) -> Vec<Vec<P2>> {
 }
 
 /// One conic with fixed ends b0 = first point, b2 = last point; variables (b1x, b1y, w).
-pub struct ConicProblem {
-    pub points: Vec<P2>,
-    pub t: Vec<f64>,
+pub(crate) struct ConicProblem {
+    pub(crate) points: Vec<P2>,
+    pub(crate) t: Vec<f64>,
     x0: Vec<f64>,
     lo: Vec<f64>,
     hi: Vec<f64>,
@@ -225,7 +225,7 @@ impl ConicProblem {
     /// Start: w = 1 and b1 the least-squares optimum for w = 1 (closed form, the residual is
     /// linear in b1 for fixed w); box: the run's bounding box widened by `margin` times its larger
     /// side, w in [w_lo, w_hi].
-    pub fn new(points: Vec<P2>, margin: f64, w_lo: f64, w_hi: f64) -> ConicProblem {
+    pub(crate) fn new(points: Vec<P2>, margin: f64, w_lo: f64, w_hi: f64) -> ConicProblem {
         let t = chord_length_params(&points);
         let b1 = Self::best_b1(&points, &t, 1.0);
         let (mut mn, mut mx) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
@@ -245,7 +245,7 @@ impl ConicProblem {
 
     /// Least-squares b1 for a fixed w: minimise sum |a_k + c_k b1|^2 with
     /// a_k = (B0 b0 + B2 b2)/den - D_k, c_k = w B1 / den.
-    pub fn best_b1(points: &[P2], t: &[f64], w: f64) -> P2 {
+    pub(crate) fn best_b1(points: &[P2], t: &[f64], w: f64) -> P2 {
         let (b0, b2) = (points[0], points[points.len() - 1]);
         let (mut num, mut den_sum) = ([0.0; 2], 0.0);
         for (p, &tk) in points.iter().zip(t) {
@@ -264,7 +264,7 @@ impl ConicProblem {
         [num[0] / den_sum, num[1] / den_sum]
     }
 
-    pub fn control(&self, x: &[f64]) -> ([P2; 3], f64) {
+    pub(crate) fn control(&self, x: &[f64]) -> ([P2; 3], f64) {
         ([self.points[0], [x[0], x[1]], self.points[self.points.len() - 1]], x[2])
     }
 }

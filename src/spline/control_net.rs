@@ -50,7 +50,7 @@ pub enum BoxSpec {
     AroundStart { half_width: f64 },
 }
 
-pub use crate::simd::Isa;
+pub(crate) use crate::simd::Isa;
 
 /// The control-net problem: minimise Eq. 6.2 over the distinct control points inside a box.
 #[derive(Debug, Clone)]
@@ -75,7 +75,7 @@ pub struct ControlNetProblem {
     term_data: Vec<Point3>,
 }
 
-pub use crate::simd::fitness::Scratch;
+pub(crate) use crate::simd::fitness::Scratch;
 
 thread_local! {
     static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
@@ -455,7 +455,7 @@ pub(crate) mod test_support {
     use crate::spline::{fit_two_view, Approach, Parameterisation};
 
     /// Approach B's parts for a `cn_x` x `cn_y` net on an `nx` x `ny` test grid.
-    pub fn test_parts(nx: usize, ny: usize, cn_x: usize, cn_y: usize) -> ControlNetParts {
+    pub(crate) fn test_parts(nx: usize, ny: usize, cn_x: usize, cn_y: usize) -> ControlNetParts {
         let grid = crate::spline::approach::tests::test_grid(nx, ny, 0.02);
         let fit = fit_two_view(
             &grid,
@@ -470,7 +470,7 @@ pub(crate) mod test_support {
     }
 
     /// The control-net problem of [`test_parts`] in the given box.
-    pub fn sphere_problem(
+    pub(crate) fn sphere_problem(
         nx: usize,
         ny: usize,
         cn_x: usize,

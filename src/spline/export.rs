@@ -44,7 +44,7 @@ fn pack(tokens: &[String], width: usize) -> Vec<String> {
 /// The length unit of exported coordinates: one of IGES 5.3's unit flags (global parameter 14,
 /// with its name, parameter 15), or unknown.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Units {
+pub(crate) enum Units {
     /// Not known (a scan's numbers as they are, or a normalised box): written as flag 2 (MM), the
     /// flag CAD readers expect, and the start section says the flag is nominal. (Flag 3, a unit
     /// named in parameter 15, would need a name the reader knows, which "unknown" is not.)
@@ -71,7 +71,7 @@ impl std::str::FromStr for Units {
 
 impl Units {
     /// The sentence the IGES start section carries.
-    pub fn describe(self) -> String {
+    pub(crate) fn describe(self) -> String {
         match self {
             Units::Unknown => format!("{}; the IGES unit flag 2 (MM) is nominal.", self.line()),
             Units::Flag(..) => format!("{}.", self.line()),
@@ -79,7 +79,7 @@ impl Units {
     }
 
     /// `Units: ...` without the IGES flag (an OBJ comment).
-    pub fn line(self) -> String {
+    pub(crate) fn line(self) -> String {
         match self {
             Units::Unknown => "Units: unknown (the numbers as they are)".into(),
             Units::Flag(_, name) => format!("Units: {name}"),
@@ -120,7 +120,11 @@ fn wrap(text: &str, width: usize) -> Vec<String> {
 
 /// IGES 5.3 text with one entity 128 per surface; `units` in the global section, and `notes`
 /// (say, the coordinate frame) in the start section after the line naming the writer.
-pub fn write_iges(surfaces: &[(&str, &BSplineSurface)], units: Units, notes: &[String]) -> String {
+pub(crate) fn write_iges(
+    surfaces: &[(&str, &BSplineSurface)],
+    units: Units,
+    notes: &[String],
+) -> String {
     let mut start =
         vec!["somnurbs: cubic B-spline surfaces (entity 128, all weights 1)".to_string()];
     for note in notes.iter().cloned().chain([units.describe()]) {
@@ -293,7 +297,7 @@ pub fn parse_iges_128(text: &str) -> Result<Vec<BSplineSurface>, SplineError> {
 
 /// Wavefront OBJ: each surface evaluated on a uniform `samples_u x samples_v` parameter grid, as
 /// an object of quads; `notes` are `#` comment lines after the one naming the writer.
-pub fn write_obj(
+pub(crate) fn write_obj(
     surfaces: &[(&str, &BSplineSurface)],
     samples_u: usize,
     samples_v: usize,

@@ -10,7 +10,7 @@ use crate::geom::Point3;
 use nalgebra::{Cholesky, DMatrix};
 
 /// Least-squares control net of one view: `cn_x x cn_y` points, row-major.
-pub fn least_squares_net(
+pub(crate) fn least_squares_net(
     view: &[Point3],
     nu: &DMatrix<f64>,
     nv: &DMatrix<f64>,
@@ -44,7 +44,7 @@ pub fn least_squares_net(
 /// weight of a control point, so that lambda means the same for every net size). Solved on the
 /// Kronecker form of the normal equations (at most a few hundred unknowns) by Cholesky. With
 /// lambda = 0 it is Eq. 5.5-5.6 up to rounding; use [`least_squares_net`] then.
-pub fn faired_net(
+pub(crate) fn faired_net(
     view: &[Point3],
     nu: &DMatrix<f64>,
     nv: &DMatrix<f64>,
@@ -93,7 +93,7 @@ pub fn faired_net(
 }
 
 /// The corner rule: the four corner control points := the four corner data points.
-pub fn pin_corners(
+pub(crate) fn pin_corners(
     net: &mut [Point3],
     cn_x: usize,
     cn_y: usize,
@@ -108,7 +108,7 @@ pub fn pin_corners(
 }
 
 /// D^G = Nu (P Nv^T): the surface at every data parameter, row-major.
-pub fn fitted_grid(net: &[Point3], nu: &DMatrix<f64>, nv: &DMatrix<f64>) -> Vec<Point3> {
+pub(crate) fn fitted_grid(net: &[Point3], nu: &DMatrix<f64>, nv: &DMatrix<f64>) -> Vec<Point3> {
     let (nx, cn_x) = nu.shape();
     let (ny, cn_y) = nv.shape();
     // Q = P Nv^T: cn_x x ny.

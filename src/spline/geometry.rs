@@ -18,11 +18,11 @@ use super::surface::BSplineSurface;
 use crate::geom::{self, Point3};
 
 /// The sampling density the harness uses: 4 points per data interval (at least 4x the data).
-pub const DENSE_FACTOR: usize = 4;
+pub(crate) const DENSE_FACTOR: usize = 4;
 
 /// What counts as "near the data": the thesis' data are normalised to the unit box, so an
 /// excursion of a tenth of its side.
-pub const NEAR: f64 = 0.1;
+pub(crate) const NEAR: f64 = 0.1;
 
 /// The dense measures of a pair of surfaces.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -34,7 +34,7 @@ pub struct DenseGeometry {
 
 /// Sorted dense parameters: `params` refined `factor` times, plus the midpoints of the non-empty
 /// knot spans.
-pub fn dense_params(params: &[f64], knots: &[f64], factor: usize) -> Vec<f64> {
+pub(crate) fn dense_params(params: &[f64], knots: &[f64], factor: usize) -> Vec<f64> {
     let mut out: Vec<f64> = Vec::with_capacity(params.len() * factor + knots.len());
     for w in params.windows(2) {
         for s in 0..factor {
@@ -49,7 +49,7 @@ pub fn dense_params(params: &[f64], knots: &[f64], factor: usize) -> Vec<f64> {
 }
 
 /// The smallest axis-aligned box holding `points`.
-pub fn bounding_box<'a>(points: impl IntoIterator<Item = &'a Point3>) -> (Point3, Point3) {
+pub(crate) fn bounding_box<'a>(points: impl IntoIterator<Item = &'a Point3>) -> (Point3, Point3) {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
     for p in points {
@@ -62,7 +62,7 @@ pub fn bounding_box<'a>(points: impl IntoIterator<Item = &'a Point3>) -> (Point3
 }
 
 /// Euclidean distance from `p` to the box [lo, hi] (0 inside).
-pub fn distance_to_box(p: Point3, lo: Point3, hi: Point3) -> f64 {
+pub(crate) fn distance_to_box(p: Point3, lo: Point3, hi: Point3) -> f64 {
     let mut s = 0.0;
     for c in 0..3 {
         let d = (lo[c] - p[c]).max(p[c] - hi[c]).max(0.0);
@@ -72,7 +72,7 @@ pub fn distance_to_box(p: Point3, lo: Point3, hi: Point3) -> f64 {
 }
 
 /// `surf` at every dense (u, v), row-major over u; returns the points and the dense u and v.
-pub fn dense_grid(
+pub(crate) fn dense_grid(
     surf: &BSplineSurface,
     params_u: &[f64],
     params_v: &[f64],
@@ -86,12 +86,12 @@ pub fn dense_grid(
 }
 
 /// A wireframe for pictures: points and the edges (index pairs) between them.
-pub type Wireframe = (Vec<Point3>, Vec<(u32, u32)>);
+pub(crate) type Wireframe = (Vec<Point3>, Vec<(u32, u32)>);
 
 /// A wireframe of `surf` for pictures: the iso-parameter lines through the data parameters, each
 /// drawn through the dense parameters of the other direction, so whatever the surface does between
 /// the data points shows.
-pub fn dense_wireframe(
+pub(crate) fn dense_wireframe(
     surf: &BSplineSurface,
     params_u: &[f64],
     params_v: &[f64],
@@ -120,7 +120,7 @@ fn at_index(params: &[f64], s: f64) -> f64 {
 
 /// The dense measures of a two-view pair: `surfaces` = [bottom, top] with their data parameters
 /// `params` = [(u, v) of bottom, (u, v) of top]; `data` is every map point (for the box).
-pub fn dense_geometry(
+pub(crate) fn dense_geometry(
     surfaces: [&BSplineSurface; 2],
     params: [(&[f64], &[f64]); 2],
     data: &[Point3],

@@ -60,7 +60,7 @@ impl FromStr for KnotRule {
 
 /// Clamped knot vector of degree `p` for `n_ctrl` control points fitted to `params` (non-decreasing,
 /// first 0, last 1) by `rule`. Errors when n_ctrl > params.len() or n_ctrl < p + 1.
-pub fn knot_vector(
+pub(crate) fn knot_vector(
     params: &[f64],
     n_ctrl: usize,
     p: usize,

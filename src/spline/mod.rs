@@ -2,31 +2,33 @@
 //! Chapter 5): basis functions, parameterisation, knots, least-squares control nets, the
 //! conventional and improved two-surface approaches, and CAD export. Pure: no file I/O.
 
-pub mod approach;
-pub mod basis;
-pub mod bezier;
-pub mod closed;
-pub mod conic;
-pub mod control_net;
-pub mod export;
-pub mod fit;
-pub mod geometry;
-pub mod knots;
-pub mod open_surface;
-pub mod param;
-pub mod rational_bezier;
-pub mod surface;
+pub(crate) mod approach;
+pub(crate) mod basis;
+pub(crate) mod bezier;
+pub(crate) mod closed;
+pub(crate) mod conic;
+pub(crate) mod control_net;
+pub(crate) mod export;
+pub(crate) mod fit;
+pub(crate) mod geometry;
+pub(crate) mod knots;
+pub(crate) mod open_surface;
+pub(crate) mod param;
+pub(crate) mod rational_bezier;
+pub(crate) mod surface;
 
-pub use approach::{
-    fit_two_view, Approach, ControlNetParts, ErrorA, FitOptions, TwoSurfaceFit, TwoViewGrid,
-};
+pub(crate) use approach::{ControlNetParts, ErrorA, FitOptions, TwoSurfaceFit, TwoViewGrid};
+pub(crate) use geometry::{DenseGeometry, DENSE_FACTOR};
+pub(crate) use param::{ParamReading, ParamRows};
+pub(crate) use surface::BSplineSurface;
+
+pub use approach::{fit_two_view, Approach};
 pub use basis::SparseBasis;
+pub use bezier::{example3, franke, height_grid, peaks, BezierParamProblem, Layout};
 pub use control_net::{BoxSpec, ControlNetProblem};
-pub use geometry::{DenseGeometry, DENSE_FACTOR};
+pub use export::parse_iges_128;
 pub use knots::KnotRule;
-pub use param::{ParamReading, ParamRows, Parameterisation};
-pub use surface::BSplineSurface;
-
+pub use param::Parameterisation;
 use thiserror::Error;
 
 #[derive(Debug, Error, PartialEq)]

@@ -35,7 +35,7 @@ impl Parameterisation {
     }
 
     /// Eq. 2.8's alpha with the exponential method's taken as `exponential` (Section 2.3.2 sets it
-    /// to 0.8; a named reading, [`ParamReading::exponential_alpha`]).
+    /// to 0.8; a named reading, `ParamReading::exponential_alpha`).
     pub fn alpha_with(self, exponential: f64) -> Option<f64> {
         match self {
             Self::Uniform => None,
@@ -48,11 +48,11 @@ impl Parameterisation {
 
 /// Section 2.3.2: "Exponential method was proposed in [88] by setting the power factor, alpha in
 /// Equation 2.8 to 0.8".
-pub const EXPONENTIAL_ALPHA: f64 = 0.8;
+pub(crate) const EXPONENTIAL_ALPHA: f64 = 0.8;
 
 /// The range `exponential_alpha` may take, (0, 1]: alpha -> 0 tends to the uniform method (Eq.
 /// 2.7), 1 is chord length.
-pub const EXPONENTIAL_ALPHA_RANGE: (f64, f64) = (0.0, 1.0);
+pub(crate) const EXPONENTIAL_ALPHA_RANGE: (f64, f64) = (0.0, 1.0);
 
 /// Which grid lines give a surface's data parameters (Section 5.2.2.1; a named reading,
 /// docs/readings.md).
@@ -124,12 +124,12 @@ impl FromStr for Parameterisation {
 
 /// Parameters of one polyline: t_0 = 0, t_n = 1, t_k = sum_{i<=k} |Q_i - Q_{i-1}|^alpha / total
 /// (Eq. 2.8), or k/n (Eq. 2.7). A polyline of zero total length falls back to uniform.
-pub fn polyline_params(points: &[Point3], method: Parameterisation) -> Vec<f64> {
+pub(crate) fn polyline_params(points: &[Point3], method: Parameterisation) -> Vec<f64> {
     polyline_params_alpha(points, method.alpha())
 }
 
 /// [`polyline_params`] with Eq. 2.8's alpha given (None: Eq. 2.7).
-pub fn polyline_params_alpha(points: &[Point3], alpha: Option<f64>) -> Vec<f64> {
+pub(crate) fn polyline_params_alpha(points: &[Point3], alpha: Option<f64>) -> Vec<f64> {
     let n = points.len();
     if n < 2 {
         return vec![0.0; n];
@@ -155,7 +155,7 @@ pub fn polyline_params_alpha(points: &[Point3], alpha: Option<f64>) -> Vec<f64> 
 /// Averaged parameters of a row-major `nx x ny` view: u (length nx) along i, the mean over the ny
 /// columns j of each column's polyline parameters (Eq. 5.1); v (length ny) along j, the mean over
 /// the nx rows (Eq. 5.2).
-pub fn grid_params(
+pub(crate) fn grid_params(
     view: &[Point3],
     nx: usize,
     ny: usize,
@@ -166,7 +166,7 @@ pub fn grid_params(
 
 /// [`grid_params`] under the named readings: Eq. 2.8's exponential alpha, and which columns
 /// (rows) give u (v): the mean over all of them (Eq. 5.1, 5.2) or the middle one alone.
-pub fn grid_params_with(
+pub(crate) fn grid_params_with(
     view: &[Point3],
     nx: usize,
     ny: usize,

@@ -15,13 +15,13 @@ use crate::optim::Problem;
 
 /// Quadratic Bernstein basis at t.
 #[inline]
-pub fn bernstein2(t: f64) -> [f64; 3] {
+pub(crate) fn bernstein2(t: f64) -> [f64; 3] {
     let s = 1.0 - t;
     [s * s, 2.0 * s * t, t * t]
 }
 
 /// Rational quadratic Bezier curve (conic) r(t) = (B0 b0 + w B1 b1 + B2 b2) / (B0 + w B1 + B2).
-pub fn conic_point<const D: usize>(b: &[[f64; D]; 3], w: f64, t: f64) -> [f64; D] {
+pub(crate) fn conic_point<const D: usize>(b: &[[f64; D]; 3], w: f64, t: f64) -> [f64; D] {
     let bb = bernstein2(t);
     let den = bb[0] + w * bb[1] + bb[2];
     let mut out = [0.0; D];
@@ -33,7 +33,8 @@ pub fn conic_point<const D: usize>(b: &[[f64; D]; 3], w: f64, t: f64) -> [f64; D
 
 /// Bi-quadratic rational Bezier patch with 3x3 points and weights, at (u, v): u runs along the
 /// first index (rows), v along the second.
-pub fn patch_point(p: &[[[f64; 3]; 3]; 3], w: &[[f64; 3]; 3], u: f64, v: f64) -> [f64; 3] {
+#[cfg(test)]
+pub(crate) fn patch_point(p: &[[[f64; 3]; 3]; 3], w: &[[f64; 3]; 3], u: f64, v: f64) -> [f64; 3] {
     let bu = bernstein2(u);
     let bv = bernstein2(v);
     let mut num = [0.0; 3];
@@ -51,6 +52,7 @@ pub fn patch_point(p: &[[[f64; 3]; 3]; 3], w: &[[f64; 3]; 3], u: f64, v: f64) ->
 }
 
 /// Homogeneous patch value and its u- and v-derivatives (numerator 3-vector and denominator).
+#[cfg(test)]
 fn patch_homog(
     p: &[[[f64; 3]; 3]; 3],
     w: &[[f64; 3]; 3],
@@ -82,7 +84,8 @@ fn patch_homog(
 }
 
 /// Partial derivatives (S_u, S_v) of a rational patch by the quotient rule.
-pub fn patch_derivatives(
+#[cfg(test)]
+pub(crate) fn patch_derivatives(
     p: &[[[f64; 3]; 3]; 3],
     w: &[[f64; 3]; 3],
     u: f64,
@@ -101,25 +104,25 @@ pub fn patch_derivatives(
 }
 
 /// Number of optimisation variables: 7 free points x 3 coordinates + w11.
-pub const FREE_DIM: usize = 22;
+pub(crate) const FREE_DIM: usize = 22;
 /// The free net entries (i, j) in the order of the decision vector.
-pub const FREE_ENTRIES: [(usize, usize); 7] =
+pub(crate) const FREE_ENTRIES: [(usize, usize); 7] =
     [(0, 1), (1, 0), (1, 1), (1, 2), (1, 4), (2, 1), (4, 1)];
 /// The fixed net entries, taken from the data.
-pub const FIXED_ENTRIES: [(usize, usize); 9] =
+pub(crate) const FIXED_ENTRIES: [(usize, usize); 9] =
     [(0, 0), (0, 2), (0, 4), (2, 0), (2, 2), (2, 4), (4, 0), (4, 2), (4, 4)];
 
 /// The four-patch surface: a full 5x5 net and weights.
 #[derive(Debug, Clone, PartialEq)]
-pub struct FourPatchSurface {
-    pub p: [[[f64; 3]; 5]; 5],
-    pub w: [[f64; 5]; 5],
+pub(crate) struct FourPatchSurface {
+    pub(crate) p: [[[f64; 3]; 5]; 5],
+    pub(crate) w: [[f64; 5]; 5],
 }
 
 impl FourPatchSurface {
     /// Build the net from the nine fixed points (in `FIXED_ENTRIES` order) and the decision
     /// vector x (7 free points in `FREE_ENTRIES` order, then w11). Requires 0 < w11 < 2.
-    pub fn from_free(fixed: &[[f64; 3]; 9], x: &[f64]) -> FourPatchSurface {
+    pub(crate) fn from_free(fixed: &[[f64; 3]; 9], x: &[f64]) -> FourPatchSurface {
         assert_eq!(x.len(), FREE_DIM, "four-patch surface takes {FREE_DIM} variables");
         let mut p = [[[f64::NAN; 3]; 5]; 5];
         for (k, &(i, j)) in FIXED_ENTRIES.iter().enumerate() {
@@ -158,7 +161,7 @@ impl FourPatchSurface {
     }
 
     /// The 3x3 net and weights of patch (a, b), a, b in {0, 1}.
-    pub fn patch(&self, a: usize, b: usize) -> ([[[f64; 3]; 3]; 3], [[f64; 3]; 3]) {
+    pub(crate) fn patch(&self, a: usize, b: usize) -> ([[[f64; 3]; 3]; 3], [[f64; 3]; 3]) {
         let mut p = [[[0.0; 3]; 3]; 3];
         let mut w = [[0.0; 3]; 3];
         for i in 0..3 {
@@ -171,14 +174,15 @@ impl FourPatchSurface {
     }
 
     /// Global parameters (s, t) in [0,1]^2 -> (patch a, patch b, local u, local v).
-    pub fn locate(s: f64, t: f64) -> (usize, usize, f64, f64) {
+    pub(crate) fn locate(s: f64, t: f64) -> (usize, usize, f64, f64) {
         let a = if s < 0.5 { 0 } else { 1 };
         let b = if t < 0.5 { 0 } else { 1 };
         (a, b, 2.0 * s - a as f64, 2.0 * t - b as f64)
     }
 
     /// Surface point at global parameters (s, t) in [0,1]^2.
-    pub fn point(&self, s: f64, t: f64) -> [f64; 3] {
+    #[cfg(test)]
+    pub(crate) fn point(&self, s: f64, t: f64) -> [f64; 3] {
         let (a, b, u, v) = Self::locate(s, t);
         let (p, w) = self.patch(a, b);
         patch_point(&p, &w, u, v)
@@ -188,18 +192,18 @@ impl FourPatchSurface {
 /// Sample grid of a height function for the surface problem: n x n points (n odd, >= 5) at
 /// uniform global parameters s_i = i/(n-1), t_j = j/(n-1).
 #[derive(Debug, Clone)]
-pub struct GridData {
-    pub n: usize,
+pub(crate) struct GridData {
+    pub(crate) n: usize,
     /// Row-major, point (i, j) at index i*n + j; i runs along s, j along t.
-    pub points: Vec<[f64; 3]>,
+    pub(crate) points: Vec<[f64; 3]>,
 }
 
 impl GridData {
-    pub fn at(&self, i: usize, j: usize) -> [f64; 3] {
+    pub(crate) fn at(&self, i: usize, j: usize) -> [f64; 3] {
         self.points[i * self.n + j]
     }
     /// The data point at global parameter (s, t) on the grid, bilinearly interpolated.
-    pub fn interp(&self, s: f64, t: f64) -> [f64; 3] {
+    pub(crate) fn interp(&self, s: f64, t: f64) -> [f64; 3] {
         let m = (self.n - 1) as f64;
         let (fs, ft) = (s * m, t * m);
         let (i0, j0) =
@@ -219,7 +223,7 @@ impl GridData {
 /// The four test surfaces of SPEC 7 on the domains we chose (the paper gives none): data are the
 /// exact function values (no noise) on a uniform n x n grid of the domain.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum TestSurface {
+pub(crate) enum TestSurface {
     /// f = sin(x) cos(y) + 0.91 on [0, pi]^2 (paper's Surface 1 of Chapter 4).
     Surface1,
     /// f = (1 + 2 exp(-3 (sqrt(x^2+y^2) - 6.7)))^-0.5 on [-10, 10]^2 (Surface 2 of Chapter 4).
@@ -231,17 +235,17 @@ pub enum TestSurface {
 }
 
 impl TestSurface {
-    pub const ALL: [TestSurface; 4] = [
+    pub(crate) const ALL: [TestSurface; 4] = [
         TestSurface::Surface1,
         TestSurface::Surface2,
         TestSurface::Surface3,
         TestSurface::Surface4,
     ];
 
-    pub fn by_name(name: &str) -> Option<TestSurface> {
+    pub(crate) fn by_name(name: &str) -> Option<TestSurface> {
         TestSurface::ALL.into_iter().find(|s| s.name() == name)
     }
-    pub fn name(self) -> &'static str {
+    pub(crate) fn name(self) -> &'static str {
         match self {
             TestSurface::Surface1 => "surface1",
             TestSurface::Surface2 => "surface2",
@@ -249,7 +253,7 @@ impl TestSurface {
             TestSurface::Surface4 => "surface4",
         }
     }
-    pub fn formula(self) -> &'static str {
+    pub(crate) fn formula(self) -> &'static str {
         match self {
             TestSurface::Surface1 => "sin(x)cos(y)+0.91 on [0,pi]^2",
             TestSurface::Surface2 => "(1+2exp(-3(sqrt(x^2+y^2)-6.7)))^-0.5 on [-10,10]^2",
@@ -258,7 +262,7 @@ impl TestSurface {
         }
     }
     /// (lower, upper) of the square domain.
-    pub fn domain(self) -> (f64, f64) {
+    pub(crate) fn domain(self) -> (f64, f64) {
         match self {
             TestSurface::Surface1 => (0.0, std::f64::consts::PI),
             TestSurface::Surface2 => (-10.0, 10.0),
@@ -266,7 +270,7 @@ impl TestSurface {
             TestSurface::Surface4 => (-1.0, 1.0),
         }
     }
-    pub fn eval(self, x: f64, y: f64) -> f64 {
+    pub(crate) fn eval(self, x: f64, y: f64) -> f64 {
         match self {
             TestSurface::Surface1 => x.sin() * y.cos() + 0.91,
             TestSurface::Surface2 => {
@@ -280,7 +284,7 @@ impl TestSurface {
         }
     }
     /// n x n samples; grid index i runs along x, j along y.
-    pub fn grid(self, n: usize) -> GridData {
+    pub(crate) fn grid(self, n: usize) -> GridData {
         let (lo, hi) = self.domain();
         let m = (n - 1) as f64;
         let points = (0..n * n)
@@ -296,9 +300,9 @@ impl TestSurface {
 
 /// Sum of squared errors between the data grid and the four-patch surface at the same
 /// parameters; variables: the 7 free points and w11 (22 numbers).
-pub struct SurfaceSse {
-    pub data: GridData,
-    pub fixed: [[f64; 3]; 9],
+pub(crate) struct SurfaceSse {
+    pub(crate) data: GridData,
+    pub(crate) fixed: [[f64; 3]; 9],
     /// (patch a, b, Bernstein products bu[i]*bv[j] row-major) per data point, precomputed.
     cache: Vec<(usize, usize, [f64; 9])>,
     x0: Vec<f64>,
@@ -311,7 +315,7 @@ impl SurfaceSse {
     /// initial free points are the data at their net positions (s, t) = (i/4, j/4), w11 = 1; the
     /// box is the data's bounding box widened by `margin` times its extent per axis, and
     /// w11 in [w_min, 2 - w_min].
-    pub fn new(data: GridData, margin: f64, w_min: f64) -> SurfaceSse {
+    pub(crate) fn new(data: GridData, margin: f64, w_min: f64) -> SurfaceSse {
         let n = data.n;
         assert!(n >= 5 && n % 2 == 1, "grid size must be odd and >= 5");
         let idx = |e: usize| e * (n - 1) / 4;
@@ -355,11 +359,11 @@ impl SurfaceSse {
         SurfaceSse { data, fixed, cache, x0, lo, hi }
     }
 
-    pub fn surface(&self, x: &[f64]) -> FourPatchSurface {
+    pub(crate) fn surface(&self, x: &[f64]) -> FourPatchSurface {
         FourPatchSurface::from_free(&self.fixed, x)
     }
 
-    pub fn n_points(&self) -> usize {
+    pub(crate) fn n_points(&self) -> usize {
         self.data.points.len()
     }
 }

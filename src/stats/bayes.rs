@@ -19,25 +19,26 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Gamma};
 
 /// baycomp's prior strength (the weight of the pseudo-observation at 0).
-pub const PRIOR: f64 = 0.5;
+pub(crate) const PRIOR: f64 = 0.5;
 /// baycomp's default number of Monte Carlo samples.
-pub const SAMPLES: usize = 50_000;
+#[cfg(test)]
+pub(crate) const SAMPLES: usize = 50_000;
 
 /// Posterior probabilities that A is better, that A and B are practically equivalent (within the
 /// rope) and that B is better; they sum to 1.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct BayesSignedRank {
-    pub p_a_better: f64,
-    pub p_rope: f64,
-    pub p_b_better: f64,
-    pub n: usize,
-    pub samples: usize,
+pub(crate) struct BayesSignedRank {
+    pub(crate) p_a_better: f64,
+    pub(crate) p_rope: f64,
+    pub(crate) p_b_better: f64,
+    pub(crate) n: usize,
+    pub(crate) samples: usize,
 }
 
 /// The test on paired errors `a`, `b` (smaller is better) with a region of practical equivalence
 /// of half-width `rope` (>= 0) on the difference, `samples` Monte Carlo draws from a stream seeded
 /// with `seed`.
-pub fn signed_rank(
+pub(crate) fn signed_rank(
     a: &[f64],
     b: &[f64],
     rope: f64,

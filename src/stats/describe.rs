@@ -2,7 +2,7 @@
 //! (divisor n - 1, as MATLAB's `var` and the papers' tables use).
 
 /// (mean, sample variance); the variance of fewer than two values is 0.
-pub fn mean_var(v: &[f64]) -> (f64, f64) {
+pub(crate) fn mean_var(v: &[f64]) -> (f64, f64) {
     let n = v.len() as f64;
     let m = v.iter().sum::<f64>() / n;
     let var = if v.len() > 1 {
@@ -14,14 +14,14 @@ pub fn mean_var(v: &[f64]) -> (f64, f64) {
 }
 
 /// (mean, sample standard deviation).
-pub fn mean_std(v: &[f64]) -> (f64, f64) {
+pub(crate) fn mean_std(v: &[f64]) -> (f64, f64) {
     let (m, var) = mean_var(v);
     (m, var.sqrt())
 }
 
 /// The median (the mean of the two middle values for an even count; NaN when empty or when a
 /// value is NaN).
-pub fn median(v: &[f64]) -> f64 {
+pub(crate) fn median(v: &[f64]) -> f64 {
     if v.is_empty() || v.iter().any(|x| x.is_nan()) {
         return f64::NAN;
     }

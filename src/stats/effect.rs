@@ -4,7 +4,7 @@
 //! 1 - A12, so a value above 0.5 means x tends to be better (smaller).
 
 /// A12 = P(X > Y) + 0.5 P(X = Y) (NaN when a sample is empty).
-pub fn a12(x: &[f64], y: &[f64]) -> f64 {
+pub(crate) fn a12(x: &[f64], y: &[f64]) -> f64 {
     if x.is_empty() || y.is_empty() {
         return f64::NAN;
     }
@@ -25,12 +25,12 @@ pub fn a12(x: &[f64], y: &[f64]) -> f64 {
 
 /// A12 by direction for minimisation: P(X < Y) + 0.5 P(X = Y), the probability that a run of x
 /// ends below (better than) a run of y, ties counting half; > 0.5 means x better.
-pub fn a12_x_better(x: &[f64], y: &[f64]) -> f64 {
+pub(crate) fn a12_x_better(x: &[f64], y: &[f64]) -> f64 {
     a12(y, x)
 }
 
 /// Vargha & Delaney's magnitude of |A12 - 0.5|: thresholds 0.56, 0.64, 0.71.
-pub fn magnitude(a: f64) -> &'static str {
+pub(crate) fn magnitude(a: f64) -> &'static str {
     let d = (a - 0.5).abs() + 0.5;
     if d < 0.56 {
         "negligible"

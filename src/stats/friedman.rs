@@ -7,24 +7,25 @@ use super::ranks::{midranks, tie_sum};
 use super::{check_finite, normal_cdf, StatsError};
 
 #[derive(Debug, Clone, PartialEq)]
-pub struct Friedman {
-    pub blocks: usize,
-    pub treatments: usize,
-    pub chi_squared: f64,
-    pub df: usize,
-    pub p_value: f64,
-    pub mean_ranks: Vec<f64>,
+pub(crate) struct Friedman {
+    pub(crate) blocks: usize,
+    pub(crate) treatments: usize,
+    pub(crate) chi_squared: f64,
+    pub(crate) df: usize,
+    pub(crate) p_value: f64,
+    pub(crate) mean_ranks: Vec<f64>,
     /// Nemenyi critical difference at alpha = 0.05 (None when k > 10).
-    pub critical_difference: Option<f64>,
+    pub(crate) critical_difference: Option<f64>,
     /// (i, j, z, p, Holm-adjusted p) for every pair i < j.
-    pub pairwise: Vec<(usize, usize, f64, f64, f64)>,
+    pub(crate) pairwise: Vec<(usize, usize, f64, f64, f64)>,
 }
 
 /// Critical values q_0.05 of the Studentised range divided by sqrt 2 (Demsar 2006, Table 5a), k = 2..10.
-pub const NEMENYI_Q05: [f64; 9] = [1.960, 2.343, 2.569, 2.728, 2.850, 2.949, 3.031, 3.102, 3.164];
+pub(crate) const NEMENYI_Q05: [f64; 9] =
+    [1.960, 2.343, 2.569, 2.728, 2.850, 2.949, 3.031, 3.102, 3.164];
 
 /// `table[b][t]`: value of treatment t on block b.
-pub fn friedman(table: &[Vec<f64>]) -> Result<Friedman, StatsError> {
+pub(crate) fn friedman(table: &[Vec<f64>]) -> Result<Friedman, StatsError> {
     let n = table.len();
     if n < 2 {
         return Err(StatsError::TooFew(format!("{n} blocks, at least 2 needed")));

@@ -1,6 +1,6 @@
 //! Holm-Bonferroni step-down adjustment of p-values (monotone, capped at 1, original order kept).
 
-pub fn holm(p: &[f64]) -> Vec<f64> {
+pub(crate) fn holm(p: &[f64]) -> Vec<f64> {
     let m = p.len();
     let mut idx: Vec<usize> = (0..m).collect();
     idx.sort_by(|&a, &b| p[a].total_cmp(&p[b]));

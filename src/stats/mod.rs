@@ -3,38 +3,38 @@
 //! Nemenyi's critical difference, and the Vargha-Delaney A12 effect size. Pure functions over
 //! slices; distributions from statrs.
 
-pub mod bayes;
-pub mod describe;
-pub mod effect;
-pub mod friedman;
-pub mod holm;
-pub mod proportion;
-pub mod rank_sum;
-pub mod ranks;
-pub mod runtime;
-pub mod wilcoxon;
+pub(crate) mod bayes;
+pub(crate) mod describe;
+pub(crate) mod effect;
+pub(crate) mod friedman;
+pub(crate) mod holm;
+pub(crate) mod proportion;
+pub(crate) mod rank_sum;
+pub(crate) mod ranks;
+pub(crate) mod runtime;
+pub(crate) mod wilcoxon;
 
 use thiserror::Error;
 
-/// The alternative hypothesis, for x relative to y.
+/// The alternative hypothesis, for x relative to y (the reports test two-sided; the one-sided
+/// alternative is checked against R in the tests; swap x and y for "smaller").
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Alternative {
+#[cfg_attr(not(test), allow(dead_code))]
+pub(crate) enum Alternative {
     TwoSided,
-    /// x tends to be smaller than y.
-    Less,
     /// x tends to be larger than y.
     Greater,
 }
 
 /// How a p-value was computed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Method {
+pub(crate) enum Method {
     Exact,
     Normal,
 }
 
 #[derive(Debug, Error, PartialEq)]
-pub enum StatsError {
+pub(crate) enum StatsError {
     #[error("samples differ in length ({0} and {1}) for a paired test")]
     LengthMismatch(usize, usize),
     #[error("too few observations: {0}")]
@@ -84,12 +84,10 @@ fn normal_approximation(diff: f64, var: f64, alt: Alternative) -> (f64, f64) {
     let correction = match alt {
         Alternative::TwoSided => 0.5 * sign(diff),
         Alternative::Greater => 0.5,
-        Alternative::Less => -0.5,
     };
     let z = (diff - correction) / var.sqrt();
     let p = match alt {
         Alternative::Greater => normal_sf(z),
-        Alternative::Less => normal_cdf(z),
         Alternative::TwoSided => (2.0 * normal_cdf(-z.abs())).min(1.0),
     };
     (z, p)

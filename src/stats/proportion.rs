@@ -4,10 +4,10 @@
 //! 0% and 100% ends that claim counts reach.
 
 /// The standard normal quantile for a two-sided 95% interval.
-pub const Z95: f64 = 1.959_963_984_540_054;
+pub(crate) const Z95: f64 = 1.959_963_984_540_054;
 
 /// Wilson's score interval for k successes in n trials (`(0, 1)` for n = 0).
-pub fn wilson(k: usize, n: usize, z: f64) -> (f64, f64) {
+pub(crate) fn wilson(k: usize, n: usize, z: f64) -> (f64, f64) {
     if n == 0 {
         return (0.0, 1.0);
     }
@@ -24,7 +24,7 @@ pub fn wilson(k: usize, n: usize, z: f64) -> (f64, f64) {
 
 /// Newcombe's hybrid score interval for p1 - p2, p1 = k1/n1 and p2 = k2/n2 independent, from the
 /// two Wilson intervals.
-pub fn difference(k1: usize, n1: usize, k2: usize, n2: usize, z: f64) -> (f64, f64) {
+pub(crate) fn difference(k1: usize, n1: usize, k2: usize, n2: usize, z: f64) -> (f64, f64) {
     let p = |k: usize, n: usize| if n == 0 { 0.5 } else { k.min(n) as f64 / n as f64 };
     let (p1, p2) = (p(k1, n1), p(k2, n2));
     let ((l1, u1), (l2, u2)) = (wilson(k1, n1, z), wilson(k2, n2, z));

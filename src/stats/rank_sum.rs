@@ -7,12 +7,12 @@ use super::ranks::{midranks, tie_sum};
 use super::{check_finite, normal_approximation, Alternative, Method, StatsError};
 
 #[derive(Debug, Clone, PartialEq)]
-pub struct RankSum {
+pub(crate) struct RankSum {
     /// U statistic of x (R's W).
-    pub w: f64,
-    pub z: Option<f64>,
-    pub p_value: f64,
-    pub method: Method,
+    pub(crate) w: f64,
+    pub(crate) z: Option<f64>,
+    pub(crate) p_value: f64,
+    pub(crate) method: Method,
 }
 
 /// Counts of U = 0..=n1 n2 over all ways to interleave the samples (DP over ranks).
@@ -44,7 +44,7 @@ fn u_counts(n1: usize, n2: usize) -> Vec<f64> {
 /// 2 / C(n1 + n2, n1) (capped at 1; 3 vs 3 gives 0.1). From the exact distribution where
 /// [`rank_sum`] uses it (both at most 50), by the closed form (in logs) beyond. Ties only make it
 /// larger.
-pub fn min_p_two_sided(n1: usize, n2: usize) -> f64 {
+pub(crate) fn min_p_two_sided(n1: usize, n2: usize) -> f64 {
     if n1 == 0 || n2 == 0 {
         return 1.0;
     }
@@ -60,7 +60,7 @@ pub fn min_p_two_sided(n1: usize, n2: usize) -> f64 {
     p.min(1.0)
 }
 
-pub fn rank_sum(x: &[f64], y: &[f64], alt: Alternative) -> Result<RankSum, StatsError> {
+pub(crate) fn rank_sum(x: &[f64], y: &[f64], alt: Alternative) -> Result<RankSum, StatsError> {
     check_finite(x)?;
     check_finite(y)?;
     let (n1, n2) = (x.len(), y.len());
@@ -78,7 +78,6 @@ pub fn rank_sum(x: &[f64], y: &[f64], alt: Alternative) -> Result<RankSum, Stats
         let ge = c[u..].iter().sum::<f64>() / total;
         let p = match alt {
             Alternative::Greater => ge,
-            Alternative::Less => le,
             Alternative::TwoSided => (2.0 * le.min(ge)).min(1.0),
         };
         return Ok(RankSum { w, z: None, p_value: p, method: Method::Exact });

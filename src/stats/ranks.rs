@@ -1,7 +1,7 @@
 //! Average ranks (midranks) with ties.
 
 /// Ranks 1..n of `v`, tied values sharing the mean of their ranks; and the sizes of the tie groups.
-pub fn midranks(v: &[f64]) -> (Vec<f64>, Vec<usize>) {
+pub(crate) fn midranks(v: &[f64]) -> (Vec<f64>, Vec<usize>) {
     let mut idx: Vec<usize> = (0..v.len()).collect();
     idx.sort_by(|&a, &b| v[a].total_cmp(&v[b]));
     let mut ranks = vec![0.0; v.len()];
@@ -25,7 +25,7 @@ pub fn midranks(v: &[f64]) -> (Vec<f64>, Vec<usize>) {
 }
 
 /// sum over tie groups of t^3 - t.
-pub fn tie_sum(ties: &[usize]) -> f64 {
+pub(crate) fn tie_sum(ties: &[usize]) -> f64 {
     ties.iter().map(|&t| (t * t * t - t) as f64).sum()
 }
 

@@ -8,19 +8,19 @@
 /// One run: its improvement rows (evaluation ascending, value strictly decreasing, as recorded)
 /// and its evaluation count.
 #[derive(Debug, Clone, Copy)]
-pub struct Trace<'a> {
-    pub improvements: &'a [(u64, f64)],
-    pub evaluations: u64,
+pub(crate) struct Trace<'a> {
+    pub(crate) improvements: &'a [(u64, f64)],
+    pub(crate) evaluations: u64,
 }
 
 impl Trace<'_> {
     /// The first evaluation at which the best so far is at most `target` (None: never).
-    pub fn hitting_time(&self, target: f64) -> Option<u64> {
+    pub(crate) fn hitting_time(&self, target: f64) -> Option<u64> {
         self.improvements.iter().find(|r| r.1 <= target).map(|r| r.0)
     }
 
     /// The best value after `budget` evaluations (+inf before the first improvement).
-    pub fn best_at(&self, budget: u64) -> f64 {
+    pub(crate) fn best_at(&self, budget: u64) -> f64 {
         self.improvements
             .iter()
             .take_while(|r| r.0 <= budget)
@@ -33,7 +33,7 @@ impl Trace<'_> {
 /// `count` targets between `start` (first) and `best` (last, included), spaced evenly in log10 of
 /// the gap above `best`: best + (start - best) 10^(-decades k / (count - 1)) for k < count - 1,
 /// and `best` itself last. A zero or negative gap gives the single target `best`.
-pub fn log_targets(start: f64, best: f64, count: usize, decades: f64) -> Vec<f64> {
+pub(crate) fn log_targets(start: f64, best: f64, count: usize, decades: f64) -> Vec<f64> {
     let gap = start - best;
     if gap.is_nan() || gap <= 0.0 || count < 2 {
         return vec![best];
@@ -55,7 +55,7 @@ pub fn log_targets(start: f64, best: f64, count: usize, decades: f64) -> Vec<f64
 ///   value;
 /// - `none`: no run ever improved (every first value is the best known): no range (None); the
 ///   problem gets the single target `best_known` and no fixed-budget gap.
-pub fn target_range(b: f64, best_known: f64, firsts: &[f64]) -> (Option<f64>, &'static str) {
+pub(crate) fn target_range(b: f64, best_known: f64, firsts: &[f64]) -> (Option<f64>, &'static str) {
     let best_first = firsts.iter().copied().fold(f64::INFINITY, f64::min);
     let worst_first = firsts.iter().copied().filter(|v| v.is_finite()).fold(f64::NAN, f64::max);
     if b > best_known {
@@ -72,14 +72,14 @@ pub fn target_range(b: f64, best_known: f64, firsts: &[f64]) -> (Option<f64>, &'
 /// The mean of curves tabulated at the same points, each curve weighing the same (the ECDF or
 /// fixed-budget values of several problems aggregated with equal weight per problem, as
 /// IOHanalyzer and COCO aggregate over functions); empty when there is no curve.
-pub fn mean_curve(curves: &[&[f64]]) -> Vec<f64> {
+pub(crate) fn mean_curve(curves: &[&[f64]]) -> Vec<f64> {
     let Some(len) = curves.iter().map(|c| c.len()).min() else { return Vec::new() };
     (0..len).map(|k| curves.iter().map(|c| c[k]).sum::<f64>() / curves.len() as f64).collect()
 }
 
 /// The expected running time to reach `target`: the evaluations of all runs (until the hit for
 /// those that hit, all for the others) over the number of hits; +inf when no run hits.
-pub fn ert(runs: &[Trace], target: f64) -> (f64, usize) {
+pub(crate) fn ert(runs: &[Trace], target: f64) -> (f64, usize) {
     let mut spent = 0u64;
     let mut hits = 0usize;
     for r in runs {
@@ -95,14 +95,14 @@ pub fn ert(runs: &[Trace], target: f64) -> (f64, usize) {
 }
 
 /// The hitting times of every (run, target) pair of a problem (None: not reached).
-pub fn hitting_times(runs: &[Trace], targets: &[f64]) -> Vec<Option<u64>> {
+pub(crate) fn hitting_times(runs: &[Trace], targets: &[f64]) -> Vec<Option<u64>> {
     runs.iter().flat_map(|r| targets.iter().map(move |&t| r.hitting_time(t))).collect()
 }
 
 /// The ECDF of hitting times (the (run, target) pairs of one problem, each weighing the same; over
 /// several problems average their ECDFs with [`mean_curve`]) at each of `budgets`: the share of
 /// pairs reached within the budget.
-pub fn ecdf(times: &[Option<u64>], budgets: &[u64]) -> Vec<f64> {
+pub(crate) fn ecdf(times: &[Option<u64>], budgets: &[u64]) -> Vec<f64> {
     let mut hit: Vec<u64> = times.iter().flatten().copied().collect();
     hit.sort_unstable();
     let n = times.len().max(1) as f64;
@@ -111,7 +111,7 @@ pub fn ecdf(times: &[Option<u64>], budgets: &[u64]) -> Vec<f64> {
 
 /// The AOCC of the ECDF over budgets 1..=`budget`: (1/B) sum_{e=1..B} ECDF(e), exactly, from the
 /// hitting times (a pair hit at h contributes (B - h + 1)/B).
-pub fn aocc(times: &[Option<u64>], budget: u64) -> f64 {
+pub(crate) fn aocc(times: &[Option<u64>], budget: u64) -> f64 {
     if times.is_empty() || budget == 0 {
         return 0.0;
     }
@@ -122,7 +122,7 @@ pub fn aocc(times: &[Option<u64>], budget: u64) -> f64 {
 
 /// `count` budgets from 1 to `max`, evenly spaced in log10 and rounded to whole evaluations
 /// (duplicates removed; `max` always included).
-pub fn log_budgets(max: u64, count: usize) -> Vec<u64> {
+pub(crate) fn log_budgets(max: u64, count: usize) -> Vec<u64> {
     if max <= 1 || count < 2 {
         return vec![max.max(1)];
     }

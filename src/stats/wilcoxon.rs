@@ -6,17 +6,17 @@ use super::ranks::{midranks, tie_sum};
 use super::{check_finite, normal_approximation, Alternative, Method, StatsError};
 
 #[derive(Debug, Clone, PartialEq)]
-pub struct SignedRank {
+pub(crate) struct SignedRank {
     /// Non-zero differences used.
-    pub n: usize,
+    pub(crate) n: usize,
     /// Sum of the ranks of the positive differences (R's V).
-    pub w_plus: f64,
-    pub w_minus: f64,
-    pub z: Option<f64>,
-    pub p_value: f64,
-    pub method: Method,
+    pub(crate) w_plus: f64,
+    pub(crate) w_minus: f64,
+    pub(crate) z: Option<f64>,
+    pub(crate) p_value: f64,
+    pub(crate) method: Method,
     /// Matched-pairs rank-biserial correlation (W+ - W-) / (W+ + W-).
-    pub rank_biserial: f64,
+    pub(crate) rank_biserial: f64,
 }
 
 /// Number of subsets of {1..n} with each sum 0..=n(n+1)/2.
@@ -36,7 +36,7 @@ fn subset_sum_counts(n: usize) -> Vec<f64> {
 /// extremes of W+ (0 and n(n+1)/2) have one subset each, so 2 / 2^n (capped at 1; n = 3 gives
 /// 0.25). From the exact distribution up to n = 50 (where [`signed_rank`] uses it), by the closed
 /// form above that. With fewer than `n` non-zero differences, or with ties, it can only be larger.
-pub fn min_p_two_sided(n: usize) -> f64 {
+pub(crate) fn min_p_two_sided(n: usize) -> f64 {
     if n == 0 {
         return 1.0;
     }
@@ -49,7 +49,11 @@ pub fn min_p_two_sided(n: usize) -> f64 {
     p.min(1.0)
 }
 
-pub fn signed_rank(x: &[f64], y: &[f64], alt: Alternative) -> Result<SignedRank, StatsError> {
+pub(crate) fn signed_rank(
+    x: &[f64],
+    y: &[f64],
+    alt: Alternative,
+) -> Result<SignedRank, StatsError> {
     if x.len() != y.len() {
         return Err(StatsError::LengthMismatch(x.len(), y.len()));
     }
@@ -75,7 +79,6 @@ pub fn signed_rank(x: &[f64], y: &[f64], alt: Alternative) -> Result<SignedRank,
         let ge: f64 = c[v..].iter().sum::<f64>() / all;
         let p = match alt {
             Alternative::Greater => ge,
-            Alternative::Less => le,
             Alternative::TwoSided => (2.0 * le.min(ge)).min(1.0),
         };
         return Ok(SignedRank {

@@ -283,7 +283,7 @@ fn fit_writes_nets_iges_and_obj_and_refuses_bad_grids() {
     let (_, nets) = read_csv(&c.path("f/control_nets.csv"));
     assert_eq!(nets.len(), 2 * 8 * 6);
     let igs = std::fs::read_to_string(c.path("f/surfaces.igs")).unwrap();
-    let surfaces = somnurbs::spline::export::parse_iges_128(&igs).unwrap();
+    let surfaces = somnurbs::spline::parse_iges_128(&igs).unwrap();
     assert_eq!((surfaces.len(), surfaces[0].cn_x, surfaces[0].cn_y), (2, 8, 6));
     let (fh, fit) = read_csv(&c.path("f/fit.csv"));
     let at = |name: &str| fit[0][fh.iter().position(|h| h == name).unwrap()].clone();

@@ -11,9 +11,9 @@ pub fn bin() -> Command {
 
 /// The data folder the tests give the binary: where a user's main job finds the data when run
 /// from the top of this clone (`SOMNURBS_DATA` if set, else `<clone>/data`; one rule,
-/// `somnurbs::data::registry::data_folder`).
+/// `somnurbs::data::clone_data_dir`).
 pub fn data_dir() -> PathBuf {
-    somnurbs::data::registry::clone_data_dir()
+    somnurbs::data::clone_data_dir()
 }
 
 pub struct Case {

@@ -4,12 +4,12 @@
 //! never above approach B's error (B lies in the box), the lower bound is below it, and the
 //! relative gap is certified to the spec's `exact_tol` (1e-7), or at the very least to 1e-6.
 
-use somnurbs::experiment::spec::Override;
+use somnurbs::experiment::Override;
 use somnurbs::experiment::RunContext;
 use somnurbs::families::optimise::{exact_optima, problems};
 use somnurbs::families::Loaded;
-use somnurbs::optim::exact::{certify_dual, ExactOptions};
-use somnurbs::optim::problem::Problem;
+use somnurbs::optim::Problem;
+use somnurbs::optim::{certify_dual, ExactOptions};
 use somnurbs::spline::KnotRule;
 use std::path::Path;
 use std::time::Instant;
@@ -30,7 +30,7 @@ fn check_spec(name: &str, profile: Option<&str>, jobs: usize, check_pipeline: bo
         let spec = spec(name, profile, knots);
         let dir = tempfile::tempdir().unwrap();
         let ctx = RunContext::new(dir.path().to_path_buf(), jobs, crate::common::data_dir());
-        let o = spec.section::<somnurbs::families::optimise::spec::OptimSpec>().unwrap();
+        let o = spec.section::<somnurbs::families::optimise::OptimSpec>().unwrap();
         let pbs = problems(&spec.spec, o, &ctx).unwrap();
         let tol = o.exact_tol;
         let opts = ExactOptions {

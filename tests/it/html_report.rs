@@ -34,10 +34,9 @@ fn a_chapter_5_run_writes_a_self_contained_report_html() {
         views.contains("sphere: A surfaces furthest from the data")
             && views.contains("sphere: B surfaces furthest from the data")
     );
-    let js = std::fs::read(out.join(somnurbs::report::html::PLOTLY_PATH)).unwrap();
-    assert_eq!(js, somnurbs::report::html::PLOTLY_JS, "the vendored library is copied as it is");
-    assert!(html
-        .contains(&format!("<script src=\"{}\"></script>", somnurbs::report::html::PLOTLY_PATH)));
+    let js = std::fs::read(out.join(somnurbs::report::PLOTLY_PATH)).unwrap();
+    assert_eq!(js, somnurbs::report::PLOTLY_JS, "the vendored library is copied as it is");
+    assert!(html.contains(&format!("<script src=\"{}\"></script>", somnurbs::report::PLOTLY_PATH)));
     assert!(html.contains("<script src=\"views3d.js\" data-folder=\"\"></script>"));
     assert!(html.contains("class=\"sortable"), "no sortable table");
     // Every picture of the folder is on the page, and nothing is fetched from elsewhere.

@@ -254,7 +254,7 @@ fn exported(c: &Case, dir: &str) -> (Vec<[f64; 3]>, Vec<[f64; 3]>, String, Strin
             [v[0], v[1], v[2]]
         })
         .collect();
-    let control = somnurbs::spline::export::parse_iges_128(&igs)
+    let control = somnurbs::spline::parse_iges_128(&igs)
         .unwrap()
         .iter()
         .flat_map(|s| s.control.clone())

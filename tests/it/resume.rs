@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 
 /// The keys of a folder's cell log (`path` is its `cells.jsonl`; a finished run's is compressed).
 fn log_keys(path: &std::path::Path) -> Vec<String> {
-    somnurbs::experiment::log::log_text(path.parent().unwrap())
+    somnurbs::experiment::log_text(path.parent().unwrap())
         .unwrap_or_default()
         .lines()
         .filter_map(|l| serde_json::from_str::<serde_json::Value>(l).ok())

@@ -146,7 +146,7 @@ fn one_writer_per_folder_and_readers_wait_for_it() {
         let v: serde_json::Value = serde_json::from_str(line).unwrap();
         assert_eq!(
             v["seed"].as_str().unwrap(),
-            somnurbs::experiment::seeds::seed_hex(11, v["key"].as_str().unwrap())
+            somnurbs::experiment::seed_hex(11, v["key"].as_str().unwrap())
         );
     }
     // The lock died with its holder: the next writer is not blocked, and is told what is there.
@@ -184,7 +184,7 @@ fn drift_merge_accept_and_resume_refuse_unfinished_or_mixed_folders() {
     let moved = format!("{key}9");
     let forged = log.replacen(&key, &moved, 1).replacen(
         first["seed"].as_str().unwrap(),
-        &somnurbs::experiment::seeds::seed_hex(11, &moved),
+        &somnurbs::experiment::seed_hex(11, &moved),
         1,
     );
     std::fs::write(c.path("sh2/cells.jsonl"), &forged).unwrap();
@@ -202,13 +202,13 @@ fn drift_merge_accept_and_resume_refuse_unfinished_or_mixed_folders() {
     c.ok(&["merge", "sh1", "sh2", "--out", "m3"]);
     c.ok(&["drift", "base", "m3"]);
     // --resume: a record of another seed in the log is refused, naming the cell and line.
-    let own = somnurbs::experiment::log::log_text(&c.path("half")).unwrap();
+    let own = somnurbs::experiment::log_text(&c.path("half")).unwrap();
     std::fs::remove_file(c.path("half/cells.jsonl.gz")).unwrap();
     let line = own.lines().nth(1).unwrap();
     let rec: serde_json::Value = serde_json::from_str(line).unwrap();
     let wrong = line.replace(
         rec["seed"].as_str().unwrap(),
-        &somnurbs::experiment::seeds::seed_hex(12, rec["key"].as_str().unwrap()),
+        &somnurbs::experiment::seed_hex(12, rec["key"].as_str().unwrap()),
     );
     std::fs::write(c.path("half/cells.jsonl"), format!("{own}{wrong}\n")).unwrap();
     c.fails(

@@ -199,7 +199,7 @@ fn resume_and_shards_of_a_sweep_give_the_plain_sweeps_tables() {
     assert_eq!(n, 16, "2 x 2 variants x 2 optimisers x 2 repeats");
     // An interrupted sweep: half its log, no manifest, no tables.
     ok(with(&["run", "d.toml", "--out", "cut"]));
-    let log = somnurbs::experiment::log::log_text(&c.path("cut")).unwrap();
+    let log = somnurbs::experiment::log_text(&c.path("cut")).unwrap();
     let half: String = log.lines().take(7).map(|l| format!("{l}\n")).collect();
     for f in walk(&c.path("cut")) {
         if f.file_name().unwrap() != "fingerprint.toml" {

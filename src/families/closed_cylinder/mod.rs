@@ -3,8 +3,8 @@
 //! (control points, repeat) cell then runs the binary-coded GA on the columns' (x, y) in a box
 //! around the analytical net, on its own stream, logged at once.
 
-pub mod report;
-pub mod spec;
+pub(crate) mod report;
+pub(crate) mod spec;
 
 use crate::data::cylinder::{lattice_cylinder, sort_into_rings};
 use crate::experiment::spec::{Spec, SpecError};
@@ -17,13 +17,13 @@ use spec::ClosedCylinderSpec;
 
 /// One (number of control points around, repeat).
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Cell {
-    pub control_points: usize,
-    pub repeat: usize,
+pub(crate) struct Cell {
+    pub(crate) control_points: usize,
+    pub(crate) repeat: usize,
 }
 
 impl Cell {
-    pub fn key(&self) -> String {
+    pub(crate) fn key(&self) -> String {
         format!("seed004/cp{}/r{}", self.control_points, self.repeat)
     }
 }
@@ -36,42 +36,42 @@ impl runner::Cell for Cell {
 
 /// One row of runs.csv.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-pub struct Row {
-    pub cell: String,
-    pub control_points: usize,
-    pub repeat: usize,
-    pub seed: String,
-    pub n_points: usize,
-    pub order_around: usize,
-    pub order_vertical: usize,
-    pub rows: usize,
+pub(crate) struct Row {
+    pub(crate) cell: String,
+    pub(crate) control_points: usize,
+    pub(crate) repeat: usize,
+    pub(crate) seed: String,
+    pub(crate) n_points: usize,
+    pub(crate) order_around: usize,
+    pub(crate) order_vertical: usize,
+    pub(crate) rows: usize,
     /// GA decision variables (x, y per control column) and chromosome length in bits.
-    pub dimension: usize,
-    pub string_length: usize,
+    pub(crate) dimension: usize,
+    pub(crate) string_length: usize,
     /// RMS error of the analytical (chord length + SVD) net.
-    pub analytical_rms: f64,
+    pub(crate) analytical_rms: f64,
     /// Best RMS of the GA's initial population (generation 0).
-    pub initial_best_rms: f64,
+    pub(crate) initial_best_rms: f64,
     /// Best RMS the GA found (best so far at the end).
-    pub best_rms: f64,
+    pub(crate) best_rms: f64,
     /// First generation at which `best_rms` was reached.
-    pub best_generation: usize,
+    pub(crate) best_generation: usize,
     /// Best RMS in the final population (no elitism: may exceed `best_rms`).
-    pub final_population_best_rms: f64,
+    pub(crate) final_population_best_rms: f64,
     /// (analytical - best) / analytical * 100.
-    pub improvement_pct: f64,
-    pub evaluations: u64,
-    pub cpu_s: f64,
+    pub(crate) improvement_pct: f64,
+    pub(crate) evaluations: u64,
+    pub(crate) cpu_s: f64,
 }
 
 /// One run: its row, per-generation histories and best decision vector.
 #[derive(Debug, Clone)]
-pub struct Run {
-    pub cell: Cell,
-    pub row: Row,
-    pub population_best: Vec<f64>,
-    pub best_so_far: Vec<f64>,
-    pub best_x: Vec<f64>,
+pub(crate) struct Run {
+    pub(crate) cell: Cell,
+    pub(crate) row: Row,
+    pub(crate) population_best: Vec<f64>,
+    pub(crate) best_so_far: Vec<f64>,
+    pub(crate) best_x: Vec<f64>,
 }
 
 impl runner::Logged for Run {
@@ -87,7 +87,7 @@ impl runner::Logged for Run {
 }
 
 /// The flat list of cells.
-pub fn cells(s: &ClosedCylinderSpec) -> Vec<Cell> {
+pub(crate) fn cells(s: &ClosedCylinderSpec) -> Vec<Cell> {
     s.control_points
         .iter()
         .flat_map(|&control_points| {
@@ -97,14 +97,14 @@ pub fn cells(s: &ClosedCylinderSpec) -> Vec<Cell> {
 }
 
 /// The paper's data: lattice cylinder sorted into rings.
-pub fn data(s: &ClosedCylinderSpec) -> RingData {
+pub(crate) fn data(s: &ClosedCylinderSpec) -> RingData {
     sort_into_rings(
         &lattice_cylinder(s.radius, s.height, s.grid_step, s.accuracy),
         s.grid_step * 1e-3,
     )
 }
 
-pub fn shape(s: &ClosedCylinderSpec, control_points: usize) -> ClosedNetShape {
+pub(crate) fn shape(s: &ClosedCylinderSpec, control_points: usize) -> ClosedNetShape {
     ClosedNetShape {
         order_around: s.order_around,
         order_up: s.order_vertical,
@@ -114,14 +114,15 @@ pub fn shape(s: &ClosedCylinderSpec, control_points: usize) -> ClosedNetShape {
 }
 
 /// The GA problem (and analytical fit) for a number of control points.
-pub fn problem(s: &ClosedCylinderSpec, data: &RingData, control_points: usize) -> Result<RingNetProblem> {
+pub(crate) fn problem(s: &ClosedCylinderSpec, data: &RingData, control_points: usize) -> Result<RingNetProblem> {
     let fit = fit_closed(data, shape(s, control_points))
         .with_context(|| format!("seed004, {control_points} control points"))?;
     Ok(RingNetProblem::new(data, fit, s.search_range).with_measure(s.error))
 }
 
 /// Run one cell (alone it gives the same numbers as inside the full run).
-pub fn run_cell(spec: &Spec, s: &ClosedCylinderSpec, data: &RingData, cell: &Cell) -> Result<Run> {
+#[cfg(test)]
+pub(crate) fn run_cell(spec: &Spec, s: &ClosedCylinderSpec, data: &RingData, cell: &Cell) -> Result<Run> {
     run_cell_on(spec, s, &problem(s, data, cell.control_points)?, cell)
 }
 
@@ -170,7 +171,7 @@ fn run_cell_on(spec: &Spec, s: &ClosedCylinderSpec, problem: &RingNetProblem, ce
 
 /// Run every cell of the spec on `data` (the analytical fit of each number of control points
 /// once, on the worker threads).
-pub fn run(spec: &Spec, s: &ClosedCylinderSpec, ctx: &RunContext, data: &RingData) -> Result<Vec<Run>> {
+pub(crate) fn run(spec: &Spec, s: &ClosedCylinderSpec, ctx: &RunContext, data: &RingData) -> Result<Vec<Run>> {
     let cps: Vec<usize> = crate::report::ordered(s.control_points.iter().copied());
     let problems = runner::run_cells(
         &cps,
@@ -204,7 +205,7 @@ pub fn run(spec: &Spec, s: &ClosedCylinderSpec, ctx: &RunContext, data: &RingDat
 
 /// The analytical method alone at every number of control points from the smallest to the
 /// largest of the spec's list (deterministic and cheap: not logged): (control points, RMS).
-pub fn analytical_sweep(s: &ClosedCylinderSpec, data: &RingData) -> Result<Vec<(usize, f64)>> {
+pub(crate) fn analytical_sweep(s: &ClosedCylinderSpec, data: &RingData) -> Result<Vec<(usize, f64)>> {
     let (lo, hi) = (
         s.control_points.iter().min().copied().unwrap_or(0),
         s.control_points.iter().max().copied().unwrap_or(0),
@@ -214,7 +215,7 @@ pub fn analytical_sweep(s: &ClosedCylinderSpec, data: &RingData) -> Result<Vec<(
 
 /// RMS distance of the data to the exact cylinder (sqrt(x^2 + y^2) - radius): a floor under
 /// every fit's RMS error at the data's own radial scatter.
-pub fn data_floor(s: &ClosedCylinderSpec, data: &RingData) -> f64 {
+pub(crate) fn data_floor(s: &ClosedCylinderSpec, data: &RingData) -> f64 {
     let sse: f64 =
         data.points().map(|p| ((p[0] * p[0] + p[1] * p[1]).sqrt() - s.radius).powi(2)).sum();
     (sse / data.n_points().max(1) as f64).sqrt()
@@ -223,19 +224,18 @@ pub fn data_floor(s: &ClosedCylinderSpec, data: &RingData) -> f64 {
 /// What the Fig. 2(a) analogue draws: the bottom ring of the data, the GA's best curve and its
 /// control polygon, and the analytical curve, all seen from the top (x, y).
 #[derive(Debug, Clone)]
-pub struct TopView {
-    pub control_points: usize,
-    pub cell: String,
-    pub best_rms: f64,
-    pub analytical_rms: f64,
-    pub data: Vec<(f64, f64)>,
-    pub ga_curve: Vec<(f64, f64)>,
-    pub ga_control: Vec<(f64, f64)>,
-    pub analytical_curve: Vec<(f64, f64)>,
+pub(crate) struct TopView {
+    pub(crate) control_points: usize,
+    pub(crate) best_rms: f64,
+    pub(crate) analytical_rms: f64,
+    pub(crate) data: Vec<(f64, f64)>,
+    pub(crate) ga_curve: Vec<(f64, f64)>,
+    pub(crate) ga_control: Vec<(f64, f64)>,
+    pub(crate) analytical_curve: Vec<(f64, f64)>,
 }
 
 /// The top view of the lowest-RMS run at `control_points` (None if there is no such run).
-pub fn top_view(
+pub(crate) fn top_view(
     s: &ClosedCylinderSpec,
     data: &RingData,
     runs: &[Run],
@@ -261,7 +261,6 @@ pub fn top_view(
     ga_control.push(ga_control[0]);
     Ok(Some(TopView {
         control_points,
-        cell: best.row.cell.clone(),
         best_rms: best.row.best_rms,
         analytical_rms: best.row.analytical_rms,
         data: data
@@ -276,7 +275,7 @@ pub fn top_view(
 }
 
 /// Seed 004's family: the `[seed004]` section.
-pub struct ClosedCylinder;
+pub(crate) struct ClosedCylinder;
 
 impl crate::experiment::family::Section for self::spec::ClosedCylinderSpec {
     fn limits(&self, c: &crate::experiment::limits::Check) -> Result<(), SpecError> {

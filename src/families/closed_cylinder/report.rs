@@ -16,7 +16,7 @@ use std::fmt::Write;
 use std::path::Path;
 
 /// Seed 004's Tables II and III.
-pub const PUBLISHED: crate::report::reference::Published = &[
+pub(crate) const PUBLISHED: crate::report::reference::Published = &[
     ("seed004_table2", include_str!("../../../experiments/reference/seed004_table2.csv")),
     ("seed004_table3", include_str!("../../../experiments/reference/seed004_table3.csv")),
 ];
@@ -247,7 +247,7 @@ fn render_pictures(
 }
 
 /// Write the tables and charts; return the REPORT.md section.
-pub fn write(
+pub(crate) fn write(
     spec_name: &str,
     s4: &ClosedCylinderSpec,
     runs: &[Run],

@@ -8,8 +8,8 @@
 //! test; Example III's clean surface and its 628 sampling parameters come from the stream
 //! `seed003/example3/surface`, the same in every run.
 
-pub mod report;
-pub mod spec;
+pub(crate) mod report;
+pub(crate) mod spec;
 
 use crate::experiment::spec::{Spec, SpecError};
 use crate::experiment::{runner, seeds, RunContext};
@@ -21,9 +21,9 @@ use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 
 /// The three examples in order.
-pub const EXAMPLES: [&str; 3] = ["example1", "example2", "example3"];
+pub(crate) const EXAMPLES: [&str; 3] = ["example1", "example2", "example3"];
 /// The five methods in the paper's Table 4 order.
-pub const METHODS: [&str; 5] = ["uniform", "chordal", "centripetal", "csa", "icsa"];
+pub(crate) const METHODS: [&str; 5] = ["uniform", "chordal", "centripetal", "csa", "icsa"];
 
 /// One example's data and budget.
 #[derive(Debug, Clone, Deserialize)]
@@ -44,7 +44,7 @@ pub struct ExampleSpec {
 #[serde(rename_all = "snake_case")]
 pub enum Start {
     /// Section 5.2: "All data parameters are initialized with random numbers within the
-    /// hypercube [0,1]^m x [0,1]^n": U[0, 1] per parameter.
+    /// hypercube \[0,1\]^m x \[0,1\]^n": U[0, 1] per parameter.
     #[default]
     Random,
     /// Section 4.3's per-component bounds low_j^k, up_j^k read as a box around a classical
@@ -192,14 +192,14 @@ impl CuckooBezierSpec {
 
 /// One (example, method, run).
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Cell {
-    pub example: String,
-    pub method: String,
-    pub run: usize,
+pub(crate) struct Cell {
+    pub(crate) example: String,
+    pub(crate) method: String,
+    pub(crate) run: usize,
 }
 
 impl Cell {
-    pub fn key(&self) -> String {
+    pub(crate) fn key(&self) -> String {
         format!("seed003/{}/{}/r{}", self.example, self.method, self.run)
     }
 }
@@ -212,38 +212,38 @@ impl runner::Cell for Cell {
 
 /// One row of runs.csv.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-pub struct Row {
-    pub cell: String,
-    pub example: String,
-    pub method: String,
-    pub run: usize,
+pub(crate) struct Row {
+    pub(crate) cell: String,
+    pub(crate) example: String,
+    pub(crate) method: String,
+    pub(crate) run: usize,
     /// The cell's stream (CSA/ICSA start population and moves).
-    pub seed: String,
+    pub(crate) seed: String,
     /// The stream of the run's noise (shared by the five methods).
-    pub data_seed: String,
-    pub n_points: usize,
-    pub degree: usize,
+    pub(crate) data_seed: String,
+    pub(crate) n_points: usize,
+    pub(crate) degree: usize,
     /// Parameters searched (grid: one per column and row; scattered: two per point).
-    pub dimension: usize,
-    pub snr_db: f64,
+    pub(crate) dimension: usize,
+    pub(crate) snr_db: f64,
     /// Standard deviation of the noise drawn for this run's data.
-    pub noise_sigma: f64,
+    pub(crate) noise_sigma: f64,
     /// Sum of squared distances of the data to the fitted surface (the paper's Eq. 4/5).
-    pub y: f64,
+    pub(crate) y: f64,
     /// sqrt(Y / n_points) (the paper's Eq. 14/15).
-    pub rmse: f64,
+    pub(crate) rmse: f64,
     /// Best Y of the start population (CSA/ICSA); Y itself for a classical parameterisation.
-    pub initial_best_y: f64,
-    pub evaluations: u64,
-    pub iterations: usize,
-    pub cpu_s: f64,
+    pub(crate) initial_best_y: f64,
+    pub(crate) evaluations: u64,
+    pub(crate) iterations: usize,
+    pub(crate) cpu_s: f64,
 }
 
 /// One run with its convergence trace (evaluations, best Y so far).
 #[derive(Debug, Clone)]
-pub struct Run {
-    pub row: Row,
-    pub trace: Vec<(u64, f64)>,
+pub(crate) struct Run {
+    pub(crate) row: Row,
+    pub(crate) trace: Vec<(u64, f64)>,
 }
 
 impl runner::Logged for Run {
@@ -254,7 +254,7 @@ impl runner::Logged for Run {
 }
 
 /// The flat list of cells: examples x methods x runs.
-pub fn cells(s: &CuckooBezierSpec) -> Vec<Cell> {
+pub(crate) fn cells(s: &CuckooBezierSpec) -> Vec<Cell> {
     runner::product_cells(&s.examples, &s.methods, s.runs, |e, m, run| Cell {
         example: e.clone(),
         method: m.clone(),
@@ -263,14 +263,14 @@ pub fn cells(s: &CuckooBezierSpec) -> Vec<Cell> {
 }
 
 /// Data of one run: the points, their layout, and the noise sigma.
-pub struct Data {
-    pub points: Vec<Point3>,
-    pub layout: Layout,
-    pub sigma: f64,
+pub(crate) struct Data {
+    pub(crate) points: Vec<Point3>,
+    pub(crate) layout: Layout,
+    pub(crate) sigma: f64,
 }
 
 /// The clean data of an example (Example III from its fixed stream).
-pub fn clean(master_seed: u64, example: &str, e: &ExampleSpec) -> Result<(Vec<Point3>, Layout)> {
+pub(crate) fn clean(master_seed: u64, example: &str, e: &ExampleSpec) -> Result<(Vec<Point3>, Layout)> {
     Ok(match example {
         "example1" => (
             bezier::height_grid(bezier::franke, e.size, 0.0, 1.0),
@@ -293,7 +293,7 @@ fn data_key(example: &str, run: usize) -> String {
 }
 
 /// Run r's noisy data of an example.
-pub fn data(master_seed: u64, example: &str, e: &ExampleSpec, run: usize) -> Result<Data> {
+pub(crate) fn data(master_seed: u64, example: &str, e: &ExampleSpec, run: usize) -> Result<Data> {
     let (mut points, layout) = clean(master_seed, example, e)?;
     let mut rng = seeds::cell_rng(master_seed, &data_key(example, run));
     let sigma = bezier::add_noise(&mut points, e.snr_db, &mut rng);
@@ -310,7 +310,7 @@ fn classical(method: &str) -> Option<Parameterisation> {
 }
 
 /// The decision vector of a classical parameterisation of the data.
-pub fn classical_start(d: &Data, p: Parameterisation) -> Vec<f64> {
+pub(crate) fn classical_start(d: &Data, p: Parameterisation) -> Vec<f64> {
     match d.layout {
         Layout::Grid { nu, nv } => bezier::classical_grid_start(&d.points, nu, nv, p),
         Layout::Scattered => bezier::classical_scattered_start(&d.points, p),
@@ -320,7 +320,7 @@ pub fn classical_start(d: &Data, p: Parameterisation) -> Vec<f64> {
 /// The CSA/ICSA budget of an example: N nests, G iterations; the start population is uniform on
 /// [0, 1]^dim (centre 0.5, half-width 0.5) under `start = "random"`, else the centre +-
 /// `start_spread`; one trace point every `trace_every` iterations (2N evaluations per iteration).
-pub fn budget(s: &CuckooBezierSpec, e: &ExampleSpec) -> Budget {
+pub(crate) fn budget(s: &CuckooBezierSpec, e: &ExampleSpec) -> Budget {
     Budget {
         generations: e.generations as u64,
         population: s.nests,
@@ -330,7 +330,7 @@ pub fn budget(s: &CuckooBezierSpec, e: &ExampleSpec) -> Budget {
 }
 
 /// Run one cell (alone it gives the same numbers as inside the full run).
-pub fn run_cell(spec: &Spec, s: &CuckooBezierSpec, cell: &Cell) -> Result<Run> {
+pub(crate) fn run_cell(spec: &Spec, s: &CuckooBezierSpec, cell: &Cell) -> Result<Run> {
     let e = s
         .example(&cell.example)
         .with_context(|| format!("seed003.examples: unknown example `{}`", cell.example))?;
@@ -390,7 +390,7 @@ pub fn run_cell(spec: &Spec, s: &CuckooBezierSpec, cell: &Cell) -> Result<Run> {
 }
 
 /// Run every cell of the spec.
-pub fn run(spec: &Spec, s: &CuckooBezierSpec, ctx: &RunContext) -> Result<Vec<Run>> {
+pub(crate) fn run(spec: &Spec, s: &CuckooBezierSpec, ctx: &RunContext) -> Result<Vec<Run>> {
     let cells = cells(s);
     runner::run_logged(
         &cells,
@@ -402,7 +402,7 @@ pub fn run(spec: &Spec, s: &CuckooBezierSpec, ctx: &RunContext) -> Result<Vec<Ru
 }
 
 /// Seed 003's family: the `[seed003]` section.
-pub struct CuckooBezier;
+pub(crate) struct CuckooBezier;
 
 impl crate::experiment::family::Section for CuckooBezierSpec {
     fn limits(&self, c: &crate::experiment::limits::Check) -> Result<(), SpecError> {

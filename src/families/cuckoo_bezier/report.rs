@@ -60,7 +60,7 @@ fn table(name: &str) -> Option<RefTable> {
 }
 
 /// Seed 003's Tables 3, 4 and 5.
-pub const PUBLISHED: crate::report::reference::Published = &[
+pub(crate) const PUBLISHED: crate::report::reference::Published = &[
     ("seed003_table3", include_str!("../../../experiments/reference/seed003_table3.csv")),
     ("seed003_table4", include_str!("../../../experiments/reference/seed003_table4.csv")),
     ("seed003_table5", include_str!("../../../experiments/reference/seed003_table5.csv")),
@@ -130,7 +130,7 @@ fn start_text(s: &CuckooBezierSpec) -> String {
 }
 
 /// Write runs.csv, the tables and the pictures; return the REPORT.md section.
-pub fn write(spec_name: &str, s: &CuckooBezierSpec, runs: &[Run], out: &Path) -> Result<String> {
+pub(crate) fn write(spec_name: &str, s: &CuckooBezierSpec, runs: &[Run], out: &Path) -> Result<String> {
     let rows: Vec<_> = runs.iter().map(|r| r.row.clone()).collect();
     crate::io::write_atomic(&out.join("runs.csv"), crate::io::csv_text(&rows)?.as_bytes())?;
     let examples: Vec<&str> =

@@ -94,10 +94,10 @@ fn net_rows(surfaces: &[(&str, &BSplineSurface)]) -> Vec<Vec<String>> {
 }
 
 /// `--samples`: evaluations per direction of the OBJ mesh (two make one quad per surface).
-pub const MIN_SAMPLES: usize = 2;
-pub const MAX_SAMPLES: usize = 1000;
+pub(crate) const MIN_SAMPLES: usize = 2;
+pub(crate) const MAX_SAMPLES: usize = 1000;
 
-pub fn fit(args: &FitArgs) -> Result<()> {
+pub(crate) fn fit(args: &FitArgs) -> Result<()> {
     let cn: GridSize = args.cn.parse().map_err(anyhow::Error::msg).context("--cn")?;
     let param: Parameterisation =
         args.param.parse().map_err(anyhow::Error::msg).context("--param")?;

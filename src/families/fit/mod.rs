@@ -1,10 +1,10 @@
 //! Chapter 5 wiring: read (or recompute) the DNSOM maps, fit every cell, log each at once.
 
-pub mod command;
-pub mod pictures;
-pub mod readings;
-pub mod report;
-pub mod spec;
+pub(crate) mod command;
+pub(crate) mod pictures;
+pub(crate) mod readings;
+pub(crate) mod report;
+pub(crate) mod spec;
 
 use super::maps::{maps_for, require_maps, MapSource, MapsFrom};
 use crate::experiment::spec::{Spec, SpecError};
@@ -17,36 +17,36 @@ use std::collections::BTreeMap;
 
 /// One row of a Chapter 5 `runs.csv`.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-pub struct FitRow {
-    pub cell: String,
-    pub dataset: String,
-    pub grid_x: usize,
-    pub grid_y: usize,
-    pub cn_x: usize,
-    pub cn_y: usize,
-    pub parameterisation: String,
-    pub approach: String,
+pub(crate) struct FitRow {
+    pub(crate) cell: String,
+    pub(crate) dataset: String,
+    pub(crate) grid_x: usize,
+    pub(crate) grid_y: usize,
+    pub(crate) cn_x: usize,
+    pub(crate) cn_y: usize,
+    pub(crate) parameterisation: String,
+    pub(crate) approach: String,
     /// Eq. 5.13 over the NOV grid classes.
-    pub surface_error: f64,
+    pub(crate) surface_error: f64,
     /// Largest distance between the two fitted surfaces along the shared border.
-    pub gap: f64,
+    pub(crate) gap: f64,
     /// The readings the fit used (docs/readings.md).
-    pub knots: String,
-    pub error_a: String,
+    pub(crate) knots: String,
+    pub(crate) error_a: String,
     /// Between the data points (dense evaluation): largest distance of a surface point from the
     /// data's bounding box, largest absolute control-point coordinate, largest border gap.
-    pub excursion: f64,
-    pub max_control: f64,
-    pub dense_gap: f64,
-    pub cpu_s: f64,
+    pub(crate) excursion: f64,
+    pub(crate) max_control: f64,
+    pub(crate) dense_gap: f64,
+    pub(crate) cpu_s: f64,
 }
 
 /// One fitted cell.
 #[derive(Debug, Clone)]
-pub struct FitRun {
-    pub cell: FitCell,
-    pub row: FitRow,
-    pub fit: TwoSurfaceFit,
+pub(crate) struct FitRun {
+    pub(crate) cell: FitCell,
+    pub(crate) row: FitRow,
+    pub(crate) fit: TwoSurfaceFit,
 }
 
 impl runner::Logged for FitRun {
@@ -58,7 +58,7 @@ impl runner::Logged for FitRun {
 
 /// Read each data set's map from the maps folder, or recompute it exactly as Chapter 4 does (same
 /// cell key, seed and settings); every map used is copied into `<out>/maps/`.
-pub fn maps(
+pub(crate) fn maps(
     spec: &Spec,
     fit: &spec::FitSpec,
     ctx: &RunContext,
@@ -74,7 +74,7 @@ pub fn maps(
 
 
 /// Fit one cell.
-pub fn run_cell(cell: &FitCell, grid: &TwoViewGrid, opts: &FitOptions) -> Result<FitRun> {
+pub(crate) fn run_cell(cell: &FitCell, grid: &TwoViewGrid, opts: &FitOptions) -> Result<FitRun> {
     let (fit, cpu_s) =
         runner::timed(|| fit_two_view(grid, cell.cn.nx, cell.cn.ny, cell.param, cell.approach, opts));
     let fit = fit.with_context(|| cell.key())?;
@@ -109,7 +109,7 @@ pub fn run_cell(cell: &FitCell, grid: &TwoViewGrid, opts: &FitOptions) -> Result
 }
 
 /// Run every fit cell of a spec.
-pub fn run(
+pub(crate) fn run(
     spec: &Spec,
     fit: &spec::FitSpec,
     ctx: &RunContext,
@@ -129,7 +129,7 @@ pub fn run(
 }
 
 /// Chapter 5's family: the `[fit]` section.
-pub struct Fit;
+pub(crate) struct Fit;
 
 impl crate::experiment::family::Section for self::spec::FitSpec {
     fn limits(&self, c: &crate::experiment::limits::Check) -> Result<(), SpecError> {

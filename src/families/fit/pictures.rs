@@ -25,7 +25,7 @@ fn surface_meshes(run: &FitRun) -> Vec<LineMesh> {
 }
 
 /// Write the pictures of one grid size; returns their paths relative to `out`.
-pub fn write(runs: &[FitRun], grid: GridSize, out: &Path) -> Result<Vec<String>> {
+pub(crate) fn write(runs: &[FitRun], grid: GridSize, out: &Path) -> Result<Vec<String>> {
     let mut written = Vec::new();
     let appendix = match (grid.nx, grid.ny) {
         (20, 20) => "appendix_g".to_string(),
@@ -124,7 +124,7 @@ pub fn write(runs: &[FitRun], grid: GridSize, out: &Path) -> Result<Vec<String>>
 /// along the grid rows and columns) and, per approach, the fitted surfaces evaluated densely of
 /// the cell whose surfaces go furthest from the data (largest `excursion`), so a blow-up between
 /// the data points shows.
-pub fn views(
+pub(crate) fn views(
     runs: &[FitRun],
     maps: &[(String, &crate::double_net::TwoViewGrid)],
 ) -> Vec<crate::report::views3d::View> {

@@ -19,7 +19,7 @@ struct FitPoint {
 
 /// The readings matrix's chart: the first fit spec every reading ran, its first data set, chord
 /// length, approach B; nothing when no reading ran a fit spec.
-pub fn combine(view: &PlanView<super::spec::FitSpec>) -> Result<Combined> {
+pub(crate) fn combine(view: &PlanView<super::spec::FitSpec>) -> Result<Combined> {
     let mut readings = Vec::new();
     if let Some(chart) = error_vs_excursion(view)? {
         readings.push(format!("\n![{chart}]({chart})\n\nSurface error against the largest distance of the fitted surfaces from the data's bounding box (log scale), one point per control net, for one data set under each reading: a reading can lower the error at the data points while its surfaces leave the data between them.\n"));

@@ -14,7 +14,7 @@ use std::fmt::Write;
 use std::path::Path;
 
 /// The thesis' Appendices E and F (surface error of approaches A and B).
-pub const PUBLISHED: crate::report::reference::Published = &[
+pub(crate) const PUBLISHED: crate::report::reference::Published = &[
     ("appendix_e", include_str!("../../../experiments/reference/appendix_e.csv")),
     ("appendix_f", include_str!("../../../experiments/reference/appendix_f.csv")),
 ];
@@ -377,7 +377,7 @@ fn side_by_side_table(g: &GridRuns) -> (Vec<String>, Rows) {
 
 /// Write every Chapter 5 file (tables computed first, then rendered); returns the REPORT.md
 /// section.
-pub fn write(
+pub(crate) fn write(
     spec_name: &str,
     runs: &[FitRun],
     out: &Path,

@@ -85,7 +85,7 @@ pub(crate) fn validate(spec: &Spec, fit: &FitSpec) -> Result<(), SpecError> {
 }
 
 /// The flat list of fit cells (data set x control net x parameterisation x approach).
-pub fn cells(fit: &FitSpec) -> Vec<FitCell> {
+pub(crate) fn cells(fit: &FitSpec) -> Vec<FitCell> {
     let mut cells = Vec::new();
     for dataset in &fit.datasets {
         for cn in &fit.control_nets {
@@ -107,12 +107,12 @@ pub fn cells(fit: &FitSpec) -> Vec<FitCell> {
 
 /// One Chapter 5 cell: a two-surface fit of one DNSOM map (deterministic: no random stream).
 #[derive(Debug, Clone, PartialEq)]
-pub struct FitCell {
-    pub dataset: String,
-    pub grid: GridSize,
-    pub cn: GridSize,
-    pub param: crate::spline::Parameterisation,
-    pub approach: crate::spline::Approach,
+pub(crate) struct FitCell {
+    pub(crate) dataset: String,
+    pub(crate) grid: GridSize,
+    pub(crate) cn: GridSize,
+    pub(crate) param: crate::spline::Parameterisation,
+    pub(crate) approach: crate::spline::Approach,
 }
 
 impl crate::experiment::runner::Cell for FitCell {
@@ -122,7 +122,7 @@ impl crate::experiment::runner::Cell for FitCell {
 }
 
 impl FitCell {
-    pub fn key(&self) -> String {
+    pub(crate) fn key(&self) -> String {
         format!(
             "fit/{}/{}/{}/{}/{}",
             self.dataset,

@@ -2,8 +2,8 @@
 //! cubic B-spline problem per (data, net, parameterisation) from the least-squares fit of that map,
 //! then every (problem, optimiser, repeat) cell on its own stream, logged at once.
 
-pub mod report;
-pub mod spec;
+pub(crate) mod report;
+pub(crate) mod spec;
 
 use crate::data::registry;
 use crate::experiment::spec::{GridSize, Spec, SpecError};
@@ -20,27 +20,27 @@ use std::collections::BTreeMap;
 
 /// One grown map.
 #[derive(Debug, Clone)]
-pub struct MapRun {
-    pub dataset: String,
-    pub points: usize,
-    pub map: grown::GrowingGrid,
-    pub qe: f64,
-    pub te: f64,
-    pub cpu_s: f64,
+pub(crate) struct MapRun {
+    pub(crate) dataset: String,
+    pub(crate) points: usize,
+    pub(crate) map: grown::GrowingGrid,
+    pub(crate) qe: f64,
+    pub(crate) te: f64,
+    pub(crate) cpu_s: f64,
 }
 
 /// One optimisation cell.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Cell {
-    pub dataset: String,
-    pub cn: GridSize,
-    pub param: Parameterisation,
-    pub optimiser: String,
-    pub repeat: usize,
+pub(crate) struct Cell {
+    pub(crate) dataset: String,
+    pub(crate) cn: GridSize,
+    pub(crate) param: Parameterisation,
+    pub(crate) optimiser: String,
+    pub(crate) repeat: usize,
 }
 
 impl Cell {
-    pub fn key(&self) -> String {
+    pub(crate) fn key(&self) -> String {
         format!(
             "seed001/{}/{}/{}/{}/r{}",
             self.dataset,
@@ -54,34 +54,34 @@ impl Cell {
 
 /// One row of `runs.csv`.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-pub struct Row {
-    pub cell: String,
-    pub dataset: String,
-    pub grid_x: usize,
-    pub grid_y: usize,
-    pub cn_x: usize,
-    pub cn_y: usize,
-    pub parameterisation: String,
-    pub optimiser: String,
-    pub repeat: usize,
-    pub seed: String,
-    pub dimension: usize,
+pub(crate) struct Row {
+    pub(crate) cell: String,
+    pub(crate) dataset: String,
+    pub(crate) grid_x: usize,
+    pub(crate) grid_y: usize,
+    pub(crate) cn_x: usize,
+    pub(crate) cn_y: usize,
+    pub(crate) parameterisation: String,
+    pub(crate) optimiser: String,
+    pub(crate) repeat: usize,
+    pub(crate) seed: String,
+    pub(crate) dimension: usize,
     /// Surface error (Eq. 5.13, one view) of the least-squares net, the start.
-    pub lsq: f64,
-    pub initial_best: f64,
+    pub(crate) lsq: f64,
+    pub(crate) initial_best: f64,
     /// Best surface error found.
-    pub best: f64,
+    pub(crate) best: f64,
     /// best / number of grid points: mean distance per grid point.
-    pub best_per_point: f64,
-    pub evaluations: u64,
-    pub cpu_s: f64,
+    pub(crate) best_per_point: f64,
+    pub(crate) evaluations: u64,
+    pub(crate) cpu_s: f64,
 }
 
 #[derive(Debug, Clone)]
-pub struct Run {
-    pub cell: Cell,
-    pub row: Row,
-    pub best_x: Vec<f64>,
+pub(crate) struct Run {
+    pub(crate) cell: Cell,
+    pub(crate) row: Row,
+    pub(crate) best_x: Vec<f64>,
 }
 
 impl runner::Cell for Cell {
@@ -99,10 +99,10 @@ impl runner::Logged for Run {
 }
 
 /// A problem: (data set, control net, parameterisation).
-pub type ProblemKey = (String, GridSize, Parameterisation);
+pub(crate) type ProblemKey = (String, GridSize, Parameterisation);
 
 /// Every cell in a fixed order: data, net, parameterisation, optimiser, repeat.
-pub fn cells(g: &GrowingGridSpec) -> Vec<Cell> {
+pub(crate) fn cells(g: &GrowingGridSpec) -> Vec<Cell> {
     let mut out = Vec::new();
     for d in g.datasets.iter().map(|d| registry::name_of(d)) {
         for &cn in &g.control_nets {
@@ -125,7 +125,7 @@ pub fn cells(g: &GrowingGridSpec) -> Vec<Cell> {
 }
 
 /// Grow one map per data set (in parallel; each on its own stream).
-pub fn maps(spec: &Spec, g: &GrowingGridSpec, ctx: &RunContext) -> Result<Vec<MapRun>> {
+pub(crate) fn maps(spec: &Spec, g: &GrowingGridSpec, ctx: &RunContext) -> Result<Vec<MapRun>> {
     let params = g.params();
     let data: Vec<(String, Vec<Point3>)> = g
         .datasets
@@ -155,7 +155,7 @@ pub fn maps(spec: &Spec, g: &GrowingGridSpec, ctx: &RunContext) -> Result<Vec<Ma
 }
 
 /// The problem of every (data, net, parameterisation).
-pub fn problems(
+pub(crate) fn problems(
     g: &GrowingGridSpec,
     maps: &[MapRun],
 ) -> Result<BTreeMap<ProblemKey, OpenSurfaceProblem>> {
@@ -186,7 +186,7 @@ fn optimiser<'a>(g: &'a GrowingGridSpec, name: &str) -> Result<&'a dyn Optimiser
 }
 
 /// Run one cell (alone or inside the full run: the same numbers).
-pub fn run_cell(
+pub(crate) fn run_cell(
     spec: &Spec,
     g: &GrowingGridSpec,
     cell: &Cell,
@@ -225,7 +225,7 @@ pub fn run_cell(
 }
 
 /// Run every cell of the spec.
-pub fn run(
+pub(crate) fn run(
     spec: &Spec,
     g: &GrowingGridSpec,
     ctx: &RunContext,
@@ -242,7 +242,7 @@ pub fn run(
 }
 
 /// Seed 001's family: the `[growing_grid]` section.
-pub struct GrowingGrid;
+pub(crate) struct GrowingGrid;
 
 impl crate::experiment::family::Section for self::spec::GrowingGridSpec {
     fn limits(&self, c: &crate::experiment::limits::Check) -> Result<(), SpecError> {

@@ -24,7 +24,7 @@ fn write_csv(out: &Path, name: &str, header: &[&str], rows: &[Vec<String>]) -> R
 }
 
 /// Write the tables and pictures; return the REPORT.md section.
-pub fn write(
+pub(crate) fn write(
     maps: &[MapRun],
     problems: &BTreeMap<ProblemKey, OpenSurfaceProblem>,
     runs: &[Run],

@@ -17,7 +17,7 @@ type CellKey = (String, usize, usize, usize, usize, String);
 /// The blocks x treatments table of the Friedman test: one row per cell (data, grid, net,
 /// parameterisation) that every optimiser ran, the mean best fitness over repeats of each
 /// optimiser (in order of first appearance).
-pub fn friedman_table(rows: &[OptimRow]) -> (Vec<String>, Vec<Vec<f64>>) {
+pub(crate) fn friedman_table(rows: &[OptimRow]) -> (Vec<String>, Vec<Vec<f64>>) {
     let mut opts: Vec<String> = Vec::new();
     let mut cells: BTreeMap<CellKey, BTreeMap<String, (f64, usize)>> = BTreeMap::new();
     for r in rows {
@@ -358,8 +358,8 @@ fn runtime_outputs(
 
 /// `--bayes-samples`: Monte Carlo samples of the Bayesian signed-rank test (below the lower
 /// bound its probabilities move in the second digit; above the upper one a run takes minutes).
-pub const MIN_BAYES_SAMPLES: usize = 1_000;
-pub const MAX_BAYES_SAMPLES: usize = 10_000_000;
+pub(crate) const MIN_BAYES_SAMPLES: usize = 1_000;
+pub(crate) const MAX_BAYES_SAMPLES: usize = 10_000_000;
 
 /// The options' ranges, before anything is read: `--alpha` in (0, 1), `--rope` finite and >= 0,
 /// `--bayes-samples` in [[`MIN_BAYES_SAMPLES`], [`MAX_BAYES_SAMPLES`]].
@@ -381,7 +381,7 @@ fn check_args(args: &CompareArgs) -> Result<()> {
 
 /// `somnurbs compare`: pairwise tests per cell, Friedman and Bayesian tests over cells, runtime
 /// distributions from the traces; tables into the folder, a summary on stdout.
-pub fn compare(args: &CompareArgs) -> Result<()> {
+pub(crate) fn compare(args: &CompareArgs) -> Result<()> {
     check_args(args)?;
     if !args.results.is_dir() {
         anyhow::bail!(
@@ -462,7 +462,7 @@ pub fn compare(args: &CompareArgs) -> Result<()> {
 }
 
 /// The folder `compare` writes into by default, inside the results folder it compares.
-pub const OUT_DIR: &str = "compare";
+pub(crate) const OUT_DIR: &str = "compare";
 /// The record `compare` writes last in its folder (what it compared, with which options).
 const RECORD: &str = "compare.toml";
 

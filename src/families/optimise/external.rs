@@ -135,15 +135,15 @@ fn check_suite(v: &Value, suite: &[String; 4], file: &Path, results: &Path) -> R
 /// What the external folders add to `compare`: their runs' traces and, per problem, the certified
 /// optimum their logs carry (run attribute `somnurbs_optimum`).
 #[derive(Debug, Default)]
-pub struct External {
-    pub traces: Vec<LoadedProblem>,
-    pub optima: BTreeMap<String, f64>,
+pub(crate) struct External {
+    pub(crate) traces: Vec<LoadedProblem>,
+    pub(crate) optima: BTreeMap<String, f64>,
 }
 
 impl External {
     /// The certified optima of the results folder (`exact_<grid>.csv`), with the external logs'
     /// for the problems it has none of (a folder run without `exact = true`).
-    pub fn add_optima(&self, certified: &mut BTreeMap<String, f64>) {
+    pub(crate) fn add_optima(&self, certified: &mut BTreeMap<String, f64>) {
         for (k, f) in &self.optima {
             certified.entry(k.clone()).or_insert(*f);
         }
@@ -224,7 +224,7 @@ fn read_file(
 
 /// The runs of the external folders, as runs.csv rows beside `rows` (the folder's) and as the
 /// traces and optima of the runtime statistics; `rows` with the external ones appended.
-pub fn join(
+pub(crate) fn join(
     results: &Path,
     folders: &[PathBuf],
     mut rows: Vec<OptimRow>,

@@ -11,14 +11,14 @@ use anyhow::{Context, Result};
 use std::path::Path;
 
 /// The IOHprofiler function name of a run's problem.
-pub fn problem_name(dataset: &str, grid: &str, cn: &str, param: &str) -> String {
+pub(crate) fn problem_name(dataset: &str, grid: &str, cn: &str, param: &str) -> String {
     format!("{dataset}_{grid}_{cn}_{param}")
 }
 
 /// Write `ioh/<optimiser>/` for every optimiser and problem of the runs (and remove the `.info`
 /// files an older version wrote there, which would stop IOHanalyzer's format detection); returns
 /// the number of (optimiser, problem) pairs.
-pub fn write(runs: &[OptimRun], out: &Path) -> Result<usize> {
+pub(crate) fn write(runs: &[OptimRun], out: &Path) -> Result<usize> {
     let mut problems: Vec<String> = Vec::new();
     let mut opts: Vec<String> = Vec::new();
     let key = |r: &OptimRun| {
@@ -86,15 +86,15 @@ fn remove_info_files(dir: &Path) -> Result<()> {
 /// The runs of one optimiser on one problem, read back from a folder's `ioh/`: (evaluations,
 /// improvement rows) per run in the JSON's order.
 #[derive(Debug, Clone, PartialEq)]
-pub struct LoadedProblem {
-    pub optimiser: String,
-    pub function_name: String,
-    pub runs: Vec<(u64, Vec<(u64, f64)>)>,
+pub(crate) struct LoadedProblem {
+    pub(crate) optimiser: String,
+    pub(crate) function_name: String,
+    pub(crate) runs: Vec<(u64, Vec<(u64, f64)>)>,
 }
 
 /// Read every `ioh/<optimiser>/IOHprofiler_*.json` of a folder and its `.dat` file (sorted by
 /// optimiser folder and file name). Errors name the file.
-pub fn read(folder: &Path) -> Result<Vec<LoadedProblem>> {
+pub(crate) fn read(folder: &Path) -> Result<Vec<LoadedProblem>> {
     let root = folder.join("ioh");
     let mut out = Vec::new();
     let mut dirs: Vec<_> = std::fs::read_dir(&root)

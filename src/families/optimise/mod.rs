@@ -2,18 +2,17 @@
 //! optimiser of a cell starts from the same control net (paired comparisons); each (cell, repeat)
 //! runs on its own stream and is logged at once.
 
-pub mod compare;
-pub mod external;
-pub mod ioh;
-pub mod overall;
-pub mod pictures;
-pub mod report;
-pub mod spec;
+pub(crate) mod compare;
+pub(crate) mod external;
+pub(crate) mod ioh;
+pub(crate) mod overall;
+pub(crate) mod pictures;
+pub(crate) mod report;
+pub(crate) mod spec;
 
 use crate::experiment::spec::GridSize;
 use crate::experiment::spec::{Spec, SpecError};
 use crate::experiment::{runner, seeds, RunContext};
-use spec::OptimSpec;
 use crate::families::maps;
 use crate::optim::{Budget, Optimiser, Problem};
 use crate::spline::BoxSpec;
@@ -23,40 +22,41 @@ use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 use spec::OptimCell;
 use std::collections::BTreeMap;
+pub use spec::OptimSpec;
 
 /// One row of a Chapter 6 `runs.csv`.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-pub struct OptimRow {
-    pub cell: String,
-    pub dataset: String,
-    pub grid_x: usize,
-    pub grid_y: usize,
-    pub cn_x: usize,
-    pub cn_y: usize,
-    pub parameterisation: String,
-    pub optimiser: String,
+pub(crate) struct OptimRow {
+    pub(crate) cell: String,
+    pub(crate) dataset: String,
+    pub(crate) grid_x: usize,
+    pub(crate) grid_y: usize,
+    pub(crate) cn_x: usize,
+    pub(crate) cn_y: usize,
+    pub(crate) parameterisation: String,
+    pub(crate) optimiser: String,
     /// The swept settings of a `--sweep` run (e.g. `optim.de.f=0.5`); no column otherwise.
     #[serde(default, skip_serializing_if = "String::is_empty")]
-    pub variant: String,
-    pub repeat: usize,
-    pub seed: String,
-    pub dimension: usize,
+    pub(crate) variant: String,
+    pub(crate) repeat: usize,
+    pub(crate) seed: String,
+    pub(crate) dimension: usize,
     /// Surface error of approach B (the start).
-    pub b: f64,
+    pub(crate) b: f64,
     /// Best fitness of the initial population.
-    pub initial_best: f64,
+    pub(crate) initial_best: f64,
     /// Best fitness found (Eq. 6.2).
-    pub best: f64,
-    pub evaluations: u64,
+    pub(crate) best: f64,
+    pub(crate) evaluations: u64,
     /// The best surfaces between the data points (dense evaluation, see `spline::geometry`).
-    pub excursion: f64,
-    pub max_control: f64,
-    pub cpu_s: f64,
+    pub(crate) excursion: f64,
+    pub(crate) max_control: f64,
+    pub(crate) cpu_s: f64,
 }
 
 impl OptimRow {
     /// What `compare` and the tables rank: the optimiser, or in a sweep `optimiser@variant`.
-    pub fn competitor(&self) -> String {
+    pub(crate) fn competitor(&self) -> String {
         if self.variant.is_empty() {
             self.optimiser.clone()
         } else {
@@ -67,31 +67,31 @@ impl OptimRow {
 
 /// One optimiser run.
 #[derive(Debug, Clone)]
-pub struct OptimRun {
-    pub cell: OptimCell,
+pub(crate) struct OptimRun {
+    pub(crate) cell: OptimCell,
     /// What the tables, charts and `compare` rank it as: its optimiser, or in a sweep
     /// `optimiser@variant` ([`OptimRow::competitor`]).
-    pub competitor: String,
-    pub row: OptimRow,
-    pub trace: Vec<(u64, f64)>,
+    pub(crate) competitor: String,
+    pub(crate) row: OptimRow,
+    pub(crate) trace: Vec<(u64, f64)>,
     /// (evaluation, fitness) at every improvement of the best so far, from evaluation 1 (the
     /// IOHprofiler `.dat` rows and the runtime distributions of `compare`).
-    pub improvements: Vec<(u64, f64)>,
+    pub(crate) improvements: Vec<(u64, f64)>,
     /// The best control points found (for the pictures of Appendices I/J).
-    pub best_x: Vec<f64>,
+    pub(crate) best_x: Vec<f64>,
 }
 
 /// What the cell log keeps of a run (a log written before `improvements` existed does not fit:
 /// `--resume` then names the cell and stops, as for any change of the record).
 #[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct OptimRecord {
-    pub row: OptimRow,
-    pub trace: Vec<(u64, f64)>,
-    pub improvements: Vec<(u64, f64)>,
+pub(crate) struct OptimRecord {
+    pub(crate) row: OptimRow,
+    pub(crate) trace: Vec<(u64, f64)>,
+    pub(crate) improvements: Vec<(u64, f64)>,
 }
 
 /// A problem: (data set, control net, parameterisation); the grid is the spec's one.
-pub type ProblemKey = (String, GridSize, Parameterisation);
+pub(crate) type ProblemKey = (String, GridSize, Parameterisation);
 
 /// The certified exact optimum of every problem, when the spec asks for it (deterministic, so
 /// computed once per problem and in parallel).
@@ -119,7 +119,7 @@ pub fn exact_optima(
 }
 
 /// Build the optimiser a cell names, with the spec's parameters.
-pub fn optimiser<'a>(o: &'a OptimSpec, name: &str) -> Result<&'a dyn Optimiser> {
+pub(crate) fn optimiser<'a>(o: &'a OptimSpec, name: &str) -> Result<&'a dyn Optimiser> {
     crate::optim::pick(&o.offered(), name).with_context(|| format!("unknown optimiser `{name}`"))
 }
 
@@ -160,7 +160,7 @@ pub fn problems(
 }
 
 /// Run one cell (also alone: the same numbers as inside the full run).
-pub fn run_cell(
+pub(crate) fn run_cell(
     spec: &Spec,
     o: &OptimSpec,
     cell: &OptimCell,
@@ -230,7 +230,7 @@ fn pictured(cell: &OptimCell, largest: GridSize) -> bool {
 }
 
 /// Run every optimisation cell of a spec (its shard's, with `--shard`).
-pub fn run(
+pub(crate) fn run(
     spec: &Spec,
     o: &OptimSpec,
     ctx: &RunContext,
@@ -319,7 +319,7 @@ fn picture_points<'a>(
 }
 
 /// One sentence on the start and the search box of a spec's runs, for the report.
-pub fn setting(o: &OptimSpec) -> String {
+pub(crate) fn setting(o: &OptimSpec) -> String {
     let fair = if o.fairness > 0.0 { format!(", fairness {:e}", o.fairness) } else { String::new() };
     let start = format!(
         "Readings: knots `{}`{fair} (docs/readings.md). Each individual starts at B + U[-{r:e}, {r:e}] per coordinate",
@@ -334,7 +334,7 @@ pub fn setting(o: &OptimSpec) -> String {
 }
 
 /// Chapter 6's family: the `[optim]` section.
-pub struct Optim;
+pub(crate) struct Optim;
 
 /// What `--sweep` may vary in `[optim]`: every registered optimiser's table (a table the section
 /// does not have is refused when the variant is read) and the run's budget and start range.

@@ -18,7 +18,7 @@ const GRIDS: [(usize, usize); 2] = [(20, 20), (18, 30)];
 
 /// The plan's thesis protocol (the first spec on each grid without the exact solve), Tables 6.8
 /// and 6.9 from its win tables, the claims summed over both grids; the other specs are beyond.
-pub fn combine(view: &PlanView<OptimSpec>) -> Result<Combined> {
+pub(crate) fn combine(view: &PlanView<OptimSpec>) -> Result<Combined> {
     let protocol: Vec<(&str, (usize, usize))> = GRIDS
         .iter()
         .filter_map(|&g| {

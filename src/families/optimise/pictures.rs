@@ -18,7 +18,7 @@ const COARSE_SIDE: usize = 16;
 
 /// One view per (grid, data set): the data (both DNSOM views) and the bottom and top surfaces of
 /// the run whose best control net has the largest dense excursion.
-pub fn views(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProblem>) -> Vec<View> {
+pub(crate) fn views(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNetProblem>) -> Vec<View> {
     let far = super::furthest(runs);
     let mut views = Vec::new();
     // Grids, then data sets, in the order the runs name them.

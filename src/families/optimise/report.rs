@@ -34,7 +34,7 @@ fn stats(v: &[f64]) -> Option<(f64, f64, f64)> {
 type CellKey = (String, Parameterisation, GridSize);
 
 /// The thesis' Appendices K and L (optimised surface error) and M and N (CPU time).
-pub const PUBLISHED: crate::report::reference::Published = &[
+pub(crate) const PUBLISHED: crate::report::reference::Published = &[
     ("appendix_k", include_str!("../../../experiments/reference/appendix_k.csv")),
     ("appendix_l", include_str!("../../../experiments/reference/appendix_l.csv")),
     ("appendix_m", include_str!("../../../experiments/reference/appendix_m.csv")),
@@ -432,7 +432,7 @@ fn winners_by_net(t: &GridTables, grid: GridSize, err_name: &str, out: &Path, ex
 }
 
 /// An optimiser's name as the reports write it (GA, DE, PSO, CSA, ICSA).
-pub fn label(o: &str) -> String {
+pub(crate) fn label(o: &str) -> String {
     o.to_uppercase()
 }
 
@@ -669,7 +669,7 @@ fn write_grid(
 }
 
 /// Write every Chapter 6 file; returns the REPORT.md section.
-pub fn write(
+pub(crate) fn write(
     spec_name: &str,
     runs: &[OptimRun],
     problems: &BTreeMap<ProblemKey, ControlNetProblem>,
@@ -951,7 +951,7 @@ fn friedman_section(runs: &[OptimRun]) -> String {
 
 /// The thesis' names of a grid's tables: (errors appendix, CPU appendix, error wins, time wins);
 /// None for a grid the thesis did not use.
-pub fn table_names(
+pub(crate) fn table_names(
     nx: usize,
     ny: usize,
 ) -> Option<(&'static str, &'static str, &'static str, &'static str)> {

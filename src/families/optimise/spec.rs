@@ -157,7 +157,7 @@ pub(crate) fn validate(spec: &Spec, o: &OptimSpec) -> Result<(), SpecError> {
 }
 
 /// The flat list of optimisation cells (data x net x parameterisation x optimiser x repeat).
-pub fn cells(spec: &Spec, o: &OptimSpec) -> Vec<OptimCell> {
+pub(crate) fn cells(spec: &Spec, o: &OptimSpec) -> Vec<OptimCell> {
     let mut cells = Vec::new();
     for dataset in &o.datasets {
         for cn in &o.control_nets {
@@ -183,16 +183,16 @@ pub fn cells(spec: &Spec, o: &OptimSpec) -> Vec<OptimCell> {
 
 /// One Chapter 6 cell: one optimiser run from approach B's control net.
 #[derive(Debug, Clone, PartialEq)]
-pub struct OptimCell {
-    pub dataset: String,
-    pub grid: GridSize,
-    pub cn: GridSize,
-    pub param: crate::spline::Parameterisation,
-    pub optimiser: String,
-    pub repeat: usize,
+pub(crate) struct OptimCell {
+    pub(crate) dataset: String,
+    pub(crate) grid: GridSize,
+    pub(crate) cn: GridSize,
+    pub(crate) param: crate::spline::Parameterisation,
+    pub(crate) optimiser: String,
+    pub(crate) repeat: usize,
     /// The spec variant's changes ([`Variant::key`](crate::experiment::spec::Variant::key);
     /// empty for a plain run).
-    pub variant: String,
+    pub(crate) variant: String,
 }
 
 impl crate::experiment::runner::Cell for OptimCell {
@@ -204,7 +204,7 @@ impl crate::experiment::runner::Cell for OptimCell {
 impl OptimCell {
     /// `optim/<data>/<grid>/<net>/<param>/<optimiser>/r<repeat>`; a variant's cells begin
     /// `optim[<changes>]/`, so their seeds differ from the plain run's and from each other's.
-    pub fn key(&self) -> String {
+    pub(crate) fn key(&self) -> String {
         let head = if self.variant.is_empty() {
             "optim".to_string()
         } else {

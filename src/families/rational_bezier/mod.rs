@@ -2,8 +2,8 @@
 //! bi-quadratic Bezier surface to the surface's grid by minimising the sum of squared errors over
 //! the seven free control points and w11, on its own stream, logged at once.
 
-pub mod report;
-pub mod spec;
+pub(crate) mod report;
+pub(crate) mod spec;
 
 use crate::experiment::spec::{Spec, SpecError};
 use crate::experiment::{runner, seeds, RunContext};
@@ -16,47 +16,45 @@ use spec::RationalBezierSpec;
 
 /// One (surface, optimiser, repeat).
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Cell {
-    pub surface: String,
-    pub optimiser: String,
-    pub repeat: usize,
+pub(crate) struct Cell {
+    pub(crate) surface: String,
+    pub(crate) optimiser: String,
+    pub(crate) repeat: usize,
 }
 
 impl Cell {
-    pub fn key(&self) -> String {
+    pub(crate) fn key(&self) -> String {
         format!("seed002/{}/{}/r{}", self.surface, self.optimiser, self.repeat)
     }
 }
 
 /// One row of runs.csv.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-pub struct Row {
-    pub cell: String,
-    pub surface: String,
-    pub optimiser: String,
-    pub repeat: usize,
-    pub seed: String,
-    pub dimension: usize,
-    pub n_points: usize,
+pub(crate) struct Row {
+    pub(crate) cell: String,
+    pub(crate) surface: String,
+    pub(crate) optimiser: String,
+    pub(crate) repeat: usize,
+    pub(crate) seed: String,
+    pub(crate) dimension: usize,
+    pub(crate) n_points: usize,
     /// SSE of the start (free points on the data, w11 = 1).
-    pub start_sse: f64,
-    pub initial_best: f64,
+    pub(crate) start_sse: f64,
+    pub(crate) initial_best: f64,
     /// Best sum of squared errors found.
-    pub best_sse: f64,
+    pub(crate) best_sse: f64,
     /// sqrt(best_sse / n_points).
-    pub rmse: f64,
-    pub w11: f64,
-    pub evaluations: u64,
-    pub cpu_s: f64,
+    pub(crate) rmse: f64,
+    pub(crate) w11: f64,
+    pub(crate) evaluations: u64,
+    pub(crate) cpu_s: f64,
 }
 
 /// One run with its convergence trace.
 #[derive(Debug, Clone)]
-pub struct Run {
-    pub cell: Cell,
-    pub row: Row,
-    pub trace: Vec<(u64, f64)>,
-    pub best_x: Vec<f64>,
+pub(crate) struct Run {
+    pub(crate) row: Row,
+    pub(crate) trace: Vec<(u64, f64)>,
 }
 
 impl runner::Cell for Cell {
@@ -74,7 +72,7 @@ impl runner::Logged for Run {
 }
 
 /// The flat list of cells.
-pub fn cells(s: &RationalBezierSpec) -> Vec<Cell> {
+pub(crate) fn cells(s: &RationalBezierSpec) -> Vec<Cell> {
     runner::product_cells(&s.surfaces, &s.optimisers, s.repeats, |sf, o, repeat| Cell {
         surface: sf.clone(),
         optimiser: o.clone(),
@@ -83,7 +81,7 @@ pub fn cells(s: &RationalBezierSpec) -> Vec<Cell> {
 }
 
 /// The SSE problem of a surface with the spec's grid and box.
-pub fn problem(s: &RationalBezierSpec, surface: &str) -> Result<SurfaceSse> {
+pub(crate) fn problem(s: &RationalBezierSpec, surface: &str) -> Result<SurfaceSse> {
     let ts = TestSurface::by_name(surface)
         .with_context(|| format!("seed002.surfaces: unknown surface `{surface}`"))?;
     Ok(SurfaceSse::new(ts.grid(s.grid), s.bounds_margin, s.w_min))
@@ -95,7 +93,7 @@ fn optimiser<'a>(s: &'a RationalBezierSpec, name: &str) -> Result<&'a dyn Optimi
 }
 
 /// Run one cell (alone it gives the same numbers as inside the full run).
-pub fn run_cell(spec: &Spec, s: &RationalBezierSpec, cell: &Cell) -> Result<Run> {
+pub(crate) fn run_cell(spec: &Spec, s: &RationalBezierSpec, cell: &Cell) -> Result<Run> {
     let problem = problem(s, &cell.surface)?;
     let opt = optimiser(s, &cell.optimiser)?;
     // init_range is a share of the data's largest bounding-box extent (the domains differ in scale).
@@ -133,67 +131,67 @@ pub fn run_cell(spec: &Spec, s: &RationalBezierSpec, cell: &Cell) -> Result<Run>
         evaluations: r.evaluations,
         cpu_s,
     };
-    Ok(Run { cell: cell.clone(), row, trace: r.trace, best_x: r.best_x })
+    Ok(Run { row, trace: r.trace })
 }
 
 /// Run every cell of the spec.
-pub fn run(spec: &Spec, s: &RationalBezierSpec, ctx: &RunContext) -> Result<Vec<Run>> {
+pub(crate) fn run(spec: &Spec, s: &RationalBezierSpec, ctx: &RunContext) -> Result<Vec<Run>> {
     let cells = cells(s);
     runner::run_logged(
         &cells,
         ctx,
         &spec.file.name,
         |cell| run_cell(spec, s, cell),
-        |cell, (row, trace)| Ok(Run { cell: cell.clone(), row, trace, best_x: Vec::new() }),
+        |_, (row, trace)| Ok(Run { row, trace }),
     )
 }
 
 /// One conic curve fit: (outline, optimiser, repeat).
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub struct CurveCell {
-    pub outline: String,
-    pub optimiser: String,
-    pub repeat: usize,
+pub(crate) struct CurveCell {
+    pub(crate) outline: String,
+    pub(crate) optimiser: String,
+    pub(crate) repeat: usize,
 }
 
 impl CurveCell {
-    pub fn key(&self) -> String {
+    pub(crate) fn key(&self) -> String {
         format!("seed002/curve/{}/{}/r{}", self.outline, self.optimiser, self.repeat)
     }
 }
 
 /// One row of seed002_curve_runs.csv.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-pub struct CurveRow {
-    pub cell: String,
-    pub outline: String,
-    pub optimiser: String,
-    pub repeat: usize,
-    pub seed: String,
-    pub n_points: usize,
-    pub true_corners: usize,
-    pub corners_found: usize,
+pub(crate) struct CurveRow {
+    pub(crate) cell: String,
+    pub(crate) outline: String,
+    pub(crate) optimiser: String,
+    pub(crate) repeat: usize,
+    pub(crate) seed: String,
+    pub(crate) n_points: usize,
+    pub(crate) true_corners: usize,
+    pub(crate) corners_found: usize,
     /// Found corners within one spacing of a true corner.
-    pub corners_matched: usize,
-    pub conics: usize,
+    pub(crate) corners_matched: usize,
+    pub(crate) conics: usize,
     /// Sum over conics of the best SSE (data points shared by two conics count in both).
-    pub sse: f64,
+    pub(crate) sse: f64,
     /// SSE of the starts (b1 by least squares at w = 1).
-    pub start_sse: f64,
-    pub evaluations: u64,
-    pub cpu_s: f64,
+    pub(crate) start_sse: f64,
+    pub(crate) evaluations: u64,
+    pub(crate) cpu_s: f64,
 }
 
 /// A curve run: its row, the outline, the corners and each conic (b0, b1, b2, w).
 #[derive(Debug, Clone)]
-pub struct CurveRun {
-    pub row: CurveRow,
-    pub points: Vec<P2>,
-    pub corners: Vec<usize>,
-    pub conics: Vec<([P2; 3], f64)>,
+pub(crate) struct CurveRun {
+    pub(crate) row: CurveRow,
+    pub(crate) points: Vec<P2>,
+    pub(crate) corners: Vec<usize>,
+    pub(crate) conics: Vec<([P2; 3], f64)>,
 }
 
-pub fn curve_cells(s: &RationalBezierSpec) -> Vec<CurveCell> {
+pub(crate) fn curve_cells(s: &RationalBezierSpec) -> Vec<CurveCell> {
     runner::product_cells(&s.outlines, &s.optimisers, s.repeats, |ol, o, repeat| CurveCell {
         outline: ol.clone(),
         optimiser: o.clone(),
@@ -203,7 +201,7 @@ pub fn curve_cells(s: &RationalBezierSpec) -> Vec<CurveCell> {
 
 /// Sample the outline, detect its corners (SAM06), cut it into conic runs and fit each run's
 /// conic with the cell's optimiser, all on the cell's stream in run order.
-pub fn run_curve_cell(spec: &Spec, s: &RationalBezierSpec, cell: &CurveCell) -> Result<CurveRun> {
+pub(crate) fn run_curve_cell(spec: &Spec, s: &RationalBezierSpec, cell: &CurveCell) -> Result<CurveRun> {
     let (pieces, truth) = conic::outline(&cell.outline)
         .with_context(|| format!("seed002.outlines: unknown outline `{}`", cell.outline))?;
     let points = conic::sample_closed(&pieces, s.outline_spacing);
@@ -261,7 +259,7 @@ pub fn run_curve_cell(spec: &Spec, s: &RationalBezierSpec, cell: &CurveCell) -> 
 
 /// The curve cells (a fraction of a second in all; not logged: a resumed run or a merge runs
 /// them again, deterministically).
-pub fn run_curves(spec: &Spec, s: &RationalBezierSpec, ctx: &RunContext) -> Result<Vec<CurveRun>> {
+pub(crate) fn run_curves(spec: &Spec, s: &RationalBezierSpec, ctx: &RunContext) -> Result<Vec<CurveRun>> {
     let cells = curve_cells(s);
     runner::run_cells(
         &cells,
@@ -273,7 +271,7 @@ pub fn run_curves(spec: &Spec, s: &RationalBezierSpec, ctx: &RunContext) -> Resu
 }
 
 /// Seed 002's family: the `[seed002]` section (surface cells logged, curve cells not).
-pub struct RationalBezier;
+pub(crate) struct RationalBezier;
 
 impl crate::experiment::family::Section for self::spec::RationalBezierSpec {
     fn limits(&self, c: &crate::experiment::limits::Check) -> Result<(), SpecError> {

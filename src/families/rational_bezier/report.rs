@@ -19,7 +19,7 @@ fn median(v: Vec<f64>) -> f64 {
 }
 
 /// Write runs.csv-derived tables and charts; return the REPORT.md section.
-pub fn write(runs: &[Run], curves: &[CurveRun], population: usize, out: &Path) -> Result<String> {
+pub(crate) fn write(runs: &[Run], curves: &[CurveRun], population: usize, out: &Path) -> Result<String> {
     let rows: Vec<_> = runs.iter().map(|r| r.row.clone()).collect();
     crate::io::write_atomic(&out.join("runs.csv"), crate::io::csv_text(&rows)?.as_bytes())?;
     // Error versus iteration, every trace point of every run.

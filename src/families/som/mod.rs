@@ -1,9 +1,9 @@
 //! Chapter 4 wiring: load the data sets, train every SOM cell on its own stream, log each finished
 //! cell at once, and hand the runs to the report.
 
-pub mod pictures;
-pub mod report;
-pub mod spec;
+pub(crate) mod pictures;
+pub(crate) mod report;
+pub(crate) mod spec;
 
 use crate::data::generators::{SpindleProfile, SpindleRings};
 use crate::data::PointCloud;
@@ -14,9 +14,10 @@ use crate::geom::Point3;
 use crate::som::{self, FinalMetrics, NeuronCounts, OnlineMetrics, SomParams};
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
-use spec::SomCell;
 use std::collections::BTreeMap;
 use std::sync::Arc;
+pub use report::PUBLISHED;
+pub use spec::{cells, SomCell, SomSpec};
 
 /// One trained SOM cell.
 #[derive(Debug, Clone)]
@@ -69,8 +70,6 @@ pub struct SomRow {
     pub cpu_s: f64,
 }
 
-/// Columns of `runs.csv` that hold timings (reported, never compared for drift).
-pub const TIMING_COLUMNS: &[&str] = &["cpu_s"];
 
 impl SomRow {
     fn new(
@@ -105,7 +104,7 @@ impl SomRow {
     }
 }
 
-/// Load every data set a spec names, once, by its name ([`crate::data::registry::dataset_name`]).
+/// Load every data set a spec names, once, by its name (`crate::data::registry::dataset_name`).
 pub fn load_datasets(
     spec: &Spec,
     names: &[String],
@@ -127,7 +126,7 @@ pub fn load_datasets(
 /// neurons: its map nodes become the grid the B-spline surfaces are fitted to (Chapters 5, 6).
 /// Other models may have more neurons than points (the thesis' 20x20x20 SOM3D on the 7352-point
 /// cube), so they are not checked.
-pub fn require_points(entry: &str, points: usize, cell: &SomCell) -> Result<()> {
+pub(crate) fn require_points(entry: &str, points: usize, cell: &SomCell) -> Result<()> {
     if cell.model != crate::som::Model::Dnsom {
         return Ok(());
     }
@@ -175,11 +174,11 @@ pub fn run_cell(
 }
 
 /// Each data set's frame (how its points were normalised), by name.
-pub type Frames = BTreeMap<String, crate::data::frame::Frame>;
+pub(crate) type Frames = BTreeMap<String, crate::data::frame::Frame>;
 
 /// Run every SOM cell of a spec, logging each finished cell to the folder's cell log; also each
 /// data set's frame, for the saved maps.
-pub fn run(
+pub(crate) fn run(
     spec: &Spec,
     som_spec: &spec::SomSpec,
     ctx: &RunContext,
@@ -225,7 +224,7 @@ pub fn run(
 }
 
 /// Chapter 4's family: the `[som]` section.
-pub struct Som;
+pub(crate) struct Som;
 
 impl crate::experiment::family::Section for self::spec::SomSpec {
     fn limits(&self, c: &crate::experiment::limits::Check) -> Result<(), SpecError> {

@@ -10,7 +10,7 @@ use rayon::prelude::*;
 use std::path::Path;
 
 /// The wireframe meshes of a trained map.
-pub fn meshes(run: &SomRun) -> Vec<LineMesh> {
+pub(crate) fn meshes(run: &SomRun) -> Vec<LineMesh> {
     let topo = match run.cell.model.topology(run.cell.grid.nx, run.cell.grid.ny) {
         Ok(t) => t,
         Err(_) => return Vec::new(),
@@ -47,7 +47,7 @@ fn cell_picture_name(run: &SomRun) -> String {
 
 /// Write every Chapter 4 picture; returns the written paths relative to `out`. A picture that
 /// fails is reported on stderr and the others are still written.
-pub fn write(runs: &[SomRun], out: &Path) -> Result<Vec<String>> {
+pub(crate) fn write(runs: &[SomRun], out: &Path) -> Result<Vec<String>> {
     crate::io::ensure_dir(&out.join("png"))?;
     let first: Vec<&SomRun> = runs.iter().filter(|r| r.cell.repeat == 0).collect();
     let mut written: Vec<String> = first

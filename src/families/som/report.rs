@@ -65,7 +65,7 @@ fn grids(runs: &[SomRun], square: bool) -> Vec<GridSize> {
 
 /// Appendix B (square grids, four models) or C (nx != ny, CKSOM and DNSOM) with the reference's
 /// exact columns. Returns (header, rows) or None when the runs hold no such cell.
-pub fn appendix_table(runs: &[SomRun], square: bool) -> Option<(Vec<String>, Vec<Vec<String>>)> {
+pub(crate) fn appendix_table(runs: &[SomRun], square: bool) -> Option<(Vec<String>, Vec<Vec<String>>)> {
     let name = if square { "appendix_b" } else { "appendix_c" };
     let header = reference::lookup(PUBLISHED, name)?.header;
     let models: Vec<Model> =
@@ -99,7 +99,7 @@ fn counts(model: Model, g: GridSize) -> Option<crate::som::NeuronCounts> {
 }
 
 /// Table 4.9 for the square grids given.
-pub fn table_4_9(grids: &[GridSize]) -> (Vec<String>, Vec<Vec<String>>) {
+pub(crate) fn table_4_9(grids: &[GridSize]) -> (Vec<String>, Vec<Vec<String>>) {
     let header = [
         "n",
         "som2d",
@@ -127,7 +127,7 @@ pub fn table_4_9(grids: &[GridSize]) -> (Vec<String>, Vec<Vec<String>>) {
 }
 
 /// Table 4.13 (CKSOM and DNSOM counts at nx x ny).
-pub fn table_4_13(grids: &[GridSize]) -> (Vec<String>, Vec<Vec<String>>) {
+pub(crate) fn table_4_13(grids: &[GridSize]) -> (Vec<String>, Vec<Vec<String>>) {
     let header = [
         "n_x",
         "n_y",
@@ -153,7 +153,7 @@ pub fn table_4_13(grids: &[GridSize]) -> (Vec<String>, Vec<Vec<String>>) {
 }
 
 /// Table 4.14 (DNSOM counts for the thesis' small grids).
-pub fn table_4_14() -> (Vec<String>, Vec<Vec<String>>) {
+pub(crate) fn table_4_14() -> (Vec<String>, Vec<Vec<String>>) {
     let rows = [(2, 3), (3, 4), (4, 5), (5, 6), (6, 7), (7, 8)]
         .iter()
         .map(|&(nx, ny)| {
@@ -168,7 +168,7 @@ pub fn table_4_14() -> (Vec<String>, Vec<Vec<String>>) {
 }
 
 /// The saved DNSOM map of a run.
-pub fn dnsom_map_csv(run: &SomRun) -> Result<String> {
+pub(crate) fn dnsom_map_csv(run: &SomRun) -> Result<String> {
     let g = run.cell.grid;
     let grid = crate::double_net::TwoViewGrid::from_weights(g.nx, g.ny, &run.weights)
         .ok_or_else(|| anyhow::anyhow!("{}: not a DNSOM map", run.row.cell))?;
@@ -177,7 +177,7 @@ pub fn dnsom_map_csv(run: &SomRun) -> Result<String> {
 
 /// Write every Chapter 4 file; returns the REPORT.md section. Each saved map has its data set's
 /// frame beside it (`maps/dnsom_<data>_<grid>.frame.toml`, not a table: drift skips `maps/`).
-pub fn write(
+pub(crate) fn write(
     spec: &Spec,
     som: &super::spec::SomSpec,
     runs: &[SomRun],
@@ -332,7 +332,7 @@ fn paired(
 }
 
 /// Chapter 4 claims, checked on the runs and, for the same cases, on the thesis' Appendix B/C.
-pub fn claims(runs: &[SomRun]) -> Vec<Claim> {
+pub(crate) fn claims(runs: &[SomRun]) -> Vec<Claim> {
     let thesis_b = reference::lookup(PUBLISHED, "appendix_b");
     let thesis_c = reference::lookup(PUBLISHED, "appendix_c");
     let ours = |d: &str, m: Model, g: GridSize, s: &str| mean_of(runs, d, m, g, s);
@@ -555,7 +555,7 @@ fn section(
 }
 
 /// Exact metric definitions, stated because libraries disagree.
-pub const DEFINITIONS: &str = "\
+pub(crate) const DEFINITIONS: &str = "\
 ### Metric definitions
 
 - **QE (online, the thesis' Eq. 4.15)**: mean over the T training iterations of the Euclidean distance |X(t) - W_c(t)| between the drawn input and its winner, measured before that iteration's update. **Min/max error**: the minimum and maximum of the same distance over the iterations.

@@ -183,7 +183,8 @@ fn lower_bound_with(
 
 /// f(x) and the best certified lower bound from the duals y_k = r_k / |r_k| (0 where r_k = 0)
 /// at a point x of the box.
-pub fn certify(pb: &dyn SumOfNorms, lower: &[f64], upper: &[f64], x: &[f64]) -> (f64, f64) {
+#[cfg(test)]
+pub(crate) fn certify(pb: &dyn SumOfNorms, lower: &[f64], upper: &[f64], x: &[f64]) -> (f64, f64) {
     let mut r = vec![[0.0; 3]; pb.n_terms()];
     pb.residuals(x, &mut r);
     let f = r.iter().map(|v| crate::geom::norm(*v)).sum();
@@ -1125,7 +1126,7 @@ fn projected_newton(
 /// returned f is never above f(clamped start): when the start is in the box (approach B's net in
 /// Chapter 6's boxes) the exact optimum is never worse than B. `converged` is false when the
 /// certified relative gap did not reach `tol_rel_gap`; `gap` then says by how much.
-pub fn solve_exact(
+pub(crate) fn solve_exact(
     pb: &dyn SumOfNorms,
     lower: &[f64],
     upper: &[f64],

@@ -18,7 +18,7 @@ use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
 /// The page's file name.
-pub const FILE: &str = "report.html";
+pub(crate) const FILE: &str = "report.html";
 
 /// The vendored plotting library: its path inside a results folder, and its bytes.
 pub const PLOTLY_PATH: &str = "vendor/plotly-gl3d-4.1.1.min.js";
@@ -27,7 +27,9 @@ pub const PLOTLY_JS: &[u8] =
 const PLOTLY_LICENSE: &[u8] =
     include_bytes!("../../../vendor/plotly.js-gl3d-dist-min-4.1.1/LICENSE");
 /// sha256 of [`PLOTLY_JS`] (the npm package plotly.js-gl3d-dist-min 4.1.1).
-pub const PLOTLY_SHA256: &str = "aab04dcd9c103a92b18723f8c837712fe820f325d0bcd2421e415e8124a75b9f";
+#[cfg(test)]
+pub(crate) const PLOTLY_SHA256: &str =
+    "aab04dcd9c103a92b18723f8c837712fe820f325d0bcd2421e415e8124a75b9f";
 
 const PAGE_JS: &str = include_str!("page.js");
 const PAGE_CSS: &str = include_str!("page.css");
@@ -35,7 +37,7 @@ const PAGE_CSS: &str = include_str!("page.css");
 const ERROR_HOOK: &str = "window.somnurbsErrors = []; window.addEventListener('error', function (e) { window.somnurbsErrors.push(e.message ? e.message + ' at ' + (e.filename || '') + ':' + (e.lineno || '') : 'cannot load ' + (e.target && (e.target.src || e.target.href) || 'a resource')); }, true); window.addEventListener('unhandledrejection', function (e) { window.somnurbsErrors.push('unhandled rejection: ' + (e.reason && e.reason.message || e.reason)); });";
 
 /// Write `root/report.html` (and `root/vendor/` when a folder has 3-D views); returns its path.
-pub fn write(root: &Path) -> Result<PathBuf> {
+pub(crate) fn write(root: &Path) -> Result<PathBuf> {
     let page = build(root)?;
     if !page.view_folders.is_empty() {
         let js = root.join(PLOTLY_PATH);

@@ -15,22 +15,22 @@ use std::path::Path;
 
 /// Five-number summary with Tukey whiskers and outliers of the finite values of one group.
 #[derive(Debug, Clone, PartialEq)]
-pub struct BoxStats {
+pub(crate) struct BoxStats {
     /// Number of finite values used.
-    pub n: usize,
-    pub q1: f64,
-    pub median: f64,
-    pub q3: f64,
+    pub(crate) n: usize,
+    pub(crate) q1: f64,
+    pub(crate) median: f64,
+    pub(crate) q3: f64,
     /// Smallest value >= q1 - 1.5 IQR.
-    pub lower_whisker: f64,
+    pub(crate) lower_whisker: f64,
     /// Largest value <= q3 + 1.5 IQR.
-    pub upper_whisker: f64,
+    pub(crate) upper_whisker: f64,
     /// Values outside the whiskers, ascending.
-    pub outliers: Vec<f64>,
+    pub(crate) outliers: Vec<f64>,
 }
 
 /// Type-7 quantile of ascending `sorted` (non-empty), p in [0, 1].
-pub fn quantile_type7(sorted: &[f64], p: f64) -> f64 {
+pub(crate) fn quantile_type7(sorted: &[f64], p: f64) -> f64 {
     let h = (sorted.len() - 1) as f64 * p.clamp(0.0, 1.0);
     let lo = h.floor() as usize;
     let hi = (lo + 1).min(sorted.len() - 1);
@@ -39,7 +39,7 @@ pub fn quantile_type7(sorted: &[f64], p: f64) -> f64 {
 
 impl BoxStats {
     /// Summary of the plottable values in `values` (None when there are none).
-    pub fn from_values(values: &[f64]) -> Option<BoxStats> {
+    pub(crate) fn from_values(values: &[f64]) -> Option<BoxStats> {
         let mut v: Vec<f64> = values.iter().copied().filter(|x| plottable(*x)).collect();
         if v.is_empty() {
             return None;
@@ -60,14 +60,14 @@ impl BoxStats {
 
 /// Picture size for `n_groups` boxes: [`style::CHART_SIZE`], widened beyond 11 groups so each
 /// keeps ~70 px.
-pub fn box_plot_size(n_groups: usize) -> (u32, u32) {
+pub(crate) fn box_plot_size(n_groups: usize) -> (u32, u32) {
     let w = (160 + 70 * n_groups.min(200)) as u32;
     (style::CHART_SIZE.0.max(w), style::CHART_SIZE.1)
 }
 
 /// Writes one box per group (name, values) to `path`; non-finite values are left out (the count
 /// used is printed under each name). An error when no group has a finite value.
-pub fn box_plot_png(
+pub(crate) fn box_plot_png(
     path: &Path,
     title: &str,
     y_label: &str,
@@ -97,10 +97,10 @@ pub fn box_plot_png(
 /// A reference level across a box plot (where every run started, a certified optimum), so a
 /// box that ends above it shows as such; `key` picks its colour ([`style::optimiser_colour`]).
 #[derive(Debug, Clone)]
-pub struct Level {
-    pub key: &'static str,
-    pub label: String,
-    pub y: f64,
+pub(crate) struct Level {
+    pub(crate) key: &'static str,
+    pub(crate) label: String,
+    pub(crate) y: f64,
 }
 
 fn draw_box_plot(

@@ -48,7 +48,8 @@ fn cliques_sorted(mean_ranks: &[(String, f64)], cd: f64) -> (Vec<usize>, Vec<(us
 
 /// The maximal groups of methods not significantly different at critical difference `cd`
 /// (mean ranks within less than `cd`), each listed by name in ascending mean rank.
-pub fn cd_cliques(mean_ranks: &[(String, f64)], cd: f64) -> Vec<Vec<String>> {
+#[cfg(test)]
+pub(crate) fn cd_cliques(mean_ranks: &[(String, f64)], cd: f64) -> Vec<Vec<String>> {
     let (order, groups) = cliques_sorted(mean_ranks, cd);
     groups
         .iter()
@@ -73,7 +74,7 @@ fn validate(mean_ranks: &[(String, f64)], cd: f64) -> Result<(), String> {
 }
 
 /// Picture size of the diagram for these inputs (None when they are invalid).
-pub fn cd_diagram_size(mean_ranks: &[(String, f64)], cd: f64) -> Option<(u32, u32)> {
+pub(crate) fn cd_diagram_size(mean_ranks: &[(String, f64)], cd: f64) -> Option<(u32, u32)> {
     validate(mean_ranks, cd).ok()?;
     let (_, groups) = cliques_sorted(mean_ranks, cd);
     let rows = mean_ranks.len().div_ceil(2) as i32;
@@ -83,7 +84,7 @@ pub fn cd_diagram_size(mean_ranks: &[(String, f64)], cd: f64) -> Option<(u32, u3
 
 /// Writes the critical-difference diagram of `mean_ranks` (name, mean rank in 1..=k) with
 /// critical difference `cd` to `path`.
-pub fn cd_diagram_png(
+pub(crate) fn cd_diagram_png(
     path: &Path,
     title: &str,
     mean_ranks: &[(String, f64)],

@@ -18,11 +18,11 @@ use std::path::Path;
 /// One curve: `points` (x, y) in drawing order, and optionally a band of (x, lower, upper)
 /// drawn as a translucent area (e.g. the quartiles over repeats around the median).
 #[derive(Debug, Clone, PartialEq)]
-pub struct Series {
-    pub label: String,
-    pub colour: RGBColor,
-    pub points: Vec<(f64, f64)>,
-    pub band: Option<Vec<(f64, f64, f64)>>,
+pub(crate) struct Series {
+    pub(crate) label: String,
+    pub(crate) colour: RGBColor,
+    pub(crate) points: Vec<(f64, f64)>,
+    pub(crate) band: Option<Vec<(f64, f64, f64)>>,
 }
 
 /// Maximal runs of consecutive items for which `f` gives a value (a break wherever it gives None).
@@ -53,7 +53,7 @@ const MARKER_LIMIT: usize = 40;
 /// Writes a line chart of `series` to `path` ([`style::CHART_SIZE`] pixels). Non-finite points
 /// (and, with `log_y`, non-positive y) are left out; it is an error only when no point at all
 /// can be drawn.
-pub fn line_chart_png(
+pub(crate) fn line_chart_png(
     path: &Path,
     title: &str,
     x_label: &str,
@@ -70,7 +70,7 @@ pub fn line_chart_png(
 /// A line chart of points in a plane (an outline, a top view) with equal scales on both axes,
 /// so a circle is drawn round: the shorter data range is widened about its centre until a unit
 /// takes as many pixels across as up.
-pub fn xy_chart_png(
+pub(crate) fn xy_chart_png(
     path: &Path,
     title: &str,
     x_label: &str,
@@ -113,14 +113,14 @@ fn equal_scale(x: (f64, f64), y: (f64, f64), dims: (u32, u32)) -> ((f64, f64), (
 }
 
 /// Size of one panel of [`small_multiples_png`].
-pub const SMALL_PANEL: (u32, u32) = (600, 400);
+pub(crate) const SMALL_PANEL: (u32, u32) = (600, 400);
 /// Height of the title band of [`small_multiples_png`].
 const SMALL_HEADER_PX: u32 = 44;
 
 /// Small multiples: one line chart per `(caption, series)` panel, `cols` per row, on one shared
 /// x range and y axis (so panels compare at a glance), under one page title. For many curves
 /// that overlap on one chart (e.g. four parameterisations x two approaches).
-pub fn small_multiples_png(
+pub(crate) fn small_multiples_png(
     path: &Path,
     title: &str,
     x_label: &str,

@@ -18,12 +18,12 @@ use std::path::Path;
 
 /// A set of 3-D points joined by straight edges (indices into `points`), drawn in one colour.
 #[derive(Debug, Clone, PartialEq)]
-pub struct LineMesh {
-    pub points: Vec<Point3>,
-    pub edges: Vec<(u32, u32)>,
-    pub colour: RGBColor,
+pub(crate) struct LineMesh {
+    pub(crate) points: Vec<Point3>,
+    pub(crate) edges: Vec<(u32, u32)>,
+    pub(crate) colour: RGBColor,
     /// Legend text; meshes with an empty label get no legend entry.
-    pub label: String,
+    pub(crate) label: String,
 }
 
 /// `other` drawn as its difference from `base` magnified: each point `b + k (o - b)`, with `k`
@@ -31,7 +31,7 @@ pub struct LineMesh {
 /// surfaces that differ by too little to see). Meshes pair up in order and must have as many
 /// points; returns the magnified meshes, `k` and the largest difference (None when nothing differs
 /// or the meshes do not pair up).
-pub fn magnified_difference(
+pub(crate) fn magnified_difference(
     base: &[LineMesh],
     other: &[LineMesh],
     frac: f64,
@@ -81,12 +81,12 @@ pub fn magnified_difference(
 /// Viewing direction of a 3-D picture (plotters' projection: yaw about the vertical axis, then
 /// pitch, in radians; `scale` shrinks the cube to fit its corners into the area).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct View3d {
-    pub yaw: f64,
-    pub pitch: f64,
-    pub scale: f64,
+pub(crate) struct View3d {
+    pub(crate) yaw: f64,
+    pub(crate) pitch: f64,
+    pub(crate) scale: f64,
     /// Draw tick labels on the axes (off for small overview panels).
-    pub tick_labels: bool,
+    pub(crate) tick_labels: bool,
 }
 
 impl Default for View3d {
@@ -97,7 +97,7 @@ impl Default for View3d {
 }
 
 /// Edges of the 4-neighbourhood of a row-major `nx` x `ny` grid (node (i, j) has index i*ny + j).
-pub fn grid_edges(nx: usize, ny: usize) -> Vec<(u32, u32)> {
+pub(crate) fn grid_edges(nx: usize, ny: usize) -> Vec<(u32, u32)> {
     let mut e = Vec::with_capacity(2 * nx * ny);
     let id = |i: usize, j: usize| (i * ny + j) as u32;
     for i in 0..nx {
@@ -115,7 +115,8 @@ pub fn grid_edges(nx: usize, ny: usize) -> Vec<(u32, u32)> {
 
 /// Edges of the 6-neighbourhood of an `n` x `n` x `n` lattice (node (i, j, k) has index
 /// (i*n + j)*n + k), as in the 3-D SOM of thesis Section 2.
-pub fn lattice_edges(n: usize) -> Vec<(u32, u32)> {
+#[cfg(test)]
+pub(crate) fn lattice_edges(n: usize) -> Vec<(u32, u32)> {
     let mut e = Vec::with_capacity(3 * n * n * n);
     let id = |i: usize, j: usize, k: usize| ((i * n + j) * n + k) as u32;
     for i in 0..n {
@@ -189,7 +190,7 @@ fn validate(meshes: &[LineMesh], view: &View3d) -> Result<(), DrawError> {
 
 /// Draws `meshes` as one 3-D wireframe picture on `area`, with `title` above (none if empty)
 /// and a legend of the labelled meshes. Edges touching a non-finite point are skipped.
-pub fn draw_meshes(
+pub(crate) fn draw_meshes(
     area: &DrawingArea<BitMapBackend<'_>, Shift>,
     title: &str,
     meshes: &[LineMesh],
@@ -320,7 +321,7 @@ pub(crate) fn draw_meshes_with(
 }
 
 /// Writes one wireframe picture of `size` pixels to `path` (a `.png` file in an existing folder).
-pub fn mesh_png(
+pub(crate) fn mesh_png(
     path: &Path,
     title: &str,
     meshes: &[LineMesh],

@@ -11,22 +11,20 @@
 //!
 //! Text uses DejaVu Sans embedded from the `dejavu` crate (no system fonts), registered once.
 
-pub mod boxplot;
-pub mod cd_diagram;
-pub mod line_chart;
-pub mod mesh3d;
-pub mod overview;
+pub(crate) mod boxplot;
+pub(crate) mod cd_diagram;
+pub(crate) mod line_chart;
+pub(crate) mod mesh3d;
+pub(crate) mod overview;
 mod palette;
-pub mod scale;
-pub mod style;
+pub(crate) mod scale;
+pub(crate) mod style;
 
-pub use boxplot::{box_plot_png, box_plot_size, BoxStats, Level};
-pub use cd_diagram::{cd_cliques, cd_diagram_png, cd_diagram_size};
-pub use line_chart::{line_chart_png, small_multiples_png, xy_chart_png, Series};
-pub use mesh3d::{
-    draw_meshes, grid_edges, lattice_edges, magnified_difference, mesh_png, LineMesh, View3d,
-};
-pub use overview::{overview_png, overview_size, Panel};
+pub(crate) use boxplot::{box_plot_png, Level};
+pub(crate) use cd_diagram::cd_diagram_png;
+pub(crate) use line_chart::{line_chart_png, small_multiples_png, xy_chart_png, Series};
+pub(crate) use mesh3d::{grid_edges, magnified_difference, mesh_png, LineMesh};
+pub(crate) use overview::{overview_png, Panel};
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -35,11 +33,11 @@ use std::path::{Path, PathBuf};
 use thiserror::Error;
 
 /// The largest width or height accepted for one picture (pixels).
-pub const MAX_SIDE: u32 = 16_384;
+pub(crate) const MAX_SIDE: u32 = 16_384;
 
 /// A failure while drawing onto a drawing area (no file involved yet).
 #[derive(Debug, Error)]
-pub enum DrawError {
+pub(crate) enum DrawError {
     /// plotters (or the bitmap backend) reported an error.
     #[error("drawing failed: {0}")]
     Backend(String),
@@ -59,7 +57,7 @@ impl<E: std::error::Error + Send + Sync> From<DrawingAreaErrorKind<E>> for DrawE
 
 /// A chart that could not be written; every variant names the PNG it was meant for.
 #[derive(Debug, Error)]
-pub enum PlotError {
+pub(crate) enum PlotError {
     /// The data or the requested picture cannot be drawn.
     #[error("chart {}: {reason}", path.display())]
     Input { path: PathBuf, reason: String },
@@ -184,10 +182,10 @@ where
 pub(crate) mod testutil {
     use std::path::Path;
 
-    pub const PNG_SIGNATURE: [u8; 8] = [0x89, b'P', b'N', b'G', 0x0d, 0x0a, 0x1a, 0x0a];
+    pub(crate) const PNG_SIGNATURE: [u8; 8] = [0x89, b'P', b'N', b'G', 0x0d, 0x0a, 0x1a, 0x0a];
 
     /// (width, height) of a PNG file, checking the signature and that the first chunk is IHDR.
-    pub fn png_size(path: &Path) -> (u32, u32) {
+    pub(crate) fn png_size(path: &Path) -> (u32, u32) {
         let bytes = std::fs::read(path).expect("png readable");
         assert!(bytes.len() > 33, "png too short: {} bytes", bytes.len());
         assert_eq!(bytes[..8], PNG_SIGNATURE, "not a PNG signature");
@@ -198,7 +196,7 @@ pub(crate) mod testutil {
     }
 
     /// Names of the files in `dir` (to check that no temporary file is left).
-    pub fn listing(dir: &Path) -> Vec<String> {
+    pub(crate) fn listing(dir: &Path) -> Vec<String> {
         let mut v: Vec<String> = std::fs::read_dir(dir)
             .expect("dir readable")
             .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
@@ -208,7 +206,7 @@ pub(crate) mod testutil {
     }
 
     /// A path inside a folder that does not exist.
-    pub fn missing_folder_path(dir: &Path) -> std::path::PathBuf {
+    pub(crate) fn missing_folder_path(dir: &Path) -> std::path::PathBuf {
         dir.join("no_such_folder").join("chart.png")
     }
 }

@@ -12,10 +12,10 @@ use std::path::Path;
 
 /// One cell of an overview page.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Panel {
+pub(crate) struct Panel {
     /// Caption above the panel (e.g. "Spindle, DNSOM 5 x 6").
-    pub title: String,
-    pub meshes: Vec<LineMesh>,
+    pub(crate) title: String,
+    pub(crate) meshes: Vec<LineMesh>,
 }
 
 /// Height of the page title band (pixels) when there is a title or a legend.
@@ -23,7 +23,7 @@ const HEADER_PX: u32 = 62;
 
 /// Pixel size of an overview page of `n_panels` in `cols` columns (cols clamped to 1..=n), each
 /// panel [`style::PANEL_PX`] square, plus a header band. None when there is nothing to lay out.
-pub fn overview_size(n_panels: usize, cols: usize) -> Option<(u32, u32)> {
+pub(crate) fn overview_size(n_panels: usize, cols: usize) -> Option<(u32, u32)> {
     if n_panels == 0 || cols == 0 {
         return None;
     }
@@ -35,7 +35,7 @@ pub fn overview_size(n_panels: usize, cols: usize) -> Option<(u32, u32)> {
 }
 
 /// Writes a grid of wireframe panels, `cols` per row, to `path`.
-pub fn overview_png(
+pub(crate) fn overview_png(
     path: &Path,
     title: &str,
     panels: &[Panel],

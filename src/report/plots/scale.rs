@@ -10,15 +10,15 @@
 
 /// Values beyond this magnitude are treated like non-finite ones (plotters maps through i32
 /// pixels and f64 spans; |v| <= 1e300 keeps every difference finite).
-pub const MAX_ABS: f64 = 1e300;
+pub(crate) const MAX_ABS: f64 = 1e300;
 
 /// True for a value a chart can place: finite and within [`MAX_ABS`].
-pub fn plottable(v: f64) -> bool {
+pub(crate) fn plottable(v: f64) -> bool {
     v.is_finite() && v.abs() <= MAX_ABS
 }
 
 /// Minimum and maximum of the plottable values (None when there are none).
-pub fn extent<I: IntoIterator<Item = f64>>(values: I) -> Option<(f64, f64)> {
+pub(crate) fn extent<I: IntoIterator<Item = f64>>(values: I) -> Option<(f64, f64)> {
     values.into_iter().filter(|v| plottable(*v)).fold(None, |acc, v| match acc {
         None => Some((v, v)),
         Some((lo, hi)) => Some((lo.min(v), hi.max(v))),
@@ -27,17 +27,17 @@ pub fn extent<I: IntoIterator<Item = f64>>(values: I) -> Option<(f64, f64)> {
 
 /// One chart axis in plot space (log10 of the values for a log axis) with its ticks and labels.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Axis {
+pub(crate) struct Axis {
     /// Lower end of the padded range, plot space.
-    pub lo: f64,
+    pub(crate) lo: f64,
     /// Upper end of the padded range, plot space.
-    pub hi: f64,
+    pub(crate) hi: f64,
     /// Tick positions, plot space, increasing.
-    pub ticks: Vec<f64>,
+    pub(crate) ticks: Vec<f64>,
     /// One label per tick.
-    pub labels: Vec<String>,
+    pub(crate) labels: Vec<String>,
     /// Whether plot space is log10 of the values.
-    pub log: bool,
+    pub(crate) log: bool,
 }
 
 /// The nice step (1, 2, 2.5 or 5 times a power of ten) nearest to `raw` on a log scale, with
@@ -102,7 +102,7 @@ impl Axis {
     /// A linear axis over [min, max] (min <= max, both plottable): padded by 5 % of the width on
     /// each side, or by 0.1 % of the magnitude (1 when zero) when the values are equal to 11
     /// significant digits.
-    pub fn linear(min: f64, max: f64, target: usize) -> Axis {
+    pub(crate) fn linear(min: f64, max: f64, target: usize) -> Axis {
         let mid = min / 2.0 + max / 2.0;
         let half = max / 2.0 - min / 2.0;
         let m = min.abs().max(max.abs());
@@ -124,7 +124,7 @@ impl Axis {
     /// A log10 axis over [min, max] (0 < min <= max): powers of ten (with 2x and 5x when fewer
     /// than three decades are shown), or nice linear ticks when the span is under one decade.
     /// None when `min` is not positive.
-    pub fn log10(min: f64, max: f64, target: usize) -> Option<Axis> {
+    pub(crate) fn log10(min: f64, max: f64, target: usize) -> Option<Axis> {
         if !(min > 0.0 && max >= min && max.is_finite()) {
             return None;
         }
@@ -176,7 +176,7 @@ impl Axis {
 
     /// A value in plot space, or None when it cannot be drawn (non-finite, or not positive on a
     /// log axis).
-    pub fn to_plot(&self, v: f64) -> Option<f64> {
+    pub(crate) fn to_plot(&self, v: f64) -> Option<f64> {
         if !plottable(v) {
             return None;
         }
@@ -188,7 +188,7 @@ impl Axis {
     }
 
     /// The label of the tick nearest to `t` (plot space), for plotters' label formatter.
-    pub fn label_at(&self, t: f64) -> String {
+    pub(crate) fn label_at(&self, t: f64) -> String {
         self.ticks
             .iter()
             .zip(&self.labels)
@@ -198,7 +198,7 @@ impl Axis {
     }
 
     /// The longest label (for sizing the label area).
-    pub fn widest_label(&self) -> &str {
+    pub(crate) fn widest_label(&self) -> &str {
         self.labels.iter().max_by_key(|l| l.chars().count()).map(|s| s.as_str()).unwrap_or("0")
     }
 }

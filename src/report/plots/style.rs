@@ -10,10 +10,10 @@ use plotters::style::{register_font, FontStyle, RGBColor, TextStyle};
 use std::sync::OnceLock;
 
 /// The font family name every chart asks plotters for.
-pub const FONT: &str = "sans-serif";
+pub(crate) const FONT: &str = "sans-serif";
 
 /// Registers DejaVu Sans (regular and bold) as `sans-serif` once per process.
-pub fn ensure_fonts() -> Result<(), DrawError> {
+pub(crate) fn ensure_fonts() -> Result<(), DrawError> {
     static REGISTERED: OnceLock<bool> = OnceLock::new();
     let ok = *REGISTERED.get_or_init(|| {
         register_font(FONT, FontStyle::Normal, dejavu::sans::regular()).is_ok()
@@ -31,52 +31,51 @@ pub fn ensure_fonts() -> Result<(), DrawError> {
 // in opposite directions (a decimal point then floats a pixel above the baseline).
 
 /// Chart title size (pixels).
-pub const TITLE_PX: f64 = 22.0;
+pub(crate) const TITLE_PX: f64 = 22.0;
 /// Axis description size (pixels).
-pub const AXIS_DESC_PX: f64 = 16.0;
+pub(crate) const AXIS_DESC_PX: f64 = 16.0;
 /// Tick label and legend size (pixels).
-pub const LABEL_PX: f64 = 14.0;
+pub(crate) const LABEL_PX: f64 = 14.0;
 /// Caption size of an overview panel (pixels).
-pub const CAPTION_PX: f64 = 16.0;
+pub(crate) const CAPTION_PX: f64 = 16.0;
 
 /// Size of a 2-D chart (line chart, box plot) in pixels.
-pub const CHART_SIZE: (u32, u32) = (960, 600);
+pub(crate) const CHART_SIZE: (u32, u32) = (960, 600);
 /// Side of one overview panel (pixels), caption included.
-pub const PANEL_PX: u32 = 200;
+pub(crate) const PANEL_PX: u32 = 200;
 /// Default size of a single mesh picture.
-pub const MESH_SIZE: (u32, u32) = (480, 420);
+pub(crate) const MESH_SIZE: (u32, u32) = (480, 420);
 
 /// Okabe-Ito black.
-pub const BLACK: RGBColor = RGBColor(0, 0, 0);
+pub(crate) const BLACK: RGBColor = RGBColor(0, 0, 0);
 /// Okabe-Ito orange.
-pub const ORANGE: RGBColor = RGBColor(230, 159, 0);
+pub(crate) const ORANGE: RGBColor = RGBColor(230, 159, 0);
 /// Okabe-Ito sky blue.
-pub const SKY_BLUE: RGBColor = RGBColor(86, 180, 233);
+pub(crate) const SKY_BLUE: RGBColor = RGBColor(86, 180, 233);
 /// Okabe-Ito bluish green.
-pub const GREEN: RGBColor = RGBColor(0, 158, 115);
-/// Okabe-Ito yellow (too light for thin lines on white; used last).
-pub const YELLOW: RGBColor = RGBColor(240, 228, 66);
+pub(crate) const GREEN: RGBColor = RGBColor(0, 158, 115);
 /// Okabe-Ito blue.
-pub const BLUE: RGBColor = RGBColor(0, 114, 178);
+pub(crate) const BLUE: RGBColor = RGBColor(0, 114, 178);
 /// Okabe-Ito vermillion.
-pub const VERMILLION: RGBColor = RGBColor(213, 94, 0);
+pub(crate) const VERMILLION: RGBColor = RGBColor(213, 94, 0);
 /// Okabe-Ito reddish purple.
-pub const PURPLE: RGBColor = RGBColor(204, 121, 167);
+pub(crate) const PURPLE: RGBColor = RGBColor(204, 121, 167);
 /// Neutral grey for baselines.
-pub const GREY: RGBColor = RGBColor(110, 110, 110);
+pub(crate) const GREY: RGBColor = RGBColor(110, 110, 110);
 /// Axis panels and grid lines.
-pub const GRID: RGBColor = RGBColor(225, 225, 225);
+pub(crate) const GRID: RGBColor = RGBColor(225, 225, 225);
 
 /// DNSOM bottom view (k = 0 side, thesis Figure 4.4).
-pub const DNSOM_BOTTOM: RGBColor = BLUE;
+pub(crate) const DNSOM_BOTTOM: RGBColor = BLUE;
 /// DNSOM top view (k = 2 side, thesis Figure 4.4).
-pub const DNSOM_TOP: RGBColor = VERMILLION;
+pub(crate) const DNSOM_TOP: RGBColor = VERMILLION;
 
 /// Series colours in the order they are handed out for unnamed series.
-pub const CYCLE: [RGBColor; 8] = [BLUE, VERMILLION, GREEN, ORANGE, PURPLE, SKY_BLUE, BLACK, GREY];
+pub(crate) const CYCLE: [RGBColor; 8] =
+    [BLUE, VERMILLION, GREEN, ORANGE, PURPLE, SKY_BLUE, BLACK, GREY];
 
 /// The `i`-th colour of [`CYCLE`] (wrapping).
-pub fn cycle_colour(i: usize) -> RGBColor {
+pub(crate) fn cycle_colour(i: usize) -> RGBColor {
     CYCLE[i % CYCLE.len()]
 }
 
@@ -84,7 +83,7 @@ pub fn cycle_colour(i: usize) -> RGBColor {
 /// exact (the certified convex optimum) and b (approach B's least-squares control points, the
 /// starting point).
 /// Unknown names get `None`; use [`cycle_colour`] for them.
-pub fn optimiser_colour(name: &str) -> Option<RGBColor> {
+pub(crate) fn optimiser_colour(name: &str) -> Option<RGBColor> {
     match name.trim().to_ascii_lowercase().as_str() {
         "exact" => Some(BLACK),
         "b" => Some(GREY),
@@ -95,12 +94,12 @@ pub fn optimiser_colour(name: &str) -> Option<RGBColor> {
 }
 
 /// Regular text of `px` pixels.
-pub fn text(px: f64) -> TextStyle<'static> {
+pub(crate) fn text(px: f64) -> TextStyle<'static> {
     (FONT, px).into_font().into()
 }
 
 /// Bold text of `px` pixels.
-pub fn bold(px: f64) -> TextStyle<'static> {
+pub(crate) fn bold(px: f64) -> TextStyle<'static> {
     (FONT, px).into_font().style(FontStyle::Bold).into()
 }
 
@@ -122,7 +121,7 @@ where
 }
 
 /// `text` cut to at most `max` characters (an ellipsis marks the cut).
-pub fn truncate(text: &str, max: usize) -> String {
+pub(crate) fn truncate(text: &str, max: usize) -> String {
     if text.chars().count() <= max {
         text.to_string()
     } else {

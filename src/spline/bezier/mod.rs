@@ -23,14 +23,14 @@ use rand_distr::{Distribution, Normal};
 use crate::simd::bezier as fast;
 
 /// The n+1 Bernstein polynomials of degree n at t (de Casteljau-style recurrence).
-pub fn bernstein(n: usize, t: f64) -> Vec<f64> {
+pub(crate) fn bernstein(n: usize, t: f64) -> Vec<f64> {
     let mut b = vec![0.0; n + 1];
     bernstein_into(n, t, &mut b);
     b
 }
 
 /// [`bernstein`] into `b` (length n + 1), no allocation.
-pub fn bernstein_into(n: usize, t: f64, b: &mut [f64]) {
+pub(crate) fn bernstein_into(n: usize, t: f64, b: &mut [f64]) {
     b.fill(0.0);
     b[0] = 1.0;
     let s = 1.0 - t;
@@ -77,7 +77,7 @@ impl BezierSurface {
 /// the design matrix A = QR (Golub and Van Loan's R-SVD: A and R have the same singular values
 /// and right singular vectors, so the solution is A's pseudo-inverse solution), with
 /// Y = ||R x - c1||^2 + ||c2||^2 for Q^T b = (c1, c2): one tall QR instead of a tall SVD.
-pub fn fit_poles(
+pub(crate) fn fit_poles(
     du: usize,
     dv: usize,
     uv: &[(f64, f64)],
@@ -154,7 +154,7 @@ fn column_basis(deg: usize, t: &[f64]) -> DMatrix<f64> {
 /// Grid data as three nu x nv matrices (entry (i, j) = coordinate of point j * nu + i) and the
 /// sum of their squared entries.
 #[derive(Debug, Clone)]
-pub struct GridData {
+pub(crate) struct GridData {
     coords: [DMatrix<f64>; 3],
     pub(crate) norm2: f64,
     pub(crate) nu: usize,
@@ -165,7 +165,7 @@ pub struct GridData {
 }
 
 impl GridData {
-    pub fn new(points: &[Point3], nu: usize, nv: usize) -> GridData {
+    pub(crate) fn new(points: &[Point3], nu: usize, nv: usize) -> GridData {
         let coords = [0, 1, 2].map(|c| DMatrix::from_fn(nu, nv, |i, j| points[j * nu + i][c]));
         let norm2 = coords.iter().map(|m| m.norm_squared()).sum();
         let lv = fast::padded(nv);
@@ -191,13 +191,14 @@ impl GridData {
 /// and summed instead, so a near-exact fit keeps its small Y to full relative precision.
 /// Computed without allocation by the fast path (stack Householder QRs), falling back to
 /// [`grid_sse_qr`] when a collocation matrix is (nearly) rank deficient.
-pub fn grid_sse(du: usize, dv: usize, u: &[f64], v: &[f64], data: &GridData) -> f64 {
+#[cfg(test)]
+pub(crate) fn grid_sse(du: usize, dv: usize, u: &[f64], v: &[f64], data: &GridData) -> f64 {
     fast::with_scratch(|s| fast::grid_sse(du, dv, u, v, data, s))
         .unwrap_or_else(|| grid_sse_qr(du, dv, u, v, data))
 }
 
 /// [`grid_sse`] by nalgebra's QRs (SVD bases when rank deficient): the reference and fallback.
-pub fn grid_sse_qr(du: usize, dv: usize, u: &[f64], v: &[f64], data: &GridData) -> f64 {
+pub(crate) fn grid_sse_qr(du: usize, dv: usize, u: &[f64], v: &[f64], data: &GridData) -> f64 {
     let qu = column_basis(du, u);
     let qv = column_basis(dv, v);
     let cores: Vec<DMatrix<f64>> = data.coords.iter().map(|d| qu.tr_mul(d) * &qv).collect();
@@ -341,7 +342,7 @@ impl Problem for BezierParamProblem {
 
 /// The classical (uniform, chordal, centripetal) start vector for grid data, in the problem's
 /// encoding (u of the nu columns, then v of the nv rows), from `param::grid_params`.
-pub fn classical_grid_start(
+pub(crate) fn classical_grid_start(
     points: &[Point3],
     nu: usize,
     nv: usize,
@@ -362,7 +363,10 @@ pub fn classical_grid_start(
 /// u_k (v_k) is the parameter of point k on the polyline of all points sorted by their coordinate
 /// along the first (second) axis, by `param::polyline_params` (uniform k/(n-1), chordal, or
 /// centripetal). Ties keep the data order.
-pub fn classical_scattered_start(points: &[Point3], method: super::Parameterisation) -> Vec<f64> {
+pub(crate) fn classical_scattered_start(
+    points: &[Point3],
+    method: super::Parameterisation,
+) -> Vec<f64> {
     let n = points.len().max(1) as f64;
     let mut c = [0.0; 3];
     for p in points {
@@ -431,7 +435,7 @@ pub fn example3(n: usize, rng: &mut ChaCha8Rng) -> (BezierSurface, Vec<Point3>) 
 
 /// Add i.i.d. Gaussian noise to every coordinate at the given SNR (dB; definition in the module
 /// doc). Returns sigma.
-pub fn add_noise(points: &mut [Point3], snr_db: f64, rng: &mut ChaCha8Rng) -> f64 {
+pub(crate) fn add_noise(points: &mut [Point3], snr_db: f64, rng: &mut ChaCha8Rng) -> f64 {
     let p_signal = points.iter().flat_map(|p| p.iter()).map(|c| c * c).sum::<f64>()
         / (3 * points.len()) as f64;
     let sigma = (p_signal / 10f64.powf(snr_db / 10.0)).sqrt();

@@ -3,6 +3,9 @@
 use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
 
+mod commands;
+pub use commands::main;
+
 const EXAMPLES: &str = "\
 Examples:
   somnurbs run experiments/ch4_models.toml                 # Appendix B/C, Tables 4.9/4.13/4.14
@@ -17,13 +20,13 @@ Data directory (bunny, talus): --data-dir, else $SOMNURBS_DATA, else ./data";
 
 #[derive(Debug, Parser)]
 #[command(name = "somnurbs", version, about = "Reproduce SOM + cubic B-spline surface reconstruction experiments from seeds", after_help = EXAMPLES)]
-pub struct Cli {
+pub(crate) struct Cli {
     #[command(subcommand)]
-    pub command: Command,
+    pub(crate) command: Command,
 }
 
 #[derive(Debug, Subcommand)]
-pub enum Command {
+pub(crate) enum Command {
     /// Run an experiment spec (TOML): every cell on its own seeded stream, then tables, pictures,
     /// REPORT.md and manifest.toml in the output folder.
     #[command(after_help = EXAMPLES)]
@@ -67,196 +70,196 @@ pub enum Command {
 }
 
 #[derive(Debug, Args)]
-pub struct CompareArgs {
+pub(crate) struct CompareArgs {
     /// A results folder written by a spec with an [optim] section (reads its runs.csv).
-    pub results: PathBuf,
+    pub(crate) results: PathBuf,
     /// Significance level for the h columns, in (0, 1).
     #[arg(long, default_value_t = 0.05)]
-    pub alpha: f64,
+    pub(crate) alpha: f64,
     /// Region of practical equivalence of the Bayesian signed-rank test: half-width on the
     /// difference of the mean errors per cell, each divided by the cell's approach-B error
     /// (finite, >= 0).
     #[arg(long, default_value_t = 1e-6)]
-    pub rope: f64,
+    pub(crate) rope: f64,
     /// Monte Carlo samples of the Bayesian signed-rank test, in [1000, 10^7].
     #[arg(long, default_value_t = 50_000)]
-    pub bayes_samples: usize,
+    pub(crate) bayes_samples: usize,
     /// Folder for the tables and charts (default RESULTS/compare). It must be missing, empty or
     /// an earlier compare's, which is replaced whole; the run's own files are never changed.
     #[arg(long)]
-    pub out: Option<PathBuf>,
+    pub(crate) out: Option<PathBuf>,
     /// An IOHprofiler folder of optimisers from outside somnurbs (written by the Python
     /// package's `somnurbs.ioh_adapter.Logger`), compared beside the folder's own (repeatable);
     /// refused unless its problems are the folder's (spec, profile, reading, box, B's error).
     #[arg(long, value_name = "DIR")]
-    pub external: Vec<PathBuf>,
+    pub(crate) external: Vec<PathBuf>,
 }
 
 #[derive(Debug, Args)]
-pub struct FitArgs {
+pub(crate) struct FitArgs {
     /// Two-view grid CSV with columns i,j,view,class,x,y,z (both views, 2 nx ny rows).
     #[arg(long)]
-    pub grid: PathBuf,
+    pub(crate) grid: PathBuf,
     /// Control-net size CNXxCNY (each side at least 4, at most the grid's).
     #[arg(long)]
-    pub cn: String,
+    pub(crate) cn: String,
     /// uniform, chord_length, centripetal or exponential.
     #[arg(long, default_value = "chord_length")]
-    pub param: String,
+    pub(crate) param: String,
     /// conventional (A) or improved (B).
     #[arg(long, default_value = "improved")]
-    pub approach: String,
+    pub(crate) approach: String,
     /// Output folder for control_nets.csv, surfaces.igs, surfaces.obj and fit.csv.
     #[arg(long, default_value = "fit")]
-    pub out: PathBuf,
+    pub(crate) out: PathBuf,
     /// Evaluation samples per direction in the OBJ mesh, in [2, 1000].
     #[arg(long, default_value_t = 40)]
-    pub samples: usize,
+    pub(crate) samples: usize,
     /// Knot reading for nets smaller than the grid: eq2_10 (the thesis' Eq. 2.10 literally) or
     /// nurbs_book (The NURBS Book eq. 9.68-9.69). See docs/readings.md.
     #[arg(long, default_value = "eq2_10")]
-    pub knots: String,
+    pub(crate) knots: String,
     /// Reading of approach A's surface error: per_surface or nov_bottom.
     #[arg(long, default_value = "per_surface")]
-    pub error_a: String,
+    pub(crate) error_a: String,
     /// Penalised least squares weight (0: plain least squares, as the thesis); a small value such
     /// as 1e-4 keeps near-square nets bounded between the data points.
     #[arg(long, default_value_t = 0.0)]
-    pub fairness: f64,
+    pub(crate) fairness: f64,
     /// Coordinates of control_nets.csv, surfaces.igs and surfaces.obj: `data` (the data set's
     /// own, the normalisation undone with the frame Chapter 4 saved beside the map,
     /// MAP.frame.toml) or `normalised` (the map's). A map without a frame is exported as it is.
     #[arg(long, default_value = "data")]
-    pub frame: String,
+    pub(crate) frame: String,
     /// Length unit of the data's coordinates, for the IGES unit flag: unknown (flag 2, MM,
     /// marked nominal in the start section), mm, cm, m, um, in or ft.
     #[arg(long, default_value = "unknown")]
-    pub units: String,
+    pub(crate) units: String,
 }
 
 #[derive(Debug, Args)]
-pub struct RunArgs {
+pub(crate) struct RunArgs {
     /// The experiment spec, e.g. experiments/ch4_models.toml.
-    pub spec: PathBuf,
+    pub(crate) spec: PathBuf,
     /// A profile defined in the spec ([profiles.NAME]), e.g. quick.
     #[arg(long)]
-    pub profile: Option<String>,
+    pub(crate) profile: Option<String>,
     /// Output folder (default: the spec's `output`, else results/<spec name>).
     #[arg(long)]
-    pub out: Option<PathBuf>,
+    pub(crate) out: Option<PathBuf>,
     /// Worker threads (default: all cores; at least 1, at most 4 x the cores: more is cut down
     /// with a note). Results do not depend on it.
     #[arg(long, short = 'j')]
-    pub jobs: Option<usize>,
+    pub(crate) jobs: Option<usize>,
     /// Folder holding bun_zipper.ply and talus_r.stl (default: $SOMNURBS_DATA, else ./data).
     #[arg(long)]
-    pub data_dir: Option<PathBuf>,
+    pub(crate) data_dir: Option<PathBuf>,
     /// List the cells and their seeds without running them.
     #[arg(long)]
-    pub dry_run: bool,
+    pub(crate) dry_run: bool,
     /// Keep the cells an earlier, interrupted run of the same spec, profile and seed finished in
     /// the output folder (its cells.jsonl) and run only the rest; refused if the folder holds
     /// another run.
     #[arg(long)]
-    pub resume: bool,
+    pub(crate) resume: bool,
     /// Run only the I-th of N deterministic slices of the cells (1-based, e.g. 3/8) and write no
     /// tables; `somnurbs merge` combines the N shard folders into one.
     #[arg(long, value_name = "I/N")]
-    pub shard: Option<String>,
+    pub(crate) shard: Option<String>,
     /// Change one key of the spec's [optim] section, validated as if written in the file, e.g.
     /// `--set optim.de.f=0.5` (repeatable). The change is recorded in the manifest and enters
     /// every cell key, so the run's seeds differ from the unchanged spec's.
     #[arg(long, value_name = "KEY=VALUE")]
-    pub set: Vec<String>,
+    pub(crate) set: Vec<String>,
     /// Run the spec once per value of an optimiser setting into one folder, e.g.
     /// `--sweep optim.de.f=0.3,0.5,0.8` (repeatable: every combination). runs.csv gets a
     /// `variant` column and `somnurbs compare` ranks each optimiser@variant like an optimiser.
     /// At most 1000 variants and 10^5 cells over all of them; a value given twice (compared as
     /// TOML values: 0.3 and 0.30 are one) is refused.
     #[arg(long, value_name = "KEY=V1,V2,...")]
-    pub sweep: Vec<String>,
+    pub(crate) sweep: Vec<String>,
 }
 
 #[derive(Debug, Args)]
-pub struct DriftArgs {
+pub(crate) struct DriftArgs {
     /// The baseline folder (e.g. results/baselines/quick); its drift.toml, if any, names
     /// timing-dependent tables and rows and per-column tolerances.
-    pub baseline: PathBuf,
+    pub(crate) baseline: PathBuf,
     /// The folder of the run to check.
-    pub current: PathBuf,
+    pub(crate) current: PathBuf,
     /// Tolerance of the columns matching COLUMN (a glob): |a - b| <= ABS + REL max(|a|, |b|).
     /// Repeatable. Default 1e-9 absolute and 1e-9 relative.
     #[arg(long, value_name = "COLUMN=ABS[,REL]")]
-    pub tol: Vec<String>,
+    pub(crate) tol: Vec<String>,
     /// Where to write the per-cell diff CSV (default drift.csv in the working folder; never
     /// inside a result folder).
     #[arg(long)]
-    pub out: Option<PathBuf>,
+    pub(crate) out: Option<PathBuf>,
     /// Compare even when the two folders were made by different specs, seeds or profiles.
     #[arg(long)]
-    pub allow_spec_change: bool,
+    pub(crate) allow_spec_change: bool,
     /// Make the baseline hold the current tables (on purpose, after a change that moves results).
     #[arg(long)]
-    pub accept: bool,
+    pub(crate) accept: bool,
 }
 
 #[derive(Debug, Args)]
-pub struct MergeArgs {
+pub(crate) struct MergeArgs {
     /// The shard folders (each written by `somnurbs run SPEC --shard I/N`), all N of them.
     #[arg(required = true)]
-    pub shards: Vec<PathBuf>,
+    pub(crate) shards: Vec<PathBuf>,
     /// The folder to write the combined run to (must not hold a run yet, nor be a shard folder).
     #[arg(long)]
-    pub out: PathBuf,
+    pub(crate) out: PathBuf,
     /// Worker threads (default: all cores; at least 1, at most 4 x the cores: more is cut down
     /// with a note). Results do not depend on it.
     #[arg(long, short = 'j')]
-    pub jobs: Option<usize>,
+    pub(crate) jobs: Option<usize>,
     /// Folder holding bun_zipper.ply and talus_r.stl (default: $SOMNURBS_DATA, else ./data).
     #[arg(long)]
-    pub data_dir: Option<PathBuf>,
+    pub(crate) data_dir: Option<PathBuf>,
 }
 
 #[derive(Debug, Args)]
-pub struct ReproduceArgs {
+pub(crate) struct ReproduceArgs {
     /// quick (every spec's quick profile: under a minute on 2 cores; what CI runs) or full (the
     /// thesis' protocol: about half an hour on 2 cores, nearly all of it Chapter 6).
     #[arg(long, default_value = "full", value_parser = ["quick", "full"])]
-    pub profile: String,
+    pub(crate) profile: String,
     /// Which plan: `<specs>/<PLAN>.toml` lists the specs to run in order (thesis: Chapters 4-6;
     /// seeds: the other seeds' experiments; all: both).
     #[arg(long, default_value = "thesis")]
-    pub plan: String,
+    pub(crate) plan: String,
     /// Output folder (default results/<PLAN>, or results/<PLAN>_quick).
     #[arg(long)]
-    pub out: Option<PathBuf>,
+    pub(crate) out: Option<PathBuf>,
     /// Folder of the plans and experiment specs (default: experiments, or, run from a folder
     /// without one, the experiments folder of the clone somnurbs was built from).
     #[arg(long)]
-    pub specs: Option<PathBuf>,
+    pub(crate) specs: Option<PathBuf>,
     /// Worker threads (default: all cores; at least 1, at most 4 x the cores: more is cut down
     /// with a note). Results do not depend on it.
     #[arg(long, short = 'j')]
-    pub jobs: Option<usize>,
+    pub(crate) jobs: Option<usize>,
     /// Folder holding bun_zipper.ply and talus_r.stl (default: $SOMNURBS_DATA, else ./data).
     #[arg(long)]
-    pub data_dir: Option<PathBuf>,
+    pub(crate) data_dir: Option<PathBuf>,
     /// Keep what an interrupted reproduction finished (per chapter, as `run --resume`).
     #[arg(long)]
-    pub resume: bool,
+    pub(crate) resume: bool,
 }
 
 #[derive(Debug, Args)]
-pub struct DatasetsArgs {
+pub(crate) struct DatasetsArgs {
     #[command(subcommand)]
-    pub action: Option<DatasetsAction>,
+    pub(crate) action: Option<DatasetsAction>,
     /// Folder holding the data files (default: $SOMNURBS_DATA, else ./data).
     #[arg(long, global = true)]
-    pub data_dir: Option<PathBuf>,
+    pub(crate) data_dir: Option<PathBuf>,
 }
 
 #[derive(Debug, Subcommand)]
-pub enum DatasetsAction {
+pub(crate) enum DatasetsAction {
     /// List the built-in data sets (default).
     List,
     /// Load one data set and print its size and bounds.

@@ -1,0 +1,166 @@
+//! The commands behind the command line: each subcommand's arguments to the library's calls, the
+//! exit code, and errors printed on one line.
+
+use super::{Cli, Command, DatasetsAction, DriftArgs, ReproduceArgs, RunArgs};
+use crate::experiment::{self, log::Shard, spec::CliOverrides, RunContext};
+use crate::families::{Loaded, Section};
+use clap::Parser;
+use std::process::ExitCode;
+
+/// The program: parse the command line, run the command, print an error chain on one line and
+/// exit 2 on error (1 for drift found, 0 otherwise).
+pub fn main() -> ExitCode {
+    // Output piped into a reader that stops early (`somnurbs drift ... | head`) ends the program
+    // quietly, as for other Unix tools, instead of a panic in println!.
+    #[cfg(unix)]
+    // SAFETY: restoring the default action of SIGPIPE before any thread starts.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("somnurbs: error: {}", crate::io::one_line(&format!("{e:#}")));
+            ExitCode::from(2)
+        }
+    }
+}
+
+/// Worker threads: the flag, else every core; at most a few per core (a note says when the flag
+/// was cut down).
+fn jobs(flag: Option<usize>) -> anyhow::Result<usize> {
+    let cpus = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
+    let (jobs, note) = experiment::limits::jobs(flag, cpus)?;
+    if let Some(note) = note {
+        eprintln!("somnurbs: note: {note}");
+    }
+    Ok(jobs)
+}
+
+fn run(cli: Cli) -> anyhow::Result<ExitCode> {
+    crate::simd::simd()?;
+    match cli.command {
+        Command::Run(args) => run_spec(&args),
+        Command::Drift(args) => drift(&args),
+        Command::Merge(args) => {
+            let ctx = RunContext {
+                page: true,
+                ..RunContext::new(
+                    args.out.clone(),
+                    jobs(args.jobs)?,
+                    experiment::data_dir(args.data_dir.as_deref()),
+                )
+            };
+            let out = experiment::merge::<Section>(&args.shards, &ctx)?;
+            eprintln!(
+                "somnurbs: merged {} shards into {} and {}",
+                args.shards.len(),
+                out.join("REPORT.md").display(),
+                out.join(crate::report::html::FILE).display()
+            );
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Reproduce(args) => reproduce(&args),
+        Command::Compare(args) => {
+            crate::families::optimise::compare::compare(&args)?;
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Fit(args) => {
+            crate::families::fit::command::fit(&args)?;
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Datasets(args) => {
+            let dir = experiment::data_dir(args.data_dir.as_deref());
+            experiment::datasets::datasets(args.action.unwrap_or(DatasetsAction::List), &dir)?;
+            Ok(ExitCode::SUCCESS)
+        }
+    }
+}
+
+/// `somnurbs run`: one spec (or its variants) into one folder, or one shard of it.
+fn run_spec(args: &RunArgs) -> anyhow::Result<ExitCode> {
+    let cli = CliOverrides { set: args.set.clone(), sweep: args.sweep.clone() };
+    let variants = Loaded::load_variants(&args.spec, args.profile.as_deref(), &cli)?;
+    let spec = &variants[0].spec;
+    if args.dry_run {
+        for (key, seed) in variants.iter().flat_map(experiment::dry_run_listing) {
+            println!("{key}\tseed {seed}");
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
+    let shard = args.shard.as_deref().map(Shard::parse).transpose()?;
+    let ctx = RunContext {
+        resume: args.resume,
+        shard,
+        page: true,
+        ..RunContext::new(
+            spec.output_dir(args.out.as_deref()),
+            jobs(args.jobs)?,
+            experiment::data_dir(args.data_dir.as_deref()),
+        )
+    };
+    let out = experiment::run_variants(&variants, &ctx)?;
+    match shard {
+        Some(s) => eprintln!(
+            "somnurbs: wrote shard {s} to {} (combine the shards with `somnurbs merge`)",
+            out.display()
+        ),
+        None => eprintln!(
+            "somnurbs: {} and {} are in place",
+            out.join("REPORT.md").display(),
+            out.join(crate::report::html::FILE).display()
+        ),
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `somnurbs drift`: compare two result folders (exit 1 on drift), or accept the current one.
+fn drift(args: &DriftArgs) -> anyhow::Result<ExitCode> {
+    use crate::report::drift;
+    if args.accept {
+        let said = drift::accept(&args.baseline, &args.current)?;
+        for l in &said {
+            println!("{l}");
+        }
+        println!(
+            "baseline {} now holds the tables of {} ({} files changed)",
+            args.baseline.display(),
+            args.current.display(),
+            said.len()
+        );
+        return Ok(ExitCode::SUCCESS);
+    }
+    let mut columns =
+        args.tol.iter().map(|t| drift::parse_tol(t)).collect::<anyhow::Result<Vec<_>>>()?;
+    let config = drift::read_config(&args.baseline)?;
+    columns.extend(
+        config
+            .tolerance
+            .iter()
+            .map(|c| (c.column.clone(), drift::Tolerance { abs: c.abs, rel: c.rel })),
+    );
+    let opts = drift::DriftOptions { columns, config, ..Default::default() };
+    let report = drift::compare_dirs(&args.baseline, &args.current, &opts, args.allow_spec_change)?;
+    let out = args.out.clone().unwrap_or_else(|| "drift.csv".into());
+    crate::io::outdir::require_outside_results(&out, "--out FILE")?;
+    crate::io::write_atomic(&out, report.csv()?.as_bytes())?;
+    println!("{}\nper-cell differences: {}", report.summary(10), out.display());
+    Ok(if report.drifted() { ExitCode::from(1) } else { ExitCode::SUCCESS })
+}
+
+/// `somnurbs reproduce`: a plan's specs in order into one folder, then the combined report.
+fn reproduce(args: &ReproduceArgs) -> anyhow::Result<ExitCode> {
+    use experiment::reproduce::{default_out, specs_dir};
+    let out = args.out.clone().unwrap_or_else(|| default_out(&args.plan, &args.profile));
+    let jobs = jobs(args.jobs)?;
+    let specs = specs_dir(args.specs.as_deref(), &args.plan)?;
+    let ctx = RunContext {
+        resume: args.resume,
+        ..RunContext::new(out, jobs, experiment::data_dir(args.data_dir.as_deref()))
+    };
+    let report =
+        experiment::reproduce::reproduce::<Section>(&specs, &args.plan, &args.profile, &ctx)?;
+    eprintln!("somnurbs: wrote {}", report.display());
+    Ok(ExitCode::SUCCESS)
+}
