@@ -36,7 +36,7 @@ fn main() {
     let spec_path =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/ch4_models.toml");
     let loaded = families::Loaded::load(&spec_path, None).expect("spec");
-    let som_spec: &families::som::SomSpec = loaded.section().expect("a [som] spec");
+    let som_spec: &families::som::SomSpec = loaded.section_as().expect("a [som] spec");
     let spec = &loaded.spec;
     let cells: Vec<_> =
         families::som::cells(som_spec).into_iter().filter(|c| c.grid.nx == c.grid.ny).collect();

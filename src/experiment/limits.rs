@@ -360,7 +360,7 @@ mod tests {
         let som = "name = \"s\"\nmaster_seed = 1\n[som]\ndatasets = [\"cube\"]\niterations = 10\nrepeats = 10000\n[[som.group]]\nmodels = [\"som2d\", \"dnsom\"]\ngrids = [\"10x10\", \"12x12\"]\n[[som.group]]\nmodels = [\"som2d\"]\ngrids = [\"10x10\"]\n";
         let t = std::time::Instant::now();
         let spec = crate::families::Loaded::parse("s.toml", som, None).unwrap();
-        assert_eq!(crate::families::som::spec::cells(spec.section().unwrap()).len(), 40_000);
+        assert_eq!(crate::families::som::spec::cells(spec.section_as().unwrap()).len(), 40_000);
         assert!(t.elapsed().as_secs_f64() < 2.0, "{:?}", t.elapsed());
     }
 
@@ -368,7 +368,8 @@ mod tests {
     fn file_names_become_stems_in_keys() {
         let text = SPEC.replace("datasets = [\"sphere\"]", "datasets = [\"/some/where/part.xyz\"]");
         let spec = crate::families::Loaded::parse("t.toml", &text, None).unwrap();
-        let cells = || crate::families::optimise::spec::cells(&spec.spec, spec.section().unwrap());
+        let cells =
+            || crate::families::optimise::spec::cells(&spec.spec, spec.section_as().unwrap());
         assert!(
             cells().iter().all(|c| c.key().starts_with("optim/part/")),
             "{:?}",

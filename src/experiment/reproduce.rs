@@ -770,8 +770,9 @@ fn readings_score<F: Families>(
 }
 
 /// The readings score's total per chapter or seed (rows of the Markdown table): for each chapter
-/// with a spec that more than one reading ran, each reading's sum over the chapter's specs that
-/// every reading running one of them ran ("-" for a reading that ran none).
+/// with two or more specs that every reading running one of them ran, each reading's sum over
+/// those specs ("-" for a reading that ran none). A chapter of one such spec has no total row: it
+/// would repeat the spec's own.
 fn chapter_totals<'s>(
     names: &[&String],
     specs: &[&String],
@@ -790,7 +791,7 @@ fn chapter_totals<'s>(
             names.iter().filter(|r| own.iter().any(|s| find(r, s).is_some())).collect();
         let common: Vec<&&&String> =
             own.iter().filter(|s| ran.iter().all(|r| find(r, s).is_some())).collect();
-        if ran.len() < 2 || common.is_empty() {
+        if ran.len() < 2 || common.len() < 2 {
             continue;
         }
         let mut row = vec![format!(

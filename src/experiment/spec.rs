@@ -182,8 +182,8 @@ impl<F: Families> Loaded<F> {
         self.section.family()
     }
 
-    /// The section of type `S` (a family's), if the spec's section is one.
-    pub fn section<S>(&self) -> Option<&S>
+    /// The section as the family type `S`, if the spec's section is one.
+    pub fn section_as<S>(&self) -> Option<&S>
     where
         F: Holds<S>,
     {

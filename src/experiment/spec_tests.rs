@@ -21,12 +21,12 @@ iterations = 7
 #[test]
 fn parses_expands_and_applies_profile() {
     let s = L::parse("t.toml", SPEC, None).unwrap();
-    assert_eq!(crate::families::som::spec::cells(s.section().unwrap()).len(), 4);
-    assert_eq!(s.section::<crate::families::som::spec::SomSpec>().unwrap().iterations, 100);
+    assert_eq!(crate::families::som::spec::cells(s.section_as().unwrap()).len(), 4);
+    assert_eq!(s.section_as::<crate::families::som::spec::SomSpec>().unwrap().iterations, 100);
     let q = L::parse("t.toml", SPEC, Some("quick")).unwrap();
-    assert_eq!(q.section::<crate::families::som::spec::SomSpec>().unwrap().iterations, 7);
+    assert_eq!(q.section_as::<crate::families::som::spec::SomSpec>().unwrap().iterations, 7);
     assert_eq!(
-        crate::families::som::spec::cells(q.section().unwrap())[3].key(),
+        crate::families::som::spec::cells(q.section_as().unwrap())[3].key(),
         "som/cube/dnsom/18x30/r0"
     );
 }
@@ -56,7 +56,7 @@ fn overrides_apply_after_the_profile_and_are_validated() {
     let text = "name = \"f\"\nmaster_seed = 1\n[fit]\ndatasets = [\"cube\"]\ngrid = \"20x20\"\ncontrol_nets = [\"6x6\"]\nparameterisations = [\"uniform\"]\napproaches = [\"A\"]\n[profiles.quick.fit]\nfairness = 0.5\n";
     let ov = |k: &str, v: toml::Value| Override { key: k.into(), value: v };
     let plain = L::parse("f.toml", text, Some("quick")).unwrap();
-    let fit = plain.section::<crate::families::fit::spec::FitSpec>().unwrap();
+    let fit = plain.section_as::<crate::families::fit::spec::FitSpec>().unwrap();
     assert_eq!(
         (fit.knots, fit.error_a, fit.fairness),
         (crate::spline::KnotRule::Eq2_10, crate::spline::ErrorA::PerSurface, 0.5)
@@ -67,13 +67,13 @@ fn overrides_apply_after_the_profile_and_are_validated() {
         ov("optim.knots", "nurbs_book".into()),
     ];
     let s = L::parse_with("f.toml", text, Some("quick"), &set).unwrap();
-    let fit = s.section::<crate::families::fit::spec::FitSpec>().unwrap();
+    let fit = s.section_as::<crate::families::fit::spec::FitSpec>().unwrap();
     assert_eq!(
         (fit.knots, fit.error_a, fit.fairness),
         (crate::spline::KnotRule::NurbsBook, crate::spline::ErrorA::NovBottom, 0.5)
     );
     assert!(
-        s.section::<crate::families::optimise::spec::OptimSpec>().is_none(),
+        s.section_as::<crate::families::optimise::spec::OptimSpec>().is_none(),
         "a key of an absent section is skipped"
     );
     let e = L::parse_with("f.toml", text, None, &[ov("fit.knots", "9.69".into())])
@@ -86,7 +86,7 @@ fn overrides_apply_after_the_profile_and_are_validated() {
     assert!(e.contains("fit.fairness"), "{e}");
     // The parameterisation readings: defaults (Section 2.3.2's 0.8, Eq. 5.1/5.2 over all lines),
     // a set value reaches the fit options, and alpha outside (0, 1] is refused naming the key.
-    let opts = plain.section::<crate::families::fit::spec::FitSpec>().unwrap().fit_options();
+    let opts = plain.section_as::<crate::families::fit::spec::FitSpec>().unwrap().fit_options();
     assert_eq!(opts.param, crate::spline::ParamReading::default());
     assert_eq!(opts.param.exponential_alpha, 0.8);
     let set = [
@@ -94,7 +94,7 @@ fn overrides_apply_after_the_profile_and_are_validated() {
         ov("fit.param_rows", "middle".into()),
     ];
     let s = L::parse_with("f.toml", text, None, &set).unwrap();
-    let opts = s.section::<crate::families::fit::spec::FitSpec>().unwrap().fit_options();
+    let opts = s.section_as::<crate::families::fit::spec::FitSpec>().unwrap().fit_options();
     assert_eq!(
         opts.param,
         crate::spline::ParamReading {
@@ -131,7 +131,7 @@ fn som_readings_default_parse_and_name_their_key() {
     use crate::som::LatticeAdjacency;
     let ov = |k: &str, v: &str| Override { key: k.into(), value: v.into() };
     let som = |s: &L| {
-        let s = s.section::<crate::families::som::spec::SomSpec>().unwrap();
+        let s = s.section_as::<crate::families::som::spec::SomSpec>().unwrap();
         (s.som3d_adjacency, s.spindle_profile, s.spindle_rings)
     };
     let plain = L::parse("t.toml", SPEC, None).unwrap();

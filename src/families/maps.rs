@@ -15,6 +15,28 @@ use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+/// One control-net problem: the data set, the control net and the parameterisation (the grid is
+/// the spec's). Chapter 6's problems, exact optima and table cells, and seed 001's problems, are
+/// keyed by it; the order of its fields is the order of `runs.csv`'s cells.
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct ProblemKey {
+    pub data: String,
+    pub cn: GridSize,
+    pub param: crate::spline::Parameterisation,
+}
+
+impl ProblemKey {
+    pub(crate) fn new(data: &str, cn: GridSize, param: crate::spline::Parameterisation) -> Self {
+        ProblemKey { data: data.to_string(), cn, param }
+    }
+}
+
+impl std::fmt::Display for ProblemKey {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} {} {}", self.data, self.cn, self.param.name())
+    }
+}
+
 /// What a run does when the `maps` folder a spec names, or a map in it, is not there.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
 #[serde(rename_all = "snake_case")]

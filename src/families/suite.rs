@@ -8,6 +8,7 @@
 //! against).
 
 use super::growing_grid::{self, spec::GrowingGridSpec};
+use super::maps::ProblemKey;
 use super::optimise::{self, spec::OptimSpec};
 use super::{Loaded, Section};
 use crate::experiment::overrides::CliOverrides;
@@ -150,7 +151,7 @@ pub fn load(
     };
     let built = optimise::problems(&spec, o, &ctx)?;
     let mut problems = Vec::with_capacity(built.len());
-    for ((dataset, net, param), problem) in built {
+    for (ProblemKey { data: dataset, cn: net, param }, problem) in built {
         let wide =
             ControlNetProblem::new(problem.parts().clone(), BoxSpec::Cover { fraction: 0.0 })
                 .with_context(|| format!("{dataset} {net} {}: the data-range box", param.name()))?;
@@ -188,7 +189,7 @@ fn open_surfaces(
 ) -> Result<Suite> {
     let maps = growing_grid::maps(spec, g, ctx)?;
     let mut problems = Vec::new();
-    for ((dataset, net, param), p) in growing_grid::problems(g, &maps)? {
+    for (ProblemKey { data: dataset, cn: net, param }, p) in growing_grid::problems(g, &maps)? {
         let grid = GridSize { nx: p.nx, ny: p.ny };
         problems.push(SuiteProblem {
             name: optimise::ioh::problem_name(

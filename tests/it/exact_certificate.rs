@@ -30,7 +30,7 @@ fn check_spec(name: &str, profile: Option<&str>, jobs: usize, check_pipeline: bo
         let spec = spec(name, profile, knots);
         let dir = tempfile::tempdir().unwrap();
         let ctx = RunContext::new(dir.path().to_path_buf(), jobs, crate::common::data_dir());
-        let o = spec.section::<somnurbs::families::optimise::OptimSpec>().unwrap();
+        let o = spec.section_as::<somnurbs::families::optimise::OptimSpec>().unwrap();
         let pbs = problems(&spec.spec, o, &ctx).unwrap();
         let tol = o.exact_tol;
         let opts = ExactOptions {
@@ -43,13 +43,7 @@ fn check_spec(name: &str, profile: Option<&str>, jobs: usize, check_pipeline: bo
         // EXACT_CELLS=18x18 (a substring of the label) limits the cells solved.
         let only = std::env::var("EXACT_CELLS").unwrap_or_default();
         for (key, pb) in &pbs {
-            let label = format!(
-                "{name} {} {knots} {} {} {}",
-                profile.unwrap_or("full"),
-                key.0,
-                key.1,
-                key.2.name()
-            );
+            let label = format!("{name} {} {knots} {key}", profile.unwrap_or("full"));
             if !label.contains(&only) {
                 continue;
             }

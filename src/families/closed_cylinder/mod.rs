@@ -348,7 +348,7 @@ mod tests {
         let at = spec_with("").unwrap();
         let foot = spec_with("error = \"closest_point\"").unwrap();
         let (sa, sf): (&ClosedCylinderSpec, &ClosedCylinderSpec) =
-            (at.section().unwrap(), foot.section().unwrap());
+            (at.section_as().unwrap(), foot.section_as().unwrap());
         assert_eq!(sa.error, crate::spline::closed::PointError::AtParameters);
         let d = data(sa);
         let cell = Cell { control_points: 7, repeat: 0 };

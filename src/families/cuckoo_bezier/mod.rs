@@ -462,7 +462,7 @@ mod tests {
 
     fn csa_example3(spec: &crate::families::Loaded) -> Row {
         let cell = Cell { example: "example3".into(), method: "csa".into(), run: 0 };
-        run_cell(&spec.spec, spec.section().unwrap(), &cell).unwrap().row
+        run_cell(&spec.spec, spec.section_as().unwrap(), &cell).unwrap().row
     }
 
     /// The default start is Section 5.2's U[0,1]; a centred start begins next to its classical
@@ -470,10 +470,10 @@ mod tests {
     #[test]
     fn start_readings() {
         let random = spec_with("").unwrap();
-        let s = random.section::<CuckooBezierSpec>().unwrap();
+        let s = random.section_as::<CuckooBezierSpec>().unwrap();
         assert_eq!((s.start, budget(s, &s.example3).init_range), (Start::Random, 0.5));
         let centred = spec_with("start = \"centripetal\"\nstart_spread = 0.01").unwrap();
-        let c = centred.section::<CuckooBezierSpec>().unwrap();
+        let c = centred.section_as::<CuckooBezierSpec>().unwrap();
         assert_eq!(budget(c, &c.example3).init_range, 0.01);
         let classical = run_cell(
             &random.spec,

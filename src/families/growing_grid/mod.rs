@@ -98,8 +98,7 @@ impl runner::Logged for Run {
     }
 }
 
-/// A problem: (data set, control net, parameterisation).
-pub(crate) type ProblemKey = (String, GridSize, Parameterisation);
+pub(crate) use crate::families::maps::ProblemKey;
 
 /// Every cell in a fixed order: data, net, parameterisation, optimiser, repeat.
 pub(crate) fn cells(g: &GrowingGridSpec) -> Vec<Cell> {
@@ -174,7 +173,7 @@ pub(crate) fn problems(
                 )
                 .map_err(anyhow::Error::msg)
                 .with_context(|| format!("{} {cn} {param}", m.dataset))?;
-                out.insert((m.dataset.clone(), cn, param), pr);
+                out.insert(ProblemKey::new(&m.dataset, cn, param), pr);
             }
         }
     }
@@ -236,7 +235,7 @@ pub(crate) fn run(
         &cells,
         ctx,
         &spec.file.name,
-        |c| run_cell(spec, g, c, &problems[&(c.dataset.clone(), c.cn, c.param)]),
+        |c| run_cell(spec, g, c, &problems[&ProblemKey::new(&c.dataset, c.cn, c.param)]),
         |c, (row, best_x)| Ok(Run { cell: c.clone(), row, best_x }),
     )
 }

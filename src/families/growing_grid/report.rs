@@ -116,7 +116,7 @@ fn least_squares(
     md: &mut String,
 ) -> Result<()> {
     let mut fit_rows = Vec::new();
-    for ((d, cn, p), pr) in problems {
+    for (ProblemKey { data: d, cn, param: p }, pr) in problems {
         let e = pr.fitness(pr.initial_point());
         fit_rows.push(vec![
             d.clone(),
@@ -347,7 +347,7 @@ fn pictures(
                 label: "map".into(),
             }],
         }];
-        let mut nets: Vec<_> = problems.keys().filter(|k| k.0 == m.dataset).map(|k| k.1).collect();
+        let mut nets: Vec<_> = problems.keys().filter(|k| k.data == m.dataset).map(|k| k.cn).collect();
         nets.dedup();
         for cn in nets {
             let best = runs
@@ -355,7 +355,7 @@ fn pictures(
                 .filter(|r| r.cell.dataset == m.dataset && r.cell.cn == cn)
                 .min_by(|a, b| a.row.best.total_cmp(&b.row.best));
             if let Some(r) = best {
-                let pr = &problems[&(r.cell.dataset.clone(), r.cell.cn, r.cell.param)];
+                let pr = &problems[&ProblemKey::new(&r.cell.dataset, r.cell.cn, r.cell.param)];
                 // Dense: between the data parameters a near-square net is free to swing out
                 // (only the grid points are fitted), and the picture must show it.
                 let (pts, edges) = crate::spline::geometry::dense_wireframe(

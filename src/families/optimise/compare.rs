@@ -12,27 +12,20 @@ use crate::stats::{
 use anyhow::{Context, Result};
 use std::collections::BTreeMap;
 
-type CellKey = (String, usize, usize, usize, usize, String);
+use super::ComparedCell;
 
 /// The blocks x treatments table of the Friedman test: one row per cell (data, grid, net,
 /// parameterisation) that every optimiser ran, the mean best fitness over repeats of each
 /// optimiser (in order of first appearance).
 pub(crate) fn friedman_table(rows: &[OptimRow]) -> (Vec<String>, Vec<Vec<f64>>) {
     let mut opts: Vec<String> = Vec::new();
-    let mut cells: BTreeMap<CellKey, BTreeMap<String, (f64, usize)>> = BTreeMap::new();
+    let mut cells: BTreeMap<ComparedCell, BTreeMap<String, (f64, usize)>> = BTreeMap::new();
     for r in rows {
         if !opts.contains(&r.competitor()) {
             opts.push(r.competitor());
         }
         let e = cells
-            .entry((
-                r.dataset.clone(),
-                r.grid_x,
-                r.grid_y,
-                r.cn_x,
-                r.cn_y,
-                r.parameterisation.clone(),
-            ))
+            .entry(r.compared_cell())
             .or_default()
             .entry(r.competitor())
             .or_default();
@@ -48,7 +41,7 @@ pub(crate) fn friedman_table(rows: &[OptimRow]) -> (Vec<String>, Vec<Vec<f64>>) 
 }
 
 /// Per cell, per competitor: its (repeat, best) pairs.
-type Cells = BTreeMap<CellKey, BTreeMap<String, Vec<(usize, f64)>>>;
+type Cells = BTreeMap<ComparedCell, BTreeMap<String, Vec<(usize, f64)>>>;
 /// Per pair of competitors: cells where the rank-sum test favours the first, the second, and the
 /// cells where the rank-sum test can reach alpha at all.
 type Wins = BTreeMap<(String, String), (usize, usize, usize)>;
@@ -133,7 +126,7 @@ fn better(
 /// One `compare_cells.csv` row: the tests and effect size of x against y in cell `k`, and whether
 /// the rank-sum test favours x (Some(true)), y (Some(false)) or neither at alpha.
 fn cell_pair(
-    k: &CellKey,
+    k: &ComparedCell,
     (x, y): (&str, &str),
     (xa, xb): (&[f64], &[f64]),
     alpha: f64,
@@ -153,10 +146,10 @@ fn cell_pair(
     let (b, by) = better(sr.as_ref(), rs.as_ref(), a12, alpha);
     let favours = rs.as_ref().filter(|r| r.p_value < alpha).map(|_| a12 > 0.5);
     let row = vec![
-        k.0.clone(),
-        format!("{}x{}", k.1, k.2),
-        format!("{}x{}", k.3, k.4),
-        k.5.clone(),
+        k.data.clone(),
+        k.grid.to_string(),
+        k.cn.to_string(),
+        k.param.clone(),
         x.to_string(),
         y.to_string(),
         xa.len().to_string(),
@@ -403,9 +396,7 @@ pub(crate) fn compare(args: &CompareArgs) -> Result<()> {
         if !opts.contains(&r.competitor()) {
             opts.push(r.competitor());
         }
-        let key =
-            (r.dataset.clone(), r.grid_x, r.grid_y, r.cn_x, r.cn_y, r.parameterisation.clone());
-        cells.entry(key).or_default().entry(r.competitor()).or_default().push((r.repeat, r.best));
+        cells.entry(r.compared_cell()).or_default().entry(r.competitor()).or_default().push((r.repeat, r.best));
     }
     if opts.len() < 2 {
         anyhow::bail!(
@@ -1033,17 +1024,10 @@ fn render_fixed_budget(
 /// The Bayesian signed-rank test of every pair over the cells every optimiser ran: each cell's
 /// mean best error divided by the cell's approach-B error.
 fn bayes_table(rows: &[OptimRow], opts: &[String], args: &CompareArgs) -> Result<Vec<Vec<String>>> {
-    let mut cells: BTreeMap<CellKey, CellSums> = BTreeMap::new();
+    let mut cells: BTreeMap<ComparedCell, CellSums> = BTreeMap::new();
     for r in rows {
         let e = cells
-            .entry((
-                r.dataset.clone(),
-                r.grid_x,
-                r.grid_y,
-                r.cn_x,
-                r.cn_y,
-                r.parameterisation.clone(),
-            ))
+            .entry(r.compared_cell())
             .or_insert((r.b, BTreeMap::new()));
         let s = e.1.entry(r.competitor()).or_default();
         s.0 += r.best;

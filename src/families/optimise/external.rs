@@ -32,7 +32,7 @@ fn folder_suite(results: &Path) -> Result<[String; 4]> {
         .into_iter()
         .next()
         .context("no spec")?;
-    let o = spec.section::<super::spec::OptimSpec>().with_context(|| {
+    let o = spec.section_as::<super::spec::OptimSpec>().with_context(|| {
         format!("{}: its spec has no [optim] section", results.display())
     })?;
     Ok([

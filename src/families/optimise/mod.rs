@@ -24,6 +24,17 @@ use spec::OptimCell;
 use std::collections::BTreeMap;
 pub use spec::OptimSpec;
 
+/// The cell of a `runs.csv` row as `somnurbs compare` groups rows from any folders: the data
+/// set, grid, control net and parameterisation as written (its own, beside [`ProblemKey`]: rows
+/// of several specs and grids meet here, and an external optimiser's rows are matched by name).
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord)]
+pub(crate) struct ComparedCell {
+    pub(crate) data: String,
+    pub(crate) grid: GridSize,
+    pub(crate) cn: GridSize,
+    pub(crate) param: String,
+}
+
 /// One row of a Chapter 6 `runs.csv`.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub(crate) struct OptimRow {
@@ -55,6 +66,16 @@ pub(crate) struct OptimRow {
 }
 
 impl OptimRow {
+    /// The cell this row belongs to, as `compare` groups rows.
+    pub(crate) fn compared_cell(&self) -> ComparedCell {
+        ComparedCell {
+            data: self.dataset.clone(),
+            grid: GridSize { nx: self.grid_x, ny: self.grid_y },
+            cn: GridSize { nx: self.cn_x, ny: self.cn_y },
+            param: self.parameterisation.clone(),
+        }
+    }
+
     /// What `compare` and the tables rank: the optimiser, or in a sweep `optimiser@variant`.
     pub(crate) fn competitor(&self) -> String {
         if self.variant.is_empty() {
@@ -90,8 +111,7 @@ pub(crate) struct OptimRecord {
     pub(crate) improvements: Vec<(u64, f64)>,
 }
 
-/// A problem: (data set, control net, parameterisation); the grid is the spec's one.
-pub(crate) type ProblemKey = (String, GridSize, Parameterisation);
+pub use crate::families::maps::ProblemKey;
 
 /// The certified exact optimum of every problem, when the spec asks for it (deterministic, so
 /// computed once per problem and in parallel).
@@ -110,7 +130,7 @@ pub fn exact_optima(
         "exact optima",
         |k| {
             problems[*k].exact_optimum(&o.exact_options()).map_err(|e| {
-                anyhow::anyhow!("exact optimum of {} {} {}: {e}", k.0, k.1, k.2.name())
+                anyhow::anyhow!("exact optimum of {k}: {e}")
             })
         },
         |_, _| Ok(()),
@@ -152,7 +172,7 @@ pub fn problems(
                 };
                 let problem = ControlNetProblem::new(parts, bounds)
                     .with_context(|| format!("{d} {cn} {param}"))?;
-                out.insert((d.clone(), cn, param), problem);
+                out.insert(ProblemKey::new(d, cn, param), problem);
             }
         }
     }
@@ -238,7 +258,7 @@ pub(crate) fn run(
 ) -> Result<Vec<OptimRun>> {
     let cells = spec::cells(spec, o);
     let largest = cells.iter().map(|c| c.cn).max().unwrap_or(GridSize { nx: 0, ny: 0 });
-    let problem = |cell: &OptimCell| &problems[&(cell.dataset.clone(), cell.cn, cell.param)];
+    let problem = |cell: &OptimCell| &problems[&ProblemKey::new(&cell.dataset, cell.cn, cell.param)];
     let mut runs = runner::run_logged(
         &cells,
         ctx,

@@ -46,7 +46,7 @@ pub(crate) fn views(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNe
             shown.extend(min.into_values().map(|k| (k, false)));
             for (k, furthest) in shown {
                 let r = &runs[k];
-                let problem = problems.get(&(d.clone(), r.cell.cn, r.cell.param));
+                let problem = problems.get(&ProblemKey::new(&d, r.cell.cn, r.cell.param));
                 if let Some(problem) = problem.filter(|_| !r.best_x.is_empty()) {
                     views.push(view(r, &d, grid, problem, furthest));
                 }

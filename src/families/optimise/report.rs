@@ -31,7 +31,6 @@ fn stats(v: &[f64]) -> Option<(f64, f64, f64)> {
     ))
 }
 
-type CellKey = (String, Parameterisation, GridSize);
 
 /// The thesis' Appendices K and L (optimised surface error) and M and N (CPU time).
 pub(crate) const PUBLISHED: crate::report::reference::Published = &[
@@ -151,12 +150,12 @@ fn significant(v: Option<f64>) -> String {
 }
 
 /// The runs of one (cell, optimiser), mapped by `f`.
-fn of(g: &[&OptimRun], c: &CellKey, o: &str, f: &dyn Fn(&OptimRun) -> f64) -> Vec<f64> {
+fn of(g: &[&OptimRun], c: &ProblemKey, o: &str, f: &dyn Fn(&OptimRun) -> f64) -> Vec<f64> {
     g.iter()
         .filter(|r| {
-            r.cell.dataset == c.0
-                && r.cell.param == c.1
-                && r.cell.cn == c.2
+            r.cell.dataset == c.data
+                && r.cell.param == c.param
+                && r.cell.cn == c.cn
                 && r.competitor == o
         })
         .map(|r| f(r))
@@ -166,7 +165,7 @@ fn of(g: &[&OptimRun], c: &CellKey, o: &str, f: &dyn Fn(&OptimRun) -> f64) -> Ve
 /// One grid's runs reduced to Appendices K-N and the win counts of Tables 6.4-6.7.
 struct GridTables {
     opts: Vec<String>,
-    cells: Vec<CellKey>,
+    cells: Vec<ProblemKey>,
     /// Appendix K/L (errors) and M/N (CPU seconds): headers and rows.
     eh: Vec<String>,
     erows: Vec<Vec<String>>,
@@ -185,8 +184,8 @@ struct GridTables {
 impl GridTables {
     fn compute(g: &[&OptimRun]) -> GridTables {
         let opts = ordered(g.iter().map(|r| r.competitor.clone()));
-        let cells: Vec<CellKey> =
-            ordered(g.iter().map(|r| (r.cell.dataset.clone(), r.cell.param, r.cell.cn)));
+        let cells: Vec<ProblemKey> =
+            ordered(g.iter().map(|r| ProblemKey::new(&r.cell.dataset, r.cell.cn, r.cell.param)));
         let mut eh =
             vec!["data".to_string(), "parameterisation".into(), "cn_x".into(), "cn_y".into()];
         let mut th = eh.clone();
@@ -219,8 +218,8 @@ impl GridTables {
     }
 
     /// One cell's rows of the appendices and its wins.
-    fn add_cell(&mut self, g: &[&OptimRun], c: &CellKey) {
-        let key = vec![c.0.clone(), c.1.name().to_string(), c.2.nx.to_string(), c.2.ny.to_string()];
+    fn add_cell(&mut self, g: &[&OptimRun], c: &ProblemKey) {
+        let key = vec![c.data.clone(), c.param.name().to_string(), c.cn.nx.to_string(), c.cn.ny.to_string()];
         let (mut er, mut tr) = (key.clone(), key);
         let mut avgs = Vec::new();
         let mut tavgs = Vec::new();
@@ -243,10 +242,10 @@ impl GridTables {
         let argmin =
             |v: &[f64]| v.iter().enumerate().min_by(|x, y| x.1.total_cmp(y.1)).map(|(i, _)| i);
         let n = self.opts.len();
-        let dp = match self.per_dp.iter().position(|x| x.0 == c.0 && x.1 == c.1) {
+        let dp = match self.per_dp.iter().position(|x| x.0 == c.data && x.1 == c.param) {
             Some(i) => i,
             None => {
-                self.per_dp.push((c.0.clone(), c.1, vec![0; n], vec![0; n]));
+                self.per_dp.push((c.data.clone(), c.param, vec![0; n], vec![0; n]));
                 self.per_dp.len() - 1
             }
         };
@@ -267,7 +266,7 @@ impl GridTables {
         wh.extend(self.opts.iter().cloned());
         wh.push("cells".into());
         let per_cells = |d: &str, p: Parameterisation| {
-            self.cells.iter().filter(|c| c.0 == d && c.1 == p).count()
+            self.cells.iter().filter(|c| c.data == d && c.param == p).count()
         };
         let mut rows: Vec<Vec<String>> = self
             .per_dp
@@ -330,7 +329,7 @@ fn thesis_wins(
     t: Option<&reference::RefTable>,
     suffix: &str,
     o: &str,
-    cells: &[CellKey],
+    cells: &[ProblemKey],
 ) -> Option<(usize, usize)> {
     let t = t?;
     let winners: Vec<&str> = cells.iter().filter_map(|c| thesis_winner(t, c, suffix)).collect();
@@ -339,8 +338,8 @@ fn thesis_wins(
 
 /// The thesis' optimiser with the least AVG of `<o>_avg<suffix>` in one of our cells (from its
 /// Appendix K-N); None where the table lacks the cell or a value.
-fn thesis_winner(t: &reference::RefTable, c: &CellKey, suffix: &str) -> Option<&'static str> {
-    let key = [c.0.clone(), c.1.name().to_string(), c.2.nx.to_string(), c.2.ny.to_string()];
+fn thesis_winner(t: &reference::RefTable, c: &ProblemKey, suffix: &str) -> Option<&'static str> {
+    let key = [c.data.clone(), c.param.name().to_string(), c.cn.nx.to_string(), c.cn.ny.to_string()];
     let row = t.find(&["data", "parameterisation", "cn_x", "cn_y"], &key)?;
     let names = ["ga", "de", "pso"];
     let v: Vec<f64> = names
@@ -357,7 +356,7 @@ fn winners_by_net(t: &GridTables, grid: GridSize, err_name: &str, out: &Path, ex
     let mut sorted = t.opts.clone();
     sorted.sort();
     let thesis = if sorted == ["de", "ga", "pso"] { reference::lookup(PUBLISHED, err_name) } else { None };
-    let nets = ordered(t.cells.iter().map(|c| c.2));
+    let nets = ordered(t.cells.iter().map(|c| c.cn));
     let mut h = vec!["cn_x".to_string(), "cn_y".into(), "cells".into()];
     h.extend(t.opts.iter().map(|o| format!("{o}_wins")));
     let mut any_thesis = false;
@@ -365,7 +364,7 @@ fn winners_by_net(t: &GridTables, grid: GridSize, err_name: &str, out: &Path, ex
     let mut ours_series: Vec<Vec<(f64, f64)>> = vec![Vec::new(); t.opts.len()];
     let mut thesis_series: Vec<Vec<(f64, f64)>> = vec![Vec::new(); t.opts.len()];
     for cn in &nets {
-        let here: Vec<usize> = (0..t.cells.len()).filter(|&i| t.cells[i].2 == *cn).collect();
+        let here: Vec<usize> = (0..t.cells.len()).filter(|&i| t.cells[i].cn == *cn).collect();
         let mut row = vec![cn.nx.to_string(), cn.ny.to_string(), here.len().to_string()];
         let ours: Vec<usize> =
             (0..t.opts.len()).map(|k| here.iter().filter(|&&i| t.winner[i] == Some(k)).count()).collect();
@@ -499,10 +498,10 @@ fn exact_section(
     grid: GridSize,
     out: &Path,
 ) -> Result<Option<(String, Claim)>> {
-    let ex_cells: Vec<(&CellKey, &ExactResult)> = t
+    let ex_cells: Vec<(&ProblemKey, &ExactResult)> = t
         .cells
         .iter()
-        .filter_map(|c| exact.get(&(c.0.clone(), c.2, c.1)).map(|e| (c, e)))
+        .filter_map(|c| exact.get(c).map(|e| (c, e)))
         .collect();
     if ex_cells.is_empty() {
         return Ok(None);
@@ -526,14 +525,14 @@ fn exact_section(
     for (c, e) in &ex_cells {
         let b = g
             .iter()
-            .find(|r| r.cell.dataset == c.0 && r.cell.param == c.1 && r.cell.cn == c.2)
+            .find(|r| r.cell.dataset == c.data && r.cell.param == c.param && r.cell.cn == c.cn)
             .map(|r| r.row.b)
             .unwrap_or(f64::NAN);
         let mut row = vec![
-            c.0.clone(),
-            c.1.name().to_string(),
-            c.2.nx.to_string(),
-            c.2.ny.to_string(),
+            c.data.clone(),
+            c.param.name().to_string(),
+            c.cn.nx.to_string(),
+            c.cn.ny.to_string(),
             format!("{b:.9}"),
             format!("{:.9}", e.f),
             format!("{:.9}", e.lower_bound),
@@ -556,10 +555,7 @@ fn exact_section(
     for (c, e) in ex_cells.iter().filter(|(_, e)| !e.converged) {
         let _ = writeln!(
             s,
-            "\n{} {} {}: not certified, gap {:.3e} ({:.3e} relative) after {} Newton steps.",
-            c.0,
-            c.2,
-            c.1.name(),
+            "\n{c}: not certified, gap {:.3e} ({:.3e} relative) after {} Newton steps.",
             e.gap,
             e.gap / e.f,
             e.iterations
@@ -707,24 +703,24 @@ pub(crate) fn write(
 /// magnified), largest net, per data set, drawn from the dense evaluation.
 fn appendix_ij(
     g: &[&OptimRun],
-    cells: &[CellKey],
+    cells: &[ProblemKey],
     opts: &[String],
     problems: &BTreeMap<ProblemKey, ControlNetProblem>,
     grid: GridSize,
     out: &Path,
     s: &mut String,
 ) -> Result<()> {
-    if let Some(&cn) = cells.iter().map(|c| &c.2).max() {
+    if let Some(&cn) = cells.iter().map(|c| &c.cn).max() {
         let appendix = match (grid.nx, grid.ny) {
             (20, 20) => "appendix_i",
             (18, 30) => "appendix_j",
             _ => "optimised_surfaces",
         };
-        let params: Vec<Parameterisation> = ordered(cells.iter().map(|c| c.1));
-        for d in ordered(cells.iter().map(|c| c.0.clone())) {
+        let params: Vec<Parameterisation> = ordered(cells.iter().map(|c| c.param));
+        for d in ordered(cells.iter().map(|c| c.data.clone())) {
             let mut panels = Vec::new();
             for &p in &params {
-                let Some(problem) = problems.get(&(d.clone(), cn, p)) else { continue };
+                let Some(problem) = problems.get(&ProblemKey::new(&d, cn, p)) else { continue };
                 // Drawn from the dense evaluation, so a surface that swings out between the
                 // data points shows.
                 let meshes = |x: &[f64]| {
@@ -820,7 +816,7 @@ fn appendix_ij(
 #[allow(clippy::too_many_arguments)]
 fn convergence_charts(
     g: &[&OptimRun],
-    cells: &[CellKey],
+    cells: &[ProblemKey],
     opts: &[String],
     problems: &BTreeMap<ProblemKey, ControlNetProblem>,
     exact: &BTreeMap<ProblemKey, ExactResult>,
@@ -828,9 +824,9 @@ fn convergence_charts(
     out: &Path,
     s: &mut String,
 ) -> Result<()> {
-    if let Some(&cn) = cells.iter().map(|c| &c.2).max() {
-        let p0 = cells[0].1;
-        for d in ordered(cells.iter().map(|c| c.0.clone())) {
+    if let Some(&cn) = cells.iter().map(|c| &c.cn).max() {
+        let p0 = cells[0].param;
+        for d in ordered(cells.iter().map(|c| c.data.clone())) {
             let mut series = Vec::new();
             let mut groups = Vec::new();
             for (k, o) in opts.iter().enumerate() {
@@ -870,11 +866,11 @@ fn convergence_charts(
             // flat lines on the convergence chart, dashed levels across the box plot (so an
             // optimiser that ends above B shows as such).
             let mut levels = Vec::new();
-            if let Some(problem) = problems.get(&(d.clone(), cn, p0)) {
+            if let Some(problem) = problems.get(&ProblemKey::new(&d, cn, p0)) {
                 let b = problem.fitness(problem.initial_point());
                 levels.push(plots::Level { key: "b", label: format!("B {b:.6}"), y: b });
             }
-            if let Some(e) = exact.get(&(d.clone(), cn, p0)) {
+            if let Some(e) = exact.get(&ProblemKey::new(&d, cn, p0)) {
                 let label = format!("certified optimum {:.6}", e.f);
                 levels.push(plots::Level { key: "exact", label, y: e.f });
             }

@@ -271,7 +271,7 @@ mod tests {
     fn offered_optimisers_are_the_registry_and_the_docs_list() {
         let text = "name = \"t\"\nmaster_seed = 1\n[optim]\ndatasets = [\"sphere\"]\ngrid = \"20x20\"\ncontrol_nets = [\"6x6\"]\nparameterisations = [\"uniform\"]\noptimisers = [\"de\"]\n";
         let spec = crate::families::Loaded::parse("t.toml", text, None).unwrap();
-        let o: &super::OptimSpec = spec.section().unwrap();
+        let o: &super::OptimSpec = spec.section_as().unwrap();
         let offered = crate::optim::names(&o.offered());
         let registered: Vec<&str> = crate::optim::REGISTRY
             .iter()
