@@ -1,10 +1,10 @@
 #!/usr/bin/env python3
-"""A PSO-only copy of a Chapter 6 spec with [optim.pso] keys added (issue 38; docs/readings.md,
+"""A PSO-only copy of a Chapter 6 spec with [optimise.pso] keys added (issue 38; docs/readings.md,
 "PSO's velocity clamp and position bound"), for scripts/readings_ch6_winners.py --pso.
 
 The keys go into the file, not through `run --set`, which would change every cell's seed: the
 copy keeps the spec's seeds, so its PSO runs are the ones a full run under those keys makes.
-The maps path is made absolute (recomputed from [optim.som] if missing, as in the spec).
+The maps path is made absolute (recomputed from [optimise.som] if missing, as in the spec).
 
     python3 scripts/readings_ch6_pso_spec.py experiments/ch6_same.toml /tmp/r38/v50_same.toml \\
         vmax_fraction=0.5
@@ -30,7 +30,7 @@ def main():
             sys.exit(f"{spec}: no line {old!r}")
         s = s.replace(old, new, 1)
     lines = s.splitlines(keepends=True)
-    start = next(i for i, l in enumerate(lines) if l.startswith("[optim.pso]")) + 1
+    start = next(i for i, l in enumerate(lines) if l.startswith("[optimise.pso]")) + 1
     end = next((i for i in range(start, len(lines)) if lines[i].startswith("[")), len(lines))
     for k, v in (p.split("=", 1) for p in pairs):
         k = k.strip()

@@ -260,7 +260,7 @@ fn problems(
 ) -> PyResult<Vec<PyProblem>> {
     let mut set = set.unwrap_or_default();
     if let Some(r) = reading {
-        set.push(format!("optim.knots={r}"));
+        set.push(format!("optimise.knots={r}"));
     }
     let work = tempfile::tempdir().map_err(err)?;
     let s: Suite = py

@@ -12,7 +12,7 @@ Examples:
   somnurbs run experiments/ch4_models.toml --profile quick # the same, T = 3000 (seconds)
   somnurbs run experiments/ch4_bunny.toml --data-dir ~/scans   # bun_zipper.ply lives in ~/scans
   somnurbs run experiments/ch4_grids.toml --dry-run        # list cells and their seeds
-  somnurbs run experiments/ch6_same.toml --profile quick --sweep optim.de.f=0.3,0.5,0.8 --out f_sweep
+  somnurbs run experiments/ch6_same.toml --profile quick --sweep optimise.de.f=0.3,0.5,0.8 --out f_sweep
   somnurbs datasets list
   somnurbs datasets export sphere sphere.xyz
 
@@ -71,7 +71,7 @@ pub(crate) enum Command {
 
 #[derive(Debug, Args)]
 pub(crate) struct CompareArgs {
-    /// A results folder written by a spec with an [optim] section (reads its runs.csv).
+    /// A results folder written by a spec with an [optimise] section (reads its runs.csv).
     pub(crate) results: PathBuf,
     /// Significance level for the h columns, in (0, 1).
     #[arg(long, default_value_t = 0.05)]
@@ -166,13 +166,13 @@ pub(crate) struct RunArgs {
     /// tables; `somnurbs merge` combines the N shard folders into one.
     #[arg(long, value_name = "I/N")]
     pub(crate) shard: Option<String>,
-    /// Change one key of the spec's [optim] section, validated as if written in the file, e.g.
-    /// `--set optim.de.f=0.5` (repeatable). The change is recorded in the manifest and enters
+    /// Change one key of the spec's [optimise] section, validated as if written in the file, e.g.
+    /// `--set optimise.de.f=0.5` (repeatable). The change is recorded in the manifest and enters
     /// every cell key, so the run's seeds differ from the unchanged spec's.
     #[arg(long, value_name = "KEY=VALUE")]
     pub(crate) set: Vec<String>,
     /// Run the spec once per value of an optimiser setting into one folder, e.g.
-    /// `--sweep optim.de.f=0.3,0.5,0.8` (repeatable: every combination). runs.csv gets a
+    /// `--sweep optimise.de.f=0.3,0.5,0.8` (repeatable: every combination). runs.csv gets a
     /// `variant` column and `somnurbs compare` ranks each optimiser@variant like an optimiser.
     /// At most 1000 variants and 10^5 cells over all of them; a value given twice (compared as
     /// TOML values: 0.3 and 0.30 are one) is refused.

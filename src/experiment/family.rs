@@ -1,5 +1,5 @@
 //! The family contract: one family per kind of spec section (Chapter 4's `[som]`, Chapter 5's
-//! `[fit]`, Chapter 6's `[optim]`, and one per other seed). A family is written as an
+//! `[fit]`, Chapter 6's `[optimise]`, and one per other seed). A family is written as an
 //! [`Experiment`]: its section type (parsed and checked once), its cells' keys and its run, each
 //! method given the section as that type. The `families!` macro of `families/mod.rs` (the only
 //! list of families) makes the enum of their sections, which implements [`Families`]; the engine
@@ -30,6 +30,9 @@ pub struct Outcome {
 pub trait Families: Clone + std::fmt::Debug + Send + Sync + Sized + 'static {
     /// Every family, in the order their sections are named in messages.
     fn all() -> &'static [&'static dyn Family<Self>];
+    /// The (former, present) names of renamed sections: a spec, `--set` key or reading set may
+    /// still use the former (docs/specs.md, "Former section names").
+    fn renamed() -> &'static [(&'static str, &'static str)];
     /// Parse a spec file's text: its header, and each family section it holds (in registry
     /// order; validation requires exactly one). Unknown keys are refused, so serde names the
     /// line and column of a bad one.
@@ -50,7 +53,7 @@ pub trait Holds<S>: Families {
 /// and how it runs. Implemented for every [`Experiment`] by the blanket impl below; every method
 /// takes the spec's section as the enum `F` and hands the family its own type.
 pub trait Family<F>: Sync {
-    /// The spec section (`som`, `fit`, `optim`, `seed002`, ...), for messages.
+    /// The spec section (`som`, `fit`, `optimise`, `rational_bezier`, ...), for messages.
     fn section(&self) -> &'static str;
     /// Check the bounds of the section's sizes and counts (before anything is allocated from them).
     fn check_limits(&self, c: &Check, s: &F) -> Result<(), SpecError>;
@@ -135,13 +138,13 @@ pub struct Combined {
 #[derive(Debug, Clone, Copy)]
 pub struct Overrides {
     /// What `--sweep` may vary: settings that leave every variant the same problems, so the
-    /// variants can be ranked like optimisers. Full dotted keys (`optim.generations`), or
-    /// prefixes ending in a dot (`optim.de.`: every key of that table).
+    /// variants can be ranked like optimisers. Full dotted keys (`optimise.generations`), or
+    /// prefixes ending in a dot (`optimise.de.`: every key of that table).
     pub sweepable: fn() -> Vec<String>,
 }
 
 impl Overrides {
-    /// Whether `--sweep` may vary `key` (a full dotted key, `optim.de.f`).
+    /// Whether `--sweep` may vary `key` (a full dotted key, `optimise.de.f`).
     pub fn sweepable(&self, key: &str) -> bool {
         (self.sweepable)().iter().any(|p| {
             if p.ends_with('.') {
@@ -152,7 +155,7 @@ impl Overrides {
         })
     }
 
-    /// The sweepable keys, for messages (`optim.de.*, optim.generations`).
+    /// The sweepable keys, for messages (`optimise.de.*, optimise.generations`).
     pub fn describe(&self) -> String {
         let shown: Vec<String> = (self.sweepable)()
             .iter()
@@ -169,7 +172,7 @@ pub trait Placed: Sized + Clone + std::fmt::Debug + Send + Sync + 'static {
     const NAME: &'static str;
 }
 
-/// A family's spec section (`[som]`, `[optim]`, `[seed004]`, ...): how it is checked. The
+/// A family's spec section (`[som]`, `[optimise]`, `[closed_cylinder]`, ...): how it is checked. The
 /// section type lives in its family's folder.
 pub trait Section: Placed {
     /// Check the bounds of the section's sizes and counts (before anything is allocated from
@@ -222,7 +225,7 @@ pub trait Experiment: Sync + 'static {
         match variants {
             [(spec, s)] => self.run(spec, s, ctx, tables),
             _ => anyhow::bail!(
-                "--sweep: [{}] specs run one variant at a time (sweeps work on [optim] specs)",
+                "--sweep: [{}] specs run one variant at a time (sweeps work on [optimise] specs)",
                 Self::Section::NAME
             ),
         }

@@ -212,7 +212,7 @@ mod tests {
     use super::*;
     use crate::experiment::spec::CliOverrides;
 
-    const SPEC: &str = "name = \"t\"\nmaster_seed = 1\n[optim]\ndatasets = [\"sphere\"]\ngrid = \"20x20\"\ncontrol_nets = [\"6x6\"]\nparameterisations = [\"uniform\"]\noptimisers = [\"ga\", \"de\"]\nrepeats = 2\ngenerations = 10\npopulation = 8\n";
+    const SPEC: &str = "name = \"t\"\nmaster_seed = 1\n[optimise]\ndatasets = [\"sphere\"]\ngrid = \"20x20\"\ncontrol_nets = [\"6x6\"]\nparameterisations = [\"uniform\"]\noptimisers = [\"ga\", \"de\"]\nrepeats = 2\ngenerations = 10\npopulation = 8\n";
 
     fn refused(from: &str, to: &str, key: &str) {
         let t = std::time::Instant::now();
@@ -226,34 +226,34 @@ mod tests {
     #[test]
     fn every_size_has_a_bound_named_by_its_key() {
         crate::families::Loaded::parse("t.toml", SPEC, None).unwrap();
-        refused("grid = \"20x20\"", "grid = \"100000x100000\"", "optim.grid");
+        refused("grid = \"20x20\"", "grid = \"100000x100000\"", "optimise.grid");
         refused(
             "control_nets = [\"6x6\"]",
             "control_nets = [\"6x6\", \"6x100000\"]",
-            "optim.control_nets",
+            "optimise.control_nets",
         );
-        refused("generations = 10", "generations = 1000000000000", "optim.generations");
-        refused("population = 8", "population = 1000000000000", "optim.population");
-        refused("repeats = 2", "repeats = 100000000", "optim.repeats");
-        refused("population = 8", "population = 8\nsearch_range = 1e308", "optim.search_range");
-        refused("population = 8", "population = 8\nsearch_range = inf", "optim.search_range");
-        refused("population = 8", "population = 8\ninit_range = nan", "optim.init_range");
+        refused("generations = 10", "generations = 1000000000000", "optimise.generations");
+        refused("population = 8", "population = 1000000000000", "optimise.population");
+        refused("repeats = 2", "repeats = 100000000", "optimise.repeats");
+        refused("population = 8", "population = 8\nsearch_range = 1e308", "optimise.search_range");
+        refused("population = 8", "population = 8\nsearch_range = inf", "optimise.search_range");
+        refused("population = 8", "population = 8\ninit_range = nan", "optimise.init_range");
         refused(
             "optimisers = [\"ga\", \"de\"]",
             "optimisers = [\"ga\", \"de\", \"ga\"]",
-            "optim.optimisers: `ga` is listed twice",
+            "optimise.optimisers: `ga` is listed twice",
         );
         refused(
             "control_nets = [\"6x6\"]",
             "control_nets = [\"6x6\", \"6\"]",
-            "optim.control_nets: `6x6` is listed twice",
+            "optimise.control_nets: `6x6` is listed twice",
         );
         refused(
             "datasets = [\"sphere\"]",
             "datasets = [\"a/x.xyz\", \"b/x.xyz\"]",
             "both go by the name `x`",
         );
-        refused("datasets = [\"sphere\"]", "datasets = [\"..\"]", "optim.datasets");
+        refused("datasets = [\"sphere\"]", "datasets = [\"..\"]", "optimise.datasets");
         refused("name = \"t\"", "name = \"..\"", "name");
         refused("name = \"t\"", "name = \".\"", "name");
         let som = "name = \"s\"\nmaster_seed = 1\n[som]\ndatasets = [\"cube\"]\niterations = 10\n[[som.group]]\nmodels = [\"som2d\"]\ngrids = [\"10x10\"]\n";
@@ -308,17 +308,18 @@ mod tests {
         let values = |n: usize| {
             (0..n).map(|k| format!("{}", 0.1 + k as f64 * 1e-4)).collect::<Vec<_>>().join(",")
         };
-        assert_eq!(sweep(&["optim.de.f=0.3,0.5"]), Ok(2));
+        assert_eq!(sweep(&["optimise.de.f=0.3,0.5"]), Ok(2));
         let t = std::time::Instant::now();
-        let big = [format!("optim.de.f={}", values(1000)), format!("optim.de.cr={}", values(1000))];
+        let big =
+            [format!("optimise.de.f={}", values(1000)), format!("optimise.de.cr={}", values(1000))];
         let e = sweep(&[&big[0], &big[1]]).unwrap_err().0;
         assert!(e.contains("1000 x 1000 = 1000000 variants, above the limit 1000"), "{e}");
         assert!(t.elapsed().as_secs_f64() < 1.0);
         // 500 variants of 200 cells (one optimiser x 200 repeats): 10^5 in all, the limit; one
         // more repeat is over.
-        let ok = format!("optim.de.f={}", values(500));
-        assert_eq!(sweep(&[&ok, "optim.repeats=200"]), Ok(500));
-        let e = sweep(&[&ok, "optim.repeats=201"]).unwrap_err().0;
+        let ok = format!("optimise.de.f={}", values(500));
+        assert_eq!(sweep(&[&ok, "optimise.repeats=200"]), Ok(500));
+        let e = sweep(&[&ok, "optimise.repeats=201"]).unwrap_err().0;
         assert!(e.contains("cells in all, above the limit 100000"), "{e}");
         for (dup, said) in [
             ("0.3,0.30", "0.3 and 0.30 are one value"),
@@ -326,7 +327,7 @@ mod tests {
             ("0.5,5e-1", "0.5 and 5e-1 are one value"),
             ("0.3,0.3", "the value 0.3 is given twice"),
         ] {
-            let e = sweep(&[&format!("optim.de.f={dup}")]).unwrap_err().0;
+            let e = sweep(&[&format!("optimise.de.f={dup}")]).unwrap_err().0;
             assert!(e.contains(said), "{dup}: {e}");
         }
     }
@@ -340,19 +341,22 @@ mod tests {
             crate::families::Loaded::parse("t.toml", &t, None).map(|_| ()).map_err(|e| e.0)
         };
         spec("\"ga\"", 4, "").unwrap();
-        spec("\"ga\", \"pso\", \"csa\"", 3, "[optim.ga]\ntournament = 3").unwrap();
+        spec("\"ga\", \"pso\", \"csa\"", 3, "[optimise.ga]\ntournament = 3").unwrap();
         spec("\"pso\"", 1, "").unwrap();
         let e = spec("\"ga\"", 3, "").unwrap_err();
-        assert!(e.contains("t.toml: optim.ga.tournament: 4 is above optim.population = 3"), "{e}");
+        assert!(
+            e.contains("t.toml: optimise.ga.tournament: 4 is above optimise.population = 3"),
+            "{e}"
+        );
         assert!(!e.contains("DE"), "{e}");
-        let e = spec("\"ga\"", 8, "[optim.ga]\ntournament = 20").unwrap_err();
-        assert!(e.contains("optim.ga.tournament: 20 is above optim.population = 8"), "{e}");
-        let e = spec("\"ga\", \"de\"", 3, "[optim.ga]\ntournament = 2").unwrap_err();
-        assert!(e.contains("optim.population: must be at least 4 for de"), "{e}");
+        let e = spec("\"ga\"", 8, "[optimise.ga]\ntournament = 20").unwrap_err();
+        assert!(e.contains("optimise.ga.tournament: 20 is above optimise.population = 8"), "{e}");
+        let e = spec("\"ga\", \"de\"", 3, "[optimise.ga]\ntournament = 2").unwrap_err();
+        assert!(e.contains("optimise.population: must be at least 4 for de"), "{e}");
         let e = spec("\"icsa\"", 1, "").unwrap_err();
-        assert!(e.contains("optim.population: must be at least 2 for icsa"), "{e}");
+        assert!(e.contains("optimise.population: must be at least 2 for icsa"), "{e}");
         let e = spec("\"pso\"", 0, "").unwrap_err();
-        assert!(e.contains("optim.population: must be at least 1 for pso"), "{e}");
+        assert!(e.contains("optimise.population: must be at least 1 for pso"), "{e}");
     }
 
     #[test]

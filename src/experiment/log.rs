@@ -412,7 +412,7 @@ mod tests {
         assert_eq!(a.difference(&b).unwrap(), "master seed: 1 vs 2");
         let c = Fingerprint { profile: "default".into(), ..a.clone() };
         assert!(a.difference(&c).unwrap().starts_with("profile"));
-        let d = Fingerprint { set: vec!["optim.de.f=0.5".into()], ..a.clone() };
-        assert_eq!(a.difference(&d).unwrap(), "--set: none vs optim.de.f=0.5");
+        let d = Fingerprint { set: vec!["optimise.de.f=0.5".into()], ..a.clone() };
+        assert_eq!(a.difference(&d).unwrap(), "--set: none vs optimise.de.f=0.5");
     }
 }

@@ -37,7 +37,7 @@ impl Variant {
 }
 
 /// A command-line value as TOML (a number, a boolean, a quoted string, an array), else the text
-/// itself as a string (so `--set optim.knots=nurbs_book` needs no quotes).
+/// itself as a string (so `--set optimise.knots=nurbs_book` needs no quotes).
 fn cli_value(raw: &str) -> toml::Value {
     match toml::from_str::<toml::Table>(&format!("v = {raw}")) {
         Ok(mut t) => t.remove("v").unwrap_or_else(|| toml::Value::String(raw.to_string())),
@@ -73,7 +73,9 @@ impl CliOverrides {
             Some((k, v)) if !k.trim().is_empty() && !v.trim().is_empty() => {
                 Ok((k.trim(), v.trim()))
             }
-            _ => Err(SpecError(format!("{flag} `{arg}`: expected KEY=VALUE, e.g. optim.de.f=0.5"))),
+            _ => Err(SpecError(format!(
+                "{flag} `{arg}`: expected KEY=VALUE, e.g. optimise.de.f=0.5"
+            ))),
         }
     }
 
@@ -141,7 +143,8 @@ impl CliOverrides {
                 .map(|(f, _)| format!("[{0}] section ({0}.KEY)", f.section()))
                 .collect::<Vec<_>>()
                 .join(", ");
-            let section = key.split('.').next().unwrap_or("");
+            let canonical = super::renamed::canonical_key::<F>(key);
+            let section = canonical.split('.').next().unwrap_or("");
             let Some((family, ov)) = takers.iter().find(|(f, _)| f.section() == section) else {
                 return Err(SpecError(format!(
                     "{flag} {key}: only keys of the {list} can be set or swept"
@@ -216,7 +219,7 @@ impl CliOverrides {
     }
 }
 
-/// One change to a spec by a dotted key (`fit.knots`, `optim.de.f`), as a reading set of a plan
+/// One change to a spec by a dotted key (`fit.knots`, `optimise.de.f`), as a reading set of a plan
 /// makes it: applied after the profile and validated exactly as the file's own value.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Override {

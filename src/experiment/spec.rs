@@ -34,7 +34,7 @@ impl std::error::Error for SpecError {}
 /// of a bad key), and each family's typed view of the enum ([`Holds`](super::family::Holds)).
 /// A family is one folder plus one line here.
 macro_rules! families {
-    ($($(#[$doc:meta])* $field:ident: $module:ident :: $($section:ident)::+ => $fmod:ident :: $family:ident),* $(,)?) => {
+    ($($(#[$doc:meta])* $field:ident $(($old:ident))?: $module:ident :: $($section:ident)::+ => $fmod:ident :: $family:ident),* $(,)?) => {
         $(pub mod $module;)*
 
         /// The section of a spec: one variant per family, holding its checked section type.
@@ -66,6 +66,10 @@ macro_rules! families {
         impl $crate::experiment::family::Families for Section {
             fn all() -> &'static [&'static dyn $crate::experiment::family::Family<Section>] {
                 &[$(&$fmod::$family),*]
+            }
+
+            fn renamed() -> &'static [(&'static str, &'static str)] {
+                &[$($((stringify!($old), stringify!($field)),)?)*]
             }
 
             fn parse(
@@ -202,13 +206,17 @@ impl<F: Families> Loaded<F> {
         if overrides.is_empty() {
             return Ok(spec);
         }
+        let (text, _) = super::renamed::canonical_text::<F>(text);
+        let text = text.as_ref();
         let mut table: toml::Table =
             toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
         if let Some(over) = profile.and_then(|p| spec.spec.file.profiles.get(p)) {
             merge(&mut table, &over.clone());
         }
         for o in overrides {
-            apply_override(&mut table, o).map_err(|e| SpecError(format!("{path}: {e}")))?;
+            let key = super::renamed::canonical_key::<F>(&o.key).into_owned();
+            let o = Override { key, value: o.value.clone() };
+            apply_override(&mut table, &o).map_err(|e| SpecError(format!("{path}: {e}")))?;
         }
         let merged = toml::to_string(&table).map_err(|e| SpecError(format!("{path}: {e}")))?;
         let (file, sections) = F::parse(&merged).map_err(|e| {
@@ -223,6 +231,10 @@ impl<F: Families> Loaded<F> {
 
     /// Parse spec text; `path` is used in messages only.
     pub fn parse(path: &str, text: &str, profile: Option<&str>) -> Result<Loaded<F>, SpecError> {
+        let written = text;
+        let (text, made) = super::renamed::canonical_text::<F>(written);
+        super::renamed::note(path, &made);
+        let text = text.as_ref();
         let (file, sections) = F::parse(text).map_err(|e| toml_error(path, text, &e))?;
         let (file, sections) = match profile {
             None => (file, sections),
@@ -249,7 +261,7 @@ impl<F: Families> Loaded<F> {
         };
         let spec = Spec {
             file,
-            text: text.to_string(),
+            text: written.to_string(),
             path: path.to_string(),
             profile: profile.map(String::from),
             cli: CliOverrides::default(),

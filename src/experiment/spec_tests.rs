@@ -64,7 +64,7 @@ fn overrides_apply_after_the_profile_and_are_validated() {
     let set = [
         ov("fit.knots", "nurbs_book".into()),
         ov("fit.error_a", "nov_bottom".into()),
-        ov("optim.knots", "nurbs_book".into()),
+        ov("optimise.knots", "nurbs_book".into()),
     ];
     let s = L::parse_with("f.toml", text, Some("quick"), &set).unwrap();
     let fit = s.section_as::<crate::families::fit::spec::FitSpec>().unwrap();
@@ -157,12 +157,14 @@ fn exactly_one_experiment_section() {
     let none = "name = \"t\"\nmaster_seed = 1\n";
     let e = L::parse("t.toml", none, None).unwrap_err().0;
     assert!(
-        e.contains("no experiment section") && e.contains("[som]") && e.contains("[seed002]"),
+        e.contains("no experiment section")
+            && e.contains("[som]")
+            && e.contains("[rational_bezier]"),
         "{e}"
     );
-    let two = format!("{SPEC}\n[seed002]\nsurfaces = [\"surface1\"]\n");
+    let two = format!("{SPEC}\n[rational_bezier]\nsurfaces = [\"surface1\"]\n");
     let e = L::parse("t.toml", &two, None).unwrap_err().0;
-    assert!(e.contains("[som] and [seed002]"), "{e}");
+    assert!(e.contains("[som] and [rational_bezier]"), "{e}");
 }
 
 #[test]
@@ -189,4 +191,37 @@ fn bad_values_name_their_key() {
     assert!(e.starts_with("t.toml:2:"), "{e}");
     let e = L::parse("t.toml", SPEC, Some("full")).unwrap_err().0;
     assert!(e.contains("no profile `full`") && e.contains("quick"), "{e}");
+}
+
+/// A spec, a profile and a `--set` key written with a former section name (`[optim]`) give the
+/// spec written with the present one (`[optimise]`): the same cells, seeds and values; an error
+/// still names the line of the file as written.
+#[test]
+fn former_section_names_read_as_the_present_ones() {
+    let new = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/ch6_same.toml"),
+    )
+    .unwrap();
+    let old = new
+        .replace("[optimise", "[optim")
+        .replace("[profiles.quick.optimise", "[profiles.quick.optim");
+    assert!(old.contains("[optim]\n") && old.contains("[profiles.quick.optim]"));
+    let cli = |k: &str| CliOverrides { set: vec![format!("{k}.de.f=0.5")], sweep: vec![] };
+    for (text, key) in [(&new, "optimise"), (&old, "optim"), (&new, "optim"), (&old, "optimise")] {
+        let v =
+            cli(key).variants::<crate::families::Section>("t.toml", text, Some("quick")).unwrap();
+        let o = v[0].section_as::<crate::families::optimise::OptimSpec>().unwrap();
+        assert_eq!((o.de.f, o.generations), (0.5, 100), "{key}");
+        let want = cli(key).variants::<crate::families::Section>("t.toml", &new, Some("quick"));
+        assert_eq!(
+            crate::experiment::dry_run_listing(&v[0]),
+            crate::experiment::dry_run_listing(&want.unwrap()[0])
+        );
+    }
+    let plain = |t: &str| crate::experiment::dry_run_listing(&L::parse("t.toml", t, None).unwrap());
+    assert_eq!(plain(&old), plain(&new));
+    let bad = old.replacen("generations = 2000", "generations = \"x\"", 1);
+    let line = old.lines().position(|l| l.starts_with("generations = 2000")).unwrap() + 1;
+    let e = L::parse("t.toml", &bad, None).unwrap_err().0;
+    assert!(e.contains(&format!("t.toml:{line}:")), "{e}");
 }

@@ -1,4 +1,4 @@
-//! The DNSOM maps Chapter 4 saves and Chapters 5 and 6 fit (`[fit]` and `[optim]` read them
+//! The DNSOM maps Chapter 4 saves and Chapters 5 and 6 fit (`[fit]` and `[optimise]` read them
 //! alike): where a section's maps come from (`maps`, `maps_missing`, `[<section>.som]`), reading
 //! them, recomputing a missing one exactly as Chapter 4's cell would (same key, seed and
 //! settings), and the keys both sections share. It sits beside the registry, not in a family,
@@ -77,7 +77,7 @@ pub(crate) fn check_exponential_alpha(
     c.real(&format!("{section}.exponential_alpha"), v, lo, false, hi)
 }
 
-/// The keys a `[fit]` and an `[optim]` section share (data sets, grid, control nets,
+/// The keys a `[fit]` and an `[optimise]` section share (data sets, grid, control nets,
 /// parameterisations), each error naming `<section>.<key>`.
 pub(crate) fn validate_grid_keys(
     spec: &Spec,

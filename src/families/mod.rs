@@ -9,15 +9,15 @@ crate::experiment::spec::families! {
     /// Chapter 5: cubic B-spline fits of saved DNSOM maps.
     fit: fit::spec::FitSpec => fit::Fit,
     /// Chapter 6: optimisation of approach B's control points.
-    optim: optimise::spec::OptimSpec => optimise::Optim,
+    optimise (optim): optimise::spec::OptimSpec => optimise::Optim,
     /// Seed 001: growing grid on open surfaces, one B-spline surface, GA/DE/PSO.
     growing_grid: growing_grid::spec::GrowingGridSpec => growing_grid::GrowingGrid,
     /// Seed 002 (Yahya): four-patch G1 rational bi-quadratic Bezier surfaces by GA/DE/PSO.
-    seed002: rational_bezier::spec::RationalBezierSpec => rational_bezier::RationalBezier,
+    rational_bezier (seed002): rational_bezier::spec::RationalBezierSpec => rational_bezier::RationalBezier,
     /// Seed 003 (Iglesias et al.): Bezier surfaces with CSA/ICSA-searched data parameters.
-    seed003: cuckoo_bezier::CuckooBezierSpec => cuckoo_bezier::CuckooBezier,
+    cuckoo_bezier (seed003): cuckoo_bezier::CuckooBezierSpec => cuckoo_bezier::CuckooBezier,
     /// Seed 004: closed B-spline surface of a cylinder by a binary-coded GA.
-    seed004: closed_cylinder::spec::ClosedCylinderSpec => closed_cylinder::ClosedCylinder,
+    closed_cylinder (seed004): closed_cylinder::spec::ClosedCylinderSpec => closed_cylinder::ClosedCylinder,
 }
 
 pub(crate) mod maps;

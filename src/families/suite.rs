@@ -1,7 +1,7 @@
 //! Chapter 6's problems outside a run, as a benchmark suite: what the Python package
 //! (`python/`) and any other caller get. It sits beside the registry, not in a family, because it
 //! serves two: the problems are made by the runs' own code paths
-//! ([`optimise::problems`] for an `[optim]` spec; `growing_grid::{maps, problems}` for seed 001's
+//! ([`optimise::problems`] for an `[optimise]` spec; `growing_grid::{maps, problems}` for seed 001's
 //! open surfaces) from the same spec, profile and `--set` readings, so a problem's fitness is bit for
 //! bit the one `somnurbs run` optimises; this module only adds what a benchmark user needs beside
 //! it (names, a second box, the metadata that `compare` checks an external optimiser's logs
@@ -90,7 +90,7 @@ pub struct Suite {
     pub problems: Vec<SuiteProblem>,
 }
 
-/// The search box of an `[optim]` section in words: `B+-<half width>` (Table 6.1's reading) or
+/// The search box of an `[optimise]` section in words: `B+-<half width>` (Table 6.1's reading) or
 /// `cover+<margin>` (the data and B's control points, widened by that share).
 pub fn box_label(o: &OptimSpec) -> String {
     match o.search_range {
@@ -113,9 +113,9 @@ pub fn spec_path(spec: &str) -> PathBuf {
     Path::new(crate::data::registry::CLONE_DIR).join("experiments").join(format!("{spec}.toml"))
 }
 
-/// Load every control-net problem of a Chapter 6 spec (`[optim]`) or of seed 001's
+/// Load every control-net problem of a Chapter 6 spec (`[optimise]`) or of seed 001's
 /// (`[growing_grid]`) under `profile` and the `KEY=VALUE` settings of `set` (as
-/// `somnurbs run --set`, e.g. `optim.knots=nurbs_book`). Data files come from `data_dir` (else as
+/// `somnurbs run --set`, e.g. `optimise.knots=nurbs_book`). Data files come from `data_dir` (else as
 /// the CLI finds them, falling back to the clone's `data/`); a map the spec names but that is
 /// missing is recomputed as the run would, written into `work` (a folder the caller owns).
 pub fn load(
@@ -145,7 +145,7 @@ pub fn load(
         Section::Optim(o) => o,
         Section::GrowingGrid(g) => return open_surfaces(&spec, g, &ctx, profile),
         _ => anyhow::bail!(
-            "{}: a suite is made of an [optim] or a [growing_grid] spec's problems",
+            "{}: a suite is made of an [optimise] or a [growing_grid] spec's problems",
             spec.path
         ),
     };
@@ -252,7 +252,7 @@ mod tests {
         let nb = load(
             "ch6_exact",
             Some("quick"),
-            &["optim.knots=nurbs_book".into()],
+            &["optimise.knots=nurbs_book".into()],
             Some(&data),
             work.path(),
         )

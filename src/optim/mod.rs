@@ -91,7 +91,7 @@ pub fn default_optimiser(name: &str) -> Option<Box<dyn Optimiser>> {
 }
 
 /// The optimiser named `name` among those a spec section offers (each with the section's
-/// parameters, e.g. `[optim.de]`).
+/// parameters, e.g. `[optimise.de]`).
 pub(crate) fn pick<'a>(offered: &[&'a dyn Optimiser], name: &str) -> Option<&'a dyn Optimiser> {
     offered.iter().copied().find(|o| o.name() == name)
 }

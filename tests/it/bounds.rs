@@ -18,7 +18,7 @@ fn refused(c: &Case, args: &[&str], needles: &[&str]) -> String {
     err
 }
 
-/// `n` distinct values for a sweep of optim.de.f.
+/// `n` distinct values for a sweep of optimise.de.f.
 fn values(n: usize) -> String {
     (0..n).map(|k| format!("{}", 0.1 + k as f64 * 1e-4)).collect::<Vec<_>>().join(",")
 }
@@ -27,7 +27,8 @@ fn values(n: usize) -> String {
 fn sweeps_are_bounded_before_they_expand() {
     let c = Case::new();
     c.write("d.toml", SPEC);
-    let (f, cr) = (format!("optim.de.f={}", values(300)), format!("optim.de.cr={}", values(300)));
+    let (f, cr) =
+        (format!("optimise.de.f={}", values(300)), format!("optimise.de.cr={}", values(300)));
     // 300 x 300 variants: refused before one is made, --dry-run or not.
     for dry in [true, false] {
         let mut args = vec!["run", "d.toml", "--sweep", &f, "--sweep", &cr, "--out", "o"];
@@ -37,10 +38,10 @@ fn sweeps_are_bounded_before_they_expand() {
         refused(&c, &args, &["--sweep: 300 x 300 = 90000 variants, above the limit 1000"]);
     }
     // 100 variants of 2 x 10000 repeats: each variant within 10^5 cells, together 2 x 10^6.
-    let f100 = format!("optim.de.f={}", values(100));
+    let f100 = format!("optimise.de.f={}", values(100));
     refused(
         &c,
-        &["run", "d.toml", "--dry-run", "--sweep", &f100, "--set", "optim.repeats=10000"],
+        &["run", "d.toml", "--dry-run", "--sweep", &f100, "--set", "optimise.repeats=10000"],
         &["d.toml have at least", "cells in all, above the limit 100000"],
     );
     // Within both limits: 100 variants x 4 cells listed.
@@ -58,14 +59,14 @@ fn swept_values_are_compared_as_values() {
         ("0.5,0.3,5e-1", "0.5 and 5e-1 are one value"),
         ("0.3,0.3", "the value 0.3 is given twice"),
     ] {
-        let arg = format!("optim.de.f={list}");
+        let arg = format!("optimise.de.f={list}");
         refused(
             &c,
             &["run", "d.toml", "--dry-run", "--sweep", &arg],
-            &["--sweep optim.de.f", said],
+            &["--sweep optimise.de.f", said],
         );
     }
-    let out = c.ok(&["run", "d.toml", "--dry-run", "--sweep", "optim.de.f=0.3,0.31"]);
+    let out = c.ok(&["run", "d.toml", "--dry-run", "--sweep", "optimise.de.f=0.3,0.31"]);
     assert_eq!(String::from_utf8_lossy(&out.stdout).lines().count(), 8);
 }
 
@@ -88,7 +89,7 @@ fn plans_list_each_spec_once_and_no_two_specs_share_a_name() {
     refused(&c, &args, &["same.toml", "d.toml and", "e.toml have the same name `d`"]);
     c.write(
         "specs/readings.toml",
-        "specs = [\"d\"]\n[[readings]]\nname = \"r\"\nset = { \"optim.knots\" = \"nurbs_book\" }\nspecs = [\"d\", \"d\"]\n",
+        "specs = [\"d\"]\n[[readings]]\nname = \"r\"\nset = { \"optimise.knots\" = \"nurbs_book\" }\nspecs = [\"d\", \"d\"]\n",
     );
     let args = reproduce("readings");
     let args: Vec<&str> = args.iter().map(String::as_str).collect();
@@ -239,32 +240,39 @@ fn population_minimum_is_each_run_optimisers_own() {
     let e = refused(
         &c,
         &["run", "ga3.toml", "--dry-run"],
-        &["ga3.toml: optim.ga.tournament: 4 is above optim.population = 3"],
+        &["ga3.toml: optimise.ga.tournament: 4 is above optimise.population = 3"],
     );
     assert!(!e.contains("DE"), "{e}");
     c.write(
         "ga3t3.toml",
-        &ga_only.replace("[optim.som]", "[optim.ga]\ntournament = 3\n[optim.som]"),
+        &ga_only.replace("[optimise.som]", "[optimise.ga]\ntournament = 3\n[optimise.som]"),
     );
     c.ok(&["run", "ga3t3.toml", "--out", "ok3"]);
-    c.write("t20.toml", &SPEC.replace("[optim.som]", "[optim.ga]\ntournament = 20\n[optim.som]"));
+    c.write(
+        "t20.toml",
+        &SPEC.replace("[optimise.som]", "[optimise.ga]\ntournament = 20\n[optimise.som]"),
+    );
     refused(
         &c,
         &["run", "t20.toml", "--dry-run"],
-        &["t20.toml: optim.ga.tournament: 20 is above optim.population = 8"],
+        &["t20.toml: optimise.ga.tournament: 20 is above optimise.population = 8"],
     );
     let de3 = SPEC.replace("population = 8", "population = 3");
-    c.write("de3.toml", &de3.replace("[optim.som]", "[optim.ga]\ntournament = 2\n[optim.som]"));
+    c.write(
+        "de3.toml",
+        &de3.replace("[optimise.som]", "[optimise.ga]\ntournament = 2\n[optimise.som]"),
+    );
     refused(
         &c,
         &["run", "de3.toml", "--dry-run"],
-        &["de3.toml: optim.population: must be at least 4 for de (DE/rand/1"],
+        &["de3.toml: optimise.population: must be at least 4 for de (DE/rand/1"],
     );
     // The other families that run these optimisers (their quick profiles' population is 20).
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments");
-    for (file, section) in
-        [("seed002_rational.toml", "seed002"), ("seed001_growing_grid.toml", "growing_grid")]
-    {
+    for (file, section) in [
+        ("seed002_rational.toml", "rational_bezier"),
+        ("seed001_growing_grid.toml", "growing_grid"),
+    ] {
         let text = std::fs::read_to_string(root.join(file)).unwrap();
         let text = text.replace("population = 40", "population = 3");
         let text = text.replacen(

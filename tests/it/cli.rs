@@ -340,7 +340,7 @@ fn fit_writes_nets_iges_and_obj_and_refuses_bad_grids() {
 const CH6_TINY: &str = r#"
 name = "opt"
 master_seed = 5
-[optim]
+[optimise]
 datasets = ["sphere"]
 grid = "20x20"
 control_nets = ["6x6", "8x8"]
@@ -349,7 +349,7 @@ optimisers = ["ga", "de", "pso"]
 repeats = 2
 generations = 15
 population = 8
-[optim.som]
+[optimise.som]
 iterations = 500
 "#;
 
@@ -411,11 +411,11 @@ fn bad_optimiser_specs_are_refused_before_any_run() {
         (
             "optimisers = [\"ga\", \"de\", \"pso\"]",
             "optimisers = [\"ga\", \"sa\"]",
-            "optim.optimisers",
+            "optimise.optimisers",
         ),
         ("population = 8", "population = -1", "opt.toml:"),
-        ("iterations = 500", "iterations = 500\n[optim.de]\ncr = 1.5", "de.cr"),
-        ("control_nets = [\"6x6\", \"8x8\"]", "control_nets = []", "optim.control_nets"),
+        ("iterations = 500", "iterations = 500\n[optimise.de]\ncr = 1.5", "de.cr"),
+        ("control_nets = [\"6x6\", \"8x8\"]", "control_nets = []", "optimise.control_nets"),
     ] {
         c.write("opt.toml", &CH6_TINY.replace(from, to));
         c.fails(&["run", "opt.toml", "--out", "o"], &[needle]);
@@ -632,7 +632,7 @@ fn exact_optimum_bounds_every_run_from_below() {
     let c = Case::new();
     c.write(
         "opt.toml",
-        &CH6_TINY.replace("[optim.som]", "exact = true\ninit_range = 1e-3\n[optim.som]"),
+        &CH6_TINY.replace("[optimise.som]", "exact = true\ninit_range = 1e-3\n[optimise.som]"),
     );
     c.ok(&["run", "opt.toml", "--out", "o"]);
     let (h, rows) = read_csv(&c.path("o/exact_20x20.csv"));

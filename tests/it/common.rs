@@ -160,7 +160,7 @@ pub fn same_tables(a: &Path, b: &Path) -> usize {
 pub const SPEC: &str = r#"
 name = "d"
 master_seed = 3
-[optim]
+[optimise]
 datasets = ["sphere"]
 grid = "20x20"
 control_nets = ["6x6"]
@@ -169,7 +169,7 @@ optimisers = ["ga", "de"]
 repeats = 2
 generations = 20
 population = 8
-[optim.som]
+[optimise.som]
 iterations = 300
 "#;
 
@@ -177,7 +177,7 @@ iterations = 300
 pub const SLOW: &str = r#"
 name = "slow"
 master_seed = 11
-[optim]
+[optimise]
 datasets = ["sphere"]
 grid = "20x20"
 control_nets = ["10x10", "12x12"]
@@ -186,7 +186,7 @@ optimisers = ["ga", "de", "pso"]
 repeats = 12
 generations = 600
 population = 20
-[optim.som]
+[optimise.som]
 iterations = 500
 "#;
 

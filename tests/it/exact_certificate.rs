@@ -19,7 +19,7 @@ fn spec(name: &str, profile: Option<&str>, knots: KnotRule) -> Loaded {
         Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments").join(format!("{name}.toml"));
     let text = std::fs::read_to_string(&path).unwrap();
     let over =
-        Override { key: "optim.knots".into(), value: toml::Value::String(knots.name().into()) };
+        Override { key: "optimise.knots".into(), value: toml::Value::String(knots.name().into()) };
     Loaded::parse_with(&path.display().to_string(), &text, profile, &[over]).unwrap()
 }
 

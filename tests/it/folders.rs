@@ -47,7 +47,7 @@ fn a_finished_folder_is_never_mixed_with_another_run() {
 fn a_sweep_folder_is_not_rerun_without_its_sweep() {
     let c = Case::new();
     c.write("s.toml", SPEC);
-    c.ok(&["run", "s.toml", "--out", "sw", "--sweep", "optim.de.f=0.3,0.5"]);
+    c.ok(&["run", "s.toml", "--out", "sw", "--sweep", "optimise.de.f=0.3,0.5"]);
     let before = snapshot(&c.path("sw"));
     c.fails(&["run", "s.toml", "--out", "sw"], &["already holds a finished run of spec `d`"]);
     c.fails(&["run", "s.toml", "--out", "sw", "--resume"], &["cannot resume", "different run"]);

@@ -148,10 +148,10 @@ fn a_named_maps_folder_that_is_not_there_is_refused_unless_recomputing_is_asked_
         &["fit.maps", "no map specs/empty/dnsom_sphere_20x20.csv"],
     );
     // Chapter 6 too.
-    c.write("specs/opt.toml", &SPEC.replace("[optim.som]", "maps = \"nomaps\"\n[optim.som]"));
+    c.write("specs/opt.toml", &SPEC.replace("[optimise.som]", "maps = \"nomaps\"\n[optimise.som]"));
     c.fails(
         &["run", "specs/opt.toml", "--out", "o"],
-        &["optim.maps", "no maps folder specs/nomaps"],
+        &["optimise.maps", "no maps folder specs/nomaps"],
     );
     // Asked for: recomputed exactly as Chapter 4 made it, said in one line.
     c.write(

@@ -90,9 +90,9 @@ fn a_rerun_with_bad_inputs_leaves_a_finished_folder_as_it_was() {
     c.write(
         "m.toml",
         &SPEC.replace(
-            "[optim.som]",
+            "[optimise.som]",
             "maps = \"maps\"
-[optim.som]",
+[optimise.som]",
         ),
     );
     c.fails(&["run", "m.toml", "--out", "done"], &["already holds a finished run"]);
@@ -300,23 +300,23 @@ fn bad_inputs_are_refused_on_one_line_quickly() {
         timed(&["run", "bad.toml", "--out", "o7"], &needles);
     }
     for (from, to, needles) in [
-        ("population = 8", "population = 1000000000000", vec!["optim.population"]),
-        ("generations = 20", "generations = 1000000000000000000", vec!["optim.generations"]),
-        ("population = 8", "population = 8\nsearch_range = 1e308", vec!["optim.search_range"]),
+        ("population = 8", "population = 1000000000000", vec!["optimise.population"]),
+        ("generations = 20", "generations = 1000000000000000000", vec!["optimise.generations"]),
+        ("population = 8", "population = 8\nsearch_range = 1e308", vec!["optimise.search_range"]),
         (
             "optimisers = [\"ga\", \"de\"]",
             "optimisers = [\"de\", \"ga\", \"de\"]",
-            vec!["optim.optimisers", "`de` is listed twice"],
+            vec!["optimise.optimisers", "`de` is listed twice"],
         ),
         (
             "parameterisations = [\"chord_length\"]",
             "parameterisations = [\"chord_length\", \"chord_length\"]",
-            vec!["optim.parameterisations", "chord_length"],
+            vec!["optimise.parameterisations", "chord_length"],
         ),
         (
             "control_nets = [\"6x6\"]",
             "control_nets = [\"6x6\", \"6\"]",
-            vec!["optim.control_nets", "6x6"],
+            vec!["optimise.control_nets", "6x6"],
         ),
     ] {
         c.write("bad.toml", &SPEC.replace(from, to));

@@ -137,5 +137,5 @@ fn seed002_bad_key_is_named() {
         .unwrap();
     assert!(!o.status.success());
     let err = String::from_utf8_lossy(&o.stderr);
-    assert!(err.contains("seed002.grid") && err.contains("odd"), "{err}");
+    assert!(err.contains("rational_bezier.grid") && err.contains("odd"), "{err}");
 }

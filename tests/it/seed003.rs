@@ -148,14 +148,14 @@ fn seed003_bad_keys_are_named() {
     let out = case.path("o");
     for (from, to, needles) in [
         ("\nnests = 100", "\nnests = 100\nnestz = 3", &["nestz"][..]),
-        ("\nruns = 50", "\nruns = 0", &["seed003.runs"][..]),
+        ("\nruns = 50", "\nruns = 0", &["cuckoo_bezier.runs"][..]),
         (
             "snr_db = 12.5\ngenerations = 2000",
             "snr_db = 12.5\ngenerations = 0",
-            &["seed003.example2.generations"][..],
+            &["cuckoo_bezier.example2.generations"][..],
         ),
-        ("\npa = 0.25", "\npa = 1.5", &["seed003.csa.pa"][..]),
-        ("\"icsa\"]", "\"icsa\", \"pso\"]", &["seed003.methods", "pso"][..]),
+        ("\npa = 0.25", "\npa = 1.5", &["cuckoo_bezier.csa.pa"][..]),
+        ("\"icsa\"]", "\"icsa\", \"pso\"]", &["cuckoo_bezier.methods", "pso"][..]),
     ] {
         assert!(text.contains(from), "{from}");
         let p = case.write("bad.toml", &text.replacen(from, to, 1));

@@ -145,9 +145,9 @@ fn seed004_dry_run_lists_cells_and_bad_keys_are_named() {
     let p = case.write("bad2.toml", &bad);
     case.fails(
         &["run", p.to_str().unwrap(), "--out", "o"],
-        &["seed004.table2_control_points", "11"],
+        &["closed_cylinder.table2_control_points", "11"],
     );
     let bad = std::fs::read_to_string(&spec).unwrap().replace("beta = 2.0", "beta = 3.0");
     let p = case.write("bad3.toml", &bad);
-    case.fails(&["run", p.to_str().unwrap(), "--out", "o"], &["seed004.ga.beta"]);
+    case.fails(&["run", p.to_str().unwrap(), "--out", "o"], &["closed_cylinder.ga.beta"]);
 }

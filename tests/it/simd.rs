@@ -10,7 +10,7 @@ use somnurbs::simd::Isa;
 const ALL_KERNELS: &str = r#"
 name = "simd"
 master_seed = 5
-[optim]
+[optimise]
 datasets = ["sphere"]
 grid = "20x20"
 control_nets = ["6x6", "9x7"]
@@ -20,7 +20,7 @@ repeats = 2
 generations = 30
 population = 10
 init_range = 1e-3
-[optim.som]
+[optimise.som]
 iterations = 300
 "#;
 

@@ -9,7 +9,7 @@ use std::process::{Command, Output};
 const SPEC: &str = r#"
 name = "tiny"
 master_seed = 5
-[optim]
+[optimise]
 datasets = ["sphere"]
 grid = "20x20"
 control_nets = ["6x6"]
@@ -18,7 +18,7 @@ optimisers = ["ga", "de", "pso"]
 repeats = 2
 generations = 20
 population = 10
-[optim.som]
+[optimise.som]
 iterations = 300
 "#;
 

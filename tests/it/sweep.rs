@@ -46,11 +46,11 @@ fn set_changes_the_results_and_the_seeds_and_is_recorded() {
     let c = Case::new();
     c.write("d.toml", SPEC);
     c.ok(&["run", "d.toml", "--out", "plain"]);
-    c.ok(&["run", "d.toml", "--out", "f5", "--set", "optim.de.f=0.5"]);
+    c.ok(&["run", "d.toml", "--out", "f5", "--set", "optimise.de.f=0.5"]);
     let (plain, f5) = (runs(&c, "plain"), runs(&c, "f5"));
     assert_eq!(plain.len(), f5.len());
     assert!(plain.keys().all(|k| k.starts_with("optim/")), "{plain:?}");
-    assert!(f5.keys().all(|k| k.starts_with("optim[optim.de.f=0.5]/")), "{f5:?}");
+    assert!(f5.keys().all(|k| k.starts_with("optim[optimise.de.f=0.5]/")), "{f5:?}");
     let plain_seeds: BTreeSet<&String> = plain.values().map(|v| &v.0).collect();
     assert!(
         f5.values().all(|v| !plain_seeds.contains(&v.0)),
@@ -63,26 +63,27 @@ fn set_changes_the_results_and_the_seeds_and_is_recorded() {
     let (h, _) = read_csv(&c.path("f5/runs.csv"));
     assert!(!h.contains(&"variant".to_string()), "--set alone adds no variant column: {h:?}");
     let manifest = std::fs::read_to_string(c.path("f5/manifest.toml")).unwrap();
-    assert!(manifest.contains("set = [\"optim.de.f=0.5\"]"), "{manifest}");
+    assert!(manifest.contains("set = [\"optimise.de.f=0.5\"]"), "{manifest}");
     assert!(std::fs::read_to_string(c.path("f5/REPORT.md"))
         .unwrap()
-        .contains("--set optim.de.f=0.5"));
+        .contains("--set optimise.de.f=0.5"));
     assert!(std::fs::read_to_string(c.path("f5/fingerprint.toml"))
         .unwrap()
-        .contains("optim.de.f=0.5"));
+        .contains("optimise.de.f=0.5"));
     // The same --set again resumes; without it, or with another value, the folder is another run's.
-    c.ok(&["run", "d.toml", "--out", "f5", "--resume", "--set", "optim.de.f=0.5"]);
+    c.ok(&["run", "d.toml", "--out", "f5", "--resume", "--set", "optimise.de.f=0.5"]);
     c.fails(&["run", "d.toml", "--out", "f5", "--resume"], &["cannot resume", "--set"]);
     c.fails(
-        &["run", "d.toml", "--out", "f5", "--resume", "--set", "optim.de.f=0.6"],
+        &["run", "d.toml", "--out", "f5", "--resume", "--set", "optimise.de.f=0.6"],
         &["cannot resume", "--set"],
     );
     // The dry run lists the variant's keys and seeds.
-    let dry =
-        String::from_utf8(c.ok(&["run", "d.toml", "--dry-run", "--set", "optim.de.f=0.5"]).stdout)
-            .unwrap();
+    let dry = String::from_utf8(
+        c.ok(&["run", "d.toml", "--dry-run", "--set", "optimise.de.f=0.5"]).stdout,
+    )
+    .unwrap();
     assert!(
-        dry.lines().count() == 4 && dry.lines().all(|l| l.starts_with("optim[optim.de.f=0.5]/")),
+        dry.lines().count() == 4 && dry.lines().all(|l| l.starts_with("optim[optimise.de.f=0.5]/")),
         "{dry}"
     );
 }
@@ -92,17 +93,23 @@ fn bad_set_and_sweep_arguments_are_one_line_naming_the_key() {
     let c = Case::new();
     c.write("d.toml", SPEC);
     let cases: &[(&[&str], &[&str])] = &[
-        (&["--set", "optim.de.ff=0.5"], &["optim.de.ff", "ff"]),
-        (&["--set", "optim.de.f=5"], &["optim.de.f"]),
-        (&["--set", "optim.de.f=fast"], &["optim.de.f"]),
-        (&["--set", "optim.de.f"], &["--set", "KEY=VALUE"]),
-        (&["--set", "som.iterations=5"], &["som.iterations", "[optim]"]),
-        (&["--sweep", "optim.de.f=0.3,0.5", "--sweep", "optim.de.f=0.8"], &["optim.de.f", "twice"]),
-        (&["--set", "optim.de.f=0.3", "--sweep", "optim.de.f=0.5,0.8"], &["optim.de.f", "twice"]),
-        (&["--sweep", "optim.de.f=0.3,0.3"], &["optim.de.f", "0.3", "twice"]),
-        (&["--sweep", "optim.de.f=0.3,"], &["optim.de.f", "empty"]),
-        (&["--sweep", "optim.de.f=0.3,7"], &["optim.de.f"]),
-        (&["--sweep", "optim.grid=10x10,20x20"], &["optim.grid", "optimiser settings"]),
+        (&["--set", "optimise.de.ff=0.5"], &["optimise.de.ff", "ff"]),
+        (&["--set", "optimise.de.f=5"], &["optimise.de.f"]),
+        (&["--set", "optimise.de.f=fast"], &["optimise.de.f"]),
+        (&["--set", "optimise.de.f"], &["--set", "KEY=VALUE"]),
+        (&["--set", "som.iterations=5"], &["som.iterations", "[optimise]"]),
+        (
+            &["--sweep", "optimise.de.f=0.3,0.5", "--sweep", "optimise.de.f=0.8"],
+            &["optimise.de.f", "twice"],
+        ),
+        (
+            &["--set", "optimise.de.f=0.3", "--sweep", "optimise.de.f=0.5,0.8"],
+            &["optimise.de.f", "twice"],
+        ),
+        (&["--sweep", "optimise.de.f=0.3,0.3"], &["optimise.de.f", "0.3", "twice"]),
+        (&["--sweep", "optimise.de.f=0.3,"], &["optimise.de.f", "empty"]),
+        (&["--sweep", "optimise.de.f=0.3,7"], &["optimise.de.f"]),
+        (&["--sweep", "optimise.grid=10x10,20x20"], &["optimise.grid", "optimiser settings"]),
     ];
     for (extra, needles) in cases {
         let args: Vec<&str> = ["run", "d.toml", "--out", "bad"]
@@ -115,19 +122,22 @@ fn bad_set_and_sweep_arguments_are_one_line_naming_the_key() {
         assert!(!c.path("bad").exists(), "{args:?} wrote the folder");
     }
     c.write("s.toml", "name = \"s\"\nmaster_seed = 1\n[som]\ndatasets = [\"cube\"]\niterations = 10\n[[som.group]]\nmodels = [\"som2d\"]\ngrids = [\"10x10\"]\n");
-    c.fails(&["run", "s.toml", "--set", "optim.de.f=0.5"], &["optim.de.f", "no [optim] section"]);
+    c.fails(
+        &["run", "s.toml", "--set", "optimise.de.f=0.5"],
+        &["optimise.de.f", "no [optimise] section"],
+    );
 }
 
 #[test]
 fn a_sweep_over_de_f_writes_one_folder_whose_variants_differ_and_compare_ranks_them() {
     let c = Case::new();
     c.write("d.toml", &de_only());
-    c.ok(&["run", "d.toml", "--out", "sweep", "--sweep", "optim.de.f=0.3,0.5,0.8"]);
+    c.ok(&["run", "d.toml", "--out", "sweep", "--sweep", "optimise.de.f=0.3,0.5,0.8"]);
     let (h, rows) = read_csv(&c.path("sweep/runs.csv"));
     let (v, best, seed) = (col(&h, "variant"), col(&h, "best"), col(&h, "seed"));
     let variants: Vec<String> =
         rows.iter().map(|r| r[v].clone()).collect::<BTreeSet<_>>().into_iter().collect();
-    assert_eq!(variants, vec!["optim.de.f=0.3", "optim.de.f=0.5", "optim.de.f=0.8"]);
+    assert_eq!(variants, vec!["optimise.de.f=0.3", "optimise.de.f=0.5", "optimise.de.f=0.8"]);
     assert_eq!(rows.len(), 18);
     let bests: BTreeSet<Vec<String>> = variants
         .iter()
@@ -141,7 +151,7 @@ fn a_sweep_over_de_f_writes_one_folder_whose_variants_differ_and_compare_ranks_t
     );
     // The variant with F = 0.3 is not the plain spec (F = 0.3 is not DE's default here), and a
     // --set run of one variant gives exactly that variant's rows.
-    c.ok(&["run", "d.toml", "--out", "one", "--sweep", "optim.de.f=0.5"]);
+    c.ok(&["run", "d.toml", "--out", "one", "--sweep", "optimise.de.f=0.5"]);
     let one = read_csv(&c.path("one/runs.csv")).1;
     let cell = col(&h, "cell");
     for r in &one {
@@ -153,7 +163,7 @@ fn a_sweep_over_de_f_writes_one_folder_whose_variants_differ_and_compare_ranks_t
     }
     let manifest = std::fs::read_to_string(c.path("sweep/manifest.toml")).unwrap();
     assert!(
-        manifest.contains("sweep = [\"optim.de.f=0.3,0.5,0.8\"]")
+        manifest.contains("sweep = [\"optimise.de.f=0.3,0.5,0.8\"]")
             && manifest.contains("cells = 18"),
         "{manifest}"
     );
@@ -164,20 +174,22 @@ fn a_sweep_over_de_f_writes_one_folder_whose_variants_differ_and_compare_ranks_t
     let pairs: BTreeSet<(String, String)> =
         brows.iter().map(|r| (r[0].clone(), r[1].clone())).collect();
     assert!(
-        pairs.contains(&("de@optim.de.f=0.3".to_string(), "de@optim.de.f=0.5".to_string())),
+        pairs.contains(&("de@optimise.de.f=0.3".to_string(), "de@optimise.de.f=0.5".to_string())),
         "{pairs:?}"
     );
     // The per-cell table pairs the variants by name, A12 by direction.
     let (ch, crows) = read_csv(&c.path("sweep/compare/compare_cells.csv"));
     let (x, a12) = (col(&ch, "x"), col(&ch, "a12_x_better"));
-    assert!(crows.iter().any(|r| r[x] == "de@optim.de.f=0.3"), "{crows:?}");
+    assert!(crows.iter().any(|r| r[x] == "de@optimise.de.f=0.3"), "{crows:?}");
     assert!(crows.iter().all(|r| (0.0..=1.0).contains(&r[a12].parse::<f64>().unwrap())));
     let (eh, erows) = read_csv(&c.path("sweep/compare/compare_aocc.csv"));
     let o = col(&eh, "optimiser");
     let ranked: BTreeSet<&str> = erows.iter().map(|r| r[o].as_str()).collect();
     assert_eq!(
         ranked,
-        ["de@optim.de.f=0.3", "de@optim.de.f=0.5", "de@optim.de.f=0.8"].into_iter().collect()
+        ["de@optimise.de.f=0.3", "de@optimise.de.f=0.5", "de@optimise.de.f=0.8"]
+            .into_iter()
+            .collect()
     );
     assert!(
         c.path("sweep/compare/compare_overall.csv").exists()
@@ -189,7 +201,7 @@ fn a_sweep_over_de_f_writes_one_folder_whose_variants_differ_and_compare_ranks_t
 fn resume_and_shards_of_a_sweep_give_the_plain_sweeps_tables() {
     let c = Case::new();
     c.write("d.toml", SPEC);
-    let sweep = ["--sweep", "optim.de.f=0.3,0.8", "--sweep", "optim.generations=10,20"];
+    let sweep = ["--sweep", "optimise.de.f=0.3,0.8", "--sweep", "optimise.generations=10,20"];
     let with = |base: &[&str]| -> Vec<String> {
         base.iter().chain(sweep.iter()).map(|s| s.to_string()).collect()
     };
@@ -226,9 +238,9 @@ fn resume_and_shards_of_a_sweep_give_the_plain_sweeps_tables() {
         "--shard",
         "3/3",
         "--sweep",
-        "optim.de.f=0.3,0.9",
+        "optimise.de.f=0.3,0.9",
         "--sweep",
-        "optim.generations=10,20",
+        "optimise.generations=10,20",
     ]);
     c.fails(&["merge", "shard1", "shard2", "other3", "--out", "m2"], &["another run", "--sweep"]);
 }

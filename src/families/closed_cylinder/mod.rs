@@ -274,7 +274,7 @@ pub(crate) fn top_view(
     }))
 }
 
-/// Seed 004's family: the `[seed004]` section.
+/// Seed 004's family: the `[closed_cylinder]` section.
 pub(crate) struct ClosedCylinder;
 
 impl crate::experiment::family::Section for self::spec::ClosedCylinderSpec {
@@ -337,7 +337,7 @@ mod tests {
     fn spec_with(extra: &str) -> Result<crate::families::Loaded, SpecError> {
         let path = concat!(env!("CARGO_MANIFEST_DIR"), "/experiments/seed004_cylinder.toml");
         let text = std::fs::read_to_string(path).unwrap();
-        let text = text.replacen("[seed004]\n", &format!("[seed004]\n{extra}\n"), 1);
+        let text = text.replacen("[closed_cylinder]\n", &format!("[closed_cylinder]\n{extra}\n"), 1);
         crate::families::Loaded::parse(path, &text, Some("quick"))
     }
 

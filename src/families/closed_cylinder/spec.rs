@@ -1,4 +1,4 @@
-//! The `[seed004]` section (Chaurasiya & Agarwal: closed cylinder surface): its defaults and
+//! The `[closed_cylinder]` section (Chaurasiya & Agarwal: closed cylinder surface): its defaults and
 //! checks.
 
 use crate::experiment::limits::{self, Check};
@@ -81,50 +81,50 @@ pub struct ClosedCylinderSpec {
     pub ga: crate::optim::binary_ga::BinaryGa,
 }
 
-/// Every value of the `[seed004]` section (after the limits).
+/// Every value of the `[closed_cylinder]` section (after the limits).
 pub(crate) fn validate(spec: &Spec, s: &ClosedCylinderSpec) -> Result<(), SpecError> {
     if s.control_points.is_empty() {
-        return Err(spec.err("seed004.control_points", "is empty"));
+        return Err(spec.err("closed_cylinder.control_points", "is empty"));
     }
     if s.order_around < 2 || s.order_around > 8 {
         return Err(
-            spec.err("seed004.order_around", format!("must be in [2, 8], got {}", s.order_around))
+            spec.err("closed_cylinder.order_around", format!("must be in [2, 8], got {}", s.order_around))
         );
     }
     if let Some(n) = s.control_points.iter().find(|&&n| n < s.order_around || n > 200) {
         return Err(spec.err(
-            "seed004.control_points",
+            "closed_cylinder.control_points",
             format!("{n} is outside [order_around = {}, 200]", s.order_around),
         ));
     }
     if let Some(n) = s.table2_control_points.iter().find(|n| !s.control_points.contains(n)) {
         return Err(spec.err(
-            "seed004.table2_control_points",
-            format!("{n} is not in seed004.control_points"),
+            "closed_cylinder.table2_control_points",
+            format!("{n} is not in closed_cylinder.control_points"),
         ));
     }
     if let Some(g) = s.table2_generations.iter().find(|&&g| g > s.generations) {
         return Err(spec.err(
-            "seed004.table2_generations",
-            format!("{g} exceeds seed004.generations = {}", s.generations),
+            "closed_cylinder.table2_generations",
+            format!("{g} exceeds closed_cylinder.generations = {}", s.generations),
         ));
     }
     if s.order_vertical < 2 || s.rows < s.order_vertical {
         return Err(spec.err(
-            "seed004.order_vertical",
+            "closed_cylinder.order_vertical",
             format!("must be at least 2 and at most rows = {}, got {}", s.rows, s.order_vertical),
         ));
     }
     if s.repeats == 0 {
-        return Err(spec.err("seed004.repeats", "must be at least 1"));
+        return Err(spec.err("closed_cylinder.repeats", "must be at least 1"));
     }
     if s.generations == 0 {
-        return Err(spec.err("seed004.generations", "must be at least 1"));
+        return Err(spec.err("closed_cylinder.generations", "must be at least 1"));
     }
     if s.population < 2 || s.population <= s.ga.elitism {
         return Err(spec.err(
-            "seed004.population",
-            format!("must be at least 2 and above seed004.ga.elitism, got {}", s.population),
+            "closed_cylinder.population",
+            format!("must be at least 2 and above closed_cylinder.ga.elitism, got {}", s.population),
         ));
     }
     for (key, v) in [
@@ -136,32 +136,32 @@ pub(crate) fn validate(spec: &Spec, s: &ClosedCylinderSpec) -> Result<(), SpecEr
     ] {
         if !(v > 0.0 && v.is_finite()) {
             return Err(
-                spec.err(&format!("seed004.{key}"), format!("must be a positive number, got {v}"))
+                spec.err(&format!("closed_cylinder.{key}"), format!("must be a positive number, got {v}"))
             );
         }
     }
     if s.radius / s.grid_step > 2000.0 || s.height / s.grid_step > 2000.0 {
         return Err(spec.err(
-            "seed004.grid_step",
+            "closed_cylinder.grid_step",
             format!("{} makes more than 2000 lattice steps across the cylinder", s.grid_step),
         ));
     }
     s.ga.validate().map_err(|e| match e {
         crate::optim::OptimError::InvalidParameter { key, message } => {
-            spec.err(&format!("seed004.{}", key.replace("binary_ga", "ga")), message)
+            spec.err(&format!("closed_cylinder.{}", key.replace("binary_ga", "ga")), message)
         }
-        other => spec.err("seed004.ga", other),
+        other => spec.err("closed_cylinder.ga", other),
     })?;
     Ok(())
 }
 
-/// The bounds of the `[seed004]` section's sizes and counts (docs/specs.md, "Spec limits").
+/// The bounds of the `[closed_cylinder]` section's sizes and counts (docs/specs.md, "Spec limits").
 pub(crate) fn limits(c: &Check, s: &ClosedCylinderSpec) -> Result<(), SpecError> {
-    c.list("seed004.control_points", &s.control_points)?;
-    c.list("seed004.table2_control_points", &s.table2_control_points)?;
-    c.list("seed004.table2_generations", &s.table2_generations)?;
-    c.optimiser_run("seed004", s.repeats, s.generations, s.population)?;
-    c.int("seed004.rows", s.rows, limits::MAX_GRID_SIDE as u64)?;
+    c.list("closed_cylinder.control_points", &s.control_points)?;
+    c.list("closed_cylinder.table2_control_points", &s.table2_control_points)?;
+    c.list("closed_cylinder.table2_generations", &s.table2_generations)?;
+    c.optimiser_run("closed_cylinder", s.repeats, s.generations, s.population)?;
+    c.int("closed_cylinder.rows", s.rows, limits::MAX_GRID_SIDE as u64)?;
     for (key, v) in [
         ("radius", s.radius),
         ("height", s.height),
@@ -169,8 +169,8 @@ pub(crate) fn limits(c: &Check, s: &ClosedCylinderSpec) -> Result<(), SpecError>
         ("accuracy", s.accuracy),
         ("search_range", s.search_range),
     ] {
-        c.real(&format!("seed004.{key}"), v, 0.0, false, limits::MAX_LENGTH)?;
+        c.real(&format!("closed_cylinder.{key}"), v, 0.0, false, limits::MAX_LENGTH)?;
     }
-    c.cells("seed004", &[s.control_points.len(), s.repeats])?;
+    c.cells("closed_cylinder", &[s.control_points.len(), s.repeats])?;
     Ok(())
 }

@@ -80,7 +80,7 @@ fn default_start_spread() -> f64 {
     0.05
 }
 
-/// The `[seed003]` section.
+/// The `[cuckoo_bezier]` section.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CuckooBezierSpec {
@@ -124,7 +124,7 @@ impl CuckooBezierSpec {
 
     /// Checks of the section, as (key, message) of the first fault.
     pub fn validate(&self) -> Result<(), (String, String)> {
-        let bad = |k: &str, m: String| Err((format!("seed003.{k}"), m));
+        let bad = |k: &str, m: String| Err((format!("cuckoo_bezier.{k}"), m));
         if self.examples.is_empty() {
             return bad("examples", "is empty".into());
         }
@@ -284,7 +284,7 @@ pub(crate) fn clean(master_seed: u64, example: &str, e: &ExampleSpec) -> Result<
             let mut rng = seeds::cell_rng(master_seed, "seed003/example3/surface");
             (bezier::example3(e.size, &mut rng).1, Layout::Scattered)
         }
-        other => anyhow::bail!("seed003.examples: unknown example `{other}`"),
+        other => anyhow::bail!("cuckoo_bezier.examples: unknown example `{other}`"),
     })
 }
 
@@ -333,7 +333,7 @@ pub(crate) fn budget(s: &CuckooBezierSpec, e: &ExampleSpec) -> Budget {
 pub(crate) fn run_cell(spec: &Spec, s: &CuckooBezierSpec, cell: &Cell) -> Result<Run> {
     let e = s
         .example(&cell.example)
-        .with_context(|| format!("seed003.examples: unknown example `{}`", cell.example))?;
+        .with_context(|| format!("cuckoo_bezier.examples: unknown example `{}`", cell.example))?;
     let key = cell.key();
     let master = spec.file.master_seed;
     let d = data(master, &cell.example, e, cell.run)?;
@@ -361,7 +361,7 @@ pub(crate) fn run_cell(spec: &Spec, s: &CuckooBezierSpec, cell: &Cell) -> Result
         let prob = BezierParamProblem::new(e.degree, e.degree, d.layout, d.points, centre)
             .map_err(|err| anyhow::anyhow!("{key}: {err}"))?;
         let Some(opt) = crate::optim::pick(&s.offered(), &cell.method) else {
-            anyhow::bail!("seed003.methods: unknown method `{}`", cell.method)
+            anyhow::bail!("cuckoo_bezier.methods: unknown method `{}`", cell.method)
         };
         let (r, cpu_s) = runner::optimise(opt, &prob, &budget(s, e), master, &key)?;
         let dim = prob.dim();
@@ -401,7 +401,7 @@ pub(crate) fn run(spec: &Spec, s: &CuckooBezierSpec, ctx: &RunContext) -> Result
     )
 }
 
-/// Seed 003's family: the `[seed003]` section.
+/// Seed 003's family: the `[cuckoo_bezier]` section.
 pub(crate) struct CuckooBezier;
 
 impl crate::experiment::family::Section for CuckooBezierSpec {
@@ -410,7 +410,7 @@ impl crate::experiment::family::Section for CuckooBezierSpec {
     }
     fn validate(&self, spec: &Spec) -> Result<(), SpecError> {
         self.validate().map_err(|(key, msg)| spec.err(&key, msg))?;
-        spec.validate_optimiser_params("seed003", &self.offered())
+        spec.validate_optimiser_params("cuckoo_bezier", &self.offered())
     }
 }
 
@@ -456,7 +456,7 @@ mod tests {
     fn spec_with(extra: &str) -> Result<crate::families::Loaded, SpecError> {
         let path = concat!(env!("CARGO_MANIFEST_DIR"), "/experiments/seed003_cuckoo_bezier.toml");
         let text = std::fs::read_to_string(path).unwrap();
-        let text = text.replacen("[seed003]\n", &format!("[seed003]\n{extra}\n"), 1);
+        let text = text.replacen("[cuckoo_bezier]\n", &format!("[cuckoo_bezier]\n{extra}\n"), 1);
         crate::families::Loaded::parse(path, &text, Some("quick"))
     }
 
@@ -488,7 +488,7 @@ mod tests {
         assert!(k.initial_best_y < 0.5 * r.initial_best_y, "{} {}", k.initial_best_y, r.initial_best_y);
         for bad in ["start_spread = 0.0", "start_spread = 0.6"] {
             let e = spec_with(bad).unwrap_err().to_string();
-            assert!(e.contains("seed003.start_spread"), "{e}");
+            assert!(e.contains("cuckoo_bezier.start_spread"), "{e}");
         }
         assert!(spec_with("start = \"somewhere\"").unwrap_err().to_string().contains("unknown variant `somewhere`"));
     }

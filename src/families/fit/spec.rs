@@ -1,5 +1,5 @@
 //! The `[fit]` section (thesis Chapter 5): data sets x control nets x parameterisations x
-//! approaches on one grid size, its checks and its cells; the keys it shares with `[optim]` are
+//! approaches on one grid size, its checks and its cells; the keys it shares with `[optimise]` are
 //! checked here for both.
 
 use crate::experiment::limits::{self, Check};

@@ -33,7 +33,7 @@ fn folder_suite(results: &Path) -> Result<[String; 4]> {
         .next()
         .context("no spec")?;
     let o = spec.section_as::<super::spec::OptimSpec>().with_context(|| {
-        format!("{}: its spec has no [optim] section", results.display())
+        format!("{}: its spec has no [optimise] section", results.display())
     })?;
     Ok([
         fp.spec_name.clone(),

@@ -46,7 +46,7 @@ pub(crate) struct OptimRow {
     pub(crate) cn_y: usize,
     pub(crate) parameterisation: String,
     pub(crate) optimiser: String,
-    /// The swept settings of a `--sweep` run (e.g. `optim.de.f=0.5`); no column otherwise.
+    /// The swept settings of a `--sweep` run (e.g. `optimise.de.f=0.5`); no column otherwise.
     #[serde(default, skip_serializing_if = "String::is_empty")]
     pub(crate) variant: String,
     pub(crate) repeat: usize,
@@ -150,7 +150,7 @@ pub fn problems(
     ctx: &RunContext,
 ) -> Result<BTreeMap<ProblemKey, ControlNetProblem>> {
     let from = maps::MapsFrom {
-        section: "optim",
+        section: "optimise",
         dir: o.maps.as_deref(),
         missing: o.maps_missing,
         som: o.som.as_ref(),
@@ -353,15 +353,15 @@ pub(crate) fn setting(o: &OptimSpec) -> String {
     }
 }
 
-/// Chapter 6's family: the `[optim]` section.
+/// Chapter 6's family: the `[optimise]` section.
 pub(crate) struct Optim;
 
-/// What `--sweep` may vary in `[optim]`: every registered optimiser's table (a table the section
+/// What `--sweep` may vary in `[optimise]`: every registered optimiser's table (a table the section
 /// does not have is refused when the variant is read) and the run's budget and start range.
 fn sweepable_keys() -> Vec<String> {
-    let opts = crate::optim::REGISTRY.iter().map(|r| format!("optim.{}.", (r.make)().name()));
+    let opts = crate::optim::REGISTRY.iter().map(|r| format!("optimise.{}.", (r.make)().name()));
     opts.chain(
-        ["optim.generations", "optim.population", "optim.init_range", "optim.repeats"]
+        ["optimise.generations", "optimise.population", "optimise.init_range", "optimise.repeats"]
             .map(String::from),
     )
     .collect()
@@ -382,7 +382,7 @@ impl crate::experiment::family::Section for self::spec::OptimSpec {
     }
     fn require_inputs(&self, spec: &Spec) -> Result<()> {
         let from = maps::MapsFrom {
-            section: "optim",
+            section: "optimise",
             dir: self.maps.as_deref(),
             missing: self.maps_missing,
             som: self.som.as_ref(),

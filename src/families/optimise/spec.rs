@@ -1,4 +1,4 @@
-//! The `[optim]` section (thesis Chapter 6): data sets x control nets x parameterisations x
+//! The `[optimise]` section (thesis Chapter 6): data sets x control nets x parameterisations x
 //! optimisers x repeats, its defaults (Table 6.1), its checks and its cells.
 
 use crate::experiment::limits::{self, Check};
@@ -110,12 +110,12 @@ fn default_exact_tol() -> f64 {
     1e-7
 }
 
-/// Every value of the `[optim]` section (after the limits).
+/// Every value of the `[optimise]` section (after the limits).
 pub(crate) fn validate(spec: &Spec, o: &OptimSpec) -> Result<(), SpecError> {
-    validate_grid_keys(spec, "optim", &o.datasets, o.grid, &o.control_nets, &o.parameterisations)?;
-    validate_map_som(spec, "optim", o.som.as_ref())?;
+    validate_grid_keys(spec, "optimise", &o.datasets, o.grid, &o.control_nets, &o.parameterisations)?;
+    validate_map_som(spec, "optimise", o.som.as_ref())?;
     spec.validate_runs(
-        "optim",
+        "optimise",
         &o.optimisers,
         &o.offered(),
         o.repeats,
@@ -124,34 +124,34 @@ pub(crate) fn validate(spec: &Spec, o: &OptimSpec) -> Result<(), SpecError> {
     )?;
     if !(o.init_range >= 0.0 && o.init_range.is_finite()) {
         return Err(spec.err(
-            "optim.init_range",
+            "optimise.init_range",
             format!("must be a non-negative number, got {}", o.init_range),
         ));
     }
     if let Some(r) = o.search_range {
         if !(r > 0.0 && r.is_finite()) {
             return Err(
-                spec.err("optim.search_range", format!("must be a positive number, got {r}"))
+                spec.err("optimise.search_range", format!("must be a positive number, got {r}"))
             );
         }
         if o.init_range > r {
             return Err(spec.err(
-                "optim.init_range",
-                format!("{} is wider than optim.search_range {r}", o.init_range),
+                "optimise.init_range",
+                format!("{} is wider than optimise.search_range {r}", o.init_range),
             ));
         }
     }
     if !(o.bounds_margin >= 0.0 && o.bounds_margin.is_finite()) {
         return Err(spec.err(
-            "optim.bounds_margin",
+            "optimise.bounds_margin",
             format!("must be a non-negative number, got {}", o.bounds_margin),
         ));
     }
     if o.trace_every_evals == 0 {
-        return Err(spec.err("optim.trace_every_evals", "must be at least 1"));
+        return Err(spec.err("optimise.trace_every_evals", "must be at least 1"));
     }
     if !(o.exact_tol > 0.0 && o.exact_tol < 1.0) {
-        return Err(spec.err("optim.exact_tol", format!("must be in (0,1), got {}", o.exact_tol)));
+        return Err(spec.err("optimise.exact_tol", format!("must be in (0,1), got {}", o.exact_tol)));
     }
     Ok(())
 }
@@ -222,29 +222,29 @@ impl OptimCell {
     }
 }
 
-/// The bounds of the `[optim]` section's sizes and counts (docs/specs.md, "Spec limits").
+/// The bounds of the `[optimise]` section's sizes and counts (docs/specs.md, "Spec limits").
 pub(crate) fn limits(c: &Check, o: &OptimSpec) -> Result<(), SpecError> {
-    c.datasets("optim.datasets", &o.datasets)?;
-    c.grids("optim.grid", [&o.grid])?;
-    c.list("optim.control_nets", &o.control_nets)?;
-    c.grids("optim.control_nets", &o.control_nets)?;
-    c.list("optim.parameterisations", &o.parameterisations)?;
-    c.list("optim.optimisers", &o.optimisers)?;
-    c.optimiser_run("optim", o.repeats, o.generations, o.population)?;
-    c.real("optim.fairness", o.fairness, 0.0, true, limits::MAX_FAIRNESS)?;
-    crate::families::maps::check_exponential_alpha(c, "optim", o.exponential_alpha)?;
-    c.real("optim.init_range", o.init_range, 0.0, true, limits::MAX_RANGE)?;
-    c.real("optim.bounds_margin", o.bounds_margin, 0.0, true, limits::MAX_RANGE)?;
+    c.datasets("optimise.datasets", &o.datasets)?;
+    c.grids("optimise.grid", [&o.grid])?;
+    c.list("optimise.control_nets", &o.control_nets)?;
+    c.grids("optimise.control_nets", &o.control_nets)?;
+    c.list("optimise.parameterisations", &o.parameterisations)?;
+    c.list("optimise.optimisers", &o.optimisers)?;
+    c.optimiser_run("optimise", o.repeats, o.generations, o.population)?;
+    c.real("optimise.fairness", o.fairness, 0.0, true, limits::MAX_FAIRNESS)?;
+    crate::families::maps::check_exponential_alpha(c, "optimise", o.exponential_alpha)?;
+    c.real("optimise.init_range", o.init_range, 0.0, true, limits::MAX_RANGE)?;
+    c.real("optimise.bounds_margin", o.bounds_margin, 0.0, true, limits::MAX_RANGE)?;
     if let Some(r) = o.search_range {
-        c.real("optim.search_range", r, 0.0, false, limits::MAX_RANGE)?;
+        c.real("optimise.search_range", r, 0.0, false, limits::MAX_RANGE)?;
     }
-    c.int("optim.trace_every_evals", o.trace_every_evals, limits::MAX_TRACE_EVERY)?;
-    c.int("optim.exact_newton_steps", o.exact_newton_steps, limits::MAX_NEWTON_STEPS)?;
+    c.int("optimise.trace_every_evals", o.trace_every_evals, limits::MAX_TRACE_EVERY)?;
+    c.int("optimise.exact_newton_steps", o.exact_newton_steps, limits::MAX_NEWTON_STEPS)?;
     if let Some(som) = &o.som {
-        c.int("optim.som.iterations", som.iterations, limits::MAX_ITERATIONS)?;
+        c.int("optimise.som.iterations", som.iterations, limits::MAX_ITERATIONS)?;
     }
     c.cells(
-        "optim",
+        "optimise",
         &[
             o.datasets.len(),
             o.control_nets.len(),
@@ -265,11 +265,11 @@ impl OptimSpec {
 
 #[cfg(test)]
 mod tests {
-    /// The optimisers `[optim]` offers are the registered ones (binary GA aside, seed 004's own),
+    /// The optimisers `[optimise]` offers are the registered ones (binary GA aside, seed 004's own),
     /// and docs/specs.md lists exactly those.
     #[test]
     fn offered_optimisers_are_the_registry_and_the_docs_list() {
-        let text = "name = \"t\"\nmaster_seed = 1\n[optim]\ndatasets = [\"sphere\"]\ngrid = \"20x20\"\ncontrol_nets = [\"6x6\"]\nparameterisations = [\"uniform\"]\noptimisers = [\"de\"]\n";
+        let text = "name = \"t\"\nmaster_seed = 1\n[optimise]\ndatasets = [\"sphere\"]\ngrid = \"20x20\"\ncontrol_nets = [\"6x6\"]\nparameterisations = [\"uniform\"]\noptimisers = [\"de\"]\n";
         let spec = crate::families::Loaded::parse("t.toml", text, None).unwrap();
         let o: &super::OptimSpec = spec.section_as().unwrap();
         let offered = crate::optim::names(&o.offered());

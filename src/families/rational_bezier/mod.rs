@@ -83,13 +83,13 @@ pub(crate) fn cells(s: &RationalBezierSpec) -> Vec<Cell> {
 /// The SSE problem of a surface with the spec's grid and box.
 pub(crate) fn problem(s: &RationalBezierSpec, surface: &str) -> Result<SurfaceSse> {
     let ts = TestSurface::by_name(surface)
-        .with_context(|| format!("seed002.surfaces: unknown surface `{surface}`"))?;
+        .with_context(|| format!("rational_bezier.surfaces: unknown surface `{surface}`"))?;
     Ok(SurfaceSse::new(ts.grid(s.grid), s.bounds_margin, s.w_min))
 }
 
 fn optimiser<'a>(s: &'a RationalBezierSpec, name: &str) -> Result<&'a dyn Optimiser> {
     crate::optim::pick(&s.offered(), name)
-        .with_context(|| format!("seed002.optimisers: unknown optimiser `{name}`"))
+        .with_context(|| format!("rational_bezier.optimisers: unknown optimiser `{name}`"))
 }
 
 /// Run one cell (alone it gives the same numbers as inside the full run).
@@ -203,7 +203,7 @@ pub(crate) fn curve_cells(s: &RationalBezierSpec) -> Vec<CurveCell> {
 /// conic with the cell's optimiser, all on the cell's stream in run order.
 pub(crate) fn run_curve_cell(spec: &Spec, s: &RationalBezierSpec, cell: &CurveCell) -> Result<CurveRun> {
     let (pieces, truth) = conic::outline(&cell.outline)
-        .with_context(|| format!("seed002.outlines: unknown outline `{}`", cell.outline))?;
+        .with_context(|| format!("rational_bezier.outlines: unknown outline `{}`", cell.outline))?;
     let points = conic::sample_closed(&pieces, s.outline_spacing);
     let corners = conic::sam06(&points, s.sam06_l, s.sam06_d, s.sam06_r.unwrap_or(s.sam06_l));
     let matched = truth
@@ -270,7 +270,7 @@ pub(crate) fn run_curves(spec: &Spec, s: &RationalBezierSpec, ctx: &RunContext) 
     )
 }
 
-/// Seed 002's family: the `[seed002]` section (surface cells logged, curve cells not).
+/// Seed 002's family: the `[rational_bezier]` section (surface cells logged, curve cells not).
 pub(crate) struct RationalBezier;
 
 impl crate::experiment::family::Section for self::spec::RationalBezierSpec {

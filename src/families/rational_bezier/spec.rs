@@ -1,4 +1,4 @@
-//! The `[seed002]` section (Yahya: rational Bezier surfaces): its defaults and checks.
+//! The `[rational_bezier]` section (Yahya: rational Bezier surfaces): its defaults and checks.
 
 use crate::experiment::limits::{self, Check};
 use crate::experiment::spec::{Spec, SpecError};
@@ -106,15 +106,15 @@ pub struct RationalBezierSpec {
     pub pso: crate::optim::pso::Pso,
 }
 
-/// Every value of the `[seed002]` section (after the limits).
+/// Every value of the `[rational_bezier]` section (after the limits).
 pub(crate) fn validate(spec: &Spec, s: &RationalBezierSpec) -> Result<(), SpecError> {
     if s.surfaces.is_empty() {
-        return Err(spec.err("seed002.surfaces", "is empty"));
+        return Err(spec.err("rational_bezier.surfaces", "is empty"));
     }
     for name in &s.surfaces {
         if crate::spline::rational_bezier::TestSurface::by_name(name).is_none() {
             return Err(spec.err(
-                "seed002.surfaces",
+                "rational_bezier.surfaces",
                 format!(
                     "unknown surface `{name}` (expected surface1, surface2, surface3 or surface4)"
                 ),
@@ -122,7 +122,7 @@ pub(crate) fn validate(spec: &Spec, s: &RationalBezierSpec) -> Result<(), SpecEr
         }
     }
     spec.validate_runs(
-        "seed002",
+        "rational_bezier",
         &s.optimisers,
         &s.offered(),
         s.repeats,
@@ -130,71 +130,71 @@ pub(crate) fn validate(spec: &Spec, s: &RationalBezierSpec) -> Result<(), SpecEr
         s.population,
     )?;
     if s.grid < 5 || s.grid.is_multiple_of(2) {
-        return Err(spec.err("seed002.grid", format!("must be odd and at least 5, got {}", s.grid)));
+        return Err(spec.err("rational_bezier.grid", format!("must be odd and at least 5, got {}", s.grid)));
     }
     if !(s.init_range >= 0.0 && s.init_range.is_finite()) {
         return Err(spec.err(
-            "seed002.init_range",
+            "rational_bezier.init_range",
             format!("must be a non-negative number, got {}", s.init_range),
         ));
     }
     if !(s.bounds_margin >= 0.0 && s.bounds_margin.is_finite()) {
         return Err(spec.err(
-            "seed002.bounds_margin",
+            "rational_bezier.bounds_margin",
             format!("must be a non-negative number, got {}", s.bounds_margin),
         ));
     }
     if !(s.w_min > 0.0 && s.w_min < 1.0) {
-        return Err(spec.err("seed002.w_min", format!("must be in (0, 1), got {}", s.w_min)));
+        return Err(spec.err("rational_bezier.w_min", format!("must be in (0, 1), got {}", s.w_min)));
     }
     if s.trace_every_evals == 0 {
-        return Err(spec.err("seed002.trace_every_evals", "must be at least 1"));
+        return Err(spec.err("rational_bezier.trace_every_evals", "must be at least 1"));
     }
     for name in &s.outlines {
         if crate::spline::conic::outline(name).is_none() {
             return Err(spec.err(
-                "seed002.outlines",
+                "rational_bezier.outlines",
                 format!("unknown outline `{name}` (expected square, letter_d or letter_p)"),
             ));
         }
     }
     if !(s.outline_spacing > 0.0 && s.outline_spacing <= 10.0) {
         return Err(spec.err(
-            "seed002.outline_spacing",
+            "rational_bezier.outline_spacing",
             format!("must be in (0, 10], got {}", s.outline_spacing),
         ));
     }
     if s.sam06_l < 2 {
-        return Err(spec.err("seed002.sam06_l", format!("must be at least 2, got {}", s.sam06_l)));
+        return Err(spec.err("rational_bezier.sam06_l", format!("must be at least 2, got {}", s.sam06_l)));
     }
     if !(s.sam06_d > 0.0 && s.sam06_d.is_finite()) {
         return Err(
-            spec.err("seed002.sam06_d", format!("must be a positive number, got {}", s.sam06_d))
+            spec.err("rational_bezier.sam06_d", format!("must be a positive number, got {}", s.sam06_d))
         );
     }
     if s.curve_generations == 0 {
-        return Err(spec.err("seed002.curve_generations", "must be at least 1"));
+        return Err(spec.err("rational_bezier.curve_generations", "must be at least 1"));
     }
     Ok(())
 }
 
-/// The bounds of the `[seed002]` section's sizes and counts (docs/specs.md, "Spec limits").
+/// The bounds of the `[rational_bezier]` section's sizes and counts (docs/specs.md, "Spec limits").
 pub(crate) fn limits(c: &Check, s: &RationalBezierSpec) -> Result<(), SpecError> {
-    c.list("seed002.surfaces", &s.surfaces)?;
-    c.list("seed002.optimisers", &s.optimisers)?;
-    c.list("seed002.outlines", &s.outlines)?;
-    c.optimiser_run("seed002", s.repeats, s.generations, s.population)?;
-    c.int("seed002.curve_generations", s.curve_generations, limits::MAX_GENERATIONS)?;
-    c.int("seed002.grid", s.grid, 1001)?;
-    c.real("seed002.init_range", s.init_range, 0.0, true, limits::MAX_RANGE)?;
-    c.real("seed002.bounds_margin", s.bounds_margin, 0.0, true, limits::MAX_RANGE)?;
-    c.int("seed002.trace_every_evals", s.trace_every_evals, limits::MAX_TRACE_EVERY)?;
-    c.int("seed002.sam06_l", s.sam06_l, 1000)?;
+    c.list("rational_bezier.surfaces", &s.surfaces)?;
+    c.list("rational_bezier.optimisers", &s.optimisers)?;
+    c.list("rational_bezier.outlines", &s.outlines)?;
+    c.optimiser_run("rational_bezier", s.repeats, s.generations, s.population)?;
+    c.int("rational_bezier.curve_generations", s.curve_generations, limits::MAX_GENERATIONS)?;
+    c.int("rational_bezier.grid", s.grid, 1001)?;
+    c.real("rational_bezier.init_range", s.init_range, 0.0, true, limits::MAX_RANGE)?;
+    c.real("rational_bezier.bounds_margin", s.bounds_margin, 0.0, true, limits::MAX_RANGE)?;
+    c.int("rational_bezier.trace_every_evals", s.trace_every_evals, limits::MAX_TRACE_EVERY)?;
+    c.int("rational_bezier.sam06_l", s.sam06_l, 1000)?;
     if let Some(r) = s.sam06_r {
-        c.int("seed002.sam06_r", r, 1000)?;
+        c.int("rational_bezier.sam06_r", r, 1000)?;
     }
-    c.real("seed002.sam06_d", s.sam06_d, 0.0, false, limits::MAX_LENGTH)?;
-    c.cells("seed002", &[s.surfaces.len().max(s.outlines.len()), s.optimisers.len(), s.repeats])?;
+    c.real("rational_bezier.sam06_d", s.sam06_d, 0.0, false, limits::MAX_LENGTH)?;
+    c.cells("rational_bezier", &[s.surfaces.len().max(s.outlines.len()), s.optimisers.len(), s.repeats])?;
     Ok(())
 }
 
