@@ -202,12 +202,13 @@ impl<F: Families> Loaded<F> {
         profile: Option<&str>,
         overrides: &[Override],
     ) -> Result<Loaded<F>, SpecError> {
-        let spec = Loaded::parse(path, text, profile)?;
+        let (canonical, made) = super::renamed::canonical_text::<F>(text);
+        super::renamed::note(path, &made);
+        let spec = Loaded::parse_canonical(path, text, &canonical, profile)?;
         if overrides.is_empty() {
             return Ok(spec);
         }
-        let (text, _) = super::renamed::canonical_text::<F>(text);
-        let text = text.as_ref();
+        let text = canonical.as_ref();
         let mut table: toml::Table =
             toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
         if let Some(over) = profile.and_then(|p| spec.spec.file.profiles.get(p)) {
@@ -231,10 +232,19 @@ impl<F: Families> Loaded<F> {
 
     /// Parse spec text; `path` is used in messages only.
     pub fn parse(path: &str, text: &str, profile: Option<&str>) -> Result<Loaded<F>, SpecError> {
-        let written = text;
-        let (text, made) = super::renamed::canonical_text::<F>(written);
+        let (canonical, made) = super::renamed::canonical_text::<F>(text);
         super::renamed::note(path, &made);
-        let text = text.as_ref();
+        Loaded::parse_canonical(path, text, &canonical, profile)
+    }
+
+    /// [`Loaded::parse`] of a spec as `written`, whose former section names are already replaced
+    /// in `text` ([`super::renamed::canonical_text`]).
+    fn parse_canonical(
+        path: &str,
+        written: &str,
+        text: &str,
+        profile: Option<&str>,
+    ) -> Result<Loaded<F>, SpecError> {
         let (file, sections) = F::parse(text).map_err(|e| toml_error(path, text, &e))?;
         let (file, sections) = match profile {
             None => (file, sections),
@@ -349,36 +359,22 @@ impl Spec {
         SpecError(format!("{}: {key}: {msg}", self.path))
     }
 
-    /// The checks every optimisation section shares: its optimiser names (from those `offered`),
+    /// The checks every optimisation section shares: its optimisers (names checked when read),
     /// repeats, generations, a population each optimiser the section runs can work with, and every
-    /// offered parameter table ([`Spec::validate_optimiser_params`]),
-    /// each error naming `<section>.<key>` (the optimiser's own key where one sets the minimum).
+    /// parameter table ([`Spec::validate_optimiser_params`]), each error naming `<section>.<key>`
+    /// (the optimiser's own key where one sets the minimum).
     pub(crate) fn validate_runs(
         &self,
         section: &str,
-        optimisers: &[String],
-        offered: &[&dyn crate::optim::Optimiser],
+        optimisers: &[crate::optim::Name],
+        tables: &crate::optim::Tables,
         repeats: usize,
         generations: u64,
         population: usize,
     ) -> Result<(), SpecError> {
         let key = |k: &str| format!("{section}.{k}");
-        let allowed = crate::optim::names(offered);
         if optimisers.is_empty() {
             return Err(self.err(&key("optimisers"), "is empty"));
-        }
-        let expected = match allowed.split_last() {
-            Some((last, [])) => last.to_string(),
-            Some((last, rest)) => format!("{} or {last}", rest.join(", ")),
-            None => String::new(),
-        };
-        for name in optimisers {
-            if !allowed.contains(&name.as_str()) {
-                return Err(self.err(
-                    &key("optimisers"),
-                    format!("unknown optimiser `{name}` (expected {expected})"),
-                ));
-            }
         }
         if repeats == 0 {
             return Err(self.err(&key("repeats"), "must be at least 1"));
@@ -386,9 +382,8 @@ impl Spec {
         if generations == 0 {
             return Err(self.err(&key("generations"), "must be at least 1"));
         }
-        for name in optimisers {
-            let Some(opt) = crate::optim::pick(offered, name) else { continue };
-            let need = opt.min_population();
+        for &name in optimisers {
+            let need = tables.get(name).min_population();
             if population >= need.n {
                 continue;
             }
@@ -411,7 +406,7 @@ impl Spec {
                 ),
             });
         }
-        self.validate_optimiser_params(section, offered)
+        self.validate_optimiser_params(section, &tables.all())
     }
 
     /// The parameter tables of the optimisers a section offers ([`crate::optim::Optimiser::validate`]),

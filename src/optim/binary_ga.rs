@@ -166,7 +166,7 @@ impl BinaryGa {
         rng: &mut ChaCha8Rng,
     ) -> Result<BinaryGaRun, OptimError> {
         self.validate()?;
-        budget.validate(self.min_population().n)?;
+        budget.validate(2)?;
         check_problem(problem)?;
         if self.elitism >= budget.population {
             return Err(OptimError::param(
@@ -275,7 +275,15 @@ impl Optimiser for BinaryGa {
     }
 
     fn min_population(&self) -> super::problem::MinPopulation {
-        super::problem::MinPopulation { n: 2, key: None, why: "rank selection needs two ranks" }
+        if self.elitism >= 2 {
+            super::problem::MinPopulation {
+                n: self.elitism + 1,
+                key: Some("elitism"),
+                why: "the elite parents must leave room for a child",
+            }
+        } else {
+            super::problem::MinPopulation { n: 2, key: None, why: "rank selection needs two ranks" }
+        }
     }
 
     fn run(

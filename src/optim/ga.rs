@@ -25,7 +25,7 @@ use serde::{Deserialize, Serialize};
 /// GA parameters (defaults: thesis Table 6.1).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
-pub struct Ga {
+pub(crate) struct Ga {
     /// Crossover probability Pc.
     pub pc: f64,
     /// Per-gene mutation probability Pm.
@@ -44,7 +44,7 @@ impl Default for Ga {
 }
 
 impl Ga {
-    pub fn validate(&self) -> Result<(), OptimError> {
+    pub(crate) fn validate(&self) -> Result<(), OptimError> {
         check_range("ga.pc", self.pc, 0.0, 1.0)?;
         check_range("ga.pm", self.pm, 0.0, 1.0)?;
         if !(1..=MAX_TOURNAMENT).contains(&self.tournament) {

@@ -5,26 +5,32 @@
 //! guessed. Pure code: no file or terminal I/O (the IOHprofiler export returns text).
 
 pub(crate) mod aligned;
-pub(crate) mod binary_ga;
-pub(crate) mod cuckoo;
-pub(crate) mod de;
 pub(crate) mod exact;
-pub(crate) mod ga;
 pub(crate) mod ioh;
 pub(crate) mod levy;
 pub(crate) mod problem;
-pub(crate) mod pso;
+pub(crate) mod registry;
 pub(crate) mod sampling;
 
-pub(crate) use binary_ga::BinaryGa;
+// The optimisers: each file's module, its optimiser types and their chart colours (Okabe-Ito).
+// A new optimiser is its file plus one line here (docs/architecture.md, "Adding an optimiser").
+registry::optimisers! {
+    ga: Ga [230, 159, 0];
+    de: De [0, 114, 178];
+    pso: Pso [0, 158, 115];
+    cuckoo: Csa [204, 121, 167], Icsa [213, 94, 0];
+    binary_ga: BinaryGa [86, 180, 233];
+}
+
 pub use cuckoo::Csa;
 pub(crate) use cuckoo::Icsa;
 pub use de::De;
 pub use exact::{certify_dual, ExactOptions, ExactResult};
-pub(crate) use ga::Ga;
 pub use problem::{Budget, Problem};
 pub(crate) use problem::{Optimiser, RunResult};
 pub use pso::Pso;
+pub use registry::default_optimiser;
+pub(crate) use registry::{registered, Name, Tables};
 
 /// What can go wrong before an optimisation starts.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -59,46 +65,6 @@ pub(crate) fn check_range(key: &str, value: f64, lo: f64, hi: f64) -> Result<(),
     } else {
         Err(OptimError::param(key, format!("must be in [{lo},{hi}], got {value}")))
     }
-}
-
-/// One optimiser the harness knows: how to make it with its default parameters (thesis Table
-/// 6.1, seed 003, seed 004) and its colour in every chart (Okabe-Ito, as RGB).
-pub(crate) struct Registered {
-    pub(crate) make: fn() -> Box<dyn Optimiser>,
-    pub(crate) colour: [u8; 3],
-}
-
-/// Every optimiser the harness knows: a new one is its own file implementing [`Optimiser`] (its
-/// parameter table is checked by [`Optimiser::validate`]) plus one line here, and a parameter
-/// table in each spec section that offers it (the section's `offered`).
-pub(crate) static REGISTRY: &[Registered] = &[
-    Registered { make: || Box::new(Ga::default()), colour: [230, 159, 0] },
-    Registered { make: || Box::new(De::default()), colour: [0, 114, 178] },
-    Registered { make: || Box::new(Pso::default()), colour: [0, 158, 115] },
-    Registered { make: || Box::new(Csa::default()), colour: [204, 121, 167] },
-    Registered { make: || Box::new(Icsa::default()), colour: [213, 94, 0] },
-    Registered { make: || Box::new(BinaryGa::default()), colour: [86, 180, 233] },
-];
-
-/// The registered optimiser named `name`.
-pub(crate) fn registered(name: &str) -> Option<&'static Registered> {
-    REGISTRY.iter().find(|r| (r.make)().name() == name)
-}
-
-/// The optimisers by name with their default parameters.
-pub fn default_optimiser(name: &str) -> Option<Box<dyn Optimiser>> {
-    registered(name).map(|r| (r.make)())
-}
-
-/// The optimiser named `name` among those a spec section offers (each with the section's
-/// parameters, e.g. `[optimise.de]`).
-pub(crate) fn pick<'a>(offered: &[&'a dyn Optimiser], name: &str) -> Option<&'a dyn Optimiser> {
-    offered.iter().copied().find(|o| o.name() == name)
-}
-
-/// The names of the optimisers a section offers, for its checks and messages.
-pub(crate) fn names(offered: &[&dyn Optimiser]) -> Vec<&'static str> {
-    offered.iter().map(|o| o.name()).collect()
 }
 
 /// Shared checks every optimiser must pass.
@@ -163,21 +129,5 @@ pub(crate) mod optimiser_tests {
             a.initial_best_fitness,
             a.best_fitness
         );
-    }
-
-    #[test]
-    fn registry_knows_the_six() {
-        let all: Vec<Box<dyn Optimiser>> = REGISTRY.iter().map(|r| (r.make)()).collect();
-        let offered: Vec<&dyn Optimiser> = all.iter().map(|o| o.as_ref()).collect();
-        let six = ["ga", "de", "pso", "csa", "icsa", "binary_ga"];
-        assert_eq!(names(&offered), six);
-        let colours: std::collections::HashSet<[u8; 3]> =
-            REGISTRY.iter().map(|r| r.colour).collect();
-        assert_eq!(colours.len(), six.len(), "one colour each");
-        for name in six {
-            assert_eq!(default_optimiser(name).unwrap().name(), name);
-            assert_eq!(pick(&offered, name).unwrap().name(), name);
-        }
-        assert!(default_optimiser("sa").is_none() && pick(&offered, "sa").is_none());
     }
 }

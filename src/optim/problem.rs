@@ -29,8 +29,8 @@ pub trait Problem: Sync {
 }
 
 /// A population-based optimiser; parameters inside, randomness only from the stream given.
-pub trait Optimiser: Send + Sync {
-    /// "ga" | "de" | "pso" | "csa" | "icsa".
+pub trait Optimiser: Send + Sync + std::fmt::Debug {
+    /// The name specs, tables and charts use (`de`), unique among the registered optimisers.
     fn name(&self) -> &'static str;
     /// The smallest population a run takes with these parameters (checked by the run and, for
     /// the optimisers a spec names, when the spec is read).

@@ -407,21 +407,31 @@ fn chapter_6_is_deterministic_paired_and_each_cell_reruns_alone() {
 #[test]
 fn bad_optimiser_specs_are_refused_before_any_run() {
     let c = Case::new();
-    for (from, to, needle) in [
+    for (from, to, needles) in [
         (
             "optimisers = [\"ga\", \"de\", \"pso\"]",
             "optimisers = [\"ga\", \"sa\"]",
-            "optimise.optimisers",
+            &["opt.toml:", "unknown optimiser `sa` (expected ga, de, pso, csa, icsa"][..],
         ),
-        ("population = 8", "population = -1", "opt.toml:"),
-        ("iterations = 500", "iterations = 500\n[optimise.de]\ncr = 1.5", "de.cr"),
-        ("control_nets = [\"6x6\", \"8x8\"]", "control_nets = []", "optimise.control_nets"),
+        ("population = 8", "population = -1", &["opt.toml:"]),
+        ("iterations = 500", "iterations = 500\n[optimise.de]\ncr = 1.5", &["de.cr"]),
+        (
+            "iterations = 500",
+            "iterations = 500\n[optimise.de]\ncrr = 1",
+            &["table `de`: unknown field `crr`"],
+        ),
+        (
+            "population = 8",
+            "population = 8\npopulaton = 9",
+            &["unknown field `populaton`: neither a key"],
+        ),
+        ("control_nets = [\"6x6\", \"8x8\"]", "control_nets = []", &["optimise.control_nets"]),
     ] {
         c.write("opt.toml", &CH6_TINY.replace(from, to));
-        c.fails(&["run", "opt.toml", "--out", "o"], &[needle]);
+        c.fails(&["run", "opt.toml", "--out", "o"], needles);
         assert!(
             !c.path("o/cells.jsonl").exists() && !c.path("o/maps").exists(),
-            "{needle}: something ran"
+            "{needles:?}: something ran"
         );
     }
 }

@@ -360,8 +360,10 @@ pub(crate) fn run_cell(spec: &Spec, s: &CuckooBezierSpec, cell: &Cell) -> Result
         };
         let prob = BezierParamProblem::new(e.degree, e.degree, d.layout, d.points, centre)
             .map_err(|err| anyhow::anyhow!("{key}: {err}"))?;
-        let Some(opt) = crate::optim::pick(&s.offered(), &cell.method) else {
-            anyhow::bail!("cuckoo_bezier.methods: unknown method `{}`", cell.method)
+        let opt: &dyn crate::optim::Optimiser = match cell.method.as_str() {
+            "csa" => &s.csa,
+            "icsa" => &s.icsa,
+            m => anyhow::bail!("cuckoo_bezier.methods: `{m}` is not a cuckoo search"),
         };
         let (r, cpu_s) = runner::optimise(opt, &prob, &budget(s, e), master, &key)?;
         let dim = prob.dim();

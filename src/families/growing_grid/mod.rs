@@ -9,7 +9,7 @@ use crate::data::registry;
 use crate::experiment::spec::{GridSize, Spec, SpecError};
 use crate::experiment::{runner, seeds, RunContext};
 use crate::geom::Point3;
-use crate::optim::{Budget, Optimiser, Problem};
+use crate::optim::{Budget, Problem};
 use crate::som::growing_grid::{self as grown, grow};
 use crate::spline::open_surface::OpenSurfaceProblem;
 use crate::spline::Parameterisation;
@@ -35,7 +35,7 @@ pub(crate) struct Cell {
     pub(crate) dataset: String,
     pub(crate) cn: GridSize,
     pub(crate) param: Parameterisation,
-    pub(crate) optimiser: String,
+    pub(crate) optimiser: crate::optim::Name,
     pub(crate) repeat: usize,
 }
 
@@ -112,7 +112,7 @@ pub(crate) fn cells(g: &GrowingGridSpec) -> Vec<Cell> {
                             dataset: d.clone(),
                             cn,
                             param,
-                            optimiser: o.clone(),
+                            optimiser: *o,
                             repeat,
                         });
                     }
@@ -180,9 +180,6 @@ pub(crate) fn problems(
     Ok(out)
 }
 
-fn optimiser<'a>(g: &'a GrowingGridSpec, name: &str) -> Result<&'a dyn Optimiser> {
-    crate::optim::pick(&g.offered(), name).with_context(|| format!("unknown optimiser `{name}`"))
-}
 
 /// Run one cell (alone or inside the full run: the same numbers).
 pub(crate) fn run_cell(
@@ -191,7 +188,7 @@ pub(crate) fn run_cell(
     cell: &Cell,
     problem: &OpenSurfaceProblem,
 ) -> Result<Run> {
-    let opt = optimiser(g, &cell.optimiser)?;
+    let opt = g.tables.get(cell.optimiser);
     let budget = Budget {
         generations: g.generations as u64,
         population: g.population,
@@ -209,7 +206,7 @@ pub(crate) fn run_cell(
         cn_x: cell.cn.nx,
         cn_y: cell.cn.ny,
         parameterisation: cell.param.name().into(),
-        optimiser: cell.optimiser.clone(),
+        optimiser: cell.optimiser.to_string(),
         repeat: cell.repeat,
         seed: seeds::seed_hex(spec.file.master_seed, &key),
         dimension: problem.dim(),

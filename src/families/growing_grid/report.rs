@@ -368,7 +368,7 @@ fn pictures(
                     title: format!(
                         "{cn} {} {} ({:.4})",
                         r.cell.param.name(),
-                        r.cell.optimiser.to_uppercase(),
+                        r.cell.optimiser.as_str().to_uppercase(),
                         r.row.best
                     ),
                     meshes: vec![LineMesh {

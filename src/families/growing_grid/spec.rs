@@ -7,16 +7,18 @@ use serde::Deserialize;
 /// Seed 001 section: a Growing Grid (Fritzke 1995) per open-surface data set, one cubic B-spline
 /// surface per (net, parameterisation) from its least-squares fit, then GA/DE/PSO on the control
 /// points (Table 6.1 settings by default).
+///
+/// No `deny_unknown_fields`: the flattened `tables` refuses every key it is handed that is not an
+/// optimiser's table, with a message naming both kinds of key.
 #[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
 pub struct GrowingGridSpec {
     pub datasets: Vec<String>,
     /// Target size of the grown map.
     pub grid: GridSize,
     pub control_nets: Vec<GridSize>,
     pub parameterisations: Vec<crate::spline::Parameterisation>,
-    /// ga, de, pso.
-    pub optimisers: Vec<String>,
+    /// Any registered optimiser (`optim::REGISTRY`).
+    pub(crate) optimisers: Vec<crate::optim::Name>,
     #[serde(default = "crate::experiment::defaults::ten")]
     pub repeats: usize,
     #[serde(default = "crate::experiment::defaults::generations")]
@@ -33,12 +35,9 @@ pub struct GrowingGridSpec {
     /// Constants of the growing grid (defaults: `som::growing_grid::GrowingGridParams`).
     #[serde(default)]
     pub growth: GrowthSpec,
-    #[serde(default)]
-    pub ga: crate::optim::ga::Ga,
-    #[serde(default)]
-    pub de: crate::optim::de::De,
-    #[serde(default)]
-    pub pso: crate::optim::pso::Pso,
+    /// Every registered optimiser's parameter table (`[growing_grid.de]`, ...; Table 6.1 by default).
+    #[serde(flatten)]
+    pub(crate) tables: crate::optim::Tables,
 }
 
 /// The growing grid's constants in a spec.
@@ -113,7 +112,7 @@ pub(crate) fn validate(spec: &Spec, g: &GrowingGridSpec) -> Result<(), SpecError
     spec.validate_runs(
         "growing_grid",
         &g.optimisers,
-        &g.offered(),
+        &g.tables,
         g.repeats,
         g.generations as u64,
         g.population,
@@ -163,9 +162,3 @@ pub(crate) fn limits(c: &Check, g: &GrowingGridSpec) -> Result<(), SpecError> {
     Ok(())
 }
 
-impl GrowingGridSpec {
-    /// The optimisers this section offers, each with its parameter table (`ga`, ...).
-    pub fn offered(&self) -> Vec<&dyn crate::optim::Optimiser> {
-        vec![&self.ga, &self.de, &self.pso]
-    }
-}

@@ -14,7 +14,7 @@ use crate::experiment::spec::GridSize;
 use crate::experiment::spec::{Spec, SpecError};
 use crate::experiment::{runner, seeds, RunContext};
 use crate::families::maps;
-use crate::optim::{Budget, Optimiser, Problem};
+use crate::optim::{Budget, Problem};
 use crate::spline::BoxSpec;
 use crate::spline::ControlNetProblem;
 use crate::spline::{fit_two_view, Approach, Parameterisation};
@@ -138,11 +138,6 @@ pub fn exact_optima(
     Ok(keys.into_iter().cloned().zip(solved).collect())
 }
 
-/// Build the optimiser a cell names, with the spec's parameters.
-pub(crate) fn optimiser<'a>(o: &'a OptimSpec, name: &str) -> Result<&'a dyn Optimiser> {
-    crate::optim::pick(&o.offered(), name).with_context(|| format!("unknown optimiser `{name}`"))
-}
-
 /// The control-net problems of every (data, net, parameterisation), from approach B's fit.
 pub fn problems(
     spec: &Spec,
@@ -186,7 +181,7 @@ pub(crate) fn run_cell(
     cell: &OptimCell,
     problem: &ControlNetProblem,
 ) -> Result<OptimRun> {
-    let opt = optimiser(o, &cell.optimiser)?;
+    let opt = o.tables.get(cell.optimiser);
     let budget = Budget {
         generations: o.generations as u64,
         population: o.population,
@@ -207,7 +202,7 @@ pub(crate) fn run_cell(
         cn_x: cell.cn.nx,
         cn_y: cell.cn.ny,
         parameterisation: cell.param.name().into(),
-        optimiser: cell.optimiser.clone(),
+        optimiser: cell.optimiser.to_string(),
         variant: spec.variant.label(),
         repeat: cell.repeat,
         seed: seeds::seed_hex(spec.file.master_seed, &key),
@@ -312,13 +307,13 @@ fn picture_points<'a>(
     largest: GridSize,
     problem: impl Fn(&OptimCell) -> &'a ControlNetProblem,
 ) -> Result<()> {
-    let mut best: BTreeMap<(String, Parameterisation, String), usize> = BTreeMap::new();
+    let mut best: BTreeMap<(String, Parameterisation, crate::optim::Name), usize> = BTreeMap::new();
     for (k, r) in runs.iter().enumerate() {
         if !pictured(&r.cell, largest) {
             continue;
         }
         let e = best
-            .entry((r.cell.dataset.clone(), r.cell.param, r.cell.optimiser.clone()))
+            .entry((r.cell.dataset.clone(), r.cell.param, r.cell.optimiser))
             .or_insert(k);
         if r.row.best < runs[*e].row.best {
             *e = k;
@@ -359,7 +354,7 @@ pub(crate) struct Optim;
 /// What `--sweep` may vary in `[optimise]`: every registered optimiser's table (a table the section
 /// does not have is refused when the variant is read) and the run's budget and start range.
 fn sweepable_keys() -> Vec<String> {
-    let opts = crate::optim::REGISTRY.iter().map(|r| format!("optimise.{}.", (r.make)().name()));
+    let opts = crate::optim::Name::all().map(|n| format!("optimise.{n}."));
     opts.chain(
         ["optimise.generations", "optimise.population", "optimise.init_range", "optimise.repeats"]
             .map(String::from),

@@ -7,7 +7,7 @@ pub(crate) mod spec;
 
 use crate::experiment::spec::{Spec, SpecError};
 use crate::experiment::{runner, seeds, RunContext};
-use crate::optim::{Budget, Optimiser, Problem};
+use crate::optim::{Budget, Problem};
 use crate::spline::conic::{self, ConicProblem, P2};
 use crate::spline::rational_bezier::{SurfaceSse, TestSurface};
 use anyhow::{Context, Result};
@@ -18,7 +18,7 @@ use spec::RationalBezierSpec;
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub(crate) struct Cell {
     pub(crate) surface: String,
-    pub(crate) optimiser: String,
+    pub(crate) optimiser: crate::optim::Name,
     pub(crate) repeat: usize,
 }
 
@@ -75,7 +75,7 @@ impl runner::Logged for Run {
 pub(crate) fn cells(s: &RationalBezierSpec) -> Vec<Cell> {
     runner::product_cells(&s.surfaces, &s.optimisers, s.repeats, |sf, o, repeat| Cell {
         surface: sf.clone(),
-        optimiser: o.clone(),
+        optimiser: *o,
         repeat,
     })
 }
@@ -87,15 +87,11 @@ pub(crate) fn problem(s: &RationalBezierSpec, surface: &str) -> Result<SurfaceSs
     Ok(SurfaceSse::new(ts.grid(s.grid), s.bounds_margin, s.w_min))
 }
 
-fn optimiser<'a>(s: &'a RationalBezierSpec, name: &str) -> Result<&'a dyn Optimiser> {
-    crate::optim::pick(&s.offered(), name)
-        .with_context(|| format!("rational_bezier.optimisers: unknown optimiser `{name}`"))
-}
 
 /// Run one cell (alone it gives the same numbers as inside the full run).
 pub(crate) fn run_cell(spec: &Spec, s: &RationalBezierSpec, cell: &Cell) -> Result<Run> {
     let problem = problem(s, &cell.surface)?;
-    let opt = optimiser(s, &cell.optimiser)?;
+    let opt = s.tables.get(cell.optimiser);
     // init_range is a share of the data's largest bounding-box extent (the domains differ in scale).
     let extent = (0..3)
         .map(|k| {
@@ -118,7 +114,7 @@ pub(crate) fn run_cell(spec: &Spec, s: &RationalBezierSpec, cell: &Cell) -> Resu
     let row = Row {
         cell: key.clone(),
         surface: cell.surface.clone(),
-        optimiser: cell.optimiser.clone(),
+        optimiser: cell.optimiser.to_string(),
         repeat: cell.repeat,
         seed: seeds::seed_hex(spec.file.master_seed, &key),
         dimension: problem.dim(),
@@ -150,7 +146,7 @@ pub(crate) fn run(spec: &Spec, s: &RationalBezierSpec, ctx: &RunContext) -> Resu
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub(crate) struct CurveCell {
     pub(crate) outline: String,
-    pub(crate) optimiser: String,
+    pub(crate) optimiser: crate::optim::Name,
     pub(crate) repeat: usize,
 }
 
@@ -194,7 +190,7 @@ pub(crate) struct CurveRun {
 pub(crate) fn curve_cells(s: &RationalBezierSpec) -> Vec<CurveCell> {
     runner::product_cells(&s.outlines, &s.optimisers, s.repeats, |ol, o, repeat| CurveCell {
         outline: ol.clone(),
-        optimiser: o.clone(),
+        optimiser: *o,
         repeat,
     })
 }
@@ -215,7 +211,7 @@ pub(crate) fn run_curve_cell(spec: &Spec, s: &RationalBezierSpec, cell: &CurveCe
             })
         })
         .count();
-    let opt = optimiser(s, &cell.optimiser)?;
+    let opt = s.tables.get(cell.optimiser);
     let key = cell.key();
     // Every conic of the outline runs on the cell's one stream, in order.
     let (fits, cpu_s) = runner::on_stream(spec.file.master_seed, &key, |rng| {
@@ -241,7 +237,7 @@ pub(crate) fn run_curve_cell(spec: &Spec, s: &RationalBezierSpec, cell: &CurveCe
     let row = CurveRow {
         cell: key.clone(),
         outline: cell.outline.clone(),
-        optimiser: cell.optimiser.clone(),
+        optimiser: cell.optimiser.to_string(),
         repeat: cell.repeat,
         seed: seeds::seed_hex(spec.file.master_seed, &key),
         n_points: points.len(),
