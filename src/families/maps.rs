@@ -77,6 +77,24 @@ pub(crate) fn check_exponential_alpha(
     c.real(&format!("{section}.exponential_alpha"), v, lo, false, hi)
 }
 
+/// The bounds of the keys a `[fit]`, an `[optimise]` and a `[growing_grid]` section share (data
+/// sets, grid, control nets, parameterisations), each error naming `<section>.<key>`.
+pub(crate) fn limit_grid_keys(
+    c: &crate::experiment::limits::Check,
+    section: &str,
+    datasets: &[String],
+    grid: &GridSize,
+    control_nets: &[GridSize],
+    parameterisations: &[crate::spline::Parameterisation],
+) -> Result<(), SpecError> {
+    let key = |k: &str| format!("{section}.{k}");
+    c.datasets(&key("datasets"), datasets)?;
+    c.grids(&key("grid"), [grid])?;
+    c.list(&key("control_nets"), control_nets)?;
+    c.grids(&key("control_nets"), control_nets)?;
+    c.list(&key("parameterisations"), parameterisations)
+}
+
 /// The keys a `[fit]` and an `[optimise]` section share (data sets, grid, control nets,
 /// parameterisations), each error naming `<section>.<key>`.
 pub(crate) fn validate_grid_keys(

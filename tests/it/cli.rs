@@ -436,6 +436,21 @@ fn bad_optimiser_specs_are_refused_before_any_run() {
     }
 }
 
+/// A run of one cell (own problem, a few optimisers) is compared cell by cell; the tests over
+/// cells, which need two, are skipped with a line saying so instead of failing.
+#[test]
+fn compare_of_one_cell_gives_the_per_cell_tests() {
+    let c = Case::new();
+    let one = CH6_TINY.replace("control_nets = [\"6x6\", \"8x8\"]", "control_nets = [\"6x6\"]");
+    c.write("opt.toml", &one.replace("repeats = 2", "repeats = 6"));
+    c.ok(&["run", "opt.toml", "--out", "o"]);
+    let out = c.ok(&["compare", "o"]);
+    assert!(String::from_utf8_lossy(&out.stdout).contains("one cell: the tests over cells"));
+    let (_, rows) = read_csv(&c.path("o/compare/compare_cells.csv"));
+    assert_eq!(rows.len(), 3, "three pairs of optimisers in the one cell");
+    assert!(!c.path("o/compare/compare_overall.csv").exists());
+}
+
 #[test]
 fn compare_writes_statistics_and_refuses_bad_folders() {
     let c = Case::new();

@@ -7,7 +7,7 @@ pub(crate) mod report;
 pub(crate) mod spec;
 
 use crate::data::cylinder::{lattice_cylinder, sort_into_rings};
-use crate::experiment::spec::{Spec, SpecError};
+use crate::experiment::spec::Spec;
 use crate::experiment::{runner, seeds, RunContext};
 use crate::optim::{Budget, Problem};
 use crate::spline::closed::{fit_closed, ClosedNetShape, RingData, RingNetProblem};
@@ -277,15 +277,6 @@ pub(crate) fn top_view(
 /// Seed 004's family: the `[closed_cylinder]` section.
 pub(crate) struct ClosedCylinder;
 
-impl crate::experiment::family::Section for self::spec::ClosedCylinderSpec {
-    fn limits(&self, c: &crate::experiment::limits::Check) -> Result<(), SpecError> {
-        self::spec::limits(c, self)
-    }
-    fn validate(&self, spec: &Spec) -> Result<(), SpecError> {
-        self::spec::validate(spec, self)
-    }
-}
-
 impl crate::experiment::family::Experiment for ClosedCylinder {
     fn title(&self) -> &'static str {
         "Seed 004"
@@ -334,7 +325,7 @@ impl crate::experiment::family::Experiment for ClosedCylinder {
 mod tests {
     use super::*;
 
-    fn spec_with(extra: &str) -> Result<crate::families::Loaded, SpecError> {
+    fn spec_with(extra: &str) -> Result<crate::families::Loaded, crate::experiment::spec::SpecError> {
         let path = concat!(env!("CARGO_MANIFEST_DIR"), "/experiments/seed004_cylinder.toml");
         let text = std::fs::read_to_string(path).unwrap();
         let text = text.replacen("[closed_cylinder]\n", &format!("[closed_cylinder]\n{extra}\n"), 1);

@@ -81,96 +81,97 @@ pub struct ClosedCylinderSpec {
     pub ga: crate::optim::binary_ga::BinaryGa,
 }
 
-/// Every value of the `[closed_cylinder]` section (after the limits).
-pub(crate) fn validate(spec: &Spec, s: &ClosedCylinderSpec) -> Result<(), SpecError> {
-    if s.control_points.is_empty() {
-        return Err(spec.err("closed_cylinder.control_points", "is empty"));
+impl crate::experiment::family::Section for ClosedCylinderSpec {
+    /// The bounds of the `[closed_cylinder]` section's sizes and counts (docs/specs.md, "Spec limits").
+    fn limits(&self, c: &Check) -> Result<(), SpecError> {
+        c.list("closed_cylinder.control_points", &self.control_points)?;
+        c.list("closed_cylinder.table2_control_points", &self.table2_control_points)?;
+        c.list("closed_cylinder.table2_generations", &self.table2_generations)?;
+        c.optimiser_run("closed_cylinder", self.repeats, self.generations, self.population)?;
+        c.int("closed_cylinder.rows", self.rows, limits::MAX_GRID_SIDE as u64)?;
+        for (key, v) in [
+            ("radius", self.radius),
+            ("height", self.height),
+            ("grid_step", self.grid_step),
+            ("accuracy", self.accuracy),
+            ("search_range", self.search_range),
+        ] {
+            c.real(&format!("closed_cylinder.{key}"), v, 0.0, false, limits::MAX_LENGTH)?;
+        }
+        c.cells("closed_cylinder", &[self.control_points.len(), self.repeats])?;
+        Ok(())
     }
-    if s.order_around < 2 || s.order_around > 8 {
-        return Err(
-            spec.err("closed_cylinder.order_around", format!("must be in [2, 8], got {}", s.order_around))
-        );
-    }
-    if let Some(n) = s.control_points.iter().find(|&&n| n < s.order_around || n > 200) {
-        return Err(spec.err(
-            "closed_cylinder.control_points",
-            format!("{n} is outside [order_around = {}, 200]", s.order_around),
-        ));
-    }
-    if let Some(n) = s.table2_control_points.iter().find(|n| !s.control_points.contains(n)) {
-        return Err(spec.err(
-            "closed_cylinder.table2_control_points",
-            format!("{n} is not in closed_cylinder.control_points"),
-        ));
-    }
-    if let Some(g) = s.table2_generations.iter().find(|&&g| g > s.generations) {
-        return Err(spec.err(
-            "closed_cylinder.table2_generations",
-            format!("{g} exceeds closed_cylinder.generations = {}", s.generations),
-        ));
-    }
-    if s.order_vertical < 2 || s.rows < s.order_vertical {
-        return Err(spec.err(
-            "closed_cylinder.order_vertical",
-            format!("must be at least 2 and at most rows = {}, got {}", s.rows, s.order_vertical),
-        ));
-    }
-    if s.repeats == 0 {
-        return Err(spec.err("closed_cylinder.repeats", "must be at least 1"));
-    }
-    if s.generations == 0 {
-        return Err(spec.err("closed_cylinder.generations", "must be at least 1"));
-    }
-    if s.population < 2 || s.population <= s.ga.elitism {
-        return Err(spec.err(
-            "closed_cylinder.population",
-            format!("must be at least 2 and above closed_cylinder.ga.elitism, got {}", s.population),
-        ));
-    }
-    for (key, v) in [
-        ("radius", s.radius),
-        ("height", s.height),
-        ("grid_step", s.grid_step),
-        ("accuracy", s.accuracy),
-        ("search_range", s.search_range),
-    ] {
-        if !(v > 0.0 && v.is_finite()) {
+    /// Every value of the `[closed_cylinder]` section (after the limits).
+    fn validate(&self, spec: &Spec) -> Result<(), SpecError> {
+        if self.control_points.is_empty() {
+            return Err(spec.err("closed_cylinder.control_points", "is empty"));
+        }
+        if self.order_around < 2 || self.order_around > 8 {
             return Err(
-                spec.err(&format!("closed_cylinder.{key}"), format!("must be a positive number, got {v}"))
+                spec.err("closed_cylinder.order_around", format!("must be in [2, 8], got {}", self.order_around))
             );
         }
-    }
-    if s.radius / s.grid_step > 2000.0 || s.height / s.grid_step > 2000.0 {
-        return Err(spec.err(
-            "closed_cylinder.grid_step",
-            format!("{} makes more than 2000 lattice steps across the cylinder", s.grid_step),
-        ));
-    }
-    s.ga.validate().map_err(|e| match e {
-        crate::optim::OptimError::InvalidParameter { key, message } => {
-            spec.err(&format!("closed_cylinder.{}", key.replace("binary_ga", "ga")), message)
+        if let Some(n) = self.control_points.iter().find(|&&n| n < self.order_around || n > 200) {
+            return Err(spec.err(
+                "closed_cylinder.control_points",
+                format!("{n} is outside [order_around = {}, 200]", self.order_around),
+            ));
         }
-        other => spec.err("closed_cylinder.ga", other),
-    })?;
-    Ok(())
-}
-
-/// The bounds of the `[closed_cylinder]` section's sizes and counts (docs/specs.md, "Spec limits").
-pub(crate) fn limits(c: &Check, s: &ClosedCylinderSpec) -> Result<(), SpecError> {
-    c.list("closed_cylinder.control_points", &s.control_points)?;
-    c.list("closed_cylinder.table2_control_points", &s.table2_control_points)?;
-    c.list("closed_cylinder.table2_generations", &s.table2_generations)?;
-    c.optimiser_run("closed_cylinder", s.repeats, s.generations, s.population)?;
-    c.int("closed_cylinder.rows", s.rows, limits::MAX_GRID_SIDE as u64)?;
-    for (key, v) in [
-        ("radius", s.radius),
-        ("height", s.height),
-        ("grid_step", s.grid_step),
-        ("accuracy", s.accuracy),
-        ("search_range", s.search_range),
-    ] {
-        c.real(&format!("closed_cylinder.{key}"), v, 0.0, false, limits::MAX_LENGTH)?;
+        if let Some(n) = self.table2_control_points.iter().find(|n| !self.control_points.contains(n)) {
+            return Err(spec.err(
+                "closed_cylinder.table2_control_points",
+                format!("{n} is not in closed_cylinder.control_points"),
+            ));
+        }
+        if let Some(g) = self.table2_generations.iter().find(|&&g| g > self.generations) {
+            return Err(spec.err(
+                "closed_cylinder.table2_generations",
+                format!("{g} exceeds closed_cylinder.generations = {}", self.generations),
+            ));
+        }
+        if self.order_vertical < 2 || self.rows < self.order_vertical {
+            return Err(spec.err(
+                "closed_cylinder.order_vertical",
+                format!("must be at least 2 and at most rows = {}, got {}", self.rows, self.order_vertical),
+            ));
+        }
+        if self.repeats == 0 {
+            return Err(spec.err("closed_cylinder.repeats", "must be at least 1"));
+        }
+        if self.generations == 0 {
+            return Err(spec.err("closed_cylinder.generations", "must be at least 1"));
+        }
+        if self.population < 2 || self.population <= self.ga.elitism {
+            return Err(spec.err(
+                "closed_cylinder.population",
+                format!("must be at least 2 and above closed_cylinder.ga.elitism, got {}", self.population),
+            ));
+        }
+        for (key, v) in [
+            ("radius", self.radius),
+            ("height", self.height),
+            ("grid_step", self.grid_step),
+            ("accuracy", self.accuracy),
+            ("search_range", self.search_range),
+        ] {
+            if !(v > 0.0 && v.is_finite()) {
+                return Err(
+                    spec.err(&format!("closed_cylinder.{key}"), format!("must be a positive number, got {v}"))
+                );
+            }
+        }
+        if self.radius / self.grid_step > 2000.0 || self.height / self.grid_step > 2000.0 {
+            return Err(spec.err(
+                "closed_cylinder.grid_step",
+                format!("{} makes more than 2000 lattice steps across the cylinder", self.grid_step),
+            ));
+        }
+        self.ga.validate().map_err(|e| match e {
+            crate::optim::OptimError::InvalidParameter { key, message } => {
+                spec.err(&format!("closed_cylinder.{}", key.replace("binary_ga", "ga")), message)
+            }
+            other => spec.err("closed_cylinder.ga", other),
+        })?;
+        Ok(())
     }
-    c.cells("closed_cylinder", &[s.control_points.len(), s.repeats])?;
-    Ok(())
 }

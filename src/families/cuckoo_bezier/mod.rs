@@ -11,7 +11,7 @@
 pub(crate) mod report;
 pub(crate) mod spec;
 
-use crate::experiment::spec::{Spec, SpecError};
+use crate::experiment::spec::Spec;
 use crate::experiment::{runner, seeds, RunContext};
 use crate::geom::Point3;
 use crate::optim::{Budget, Csa, Icsa, Problem};
@@ -406,16 +406,6 @@ pub(crate) fn run(spec: &Spec, s: &CuckooBezierSpec, ctx: &RunContext) -> Result
 /// Seed 003's family: the `[cuckoo_bezier]` section.
 pub(crate) struct CuckooBezier;
 
-impl crate::experiment::family::Section for CuckooBezierSpec {
-    fn limits(&self, c: &crate::experiment::limits::Check) -> Result<(), SpecError> {
-        self::spec::limits(c, self)
-    }
-    fn validate(&self, spec: &Spec) -> Result<(), SpecError> {
-        self.validate().map_err(|(key, msg)| spec.err(&key, msg))?;
-        spec.validate_optimiser_params("cuckoo_bezier", &self.offered())
-    }
-}
-
 impl crate::experiment::family::Experiment for CuckooBezier {
     fn title(&self) -> &'static str {
         "Seed 003"
@@ -455,7 +445,7 @@ impl CuckooBezierSpec {
 mod tests {
     use super::*;
 
-    fn spec_with(extra: &str) -> Result<crate::families::Loaded, SpecError> {
+    fn spec_with(extra: &str) -> Result<crate::families::Loaded, crate::experiment::spec::SpecError> {
         let path = concat!(env!("CARGO_MANIFEST_DIR"), "/experiments/seed003_cuckoo_bezier.toml");
         let text = std::fs::read_to_string(path).unwrap();
         let text = text.replacen("[cuckoo_bezier]\n", &format!("[cuckoo_bezier]\n{extra}\n"), 1);

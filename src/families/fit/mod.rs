@@ -6,8 +6,8 @@ pub(crate) mod readings;
 pub(crate) mod report;
 pub(crate) mod spec;
 
-use super::maps::{maps_for, require_maps, MapSource, MapsFrom};
-use crate::experiment::spec::{Spec, SpecError};
+use super::maps::{maps_for, MapSource, MapsFrom};
+use crate::experiment::spec::Spec;
 use crate::experiment::{runner, RunContext};
 use crate::spline::{fit_two_view, FitOptions, TwoSurfaceFit, TwoViewGrid};
 use anyhow::{Context, Result};
@@ -72,7 +72,6 @@ pub(crate) fn maps(
     maps_for(spec, ctx, &fit.datasets, fit.grid, &from)
 }
 
-
 /// Fit one cell.
 pub(crate) fn run_cell(cell: &FitCell, grid: &TwoViewGrid, opts: &FitOptions) -> Result<FitRun> {
     let (fit, cpu_s) =
@@ -130,30 +129,6 @@ pub(crate) fn run(
 
 /// Chapter 5's family: the `[fit]` section.
 pub(crate) struct Fit;
-
-impl crate::experiment::family::Section for self::spec::FitSpec {
-    fn limits(&self, c: &crate::experiment::limits::Check) -> Result<(), SpecError> {
-        self::spec::limits(c, self)
-    }
-    fn validate(&self, spec: &Spec) -> Result<(), SpecError> {
-        self::spec::validate(spec, self)
-    }
-    fn datasets(&self) -> &[String] {
-        &self.datasets
-    }
-    fn use_maps(&mut self, maps: &str) {
-        self.maps = Some(maps.to_string());
-    }
-    fn require_inputs(&self, spec: &Spec) -> Result<()> {
-        let from = MapsFrom {
-            section: "fit",
-            dir: self.maps.as_deref(),
-            missing: self.maps_missing,
-            som: self.som.as_ref(),
-        };
-        require_maps(spec, &self.datasets, self.grid, &from).map(drop)
-    }
-}
 
 impl crate::experiment::family::Experiment for Fit {
     fn title(&self) -> &'static str {

@@ -4,7 +4,9 @@
 
 use crate::experiment::limits::{self, Check};
 use crate::experiment::spec::{GridSize, Spec, SpecError};
-use crate::families::maps::{validate_grid_keys, validate_map_som, MapSom, MapsMissing};
+use crate::families::maps::{
+    require_maps, validate_grid_keys, validate_map_som, MapSom, MapsFrom, MapsMissing,
+};
 use serde::Deserialize;
 
 /// Chapter 5 section: data sets x control nets x parameterisations x approaches on one grid size.
@@ -68,20 +70,59 @@ impl FitSpec {
     }
 }
 
-/// Every value of the `[fit]` section (after the limits).
-pub(crate) fn validate(spec: &Spec, fit: &FitSpec) -> Result<(), SpecError> {
-    validate_grid_keys(
-        spec,
-        "fit",
-        &fit.datasets,
-        fit.grid,
-        &fit.control_nets,
-        &fit.parameterisations,
-    )?;
-    if fit.approaches.is_empty() {
-        return Err(spec.err("fit.approaches", "is empty"));
+impl crate::experiment::family::Section for FitSpec {
+    /// The bounds of the `[fit]` section's sizes and counts (docs/specs.md, "Spec limits").
+    fn limits(&self, c: &Check) -> Result<(), SpecError> {
+        crate::families::maps::limit_grid_keys(
+            c,
+            "fit",
+            &self.datasets,
+            &self.grid,
+            &self.control_nets,
+            &self.parameterisations,
+        )?;
+        c.list("fit.approaches", &self.approaches)?;
+        if let Some(som) = &self.som {
+            c.int("fit.som.iterations", som.iterations, limits::MAX_ITERATIONS)?;
+        }
+        c.real("fit.fairness", self.fairness, 0.0, true, limits::MAX_FAIRNESS)?;
+        crate::families::maps::check_exponential_alpha(c, "fit", self.exponential_alpha)?;
+        c.cells(
+            "fit",
+            &[self.datasets.len(), self.control_nets.len(), self.parameterisations.len(), self.approaches.len()],
+        )?;
+        Ok(())
     }
-    validate_map_som(spec, "fit", fit.som.as_ref())
+    /// Every value of the `[fit]` section (after the limits).
+    fn validate(&self, spec: &Spec) -> Result<(), SpecError> {
+        validate_grid_keys(
+            spec,
+            "fit",
+            &self.datasets,
+            self.grid,
+            &self.control_nets,
+            &self.parameterisations,
+        )?;
+        if self.approaches.is_empty() {
+            return Err(spec.err("fit.approaches", "is empty"));
+        }
+        validate_map_som(spec, "fit", self.som.as_ref())
+    }
+    fn datasets(&self) -> &[String] {
+        &self.datasets
+    }
+    fn use_maps(&mut self, maps: &str) {
+        self.maps = Some(maps.to_string());
+    }
+    fn require_inputs(&self, spec: &Spec) -> anyhow::Result<()> {
+        let from = MapsFrom {
+            section: "fit",
+            dir: self.maps.as_deref(),
+            missing: self.maps_missing,
+            som: self.som.as_ref(),
+        };
+        require_maps(spec, &self.datasets, self.grid, &from).map(drop)
+    }
 }
 
 /// The flat list of fit cells (data set x control net x parameterisation x approach).
@@ -132,24 +173,4 @@ impl FitCell {
             self.approach.letter()
         )
     }
-}
-
-/// The bounds of the `[fit]` section's sizes and counts (docs/specs.md, "Spec limits").
-pub(crate) fn limits(c: &Check, s: &FitSpec) -> Result<(), SpecError> {
-    c.datasets("fit.datasets", &s.datasets)?;
-    c.grids("fit.grid", [&s.grid])?;
-    c.list("fit.control_nets", &s.control_nets)?;
-    c.grids("fit.control_nets", &s.control_nets)?;
-    c.list("fit.parameterisations", &s.parameterisations)?;
-    c.list("fit.approaches", &s.approaches)?;
-    if let Some(som) = &s.som {
-        c.int("fit.som.iterations", som.iterations, limits::MAX_ITERATIONS)?;
-    }
-    c.real("fit.fairness", s.fairness, 0.0, true, limits::MAX_FAIRNESS)?;
-    crate::families::maps::check_exponential_alpha(c, "fit", s.exponential_alpha)?;
-    c.cells(
-        "fit",
-        &[s.datasets.len(), s.control_nets.len(), s.parameterisations.len(), s.approaches.len()],
-    )?;
-    Ok(())
 }

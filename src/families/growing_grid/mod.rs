@@ -6,7 +6,7 @@ pub(crate) mod report;
 pub(crate) mod spec;
 
 use crate::data::registry;
-use crate::experiment::spec::{GridSize, Spec, SpecError};
+use crate::experiment::spec::{GridSize, Spec};
 use crate::experiment::{runner, seeds, RunContext};
 use crate::geom::Point3;
 use crate::optim::{Budget, Problem};
@@ -180,7 +180,6 @@ pub(crate) fn problems(
     Ok(out)
 }
 
-
 /// Run one cell (alone or inside the full run: the same numbers).
 pub(crate) fn run_cell(
     spec: &Spec,
@@ -239,18 +238,6 @@ pub(crate) fn run(
 
 /// Seed 001's family: the `[growing_grid]` section.
 pub(crate) struct GrowingGrid;
-
-impl crate::experiment::family::Section for self::spec::GrowingGridSpec {
-    fn limits(&self, c: &crate::experiment::limits::Check) -> Result<(), SpecError> {
-        self::spec::limits(c, self)
-    }
-    fn validate(&self, spec: &Spec) -> Result<(), SpecError> {
-        self::spec::validate(spec, self)
-    }
-    fn datasets(&self) -> &[String] {
-        &self.datasets
-    }
-}
 
 impl crate::experiment::family::Experiment for GrowingGrid {
     fn title(&self) -> &'static str {

@@ -86,79 +86,86 @@ impl GrowingGridSpec {
     }
 }
 
-/// Every value of the `[growing_grid]` section (after the limits).
-pub(crate) fn validate(spec: &Spec, g: &GrowingGridSpec) -> Result<(), SpecError> {
-    if g.datasets.is_empty() {
-        return Err(spec.err("growing_grid.datasets", "is empty"));
+impl crate::experiment::family::Section for GrowingGridSpec {
+    /// The bounds of the `[growing_grid]` section's sizes and counts (docs/specs.md, "Spec limits").
+    fn limits(&self, c: &Check) -> Result<(), SpecError> {
+        crate::families::maps::limit_grid_keys(
+            c,
+            "growing_grid",
+            &self.datasets,
+            &self.grid,
+            &self.control_nets,
+            &self.parameterisations,
+        )?;
+        c.list("growing_grid.optimisers", &self.optimisers)?;
+        c.optimiser_run("growing_grid", self.repeats, self.generations, self.population)?;
+        c.real("growing_grid.init_range", self.init_range, 0.0, true, limits::MAX_RANGE)?;
+        c.real("growing_grid.bounds_margin", self.bounds_margin, 0.0, true, limits::MAX_RANGE)?;
+        c.int("growing_grid.trace_every_evals", self.trace_every_evals, limits::MAX_TRACE_EVERY)?;
+        c.int("growing_grid.growth.lambda_g", self.growth.lambda_g, limits::MAX_ITERATIONS)?;
+        c.int("growing_grid.growth.lambda_f", self.growth.lambda_f, limits::MAX_ITERATIONS)?;
+        c.cells(
+            "growing_grid",
+            &[
+                self.datasets.len(),
+                self.control_nets.len(),
+                self.parameterisations.len(),
+                self.optimisers.len(),
+                self.repeats,
+            ],
+        )?;
+        Ok(())
     }
-    if let Some(d) = g.datasets.iter().find(|d| d.trim().is_empty()) {
-        return Err(spec.err("growing_grid.datasets", format!("empty data set name `{d}`")));
-    }
-    g.params().validate().map_err(|e| spec.err("growing_grid.growth", e))?;
-    if g.control_nets.is_empty() {
-        return Err(spec.err("growing_grid.control_nets", "is empty"));
-    }
-    for cn in &g.control_nets {
-        if cn.nx < 4 || cn.ny < 4 || cn.nx > g.grid.nx || cn.ny > g.grid.ny {
+    /// Every value of the `[growing_grid]` section (after the limits).
+    fn validate(&self, spec: &Spec) -> Result<(), SpecError> {
+        if self.datasets.is_empty() {
+            return Err(spec.err("growing_grid.datasets", "is empty"));
+        }
+        if let Some(d) = self.datasets.iter().find(|d| d.trim().is_empty()) {
+            return Err(spec.err("growing_grid.datasets", format!("empty data set name `{d}`")));
+        }
+        self.params().validate().map_err(|e| spec.err("growing_grid.growth", e))?;
+        if self.control_nets.is_empty() {
+            return Err(spec.err("growing_grid.control_nets", "is empty"));
+        }
+        for cn in &self.control_nets {
+            if cn.nx < 4 || cn.ny < 4 || cn.nx > self.grid.nx || cn.ny > self.grid.ny {
+                return Err(spec.err(
+                    "growing_grid.control_nets",
+                    format!("net {cn} must be at least 4x4 (cubic) and at most the grid {}", self.grid),
+                ));
+            }
+        }
+        if self.parameterisations.is_empty() {
+            return Err(spec.err("growing_grid.parameterisations", "is empty"));
+        }
+        spec.validate_runs(
+            "growing_grid",
+            &self.optimisers,
+            &self.tables,
+            self.repeats,
+            self.generations as u64,
+            self.population,
+        )?;
+        if !(self.init_range >= 0.0 && self.init_range.is_finite()) {
             return Err(spec.err(
-                "growing_grid.control_nets",
-                format!("net {cn} must be at least 4x4 (cubic) and at most the grid {}", g.grid),
+                "growing_grid.init_range",
+                format!("must be a non-negative number, got {}", self.init_range),
             ));
         }
+        if !(self.bounds_margin >= 0.0 && self.bounds_margin.is_finite()) {
+            return Err(spec.err(
+                "growing_grid.bounds_margin",
+                format!("must be a non-negative number, got {}", self.bounds_margin),
+            ));
+        }
+        if self.trace_every_evals == 0 {
+            return Err(spec.err("growing_grid.trace_every_evals", "must be at least 1"));
+        }
+        Ok(())
     }
-    if g.parameterisations.is_empty() {
-        return Err(spec.err("growing_grid.parameterisations", "is empty"));
+    fn datasets(&self) -> &[String] {
+        &self.datasets
     }
-    spec.validate_runs(
-        "growing_grid",
-        &g.optimisers,
-        &g.tables,
-        g.repeats,
-        g.generations as u64,
-        g.population,
-    )?;
-    if !(g.init_range >= 0.0 && g.init_range.is_finite()) {
-        return Err(spec.err(
-            "growing_grid.init_range",
-            format!("must be a non-negative number, got {}", g.init_range),
-        ));
-    }
-    if !(g.bounds_margin >= 0.0 && g.bounds_margin.is_finite()) {
-        return Err(spec.err(
-            "growing_grid.bounds_margin",
-            format!("must be a non-negative number, got {}", g.bounds_margin),
-        ));
-    }
-    if g.trace_every_evals == 0 {
-        return Err(spec.err("growing_grid.trace_every_evals", "must be at least 1"));
-    }
-    Ok(())
-}
-
-/// The bounds of the `[growing_grid]` section's sizes and counts (docs/specs.md, "Spec limits").
-pub(crate) fn limits(c: &Check, g: &GrowingGridSpec) -> Result<(), SpecError> {
-    c.datasets("growing_grid.datasets", &g.datasets)?;
-    c.grids("growing_grid.grid", [&g.grid])?;
-    c.list("growing_grid.control_nets", &g.control_nets)?;
-    c.grids("growing_grid.control_nets", &g.control_nets)?;
-    c.list("growing_grid.parameterisations", &g.parameterisations)?;
-    c.list("growing_grid.optimisers", &g.optimisers)?;
-    c.optimiser_run("growing_grid", g.repeats, g.generations, g.population)?;
-    c.real("growing_grid.init_range", g.init_range, 0.0, true, limits::MAX_RANGE)?;
-    c.real("growing_grid.bounds_margin", g.bounds_margin, 0.0, true, limits::MAX_RANGE)?;
-    c.int("growing_grid.trace_every_evals", g.trace_every_evals, limits::MAX_TRACE_EVERY)?;
-    c.int("growing_grid.growth.lambda_g", g.growth.lambda_g, limits::MAX_ITERATIONS)?;
-    c.int("growing_grid.growth.lambda_f", g.growth.lambda_f, limits::MAX_ITERATIONS)?;
-    c.cells(
-        "growing_grid",
-        &[
-            g.datasets.len(),
-            g.control_nets.len(),
-            g.parameterisations.len(),
-            g.optimisers.len(),
-            g.repeats,
-        ],
-    )?;
-    Ok(())
 }
 

@@ -226,10 +226,11 @@ fn pairwise_cells(
     (out, wins, unreachable)
 }
 
-/// Friedman over cells on the mean best of each optimiser, with Holm-adjusted pairwise tests:
-/// `compare_overall.csv`, the critical-difference diagram, and the summary on stdout. Returns the
-/// note naming the diagram (empty without one).
-fn friedman_overall(
+/// The tests over cells: Friedman on the mean best of each optimiser, with Holm-adjusted pairwise
+/// tests (`compare_overall.csv`, the critical-difference diagram), and the Bayesian signed-rank
+/// test of every pair (`compare_bayes.csv`), with the summary on stdout. Returns the note naming
+/// the diagram (empty without one).
+fn over_cells(
     rows: &[OptimRow],
     opts: &[String],
     wins: &Wins,
@@ -299,6 +300,16 @@ fn friedman_overall(
     }
     for row in &orows {
         println!("  {} vs {}: z {}, p {} (Holm {}); cells where the rank-sum test favours {}: {}, {}: {} (of {} where it can reach alpha)", row[0], row[1], row[4], row[5], row[6], row[0], row[7], row[1], row[8], row[9]);
+    }
+    let brows = bayes_table(rows, opts, args)?;
+    let bh: Vec<String> =
+        ["x", "y", "cells", "rope", "samples", "p_x_better", "p_rope", "p_y_better"]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+    write_atomic(&out.join("compare_bayes.csv"), csv_records(&bh, &brows)?.as_bytes())?;
+    for r in &brows {
+        println!("  Bayesian signed-rank {} vs {} over {} cells (rope {} of B's error): P({} better) {}, P(equivalent) {}, P({} better) {}", r[0], r[1], r[2], r[3], r[0], r[5], r[6], r[1], r[7]);
     }
     Ok(cd_note)
 }
@@ -419,19 +430,12 @@ pub(crate) fn compare(args: &CompareArgs) -> Result<()> {
     // Built whole in a sibling folder and swapped in: a reader sees the old tables or the new.
     crate::io::outdir::replace_dir(&dest, |out| {
         write_atomic(&out.join("compare_cells.csv"), csv_records(&header, &cell_rows)?.as_bytes())?;
-        let cd_note = friedman_overall(&rows, &opts, &wins, args, out)?;
-        // Bayesian signed-rank test of every pair over the cells.
-        let brows = bayes_table(&rows, &opts, args)?;
-        let bh: Vec<String> =
-            ["x", "y", "cells", "rope", "samples", "p_x_better", "p_rope", "p_y_better"]
-                .iter()
-                .map(|s| s.to_string())
-                .collect();
-        write_atomic(&out.join("compare_bayes.csv"), csv_records(&bh, &brows)?.as_bytes())?;
-        for r in &brows {
-            println!("  Bayesian signed-rank {} vs {} over {} cells (rope {} of B's error): P({} better) {}, P(equivalent) {}, P({} better) {}", r[0], r[1], r[2], r[3], r[0], r[5], r[6], r[1], r[7]);
-        }
-        let mut written = String::from("compare_cells.csv, compare_overall.csv, compare_bayes.csv");
+        let (cd_note, mut written) = if cells.len() >= 2 {
+            (over_cells(&rows, &opts, &wins, args, out)?, String::from("compare_cells.csv, compare_overall.csv, compare_bayes.csv"))
+        } else {
+            println!("  one cell: the tests over cells (Friedman, Nemenyi, Bayesian signed-rank) need two or more; the per-cell tests are in compare_cells.csv");
+            (String::new(), String::from("compare_cells.csv"))
+        };
         if let Some(probs) = &probs {
             written.push_str(&runtime_outputs(probs, &opts, out)?);
         } else {

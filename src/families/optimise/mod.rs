@@ -11,7 +11,7 @@ pub(crate) mod report;
 pub(crate) mod spec;
 
 use crate::experiment::spec::GridSize;
-use crate::experiment::spec::{Spec, SpecError};
+use crate::experiment::spec::Spec;
 use crate::experiment::{runner, seeds, RunContext};
 use crate::families::maps;
 use crate::optim::{Budget, Problem};
@@ -360,34 +360,6 @@ fn sweepable_keys() -> Vec<String> {
             .map(String::from),
     )
     .collect()
-}
-
-impl crate::experiment::family::Section for self::spec::OptimSpec {
-    fn limits(&self, c: &crate::experiment::limits::Check) -> Result<(), SpecError> {
-        self::spec::limits(c, self)
-    }
-    fn validate(&self, spec: &Spec) -> Result<(), SpecError> {
-        self::spec::validate(spec, self)
-    }
-    fn datasets(&self) -> &[String] {
-        &self.datasets
-    }
-    fn use_maps(&mut self, maps: &str) {
-        self.maps = Some(maps.to_string());
-    }
-    fn require_inputs(&self, spec: &Spec) -> Result<()> {
-        let from = maps::MapsFrom {
-            section: "optimise",
-            dir: self.maps.as_deref(),
-            missing: self.maps_missing,
-            som: self.som.as_ref(),
-        };
-        maps::require_maps(spec, &self.datasets, self.grid, &from).map(drop)
-    }
-    /// Optimiser settings only, so that every variant solves the same problems (same data,
-    /// nets, search box) and the variants can be ranked like optimisers.
-    const OVERRIDES: Option<crate::experiment::family::Overrides> =
-        Some(crate::experiment::family::Overrides { sweepable: sweepable_keys });
 }
 
 impl crate::experiment::family::Experiment for Optim {

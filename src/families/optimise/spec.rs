@@ -105,50 +105,107 @@ fn default_exact_tol() -> f64 {
     1e-7
 }
 
-/// Every value of the `[optimise]` section (after the limits).
-pub(crate) fn validate(spec: &Spec, o: &OptimSpec) -> Result<(), SpecError> {
-    validate_grid_keys(spec, "optimise", &o.datasets, o.grid, &o.control_nets, &o.parameterisations)?;
-    validate_map_som(spec, "optimise", o.som.as_ref())?;
-    spec.validate_runs(
-        "optimise",
-        &o.optimisers,
-        &o.tables,
-        o.repeats,
-        o.generations as u64,
-        o.population,
-    )?;
-    if !(o.init_range >= 0.0 && o.init_range.is_finite()) {
-        return Err(spec.err(
-            "optimise.init_range",
-            format!("must be a non-negative number, got {}", o.init_range),
-        ));
-    }
-    if let Some(r) = o.search_range {
-        if !(r > 0.0 && r.is_finite()) {
-            return Err(
-                spec.err("optimise.search_range", format!("must be a positive number, got {r}"))
-            );
+impl crate::experiment::family::Section for OptimSpec {
+    /// The bounds of the `[optimise]` section's sizes and counts (docs/specs.md, "Spec limits").
+    fn limits(&self, c: &Check) -> Result<(), SpecError> {
+        crate::families::maps::limit_grid_keys(
+            c,
+            "optimise",
+            &self.datasets,
+            &self.grid,
+            &self.control_nets,
+            &self.parameterisations,
+        )?;
+        c.list("optimise.optimisers", &self.optimisers)?;
+        c.optimiser_run("optimise", self.repeats, self.generations, self.population)?;
+        c.real("optimise.fairness", self.fairness, 0.0, true, limits::MAX_FAIRNESS)?;
+        crate::families::maps::check_exponential_alpha(c, "optimise", self.exponential_alpha)?;
+        c.real("optimise.init_range", self.init_range, 0.0, true, limits::MAX_RANGE)?;
+        c.real("optimise.bounds_margin", self.bounds_margin, 0.0, true, limits::MAX_RANGE)?;
+        if let Some(r) = self.search_range {
+            c.real("optimise.search_range", r, 0.0, false, limits::MAX_RANGE)?;
         }
-        if o.init_range > r {
+        c.int("optimise.trace_every_evals", self.trace_every_evals, limits::MAX_TRACE_EVERY)?;
+        c.int("optimise.exact_newton_steps", self.exact_newton_steps, limits::MAX_NEWTON_STEPS)?;
+        if let Some(som) = &self.som {
+            c.int("optimise.som.iterations", som.iterations, limits::MAX_ITERATIONS)?;
+        }
+        c.cells(
+            "optimise",
+            &[
+                self.datasets.len(),
+                self.control_nets.len(),
+                self.parameterisations.len(),
+                self.optimisers.len(),
+                self.repeats,
+            ],
+        )?;
+        Ok(())
+    }
+    /// Every value of the `[optimise]` section (after the limits).
+    fn validate(&self, spec: &Spec) -> Result<(), SpecError> {
+        validate_grid_keys(spec, "optimise", &self.datasets, self.grid, &self.control_nets, &self.parameterisations)?;
+        validate_map_som(spec, "optimise", self.som.as_ref())?;
+        spec.validate_runs(
+            "optimise",
+            &self.optimisers,
+            &self.tables,
+            self.repeats,
+            self.generations as u64,
+            self.population,
+        )?;
+        if !(self.init_range >= 0.0 && self.init_range.is_finite()) {
             return Err(spec.err(
                 "optimise.init_range",
-                format!("{} is wider than optimise.search_range {r}", o.init_range),
+                format!("must be a non-negative number, got {}", self.init_range),
             ));
         }
+        if let Some(r) = self.search_range {
+            if !(r > 0.0 && r.is_finite()) {
+                return Err(
+                    spec.err("optimise.search_range", format!("must be a positive number, got {r}"))
+                );
+            }
+            if self.init_range > r {
+                return Err(spec.err(
+                    "optimise.init_range",
+                    format!("{} is wider than optimise.search_range {r}", self.init_range),
+                ));
+            }
+        }
+        if !(self.bounds_margin >= 0.0 && self.bounds_margin.is_finite()) {
+            return Err(spec.err(
+                "optimise.bounds_margin",
+                format!("must be a non-negative number, got {}", self.bounds_margin),
+            ));
+        }
+        if self.trace_every_evals == 0 {
+            return Err(spec.err("optimise.trace_every_evals", "must be at least 1"));
+        }
+        if !(self.exact_tol > 0.0 && self.exact_tol < 1.0) {
+            return Err(spec.err("optimise.exact_tol", format!("must be in (0,1), got {}", self.exact_tol)));
+        }
+        Ok(())
     }
-    if !(o.bounds_margin >= 0.0 && o.bounds_margin.is_finite()) {
-        return Err(spec.err(
-            "optimise.bounds_margin",
-            format!("must be a non-negative number, got {}", o.bounds_margin),
-        ));
+    fn datasets(&self) -> &[String] {
+        &self.datasets
     }
-    if o.trace_every_evals == 0 {
-        return Err(spec.err("optimise.trace_every_evals", "must be at least 1"));
+    fn use_maps(&mut self, maps: &str) {
+        self.maps = Some(maps.to_string());
     }
-    if !(o.exact_tol > 0.0 && o.exact_tol < 1.0) {
-        return Err(spec.err("optimise.exact_tol", format!("must be in (0,1), got {}", o.exact_tol)));
+    fn require_inputs(&self, spec: &Spec) -> anyhow::Result<()> {
+        let from = crate::families::maps::MapsFrom {
+            section: "optimise",
+            dir: self.maps.as_deref(),
+            missing: self.maps_missing,
+            som: self.som.as_ref(),
+        };
+        crate::families::maps::require_maps(spec, &self.datasets, self.grid, &from).map(drop)
     }
-    Ok(())
+    /// Optimiser settings only, so that every variant solves the same problems (same data,
+    /// nets, search box) and the variants can be ranked like optimisers.
+    const OVERRIDES: Option<crate::experiment::family::Overrides> =
+        Some(crate::experiment::family::Overrides { sweepable: super::sweepable_keys });
 }
 
 /// The flat list of optimisation cells (data x net x parameterisation x optimiser x repeat).
@@ -215,40 +272,6 @@ impl OptimCell {
             self.repeat
         )
     }
-}
-
-/// The bounds of the `[optimise]` section's sizes and counts (docs/specs.md, "Spec limits").
-pub(crate) fn limits(c: &Check, o: &OptimSpec) -> Result<(), SpecError> {
-    c.datasets("optimise.datasets", &o.datasets)?;
-    c.grids("optimise.grid", [&o.grid])?;
-    c.list("optimise.control_nets", &o.control_nets)?;
-    c.grids("optimise.control_nets", &o.control_nets)?;
-    c.list("optimise.parameterisations", &o.parameterisations)?;
-    c.list("optimise.optimisers", &o.optimisers)?;
-    c.optimiser_run("optimise", o.repeats, o.generations, o.population)?;
-    c.real("optimise.fairness", o.fairness, 0.0, true, limits::MAX_FAIRNESS)?;
-    crate::families::maps::check_exponential_alpha(c, "optimise", o.exponential_alpha)?;
-    c.real("optimise.init_range", o.init_range, 0.0, true, limits::MAX_RANGE)?;
-    c.real("optimise.bounds_margin", o.bounds_margin, 0.0, true, limits::MAX_RANGE)?;
-    if let Some(r) = o.search_range {
-        c.real("optimise.search_range", r, 0.0, false, limits::MAX_RANGE)?;
-    }
-    c.int("optimise.trace_every_evals", o.trace_every_evals, limits::MAX_TRACE_EVERY)?;
-    c.int("optimise.exact_newton_steps", o.exact_newton_steps, limits::MAX_NEWTON_STEPS)?;
-    if let Some(som) = &o.som {
-        c.int("optimise.som.iterations", som.iterations, limits::MAX_ITERATIONS)?;
-    }
-    c.cells(
-        "optimise",
-        &[
-            o.datasets.len(),
-            o.control_nets.len(),
-            o.parameterisations.len(),
-            o.optimisers.len(),
-            o.repeats,
-        ],
-    )?;
-    Ok(())
 }
 
 

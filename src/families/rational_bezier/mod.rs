@@ -5,7 +5,7 @@
 pub(crate) mod report;
 pub(crate) mod spec;
 
-use crate::experiment::spec::{Spec, SpecError};
+use crate::experiment::spec::Spec;
 use crate::experiment::{runner, seeds, RunContext};
 use crate::optim::{Budget, Problem};
 use crate::spline::conic::{self, ConicProblem, P2};
@@ -86,7 +86,6 @@ pub(crate) fn problem(s: &RationalBezierSpec, surface: &str) -> Result<SurfaceSs
         .with_context(|| format!("rational_bezier.surfaces: unknown surface `{surface}`"))?;
     Ok(SurfaceSse::new(ts.grid(s.grid), s.bounds_margin, s.w_min))
 }
-
 
 /// Run one cell (alone it gives the same numbers as inside the full run).
 pub(crate) fn run_cell(spec: &Spec, s: &RationalBezierSpec, cell: &Cell) -> Result<Run> {
@@ -268,15 +267,6 @@ pub(crate) fn run_curves(spec: &Spec, s: &RationalBezierSpec, ctx: &RunContext) 
 
 /// Seed 002's family: the `[rational_bezier]` section (surface cells logged, curve cells not).
 pub(crate) struct RationalBezier;
-
-impl crate::experiment::family::Section for self::spec::RationalBezierSpec {
-    fn limits(&self, c: &crate::experiment::limits::Check) -> Result<(), SpecError> {
-        self::spec::limits(c, self)
-    }
-    fn validate(&self, spec: &Spec) -> Result<(), SpecError> {
-        self::spec::validate(spec, self)
-    }
-}
 
 impl crate::experiment::family::Experiment for RationalBezier {
     fn title(&self) -> &'static str {

@@ -105,95 +105,96 @@ pub struct RationalBezierSpec {
     pub(crate) tables: crate::optim::Tables,
 }
 
-/// Every value of the `[rational_bezier]` section (after the limits).
-pub(crate) fn validate(spec: &Spec, s: &RationalBezierSpec) -> Result<(), SpecError> {
-    if s.surfaces.is_empty() {
-        return Err(spec.err("rational_bezier.surfaces", "is empty"));
+impl crate::experiment::family::Section for RationalBezierSpec {
+    /// The bounds of the `[rational_bezier]` section's sizes and counts (docs/specs.md, "Spec limits").
+    fn limits(&self, c: &Check) -> Result<(), SpecError> {
+        c.list("rational_bezier.surfaces", &self.surfaces)?;
+        c.list("rational_bezier.optimisers", &self.optimisers)?;
+        c.list("rational_bezier.outlines", &self.outlines)?;
+        c.optimiser_run("rational_bezier", self.repeats, self.generations, self.population)?;
+        c.int("rational_bezier.curve_generations", self.curve_generations, limits::MAX_GENERATIONS)?;
+        c.int("rational_bezier.grid", self.grid, 1001)?;
+        c.real("rational_bezier.init_range", self.init_range, 0.0, true, limits::MAX_RANGE)?;
+        c.real("rational_bezier.bounds_margin", self.bounds_margin, 0.0, true, limits::MAX_RANGE)?;
+        c.int("rational_bezier.trace_every_evals", self.trace_every_evals, limits::MAX_TRACE_EVERY)?;
+        c.int("rational_bezier.sam06_l", self.sam06_l, 1000)?;
+        if let Some(r) = self.sam06_r {
+            c.int("rational_bezier.sam06_r", r, 1000)?;
+        }
+        c.real("rational_bezier.sam06_d", self.sam06_d, 0.0, false, limits::MAX_LENGTH)?;
+        c.cells("rational_bezier", &[self.surfaces.len().max(self.outlines.len()), self.optimisers.len(), self.repeats])?;
+        Ok(())
     }
-    for name in &s.surfaces {
-        if crate::spline::rational_bezier::TestSurface::by_name(name).is_none() {
+    /// Every value of the `[rational_bezier]` section (after the limits).
+    fn validate(&self, spec: &Spec) -> Result<(), SpecError> {
+        if self.surfaces.is_empty() {
+            return Err(spec.err("rational_bezier.surfaces", "is empty"));
+        }
+        for name in &self.surfaces {
+            if crate::spline::rational_bezier::TestSurface::by_name(name).is_none() {
+                return Err(spec.err(
+                    "rational_bezier.surfaces",
+                    format!(
+                        "unknown surface `{name}` (expected surface1, surface2, surface3 or surface4)"
+                    ),
+                ));
+            }
+        }
+        spec.validate_runs(
+            "rational_bezier",
+            &self.optimisers,
+            &self.tables,
+            self.repeats,
+            self.generations as u64,
+            self.population,
+        )?;
+        if self.grid < 5 || self.grid.is_multiple_of(2) {
+            return Err(spec.err("rational_bezier.grid", format!("must be odd and at least 5, got {}", self.grid)));
+        }
+        if !(self.init_range >= 0.0 && self.init_range.is_finite()) {
             return Err(spec.err(
-                "rational_bezier.surfaces",
-                format!(
-                    "unknown surface `{name}` (expected surface1, surface2, surface3 or surface4)"
-                ),
+                "rational_bezier.init_range",
+                format!("must be a non-negative number, got {}", self.init_range),
             ));
         }
-    }
-    spec.validate_runs(
-        "rational_bezier",
-        &s.optimisers,
-        &s.tables,
-        s.repeats,
-        s.generations as u64,
-        s.population,
-    )?;
-    if s.grid < 5 || s.grid.is_multiple_of(2) {
-        return Err(spec.err("rational_bezier.grid", format!("must be odd and at least 5, got {}", s.grid)));
-    }
-    if !(s.init_range >= 0.0 && s.init_range.is_finite()) {
-        return Err(spec.err(
-            "rational_bezier.init_range",
-            format!("must be a non-negative number, got {}", s.init_range),
-        ));
-    }
-    if !(s.bounds_margin >= 0.0 && s.bounds_margin.is_finite()) {
-        return Err(spec.err(
-            "rational_bezier.bounds_margin",
-            format!("must be a non-negative number, got {}", s.bounds_margin),
-        ));
-    }
-    if !(s.w_min > 0.0 && s.w_min < 1.0) {
-        return Err(spec.err("rational_bezier.w_min", format!("must be in (0, 1), got {}", s.w_min)));
-    }
-    if s.trace_every_evals == 0 {
-        return Err(spec.err("rational_bezier.trace_every_evals", "must be at least 1"));
-    }
-    for name in &s.outlines {
-        if crate::spline::conic::outline(name).is_none() {
+        if !(self.bounds_margin >= 0.0 && self.bounds_margin.is_finite()) {
             return Err(spec.err(
-                "rational_bezier.outlines",
-                format!("unknown outline `{name}` (expected square, letter_d or letter_p)"),
+                "rational_bezier.bounds_margin",
+                format!("must be a non-negative number, got {}", self.bounds_margin),
             ));
         }
+        if !(self.w_min > 0.0 && self.w_min < 1.0) {
+            return Err(spec.err("rational_bezier.w_min", format!("must be in (0, 1), got {}", self.w_min)));
+        }
+        if self.trace_every_evals == 0 {
+            return Err(spec.err("rational_bezier.trace_every_evals", "must be at least 1"));
+        }
+        for name in &self.outlines {
+            if crate::spline::conic::outline(name).is_none() {
+                return Err(spec.err(
+                    "rational_bezier.outlines",
+                    format!("unknown outline `{name}` (expected square, letter_d or letter_p)"),
+                ));
+            }
+        }
+        if !(self.outline_spacing > 0.0 && self.outline_spacing <= 10.0) {
+            return Err(spec.err(
+                "rational_bezier.outline_spacing",
+                format!("must be in (0, 10], got {}", self.outline_spacing),
+            ));
+        }
+        if self.sam06_l < 2 {
+            return Err(spec.err("rational_bezier.sam06_l", format!("must be at least 2, got {}", self.sam06_l)));
+        }
+        if !(self.sam06_d > 0.0 && self.sam06_d.is_finite()) {
+            return Err(
+                spec.err("rational_bezier.sam06_d", format!("must be a positive number, got {}", self.sam06_d))
+            );
+        }
+        if self.curve_generations == 0 {
+            return Err(spec.err("rational_bezier.curve_generations", "must be at least 1"));
+        }
+        Ok(())
     }
-    if !(s.outline_spacing > 0.0 && s.outline_spacing <= 10.0) {
-        return Err(spec.err(
-            "rational_bezier.outline_spacing",
-            format!("must be in (0, 10], got {}", s.outline_spacing),
-        ));
-    }
-    if s.sam06_l < 2 {
-        return Err(spec.err("rational_bezier.sam06_l", format!("must be at least 2, got {}", s.sam06_l)));
-    }
-    if !(s.sam06_d > 0.0 && s.sam06_d.is_finite()) {
-        return Err(
-            spec.err("rational_bezier.sam06_d", format!("must be a positive number, got {}", s.sam06_d))
-        );
-    }
-    if s.curve_generations == 0 {
-        return Err(spec.err("rational_bezier.curve_generations", "must be at least 1"));
-    }
-    Ok(())
-}
-
-/// The bounds of the `[rational_bezier]` section's sizes and counts (docs/specs.md, "Spec limits").
-pub(crate) fn limits(c: &Check, s: &RationalBezierSpec) -> Result<(), SpecError> {
-    c.list("rational_bezier.surfaces", &s.surfaces)?;
-    c.list("rational_bezier.optimisers", &s.optimisers)?;
-    c.list("rational_bezier.outlines", &s.outlines)?;
-    c.optimiser_run("rational_bezier", s.repeats, s.generations, s.population)?;
-    c.int("rational_bezier.curve_generations", s.curve_generations, limits::MAX_GENERATIONS)?;
-    c.int("rational_bezier.grid", s.grid, 1001)?;
-    c.real("rational_bezier.init_range", s.init_range, 0.0, true, limits::MAX_RANGE)?;
-    c.real("rational_bezier.bounds_margin", s.bounds_margin, 0.0, true, limits::MAX_RANGE)?;
-    c.int("rational_bezier.trace_every_evals", s.trace_every_evals, limits::MAX_TRACE_EVERY)?;
-    c.int("rational_bezier.sam06_l", s.sam06_l, 1000)?;
-    if let Some(r) = s.sam06_r {
-        c.int("rational_bezier.sam06_r", r, 1000)?;
-    }
-    c.real("rational_bezier.sam06_d", s.sam06_d, 0.0, false, limits::MAX_LENGTH)?;
-    c.cells("rational_bezier", &[s.surfaces.len().max(s.outlines.len()), s.optimisers.len(), s.repeats])?;
-    Ok(())
 }
 

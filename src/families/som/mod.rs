@@ -7,7 +7,7 @@ pub(crate) mod spec;
 
 use crate::data::generators::{SpindleProfile, SpindleRings};
 use crate::data::PointCloud;
-use crate::experiment::spec::{Spec, SpecError};
+use crate::experiment::spec::Spec;
 use crate::experiment::packed::PackedPoints;
 use crate::experiment::{runner, seeds, RunContext};
 use crate::geom::Point3;
@@ -69,7 +69,6 @@ pub struct SomRow {
     pub te_final: f64,
     pub cpu_s: f64,
 }
-
 
 impl SomRow {
     fn new(
@@ -225,18 +224,6 @@ pub(crate) fn run(
 
 /// Chapter 4's family: the `[som]` section.
 pub(crate) struct Som;
-
-impl crate::experiment::family::Section for self::spec::SomSpec {
-    fn limits(&self, c: &crate::experiment::limits::Check) -> Result<(), SpecError> {
-        self::spec::limits(c, self)
-    }
-    fn validate(&self, spec: &Spec) -> Result<(), SpecError> {
-        self::spec::validate(spec, self)
-    }
-    fn datasets(&self) -> &[String] {
-        &self.datasets
-    }
-}
 
 impl crate::experiment::family::Experiment for Som {
     fn title(&self) -> &'static str {

@@ -55,60 +55,86 @@ pub struct SomGroup {
     pub grids: Vec<GridSize>,
 }
 
-/// Every value of the `[som]` section (after the limits).
-pub(crate) fn validate(spec: &Spec, som: &SomSpec) -> Result<(), SpecError> {
-    if som.datasets.is_empty() {
-        return Err(spec.err("som.datasets", "is empty"));
-    }
-    if som.iterations == 0 {
-        return Err(spec.err("som.iterations", "must be at least 1"));
-    }
-    if !(som.alpha0 > 0.0 && som.alpha0 <= 1.0) {
-        return Err(spec.err("som.alpha0", format!("must be in (0, 1], got {}", som.alpha0)));
-    }
-    if let Some(s) = som.sigma0 {
-        if s.is_nan() || s <= 1.0 {
-            return Err(
-                spec.err("som.sigma0", format!("must exceed 1 (tau = T / ln sigma0), got {s}"))
-            );
+impl crate::experiment::family::Section for SomSpec {
+    /// The bounds of the `[som]` section's sizes and counts (docs/specs.md, "Spec limits").
+    fn limits(&self, c: &Check) -> Result<(), SpecError> {
+        c.datasets("som.datasets", &self.datasets)?;
+        c.int("som.iterations", self.iterations, limits::MAX_ITERATIONS)?;
+        if let Some(sigma0) = self.sigma0 {
+            c.real("som.sigma0", sigma0, 1.0, false, limits::MAX_SIGMA0)?;
         }
-    }
-    if som.repeats == 0 {
-        return Err(spec.err("som.repeats", "must be at least 1"));
-    }
-    if som.groups.is_empty() {
-        return Err(spec.err("som.group", "no [[som.group]] given"));
-    }
-    for (g, group) in som.groups.iter().enumerate() {
-        let key = format!("som.group[{g}]");
-        if group.models.is_empty() {
-            return Err(spec.err(&format!("{key}.models"), "is empty"));
+        c.int("som.repeats", self.repeats, limits::MAX_REPEATS)?;
+        c.list("som.group", &(0..self.groups.len()).collect::<Vec<_>>())?;
+        let mut per_data = 0usize;
+        for (g, group) in self.groups.iter().enumerate() {
+            c.list(&format!("som.group[{g}].models"), &group.models)?;
+            c.list(&format!("som.group[{g}].grids"), &group.grids)?;
+            c.grids(&format!("som.group[{g}].grids"), &group.grids)?;
+            per_data = per_data.saturating_add(group.models.len().saturating_mul(group.grids.len()));
         }
-        if group.grids.is_empty() {
-            return Err(spec.err(&format!("{key}.grids"), "is empty"));
+        c.list("som.save_maps", &self.save_maps)?;
+        c.grids("som.save_maps", &self.save_maps)?;
+        c.cells("som", &[self.datasets.len(), per_data, self.repeats])?;
+        Ok(())
+    }
+    /// Every value of the `[som]` section (after the limits).
+    fn validate(&self, spec: &Spec) -> Result<(), SpecError> {
+        if self.datasets.is_empty() {
+            return Err(spec.err("som.datasets", "is empty"));
         }
-        for &model in &group.models {
-            for grid in &group.grids {
-                if som.sigma0.is_none() && grid.nx.min(grid.ny) < 3 {
-                    return Err(spec.err(
-                        &format!("{key}.grids"),
-                        format!("grid {grid} is too small: sigma0 = min(nx,ny)/2 must exceed 1"),
-                    ));
-                }
-                model
-                    .topology(grid.nx, grid.ny)
-                    .map_err(|e| spec.err(&format!("{key}.grids"), e))?;
+        if self.iterations == 0 {
+            return Err(spec.err("som.iterations", "must be at least 1"));
+        }
+        if !(self.alpha0 > 0.0 && self.alpha0 <= 1.0) {
+            return Err(spec.err("som.alpha0", format!("must be in (0, 1], got {}", self.alpha0)));
+        }
+        if let Some(s) = self.sigma0 {
+            if s.is_nan() || s <= 1.0 {
+                return Err(
+                    spec.err("som.sigma0", format!("must exceed 1 (tau = T / ln sigma0), got {s}"))
+                );
             }
         }
-    }
-    for grid in &som.save_maps {
-        let has =
-            cells(som).iter().any(|c| c.model == crate::som::Model::Dnsom && c.grid == *grid);
-        if !has {
-            return Err(spec.err("som.save_maps", format!("no DNSOM cell at grid {grid} to save")));
+        if self.repeats == 0 {
+            return Err(spec.err("som.repeats", "must be at least 1"));
         }
+        if self.groups.is_empty() {
+            return Err(spec.err("som.group", "no [[som.group]] given"));
+        }
+        for (g, group) in self.groups.iter().enumerate() {
+            let key = format!("som.group[{g}]");
+            if group.models.is_empty() {
+                return Err(spec.err(&format!("{key}.models"), "is empty"));
+            }
+            if group.grids.is_empty() {
+                return Err(spec.err(&format!("{key}.grids"), "is empty"));
+            }
+            for &model in &group.models {
+                for grid in &group.grids {
+                    if self.sigma0.is_none() && grid.nx.min(grid.ny) < 3 {
+                        return Err(spec.err(
+                            &format!("{key}.grids"),
+                            format!("grid {grid} is too small: sigma0 = min(nx,ny)/2 must exceed 1"),
+                        ));
+                    }
+                    model
+                        .topology(grid.nx, grid.ny)
+                        .map_err(|e| spec.err(&format!("{key}.grids"), e))?;
+                }
+            }
+        }
+        for grid in &self.save_maps {
+            let has =
+                cells(self).iter().any(|c| c.model == crate::som::Model::Dnsom && c.grid == *grid);
+            if !has {
+                return Err(spec.err("som.save_maps", format!("no DNSOM cell at grid {grid} to save")));
+            }
+        }
+        Ok(())
     }
-    Ok(())
+    fn datasets(&self) -> &[String] {
+        &self.datasets
+    }
 }
 
 /// The flat list of SOM cells (data set x group x grid x model x repeat), in report order.
@@ -158,26 +184,4 @@ impl SomCell {
     pub fn key(&self) -> String {
         format!("som/{}/{}/{}/r{}", self.dataset, self.model.key(), self.grid, self.repeat)
     }
-}
-
-/// The bounds of the `[som]` section's sizes and counts (docs/specs.md, "Spec limits").
-pub(crate) fn limits(c: &Check, s: &SomSpec) -> Result<(), SpecError> {
-    c.datasets("som.datasets", &s.datasets)?;
-    c.int("som.iterations", s.iterations, limits::MAX_ITERATIONS)?;
-    if let Some(sigma0) = s.sigma0 {
-        c.real("som.sigma0", sigma0, 1.0, false, limits::MAX_SIGMA0)?;
-    }
-    c.int("som.repeats", s.repeats, limits::MAX_REPEATS)?;
-    c.list("som.group", &(0..s.groups.len()).collect::<Vec<_>>())?;
-    let mut per_data = 0usize;
-    for (g, group) in s.groups.iter().enumerate() {
-        c.list(&format!("som.group[{g}].models"), &group.models)?;
-        c.list(&format!("som.group[{g}].grids"), &group.grids)?;
-        c.grids(&format!("som.group[{g}].grids"), &group.grids)?;
-        per_data = per_data.saturating_add(group.models.len().saturating_mul(group.grids.len()));
-    }
-    c.list("som.save_maps", &s.save_maps)?;
-    c.grids("som.save_maps", &s.save_maps)?;
-    c.cells("som", &[s.datasets.len(), per_data, s.repeats])?;
-    Ok(())
 }
