@@ -36,10 +36,15 @@ use rand_chacha::ChaCha8Rng;
 /// Constants of the growing grid. Defaults: Fritzke's constant sigma of the neighbourhood and
 /// lambda_g = 30 steps per unit between insertions; the learning rates are this project's choice
 /// (the surviving seed gives none), see the module doc.
-#[derive(Debug, Clone, Copy, PartialEq)]
+///
+/// A spec's `[growing_grid.growth]` table reads the constants (the target size is its `grid`).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Deserialize)]
+#[serde(deny_unknown_fields, default)]
 pub struct GrowingGridParams {
     /// Target size (rows nx along i, columns ny along j); both at least 2.
+    #[serde(skip)]
     pub nx: usize,
+    #[serde(skip)]
     pub ny: usize,
     /// Adaptation steps per unit between two insertions.
     pub lambda_g: usize,

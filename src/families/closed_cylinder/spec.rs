@@ -147,19 +147,6 @@ impl crate::experiment::family::Section for ClosedCylinderSpec {
                 format!("must be at least 2 and above closed_cylinder.ga.elitism, got {}", self.population),
             ));
         }
-        for (key, v) in [
-            ("radius", self.radius),
-            ("height", self.height),
-            ("grid_step", self.grid_step),
-            ("accuracy", self.accuracy),
-            ("search_range", self.search_range),
-        ] {
-            if !(v > 0.0 && v.is_finite()) {
-                return Err(
-                    spec.err(&format!("closed_cylinder.{key}"), format!("must be a positive number, got {v}"))
-                );
-            }
-        }
         if self.radius / self.grid_step > 2000.0 || self.height / self.grid_step > 2000.0 {
             return Err(spec.err(
                 "closed_cylinder.grid_step",

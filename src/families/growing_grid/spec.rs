@@ -2,6 +2,7 @@
 
 use crate::experiment::limits::{self, Check};
 use crate::experiment::spec::{GridSize, Spec, SpecError};
+use crate::som::growing_grid::GrowingGridParams;
 use serde::Deserialize;
 
 /// Seed 001 section: a Growing Grid (Fritzke 1995) per open-surface data set, one cubic B-spline
@@ -34,55 +35,16 @@ pub struct GrowingGridSpec {
     pub trace_every_evals: u64,
     /// Constants of the growing grid (defaults: `som::growing_grid::GrowingGridParams`).
     #[serde(default)]
-    pub growth: GrowthSpec,
+    pub growth: GrowingGridParams,
     /// Every registered optimiser's parameter table (`[growing_grid.de]`, ...; Table 6.1 by default).
     #[serde(flatten)]
     pub(crate) tables: crate::optim::Tables,
 }
 
-/// The growing grid's constants in a spec.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct GrowthSpec {
-    pub lambda_g: usize,
-    pub eps_g: f64,
-    pub lambda_f: usize,
-    pub eps_f0: f64,
-    pub eps_f1: f64,
-    pub sigma: f64,
-    pub reach2: i32,
-}
-
-impl Default for GrowthSpec {
-    fn default() -> Self {
-        let p = crate::som::growing_grid::GrowingGridParams::default();
-        GrowthSpec {
-            lambda_g: p.lambda_g,
-            eps_g: p.eps_g,
-            lambda_f: p.lambda_f,
-            eps_f0: p.eps_f0,
-            eps_f1: p.eps_f1,
-            sigma: p.sigma,
-            reach2: p.reach2,
-        }
-    }
-}
-
 impl GrowingGridSpec {
     /// The growing grid's parameters for the target grid.
-    pub fn params(&self) -> crate::som::growing_grid::GrowingGridParams {
-        let g = &self.growth;
-        crate::som::growing_grid::GrowingGridParams {
-            nx: self.grid.nx,
-            ny: self.grid.ny,
-            lambda_g: g.lambda_g,
-            eps_g: g.eps_g,
-            lambda_f: g.lambda_f,
-            eps_f0: g.eps_f0,
-            eps_f1: g.eps_f1,
-            sigma: g.sigma,
-            reach2: g.reach2,
-        }
+    pub fn params(&self) -> GrowingGridParams {
+        GrowingGridParams { nx: self.grid.nx, ny: self.grid.ny, ..self.growth }
     }
 }
 
@@ -147,18 +109,6 @@ impl crate::experiment::family::Section for GrowingGridSpec {
             self.generations as u64,
             self.population,
         )?;
-        if !(self.init_range >= 0.0 && self.init_range.is_finite()) {
-            return Err(spec.err(
-                "growing_grid.init_range",
-                format!("must be a non-negative number, got {}", self.init_range),
-            ));
-        }
-        if !(self.bounds_margin >= 0.0 && self.bounds_margin.is_finite()) {
-            return Err(spec.err(
-                "growing_grid.bounds_margin",
-                format!("must be a non-negative number, got {}", self.bounds_margin),
-            ));
-        }
         if self.trace_every_evals == 0 {
             return Err(spec.err("growing_grid.trace_every_evals", "must be at least 1"));
         }

@@ -154,30 +154,13 @@ impl crate::experiment::family::Section for OptimSpec {
             self.generations as u64,
             self.population,
         )?;
-        if !(self.init_range >= 0.0 && self.init_range.is_finite()) {
-            return Err(spec.err(
-                "optimise.init_range",
-                format!("must be a non-negative number, got {}", self.init_range),
-            ));
-        }
         if let Some(r) = self.search_range {
-            if !(r > 0.0 && r.is_finite()) {
-                return Err(
-                    spec.err("optimise.search_range", format!("must be a positive number, got {r}"))
-                );
-            }
             if self.init_range > r {
                 return Err(spec.err(
                     "optimise.init_range",
                     format!("{} is wider than optimise.search_range {r}", self.init_range),
                 ));
             }
-        }
-        if !(self.bounds_margin >= 0.0 && self.bounds_margin.is_finite()) {
-            return Err(spec.err(
-                "optimise.bounds_margin",
-                format!("must be a non-negative number, got {}", self.bounds_margin),
-            ));
         }
         if self.trace_every_evals == 0 {
             return Err(spec.err("optimise.trace_every_evals", "must be at least 1"));

@@ -151,18 +151,6 @@ impl crate::experiment::family::Section for RationalBezierSpec {
         if self.grid < 5 || self.grid.is_multiple_of(2) {
             return Err(spec.err("rational_bezier.grid", format!("must be odd and at least 5, got {}", self.grid)));
         }
-        if !(self.init_range >= 0.0 && self.init_range.is_finite()) {
-            return Err(spec.err(
-                "rational_bezier.init_range",
-                format!("must be a non-negative number, got {}", self.init_range),
-            ));
-        }
-        if !(self.bounds_margin >= 0.0 && self.bounds_margin.is_finite()) {
-            return Err(spec.err(
-                "rational_bezier.bounds_margin",
-                format!("must be a non-negative number, got {}", self.bounds_margin),
-            ));
-        }
         if !(self.w_min > 0.0 && self.w_min < 1.0) {
             return Err(spec.err("rational_bezier.w_min", format!("must be in (0, 1), got {}", self.w_min)));
         }
@@ -185,11 +173,6 @@ impl crate::experiment::family::Section for RationalBezierSpec {
         }
         if self.sam06_l < 2 {
             return Err(spec.err("rational_bezier.sam06_l", format!("must be at least 2, got {}", self.sam06_l)));
-        }
-        if !(self.sam06_d > 0.0 && self.sam06_d.is_finite()) {
-            return Err(
-                spec.err("rational_bezier.sam06_d", format!("must be a positive number, got {}", self.sam06_d))
-            );
         }
         if self.curve_generations == 0 {
             return Err(spec.err("rational_bezier.curve_generations", "must be at least 1"));
