@@ -138,8 +138,16 @@ pub(crate) fn is_timing_column(name: &str) -> bool {
 }
 
 /// Columns that identify a row even when numeric.
-const IDENTITY: [&str; 9] =
-    ["cn_x", "cn_y", "grid_x", "grid_y", "nx", "ny", "repeat", "n", "cells"];
+const IDENTITY: [&str; 10] =
+    ["cn_x", "cn_y", "grid_x", "grid_y", "nx", "ny", "repeat", "n", "cells", "seed"];
+
+/// A cell's value as a number, if it is written as one: text that only parses by overflowing (the
+/// hex seed `9e71084187728100` read as 9e71084187728100) is text, not infinity.
+fn number(v: &str) -> Option<f64> {
+    let x = v.parse::<f64>().ok()?;
+    let spelt_inf = v.trim_start_matches(['+', '-']).to_ascii_lowercase().starts_with("inf");
+    (!x.is_infinite() || spelt_inf).then_some(x)
+}
 
 /// One difference.
 #[derive(Debug, Clone, PartialEq)]
@@ -422,8 +430,7 @@ pub(crate) fn compare_table(
         .enumerate()
         .filter_map(|(i, c)| cur.header.iter().position(|d| d == c).map(|j| (i, j, c)))
         .collect();
-    let is_key =
-        |c: &str, v: &str| IDENTITY.contains(&c) || (!v.is_empty() && v.parse::<f64>().is_err());
+    let is_key = |c: &str, v: &str| IDENTITY.contains(&c) || (!v.is_empty() && number(v).is_none());
     for (r, (b, c)) in base.rows.iter().zip(&cur.rows).enumerate() {
         let key_cols: Vec<(usize, usize)> = cols
             .iter()
@@ -480,7 +487,7 @@ fn compare_cell(
 ) {
     report.cells += 1;
     if vb == vc {
-        if vb.parse::<f64>().is_ok_and(|x| !x.is_finite()) {
+        if number(vb).is_some_and(|x| !x.is_finite()) {
             report.findings.push(Finding::NonFinite {
                 table: name.into(),
                 row: key.into(),
@@ -490,8 +497,8 @@ fn compare_cell(
         }
         return;
     }
-    match (vb.parse::<f64>(), vc.parse::<f64>()) {
-        (Ok(x), Ok(y)) => {
+    match (number(vb), number(vc)) {
+        (Some(x), Some(y)) => {
             if judged && opts.tolerance(col).equal(x, y) {
                 return;
             }
@@ -841,5 +848,21 @@ mod tests {
             "{}",
             r.summary(5)
         );
+    }
+
+    /// A hex seed that reads as an overflowing number is text (no "inf" note), and a seed is part
+    /// of its row's key, so two all-digit seeds that differ in the last digit are a drift, not a
+    /// difference within the tolerance.
+    #[test]
+    fn seeds_are_keys_and_hex_is_not_infinity() {
+        let base = "cell,seed,best\na,9e71084187728100,1.5\nb,1234567890123456,2.5\n";
+        let r = cmp(base, base, &DriftOptions::default());
+        assert!(!r.drifted() && !r.summary(5).contains("inf"), "{}", r.summary(5));
+        let moved = base.replace("1234567890123456", "1234567890123457");
+        let r = cmp(base, &moved, &DriftOptions::default());
+        assert!(r.drifted() && r.summary(5).contains("1234567890123457"), "{}", r.summary(5));
+        assert_eq!(number("inf"), Some(f64::INFINITY));
+        assert_eq!(number("-Infinity"), Some(f64::NEG_INFINITY));
+        assert_eq!((number("9e71084187728100"), number("1e5")), (None, Some(1e5)));
     }
 }
