@@ -95,8 +95,8 @@ pub(crate) fn limit_grid_keys(
     c.list(&key("parameterisations"), parameterisations)
 }
 
-/// The keys a `[fit]` and an `[optimise]` section share (data sets, grid, control nets,
-/// parameterisations), each error naming `<section>.<key>`.
+/// The keys a `[fit]`, an `[optimise]` and a `[growing_grid]` section share (data sets, grid,
+/// control nets, parameterisations), each error naming `<section>.<key>`.
 pub(crate) fn validate_grid_keys(
     spec: &Spec,
     section: &str,

@@ -80,27 +80,15 @@ impl crate::experiment::family::Section for GrowingGridSpec {
     }
     /// Every value of the `[growing_grid]` section (after the limits).
     fn validate(&self, spec: &Spec) -> Result<(), SpecError> {
-        if self.datasets.is_empty() {
-            return Err(spec.err("growing_grid.datasets", "is empty"));
-        }
-        if let Some(d) = self.datasets.iter().find(|d| d.trim().is_empty()) {
-            return Err(spec.err("growing_grid.datasets", format!("empty data set name `{d}`")));
-        }
+        crate::families::maps::validate_grid_keys(
+            spec,
+            "growing_grid",
+            &self.datasets,
+            self.grid,
+            &self.control_nets,
+            &self.parameterisations,
+        )?;
         self.params().validate().map_err(|e| spec.err("growing_grid.growth", e))?;
-        if self.control_nets.is_empty() {
-            return Err(spec.err("growing_grid.control_nets", "is empty"));
-        }
-        for cn in &self.control_nets {
-            if cn.nx < 4 || cn.ny < 4 || cn.nx > self.grid.nx || cn.ny > self.grid.ny {
-                return Err(spec.err(
-                    "growing_grid.control_nets",
-                    format!("net {cn} must be at least 4x4 (cubic) and at most the grid {}", self.grid),
-                ));
-            }
-        }
-        if self.parameterisations.is_empty() {
-            return Err(spec.err("growing_grid.parameterisations", "is empty"));
-        }
         spec.validate_runs(
             "growing_grid",
             &self.optimisers,
