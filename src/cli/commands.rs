@@ -52,6 +52,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
                     experiment::data_dir(args.data_dir.as_deref()),
                 )
             };
+            crate::io::outdir::require_folder_outside_results(&args.out, "--out")?;
             let out = experiment::merge::<Section>(&args.shards, &ctx)?;
             eprintln!(
                 "somnurbs: merged {} shards into {} and {}",
@@ -90,15 +91,13 @@ fn run_spec(args: &RunArgs) -> anyhow::Result<ExitCode> {
         return Ok(ExitCode::SUCCESS);
     }
     let shard = args.shard.as_deref().map(Shard::parse).transpose()?;
+    let out = spec.output_dir(args.out.as_deref());
+    crate::io::outdir::require_folder_outside_results(&out, "output folder")?;
     let ctx = RunContext {
         resume: args.resume,
         shard,
         page: true,
-        ..RunContext::new(
-            spec.output_dir(args.out.as_deref()),
-            jobs(args.jobs)?,
-            experiment::data_dir(args.data_dir.as_deref()),
-        )
+        ..RunContext::new(out, jobs(args.jobs)?, experiment::data_dir(args.data_dir.as_deref()))
     };
     let out = experiment::run_variants(&variants, &ctx)?;
     match shard {
@@ -153,6 +152,7 @@ fn drift(args: &DriftArgs) -> anyhow::Result<ExitCode> {
 fn reproduce(args: &ReproduceArgs) -> anyhow::Result<ExitCode> {
     use experiment::reproduce::{default_out, specs_dir};
     let out = args.out.clone().unwrap_or_else(|| default_out(&args.plan, &args.profile));
+    crate::io::outdir::require_folder_outside_results(&out, "output folder")?;
     let jobs = jobs(args.jobs)?;
     let specs = specs_dir(args.specs.as_deref(), &args.plan)?;
     let ctx = RunContext {

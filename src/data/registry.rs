@@ -100,12 +100,12 @@ pub(crate) fn describe(name: &str) -> Option<&'static str> {
 }
 
 fn read(path: &Path, hint: &str) -> Result<Vec<u8>, DataError> {
-    std::fs::read(path).map_err(|e| {
-        if e.kind() == std::io::ErrorKind::NotFound {
+    use crate::io::input::{self, InputError, Kind};
+    input::read(path, Kind::Data).map_err(|e| match e {
+        InputError::NotFound { .. } => {
             DataError::Missing { path: path.display().to_string(), hint: hint.to_string() }
-        } else {
-            DataError::Io { path: path.display().to_string(), source: e }
         }
+        e => DataError::Invalid(e.to_string()),
     })
 }
 
@@ -159,8 +159,11 @@ impl Loader {
         }
         dataset_name(entry)?;
         let path = self.resolve(entry)?;
-        if !path.is_file() {
-            return Err(DataError::Missing { path: path.display().to_string(), hint: format!("The spec names `{entry}`; a relative data-set path is read from the spec's folder ({}).", if self.base.as_os_str().is_empty() { ".".into() } else { self.base.display().to_string() }) });
+        use crate::io::input::{self, InputError, Kind};
+        match input::check(&path, Kind::Data) {
+            Ok(()) => {}
+            Err(InputError::NotFound { .. }) => return Err(DataError::Missing { path: path.display().to_string(), hint: format!("The spec names `{entry}`; a relative data-set path is read from the spec's folder ({}).", if self.base.as_os_str().is_empty() { ".".into() } else { self.base.display().to_string() }) }),
+            Err(e) => return Err(DataError::Invalid(e.to_string())),
         }
         Ok(())
     }

@@ -12,6 +12,7 @@ use serde::{de::DeserializeOwned, Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::fs::{File, OpenOptions};
 use std::io::Write;
+use std::os::unix::fs::OpenOptionsExt;
 use std::path::{Path, PathBuf};
 
 pub(crate) use crate::io::outdir::{FINGERPRINT_FILE, LOG_FILE, LOG_GZ};
@@ -165,16 +166,17 @@ pub(crate) fn read_records<T: DeserializeOwned>(
     if !path.exists() {
         return Ok(out);
     }
-    let text = std::fs::read_to_string(&path)
-        .with_context(|| format!("cannot read {}", path.display()))?;
+    let text = crate::io::read_text(&path)?;
     let complete = match text.rfind('\n') {
         Some(k) => k + 1,
         None => 0,
     };
     parse_lines(&path, &text[..complete], master_seed, &mut out)?;
     if complete < text.len() {
+        crate::io::outdir::no_link_inside(&path)?;
         let f = OpenOptions::new()
             .write(true)
+            .custom_flags(libc::O_NOFOLLOW)
             .open(&path)
             .with_context(|| format!("cannot open {}", path.display()))?;
         f.set_len(complete as u64)
@@ -207,12 +209,19 @@ fn parse_lines<T: DeserializeOwned>(
 
 /// The text of a gzip-compressed log, whole (a truncated or corrupt file is an error naming it).
 fn gunzip(path: &Path) -> Result<String> {
-    use std::io::Read;
-    let file = File::open(path).with_context(|| format!("cannot open {}", path.display()))?;
-    let mut text = String::new();
-    flate2::read::GzDecoder::new(std::io::BufReader::new(file))
-        .read_to_string(&mut text)
-        .with_context(|| format!("{}: not a whole gzip-compressed cell log", path.display()))?;
+    use crate::io::input::{self, InputError, Kind};
+    let (file, size) = input::open(path, Kind::Text)?;
+    let decoder = flate2::read::GzDecoder::new(std::io::BufReader::new(file));
+    // Decompressed, the log is bounded like any other log (a small file can hold a huge line).
+    let bytes = input::read_bounded(path, decoder, size.saturating_mul(8), Kind::Text).map_err(
+        |e| match e {
+            InputError::Io { .. } => anyhow::Error::from(e)
+                .context(format!("{}: not a whole gzip-compressed cell log", path.display())),
+            e => e.into(),
+        },
+    )?;
+    let text =
+        crate::io::utf8_text(&path.display().to_string(), bytes).map_err(anyhow::Error::msg)?;
     if !text.is_empty() && !text.ends_with('\n') {
         bail!("{}: its last line is torn", path.display());
     }
@@ -228,10 +237,7 @@ pub fn log_text(dir: &Path) -> Result<String> {
     }
     let plain = dir.join(LOG_FILE);
     if plain.exists() {
-        text.push_str(
-            &std::fs::read_to_string(&plain)
-                .with_context(|| format!("cannot read {}", plain.display()))?,
-        );
+        text.push_str(&crate::io::read_text(&plain)?);
     }
     Ok(text)
 }
@@ -266,12 +272,16 @@ impl CellLog {
     /// opens it once, empty or not, and every cell family of the spec appends (`append`).
     pub(crate) fn open(dir: &Path, resume: bool, master_seed: u64) -> Result<CellLog> {
         let path = dir.join(LOG_FILE);
-        let file = if resume {
-            OpenOptions::new().create(true).append(true).open(&path)
+        crate::io::outdir::no_link_inside(&path)?;
+        crate::io::require_regular_or_absent(&path)?;
+        let mut opts = OpenOptions::new();
+        opts.create(true).custom_flags(libc::O_NOFOLLOW | libc::O_NONBLOCK);
+        if resume {
+            opts.append(true);
         } else {
-            File::create(&path)
+            opts.write(true).truncate(true);
         }
-        .with_context(|| format!("cannot open {}", path.display()))?;
+        let file = opts.open(&path).with_context(|| format!("cannot open {}", path.display()))?;
         Ok(CellLog { file, path, master_seed })
     }
 

@@ -201,7 +201,7 @@ fn load_specs<F: Families>(
 /// Whether a spec defines the profile (a spec without `quick` runs as it is, e.g. one that is
 /// already quick).
 fn has_profile(path: &Path, profile: &str) -> bool {
-    std::fs::read_to_string(path)
+    crate::io::read_text_of(path, crate::io::input::Kind::Toml)
         .ok()
         .and_then(|t| t.parse::<toml::Table>().ok())
         .and_then(|t| t.get("profiles").and_then(|p| p.get(profile)).map(|_| ()))
@@ -881,8 +881,7 @@ fn combined_report(
     for spec in specs {
         let name = &spec.file.name;
         let path = out.join(name).join("REPORT.md");
-        let text = std::fs::read_to_string(&path)
-            .with_context(|| format!("cannot read {}", path.display()))?;
+        let text = crate::io::read_text(&path)?;
         let _ = writeln!(s, "\n---\n\n# {name}\n");
         s.push_str(&sub_report(&text, name, &mut seen));
     }

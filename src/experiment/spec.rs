@@ -151,7 +151,12 @@ pub struct Spec {
 pub(crate) fn read_spec(path: &Path) -> Result<String, SpecError> {
     let shown = path.display().to_string();
     let bytes =
-        std::fs::read(path).map_err(|e| SpecError(format!("{shown}: cannot read spec: {e}")))?;
+        crate::io::input::read(path, crate::io::input::Kind::Toml).map_err(|e| match e {
+            crate::io::input::InputError::NotFound { .. } => {
+                SpecError(format!("{shown}: cannot read spec: no such file"))
+            }
+            e => SpecError(format!("cannot read spec: {e}")),
+        })?;
     crate::io::utf8_text(&shown, bytes).map_err(SpecError)
 }
 

@@ -3,6 +3,7 @@
 //! so a reader never sees half a file and two writers never share a temporary file (the rest of
 //! the output-folder contract is in [`crate::io::outdir`]).
 
+pub(crate) mod input;
 pub(crate) mod map_file;
 pub(crate) mod outdir;
 
@@ -11,8 +12,10 @@ use std::fs::{self, File};
 use std::io::Write;
 use std::path::Path;
 
-/// Create a folder (and parents), naming it on failure.
+/// Create a folder (and parents), naming it on failure; inside a result folder this process
+/// writes, no part of the path may be a link ([`outdir::no_link_inside`]).
 pub(crate) fn ensure_dir(dir: &Path) -> Result<()> {
+    outdir::no_link_inside(dir)?;
     fs::create_dir_all(dir).with_context(|| format!("cannot create folder {}", dir.display()))
 }
 
@@ -20,35 +23,20 @@ pub(crate) fn ensure_dir(dir: &Path) -> Result<()> {
 /// device, a pipe, a socket, a folder or a link (a link's target would not be written).
 pub(crate) fn require_regular_or_absent(path: &Path) -> Result<()> {
     let Ok(meta) = fs::symlink_metadata(path) else { return Ok(()) };
-    let ty = meta.file_type();
-    if ty.is_file() {
+    if meta.file_type().is_file() {
         return Ok(());
     }
-    let kind = {
-        use std::os::unix::fs::FileTypeExt;
-        if ty.is_dir() {
-            "a folder"
-        } else if ty.is_symlink() {
-            "a symbolic link"
-        } else if ty.is_char_device() || ty.is_block_device() {
-            "a device"
-        } else if ty.is_fifo() {
-            "a named pipe"
-        } else if ty.is_socket() {
-            "a socket"
-        } else {
-            "not a regular file"
-        }
-    };
     anyhow::bail!(
-        "cannot write {}: it is {kind}, and somnurbs replaces only regular files; name a new file",
-        path.display()
+        "cannot write {}: it is {}, and somnurbs replaces only regular files; name a new file",
+        path.display(),
+        input::kind_of(meta.file_type())
     )
 }
 
 /// Write `bytes` to `path` atomically (temporary file + rename); `path` must be a regular file or
 /// absent ([`require_regular_or_absent`]).
 pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    outdir::no_link_inside(path)?;
     require_regular_or_absent(path)?;
     if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
         ensure_dir(parent)?;
@@ -67,9 +55,15 @@ pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     crate::io::outdir::sync_dir(path.parent().unwrap_or(Path::new(".")))
 }
 
-/// Read a whole file as text, naming it on failure (a UTF-16 or binary file: [`utf8_text`]).
+/// Read a whole table or log as text ([`input::Kind::Text`]: a regular file within its limit),
+/// naming it on failure (a UTF-16 or binary file: [`utf8_text`]).
 pub(crate) fn read_text(path: &Path) -> Result<String> {
-    let bytes = fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
+    read_text_of(path, input::Kind::Text)
+}
+
+/// Read a whole input of `kind` as UTF-8 text ([`input::read`], [`utf8_text`]).
+pub(crate) fn read_text_of(path: &Path, kind: input::Kind) -> Result<String> {
+    let bytes = input::read(path, kind)?;
     utf8_text(&path.display().to_string(), bytes).map_err(anyhow::Error::msg)
 }
 
@@ -124,7 +118,7 @@ pub(crate) fn toml_message(path: &str, text: &str, e: &toml::de::Error) -> Strin
 
 /// Read and parse a TOML file; an error names the file, and the line and column where it can.
 pub(crate) fn read_toml<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T> {
-    let text = read_text(path)?;
+    let text = read_text_of(path, input::Kind::Toml)?;
     toml::from_str(&text)
         .map_err(|e| anyhow::Error::msg(toml_message(&path.display().to_string(), &text, &e)))
 }

@@ -64,6 +64,37 @@ pub(crate) fn temp_name(path: &Path, what: &str) -> PathBuf {
     path.with_file_name(format!(".{name}.{}.{n}.{what}", std::process::id()))
 }
 
+/// The result folders this process holds the lock of ([`lock`]), as given and canonical: below
+/// them no link is followed ([`no_link_inside`]).
+static ROOTS: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+fn roots() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
+    ROOTS.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
+/// Refuse `path` when, inside a result folder this process holds, it or a folder on its way is a
+/// symbolic link: a write through it would land outside the folder it was given.
+pub(crate) fn no_link_inside(path: &Path) -> Result<()> {
+    let held: Vec<PathBuf> = roots().iter().filter(|r| path.starts_with(r)).cloned().collect();
+    for root in held {
+        let Ok(rel) = path.strip_prefix(&root) else { continue };
+        let mut at = root.clone();
+        for part in rel.components() {
+            at.push(part);
+            match fs::symlink_metadata(&at) {
+                Ok(m) if m.file_type().is_symlink() => bail!(
+                    "{} is a symbolic link inside the result folder {}; somnurbs follows no link inside a result folder (remove the link, or start afresh in a new folder)",
+                    at.display(),
+                    root.display()
+                ),
+                Ok(_) => {}
+                Err(_) => break,
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Whether a file name is one [`temp_name`] made: `.NAME.PID.N.WHAT` for a temporary file
 /// (`tmp`) or folder (`staged`, `old`).
 fn is_temp_name(name: &str) -> bool {
@@ -132,7 +163,7 @@ fn describe(dir: &Path, entries: &[String]) -> String {
         shard: Option<String>,
     }
     let named = |file: &str| -> Option<Named> {
-        let text = fs::read_to_string(dir.join(file)).ok()?;
+        let text = crate::io::read_text_of(&dir.join(file), crate::io::input::Kind::Toml).ok()?;
         toml::from_str(&text).ok()
     };
     let has = |f: &str| entries.iter().any(|e| e == f);
@@ -191,8 +222,26 @@ pub(crate) fn require_empty(dir: &Path) -> Result<()> {
 /// folder or one of its parents.
 pub(crate) fn result_folder_of(path: &Path) -> Option<PathBuf> {
     let parent = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    let start = fs::canonicalize(parent).ok()?;
-    start.ancestors().find(|d| MARKERS.iter().any(|m| d.join(m).exists())).map(Path::to_path_buf)
+    // The deepest folder on the way that exists (the rest would be created inside it).
+    let start = parent.ancestors().find_map(|a| {
+        let a = if a.as_os_str().is_empty() { Path::new(".") } else { a };
+        fs::canonicalize(a).ok()
+    })?;
+    let marked = |d: &Path| MARKERS.iter().any(|m| fs::symlink_metadata(d.join(m)).is_ok());
+    start.ancestors().find(|d| marked(d)).map(Path::to_path_buf)
+}
+
+/// Refuse a new output folder `out` (given with `option`) inside a result folder: a finished run,
+/// a shard or a reproduction holds one result and nothing else, so nothing new is written into it.
+pub(crate) fn require_folder_outside_results(out: &Path, option: &str) -> Result<()> {
+    if let Some(folder) = result_folder_of(out) {
+        bail!(
+            "{option} {} is inside the result folder {}, which holds one result and nothing else; choose a folder outside it",
+            out.display(),
+            folder.display()
+        );
+    }
+    Ok(())
 }
 
 /// Refuse to write the single file `path` (e.g. `datasets export`, `drift`'s CSV) inside a result
@@ -334,6 +383,8 @@ pub(crate) struct Lock {
     path: PathBuf,
     stop: Arc<AtomicBool>,
     heartbeat: Option<std::thread::JoinHandle<()>>,
+    /// What this lock added to [`ROOTS`].
+    roots: Vec<PathBuf>,
 }
 
 impl std::fmt::Debug for Lock {
@@ -350,15 +401,9 @@ pub(crate) fn lock(dir: &Path, command: &str) -> Result<Lock> {
     }
     crate::io::ensure_dir(dir)?;
     let path = dir.join(LOCK_FILE);
-    let mut file = OpenOptions::new()
-        .read(true)
-        .write(true)
-        .create(true)
-        .truncate(false)
-        .open(&path)
-        .with_context(|| {
-            format!("output folder {} is not writable (cannot open {LOCK_FILE})", dir.display())
-        })?;
+    let mut file = open_lock_file(&path, true).with_context(|| {
+        format!("output folder {} is not writable (cannot open {LOCK_FILE})", dir.display())
+    })?;
     let refused = |who: String| {
         anyhow::anyhow!("output folder {} is in use by another writer: {who}; wait for it to finish or choose another folder", dir.display())
     };
@@ -403,7 +448,43 @@ pub(crate) fn lock(dir: &Path, command: &str) -> Result<Lock> {
             })
             .ok()
     };
-    Ok(Lock { file, path, stop, heartbeat })
+    let mut held_roots = vec![dir.to_path_buf()];
+    held_roots.extend(fs::canonicalize(dir).ok().filter(|c| c != dir));
+    roots().extend(held_roots.iter().cloned());
+    Ok(Lock { file, path, stop, heartbeat, roots: held_roots })
+}
+
+/// Open a folder's lock file (created when `create`) without following a link and without
+/// blocking (a named pipe there would hang a plain open), refusing anything but a regular file.
+fn open_lock_file(path: &Path, create: bool) -> Result<File> {
+    use std::os::unix::fs::OpenOptionsExt;
+    let mut opts = OpenOptions::new();
+    opts.read(true).custom_flags(libc::O_NOFOLLOW | libc::O_NONBLOCK);
+    if create {
+        opts.write(true).create(true).truncate(false);
+    }
+    let file = opts.open(path).map_err(|e| {
+        let link = e.raw_os_error() == Some(libc::ELOOP);
+        let e = anyhow::Error::from(e);
+        if link {
+            e.context(format!(
+                "{} is a symbolic link; somnurbs opens no lock through a link (remove it)",
+                path.display()
+            ))
+        } else {
+            e.context(format!("cannot open {}", path.display()))
+        }
+    })?;
+    let ty =
+        file.metadata().with_context(|| format!("cannot read {}", path.display()))?.file_type();
+    if !ty.is_file() {
+        bail!(
+            "{} is {}, not a regular file; remove it (somnurbs keeps its lock record there)",
+            path.display(),
+            crate::io::input::kind_of(ty)
+        );
+    }
+    Ok(file)
 }
 
 fn write_record(file: &mut File, text: &str) -> std::io::Result<()> {
@@ -422,13 +503,22 @@ impl Drop for Lock {
         }
         // An empty record says "released"; the flock goes with the file descriptor.
         let _ = self.file.set_len(0);
+        let mut held = roots();
+        for r in &self.roots {
+            if let Some(k) = held.iter().position(|h| h == r) {
+                held.remove(k);
+            }
+        }
     }
 }
 
 /// Refuse to read a folder a live writer holds (a shared flock that would wait, or a live record).
 pub(crate) fn require_not_being_written(dir: &Path) -> Result<()> {
     let path = dir.join(LOCK_FILE);
-    let Ok(mut file) = File::open(&path) else { return Ok(()) };
+    if fs::symlink_metadata(&path).is_err() {
+        return Ok(());
+    }
+    let mut file = open_lock_file(&path, false)?;
     let held = match try_flock(&file, libc::LOCK_SH)
         .with_context(|| format!("cannot check the lock {}", path.display()))?
     {

@@ -630,8 +630,7 @@ pub(crate) fn compare_dirs(
         }
         let read = |root: &Path| -> Result<Table> {
             let p = root.join(t);
-            let text = std::fs::read_to_string(&p)
-                .with_context(|| format!("cannot read {}", p.display()))?;
+            let text = crate::io::read_text(&p)?;
             Table::parse(&p.display().to_string(), &text)
         };
         compare_table(&name, &read(baseline)?, &read(current)?, opts, &mut report);
@@ -666,15 +665,13 @@ pub(crate) fn accept(baseline: &Path, current: &Path) -> Result<Vec<String>> {
             .iter()
             .filter(|f| !tc.contains(f) && !tb.contains(f) && !files.contains(f) && !lock(f))
         {
-            let text = std::fs::read(baseline.join(f))
-                .with_context(|| format!("cannot read {}", baseline.join(f).display()))?;
+            let text = crate::io::input::read(&baseline.join(f), crate::io::input::Kind::Text)?;
             write_atomic(&staged.join(f), &text)?;
         }
         // ... then the current run's tables and manifests.
         for f in &files {
-            let text = std::fs::read(current.join(f))
-                .with_context(|| format!("cannot read {}", current.join(f).display()))?;
-            let old = std::fs::read(baseline.join(f)).ok();
+            let text = crate::io::input::read(&current.join(f), crate::io::input::Kind::Text)?;
+            let old = crate::io::input::read(&baseline.join(f), crate::io::input::Kind::Text).ok();
             write_atomic(&staged.join(f), &text)?;
             if old.as_deref() != Some(&text[..]) {
                 said.push(format!(

@@ -10,6 +10,7 @@ mod drift;
 mod exact_certificate;
 mod folders;
 mod fuzz;
+mod hostile;
 mod html_report;
 mod own_data;
 mod resume;

@@ -135,6 +135,7 @@ pub(crate) fn fit(args: &FitArgs) -> Result<()> {
     let out = &args.out;
     // Every input has loaded: the folder is this command's (one writer at a time), and a fit
     // folder, like a run's, holds one result: it must be missing or empty.
+    crate::io::outdir::require_folder_outside_results(out, "--out")?;
     let _lock = crate::io::outdir::lock(out, "fit")?;
     crate::io::outdir::require_empty(out)?;
     if let Some(line) = &export.warn {

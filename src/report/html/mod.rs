@@ -41,7 +41,9 @@ pub(crate) fn write(root: &Path) -> Result<PathBuf> {
     let page = build(root)?;
     if !page.view_folders.is_empty() {
         let js = root.join(PLOTLY_PATH);
-        let fresh = std::fs::read(&js).map(|b| b == PLOTLY_JS).unwrap_or(false);
+        let fresh = crate::io::input::read(&js, crate::io::input::Kind::Text)
+            .map(|b| b == PLOTLY_JS)
+            .unwrap_or(false);
         if !fresh {
             write_atomic(&js, PLOTLY_JS)?;
             write_atomic(&root.join("vendor/plotly-LICENSE.txt"), PLOTLY_LICENSE)?;

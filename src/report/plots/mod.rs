@@ -105,6 +105,8 @@ where
     // The temporary sibling every writer uses (`.NAME.PID.N.tmp`: a resumed run removes one a
     // kill left behind).
     let tmp = crate::io::outdir::temp_name(path, "tmp");
+    crate::io::outdir::no_link_inside(path)
+        .map_err(|e| PlotError::input(path, format!("{e:#}")))?;
     let folder = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
@@ -158,7 +160,12 @@ where
         path: path.to_path_buf(),
         source: DrawError::Backend(format!("cannot encode the PNG: {e}")),
     })?;
-    if let Err(source) = std::fs::write(&tmp, &bytes) {
+    let written = std::fs::File::options()
+        .write(true)
+        .create_new(true)
+        .open(&tmp)
+        .and_then(|mut f| std::io::Write::write_all(&mut f, &bytes));
+    if let Err(source) = written {
         let _ = std::fs::remove_file(&tmp);
         return Err(PlotError::Io {
             path: path.to_path_buf(),
