@@ -129,8 +129,45 @@ fn sample_stl(bytes: &[u8], n: usize, seed: u64, shown: &str) -> Result<Vec<Poin
 
 /// Load a data set by name or path (`Loader::load`): paths relative to the working folder,
 /// normalised per axis (the thesis).
+/// No spec is involved, so a missing file's hint names the working folder, not a spec.
 pub fn load_dataset(name: &str, data_dir: &Path) -> Result<PointCloud, DataError> {
-    Loader { data_dir: data_dir.to_path_buf(), ..Loader::default() }.load(name)
+    let loader = Loader { data_dir: data_dir.to_path_buf(), ..Loader::default() };
+    loader.load(name).map_err(|e| match e {
+        DataError::Missing { path, .. } if !BUILTIN.contains(&name) => DataError::Missing {
+            path,
+            hint: "A relative path is read from the working folder; `somnurbs datasets list` \
+                   names the built-in data sets."
+                .into(),
+        },
+        other => other,
+    })
+}
+
+/// What a path that is there but is not a regular file is (`a folder`, `a FIFO`, ...); `None`
+/// for a regular file or a path that is not there. Nothing is opened.
+fn not_a_file(path: &Path) -> Option<&'static str> {
+    let meta = std::fs::metadata(path).ok()?;
+    let kind = meta.file_type();
+    if kind.is_file() {
+        return None;
+    }
+    if kind.is_dir() {
+        return Some("a folder");
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if kind.is_fifo() {
+            return Some("a FIFO (named pipe)");
+        }
+        if kind.is_char_device() || kind.is_block_device() {
+            return Some("a device");
+        }
+        if kind.is_socket() {
+            return Some("a socket");
+        }
+    }
+    Some("not a regular file")
 }
 
 /// How a spec's data sets load: the folder of the data files (bunny, talus), the folder a
@@ -159,6 +196,13 @@ impl Loader {
         }
         dataset_name(entry)?;
         let path = self.resolve(entry)?;
+        if let Some(kind) = not_a_file(&path) {
+            return Err(DataError::Invalid(format!(
+                "{} is {kind}, not a data file (name a .ply, .stl, .off, .obj, .xyz, .csv or \
+                 .txt file)",
+                path.display()
+            )));
+        }
         if !path.is_file() {
             return Err(DataError::Missing { path: path.display().to_string(), hint: format!("The spec names `{entry}`; a relative data-set path is read from the spec's folder ({}).", if self.base.as_os_str().is_empty() { ".".into() } else { self.base.display().to_string() }) });
         }
@@ -325,6 +369,30 @@ mod tests {
         );
         let e = load_dataset("teapot", Path::new(".")).unwrap_err().to_string();
         assert!(e.contains("teapot") && e.contains("cube"), "{e}");
+    }
+
+    /// A path that is there but is no regular file is named for what it is (checked without
+    /// opening it), and a missing one outside a spec mentions no spec.
+    #[test]
+    fn a_path_that_is_no_regular_file_says_what_it_is() {
+        let dir = tempfile::tempdir().unwrap();
+        let folder = dir.path().join("scans.xyz");
+        std::fs::create_dir(&folder).unwrap();
+        let null = dir.path().join("null.xyz");
+        std::os::unix::fs::symlink("/dev/null", &null).unwrap();
+        for (path, kind) in [(&folder, "a folder"), (&null, "a device")] {
+            let shown = path.display().to_string();
+            let e = load_dataset(&shown, dir.path()).unwrap_err().to_string();
+            let want = format!("{shown} is {kind}, not a data file (name a .ply,");
+            assert!(e.starts_with(&want) && !e.contains("spec"), "{e}");
+            let own = Loader { base: dir.path().to_path_buf(), ..Loader::default() };
+            let e = own.require_file(&shown).unwrap_err().to_string();
+            assert!(e.starts_with(&want), "{e}");
+        }
+        let none = dir.path().join("none.xyz").display().to_string();
+        let e = load_dataset(&none, dir.path()).unwrap_err().to_string();
+        assert!(e.contains("data file not found") && e.contains("working folder"), "{e}");
+        assert!(!e.contains("spec"), "{e}");
     }
 
     #[test]
