@@ -12,6 +12,7 @@ mod folders;
 mod fuzz;
 mod html_report;
 mod own_data;
+mod plans;
 mod resume;
 mod robust;
 mod seed001;
