@@ -7,8 +7,9 @@ use super::{DataError, Normalise};
 use crate::geom::Point3;
 use serde::{Deserialize, Serialize};
 
-/// Data = `offset + scale * normalised`, axis by axis (x, y, z). An axis of zero range (mapped to
-/// 0 by the normalisation) has scale 0, so it maps back to its one value.
+/// Data = `offset + scale * normalised`, axis by axis (x, y, z). Every scale is finite and above
+/// 0; an axis of zero range (mapped to 0 by the normalisation) has scale 1, so its normalised 0
+/// maps back to its one value, the offset.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Frame {
@@ -33,11 +34,12 @@ impl Frame {
         let (offset, scale) = match (normalise, crate::geom::bounding_box(points)) {
             (Normalise::None, _) | (_, None) => ([0.0; 3], [1.0; 3]),
             (Normalise::PerAxis, Some((lo, hi))) => {
-                (lo, [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]].map(|r| r.max(0.0)))
+                let range = [0, 1, 2].map(|a| hi[a] - lo[a]);
+                (lo, range.map(|r| if r > 0.0 { r } else { 1.0 }))
             }
             (Normalise::Uniform, Some((lo, hi))) => {
                 let range = (0..3).map(|a| hi[a] - lo[a]).fold(0.0, f64::max);
-                (lo, [range; 3])
+                (lo, [if range > 0.0 { range } else { 1.0 }; 3])
             }
         };
         Frame { dataset: dataset.to_string(), source: source.to_string(), normalise, offset, scale }
@@ -57,7 +59,9 @@ impl Frame {
         ))
     }
 
-    /// Parse a frame file's text; offsets and scales must be finite, scales not negative.
+    /// Parse a frame file's text; every offset must be finite, every scale finite and above 0
+    /// (a zero scale would send every exported point of that axis to the offset). An error names
+    /// the key and the axis.
     pub fn parse(text: &str) -> Result<Frame, DataError> {
         let f: Frame = toml::from_str(text).map_err(|e| {
             let line = e
@@ -68,10 +72,17 @@ impl Frame {
             DataError::parse(line, e.message().to_string())
         })?;
         for (a, axis) in ["x", "y", "z"].iter().enumerate() {
-            if !(f.offset[a].is_finite() && f.scale[a].is_finite() && f.scale[a] >= 0.0) {
+            let (offset, scale) = (f.offset[a], f.scale[a]);
+            if !offset.is_finite() {
                 return Err(DataError::Invalid(format!(
-                    "the {axis} offset ({}) or scale ({}) is not a finite number (scale >= 0)",
-                    f.offset[a], f.scale[a]
+                    "offset: the {axis} offset is {offset}; a frame's offsets must be finite \
+                     numbers (data = offset + scale * map)"
+                )));
+            }
+            if !(scale.is_finite() && scale > 0.0) {
+                return Err(DataError::Invalid(format!(
+                    "scale: the {axis} scale is {scale}; a frame's scales must be finite and above \
+                     0 (data = offset + scale * map; 1 for a flat axis)"
                 )));
             }
         }
@@ -121,10 +132,12 @@ mod tests {
         assert_eq!((f.offset, f.scale), ([-3.0, 10.0, 0.0], [8.0, 1.0, 100.0]));
         let u = Frame::of(Normalise::Uniform, &cloud(), "c", "c.xyz");
         assert_eq!(u.scale, [100.0; 3]);
-        // A flat axis maps back to its one value.
+        // A flat axis has scale 1 (a frame the parser takes) and maps back to its one value.
         let flat = vec![[0.0, 2.0, 1.0], [1.0, 2.0, 3.0]];
         let f = Frame::of(Normalise::PerAxis, &flat, "f", GENERATED);
+        assert_eq!(f.scale, [1.0, 1.0, 2.0]);
         assert_eq!(f.to_data([0.5, 0.0, 0.5]), [0.5, 2.0, 2.0]);
+        assert_eq!(Frame::parse(&f.to_toml("f.csv").unwrap()).unwrap(), f);
     }
 
     #[test]
@@ -142,12 +155,26 @@ mod tests {
         assert!(e.contains("line") && e.contains("cube"), "{e}");
         let e = Frame::parse(&format!("{text}units = \"mm\"\n")).unwrap_err().to_string();
         assert!(e.contains("line 7") && e.contains("units"), "{e}");
-        let bad: Vec<&str> = text
-            .lines()
-            .map(|l| if l.starts_with("scale") { "scale = [-2.0, 1.0, 1.0]" } else { l })
-            .collect();
-        let e = Frame::parse(&bad.join("\n")).unwrap_err().to_string();
-        assert!(e.contains("x offset"), "{e}");
+        let with = |key: &str, line: &str| -> String {
+            let lines: Vec<&str> =
+                text.lines().map(|l| if l.starts_with(key) { line } else { l }).collect();
+            match Frame::parse(&lines.join("\n")) {
+                Ok(f) => panic!("{line}: taken as {f:?}"),
+                Err(e) => e.to_string(),
+            }
+        };
+        for (line, want) in [
+            ("scale = [-2.0, 1.0, 1.0]", "scale: the x scale is -2;"),
+            ("scale = [0, 0, 0]", "scale: the x scale is 0;"),
+            ("scale = [1.0, 0.0, 1.0]", "scale: the y scale is 0;"),
+            ("scale = [1.0, 1.0, nan]", "scale: the z scale is NaN;"),
+            ("scale = [1.0, inf, 1.0]", "scale: the y scale is inf;"),
+        ] {
+            let e = with("scale", line);
+            assert!(e.contains(want) && e.contains("finite and above 0"), "{line}: {e}");
+        }
+        let e = with("offset", "offset = [0.0, -inf, 1.0]");
+        assert!(e.contains("offset: the y offset is -inf;"), "{e}");
         assert_eq!(
             sidecar(std::path::Path::new("maps/dnsom_a_6x6.csv")),
             std::path::Path::new("maps/dnsom_a_6x6.frame.toml")

@@ -105,8 +105,20 @@ fn read(path: &Path, hint: &str) -> Result<Vec<u8>, DataError> {
         InputError::NotFound { .. } => {
             DataError::Missing { path: path.display().to_string(), hint: hint.to_string() }
         }
-        e => DataError::Invalid(e.to_string()),
+        e => input_error(e),
     })
+}
+
+/// A data file that could not be read: one that is there but is no regular file is named for
+/// what it is (checked without opening it).
+fn input_error(e: crate::io::input::InputError) -> DataError {
+    use crate::io::input::InputError;
+    match e {
+        InputError::NotRegular { path, what } => DataError::Invalid(format!(
+            "{path} is {what}, not a data file (name a .ply, .stl, .off, .obj, .xyz, .csv or .txt file)"
+        )),
+        e => DataError::Invalid(e.to_string()),
+    }
 }
 
 fn where_to_get(file: &str) -> String {
@@ -129,8 +141,18 @@ fn sample_stl(bytes: &[u8], n: usize, seed: u64, shown: &str) -> Result<Vec<Poin
 
 /// Load a data set by name or path (`Loader::load`): paths relative to the working folder,
 /// normalised per axis (the thesis).
+/// No spec is involved, so a missing file's hint names the working folder, not a spec.
 pub fn load_dataset(name: &str, data_dir: &Path) -> Result<PointCloud, DataError> {
-    Loader { data_dir: data_dir.to_path_buf(), ..Loader::default() }.load(name)
+    let loader = Loader { data_dir: data_dir.to_path_buf(), ..Loader::default() };
+    loader.load(name).map_err(|e| match e {
+        DataError::Missing { path, .. } if !BUILTIN.contains(&name) => DataError::Missing {
+            path,
+            hint: "A relative path is read from the working folder; `somnurbs datasets list` \
+                   names the built-in data sets."
+                .into(),
+        },
+        other => other,
+    })
 }
 
 /// How a spec's data sets load: the folder of the data files (bunny, talus), the folder a
@@ -163,7 +185,7 @@ impl Loader {
         match input::check(&path, Kind::Data) {
             Ok(()) => {}
             Err(InputError::NotFound { .. }) => return Err(DataError::Missing { path: path.display().to_string(), hint: format!("The spec names `{entry}`; a relative data-set path is read from the spec's folder ({}).", if self.base.as_os_str().is_empty() { ".".into() } else { self.base.display().to_string() }) }),
-            Err(e) => return Err(DataError::Invalid(e.to_string())),
+            Err(e) => return Err(input_error(e)),
         }
         Ok(())
     }
@@ -328,6 +350,30 @@ mod tests {
         );
         let e = load_dataset("teapot", Path::new(".")).unwrap_err().to_string();
         assert!(e.contains("teapot") && e.contains("cube"), "{e}");
+    }
+
+    /// A path that is there but is no regular file is named for what it is (checked without
+    /// opening it), and a missing one outside a spec mentions no spec.
+    #[test]
+    fn a_path_that_is_no_regular_file_says_what_it_is() {
+        let dir = tempfile::tempdir().unwrap();
+        let folder = dir.path().join("scans.xyz");
+        std::fs::create_dir(&folder).unwrap();
+        let null = dir.path().join("null.xyz");
+        std::os::unix::fs::symlink("/dev/null", &null).unwrap();
+        for (path, kind) in [(&folder, "a folder"), (&null, "a device")] {
+            let shown = path.display().to_string();
+            let e = load_dataset(&shown, dir.path()).unwrap_err().to_string();
+            let want = format!("{shown} is {kind}, not a data file (name a .ply,");
+            assert!(e.starts_with(&want) && !e.contains("spec"), "{e}");
+            let own = Loader { base: dir.path().to_path_buf(), ..Loader::default() };
+            let e = own.require_file(&shown).unwrap_err().to_string();
+            assert!(e.starts_with(&want), "{e}");
+        }
+        let none = dir.path().join("none.xyz").display().to_string();
+        let e = load_dataset(&none, dir.path()).unwrap_err().to_string();
+        assert!(e.contains("data file not found") && e.contains("working folder"), "{e}");
+        assert!(!e.contains("spec"), "{e}");
     }
 
     #[test]

@@ -62,6 +62,9 @@ fn same_value(a: &toml::Value, b: &toml::Value) -> bool {
     }
 }
 
+/// What the note on a `--set`/`--sweep` key with a former section name names in place of a file.
+const KEYS_NOTED_AS: &str = "--set/--sweep";
+
 impl CliOverrides {
     pub fn is_empty(&self) -> bool {
         self.set.is_empty() && self.sweep.is_empty()
@@ -126,15 +129,19 @@ impl CliOverrides {
         }
         let flags =
             self.set.iter().map(|a| ("--set", a)).chain(self.sweep.iter().map(|a| ("--sweep", a)));
-        let mut seen: Vec<String> = Vec::new();
+        let mut seen: Vec<(&str, String)> = Vec::new();
+        let mut renamed = Vec::new();
         for (flag, arg) in flags {
             let (key, _) = Self::split(flag, arg)?;
-            if seen.iter().any(|k| k == key) {
-                return Err(SpecError(format!(
-                    "{flag} {key}: the key is given twice (--set and --sweep take each key once)"
-                )));
+            let canonical = super::renamed::canonical_key::<F>(key);
+            if let Some((before, _)) = seen.iter().find(|(_, c)| *c == canonical) {
+                let why = super::renamed::both_spellings::<F>(before, key).unwrap_or_else(|| {
+                    "the key is given twice (--set and --sweep take each key once)".into()
+                });
+                return Err(SpecError(format!("{flag} {key}: {why}")));
             }
-            seen.push(key.to_string());
+            seen.push((key, canonical.clone().into_owned()));
+            renamed.extend(super::renamed::renamed_key::<F>(key).map(|(_, pair)| pair));
             // The sections that take --set/--sweep, as the families declare them.
             let takers: Vec<_> =
                 F::all().iter().filter_map(|f| f.overrides().map(|o| (*f, o))).collect();
@@ -143,7 +150,6 @@ impl CliOverrides {
                 .map(|(f, _)| format!("[{0}] section ({0}.KEY)", f.section()))
                 .collect::<Vec<_>>()
                 .join(", ");
-            let canonical = super::renamed::canonical_key::<F>(key);
             let section = canonical.split('.').next().unwrap_or("");
             let Some((family, ov)) = takers.iter().find(|(f, _)| f.section() == section) else {
                 return Err(SpecError(format!(
@@ -156,7 +162,7 @@ impl CliOverrides {
                      specs with one)"
                 )));
             }
-            if flag == "--sweep" && !ov.sweepable(key) {
+            if flag == "--sweep" && !ov.sweepable(&canonical) {
                 return Err(SpecError(format!("{flag} {key}: a sweep varies optimiser settings only ({}), so that every variant solves the same problems", ov.describe())));
             }
         }
@@ -190,7 +196,7 @@ impl CliOverrides {
                 .collect();
         }
         let mut cells = 0u64;
-        combos
+        let loaded: Vec<Loaded<F>> = combos
             .into_iter()
             .map(|swept| {
                 let overrides: Vec<Override> = set
@@ -215,7 +221,10 @@ impl CliOverrides {
                 spec.spec.variant = Variant { set: pairs(&set), swept: pairs(&swept) };
                 Ok(spec)
             })
-            .collect()
+            .collect::<Result<_, SpecError>>()?;
+        // Said once the keys are taken, so that a refusal stays one line.
+        super::renamed::note(KEYS_NOTED_AS, &renamed);
+        Ok(loaded)
     }
 }
 

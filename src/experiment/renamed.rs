@@ -113,10 +113,34 @@ pub(crate) fn canonical_text<F: Families>(
 /// A `--set`/`--sweep`/reading-set key with a former section name replaced (`optim.de.f` ->
 /// `optimise.de.f`).
 pub(crate) fn canonical_key<F: Families>(key: &str) -> Cow<'_, str> {
-    match rename_at(key, 0, F::renamed()) {
+    match renamed_key::<F>(key) {
         Some((new, _)) => Cow::Owned(new),
         None => Cow::Borrowed(key),
     }
+}
+
+/// A key whose section is a former name: the key under the present name and the (old, new)
+/// pair, for [`note`]; `None` for a key written with the present name.
+pub(crate) fn renamed_key<F: Families>(
+    key: &str,
+) -> Option<(String, (&'static str, &'static str))> {
+    rename_at(key, 0, F::renamed())
+}
+
+/// The message for one key written under both its former and its present section name (`optim.de.f`
+/// and `optimise.de.f`): the two spellings and the rename, `None` when `a` and `b` are not
+/// such a pair.
+pub(crate) fn both_spellings<F: Families>(a: &str, b: &str) -> Option<String> {
+    if a == b || canonical_key::<F>(a) != canonical_key::<F>(b) {
+        return None;
+    }
+    // The former spelling first, whichever came first.
+    let (former, present) = if renamed_key::<F>(a).is_some() { (a, b) } else { (b, a) };
+    let (old, new) = renamed_key::<F>(former)?.1;
+    Some(format!(
+        "`{former}` and `{present}` are one key ([{old}] is the former name of [{new}]); give it \
+         once"
+    ))
 }
 
 /// Say once per file and former name that the name changed.

@@ -73,11 +73,53 @@ fn default_title() -> String {
     "reproduction of the thesis".into()
 }
 
+/// Where each entry of a plan's `specs` is written in its file (for messages).
+#[derive(Deserialize)]
+struct SpecSpans {
+    specs: Vec<toml::Spanned<String>>,
+}
+
+/// Why `name` cannot name a spec of a plan: a spec is the file `<name>.toml` in the plan's own
+/// folder, so a name holds no folder part (no `/` or `\`, not `.` or `..`, not absolute) and
+/// nothing outside that folder is read.
+fn spec_name_fault(name: &str) -> Option<&'static str> {
+    if name.trim().is_empty() {
+        Some("is empty")
+    } else if Path::new(name).is_absolute() {
+        Some("is an absolute path")
+    } else if name.contains(['/', '\\']) {
+        Some("holds a folder part")
+    } else if name == "." || name == ".." {
+        Some("is a folder")
+    } else {
+        None
+    }
+}
+
 impl Plan {
     pub(crate) fn load(path: &Path) -> Result<Plan> {
-        let plan: Plan = crate::io::read_toml(path)?;
+        let text = crate::io::read_text_of(path, crate::io::input::Kind::Toml)?;
+        let shown = path.display().to_string();
+        let plan: Plan = toml::from_str(&text)
+            .map_err(|e| anyhow::Error::msg(crate::io::toml_message(&shown, &text, &e)))?;
         if plan.specs.is_empty() {
-            anyhow::bail!("{}: specs: is empty", path.display());
+            anyhow::bail!("{shown}: specs: is empty");
+        }
+        if let Some((k, fault)) =
+            plan.specs.iter().enumerate().find_map(|(k, s)| spec_name_fault(s).map(|f| (k, f)))
+        {
+            let line = toml::from_str::<SpecSpans>(&text)
+                .ok()
+                .and_then(|s| s.specs.get(k).map(|s| s.span().start))
+                .map(|at| format!("{}:", text[..at.min(text.len())].matches('\n').count() + 1))
+                .unwrap_or_default();
+            anyhow::bail!(
+                "{shown}:{line} specs: `{}` {fault}; a plan runs only the specs in its own folder, \
+                 each named by its file name without .toml (no `/`, `\\`, `.` or `..`): copy the \
+                 spec into {} and name it there",
+                plan.specs[k],
+                path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new(".")).display()
+            );
         }
         if let Some(s) = twice(&plan.specs) {
             anyhow::bail!("{}: specs: `{s}` is listed twice", path.display());
@@ -110,6 +152,15 @@ impl Plan {
                     "{}: readings.{}.specs: `{s}` is not one of the plan's specs",
                     path.display(),
                     r.name
+                );
+            }
+            if r.specs.is_empty() {
+                anyhow::bail!(
+                    "{}: readings.{}.specs: is empty; list the plan's specs this set runs again \
+                     (e.g. specs = [\"{}\"]) or remove the set",
+                    path.display(),
+                    r.name,
+                    plan.specs[0]
                 );
             }
             if r.set.is_empty() {
@@ -162,16 +213,97 @@ fn check_specs<F: Families>(
 }
 
 /// Load every spec of the plan (all before any runs, so a bad one stops nothing half-way), with
-/// the maps of the later ones pointed at `<out>/<maps_from>/maps`; `names` and `overrides` select
-/// a reading set's specs and apply its keys.
+/// the maps of the later ones pointed at `<out>/<maps_from>/maps`.
 fn load_specs<F: Families>(
+    dir: &Path,
+    plan: &Plan,
+    profile: Option<&str>,
+    out: &Path,
+) -> Result<Vec<Loaded<F>>> {
+    let loaded = load_reached(dir, plan, &plan.specs, &[], profile, out)?;
+    Ok(loaded.into_iter().map(|(spec, _)| spec).collect())
+}
+
+/// A reading set's keys: none written under both its former and its present section name
+/// (`optim.de.f` and `optimise.de.f`). Returns the former names they use, for the note.
+fn check_set_keys<F: Families>(
+    plan_path: &Path,
+    plan: &Plan,
+) -> Result<Vec<(&'static str, &'static str)>> {
+    let mut renamed = Vec::new();
+    for r in &plan.readings {
+        let keys: Vec<&String> = r.set.keys().collect();
+        for (k, key) in keys.iter().enumerate() {
+            let both = keys[..k].iter().find_map(|b| super::renamed::both_spellings::<F>(b, key));
+            if let Some(both) = both {
+                anyhow::bail!("{}: readings.{}.set: {both}", plan_path.display(), r.name);
+            }
+            renamed.extend(super::renamed::renamed_key::<F>(key).map(|(_, pair)| pair));
+        }
+    }
+    Ok(renamed)
+}
+
+/// The specs of the reading set `r` with its keys applied. Every key changes at least one of
+/// them, and each of them is changed by at least one key: a set would otherwise run a spec as
+/// written (or carry a key that does nothing) and list the run as a reading.
+fn load_reading<F: Families>(
+    dir: &Path,
+    plan_path: &Path,
+    plan: &Plan,
+    r: &ReadingSet,
+    profile: Option<&str>,
+    out: &Path,
+) -> Result<Vec<Loaded<F>>> {
+    let overrides = r.overrides();
+    let loaded = load_reached::<F>(dir, plan, &r.specs, &overrides, profile, out)?;
+    let section = |spec: &Loaded<F>| spec.family().section();
+    let idle: Vec<String> = (overrides.iter().enumerate())
+        .filter(|(k, _)| loaded.iter().all(|(_, reached)| !reached[*k]))
+        .map(|(_, o)| format!("`{}`", o.key))
+        .collect();
+    if !idle.is_empty() {
+        let has: Vec<String> = r
+            .specs
+            .iter()
+            .zip(&loaded)
+            .map(|(n, (s, _))| format!("{n}: [{}]", section(s)))
+            .collect();
+        anyhow::bail!(
+            "{}: readings.{}.set: {} {} none of the set's specs ({}); name keys of their \
+             sections, or list the specs the {} for",
+            plan_path.display(),
+            r.name,
+            idle.join(", "),
+            if idle.len() == 1 { "changes" } else { "change" },
+            has.join(", "),
+            if idle.len() == 1 { "key is" } else { "keys are" }
+        );
+    }
+    let unchanged = r.specs.iter().zip(&loaded).find(|(_, (_, reached))| !reached.contains(&true));
+    if let Some((name, (spec, _))) = unchanged {
+        anyhow::bail!(
+            "{}: readings.{}.specs: none of the set's keys changes `{name}` (its section is [{}]), \
+             so it would run as written; remove it from the set or add a key of [{}]",
+            plan_path.display(),
+            r.name,
+            section(spec),
+            section(spec)
+        );
+    }
+    Ok(loaded.into_iter().map(|(spec, _)| spec).collect())
+}
+
+/// The specs `names` of the plan with `overrides` applied, each with which overrides reached it
+/// ([`Loaded::parse_reaching`]).
+fn load_reached<F: Families>(
     dir: &Path,
     plan: &Plan,
     names: &[String],
     overrides: &[Override],
     profile: Option<&str>,
     out: &Path,
-) -> Result<Vec<Loaded<F>>> {
+) -> Result<Vec<(Loaded<F>, Vec<bool>)>> {
     // Absolute: a relative `maps` would resolve against the spec's folder, this one is the run's.
     let maps = plan.maps_from.as_ref().map(|m| {
         let dir = out.join(m).join("maps");
@@ -183,7 +315,7 @@ fn load_specs<F: Families>(
             let path = dir.join(format!("{name}.toml"));
             let shown = path.display().to_string();
             let text = super::spec::read_spec(&path)?;
-            let mut spec = Loaded::<F>::parse_with(
+            let (mut spec, reached) = Loaded::<F>::parse_reaching(
                 &shown,
                 &text,
                 profile.filter(|p| has_profile(&path, p)),
@@ -193,7 +325,7 @@ fn load_specs<F: Families>(
                 let family = spec.family();
                 family.use_maps(&mut spec.section, maps);
             }
-            Ok(spec)
+            Ok((spec, reached))
         })
         .collect()
 }
@@ -274,19 +406,18 @@ pub(crate) fn reproduce<F: Families>(
         );
     }
     let plan = Plan::load(&plan_path)?;
+    let renamed = check_set_keys::<F>(&plan_path, &plan)?;
     let rerun = reproduce_command(specs_dir, plan_name, profile, &ctx.out);
     let ctx = &RunContext { rerun: Some(rerun.clone()), ..ctx.clone() };
     let profile = if profile == "full" { None } else { Some(profile) };
-    let specs = load_specs(specs_dir, &plan, &plan.specs, &[], profile, &ctx.out)?;
-    let specs: Vec<Loaded<F>> = specs;
+    let specs: Vec<Loaded<F>> = load_specs(specs_dir, &plan, profile, &ctx.out)?;
     let reading_specs: Vec<(&ReadingSet, Vec<Loaded<F>>)> = plan
         .readings
         .iter()
-        .map(|r| {
-            Ok((r, load_specs(specs_dir, &plan, &r.specs, &r.overrides(), profile, &ctx.out)?))
-        })
+        .map(|r| Ok((r, load_reading(specs_dir, &plan_path, &plan, r, profile, &ctx.out)?)))
         .collect::<Result<_>>()?;
     check_specs(&plan_path, &specs, &reading_specs)?;
+    super::renamed::note(&plan_path.display().to_string(), &renamed);
     // Every data set of every spec loads before the folder changes (a bad --data-dir changes nothing).
     for spec in &specs {
         for d in super::limits::dataset_entries(spec) {
@@ -975,19 +1106,14 @@ mod tests {
         for plan_name in ["thesis", "seeds", "all"] {
             let path = dir.join(format!("{plan_name}.toml"));
             let plan = Plan::load(&path).unwrap();
+            assert!(check_set_keys::<crate::families::Section>(&path, &plan).unwrap().is_empty());
             for profile in [None, Some("quick")] {
                 let specs: Vec<Loaded<crate::families::Section>> =
-                    load_specs(&dir, &plan, &plan.specs, &[], profile, out).unwrap();
+                    load_specs(&dir, &plan, profile, out).unwrap();
                 let readings: Vec<(&ReadingSet, Vec<_>)> = plan
                     .readings
                     .iter()
-                    .map(|r| {
-                        (
-                            r,
-                            load_specs(&dir, &plan, &r.specs, &r.overrides(), profile, out)
-                                .unwrap(),
-                        )
-                    })
+                    .map(|r| (r, load_reading(&dir, &path, &plan, r, profile, out).unwrap()))
                     .collect();
                 let all = specs.iter().chain(readings.iter().flat_map(|(_, r)| r));
                 let cells: u64 = all.map(super::super::limits::cell_count).sum();
@@ -997,8 +1123,7 @@ mod tests {
             }
         }
         let plan = Plan::load(&dir.join("thesis.toml")).unwrap();
-        let specs: Vec<crate::families::Loaded> =
-            load_specs(&dir, &plan, &plan.specs, &[], None, out).unwrap();
+        let specs: Vec<crate::families::Loaded> = load_specs(&dir, &plan, None, out).unwrap();
         let twice = [specs[0].clone(), specs[1].clone(), specs[0].clone()];
         let e = check_specs(Path::new("p.toml"), &twice, &[]).unwrap_err().to_string();
         assert!(
@@ -1016,6 +1141,48 @@ mod tests {
         check_specs(Path::new("p.toml"), &big[..10], &[]).unwrap();
         let e = check_specs(Path::new("p.toml"), &big, &[]).unwrap_err().to_string();
         assert!(e.contains("1100000 cells in all, above the limit 1000000"), "{e}");
+    }
+
+    /// A plan names only the specs of its own folder; a reading set lists its specs and writes
+    /// each key once, under one of its spellings.
+    #[test]
+    fn plan_names_stay_in_their_folder_and_reading_sets_are_whole() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("p.toml");
+        let load = |text: &str| {
+            std::fs::write(&path, text).unwrap();
+            Plan::load(&path)
+        };
+        for (name, fault) in [
+            ("../x", "holds a folder part"),
+            ("sub/x", "holds a folder part"),
+            ("a\\b", "holds a folder part"),
+            ("/abs/x", "is an absolute path"),
+            ("..", "is a folder"),
+            (".", "is a folder"),
+            (" ", "is empty"),
+        ] {
+            let e = load(&format!("title = 't'\nspecs = ['a',\n '{name}']\n")).unwrap_err();
+            let want = format!("p.toml:3: specs: `{name}` {fault}; a plan runs only the specs");
+            assert!(e.to_string().contains(&want), "{e}");
+        }
+        assert!(load("specs = ['a', 'b.c', '...']").is_ok());
+        let set = |keys: &str, specs: &str| {
+            format!(
+                "specs = ['a']\n[[readings]]\nname = 'r'\nset = {{ {keys} }}\nspecs = {specs}\n"
+            )
+        };
+        let e = load(&set("'x.y' = 1", "[]")).unwrap_err().to_string();
+        assert!(e.contains("p.toml: readings.r.specs: is empty; list the plan's specs"), "{e}");
+        type S = crate::families::Section;
+        let plan = load(&set("'optim.de.f' = 1, 'som.iterations' = 2", "['a']")).unwrap();
+        assert_eq!(check_set_keys::<S>(&path, &plan).unwrap(), [("optim", "optimise")]);
+        let plan = load(&set("'optimise.de.f' = 1, 'optim.de.f' = 2", "['a']")).unwrap();
+        let e = check_set_keys::<S>(&path, &plan).unwrap_err().to_string();
+        assert!(
+            e.contains("p.toml: readings.r.set: `optim.de.f` and `optimise.de.f` are one key"),
+            "{e}"
+        );
     }
 
     #[test]

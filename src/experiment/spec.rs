@@ -207,11 +207,22 @@ impl<F: Families> Loaded<F> {
         profile: Option<&str>,
         overrides: &[Override],
     ) -> Result<Loaded<F>, SpecError> {
+        Loaded::parse_reaching(path, text, profile, overrides).map(|(spec, _)| spec)
+    }
+
+    /// [`Loaded::parse_with`], and for each override whether it reached the spec (`false`: the
+    /// spec has no section of its key, so it was skipped).
+    pub(crate) fn parse_reaching(
+        path: &str,
+        text: &str,
+        profile: Option<&str>,
+        overrides: &[Override],
+    ) -> Result<(Loaded<F>, Vec<bool>), SpecError> {
         let (canonical, made) = super::renamed::canonical_text::<F>(text);
         super::renamed::note(path, &made);
         let spec = Loaded::parse_canonical(path, text, &canonical, profile)?;
         if overrides.is_empty() {
-            return Ok(spec);
+            return Ok((spec, Vec::new()));
         }
         let text = canonical.as_ref();
         let mut table: toml::Table =
@@ -219,10 +230,13 @@ impl<F: Families> Loaded<F> {
         if let Some(over) = profile.and_then(|p| spec.spec.file.profiles.get(p)) {
             merge(&mut table, &over.clone());
         }
+        let mut reached = Vec::with_capacity(overrides.len());
         for o in overrides {
             let key = super::renamed::canonical_key::<F>(&o.key).into_owned();
             let o = Override { key, value: o.value.clone() };
-            apply_override(&mut table, &o).map_err(|e| SpecError(format!("{path}: {e}")))?;
+            reached.push(
+                apply_override(&mut table, &o).map_err(|e| SpecError(format!("{path}: {e}")))?,
+            );
         }
         let merged = toml::to_string(&table).map_err(|e| SpecError(format!("{path}: {e}")))?;
         let (file, sections) = F::parse(&merged).map_err(|e| {
@@ -232,7 +246,7 @@ impl<F: Families> Loaded<F> {
                 e.message().replace('\n', " ")
             ))
         })?;
-        Loaded::checked(Spec { file, ..spec.spec }, sections)
+        Ok((Loaded::checked(Spec { file, ..spec.spec }, sections)?, reached))
     }
 
     /// Parse spec text; `path` is used in messages only.

@@ -82,7 +82,7 @@ pub(crate) fn kind_of(ty: std::fs::FileType) -> &'static str {
     } else if ty.is_char_device() || ty.is_block_device() {
         "a device"
     } else if ty.is_fifo() {
-        "a named pipe"
+        "a FIFO (named pipe)"
     } else if ty.is_socket() {
         "a socket"
     } else {
@@ -171,7 +171,7 @@ mod tests {
         // SAFETY: a NUL-terminated path.
         assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
         for (p, what) in [
-            (fifo.as_path(), "a named pipe"),
+            (fifo.as_path(), "named pipe"),
             (Path::new("/dev/zero"), "a device"),
             (dir.path(), "a folder"),
         ] {

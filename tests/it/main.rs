@@ -13,6 +13,7 @@ mod fuzz;
 mod hostile;
 mod html_report;
 mod own_data;
+mod plans;
 mod resume;
 mod robust;
 mod seed001;
