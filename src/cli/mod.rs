@@ -85,12 +85,14 @@ pub(crate) struct CompareArgs {
     #[arg(long, default_value_t = 50_000)]
     pub(crate) bayes_samples: usize,
     /// Folder for the tables and charts (default RESULTS/compare). It must be missing, empty or
-    /// an earlier compare's, which is replaced whole; the run's own files are never changed.
+    /// an earlier compare's, which is replaced whole, and not inside a result folder
+    /// (RESULTS/compare aside); the run's own files are never changed.
     #[arg(long)]
     pub(crate) out: Option<PathBuf>,
     /// An IOHprofiler folder of optimisers from outside somnurbs (written by the Python
     /// package's `somnurbs.ioh_adapter.Logger`), compared beside the folder's own (repeatable);
-    /// refused unless its problems are the folder's (spec, profile, reading, box, B's error).
+    /// refused unless its problems are the folder's (spec, profile, reading, box, B's error) and
+    /// its traces agree with its records and with the folder's certified lower bounds.
     #[arg(long, value_name = "DIR")]
     pub(crate) external: Vec<PathBuf>,
 }

@@ -658,6 +658,40 @@ pub(crate) fn replace_dir(target: &Path, build: impl FnOnce(&Path) -> Result<()>
     sync_dir(parent)
 }
 
+/// The folders an interrupted [`replace_dir`] of `target` left beside it: its temporary siblings
+/// (`.NAME.PID.N.staged` or `.old`, names [`temp_name`] made for it; real folders, not links)
+/// whose process is not alive on this host. Sorted; none when the parent does not exist.
+pub(crate) fn stale_siblings(target: &Path) -> Result<Vec<PathBuf>> {
+    let parent = target.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let name = target.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let rd = match fs::read_dir(parent) {
+        Ok(rd) => rd,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(e) => {
+            return Err(e).with_context(|| format!("cannot read folder {}", parent.display()))
+        }
+    };
+    let mut out = Vec::new();
+    for e in rd {
+        let e = e.with_context(|| format!("cannot read folder {}", parent.display()))?;
+        let entry = e.file_name().to_string_lossy().into_owned();
+        if !e.file_type().is_ok_and(|t| t.is_dir()) || !is_temp_name(&entry) {
+            continue;
+        }
+        let mut parts = entry[1..].rsplitn(4, '.');
+        let (what, _, pid, stem) = (parts.next(), parts.next(), parts.next(), parts.next());
+        let pid = pid.and_then(|p| p.parse::<u32>().ok());
+        if stem == Some(name.as_str())
+            && matches!(what, Some("staged" | "old"))
+            && pid.is_some_and(|p| !pid_alive(p))
+        {
+            out.push(e.path());
+        }
+    }
+    out.sort();
+    Ok(out)
+}
+
 /// Atomically exchange two paths; Ok(false) if the file system cannot.
 fn exchange(a: &Path, b: &Path) -> std::io::Result<bool> {
     use std::os::unix::ffi::OsStrExt;
@@ -790,5 +824,32 @@ mod tests {
             .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
             .collect();
         assert_eq!(names, vec!["base"], "no temporary folder left behind");
+    }
+
+    /// Only the target's own staged and old siblings of a dead process are stale: not another
+    /// name's, not a live process's, not a temporary file, not a link.
+    #[test]
+    fn stale_siblings_are_the_targets_leftovers_of_dead_processes() {
+        let dir = tempfile::tempdir().unwrap();
+        let target = dir.path().join("compare");
+        let me = std::process::id();
+        for name in [
+            ".compare.999999999.0.staged".to_string(),
+            ".compare.999999998.3.old".to_string(),
+            format!(".compare.{me}.0.staged"),
+            ".other.999999999.0.staged".to_string(),
+            ".compare.999999999.0.tmp".to_string(),
+            ".compare.x.0.staged".to_string(),
+        ] {
+            fs::create_dir(dir.path().join(name)).unwrap();
+        }
+        fs::write(dir.path().join(".compare.999999997.0.old"), "").unwrap();
+        std::os::unix::fs::symlink(dir.path(), dir.path().join(".compare.999999996.0.old"))
+            .unwrap();
+        let found = stale_siblings(&target).unwrap();
+        let names: Vec<String> =
+            found.iter().map(|p| p.file_name().unwrap().to_string_lossy().into_owned()).collect();
+        assert_eq!(names, vec![".compare.999999998.3.old", ".compare.999999999.0.staged"]);
+        assert!(stale_siblings(&dir.path().join("missing/compare")).unwrap().is_empty());
     }
 }

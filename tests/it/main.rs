@@ -6,6 +6,7 @@ mod common;
 
 mod bounds;
 mod cli;
+mod compare_guards;
 mod drift;
 mod exact_certificate;
 mod folders;

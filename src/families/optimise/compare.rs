@@ -11,7 +11,9 @@ use crate::stats::{
 };
 use anyhow::{Context, Result};
 use std::collections::BTreeMap;
+use std::path::PathBuf;
 
+use super::external::Certificate;
 use super::ComparedCell;
 
 /// The blocks x treatments table of the Friedman test: one row per cell (data, grid, net,
@@ -288,7 +290,7 @@ fn over_cells(
             cd,
         ) {
             Ok(()) => cd_note = ", critical-difference diagram cd_diagram.png".into(),
-            Err(e) => eprintln!("somnurbs: warning: picture skipped: {e}"),
+            Err(e) => chart_skipped(e)?,
         }
     }
     println!(
@@ -333,13 +335,13 @@ fn runtime_outputs(
             if g == "all" { results.to_path_buf() } else { results.join("png").join("compare") };
         match render_ecdf(&rt, g, opts, &dir.join(format!("compare_ecdf_{g}.png"))) {
             Ok(()) => pngs += 1,
-            Err(e) => eprintln!("somnurbs: warning: ecdf picture of {g} skipped: {e}"),
+            Err(e) => chart_skipped(e)?,
         }
         let png = dir.join(format!("compare_fixed_budget_{g}.png"));
         match render_fixed_budget(&rt, g, opts, &png) {
             Ok(true) => pngs += 1,
             Ok(false) => println!("  no fixed-budget chart of {g}: {NO_GAP}"),
-            Err(e) => eprintln!("somnurbs: warning: fixed_budget picture of {g} skipped: {e}"),
+            Err(e) => chart_skipped(e)?,
         }
     }
     let moved: Vec<&Problem> = probs.iter().filter(|p| p.rule != "b_to_best_known").collect();
@@ -358,6 +360,17 @@ fn runtime_outputs(
     }
     written.push_str(&format!(", {pngs} runtime charts (compare_ecdf_all.png, compare_fixed_budget_all.png, per problem in png/compare/)"));
     Ok(written)
+}
+
+/// A chart that could not be made: one that cannot be drawn from its data is skipped with a
+/// warning; a file that could not be written (a full disk, a folder that vanished) stops compare.
+fn chart_skipped(e: plots::PlotError) -> Result<()> {
+    if let plots::PlotError::Io { .. } = e {
+        // Its message already holds the cause (no chain, or the cause would be said twice).
+        anyhow::bail!("{e}");
+    }
+    eprintln!("somnurbs: warning: picture skipped: {e}");
+    Ok(())
 }
 
 /// `--bayes-samples`: Monte Carlo samples of the Bayesian signed-rank test (below the lower
@@ -397,10 +410,19 @@ pub(crate) fn compare(args: &CompareArgs) -> Result<()> {
     crate::io::outdir::require_finished(&args.results, "the results folder")?;
     let _lock = crate::io::outdir::lock(&args.results, "compare")?;
     let dest = args.out.clone().unwrap_or_else(|| args.results.join(OUT_DIR));
+    let stale = check_destination(args, &dest)?;
     require_compare_folder(&dest)?;
     let rows = read_runs(&args.results)?;
+    let traced = args.results.join("ioh").is_dir();
+    // What the folder itself certifies: the exact solver's optimum and lower bound per problem.
+    let certified = if traced || !args.external.is_empty() {
+        certificates(&args.results)?
+    } else {
+        BTreeMap::new()
+    };
     // Optimisers from outside somnurbs (issue 39), matched and checked first: external.rs.
-    let (rows, external) = super::external::join(&args.results, &args.external, rows)?;
+    let (rows, external) =
+        super::external::join(&args.results, &args.external, rows, &certified)?;
     let mut opts: Vec<String> = Vec::new();
     let mut cells: Cells = BTreeMap::new();
     for r in &rows {
@@ -417,43 +439,142 @@ pub(crate) fn compare(args: &CompareArgs) -> Result<()> {
         );
     }
     // The traces first, so that a folder whose ioh/ does not match runs.csv gets nothing written.
-    let probs = if args.results.join("ioh").is_dir() {
-        Some(problems(&rows, &args.results, external)?)
+    let probs = if traced {
+        Some(problems(&rows, &args.results, external, &certified)?)
     } else {
         None
     };
-    let header: Vec<String> = CELL_HEADER.iter().map(|s| s.to_string()).collect();
     let (cell_rows, wins, unreachable) = pairwise_cells(&cells, &opts, args.alpha);
     if let Some((n, sr, rs)) = unreachable.smallest {
         eprintln!("somnurbs: warning: of {} cell comparisons, {} cannot reach alpha {} by the signed-rank test and {} by the rank-sum test with their repeats (with {n} repeats a two-sided p is at least {sr} signed-rank, {rs} rank-sum): there h is 0 and no cell is favoured whatever the data (compare_cells.csv: min_p_signed_rank, min_p_rank_sum, can_reach_alpha)", unreachable.of, unreachable.signed_rank, args.alpha, unreachable.rank_sum);
     }
-    // Built whole in a sibling folder and swapped in: a reader sees the old tables or the new.
+    remove_stale(&stale, &dest)?;
+    // Built whole in a sibling folder and swapped in: a reader sees the old tables or the new, and
+    // any failed write (a table or a chart) leaves the old folder as it was.
+    let tables = Tables { rows: &rows, opts: &opts, cells: cells.len(), cell_rows, wins };
     crate::io::outdir::replace_dir(&dest, |out| {
-        write_atomic(&out.join("compare_cells.csv"), csv_records(&header, &cell_rows)?.as_bytes())?;
-        let (cd_note, mut written) = if cells.len() >= 2 {
-            (over_cells(&rows, &opts, &wins, args, out)?, String::from("compare_cells.csv, compare_overall.csv, compare_bayes.csv"))
-        } else {
-            println!("  one cell: the tests over cells (Friedman, Nemenyi, Bayesian signed-rank) need two or more; the per-cell tests are in compare_cells.csv");
-            (String::new(), String::from("compare_cells.csv"))
-        };
-        if let Some(probs) = &probs {
-            written.push_str(&runtime_outputs(probs, &opts, out)?);
-        } else {
-            println!("  no ioh/ folder: runtime distributions skipped");
-        }
-        // Last: the record that makes the folder a compare's (a later compare may replace it).
-        let record = format!(
-            "results = {:?}\nalpha = {:?}\nrope = {:?}\nbayes_samples = {}\nsomnurbs = {:?}\n",
-            args.results.display().to_string(),
-            args.alpha,
-            args.rope,
-            args.bayes_samples,
-            env!("CARGO_PKG_VERSION")
-        );
-        write_atomic(&out.join(RECORD), record.as_bytes())?;
-        println!("wrote {written}{cd_note} in {}", dest.display());
-        Ok(())
+        write_folder(args, &tables, probs.as_deref(), out)
+            .with_context(|| format!("{} left as it was", dest.display()))
     })
+}
+
+/// What `compare` writes, computed before anything is written.
+struct Tables<'a> {
+    rows: &'a [OptimRow],
+    opts: &'a [String],
+    /// How many cells.
+    cells: usize,
+    cell_rows: Vec<Vec<String>>,
+    wins: Wins,
+}
+
+/// Write every table and chart of `compare` into `out` (the staged folder), the record last.
+fn write_folder(
+    args: &CompareArgs,
+    t: &Tables,
+    probs: Option<&[Problem]>,
+    out: &std::path::Path,
+) -> Result<()> {
+    let header: Vec<String> = CELL_HEADER.iter().map(|s| s.to_string()).collect();
+    write_atomic(&out.join("compare_cells.csv"), csv_records(&header, &t.cell_rows)?.as_bytes())?;
+    let (cd_note, mut written) = if t.cells >= 2 {
+        (over_cells(t.rows, t.opts, &t.wins, args, out)?, String::from("compare_cells.csv, compare_overall.csv, compare_bayes.csv"))
+    } else {
+        println!("  one cell: the tests over cells (Friedman, Nemenyi, Bayesian signed-rank) need two or more; the per-cell tests are in compare_cells.csv");
+        (String::new(), String::from("compare_cells.csv"))
+    };
+    if let Some(probs) = probs {
+        written.push_str(&runtime_outputs(probs, t.opts, out)?);
+    } else {
+        println!("  no ioh/ folder: runtime distributions skipped");
+    }
+    // Last: the record that makes the folder a compare's (a later compare may replace it).
+    let record = format!(
+        "results = {:?}\nalpha = {:?}\nrope = {:?}\nbayes_samples = {}\nsomnurbs = {:?}\n",
+        args.results.display().to_string(),
+        args.alpha,
+        args.rope,
+        args.bayes_samples,
+        env!("CARGO_PKG_VERSION")
+    );
+    write_atomic(&out.join(RECORD), record.as_bytes())?;
+    let dest = args.out.clone().unwrap_or_else(|| args.results.join(OUT_DIR));
+    println!("wrote {written}{cd_note} in {}", dest.display());
+    Ok(())
+}
+
+/// `path` made absolute, with the links of its nearest existing ancestor resolved and the rest
+/// (which need not exist yet) taken as written; and that ancestor.
+fn resolved(path: &std::path::Path) -> Result<(PathBuf, PathBuf)> {
+    use std::path::Component;
+    let cwd = std::env::current_dir().context("cannot read the working folder")?;
+    let abs = cwd.join(path);
+    let (anchor, rest) = abs
+        .ancestors()
+        .find_map(|a| Some((std::fs::canonicalize(a).ok()?, abs.strip_prefix(a).ok()?)))
+        .with_context(|| format!("{}: no part of it exists", path.display()))?;
+    let mut full = anchor.clone();
+    for c in rest.components() {
+        match c {
+            Component::Normal(n) => full.push(n),
+            Component::ParentDir => {
+                full.pop();
+            }
+            _ => {}
+        }
+    }
+    Ok((anchor, full))
+}
+
+/// Refuse a destination that lies inside a result folder (a run, shard, plan or `fit` folder;
+/// compare's own default, `RESULTS/compare`, aside) and an `--external` folder inside the
+/// destination (the swap would delete what was read) or inside a folder an interrupted compare
+/// left beside it (removed before the swap). Returns those leftovers: the temporary siblings of
+/// the destination whose process is gone.
+fn check_destination(args: &CompareArgs, dest: &std::path::Path) -> Result<Vec<PathBuf>> {
+    let (anchor, full) = resolved(dest)?;
+    let default = resolved(&args.results.join(OUT_DIR))?.1;
+    if full != default {
+        if let Some(folder) = crate::io::outdir::result_folder_of(&anchor.join(OUT_DIR)) {
+            anyhow::bail!("compare --out {} is inside the result folder {}, which holds one run and nothing else: give --out a folder outside it (or no --out, for {})", dest.display(), folder.display(), args.results.join(OUT_DIR).display());
+        }
+    }
+    let stale = match full.parent() {
+        Some(_) => crate::io::outdir::stale_siblings(&full)?,
+        None => Vec::new(),
+    };
+    for ext in &args.external {
+        let e = resolved(ext)?.1;
+        if e.starts_with(&full) {
+            anyhow::bail!("compare --external {} is inside {}, the folder compare replaces: move the logs out of it first", ext.display(), dest.display());
+        }
+        if let Some(s) = stale.iter().find(|s| e.starts_with(s)) {
+            anyhow::bail!("compare --external {} is inside {}, a folder an interrupted compare left (removed before {} is written): move the logs out of it first", ext.display(), s.display(), dest.display());
+        }
+    }
+    Ok(stale)
+}
+
+/// Remove the folders an interrupted compare left beside `dest`, saying so in one line.
+fn remove_stale(stale: &[PathBuf], dest: &std::path::Path) -> Result<()> {
+    if stale.is_empty() {
+        return Ok(());
+    }
+    for s in stale {
+        std::fs::remove_dir_all(s)
+            .with_context(|| format!("cannot remove {}, left by an interrupted compare", s.display()))?;
+    }
+    let names: Vec<String> = stale
+        .iter()
+        .filter_map(|s| s.file_name().map(|n| n.to_string_lossy().into_owned()))
+        .collect();
+    eprintln!(
+        "somnurbs: note: removed {} folder(s) an interrupted compare left beside {} (their process is gone): {}",
+        stale.len(),
+        dest.display(),
+        names.join(", ")
+    );
+    Ok(())
 }
 
 /// The folder `compare` writes into by default, inside the results folder it compares.
@@ -541,16 +662,21 @@ struct Runtime {
     ert: Vec<ErtRow>,
 }
 
-/// The certified optima of a folder's `exact_<grid>.csv` tables, by problem name.
-fn certified_optima(folder: &std::path::Path) -> Result<BTreeMap<String, f64>> {
+/// The certificates of a folder's `exact_<grid>.csv` tables (the exact solver's optimum and its
+/// proven lower bound), by problem name: what the folder itself certifies.
+pub(crate) fn certificates(folder: &std::path::Path) -> Result<BTreeMap<String, Certificate>> {
     let mut out = BTreeMap::new();
     let Ok(entries) = std::fs::read_dir(folder) else { return Ok(out) };
-    for e in entries.flatten() {
-        let p = e.path();
-        let name = p.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-        let Some(grid) = name.strip_prefix("exact_").and_then(|g| g.strip_suffix(".csv")) else {
-            continue;
-        };
+    let mut tables: Vec<(std::path::PathBuf, String)> = entries
+        .flatten()
+        .filter_map(|e| {
+            let name = e.file_name().to_string_lossy().into_owned();
+            let grid = name.strip_prefix("exact_")?.strip_suffix(".csv")?.to_string();
+            Some((e.path(), grid))
+        })
+        .collect();
+    tables.sort();
+    for (p, grid) in tables {
         let text = crate::io::read_text(&p)?;
         let mut r = csv::Reader::from_reader(text.as_bytes());
         for (n, rec) in r.deserialize::<BTreeMap<String, String>>().enumerate() {
@@ -559,16 +685,23 @@ fn certified_optima(folder: &std::path::Path) -> Result<BTreeMap<String, f64>> {
                 rec.get(k)
                     .with_context(|| format!("{}: line {}: no column {k}", p.display(), n + 2))
             };
-            let f: f64 = get("exact_f")?.parse().with_context(|| {
-                format!("{}: line {}: exact_f is not a number", p.display(), n + 2)
-            })?;
+            let value = |k: &str| -> Result<f64> {
+                get(k)?.parse::<f64>().ok().filter(|v| v.is_finite()).with_context(|| {
+                    format!("{}: line {}: {k} is not a number", p.display(), n + 2)
+                })
+            };
             let key = super::ioh::problem_name(
                 get("data")?,
-                grid,
+                &grid,
                 &format!("{}x{}", get("cn_x")?, get("cn_y")?),
                 get("parameterisation")?,
             );
-            out.insert(key, f);
+            let c = Certificate {
+                optimum: value("exact_f")?,
+                lower_bound: value("lower_bound")?,
+                table: p.clone(),
+            };
+            out.insert(key, c);
         }
     }
     Ok(out)
@@ -579,10 +712,9 @@ fn certified_optima(folder: &std::path::Path) -> Result<BTreeMap<String, f64>> {
 fn problems(
     rows: &[OptimRow],
     folder: &std::path::Path,
-    external: super::external::External,
+    external: Vec<super::ioh::LoadedProblem>,
+    certified: &BTreeMap<String, Certificate>,
 ) -> Result<Vec<Problem>> {
-    let mut certified = certified_optima(folder)?;
-    external.add_optima(&mut certified);
     let name = |r: &OptimRow| {
         super::ioh::problem_name(
             &r.dataset,
@@ -596,7 +728,7 @@ fn problems(
         expected.entry((name(r), r.competitor())).or_default().push(r);
     }
     let mut out: BTreeMap<String, Problem> = BTreeMap::new();
-    for lp in super::ioh::read(folder)?.into_iter().chain(external.traces) {
+    for lp in super::ioh::read(folder)?.into_iter().chain(external) {
         let mut exp = expected
             .remove(&(lp.function_name.clone(), lp.optimiser.clone()))
             .with_context(|| {
@@ -635,8 +767,8 @@ fn problems(
         let found =
             rows.iter().filter(|r| &name(r) == pn).map(|r| r.best).fold(f64::INFINITY, f64::min);
         p.best_known = found;
-        if let Some(&f) = certified.get(pn) {
-            p.best_known = f.min(found);
+        if let Some(c) = certified.get(pn) {
+            p.best_known = c.optimum.min(found);
             p.certified = true;
         }
         let firsts: Vec<f64> =
@@ -1094,5 +1226,34 @@ mod tests {
         assert_eq!(better(Some(&sr), Some(&rs), a, 0.05), ("y", "a12 (no test significant)"));
         assert_eq!(better(Some(&sr), Some(&rs), 0.52, 0.05).0, "none");
         assert_eq!(better(None, None, f64::NAN, 0.05).0, "none");
+    }
+
+    /// A chart whose file cannot be written stops the runtime outputs with an error naming it; a
+    /// chart that cannot be drawn from its data is skipped.
+    #[test]
+    fn a_chart_that_cannot_be_written_is_an_error_and_one_that_cannot_be_drawn_a_note() {
+        let runs = |first: f64, last: f64| vec![(10, vec![(1, first), (7, last)])];
+        let problem = Problem {
+            name: "p".into(),
+            b: 2.0,
+            best_known: 1.0,
+            certified: false,
+            reference: Some(2.0),
+            rule: "b_to_best_known",
+            targets: stats::runtime::log_targets(2.0, 1.0, TARGETS, TARGET_DECADES),
+            runs: [("x".to_string(), runs(1.9, 1.0)), ("y".to_string(), runs(1.95, 1.5))]
+                .into_iter()
+                .collect(),
+        };
+        let opts = ["x".to_string(), "y".to_string()];
+        let dir = tempfile::tempdir().unwrap();
+        runtime_outputs(std::slice::from_ref(&problem), &opts, dir.path()).unwrap();
+        // A folder where the chart goes: the rename into place fails.
+        let blocked = tempfile::tempdir().unwrap();
+        std::fs::create_dir_all(blocked.path().join("compare_ecdf_all.png/x")).unwrap();
+        let e = runtime_outputs(&[problem], &opts, blocked.path()).unwrap_err().to_string();
+        assert!(e.contains("compare_ecdf_all.png"), "{e}");
+        let drawn = plots::PlotError::input(std::path::Path::new("a.png"), "no data");
+        chart_skipped(drawn).unwrap();
     }
 }

@@ -3,12 +3,23 @@
 //! `somnurbs.ioh_adapter.Logger`, joined to a Chapter 6 folder's runs so that every statistic of
 //! `compare` ranks them beside GA, DE and PSO.
 //!
-//! A folder is matched by its metadata and refused on any mismatch, before anything is written:
-//! its experiment attributes (spec, profile, knot reading, search box) must be the results
-//! folder's (read from its fingerprint), every problem (IOHprofiler function name) one of the
-//! folder's with the same dimension, every run's B error (run attribute `somnurbs_b`) bit for
-//! bit the folder's (which pins the map, the net, the parameterisation and the reading), and no
-//! run may end below the problem's certified lower bound (`somnurbs_bound`).
+//! A log is judged by the results folder and by its own traces, never by what its metadata claims
+//! of itself, and refused on any mismatch before anything is written, in one line naming the file
+//! and the field or run:
+//!
+//! - every field `compare` reads must be well formed (strings, whole numbers, finite numbers,
+//!   non-empty lists) and a `.dat` path must stay in the JSON's folder;
+//! - its experiment attributes (spec, profile, knot reading, search box) must be the results
+//!   folder's (read from its fingerprint), every problem (IOHprofiler function name) one of the
+//!   folder's with the same dimension, and every run's B error (run attribute `somnurbs_b`) bit
+//!   for bit the folder's (which pins the map, the net, the parameterisation and the reading);
+//! - where the folder certifies the problem (its own `exact_<grid>.csv`, a [`Certificate`]), no
+//!   run's best (read from its `.dat` trace) may lie below the certified lower bound, and the
+//!   log's own `somnurbs_bound` and `somnurbs_optimum`, where given, must not contradict it; they
+//!   are never used otherwise. Where it does not, B's error and the traces are what is checked;
+//! - every run's trace must agree with its JSON record: evaluations increasing from 1 and never
+//!   beyond the run's `evals`, and the run's `best` (where given) the trace's best, at the same
+//!   evaluation.
 
 use super::ioh::{problem_name, LoadedProblem};
 use super::OptimRow;
@@ -71,12 +82,17 @@ fn json_files(folder: &Path) -> Result<Vec<PathBuf>> {
     Ok(out)
 }
 
-/// The runs of an Analyzer `.dat` file: per run (from its header line) the strict improvements of
-/// the best so far as (evaluation, value), read from the `evaluations` and `raw_y` columns.
-fn dat_runs(text: &str) -> Result<Vec<Vec<(u64, f64)>>, String> {
-    let mut runs: Vec<Vec<(u64, f64)>> = Vec::new();
+/// One run of an Analyzer `.dat` file: its rows as (1-based line, evaluation, value), in file
+/// order.
+type DatRun = Vec<(usize, u64, f64)>;
+/// A checked run: its evaluations and the strict improvements of its trace.
+type Trace = (u64, Vec<(u64, f64)>);
+
+/// The runs of an Analyzer `.dat` file (a header line starts one), read from the `evaluations`
+/// and `raw_y` columns. A value that is `nan` or minus infinity is refused, naming the line.
+fn dat_runs(text: &str) -> Result<Vec<DatRun>, String> {
+    let mut runs: Vec<DatRun> = Vec::new();
     let mut cols = (0, 1);
-    let mut best = f64::INFINITY;
     for (n, line) in text.lines().enumerate() {
         let fields: Vec<&str> = line.split_whitespace().collect();
         if fields.is_empty() {
@@ -86,40 +102,91 @@ fn dat_runs(text: &str) -> Result<Vec<Vec<(u64, f64)>>, String> {
             let at = |name: &str| fields.iter().position(|f| *f == name);
             cols = (at("evaluations").unwrap_or(0), at("raw_y").ok_or("no raw_y column")?);
             runs.push(Vec::new());
-            best = f64::INFINITY;
             continue;
         }
         let run = runs.last_mut().ok_or("a data row before the first header")?;
         let get = |k: usize| fields.get(k).copied().ok_or(format!("line {}: too few columns", n + 1));
         let e: u64 = get(cols.0)?.parse().map_err(|_| format!("line {}: evaluations", n + 1))?;
         let y: f64 = get(cols.1)?.parse().map_err(|_| format!("line {}: raw_y", n + 1))?;
-        if y < best {
-            best = y;
-            run.push((e, y));
+        if y.is_nan() || y == f64::NEG_INFINITY {
+            return Err(format!("line {}: raw_y {y} is not a value", n + 1));
         }
+        run.push((n + 1, e, y));
     }
     Ok(runs)
 }
 
-/// A JSON field, or an error naming the file.
-fn field<'a>(v: &'a Value, key: &str, file: &Path) -> Result<&'a Value> {
-    v.get(key).with_context(|| format!("{}: no `{key}`", file.display()))
-}
-
-/// The experiment attributes (a list of one-key objects) as a map.
-fn experiment_attributes(v: &Value) -> BTreeMap<String, String> {
-    let mut out = BTreeMap::new();
-    for a in v.get("experiment_attributes").and_then(|a| a.as_array()).into_iter().flatten() {
-        for (k, val) in a.as_object().into_iter().flatten() {
-            out.insert(k.clone(), val.as_str().unwrap_or_default().to_string());
+/// The strict improvements of the best so far of a run, as (evaluation, value).
+fn improvements(run: &DatRun) -> Vec<(u64, f64)> {
+    let mut best = f64::INFINITY;
+    let mut out = Vec::new();
+    for &(_, e, y) in run {
+        if y < best {
+            best = y;
+            out.push((e, y));
         }
     }
     out
 }
 
+/// A malformed field of an IOHprofiler JSON, in one line naming the file and the field.
+fn malformed(file: &Path, at: &str, want: &str) -> anyhow::Error {
+    anyhow::anyhow!("{}: field `{at}` is missing or not {want} (a malformed IOHprofiler JSON)", file.display())
+}
+
+/// Field `key` of `v` (shown as `at`), a non-empty string.
+fn text_field<'a>(v: &'a Value, key: &str, at: &str, file: &Path) -> Result<&'a str> {
+    v.get(key)
+        .and_then(Value::as_str)
+        .filter(|s| !s.is_empty())
+        .ok_or_else(|| malformed(file, at, "a non-empty string"))
+}
+
+/// Field `key` of `v` (shown as `at`), a whole number.
+fn count_field(v: &Value, key: &str, at: &str, file: &Path) -> Result<u64> {
+    v.get(key).and_then(Value::as_u64).ok_or_else(|| malformed(file, at, "a whole number"))
+}
+
+/// Field `key` of `v` (shown as `at`): None when absent, else a finite number.
+fn number_field(v: &Value, key: &str, at: &str, file: &Path) -> Result<Option<f64>> {
+    match v.get(key) {
+        None => Ok(None),
+        Some(x) => x
+            .as_f64()
+            .filter(|x| x.is_finite())
+            .map(Some)
+            .ok_or_else(|| malformed(file, at, "a finite number")),
+    }
+}
+
+/// Field `key` of `v` (shown as `at`), a non-empty list.
+fn list_field<'a>(v: &'a Value, key: &str, at: &str, file: &Path) -> Result<&'a Vec<Value>> {
+    v.get(key)
+        .and_then(Value::as_array)
+        .filter(|a| !a.is_empty())
+        .ok_or_else(|| malformed(file, at, "a non-empty list"))
+}
+
+/// The experiment attributes (a list of one-key objects with string values) as a map; an absent
+/// list is an empty map.
+fn experiment_attributes(v: &Value, file: &Path) -> Result<BTreeMap<String, String>> {
+    let mut out = BTreeMap::new();
+    let Some(list) = v.get("experiment_attributes") else { return Ok(out) };
+    let want = "a list of objects with string values";
+    for a in list.as_array().ok_or_else(|| malformed(file, "experiment_attributes", want))? {
+        let a = a.as_object().ok_or_else(|| malformed(file, "experiment_attributes", want))?;
+        for (k, val) in a {
+            let at = format!("experiment_attributes.{k}");
+            let s = val.as_str().ok_or_else(|| malformed(file, &at, "a string"))?;
+            out.insert(k.clone(), s.to_string());
+        }
+    }
+    Ok(out)
+}
+
 /// Refuse a file whose suite is not the folder's.
 fn check_suite(v: &Value, suite: &[String; 4], file: &Path, results: &Path) -> Result<()> {
-    let attrs = experiment_attributes(v);
+    let attrs = experiment_attributes(v, file)?;
     let names = ["somnurbs_spec", "somnurbs_profile", "somnurbs_reading", "somnurbs_box"];
     for (name, want) in names.iter().zip(suite) {
         let Some(have) = attrs.get(*name) else {
@@ -132,105 +199,194 @@ fn check_suite(v: &Value, suite: &[String; 4], file: &Path, results: &Path) -> R
     Ok(())
 }
 
-/// What the external folders add to `compare`: their runs' traces and, per problem, the certified
-/// optimum their logs carry (run attribute `somnurbs_optimum`).
-#[derive(Debug, Default)]
-pub(crate) struct External {
-    pub(crate) traces: Vec<LoadedProblem>,
-    pub(crate) optima: BTreeMap<String, f64>,
-}
-
-impl External {
-    /// The certified optima of the results folder (`exact_<grid>.csv`), with the external logs'
-    /// for the problems it has none of (a folder run without `exact = true`).
-    pub(crate) fn add_optima(&self, certified: &mut BTreeMap<String, f64>) {
-        for (k, f) in &self.optima {
-            certified.entry(k.clone()).or_insert(*f);
+/// The fields of the top level that `compare` does not read but that must not say something else
+/// than a minimised problem logged as evaluations and raw values.
+fn check_header(v: &Value, file: &Path) -> Result<()> {
+    if !v.is_object() {
+        anyhow::bail!("{}: not a JSON object (a malformed IOHprofiler JSON)", file.display());
+    }
+    if let Some(m) = v.get("maximization") {
+        if m.as_bool() != Some(false) {
+            return Err(malformed(file, "maximization", "false (compare's problems are minimised)"));
         }
     }
+    if let Some(a) = v.get("attributes") {
+        let names = a.as_array().filter(|l| l.iter().all(Value::is_string));
+        let names = names.ok_or_else(|| malformed(file, "attributes", "a list of strings"))?;
+        if !["evaluations", "raw_y"].iter().all(|c| names.iter().any(|n| n == c)) {
+            return Err(malformed(file, "attributes", "a list holding evaluations and raw_y"));
+        }
+    }
+    Ok(())
 }
 
-/// The external runs of one JSON file, checked against the folder's rows, as rows, traces and
-/// the certified optimum the runs carry.
+/// What a results folder certifies of one problem, read from its own `exact_<grid>.csv`: the
+/// exact solver's optimum and its proven lower bound (each printed to 9 decimals).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Certificate {
+    pub(crate) optimum: f64,
+    pub(crate) lower_bound: f64,
+    /// The table it comes from (named in refusals).
+    pub(crate) table: PathBuf,
+}
+
+/// How far a value may lie on the wrong side of a certificate read back from `exact_<grid>.csv`:
+/// the table prints 9 decimals, so its values are within half of 1e-9 of the solver's.
+pub(crate) const CERTIFICATE_TOLERANCE: f64 = 1e-9;
+
+/// One problem's context while its external runs are read.
+struct Problem<'a> {
+    file: &'a Path,
+    name: &'a str,
+    row: &'a OptimRow,
+    results: &'a Path,
+    certificate: Option<&'a Certificate>,
+}
+
+/// Check one run (JSON record `r` at `at`, trace `rows` of `dat`) against the folder and its own
+/// trace; returns its evaluations and improvements.
+fn check_run(p: &Problem, r: &Value, at: &str, rows: &DatRun, dat: &Path) -> Result<Trace> {
+    let file = p.file.display();
+    let b = number_field(r, "somnurbs_b", &format!("{at}.somnurbs_b"), p.file)?
+        .ok_or_else(|| malformed(p.file, &format!("{at}.somnurbs_b"), "a number (B's error)"))?;
+    if b.to_bits() != p.row.b.to_bits() {
+        anyhow::bail!("{file}: {}: B's error is {b:e} here but {:e} in {}: the problem differs (another map, reading or build)", p.name, p.row.b, p.results.display());
+    }
+    let imp = improvements(rows);
+    let &(best_at, best) = imp.last().with_context(|| format!("{}: {} {at}: the run has no rows", dat.display(), p.name))?;
+    // The log's own certificate is read only to be checked against the folder's.
+    let bound = number_field(r, "somnurbs_bound", &format!("{at}.somnurbs_bound"), p.file)?;
+    let optimum = number_field(r, "somnurbs_optimum", &format!("{at}.somnurbs_optimum"), p.file)?;
+    if let Some(c) = p.certificate {
+        if best < c.lower_bound - CERTIFICATE_TOLERANCE {
+            anyhow::bail!("{file}: {} {at}: the run ends at {best:e} (its trace {}), below the certified lower bound {:e} of {}: not this problem, or a forged trace", p.name, dat.display(), c.lower_bound, c.table.display());
+        }
+        if let Some(lb) = bound.filter(|lb| *lb > c.optimum + CERTIFICATE_TOLERANCE) {
+            anyhow::bail!("{file}: {} {at}: somnurbs_bound {lb:e} is above the certified optimum {:e} of {}: the log's certificate contradicts the folder's", p.name, c.optimum, c.table.display());
+        }
+        if let Some(f) = optimum.filter(|f| *f < c.lower_bound - CERTIFICATE_TOLERANCE) {
+            anyhow::bail!("{file}: {} {at}: somnurbs_optimum {f:e} is below the certified lower bound {:e} of {}: the log's certificate contradicts the folder's", p.name, c.lower_bound, c.table.display());
+        }
+    }
+    let evals = count_field(r, "evals", &format!("{at}.evals"), p.file)?;
+    let mut previous = 0;
+    for &(line, e, _) in rows {
+        if e <= previous {
+            anyhow::bail!("{}: line {line}: evaluation {e} does not follow {previous} ({file} {at}: a trace counts its evaluations up from 1)", dat.display());
+        }
+        if e > evals {
+            anyhow::bail!("{file}: {} {at}: evals is {evals} but its trace {} logs evaluation {e} at line {line}: the count and the trace contradict each other", p.name, dat.display());
+        }
+        previous = e;
+    }
+    if let Some(claimed) = r.get("best") {
+        let y = number_field(claimed, "y", &format!("{at}.best.y"), p.file)?;
+        let y = y.ok_or_else(|| malformed(p.file, &format!("{at}.best.y"), "a finite number"))?;
+        let e = count_field(claimed, "evals", &format!("{at}.best.evals"), p.file)?;
+        if (y - best).abs() > 1e-12 * best.abs().max(1.0) || e != best_at {
+            anyhow::bail!("{file}: {} {at}: best is {y:e} at evaluation {e} but its trace {} reaches {best:e} first at evaluation {best_at}: the record and the trace contradict each other", p.name, dat.display());
+        }
+    }
+    Ok((evals, imp))
+}
+
+/// The `.dat` file a scenario names (`path`, relative to the JSON's folder and inside it).
+fn dat_path(s: &Value, at: &str, file: &Path) -> Result<PathBuf> {
+    let path = text_field(s, "path", &format!("{at}.path"), file)?;
+    let rel = Path::new(path);
+    let inside = rel.components().all(|c| matches!(c, std::path::Component::Normal(_)));
+    if !inside {
+        anyhow::bail!("{}: field `{at}.path` {path:?} leaves the JSON's folder (an absolute path or ..): a log names its .dat files beside it", file.display());
+    }
+    Ok(file.parent().unwrap_or(Path::new("")).join(rel))
+}
+
+/// The runs of one scenario (`at`, e.g. `scenarios[0]`), checked, as (evaluations, improvements).
+fn read_scenario(p: &Problem, s: &Value, at: &str) -> Result<Vec<Trace>> {
+    let dim = count_field(s, "dimension", &format!("{at}.dimension"), p.file)?;
+    if dim != p.row.dimension as u64 {
+        anyhow::bail!("{}: {} has dimension {dim} here but {} in {}", p.file.display(), p.name, p.row.dimension, p.results.display());
+    }
+    let dat = dat_path(s, at, p.file)?;
+    let runs = dat_runs(&read_text(&dat)?)
+        .map_err(anyhow::Error::msg)
+        .with_context(|| dat.display().to_string())?;
+    let listed = list_field(s, "runs", &format!("{at}.runs"), p.file)?;
+    if listed.len() != runs.len() {
+        anyhow::bail!("{}: {} runs listed in `{at}.runs` but {} in {}", p.file.display(), listed.len(), runs.len(), dat.display());
+    }
+    let mut out = Vec::new();
+    for (k, (r, rows)) in listed.iter().zip(&runs).enumerate() {
+        let at = format!("{at}.runs[{k}]");
+        if !r.is_object() {
+            return Err(malformed(p.file, &at, "an object"));
+        }
+        out.push(check_run(p, r, &at, rows, &dat)?);
+    }
+    Ok(out)
+}
+
+/// The external runs of one JSON file, checked against the folder's rows and certificates, as
+/// rows and traces.
 fn read_file(
     file: &Path,
     suite: &[String; 4],
     results: &Path,
     by_name: &BTreeMap<String, &OptimRow>,
-) -> Result<(Vec<OptimRow>, LoadedProblem, Option<f64>)> {
+    certificates: &BTreeMap<String, Certificate>,
+) -> Result<(Vec<OptimRow>, LoadedProblem)> {
     let v: Value = serde_json::from_str(&read_text(file)?)
         .with_context(|| format!("{}: not JSON", file.display()))?;
+    check_header(&v, file)?;
     check_suite(&v, suite, file, results)?;
-    let name = field(&v, "function_name", file)?.as_str().unwrap_or_default().to_string();
-    let optimiser = field(&v, "algorithm", file)?
-        .get("name")
-        .and_then(|s| s.as_str())
-        .with_context(|| format!("{}: no algorithm.name", file.display()))?
-        .to_string();
+    let name = text_field(&v, "function_name", "function_name", file)?.to_string();
+    let algorithm = v.get("algorithm").unwrap_or(&Value::Null);
+    let optimiser = text_field(algorithm, "name", "algorithm.name", file)?.to_string();
     let Some(row) = by_name.get(&name) else {
         anyhow::bail!("{}: problem {name} is not one of {}'s problems ({})", file.display(), results.display(), by_name.keys().cloned().collect::<Vec<_>>().join(", "));
     };
-    let mut rows = Vec::new();
+    let p = Problem { file, name: &name, row, results, certificate: certificates.get(&name) };
     let mut traces = Vec::new();
-    let mut optimum: Option<f64> = None;
-    for s in field(&v, "scenarios", file)?.as_array().into_iter().flatten() {
-        let dim = s.get("dimension").and_then(|d| d.as_u64()).unwrap_or(0) as usize;
-        if dim != row.dimension {
-            anyhow::bail!("{}: {name} has dimension {dim} here but {} in {}", file.display(), row.dimension, results.display());
+    for (k, s) in list_field(&v, "scenarios", "scenarios", file)?.iter().enumerate() {
+        let at = format!("scenarios[{k}]");
+        if !s.is_object() {
+            return Err(malformed(file, &at, "an object"));
         }
-        let path = s.get("path").and_then(|p| p.as_str()).unwrap_or_default();
-        let dat = file.parent().unwrap_or(Path::new("")).join(path);
-        let runs = dat_runs(&read_text(&dat)?)
-            .map_err(anyhow::Error::msg)
-            .with_context(|| dat.display().to_string())?;
-        let listed: Vec<&Value> = s.get("runs").and_then(|r| r.as_array()).into_iter().flatten().collect();
-        if listed.len() != runs.len() {
-            anyhow::bail!("{}: {} runs listed but {} in {}", file.display(), listed.len(), runs.len(), dat.display());
-        }
-        for (r, imp) in listed.into_iter().zip(runs) {
-            let num = |k: &str| r.get(k).and_then(|x| x.as_f64());
-            let b = num("somnurbs_b").with_context(|| format!("{}: a run has no somnurbs_b (B's error)", file.display()))?;
-            if b.to_bits() != row.b.to_bits() {
-                anyhow::bail!("{}: {name}: B's error is {b:e} here but {:e} in {}: the problem differs (another map, reading or build)", file.display(), row.b, results.display());
-            }
-            let best = imp.last().map(|x| x.1).with_context(|| format!("{}: a run of {name} has no rows", dat.display()))?;
-            if let Some(bound) = num("somnurbs_bound").filter(|lb| best < *lb) {
-                anyhow::bail!("{}: {name}: a run ends at {best:e}, below the certified lower bound {bound:e}: not this problem, or a wrong bound", file.display());
-            }
-            if let Some(f) = num("somnurbs_optimum") {
-                optimum = Some(optimum.map_or(f, |o| o.min(f)));
-            }
-            let evals = r.get("evals").and_then(|e| e.as_u64()).with_context(|| format!("{}: a run has no evals", file.display()))?;
-            let repeat = rows.len();
-            rows.push(OptimRow {
-                cell: format!("external/{optimiser}/{name}/r{repeat}"),
-                optimiser: optimiser.clone(),
-                variant: String::new(),
-                repeat,
-                seed: String::new(),
-                initial_best: imp[0].1,
-                best,
-                evaluations: evals,
-                excursion: f64::NAN,
-                max_control: f64::NAN,
-                cpu_s: f64::NAN,
-                ..(*row).clone()
-            });
-            traces.push((evals, imp));
-        }
+        traces.extend(read_scenario(&p, s, &at)?);
     }
-    Ok((rows, LoadedProblem { optimiser, function_name: name, runs: traces }, optimum))
+    let rows = traces
+        .iter()
+        .enumerate()
+        .map(|(repeat, (evals, imp))| OptimRow {
+            cell: format!("external/{optimiser}/{name}/r{repeat}"),
+            optimiser: optimiser.clone(),
+            variant: String::new(),
+            repeat,
+            seed: String::new(),
+            initial_best: imp[0].1,
+            best: imp[imp.len() - 1].1,
+            evaluations: *evals,
+            excursion: f64::NAN,
+            max_control: f64::NAN,
+            cpu_s: f64::NAN,
+            ..(*row).clone()
+        })
+        .collect();
+    Ok((rows, LoadedProblem { optimiser, function_name: name, runs: traces }))
 }
 
 /// The runs of the external folders, as runs.csv rows beside `rows` (the folder's) and as the
-/// traces and optima of the runtime statistics; `rows` with the external ones appended.
+/// traces of the runtime statistics; `rows` with the external ones appended. `certificates` are
+/// the results folder's own (`exact_<grid>.csv`); a problem without one is named on stderr with
+/// what is checked instead.
 pub(crate) fn join(
     results: &Path,
     folders: &[PathBuf],
     mut rows: Vec<OptimRow>,
-) -> Result<(Vec<OptimRow>, External)> {
+    certificates: &BTreeMap<String, Certificate>,
+) -> Result<(Vec<OptimRow>, Vec<LoadedProblem>)> {
     if folders.is_empty() {
-        return Ok((rows, External::default()));
+        return Ok((rows, Vec::new()));
     }
     let suite = folder_suite(results)?;
     let by_name: BTreeMap<String, &OptimRow> = rows
@@ -243,41 +399,53 @@ pub(crate) fn join(
         .collect();
     let ours: Vec<String> = rows.iter().map(|r| r.competitor()).collect();
     let mut extra = Vec::new();
-    let mut ext = External::default();
+    let mut traces: Vec<LoadedProblem> = Vec::new();
     for folder in folders {
         for file in json_files(folder)? {
-            let (r, lp, optimum) = read_file(&file, &suite, results, &by_name)?;
+            let (r, lp) = read_file(&file, &suite, results, &by_name, certificates)?;
             if ours.contains(&lp.optimiser) {
                 anyhow::bail!("{}: algorithm name {:?} is one of {}'s optimisers: give the external optimiser another name", file.display(), lp.optimiser, results.display());
             }
-            if ext.traces.iter().any(|t| t.optimiser == lp.optimiser && t.function_name == lp.function_name) {
+            if traces.iter().any(|t| t.optimiser == lp.optimiser && t.function_name == lp.function_name) {
                 anyhow::bail!("{}: {} on {} is given twice", file.display(), lp.optimiser, lp.function_name);
             }
-            if let Some(f) = optimum {
-                let o = ext.optima.entry(lp.function_name.clone()).or_insert(f);
-                *o = o.min(f);
-            }
             extra.extend(r);
-            ext.traces.push(lp);
+            traces.push(lp);
         }
     }
+    let uncertified: std::collections::BTreeSet<&str> = traces
+        .iter()
+        .map(|t| t.function_name.as_str())
+        .filter(|n| !certificates.contains_key(*n))
+        .collect();
+    if !uncertified.is_empty() {
+        let uncertified: Vec<&str> = uncertified.into_iter().collect();
+        eprintln!("somnurbs: note: {} certifies no lower bound of {} (no exact_<grid>.csv: its spec does not say exact = true): their external runs are checked by B's error and their own traces only", results.display(), uncertified.join(", "));
+    }
     rows.extend(extra);
-    Ok((rows, ext))
+    Ok((rows, traces))
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    /// An Analyzer `.dat`: a header per run, columns found by name, the closing row of a run that
-    /// did not improve dropped, and only strict improvements kept.
+    /// An Analyzer `.dat`: a header per run, columns found by name, every row kept with its line;
+    /// the improvements drop the closing row of a run that did not improve and keep only strict
+    /// improvements; `nan` and minus infinity are refused with their line.
     #[test]
     fn dat_rows_become_strict_improvements_per_run() {
         let text = "evaluations raw_y\n1 3.5\n2 3.25\n5 3.75\nevaluations x0 raw_y\n1 0 2\n3 0 2\n4 0 1.5\n";
         let runs = dat_runs(text).unwrap();
-        assert_eq!(runs, vec![vec![(1, 3.5), (2, 3.25)], vec![(1, 2.0), (4, 1.5)]]);
+        assert_eq!(runs[0], vec![(2, 1, 3.5), (3, 2, 3.25), (4, 5, 3.75)]);
+        let imp: Vec<Vec<(u64, f64)>> = runs.iter().map(improvements).collect();
+        assert_eq!(imp, vec![vec![(1, 3.5), (2, 3.25)], vec![(1, 2.0), (4, 1.5)]]);
         assert!(dat_runs("1 2\n").is_err());
         assert!(dat_runs("evaluations y\n1 2\n").is_err());
+        for bad in ["nan", "-inf"] {
+            let e = dat_runs(&format!("evaluations raw_y\n1 3\n2 {bad}\n")).unwrap_err();
+            assert!(e.starts_with("line 3:"), "{e}");
+        }
     }
 
     /// The four experiment attributes must all be there and equal the folder's.
