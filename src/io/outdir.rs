@@ -692,6 +692,30 @@ pub(crate) fn stale_siblings(target: &Path) -> Result<Vec<PathBuf>> {
     Ok(out)
 }
 
+/// Remove `stale` ([`stale_siblings`] of `target`, left by an interrupted `command`), saying so
+/// in one line; call it only while holding the lock that guards `target`.
+pub(crate) fn remove_stale(stale: &[PathBuf], target: &Path, command: &str) -> Result<()> {
+    if stale.is_empty() {
+        return Ok(());
+    }
+    for s in stale {
+        fs::remove_dir_all(s).with_context(|| {
+            format!("cannot remove {}, left by an interrupted {command}", s.display())
+        })?;
+    }
+    let names: Vec<String> = stale
+        .iter()
+        .filter_map(|s| s.file_name().map(|n| n.to_string_lossy().into_owned()))
+        .collect();
+    eprintln!(
+        "somnurbs: note: removed {} folder(s) an interrupted {command} left beside {} (their process is gone): {}",
+        stale.len(),
+        target.display(),
+        names.join(", ")
+    );
+    Ok(())
+}
+
 /// Atomically exchange two paths; Ok(false) if the file system cannot.
 fn exchange(a: &Path, b: &Path) -> std::io::Result<bool> {
     use std::os::unix::ffi::OsStrExt;

@@ -653,6 +653,8 @@ pub(crate) fn accept(baseline: &Path, current: &Path) -> Result<Vec<String>> {
         bail!("{} holds no tables (*.csv)", current.display());
     }
     let _lock = crate::io::outdir::lock(baseline, "drift --accept")?;
+    let stale = crate::io::outdir::stale_siblings(baseline)?;
+    crate::io::outdir::remove_stale(&stale, baseline, "drift --accept")?;
     let (old_files, _) = crate::io::outdir::walk(baseline)?;
     let tb = tables(baseline)?;
     let mut files: Vec<PathBuf> = tc.clone();

@@ -211,3 +211,17 @@ fn a_full_disk_stops_the_run_and_resume_finishes_it() {
     c.ok(&["run", "s.toml", "--out", "whole"]);
     assert!(same_tables(&c.path("whole"), &c.path("o")) > 0);
 }
+
+#[test]
+fn an_interrupted_accept_leaves_nothing_the_next_one_keeps() {
+    let c = Case::new();
+    c.write("a.toml", &som());
+    c.ok(&["run", "a.toml", "--out", "cur"]);
+    c.ok(&["drift", "base", "cur", "--accept"]);
+    // What a kill during the swap leaves beside the baseline: a staged folder of a dead process.
+    c.write("base/../.base.999999999.0.staged/runs.csv", "x\n1\n");
+    let out = c.ok(&["drift", "base", "cur", "--accept"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("removed 1 folder(s) an interrupted drift --accept left"), "{err}");
+    assert!(!c.path(".base.999999999.0.staged").exists());
+}

@@ -448,7 +448,7 @@ pub(crate) fn compare(args: &CompareArgs) -> Result<()> {
     if let Some((n, sr, rs)) = unreachable.smallest {
         eprintln!("somnurbs: warning: of {} cell comparisons, {} cannot reach alpha {} by the signed-rank test and {} by the rank-sum test with their repeats (with {n} repeats a two-sided p is at least {sr} signed-rank, {rs} rank-sum): there h is 0 and no cell is favoured whatever the data (compare_cells.csv: min_p_signed_rank, min_p_rank_sum, can_reach_alpha)", unreachable.of, unreachable.signed_rank, args.alpha, unreachable.rank_sum);
     }
-    remove_stale(&stale, &dest)?;
+    crate::io::outdir::remove_stale(&stale, &dest, "compare")?;
     // Built whole in a sibling folder and swapped in: a reader sees the old tables or the new, and
     // any failed write (a table or a chart) leaves the old folder as it was.
     let tables = Tables { rows: &rows, opts: &opts, cells: cells.len(), cell_rows, wins };
@@ -553,28 +553,6 @@ fn check_destination(args: &CompareArgs, dest: &std::path::Path) -> Result<Vec<P
         }
     }
     Ok(stale)
-}
-
-/// Remove the folders an interrupted compare left beside `dest`, saying so in one line.
-fn remove_stale(stale: &[PathBuf], dest: &std::path::Path) -> Result<()> {
-    if stale.is_empty() {
-        return Ok(());
-    }
-    for s in stale {
-        std::fs::remove_dir_all(s)
-            .with_context(|| format!("cannot remove {}, left by an interrupted compare", s.display()))?;
-    }
-    let names: Vec<String> = stale
-        .iter()
-        .filter_map(|s| s.file_name().map(|n| n.to_string_lossy().into_owned()))
-        .collect();
-    eprintln!(
-        "somnurbs: note: removed {} folder(s) an interrupted compare left beside {} (their process is gone): {}",
-        stale.len(),
-        dest.display(),
-        names.join(", ")
-    );
-    Ok(())
 }
 
 /// The folder `compare` writes into by default, inside the results folder it compares.
