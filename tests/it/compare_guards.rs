@@ -429,3 +429,31 @@ fn copy_dir(from: &Path, to: &Path) {
         }
     }
 }
+
+/// A named pipe or a device in place of an external log's `.dat` or `.json` is refused for what it
+/// is, at once (a plain read would wait on the pipe forever or read the device without end).
+#[test]
+fn an_external_log_that_is_a_pipe_or_a_device_is_refused_without_waiting() {
+    let c = Case::new();
+    let ext = fixture(&c);
+    let (json, dat) = first_log(&ext);
+    let fifo = |p: &Path| {
+        std::fs::remove_file(p).unwrap();
+        assert!(std::process::Command::new("mkfifo").arg(p).status().unwrap().success());
+    };
+    let start = std::time::Instant::now();
+    let good_dat = std::fs::read(&dat).unwrap();
+    fifo(&dat);
+    let dat_name = dat.file_name().unwrap().to_string_lossy().into_owned();
+    c.fails(&["compare", "r", "--external", "ext"], &[&dat_name, "named pipe"]);
+    std::fs::remove_file(&dat).unwrap();
+    std::os::unix::fs::symlink("/dev/zero", &dat).unwrap();
+    c.fails(&["compare", "r", "--external", "ext"], &[&dat_name, "device"]);
+    std::fs::remove_file(&dat).unwrap();
+    std::fs::write(&dat, good_dat).unwrap();
+    let json_name = json.file_name().unwrap().to_string_lossy().into_owned();
+    fifo(&json);
+    c.fails(&["compare", "r", "--external", "ext"], &[&json_name, "named pipe"]);
+    assert!(start.elapsed().as_secs() < 60, "took {:?}", start.elapsed());
+    assert!(!c.path("r/compare").exists());
+}
