@@ -1049,12 +1049,11 @@ fn series_of(
 ) -> Vec<plots::Series> {
     use crate::report::plots::style;
     opts.iter()
-        .enumerate()
-        .filter_map(|(k, o)| {
+        .filter_map(|o| {
             let (_, _, v) = rt_rows.iter().find(|r| r.0 == group && &r.1 == o)?;
             Some(plots::Series {
                 label: o.clone(),
-                colour: style::optimiser_colour(o).unwrap_or_else(|| style::cycle_colour(k)),
+                colour: style::series_colour(o, opts),
                 points: budgets.iter().zip(v).map(|(b, y)| ((*b as f64).log10(), *y)).collect(),
                 band: None,
             })

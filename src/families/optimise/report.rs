@@ -400,7 +400,7 @@ fn winners_by_net(t: &GridTables, grid: GridSize, err_name: &str, out: &Path, ex
                 .enumerate()
                 .map(|(k, o)| Series {
                     label: label(o),
-                    colour: style::optimiser_colour(o).unwrap_or_else(|| style::cycle_colour(k)),
+                    colour: style::series_colour(o, &t.opts),
                     points: pts[k].clone(),
                     band: None,
                 })
@@ -829,7 +829,7 @@ fn convergence_charts(
         for d in ordered(cells.iter().map(|c| c.data.clone())) {
             let mut series = Vec::new();
             let mut groups = Vec::new();
-            for (k, o) in opts.iter().enumerate() {
+            for o in opts {
                 let rs: Vec<&&OptimRun> = g
                     .iter()
                     .filter(|r| {
@@ -857,7 +857,7 @@ fn convergence_charts(
                 }
                 series.push(Series {
                     label: o.clone(),
-                    colour: style::optimiser_colour(o).unwrap_or_else(|| style::cycle_colour(k)),
+                    colour: style::series_colour(o, opts),
                     points: pts,
                     band: Some(band),
                 });

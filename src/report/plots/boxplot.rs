@@ -154,9 +154,10 @@ fn draw_box_plot(
     }
     let slot_px =
         chart.backend_coord(&(1.5, y_axis.lo)).0 - chart.backend_coord(&(0.5, y_axis.lo)).0;
+    let names: Vec<&str> = groups.iter().map(|(n, _)| n.as_str()).collect();
     for (i, ((name, _), st)) in groups.iter().zip(stats).enumerate() {
         let x = i as f64 + 1.0;
-        let colour = style::optimiser_colour(name).unwrap_or_else(|| style::cycle_colour(i));
+        let colour = style::series_colour(name, &names);
         if let Some(s) = st {
             let (l, r) = (x - 0.25, x + 0.25);
             chart.draw_series([

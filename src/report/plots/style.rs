@@ -79,6 +79,38 @@ pub(crate) fn cycle_colour(i: usize) -> RGBColor {
     CYCLE[i % CYCLE.len()]
 }
 
+/// Colours for optimisers somnurbs does not know (externals logged from Python, such as CMA-ES),
+/// handed out in their order among such names: none is a registered optimiser's, the exact
+/// optimum's or B's (Okabe-Ito's yellow, then Paul Tol's muted scheme and two darks).
+pub(crate) const EXTRA: [RGBColor; 8] = [
+    RGBColor(51, 34, 136),
+    RGBColor(204, 102, 119),
+    RGBColor(68, 170, 153),
+    RGBColor(153, 153, 51),
+    RGBColor(136, 34, 85),
+    RGBColor(140, 86, 75),
+    RGBColor(240, 228, 66),
+    RGBColor(47, 79, 79),
+];
+
+/// The colour of the series `name` among the series `names` of one chart: an optimiser's own
+/// ([`optimiser_colour`]), else the [`EXTRA`] colour of its place among the names that have none,
+/// so that no two optimisers of a chart share a colour (up to eight unknown ones).
+pub(crate) fn series_colour<S: AsRef<str>>(name: &str, names: &[S]) -> RGBColor {
+    if let Some(c) = optimiser_colour(name) {
+        return c;
+    }
+    let unknown = names.iter().map(AsRef::as_ref).filter(|n| optimiser_colour(n).is_none());
+    let mut seen: Vec<&str> = Vec::new();
+    for n in unknown {
+        if !seen.contains(&n) {
+            seen.push(n);
+        }
+    }
+    let k = seen.iter().position(|n| *n == name).unwrap_or(seen.len());
+    EXTRA[k % EXTRA.len()]
+}
+
 /// One colour per optimiser (case-insensitive): each registered one's (`optim::REGISTRY`), and
 /// exact (the certified convex optimum) and b (approach B's least-squares control points, the
 /// starting point).
@@ -151,6 +183,20 @@ mod tests {
             }
         }
         assert_eq!(optimiser_colour(" DE "), Some(BLUE));
+        // Externals: each its own colour, none of the named ones', whatever their place.
+        let chart = ["cma-es", "ga", "scipy-de", "de", "nelder-mead", "exact", "b"];
+        let got: Vec<RGBColor> = chart.iter().map(|n| series_colour(n, &chart)).collect();
+        for i in 0..got.len() {
+            for j in 0..i {
+                assert_ne!(got[i], got[j], "{} and {} share a colour", chart[i], chart[j]);
+            }
+        }
+        for (k, extra) in EXTRA.iter().enumerate() {
+            assert!(!cs.contains(extra), "EXTRA[{k}] is a named optimiser's colour");
+            assert!(!EXTRA[..k].contains(extra), "EXTRA[{k}] repeats");
+        }
+        assert_eq!(series_colour("ga", &chart), ORANGE);
+        assert_eq!(series_colour("cma-es", &chart), EXTRA[0]);
         assert_eq!(optimiser_colour("sa"), None);
     }
 
