@@ -591,7 +591,8 @@ struct Problem {
     name: String,
     b: f64,
     best_known: f64,
-    certified: bool,
+    /// Where `best_known` comes from, in words (`compare_targets.csv`'s `best_known_from`).
+    from: String,
     /// The start of the targets' range (the fixed-budget gap's reference), None when no run ever
     /// improved, and the rule that chose it.
     reference: Option<f64>,
@@ -730,7 +731,7 @@ fn problems(
             name: lp.function_name.clone(),
             b: exp[0].b,
             best_known: f64::INFINITY,
-            certified: false,
+            from: String::new(),
             reference: None,
             rule: "none",
             targets: Vec::new(),
@@ -742,13 +743,11 @@ fn problems(
         anyhow::bail!("{}: runs.csv has {o} on {p} but ioh/ has no trace of it", folder.display());
     }
     for (pn, p) in out.iter_mut() {
-        let found =
-            rows.iter().filter(|r| &name(r) == pn).map(|r| r.best).fold(f64::INFINITY, f64::min);
-        p.best_known = found;
-        if let Some(c) = certified.get(pn) {
-            p.best_known = c.optimum.min(found);
-            p.certified = true;
-        }
+        let best_run = rows
+            .iter()
+            .filter(|r| &name(r) == pn)
+            .min_by(|a, b| a.best.total_cmp(&b.best).then(a.repeat.cmp(&b.repeat)));
+        (p.best_known, p.from) = best_known(best_run, certified.get(pn));
         let firsts: Vec<f64> =
             p.runs.values().flatten().filter_map(|r| r.1.first().map(|x| x.1)).collect();
         (p.reference, p.rule) = stats::runtime::target_range(p.b, p.best_known, &firsts);
@@ -760,6 +759,22 @@ fn problems(
         };
     }
     Ok(out.into_values().collect())
+}
+
+/// The best known value of a problem and its provenance: the exact solver's `f` (the upper end of
+/// its certified interval [lower_bound, f]) unless a run ended below it (within the certified
+/// gap), then that run, named.
+fn best_known(best_run: Option<&OptimRow>, cert: Option<&Certificate>) -> (f64, String) {
+    let run = |r: &OptimRow| format!("best run ({} repeat {})", r.competitor(), r.repeat);
+    match (best_run, cert) {
+        (Some(r), Some(c)) if r.best < c.optimum => (
+            r.best,
+            format!("{}, below the exact solver's f, within its certified gap", run(r)),
+        ),
+        (_, Some(c)) => (c.optimum, "certified optimum (the exact solver's f)".into()),
+        (Some(r), None) => (r.best, run(r)),
+        (None, None) => (f64::INFINITY, "none".into()),
+    }
 }
 
 /// Targets per problem in words: "16 targets each", or "16 targets each (1 in 2)"
@@ -1019,7 +1034,7 @@ fn write_ert_and_targets(
                 p.name.clone(),
                 num(p.b),
                 num(p.best_known),
-                if p.certified { "certified optimum" } else { "best run" }.to_string(),
+                p.from.clone(),
                 p.rule.to_string(),
                 p.reference.map(num).unwrap_or_default(),
                 p.targets.len().to_string(),
@@ -1184,6 +1199,25 @@ fn bayes_table(rows: &[OptimRow], opts: &[String], args: &CompareArgs) -> Result
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn the_best_known_value_names_where_it_comes_from() {
+        use super::super::external::Certificate;
+        let row = |o: &str, repeat: usize, best: f64| super::OptimRow {
+            optimiser: o.into(),
+            repeat,
+            best,
+            ..Default::default()
+        };
+        let cert = Certificate { optimum: 2.0, lower_bound: 1.5, table: "exact_6x6.csv".into() };
+        let (v, from) = super::best_known(Some(&row("de", 3, 2.5)), Some(&cert));
+        assert_eq!((v, from.as_str()), (2.0, "certified optimum (the exact solver's f)"));
+        let (v, from) = super::best_known(Some(&row("cma-es", 1, 1.9)), Some(&cert));
+        assert_eq!(v, 1.9);
+        assert_eq!(from, "best run (cma-es repeat 1), below the exact solver's f, within its certified gap");
+        let (v, from) = super::best_known(Some(&row("pso", 0, 4.0)), None);
+        assert_eq!((v, from.as_str()), (4.0, "best run (pso repeat 0)"));
+    }
+
     use super::*;
 
     /// The `better` rule: the signed-rank test first (x when W+ < W-), then the rank-sum test
@@ -1214,7 +1248,7 @@ mod tests {
             name: "p".into(),
             b: 2.0,
             best_known: 1.0,
-            certified: false,
+            from: "best run (de repeat 0)".into(),
             reference: Some(2.0),
             rule: "b_to_best_known",
             targets: stats::runtime::log_targets(2.0, 1.0, TARGETS, TARGET_DECADES),
