@@ -445,7 +445,8 @@ fn compare_of_one_cell_gives_the_per_cell_tests() {
     c.write("opt.toml", &one.replace("repeats = 2", "repeats = 6"));
     c.ok(&["run", "opt.toml", "--out", "o"]);
     let out = c.ok(&["compare", "o"]);
-    assert!(String::from_utf8_lossy(&out.stdout).contains("one cell: the tests over cells"));
+    assert!(String::from_utf8_lossy(&out.stdout)
+        .contains("1 cell(s) that every optimiser ran: the tests over cells"));
     let (_, rows) = read_csv(&c.path("o/compare/compare_cells.csv"));
     assert_eq!(rows.len(), 3, "three pairs of optimisers in the one cell");
     assert!(!c.path("o/compare/compare_overall.csv").exists());

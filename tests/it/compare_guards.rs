@@ -460,3 +460,30 @@ fn an_external_log_that_is_a_pipe_or_a_device_is_refused_without_waiting() {
     assert!(start.elapsed().as_secs() < 60, "took {:?}", start.elapsed());
     assert!(!c.path("r/compare").exists());
 }
+
+/// An external that ran part of the problems: a one-line warning names its count and what the
+/// statistics over cells use, and the runtime aggregate `all` is over the problems every
+/// optimiser ran, for every optimiser alike.
+#[test]
+fn an_external_that_ran_part_of_the_problems_is_warned_and_aggregated_over_the_common_ones() {
+    let c = Case::new();
+    let ext = fixture(&c);
+    let (json, dat) = first_log(&ext);
+    std::fs::remove_file(&json).unwrap();
+    std::fs::remove_file(&dat).unwrap();
+    let (_, all_rows) = read_csv(&c.path("r/runs.csv"));
+    let out = c.ok(&["compare", "r", "--external", "ext", "--bayes-samples", "1000"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    let warning = err.lines().find(|l| l.contains("not every optimiser ran every cell"));
+    let warning = warning.unwrap_or_else(|| panic!("no coverage warning: {err}"));
+    assert!(
+        warning.contains(&format!("{EXT} ran ")) && warning.contains("cells every optimiser ran"),
+        "{warning}"
+    );
+    let (h, rows) = read_csv(&c.path("r/compare/compare_aocc.csv"));
+    let all: Vec<&Vec<String>> = rows.iter().filter(|r| r[col(&h, "group")] == "all").collect();
+    assert!(all.len() >= 3 && all.iter().any(|r| r[col(&h, "optimiser")] == EXT), "{rows:?}");
+    let n = &all[0][col(&h, "problems")];
+    assert!(all.iter().all(|r| &r[col(&h, "problems")] == n), "{all:?}");
+    assert!(!all_rows.is_empty());
+}

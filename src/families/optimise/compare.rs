@@ -444,6 +444,9 @@ pub(crate) fn compare(args: &CompareArgs) -> Result<()> {
     } else {
         None
     };
+    if let Some(line) = coverage_note(&cells, &opts) {
+        eprintln!("somnurbs: warning: {line}");
+    }
     let (cell_rows, wins, unreachable) = pairwise_cells(&cells, &opts, args.alpha);
     if let Some((n, sr, rs)) = unreachable.smallest {
         eprintln!("somnurbs: warning: of {} cell comparisons, {} cannot reach alpha {} by the signed-rank test and {} by the rank-sum test with their repeats (with {n} repeats a two-sided p is at least {sr} signed-rank, {rs} rank-sum): there h is 0 and no cell is favoured whatever the data (compare_cells.csv: min_p_signed_rank, min_p_rank_sum, can_reach_alpha)", unreachable.of, unreachable.signed_rank, args.alpha, unreachable.rank_sum);
@@ -451,18 +454,39 @@ pub(crate) fn compare(args: &CompareArgs) -> Result<()> {
     crate::io::outdir::remove_stale(&stale, &dest, "compare")?;
     // Built whole in a sibling folder and swapped in: a reader sees the old tables or the new, and
     // any failed write (a table or a chart) leaves the old folder as it was.
-    let tables = Tables { rows: &rows, opts: &opts, cells: cells.len(), cell_rows, wins };
+    let common = cells.values().filter(|per| opts.iter().all(|o| per.contains_key(o))).count();
+    let tables = Tables { rows: &rows, opts: &opts, cells: common, cell_rows, wins };
     crate::io::outdir::replace_dir(&dest, |out| {
         write_folder(args, &tables, probs.as_deref(), out)
             .with_context(|| format!("{} left as it was", dest.display()))
     })
 }
 
+/// Where some optimiser did not run every cell (an external logged on part of the problems): one
+/// line naming each such optimiser's count and what the statistics over cells use; None when
+/// every optimiser ran every cell.
+fn coverage_note(cells: &Cells, opts: &[String]) -> Option<String> {
+    let ran = |o: &String| cells.values().filter(|per| per.contains_key(o)).count();
+    let partial: Vec<String> = opts
+        .iter()
+        .filter(|o| ran(o) < cells.len())
+        .map(|o| format!("{o} ran {} of {}", ran(o), cells.len()))
+        .collect();
+    if partial.is_empty() {
+        return None;
+    }
+    let common = cells.values().filter(|per| opts.iter().all(|o| per.contains_key(o))).count();
+    Some(format!(
+        "not every optimiser ran every cell ({}): the tests over cells (Friedman, the critical-difference diagram, the Bayesian signed-rank test) and the runtime aggregate `all` use the {common} cells every optimiser ran; the per-cell tests and per-problem runtime tables use each pair's or optimiser's own",
+        partial.join(", ")
+    ))
+}
+
 /// What `compare` writes, computed before anything is written.
 struct Tables<'a> {
     rows: &'a [OptimRow],
     opts: &'a [String],
-    /// How many cells.
+    /// How many cells every optimiser ran (what the tests over cells use).
     cells: usize,
     cell_rows: Vec<Vec<String>>,
     wins: Wins,
@@ -480,7 +504,7 @@ fn write_folder(
     let (cd_note, mut written) = if t.cells >= 2 {
         (over_cells(t.rows, t.opts, &t.wins, args, out)?, String::from("compare_cells.csv, compare_overall.csv, compare_bayes.csv"))
     } else {
-        println!("  one cell: the tests over cells (Friedman, Nemenyi, Bayesian signed-rank) need two or more; the per-cell tests are in compare_cells.csv");
+        println!("  {} cell(s) that every optimiser ran: the tests over cells (Friedman, Nemenyi, Bayesian signed-rank) need two or more; the per-cell tests are in compare_cells.csv", t.cells);
         (String::new(), String::from("compare_cells.csv"))
     };
     if let Some(probs) = probs {
@@ -639,6 +663,9 @@ struct Runtime {
     targets_desc: String,
     /// Per problem, optimiser and target.
     ert: Vec<ErtRow>,
+    /// The problems "all" aggregates, in words for the titles: "problems " when every optimiser
+    /// ran every problem, else "problems every optimiser ran ".
+    common_desc: String,
 }
 
 /// The certificates of a folder's `exact_<grid>.csv` tables (the exact solver's optimum and its
@@ -863,17 +890,33 @@ fn runtime(problems: &[Problem], opts: &[String]) -> Runtime {
         fixed_budget: Vec::new(),
         targets_desc: targets_desc(problems),
         ert: Vec::new(),
+        common_desc: "problems ".into(),
     };
+    if problems.iter().any(|p| opts.iter().any(|o| !p.runs.contains_key(o))) {
+        rt.common_desc = "problems every optimiser ran ".into();
+    }
+    // "all" aggregates the problems every optimiser ran (all of them unless an external ran part),
+    // so that every optimiser's aggregate is over the same problems.
+    let common = |p: &Problem| opts.iter().all(|o| p.runs.contains_key(o));
+    let any_common = problems.iter().any(common);
     for o in opts {
         let (mut es, mut gs) = (Vec::new(), Vec::new());
+        let (mut own_e, mut own_g) = (Vec::new(), Vec::new());
         for p in problems {
             let Some(runs) = p.runs.get(o) else { continue };
             let (e, g, ert_rows) = problem_runtime(p, o, runs, &budgets, budget);
-            es.push(e);
-            gs.push(g);
             rt.ert.extend(ert_rows);
+            if common(p) || !any_common {
+                es.push(e);
+                gs.push(g);
+            } else {
+                own_e.push(e);
+                own_g.push(g);
+            }
         }
         if es.is_empty() {
+            rt.ecdf.extend(own_e);
+            rt.fixed_budget.extend(own_g);
             continue;
         }
         let curves: Vec<&[f64]> = es.iter().map(|e| e.values.as_slice()).collect();
@@ -902,8 +945,10 @@ fn runtime(problems: &[Problem], opts: &[String]) -> Runtime {
             },
         };
         rt.ecdf.extend(es);
+        rt.ecdf.extend(own_e);
         rt.ecdf.push(all);
         rt.fixed_budget.extend(gs);
+        rt.fixed_budget.extend(own_g);
         rt.fixed_budget.push(all_gap);
     }
     rt
@@ -1093,7 +1138,7 @@ fn render_ecdf(
         rt.ecdf.iter().map(|r| (r.group.clone(), r.optimiser.clone(), r.values.clone())).collect();
     let title = if group == "all" {
         let n = group_problems(rt.ecdf.iter().map(|e| (e.group.as_str(), e.problems)), group);
-        format!("all: mean ECDF of {n} problems (equal weight), {}", rt.targets_desc)
+        format!("all: mean ECDF of {n} {}(equal weight), {}", rt.common_desc, rt.targets_desc)
     } else {
         format!("{group}: share of (run, target) pairs reached")
     };
@@ -1128,7 +1173,7 @@ fn render_fixed_budget(
             rt.fixed_budget.iter().map(|g| (g.group.as_str(), g.problems)),
             group,
         );
-        format!("all: mean normalised gap of {n} problems (equal weight)")
+        format!("all: mean normalised gap of {n} {}(equal weight)", rt.common_desc)
     } else {
         let rule = rt.fixed_budget.iter().find(|g| g.group == group).map(|g| g.rule.as_str());
         let reference = match rule {
