@@ -84,7 +84,10 @@ fn run_spec(args: &RunArgs) -> anyhow::Result<ExitCode> {
     let cli = CliOverrides { set: args.set.clone(), sweep: args.sweep.clone() };
     let variants = Loaded::load_variants(&args.spec, args.profile.as_deref(), &cli)?;
     let spec = &variants[0].spec;
+    let data_dir = experiment::data_dir(args.data_dir.as_deref());
     if args.dry_run {
+        let out = spec.output_dir(args.out.as_deref());
+        experiment::preflight(&variants[0], &RunContext::new(out, 1, data_dir))?;
         for (key, seed) in variants.iter().flat_map(experiment::dry_run_listing) {
             println!("{key}\tseed {seed}");
         }
