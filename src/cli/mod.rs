@@ -4,6 +4,7 @@ use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
 
 mod commands;
+mod interrupt;
 pub use commands::main;
 
 const EXAMPLES: &str = "\

@@ -41,3 +41,48 @@ fn dry_run_makes_the_checks_of_a_run() {
     let listed = String::from_utf8(c.ok(&["run", "ok.toml", "--dry-run"]).stdout).unwrap();
     assert_eq!(listed.lines().count(), 1, "{listed}");
 }
+
+/// Runs `args` in the case folder, sends SIGINT once `ready` (a file) exists, and returns the
+/// exit code and stderr.
+fn interrupted(c: &Case, args: &[&str], ready: &str) -> (Option<i32>, String) {
+    use std::time::{Duration, Instant};
+    let child = bin()
+        .args(args)
+        .current_dir(c.dir.path())
+        .env("SOMNURBS_DATA", data_dir())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let t0 = Instant::now();
+    while !c.path(ready).exists() {
+        assert!(t0.elapsed() < Duration::from_secs(120), "{ready} never appeared");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    // SAFETY: kill(2) on the child's own pid.
+    assert_eq!(unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGINT) }, 0);
+    let out = child.wait_with_output().unwrap();
+    (out.status.code(), String::from_utf8_lossy(&out.stderr).to_string())
+}
+
+#[test]
+fn sigint_says_how_to_resume_and_exits_130() {
+    let c = Case::new();
+    // Ten times SLOW's generations: the run is still going when the signal comes.
+    let slower = SLOW.replace("generations = 600", "generations = 6000");
+    c.write("slow.toml", &slower);
+    let args = ["run", "slow.toml", "--out", "my run", "--jobs", "1"];
+    let (code, err) = interrupted(&c, &args, "my run/cells.jsonl");
+    assert_eq!(code, Some(130), "{err}");
+    let want =
+        "somnurbs: interrupted; continue with: somnurbs run slow.toml --out 'my run' --resume";
+    assert_eq!(err.lines().last(), Some(want), "{err}");
+    assert!(!c.path("my run/manifest.toml").exists());
+    // reproduce names its plan and profile.
+    c.write("plans/p.toml", "specs = [\"slow\"]\n");
+    c.write("plans/slow.toml", &slower);
+    let args = ["reproduce", "--specs", "plans", "--plan", "p", "--out", "r", "--jobs", "1"];
+    let (code, err) = interrupted(&c, &args, "r/slow/cells.jsonl");
+    assert_eq!(code, Some(130), "{err}");
+    let want = "somnurbs: interrupted; continue with: somnurbs reproduce --plan p --profile full --specs plans --out r --resume";
+    assert_eq!(err.lines().last(), Some(want), "{err}");
+}
