@@ -86,3 +86,52 @@ fn sigint_says_how_to_resume_and_exits_130() {
     let want = "somnurbs: interrupted; continue with: somnurbs reproduce --plan p --profile full --specs plans --out r --resume";
     assert_eq!(err.lines().last(), Some(want), "{err}");
 }
+
+/// A Chapter 4 folder `maps` with a saved 20x20 map, and `fit` folders from it.
+fn maps_and_fit(c: &Case, fits: &[(&str, &str)]) {
+    c.write("maps.toml", CH4_FOR_FIT);
+    c.ok(&["run", "maps.toml", "--out", "maps"]);
+    for (out, cn) in fits {
+        c.ok(&["fit", "--grid", "maps/maps/dnsom_sphere_20x20.csv", "--cn", cn, "--out", out]);
+    }
+}
+
+#[test]
+fn compare_says_what_a_folder_is_when_it_is_no_chapter_6_run() {
+    let c = Case::new();
+    maps_and_fit(&c, &[("F", "8x8")]);
+    let takes = "compare takes the folder of a finished run of a spec with an [optimise] section";
+    c.fails(
+        &["compare", "F"],
+        &["F is a `somnurbs fit` folder, not a Chapter 6 (optimise) run", takes],
+    );
+    c.fails(
+        &["compare", "maps"],
+        &["maps is a run of spec maps ([som], Chapter 4), not a Chapter 6 (optimise) run", takes],
+    );
+    assert!(!c.path("F/compare").exists() && !c.path("maps/compare").exists());
+}
+
+#[test]
+fn drift_refuses_other_runs_naming_both_folders_and_what_differs() {
+    let c = Case::new();
+    c.write("d.toml", SPEC);
+    c.write("e.toml", &SPEC.replace("master_seed = 3", "master_seed = 4"));
+    c.ok(&["run", "d.toml", "--out", "plain"]);
+    c.ok(&["run", "d.toml", "--out", "set", "--set", "optimise.de.f=0.5"]);
+    c.ok(&["run", "e.toml", "--out", "seed"]);
+    let needles = [
+        "plain and set hold different runs (--set none vs optimise.de.f=0.5)",
+        "--allow-spec-change",
+    ];
+    c.fails(&["drift", "plain", "set"], &needles);
+    c.fails(
+        &["drift", "plain", "seed"],
+        &["plain and seed hold different runs (", "master seed 3 vs 4"],
+    );
+    let err = c.fails(&["drift", "plain", "seed"], &[]);
+    assert!(!err.contains(": .:") && !err.contains("error: ."), "{err}");
+    assert!(!c.path("drift.csv").exists());
+    let out = c.run(&["drift", "plain", "set", "--allow-spec-change"]);
+    assert_eq!(out.status.code(), Some(1), "{}", c.explain(&["drift"], &out));
+}
