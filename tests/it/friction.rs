@@ -135,3 +135,30 @@ fn drift_refuses_other_runs_naming_both_folders_and_what_differs() {
     let out = c.run(&["drift", "plain", "set", "--allow-spec-change"]);
     assert_eq!(out.status.code(), Some(1), "{}", c.explain(&["drift"], &out));
 }
+
+#[test]
+fn fit_and_specs_take_one_spelling_per_value() {
+    let c = Case::new();
+    maps_and_fit(&c, &[]);
+    let grid = "maps/maps/dnsom_sphere_20x20.csv";
+    let fit = |extra: &[&str], needles: &[&str]| {
+        let mut args = vec!["fit", "--grid", grid, "--out", "F"];
+        args.extend_from_slice(extra);
+        if !extra.contains(&"--cn") {
+            args.extend_from_slice(&["--cn", "8x8"]);
+        }
+        c.fails(&args, needles);
+        assert!(!c.path("F").exists());
+    };
+    fit(&["--cn", "18"], &["--cn", "`18` is not a grid size (write NXxNY"]);
+    let params = "(expected uniform, chord_length, centripetal or exponential)";
+    fit(&["--param", "chordal"], &["--param", "unknown parameterisation `chordal`", params]);
+    fit(&["--param", "Chord-Length"], &["--param", "`Chord-Length`", params]);
+    fit(&["--approach", "b"], &["--approach", "expected A/conventional or B/improved"]);
+    // A spec is read the same way.
+    let spec = SPEC.replace("\"chord_length\"", "\"chordal\"");
+    c.write("p.toml", &spec);
+    c.fails(&["run", "p.toml", "--dry-run"], &["p.toml:8", "`chordal`", params]);
+    c.write("g.toml", &SPEC.replace("grid = \"20x20\"", "grid = 20"));
+    c.fails(&["run", "g.toml", "--dry-run"], &["g.toml", "20 is not a grid size", "\"20x20\""]);
+}
