@@ -551,8 +551,16 @@ pub(crate) fn merge<F: Families>(shards: &[PathBuf], ctx: &RunContext) -> Result
     run_spec_locked(&variants, &RunContext { resume: true, shard: None, ..ctx.clone() })
 }
 
-/// Resolve the data directory: flag, else `SOMNURBS_DATA`, else `./data` (in the working folder;
-/// `crate::data::registry::data_folder` is the rule).
+/// Resolve the data directory: `--data-dir`, else `SOMNURBS_DATA`, else `data/` in the working
+/// folder, else the `data/` of the clone somnurbs was built from (said on stderr), the rule of
+/// `crate::data::registry::found_folder`.
 pub fn data_dir(flag: Option<&Path>) -> PathBuf {
-    crate::data::registry::data_folder(flag, Path::new(""))
+    let (dir, clone) = crate::data::registry::found_folder(flag, Some("SOMNURBS_DATA"), "data");
+    if clone {
+        eprintln!(
+            "somnurbs: note: no data/ in the working folder; reading data files from the clone somnurbs was built from, {} (--data-dir DIR or SOMNURBS_DATA names another)",
+            dir.display()
+        );
+    }
+    dir
 }
