@@ -162,3 +162,66 @@ fn fit_and_specs_take_one_spelling_per_value() {
     c.write("g.toml", &SPEC.replace("grid = \"20x20\"", "grid = 20"));
     c.fails(&["run", "g.toml", "--dry-run"], &["g.toml", "20 is not a grid size", "\"20x20\""]);
 }
+
+#[test]
+fn a_fit_folder_has_a_real_iges_date_and_a_manifest_of_what_fit_did() {
+    let c = Case::new();
+    maps_and_fit(&c, &[]);
+    let args = ["fit", "--grid", "maps/maps/dnsom_sphere_20x20.csv", "--cn", "8x8", "--out", "F"];
+    let out = bin()
+        .args(args)
+        .current_dir(c.dir.path())
+        .env("SOURCE_DATE_EPOCH", "1709251199")
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", c.explain(&args, &out));
+    let iges = std::fs::read_to_string(c.path("F/surfaces.igs")).unwrap();
+    let global: String =
+        iges.lines().filter(|l| &l[72..73] == "G").map(|l| l[..72].trim_end()).collect();
+    assert!(global.contains(",15H20240229.235959,1.0E-9,"), "{global}");
+    assert!(!global.contains(",1.0E-9,0.0,"), "the maximum coordinate is written: {global}");
+    let m: toml::Table =
+        toml::from_str(&std::fs::read_to_string(c.path("F/manifest.toml")).unwrap()).unwrap();
+    assert_eq!(m["kind"].as_str(), Some("fit"));
+    assert_eq!(m["grid"].as_str(), Some("maps/maps/dnsom_sphere_20x20.csv"));
+    assert_eq!(m["grid_sha256"].as_str().map(str::len), Some(64));
+    assert_eq!(m["generated_unix"].as_integer(), Some(1_709_251_199));
+    for absent in ["spec_name", "master_seed", "profile"] {
+        assert!(!m.contains_key(absent), "{absent} in {m:?}");
+    }
+    let o = m["options"].as_table().unwrap();
+    for (k, v) in [
+        ("cn", "8x8"),
+        ("param", "chord_length"),
+        ("approach", "B"),
+        ("knots", "eq2_10"),
+        ("error_a", "per_surface"),
+        ("frame", "data"),
+        ("units", "unknown"),
+    ] {
+        assert_eq!(o[k].as_str(), Some(v), "{k}");
+    }
+    assert_eq!(o["fairness"].as_float(), Some(0.0));
+    // A bad SOURCE_DATE_EPOCH is refused, naming it.
+    let out = bin()
+        .args(["fit", "--grid", "maps/maps/dnsom_sphere_20x20.csv", "--cn", "8x8", "--out", "G"])
+        .current_dir(c.dir.path())
+        .env("SOURCE_DATE_EPOCH", "yesterday")
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("SOURCE_DATE_EPOCH: `yesterday`"));
+    assert!(!c.path("G").exists());
+    // Two fit folders: the same fit compares; another net is refused, a run beside a fit too.
+    for (out, cn) in [("F1", "8x8"), ("F2", "8x8"), ("F3", "10x10")] {
+        c.ok(&["fit", "--grid", "maps/maps/dnsom_sphere_20x20.csv", "--cn", cn, "--out", out]);
+    }
+    c.write("d.toml", SPEC);
+    c.ok(&["run", "d.toml", "--out", "plain"]);
+    c.ok(&["drift", "F1", "F2"]);
+    c.fails(&["drift", "F1", "F3"], &["F1 and F3 hold different runs", "--cn"]);
+    c.fails(
+        &["drift", "F1", "plain"],
+        &["F1 and plain hold different runs", "`somnurbs fit` folder vs a run of spec d"],
+    );
+}
