@@ -84,7 +84,10 @@ fn run_spec(args: &RunArgs) -> anyhow::Result<ExitCode> {
     let cli = CliOverrides { set: args.set.clone(), sweep: args.sweep.clone() };
     let variants = Loaded::load_variants(&args.spec, args.profile.as_deref(), &cli)?;
     let spec = &variants[0].spec;
+    let data_dir = experiment::data_dir(args.data_dir.as_deref());
     if args.dry_run {
+        let out = spec.output_dir(args.out.as_deref());
+        experiment::preflight(&variants[0], &RunContext::new(out, 1, data_dir))?;
         for (key, seed) in variants.iter().flat_map(experiment::dry_run_listing) {
             println!("{key}\tseed {seed}");
         }
@@ -97,8 +100,9 @@ fn run_spec(args: &RunArgs) -> anyhow::Result<ExitCode> {
         resume: args.resume,
         shard,
         page: true,
-        ..RunContext::new(out, jobs(args.jobs)?, experiment::data_dir(args.data_dir.as_deref()))
+        ..RunContext::new(out, jobs(args.jobs)?, data_dir)
     };
+    super::interrupt::on_sigint(&run_resume_command(args, &ctx.out));
     let out = experiment::run_variants(&variants, &ctx)?;
     match shard {
         Some(s) => eprintln!(
@@ -112,6 +116,31 @@ fn run_spec(args: &RunArgs) -> anyhow::Result<ExitCode> {
         ),
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The command that continues an interrupted `somnurbs run` (the SIGINT line).
+fn run_resume_command(args: &RunArgs, out: &std::path::Path) -> String {
+    use super::interrupt::quote;
+    let mut words = vec!["somnurbs".to_string(), "run".into(), quote(&args.spec.to_string_lossy())];
+    let mut flag = |name: &str, value: &str| words.push(format!("--{name} {}", quote(value)));
+    if let Some(p) = &args.profile {
+        flag("profile", p);
+    }
+    for s in &args.set {
+        flag("set", s);
+    }
+    for s in &args.sweep {
+        flag("sweep", s);
+    }
+    if let Some(s) = &args.shard {
+        flag("shard", s);
+    }
+    if let Some(d) = &args.data_dir {
+        flag("data-dir", &d.to_string_lossy());
+    }
+    flag("out", &out.to_string_lossy());
+    words.push("--resume".into());
+    words.join(" ")
 }
 
 /// `somnurbs drift`: compare two result folders (exit 1 on drift), or accept the current one.
@@ -159,8 +188,31 @@ fn reproduce(args: &ReproduceArgs) -> anyhow::Result<ExitCode> {
         resume: args.resume,
         ..RunContext::new(out, jobs, experiment::data_dir(args.data_dir.as_deref()))
     };
+    super::interrupt::on_sigint(&reproduce_resume_command(args, &specs, &ctx.out));
     let report =
         experiment::reproduce::reproduce::<Section>(&specs, &args.plan, &args.profile, &ctx)?;
     eprintln!("somnurbs: wrote {}", report.display());
     Ok(ExitCode::SUCCESS)
+}
+
+/// The command that continues an interrupted `somnurbs reproduce` (the SIGINT line).
+fn reproduce_resume_command(
+    args: &ReproduceArgs,
+    specs: &std::path::Path,
+    out: &std::path::Path,
+) -> String {
+    use super::interrupt::quote;
+    let mut words = vec!["somnurbs reproduce".to_string()];
+    let mut flag = |name: &str, value: &str| words.push(format!("--{name} {}", quote(value)));
+    flag("plan", &args.plan);
+    flag("profile", &args.profile);
+    if args.specs.is_some() {
+        flag("specs", &specs.to_string_lossy());
+    }
+    if let Some(d) = &args.data_dir {
+        flag("data-dir", &d.to_string_lossy());
+    }
+    flag("out", &out.to_string_lossy());
+    words.push("--resume".into());
+    words.join(" ")
 }

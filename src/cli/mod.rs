@@ -4,6 +4,7 @@ use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
 
 mod commands;
+mod interrupt;
 pub use commands::main;
 
 const EXAMPLES: &str = "\
@@ -16,7 +17,7 @@ Examples:
   somnurbs datasets list
   somnurbs datasets export sphere sphere.xyz
 
-Data directory (bunny, talus): --data-dir, else $SOMNURBS_DATA, else ./data";
+Data directory (bunny, talus): --data-dir, else $SOMNURBS_DATA, else ./data, else the clone's data/";
 
 #[derive(Debug, Parser)]
 #[command(name = "somnurbs", version, about = "Reproduce SOM + cubic B-spline surface reconstruction experiments from seeds", after_help = EXAMPLES)]
@@ -153,7 +154,8 @@ pub(crate) struct RunArgs {
     /// with a note). Results do not depend on it.
     #[arg(long, short = 'j')]
     pub(crate) jobs: Option<usize>,
-    /// Folder holding bun_zipper.ply and talus_r.stl (default: $SOMNURBS_DATA, else ./data).
+    /// Folder holding bun_zipper.ply and talus_r.stl (default: $SOMNURBS_DATA, else ./data, else
+    /// the data/ of the clone somnurbs was built from).
     #[arg(long)]
     pub(crate) data_dir: Option<PathBuf>,
     /// List the cells and their seeds without running them.
@@ -217,7 +219,8 @@ pub(crate) struct MergeArgs {
     /// with a note). Results do not depend on it.
     #[arg(long, short = 'j')]
     pub(crate) jobs: Option<usize>,
-    /// Folder holding bun_zipper.ply and talus_r.stl (default: $SOMNURBS_DATA, else ./data).
+    /// Folder holding bun_zipper.ply and talus_r.stl (default: $SOMNURBS_DATA, else ./data, else
+    /// the data/ of the clone somnurbs was built from).
     #[arg(long)]
     pub(crate) data_dir: Option<PathBuf>,
 }
@@ -243,7 +246,8 @@ pub(crate) struct ReproduceArgs {
     /// with a note). Results do not depend on it.
     #[arg(long, short = 'j')]
     pub(crate) jobs: Option<usize>,
-    /// Folder holding bun_zipper.ply and talus_r.stl (default: $SOMNURBS_DATA, else ./data).
+    /// Folder holding bun_zipper.ply and talus_r.stl (default: $SOMNURBS_DATA, else ./data, else
+    /// the data/ of the clone somnurbs was built from).
     #[arg(long)]
     pub(crate) data_dir: Option<PathBuf>,
     /// Keep what an interrupted reproduction finished (per chapter, as `run --resume`).
@@ -255,7 +259,7 @@ pub(crate) struct ReproduceArgs {
 pub(crate) struct DatasetsArgs {
     #[command(subcommand)]
     pub(crate) action: Option<DatasetsAction>,
-    /// Folder holding the data files (default: $SOMNURBS_DATA, else ./data).
+    /// Folder holding the data files (default: $SOMNURBS_DATA, else ./data, else the clone's data/).
     #[arg(long, global = true)]
     pub(crate) data_dir: Option<PathBuf>,
 }

@@ -297,28 +297,57 @@ fn note_once(key: &str, message: &str) {
 /// the data, and where `reproduce` finds its plans when run from another folder without `--specs`.
 pub(crate) const CLONE_DIR: &str = env!("CARGO_MANIFEST_DIR");
 
-/// The folder of the data files (bunny, talus), the one rule for the main job and the tests:
-/// `flag` (`--data-dir`), else `SOMNURBS_DATA`, else `data` in `top` (the working folder for the
-/// binary, the top of the clone for the tests: [`clone_data_dir`]).
-pub(crate) fn data_folder(flag: Option<&Path>, top: &Path) -> PathBuf {
+/// Where somnurbs finds a folder it reads, the one rule for the data folder and the folder of the
+/// plans (docs/running.md, "Where data, specs and plans are found"): `flag`, else the environment
+/// variable `env` when set and not empty, else `name` in the working folder when it is a folder,
+/// else `name` in the clone somnurbs was built from when that is one, else `name` in the working
+/// folder (what errors then name). The flag says the clone's was taken.
+pub(crate) fn found_folder(flag: Option<&Path>, env: Option<&str>, name: &str) -> (PathBuf, bool) {
     if let Some(p) = flag {
-        return p.to_path_buf();
+        return (p.to_path_buf(), false);
     }
-    match std::env::var_os("SOMNURBS_DATA") {
-        Some(v) if !v.is_empty() => PathBuf::from(v),
-        _ => top.join("data"),
+    if let Some(v) = env.and_then(std::env::var_os).filter(|v| !v.is_empty()) {
+        return (PathBuf::from(v), false);
     }
+    let here = PathBuf::from(name);
+    if here.is_dir() {
+        return (here, false);
+    }
+    let clone = Path::new(CLONE_DIR).join(name);
+    if clone.is_dir() {
+        return (clone, true);
+    }
+    (here, false)
 }
 
-/// The data folder the tests use: `data_folder` at the top of the clone, i.e. what a user's
-/// main job uses when run from there (`SOMNURBS_DATA` if set, else `<clone>/data`).
+/// The data folder the tests use: what a user's main job uses when run from the top of the clone
+/// ([`found_folder`]: `SOMNURBS_DATA` if set, else `<clone>/data`).
 pub fn clone_data_dir() -> PathBuf {
-    data_folder(None, Path::new(CLONE_DIR))
+    match std::env::var_os("SOMNURBS_DATA") {
+        Some(v) if !v.is_empty() => PathBuf::from(v),
+        _ => Path::new(CLONE_DIR).join("data"),
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn folders_are_found_by_flag_then_environment_then_working_folder() {
+        // The unit tests run at the top of the clone, which has experiments/.
+        let var = "SOMNURBS_TEST_FOUND_FOLDER";
+        assert_eq!(
+            found_folder(Some(Path::new("f")), Some(var), "experiments"),
+            ("f".into(), false)
+        );
+        assert_eq!(found_folder(None, Some(var), "experiments"), ("experiments".into(), false));
+        assert_eq!(found_folder(None, None, "no_such_folder"), ("no_such_folder".into(), false));
+        std::env::set_var(var, "from_env");
+        assert_eq!(found_folder(None, Some(var), "experiments"), ("from_env".into(), false));
+        std::env::set_var(var, "");
+        assert_eq!(found_folder(None, Some(var), "experiments"), ("experiments".into(), false));
+    }
 
     #[test]
     fn bunny_first_point_after_normalisation() {

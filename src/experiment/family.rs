@@ -62,9 +62,11 @@ pub trait Family<F>: Sync {
     /// Read the SOM maps from the folder `maps` (a plan whose earlier spec saved them); families
     /// that read no maps ignore it.
     fn use_maps(&self, s: &mut F, maps: &str);
-    /// Check that the files the section names besides its data sets (Chapter 4's maps) are
-    /// there, before the output folder is touched.
-    fn require_inputs(&self, spec: &Spec, s: &F) -> Result<()>;
+    /// Check what the run checks before its first cell besides its data files loading: the
+    /// files the section names (Chapter 4's maps) are there, and the data sets are large enough
+    /// for the maps trained on them. Called before the output folder is touched, and by
+    /// `--dry-run`.
+    fn require_inputs(&self, spec: &Spec, s: &F, ctx: &RunContext) -> Result<()>;
     /// Check every value of the family's section (called once the limits have passed and the
     /// spec has been found to hold this family's section only).
     fn validate(&self, spec: &Spec, s: &F) -> Result<(), SpecError>;
@@ -187,7 +189,7 @@ pub trait Section: Placed {
     /// Read the SOM maps from the folder `maps` (a plan whose earlier spec saved them).
     fn use_maps(&mut self, _maps: &str) {}
     /// See [`Family::require_inputs`]; by default nothing to check.
-    fn require_inputs(&self, _spec: &Spec) -> Result<()> {
+    fn require_inputs(&self, _spec: &Spec, _ctx: &RunContext) -> Result<()> {
         Ok(())
     }
     /// Whether the section takes `--set`/`--sweep` (None: it does not), and which keys a sweep
@@ -267,8 +269,8 @@ impl<F: Holds<E::Section>, E: Experiment> Family<F> for E {
             s.use_maps(maps);
         }
     }
-    fn require_inputs(&self, spec: &Spec, s: &F) -> Result<()> {
-        s.get().ok_or_else(|| foreign(E::Section::NAME))?.require_inputs(spec)
+    fn require_inputs(&self, spec: &Spec, s: &F, ctx: &RunContext) -> Result<()> {
+        s.get().ok_or_else(|| foreign(E::Section::NAME))?.require_inputs(spec, ctx)
     }
     fn validate(&self, spec: &Spec, s: &F) -> Result<(), SpecError> {
         s.get().ok_or_else(|| foreign(E::Section::NAME))?.validate(spec)

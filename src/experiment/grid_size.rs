@@ -1,11 +1,11 @@
-//! The size of a SOM grid or a control net, `nx x ny`, as specs write it ("20x12", or "20"
-//! for 20x20).
+//! The size of a SOM grid or a control net, `nx x ny`, as specs and `fit --cn` write it:
+//! "20x12", "20x20" (one spelling).
 
 use serde::Deserialize;
 use std::fmt;
 use std::str::FromStr;
 
-/// Grid or control-net size `nx x ny`, written "20x12" (or "20" for 20x20).
+/// Grid or control-net size `nx x ny`, written "20x12".
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct GridSize {
     pub nx: usize,
@@ -21,16 +21,17 @@ impl fmt::Display for GridSize {
 impl FromStr for GridSize {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        let bad = || format!("`{s}` is not a grid size (write NXxNY, e.g. \"20x12\")");
-        let parts: Vec<&str> = s.trim().split(['x', 'X']).collect();
-        let num = |p: &str| p.trim().parse::<usize>().map_err(|_| bad());
-        match parts.as_slice() {
-            [n] => {
-                let n = num(n)?;
-                Ok(GridSize { nx: n, ny: n })
+        // One spelling: digits, `x`, digits (a square is written in full, "20x20").
+        let bad = || format!("`{s}` is not a grid size (write NXxNY, e.g. \"20x12\" or \"20x20\")");
+        let num = |p: &str| {
+            if p.is_empty() || !p.bytes().all(|b| b.is_ascii_digit()) {
+                return Err(bad());
             }
-            [a, b] => Ok(GridSize { nx: num(a)?, ny: num(b)? }),
-            _ => Err(bad()),
+            p.parse::<usize>().map_err(|_| bad())
+        };
+        match s.split_once('x') {
+            Some((a, b)) => Ok(GridSize { nx: num(a)?, ny: num(b)? }),
+            None => Err(bad()),
         }
     }
 }
@@ -41,11 +42,13 @@ impl<'de> Deserialize<'de> for GridSize {
         #[serde(untagged)]
         enum Raw {
             Text(String),
-            Square(usize),
+            Number(i64),
         }
         match Raw::deserialize(d)? {
             Raw::Text(s) => s.parse().map_err(serde::de::Error::custom),
-            Raw::Square(n) => Ok(GridSize { nx: n, ny: n }),
+            Raw::Number(n) => Err(serde::de::Error::custom(format!(
+                "{n} is not a grid size (write NXxNY as a string, e.g. \"{n}x{n}\")"
+            ))),
         }
     }
 }
@@ -63,7 +66,17 @@ mod tests {
     #[test]
     fn grid_sizes() {
         assert_eq!("20x12".parse::<GridSize>().unwrap(), GridSize { nx: 20, ny: 12 });
-        assert_eq!("7".parse::<GridSize>().unwrap(), GridSize { nx: 7, ny: 7 });
-        assert!("20y12".parse::<GridSize>().is_err());
+        assert_eq!("7x7".parse::<GridSize>().unwrap(), GridSize { nx: 7, ny: 7 });
+        for other in ["20y12", "7", "20X12", " 20x12", "20 x 12", "+20x12", "x12", "20x"] {
+            assert!(other.parse::<GridSize>().is_err(), "{other}");
+        }
+        #[derive(Debug, Deserialize)]
+        struct S {
+            #[allow(dead_code)]
+            grid: GridSize,
+        }
+        let e = toml::from_str::<S>("grid = 18").unwrap_err().to_string();
+        assert!(e.contains("write NXxNY as a string, e.g. \"18x18\""), "{e}");
+        assert!(toml::from_str::<S>("grid = \"18x18\"").is_ok());
     }
 }

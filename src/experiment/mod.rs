@@ -109,6 +109,19 @@ pub struct Session {
     pending: std::sync::Mutex<Option<log::Fingerprint>>,
 }
 
+/// Every check a run makes before its first cell, before the folder is touched (`run` and
+/// `--dry-run` call this one function): each data file the spec names is there and loads, the
+/// maps folder it names is there (unless it asks for the maps to be recomputed), and each data
+/// set has enough points for the maps trained on it. Data are loaded here once more than the run
+/// needs: milliseconds for the largest scan.
+pub(crate) fn preflight<F: Families>(spec: &Loaded<F>, ctx: &RunContext) -> Result<()> {
+    let (loaded, spec) = (spec, &spec.spec);
+    for d in limits::dataset_entries(loaded) {
+        ctx.loader(spec).load(d).with_context(|| format!("{}: data set `{d}`", spec.path))?;
+    }
+    loaded.family().require_inputs(spec, &loaded.section, ctx)
+}
+
 /// One line per cell for `--dry-run`: key and seed.
 pub fn dry_run_listing<F: Families>(spec: &Loaded<F>) -> Vec<(String, String)> {
     let mut keys = logged_cell_keys(spec);
@@ -221,13 +234,7 @@ pub(crate) fn run_variants<F: Families>(
 ) -> Result<PathBuf> {
     let first = variants.first().context("no spec to run")?;
     let spec = &first.spec;
-    // A data file the spec names that is not there or does not load: refused before the folder
-    // is touched (loaded here once more than the run needs: milliseconds for the largest scan).
-    for d in limits::dataset_entries(first) {
-        ctx.loader(spec).load(d).with_context(|| format!("{}: data set `{d}`", spec.path))?;
-    }
-    // So is a maps folder it names (unless it asks for the maps to be recomputed).
-    first.family().require_inputs(spec, &first.section)?;
+    preflight(first, ctx)?;
     let _lock = crate::io::outdir::lock(&ctx.out, &format!("run {}", spec.path))?;
     let fp = fingerprint(variants, ctx.shard);
     match claim(&ctx.out, &fp, ctx.resume)? {
@@ -544,8 +551,16 @@ pub(crate) fn merge<F: Families>(shards: &[PathBuf], ctx: &RunContext) -> Result
     run_spec_locked(&variants, &RunContext { resume: true, shard: None, ..ctx.clone() })
 }
 
-/// Resolve the data directory: flag, else `SOMNURBS_DATA`, else `./data` (in the working folder;
-/// `crate::data::registry::data_folder` is the rule).
+/// Resolve the data directory: `--data-dir`, else `SOMNURBS_DATA`, else `data/` in the working
+/// folder, else the `data/` of the clone somnurbs was built from (said on stderr), the rule of
+/// `crate::data::registry::found_folder`.
 pub fn data_dir(flag: Option<&Path>) -> PathBuf {
-    crate::data::registry::data_folder(flag, Path::new(""))
+    let (dir, clone) = crate::data::registry::found_folder(flag, Some("SOMNURBS_DATA"), "data");
+    if clone {
+        eprintln!(
+            "somnurbs: note: no data/ in the working folder; reading data files from the clone somnurbs was built from, {} (--data-dir DIR or SOMNURBS_DATA names another)",
+            dir.display()
+        );
+    }
+    dir
 }

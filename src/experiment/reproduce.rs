@@ -352,30 +352,25 @@ pub(crate) fn default_out(plan: &str, profile: &str) -> PathBuf {
     }
 }
 
-/// The folder of the plans and specs: `--specs`, else `experiments` in the working folder, else,
-/// run from a folder that has no `experiments` (and no `--specs`), the one in the clone somnurbs
-/// was built from (said on stderr). An error names the folders tried and hints `--specs DIR`.
+/// The folder of the plans and specs: `--specs`, else `experiments` in the working folder, else
+/// the one in the clone somnurbs was built from (said on stderr), the rule of
+/// `crate::data::registry::found_folder`. An error names the folder tried and hints `--specs DIR`.
 pub(crate) fn specs_dir(flag: Option<&Path>, plan: &str) -> Result<PathBuf> {
-    if let Some(d) = flag {
-        return Ok(d.to_path_buf());
-    }
-    let here = Path::new(DEFAULT_SPECS);
+    let (dir, clone) = crate::data::registry::found_folder(flag, None, DEFAULT_SPECS);
     let file = format!("{plan}.toml");
-    if here.is_dir() {
-        return Ok(here.to_path_buf());
+    if flag.is_none() && (!dir.is_dir() || (clone && !dir.join(&file).is_file())) {
+        anyhow::bail!(
+            "--plan {plan}: no folder {DEFAULT_SPECS}/ in the working folder and no {} (run from the top of the clone, or name the folder of the plans with --specs DIR)",
+            Path::new(crate::data::registry::CLONE_DIR).join(DEFAULT_SPECS).join(&file).display()
+        );
     }
-    let clone = Path::new(crate::data::registry::CLONE_DIR).join(DEFAULT_SPECS);
-    if clone.join(&file).is_file() {
+    if clone {
         eprintln!(
             "somnurbs: reproduce: no {DEFAULT_SPECS}/ in the working folder; using the plans of the clone somnurbs was built from, {} (--specs DIR names another folder)",
-            clone.display()
+            dir.display()
         );
-        return Ok(clone);
     }
-    anyhow::bail!(
-        "--plan {plan}: no folder {DEFAULT_SPECS}/ in the working folder and no {} (run from the top of the clone, or name the folder of the plans with --specs DIR)",
-        clone.join(&file).display()
-    )
+    Ok(dir)
 }
 
 /// The `somnurbs reproduce` command that makes the folder `out` again: `--specs` and `--out`

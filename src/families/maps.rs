@@ -283,6 +283,41 @@ fn read_map(path: &Path, grid: GridSize) -> Result<MapSource> {
     })
 }
 
+/// The cloud a recomputed map of `data` at `grid` trains on, checked to have enough points for
+/// it, and the map's cell.
+fn recompute_input(
+    spec: &Spec,
+    ctx: &RunContext,
+    data: &str,
+    grid: GridSize,
+) -> Result<(std::sync::Arc<crate::data::PointCloud>, SomCell)> {
+    let mut clouds = som::load_datasets(spec, &[data.to_string()], ctx, Default::default())?;
+    let name = crate::data::registry::name_of(data);
+    let cloud = clouds.remove(&name).context("internal: a loaded data set is not listed")?;
+    let cell = SomCell { dataset: name, model: Model::Dnsom, grid, repeat: 0 };
+    som::require_points(data, cloud.points.len(), &cell)?;
+    Ok((cloud, cell))
+}
+
+/// What a run checks of a section's maps before its first cell ([`require_maps`]), and for each
+/// map to recompute, that its data set has enough points for it: the section's
+/// `require_inputs`, so `--dry-run` checks it too.
+pub(crate) fn require_maps_and_data(
+    spec: &Spec,
+    ctx: &RunContext,
+    datasets: &[String],
+    grid: GridSize,
+    from: &MapsFrom,
+) -> Result<()> {
+    require_maps(spec, datasets, grid, from)?;
+    for (entry, _, file) in map_files(spec, datasets, grid, from) {
+        if file.filter(|f| f.exists()).is_none() {
+            recompute_input(spec, ctx, entry, grid)?;
+        }
+    }
+    Ok(())
+}
+
 fn recompute_map(
     spec: &Spec,
     ctx: &RunContext,
@@ -297,13 +332,10 @@ fn recompute_map(
         ),
         None => (spec.file.master_seed, SomParams::default()),
     };
-    let clouds = som::load_datasets(spec, &[data.to_string()], ctx, Default::default())?;
-    let name = crate::data::registry::name_of(data);
-    let cell = SomCell { dataset: name.clone(), model: Model::Dnsom, grid, repeat: 0 };
-    som::require_points(data, clouds[&name].points.len(), &cell)?;
-    let run = som::run_cell(&cell, &clouds[&name].points, &params, seed)?;
+    let (cloud, cell) = recompute_input(spec, ctx, data, grid)?;
+    let run = som::run_cell(&cell, &cloud.points, &params, seed)?;
     Ok(MapSource {
-        frame: Some(clouds[&name].frame.clone()),
+        frame: Some(cloud.frame.clone()),
         grid: TwoViewGrid::from_weights(grid.nx, grid.ny, &run.weights)
             .with_context(|| format!("{}: not a DNSOM map", cell.key()))?,
         origin: format!(

@@ -129,17 +129,7 @@ pub fn load(
     let cli = CliOverrides { set: set.to_vec(), sweep: Vec::new() };
     let mut variants = Loaded::load_variants(&path, profile, &cli)?;
     let Loaded { spec, section } = variants.pop().context("no spec")?;
-    let data_dir = match data_dir {
-        Some(d) => d.to_path_buf(),
-        None => {
-            let d = crate::experiment::data_dir(None);
-            if d.is_dir() {
-                d
-            } else {
-                crate::data::registry::clone_data_dir()
-            }
-        }
-    };
+    let data_dir = crate::data::registry::found_folder(data_dir, Some("SOMNURBS_DATA"), "data").0;
     let ctx = RunContext::new(work.to_path_buf(), 1, data_dir);
     let o = match &section {
         Section::Optim(o) => o,

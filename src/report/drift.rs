@@ -552,28 +552,142 @@ pub(crate) fn tables(dir: &Path) -> Result<Vec<PathBuf>> {
         .collect())
 }
 
-/// The run identity of every `manifest.toml` under a folder, by relative folder.
-fn identities(dir: &Path) -> Result<BTreeMap<PathBuf, (String, String, String)>> {
-    #[derive(Deserialize)]
-    struct Id {
-        spec_sha256: String,
-        profile: String,
-        master_seed: u64,
+/// What made a result folder, from its `manifest.toml`: the fields two folders must share for
+/// their tables to be compared (a run's spec, seed, profile and `--set`/`--sweep`; a `fit`
+/// folder's grid and options).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+pub(crate) struct Identity {
+    /// `fit` for a `somnurbs fit` folder (absent in a run's manifest).
+    #[serde(default)]
+    pub(crate) kind: Option<String>,
+    #[serde(default)]
+    pub(crate) spec_name: Option<String>,
+    #[serde(default)]
+    spec_sha256: Option<String>,
+    #[serde(default)]
+    profile: Option<String>,
+    #[serde(default)]
+    master_seed: Option<u64>,
+    #[serde(default)]
+    set: Vec<String>,
+    #[serde(default)]
+    sweep: Vec<String>,
+    /// A fit folder's grid file, its hash and options.
+    #[serde(default)]
+    grid_sha256: Option<String>,
+    #[serde(default)]
+    options: BTreeMap<String, toml::Value>,
+    /// The run's spec text (its sections tell which chapter made it).
+    #[serde(default)]
+    pub(crate) spec_text: Option<String>,
+}
+
+impl Identity {
+    /// Read the identity of the folder holding `manifest`.
+    pub(crate) fn read(manifest: &Path) -> Result<Identity> {
+        crate::io::read_toml(manifest)
     }
+
+    /// Whether the folder was written by `somnurbs fit` (today's manifest says `kind = "fit"`; an
+    /// older one named its spec `fit` and had a `command` line).
+    pub(crate) fn is_fit(&self) -> bool {
+        self.kind.as_deref() == Some("fit")
+            || (self.spec_name.as_deref() == Some("fit") && self.master_seed == Some(0))
+    }
+
+    /// What the folder holds, for messages: `a somnurbs fit folder`, `a run of spec ch6_same`.
+    pub(crate) fn describe(&self) -> String {
+        if self.is_fit() {
+            return "a `somnurbs fit` folder".into();
+        }
+        match &self.spec_name {
+            Some(n) => format!("a run of spec {n}"),
+            None => "a result folder".into(),
+        }
+    }
+
+    /// What differs between two identities (None: the same run), e.g. `master seed 11 vs 12;
+    /// --set none vs optimise.de.f=0.5`.
+    pub(crate) fn difference(&self, other: &Identity) -> Option<String> {
+        let mut what: Vec<String> = Vec::new();
+        let opt = |v: &Option<String>| v.clone().unwrap_or_else(|| "none".into());
+        let list = |v: &[String]| if v.is_empty() { "none".into() } else { v.join(" ") };
+        if self.is_fit() != other.is_fit() {
+            what.push(format!("kind: {} vs {}", self.describe(), other.describe()));
+            return Some(what.join("; "));
+        }
+        if self.spec_name != other.spec_name {
+            what.push(format!("spec {} vs {}", opt(&self.spec_name), opt(&other.spec_name)));
+        } else if self.spec_sha256 != other.spec_sha256 {
+            let short = |v: &Option<String>| opt(v).chars().take(12).collect::<String>();
+            what.push(format!(
+                "spec text (sha256 {} vs {})",
+                short(&self.spec_sha256),
+                short(&other.spec_sha256)
+            ));
+        }
+        if self.master_seed != other.master_seed {
+            let seed = |v: Option<u64>| v.map_or("none".into(), |s| s.to_string());
+            what.push(format!(
+                "master seed {} vs {}",
+                seed(self.master_seed),
+                seed(other.master_seed)
+            ));
+        }
+        if self.profile != other.profile {
+            what.push(format!("profile {} vs {}", opt(&self.profile), opt(&other.profile)));
+        }
+        if self.set != other.set {
+            what.push(format!("--set {} vs {}", list(&self.set), list(&other.set)));
+        }
+        if self.sweep != other.sweep {
+            what.push(format!("--sweep {} vs {}", list(&self.sweep), list(&other.sweep)));
+        }
+        if self.grid_sha256 != other.grid_sha256 {
+            what.push("grid file (sha256)".into());
+        }
+        for (k, v) in &self.options {
+            let o = other.options.get(k);
+            if o != Some(v) {
+                let shown = o.map_or("none".into(), |o| o.to_string());
+                what.push(format!("--{} {v} vs {shown}", k.replace('_', "-")));
+            }
+        }
+        (!what.is_empty()).then(|| what.join("; "))
+    }
+}
+
+/// The identity of every `manifest.toml` under a folder, by relative folder.
+fn identities(dir: &Path) -> Result<BTreeMap<PathBuf, Identity>> {
     let mut out = BTreeMap::new();
     for f in crate::io::outdir::walk(dir)?
         .0
         .into_iter()
         .filter(|f| f.file_name().is_some_and(|n| n == crate::io::outdir::MANIFEST))
     {
-        let m = dir.join(&f);
-        let id: Id = crate::io::read_toml(&m)?;
-        out.insert(
-            f.parent().unwrap_or(Path::new("")).to_path_buf(),
-            (id.spec_sha256, id.profile, id.master_seed.to_string()),
-        );
+        let id = Identity::read(&dir.join(&f))?;
+        out.insert(f.parent().unwrap_or(Path::new("")).to_path_buf(), id);
     }
     Ok(out)
+}
+
+/// Refuse two folders whose runs differ (naming both folders and what differs).
+fn require_same_runs(baseline: &Path, current: &Path) -> Result<()> {
+    let (ib, ic) = (identities(baseline)?, identities(current)?);
+    for (dir, b) in &ib {
+        let Some(c) = ic.get(dir) else { continue };
+        if let Some(w) = b.difference(c) {
+            let at = |root: &Path| {
+                if dir.as_os_str().is_empty() {
+                    root.to_path_buf()
+                } else {
+                    root.join(dir)
+                }
+            };
+            bail!("{} and {} hold different runs ({w}): drift is expected; compare them anyway with --allow-spec-change", at(baseline).display(), at(current).display());
+        }
+    }
+    Ok(())
 }
 
 /// Read `drift.toml` of a baseline folder (absent: defaults).
@@ -599,27 +713,7 @@ pub(crate) fn compare_dirs(
         bail!("{} holds no tables (*.csv): not a baseline", baseline.display());
     }
     if !allow_spec_change {
-        let (ib, ic) = (identities(baseline)?, identities(current)?);
-        for (dir, (sb, pb, mb)) in &ib {
-            if let Some((sc, pc, mc)) = ic.get(dir) {
-                let what = if mb != mc {
-                    Some(format!("master seed {mb} vs {mc}"))
-                } else if pb != pc {
-                    Some(format!("profile {pb} vs {pc}"))
-                } else if sb != sc {
-                    Some(format!(
-                        "spec sha256 {} vs {}",
-                        &sb[..12.min(sb.len())],
-                        &sc[..12.min(sc.len())]
-                    ))
-                } else {
-                    None
-                };
-                if let Some(w) = what {
-                    bail!("{}: the baseline and the current run differ in their spec ({w}): drift is expected; compare with --allow-spec-change", if dir.as_os_str().is_empty() { ".".to_string() } else { dir.display().to_string() });
-                }
-            }
-        }
+        require_same_runs(baseline, current)?;
     }
     let mut report = DriftReport::default();
     for t in &tb {

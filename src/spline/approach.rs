@@ -122,9 +122,10 @@ impl TryFrom<String> for Approach {
 impl FromStr for Approach {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        match s.to_ascii_lowercase().as_str() {
-            "a" | "conventional" => Ok(Approach::Conventional),
-            "b" | "improved" => Ok(Approach::Improved),
+        // The thesis' letter or the name, as written here (no other case).
+        match s {
+            "A" | "conventional" => Ok(Approach::Conventional),
+            "B" | "improved" => Ok(Approach::Improved),
             _ => Err(format!("unknown approach `{s}` (expected A/conventional or B/improved)")),
         }
     }

@@ -118,12 +118,60 @@ fn wrap(text: &str, width: usize) -> Vec<String> {
     lines
 }
 
+/// Days since 1970-01-01 as a civil (proleptic Gregorian) date (year, month, day): the
+/// days-from-civil algorithm's inverse (H. Hinnant, "chrono-Compatible Low-Level Date
+/// Algorithms", `civil_from_days`).
+fn civil_from_days(days: i64) -> (i64, u32, u32) {
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z.rem_euclid(146_097); // [0, 146096]
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365; // [0, 399]
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100); // [0, 365]
+    let mp = (5 * doy + 2) / 153; // [0, 11], March first
+    let day = (doy - (153 * mp + 2) / 5 + 1) as u32;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 } as u32;
+    let year = yoe + era * 400 + i64::from(month <= 2);
+    (year, month, day)
+}
+
+/// The latest second IGES 5.3's four-digit year can say (9999-12-31 23:59:59 UTC).
+const MAX_IGES_SECONDS: i64 = 253_402_300_799;
+
+/// IGES 5.3's date and time of a file (global parameter 18): `YYYYMMDD.HHNNSS`, UTC, of `unix`
+/// seconds since 1970 (in [0, 9999-12-31 23:59:59]).
+pub(crate) fn iges_date(unix: i64) -> Result<String, String> {
+    if !(0..=MAX_IGES_SECONDS).contains(&unix) {
+        return Err(format!(
+            "{unix} seconds since 1970 is outside the years 1970-9999 an IGES date can say"
+        ));
+    }
+    let (year, month, day) = civil_from_days(unix.div_euclid(86_400));
+    let s = unix.rem_euclid(86_400);
+    Ok(format!("{year:04}{month:02}{day:02}.{:02}{:02}{:02}", s / 3600, s / 60 % 60, s % 60))
+}
+
+/// When an export is generated, in seconds since 1970: `SOURCE_DATE_EPOCH` when set (the
+/// reproducible-builds convention, so that a file can be made byte for byte again), else now.
+pub(crate) fn generation_time() -> Result<i64, String> {
+    match std::env::var("SOURCE_DATE_EPOCH") {
+        Ok(v) if !v.is_empty() => v.trim().parse::<i64>().map_err(|_| {
+            format!("SOURCE_DATE_EPOCH: `{v}` is not a whole number of seconds since 1970 (unset it, or set e.g. 1700000000)")
+        }),
+        _ => Ok(std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| i64::try_from(d.as_secs()).unwrap_or(i64::MAX))),
+    }
+}
+
 /// IGES 5.3 text with one entity 128 per surface; `units` in the global section, and `notes`
-/// (say, the coordinate frame) in the start section after the line naming the writer.
+/// (say, the coordinate frame) in the start section after the line naming the writer. `date` is
+/// the file's generation time ([`iges_date`]); the maximum coordinate value (global parameter
+/// 20) is the largest absolute coordinate of the control points.
 pub(crate) fn write_iges(
     surfaces: &[(&str, &BSplineSurface)],
     units: Units,
     notes: &[String],
+    date: &str,
 ) -> String {
     let mut start =
         vec!["somnurbs: cubic B-spline surfaces (entity 128, all weights 1)".to_string()];
@@ -131,6 +179,11 @@ pub(crate) fn write_iges(
         start.extend(wrap(&note, 72));
     }
     let (flag, unit_name) = units.flag_and_name();
+    let max_coordinate = surfaces
+        .iter()
+        .flat_map(|(_, s)| s.control.iter().flatten())
+        .fold(0.0f64, |m, &x| m.max(x.abs()));
+    // The global section's parameters, 1 to 24 in IGES 5.3's order.
     let global_tokens: Vec<String> = vec![
         "1H,".into(),
         "1H;".into(),
@@ -149,9 +202,9 @@ pub(crate) fn write_iges(
         hollerith(unit_name),
         "1".into(),
         "1.0".into(),
-        hollerith("20260101.000000"),
+        hollerith(date), // 18: date and time of exchange file generation
         "1.0E-9".into(),
-        "0.0".into(),
+        real(max_coordinate), // 20: maximum coordinate value
         hollerith("somnurbs"),
         hollerith("somnurbs"),
         "11".into(),
@@ -357,7 +410,7 @@ mod tests {
     fn iges_round_trip_re_evaluates_the_same_points() {
         let (a, b) = (surface(6, 18, 1), surface(16, 28, 2));
         let long = format!("Frame: the data's own coordinates, from {}", "/very/long".repeat(12));
-        let text = write_iges(&[("bottom", &a), ("top", &b)], Units::Unknown, &[long]);
+        let text = write_iges(&[("bottom", &a), ("top", &b)], Units::Unknown, &[long], DATE);
         for (n, line) in text.lines().enumerate() {
             assert_eq!(line.len(), 80, "line {} is not 80 columns: {line:?}", n + 1);
         }
@@ -370,7 +423,7 @@ mod tests {
             t.lines().filter(|l| &l[72..73] == "G").map(|l| l[..72].trim_end()).collect()
         };
         assert!(global(&text).contains(",1.0,2,2HMM,"), "{text}");
-        let inches = write_iges(&[("s", &a)], "in".parse().unwrap(), &[]);
+        let inches = write_iges(&[("s", &a)], "in".parse().unwrap(), &[], DATE);
         assert!(global(&inches).contains(",1.0,1,2HIN,"), "{inches}");
         assert!(inches.contains("Units: IN."), "{inches}");
         assert!("yards".parse::<Units>().is_err());
@@ -388,6 +441,60 @@ mod tests {
         }
         assert_eq!(real(1e-7), "1.0E-7");
         assert_eq!(real(0.25), "0.25");
+    }
+
+    const DATE: &str = "20260101.000000";
+
+    /// The global section's parameters (1-indexed: `g[18]` is parameter 18), split at its `,`
+    /// delimiters (Hollerith strings read whole).
+    fn global_parameters(text: &str) -> Vec<String> {
+        let g: String =
+            text.lines().filter(|l| &l[72..73] == "G").map(|l| l[..72].trim_end()).collect();
+        let (mut out, mut rest) = (vec![String::new()], g.as_str());
+        while !rest.is_empty() && !rest.starts_with(';') {
+            let digits = rest.chars().take_while(char::is_ascii_digit).count();
+            let len = if rest[digits..].starts_with('H') && digits > 0 {
+                digits + 1 + rest[..digits].parse::<usize>().unwrap()
+            } else {
+                rest.find([',', ';']).unwrap_or(rest.len())
+            };
+            out.push(rest[..len].to_string());
+            rest = &rest[len..];
+            rest = rest.strip_prefix(',').unwrap_or(rest);
+        }
+        out
+    }
+
+    #[test]
+    fn civil_dates_of_known_days() {
+        for (unix, date) in [
+            (0, "19700101.000000"),
+            (951_782_400, "20000229.000000"),
+            (1_700_000_000, "20231114.221320"),
+            (1_709_251_199, "20240229.235959"),
+            (4_107_542_400, "21000301.000000"),
+            (MAX_IGES_SECONDS, "99991231.235959"),
+        ] {
+            assert_eq!(iges_date(unix).unwrap(), date, "{unix}");
+        }
+        assert_eq!(civil_from_days(-1), (1969, 12, 31));
+        assert_eq!(civil_from_days(11_016), (2000, 2, 29));
+        assert!(iges_date(-1).is_err() && iges_date(MAX_IGES_SECONDS + 1).is_err());
+    }
+
+    #[test]
+    fn global_section_carries_the_date_and_the_largest_coordinate() {
+        let (mut a, b) = (surface(6, 8, 1), surface(5, 5, 2));
+        a.control[7] = [1.0, -286.25, 3.0];
+        let text =
+            write_iges(&[("bottom", &a), ("top", &b)], Units::Unknown, &[], "20240229.235959");
+        let g = global_parameters(&text);
+        assert_eq!(g.len(), 25, "{g:?}");
+        assert_eq!((g[1].as_str(), g[2].as_str(), g[14].as_str()), ("1H,", "1H;", "2"));
+        assert_eq!(g[18], "15H20240229.235959");
+        assert_eq!(g[19], "1.0E-9");
+        assert_eq!(g[20], "286.25");
+        assert_eq!(g[23], "11");
     }
 
     #[test]

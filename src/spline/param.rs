@@ -112,9 +112,10 @@ impl TryFrom<String> for Parameterisation {
 impl FromStr for Parameterisation {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
-        match s.to_ascii_lowercase().replace(['-', ' '], "_").as_str() {
+        // One spelling per value, in a spec and on the command line alike.
+        match s {
             "uniform" => Ok(Self::Uniform),
-            "chord_length" | "chord" | "chordal" => Ok(Self::ChordLength),
+            "chord_length" => Ok(Self::ChordLength),
             "centripetal" => Ok(Self::Centripetal),
             "exponential" => Ok(Self::Exponential),
             _ => Err(format!("unknown parameterisation `{s}` (expected uniform, chord_length, centripetal or exponential)")),
@@ -201,6 +202,36 @@ pub(crate) fn grid_params_with(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn one_spelling_per_value_in_specs_and_on_the_command_line() {
+        use crate::spline::Approach;
+        for (ok, want) in [
+            ("chord_length", Parameterisation::ChordLength),
+            ("uniform", Parameterisation::Uniform),
+        ] {
+            assert_eq!(ok.parse::<Parameterisation>(), Ok(want));
+            assert_eq!(Parameterisation::try_from(ok.to_string()), Ok(want));
+        }
+        for alias in ["chordal", "chord", "Chord-Length", "chord length", "Uniform", "CENTRIPETAL"]
+        {
+            let e = alias.parse::<Parameterisation>().unwrap_err();
+            assert!(e.contains("uniform, chord_length, centripetal or exponential"), "{e}");
+            assert!(Parameterisation::try_from(alias.to_string()).is_err(), "{alias}");
+        }
+        for (ok, want) in [
+            ("A", Approach::Conventional),
+            ("conventional", Approach::Conventional),
+            ("B", Approach::Improved),
+            ("improved", Approach::Improved),
+        ] {
+            assert_eq!(ok.parse::<Approach>(), Ok(want));
+        }
+        for alias in ["a", "b", "Improved", "CONVENTIONAL"] {
+            assert!(alias.parse::<Approach>().is_err(), "{alias}");
+            assert!(Approach::try_from(alias.to_string()).is_err(), "{alias}");
+        }
+    }
 
     #[test]
     fn chord_length_example_of_seed_002() {

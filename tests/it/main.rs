@@ -10,6 +10,7 @@ mod compare_guards;
 mod drift;
 mod exact_certificate;
 mod folders;
+mod friction;
 mod fuzz;
 mod hostile;
 mod html_report;

@@ -315,7 +315,7 @@ fn bad_inputs_are_refused_on_one_line_quickly() {
         ),
         (
             "control_nets = [\"6x6\"]",
-            "control_nets = [\"6x6\", \"6\"]",
+            "control_nets = [\"6x6\", \"6x6\"]",
             vec!["optimise.control_nets", "6x6"],
         ),
     ] {

@@ -93,6 +93,53 @@ fn net_rows(surfaces: &[(&str, &BSplineSurface)]) -> Vec<Vec<String>> {
     rows
 }
 
+/// A fit folder's `manifest.toml`: the grid file it fitted and the options it used.
+#[derive(serde::Serialize)]
+struct FitManifest {
+    kind: &'static str,
+    grid: String,
+    grid_sha256: String,
+    command: String,
+    /// The IGES file's generation time (`SOURCE_DATE_EPOCH` when set), seconds since 1970.
+    generated_unix: i64,
+    crate_version: &'static str,
+    git_commit: &'static str,
+    git_dirty: bool,
+    rustc: &'static str,
+    options: FitRecord,
+}
+
+/// The options of a fit, each by its canonical name (as `fit`'s flags take them).
+#[derive(serde::Serialize)]
+struct FitRecord {
+    cn: String,
+    param: &'static str,
+    approach: &'static str,
+    knots: &'static str,
+    error_a: &'static str,
+    fairness: f64,
+    frame: String,
+    units: String,
+    samples: usize,
+}
+
+/// The text of a fit folder's `manifest.toml`.
+fn manifest_text(grid: &str, grid_text: &str, generated: i64, options: FitRecord) -> Result<String> {
+    let manifest = FitManifest {
+        kind: "fit",
+        grid: grid.to_string(),
+        grid_sha256: hex::encode(<sha2::Sha256 as sha2::Digest>::digest(grid_text.as_bytes())),
+        command: std::env::args().skip(1).collect::<Vec<_>>().join(" "),
+        generated_unix: generated,
+        crate_version: env!("CARGO_PKG_VERSION"),
+        git_commit: env!("SOMNURBS_GIT_COMMIT"),
+        git_dirty: env!("SOMNURBS_GIT_DIRTY") == "true",
+        rustc: env!("SOMNURBS_RUSTC"),
+        options,
+    };
+    toml::to_string(&manifest).context("manifest.toml")
+}
+
 /// `--samples`: evaluations per direction of the OBJ mesh (two make one quad per surface).
 pub(crate) const MIN_SAMPLES: usize = 2;
 pub(crate) const MAX_SAMPLES: usize = 1000;
@@ -121,6 +168,8 @@ pub(crate) fn fit(args: &FitArgs) -> Result<()> {
     let fit = fit_two_view(&grid, cn.nx, cn.ny, param, approach, &opts)
         .with_context(|| format!("{shown}: {}x{} grid", grid.nx, grid.ny))?;
 
+    let generated = export::generation_time().map_err(anyhow::Error::msg)?;
+    let date = export::iges_date(generated).map_err(anyhow::Error::msg).context("SOURCE_DATE_EPOCH")?;
     let frame = crate::io::map_file::read_frame(&args.grid)?;
     let export = export_frame(&args.grid, frame, &args.frame, &args.units)?;
     let placed = |s: &BSplineSurface| match export.affine {
@@ -145,7 +194,7 @@ pub(crate) fn fit(args: &FitArgs) -> Result<()> {
     let notes = [export.note.clone()];
     write_atomic(
         &out.join("surfaces.igs"),
-        export::write_iges(&surfaces, export.units, &notes).as_bytes(),
+        export::write_iges(&surfaces, export.units, &notes, &date).as_bytes(),
     )?;
     let obj_notes = [export.note.clone(), format!("{}.", export.units.line())];
     write_atomic(
@@ -187,15 +236,20 @@ pub(crate) fn fit(args: &FitArgs) -> Result<()> {
         export.label.to_string(),
     ];
     write_atomic(&out.join("fit.csv"), csv_records(&summary, &[row])?.as_bytes())?;
-    // Last, the manifest: its presence says the folder is whole (the drift and merge readers'
-    // identity fields: the grid file stands in for a spec).
-    let manifest = format!(
-        "spec_name = \"fit\"\nspec_path = {:?}\nspec_sha256 = {:?}\nprofile = \"default\"\nmaster_seed = 0\ncommand = {:?}\ncrate_version = {:?}\n",
-        shown,
-        hex::encode(<sha2::Sha256 as sha2::Digest>::digest(text.as_bytes())),
-        std::env::args().skip(1).collect::<Vec<_>>().join(" "),
-        env!("CARGO_PKG_VERSION")
-    );
+    // Last, the manifest: its presence says the folder is whole; it says what fit did (drift
+    // reads it to tell fits apart).
+    let options = FitRecord {
+        cn: cn.to_string(),
+        param: param.name(),
+        approach: approach.letter(),
+        knots: knots.name(),
+        error_a: error_a.name(),
+        fairness: args.fairness,
+        frame: args.frame.clone(),
+        units: args.units.clone(),
+        samples: args.samples,
+    };
+    let manifest = manifest_text(&shown, &text, generated, options)?;
     write_atomic(&out.join(crate::io::outdir::MANIFEST), manifest.as_bytes())?;
     println!("surface error {:.6}, gap {:.3e}, excursion {:.3e}; wrote control_nets.csv, surfaces.igs, surfaces.obj, fit.csv in {}", fit.surface_error, fit.gap, dense.excursion, out.display());
     let (lo, hi) = crate::spline::geometry::bounding_box(grid.bottom.iter().chain(&grid.top));

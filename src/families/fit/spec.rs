@@ -5,7 +5,7 @@
 use crate::experiment::limits::{self, Check};
 use crate::experiment::spec::{GridSize, Spec, SpecError};
 use crate::families::maps::{
-    require_maps, validate_grid_keys, validate_map_som, MapSom, MapsFrom, MapsMissing,
+    validate_grid_keys, validate_map_som, MapSom, MapsFrom, MapsMissing,
 };
 use serde::Deserialize;
 
@@ -114,14 +114,18 @@ impl crate::experiment::family::Section for FitSpec {
     fn use_maps(&mut self, maps: &str) {
         self.maps = Some(maps.to_string());
     }
-    fn require_inputs(&self, spec: &Spec) -> anyhow::Result<()> {
+    fn require_inputs(
+        &self,
+        spec: &Spec,
+        ctx: &crate::experiment::RunContext,
+    ) -> anyhow::Result<()> {
         let from = MapsFrom {
             section: "fit",
             dir: self.maps.as_deref(),
             missing: self.maps_missing,
             som: self.som.as_ref(),
         };
-        require_maps(spec, &self.datasets, self.grid, &from).map(drop)
+        crate::families::maps::require_maps_and_data(spec, ctx, &self.datasets, self.grid, &from)
     }
 }
 

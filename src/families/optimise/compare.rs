@@ -88,6 +88,38 @@ struct Unreachable {
 }
 
 /// The rows of `results/runs.csv`, every one checked.
+/// Refuse a finished folder that is not a run of an `[optimise]` spec (a `fit` folder, a Chapter
+/// 4 or 5 run, a reproduction), saying what it is and which folders `compare` takes.
+fn require_optimise_run(results: &std::path::Path) -> Result<()> {
+    use crate::experiment::family::Families;
+    let takes = "compare takes the folder of a finished run of a spec with an [optimise] section (Chapter 6), e.g. results/thesis/ch6_same";
+    let shown = results.display();
+    if results.join(crate::io::outdir::PLAN_FILE).exists() {
+        anyhow::bail!("{shown} is a reproduction folder, not a Chapter 6 run; {takes} (one of its sub-folders)");
+    }
+    let manifest = results.join(crate::io::outdir::MANIFEST);
+    if !manifest.exists() {
+        return Ok(());
+    }
+    let id = crate::report::drift::Identity::read(&manifest)?;
+    if id.is_fit() {
+        anyhow::bail!("{shown} is a `somnurbs fit` folder, not a Chapter 6 (optimise) run; {takes}");
+    }
+    let spec: Option<toml::Table> = id.spec_text.as_deref().and_then(|t| toml::from_str(t).ok());
+    let section = crate::families::Section::all()
+        .iter()
+        .find(|f| spec.as_ref().is_some_and(|s| s.contains_key(f.section())));
+    match section {
+        Some(f) if f.section() != "optimise" => anyhow::bail!(
+            "{shown} is {} ([{}], {}), not a Chapter 6 (optimise) run; {takes}",
+            id.describe(),
+            f.section(),
+            f.title()
+        ),
+        _ => Ok(()),
+    }
+}
+
 fn read_runs(results: &std::path::Path) -> Result<Vec<OptimRow>> {
     let path = results.join("runs.csv");
     let text = crate::io::read_text(&path)?;
@@ -408,6 +440,7 @@ pub(crate) fn compare(args: &CompareArgs) -> Result<()> {
     }
     // Only a finished, whole run is compared, and one compare at a time per results folder.
     crate::io::outdir::require_finished(&args.results, "the results folder")?;
+    require_optimise_run(&args.results)?;
     let _lock = crate::io::outdir::lock(&args.results, "compare")?;
     let dest = args.out.clone().unwrap_or_else(|| args.results.join(OUT_DIR));
     let stale = check_destination(args, &dest)?;

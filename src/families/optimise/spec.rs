@@ -176,14 +176,18 @@ impl crate::experiment::family::Section for OptimSpec {
     fn use_maps(&mut self, maps: &str) {
         self.maps = Some(maps.to_string());
     }
-    fn require_inputs(&self, spec: &Spec) -> anyhow::Result<()> {
+    fn require_inputs(
+        &self,
+        spec: &Spec,
+        ctx: &crate::experiment::RunContext,
+    ) -> anyhow::Result<()> {
         let from = crate::families::maps::MapsFrom {
             section: "optimise",
             dir: self.maps.as_deref(),
             missing: self.maps_missing,
             som: self.som.as_ref(),
         };
-        crate::families::maps::require_maps(spec, &self.datasets, self.grid, &from).map(drop)
+        crate::families::maps::require_maps_and_data(spec, ctx, &self.datasets, self.grid, &from)
     }
     /// Optimiser settings only, so that every variant solves the same problems (same data,
     /// nets, search box) and the variants can be ranked like optimisers.

@@ -139,6 +139,26 @@ pub(crate) fn require_points(entry: &str, points: usize, cell: &SomCell) -> Resu
     )?)
 }
 
+/// The data sets of a `[som]` section, loaded, each checked against the maps trained on it
+/// ([`require_points`]): what a run loads before its first cell, and what `--dry-run` checks
+/// (through [`crate::experiment::family::Section::require_inputs`]).
+pub(crate) fn load_checked(
+    spec: &Spec,
+    som_spec: &spec::SomSpec,
+    ctx: &RunContext,
+) -> Result<BTreeMap<String, Arc<PointCloud>>> {
+    let spindle = (som_spec.spindle_profile, som_spec.spindle_rings);
+    let data = load_datasets(spec, &som_spec.datasets, ctx, spindle)?;
+    let cells = spec::cells(som_spec);
+    for entry in &som_spec.datasets {
+        let name = crate::data::registry::name_of(entry);
+        for c in cells.iter().filter(|c| c.dataset == name) {
+            require_points(entry, data[&name].points.len(), c)?;
+        }
+    }
+    Ok(data)
+}
+
 /// Train one cell (pure apart from the CPU clock).
 pub fn run_cell(
     cell: &SomCell,
@@ -182,8 +202,7 @@ pub(crate) fn run(
     som_spec: &spec::SomSpec,
     ctx: &RunContext,
 ) -> Result<(Vec<SomRun>, Frames)> {
-    let spindle = (som_spec.spindle_profile, som_spec.spindle_rings);
-    let data = load_datasets(spec, &som_spec.datasets, ctx, spindle)?;
+    let data = load_checked(spec, som_spec, ctx)?;
     let params = SomParams {
         iterations: som_spec.iterations,
         alpha0: som_spec.alpha0,
@@ -191,12 +210,6 @@ pub(crate) fn run(
         som3d_adjacency: som_spec.som3d_adjacency,
     };
     let cells = spec::cells(som_spec);
-    for entry in &som_spec.datasets {
-        let name = crate::data::registry::name_of(entry);
-        for c in cells.iter().filter(|c| c.dataset == name) {
-            require_points(entry, data[&name].points.len(), c)?;
-        }
-    }
     let runs = runner::run_logged(
         &cells,
         ctx,

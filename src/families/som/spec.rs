@@ -135,6 +135,14 @@ impl crate::experiment::family::Section for SomSpec {
     fn datasets(&self) -> &[String] {
         &self.datasets
     }
+    /// Each data set has enough points for the DNSOM maps trained on it.
+    fn require_inputs(
+        &self,
+        spec: &Spec,
+        ctx: &crate::experiment::RunContext,
+    ) -> anyhow::Result<()> {
+        super::load_checked(spec, self, ctx).map(drop)
+    }
 }
 
 /// The flat list of SOM cells (data set x group x grid x model x repeat), in report order.
