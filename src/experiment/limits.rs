@@ -245,7 +245,7 @@ mod tests {
         );
         refused(
             "control_nets = [\"6x6\"]",
-            "control_nets = [\"6x6\", \"6\"]",
+            "control_nets = [\"6x6\", \"6x6\"]",
             "optimise.control_nets: `6x6` is listed twice",
         );
         refused(

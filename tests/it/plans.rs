@@ -238,6 +238,7 @@ fn show(c: &Case, path: &str) -> (Option<i32>, String) {
     let mut child = crate::common::bin()
         .args(["datasets", "show", path])
         .current_dir(c.dir.path())
+        .env("SOMNURBS_DATA", crate::common::data_dir())
         .stdout(std::process::Stdio::null())
         .stderr(std::process::Stdio::piped())
         .spawn()
