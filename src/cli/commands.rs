@@ -43,6 +43,30 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
         Command::Run(args) => run_spec(&args),
         Command::Drift(args) => drift(&args),
+        Command::Export(args) => {
+            let data = experiment::data_dir(args.data_dir.as_deref());
+            let request = crate::families::optimise::export::Request {
+                results: args.results,
+                cell: args.cell,
+                variant: args.variant,
+                start: args.start,
+                out: args.out,
+                frame: args.frame,
+                units: args.units,
+                samples: args.samples,
+            };
+            crate::families::optimise::export::export(&request, data)?;
+            Ok(ExitCode::SUCCESS)
+        }
+        Command::Report(args) => {
+            let data = experiment::data_dir(args.data_dir.as_deref());
+            let out = experiment::report::<Section>(&args.results, data, jobs(args.jobs)?)?;
+            eprintln!(
+                "somnurbs: {} is whole: every file its records give is in place",
+                out.display()
+            );
+            Ok(ExitCode::SUCCESS)
+        }
         Command::Merge(args) => {
             let ctx = RunContext {
                 page: true,
@@ -100,6 +124,7 @@ fn run_spec(args: &RunArgs) -> anyhow::Result<ExitCode> {
         resume: args.resume,
         shard,
         page: true,
+        reuse: reuse_folders(&args.reuse)?,
         ..RunContext::new(out, jobs(args.jobs)?, data_dir)
     };
     super::interrupt::on_sigint(&run_resume_command(args, &ctx.out));
@@ -186,6 +211,7 @@ fn reproduce(args: &ReproduceArgs) -> anyhow::Result<ExitCode> {
     let specs = specs_dir(args.specs.as_deref(), &args.plan)?;
     let ctx = RunContext {
         resume: args.resume,
+        reuse: reuse_folders(&args.reuse)?,
         ..RunContext::new(out, jobs, experiment::data_dir(args.data_dir.as_deref()))
     };
     super::interrupt::on_sigint(&reproduce_resume_command(args, &specs, &ctx.out));
@@ -193,6 +219,23 @@ fn reproduce(args: &ReproduceArgs) -> anyhow::Result<ExitCode> {
         experiment::reproduce::reproduce::<Section>(&specs, &args.plan, &args.profile, &ctx)?;
     eprintln!("somnurbs: wrote {}", report.display());
     Ok(ExitCode::SUCCESS)
+}
+
+/// The folders of `--reuse`, each checked to be a folder holding a cell log (read only).
+fn reuse_folders(dirs: &[std::path::PathBuf]) -> anyhow::Result<Vec<std::path::PathBuf>> {
+    use crate::io::outdir::{LOG_FILE, LOG_GZ};
+    for d in dirs {
+        if !d.is_dir() {
+            anyhow::bail!("--reuse {}: not a folder", d.display());
+        }
+        if !d.join(LOG_GZ).is_file() && !d.join(LOG_FILE).is_file() {
+            anyhow::bail!(
+                "--reuse {}: holds no cell log ({LOG_GZ} or {LOG_FILE}): name a result folder of `somnurbs run`",
+                d.display()
+            );
+        }
+    }
+    Ok(dirs.to_vec())
 }
 
 /// The command that continues an interrupted `somnurbs reproduce` (the SIGINT line).

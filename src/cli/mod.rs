@@ -68,6 +68,69 @@ pub(crate) enum Command {
         after_help = "Example:\n  somnurbs run experiments/ch6_same.toml --shard 1/2 --out s1   # on one machine\n  somnurbs run experiments/ch6_same.toml --shard 2/2 --out s2   # on another\n  somnurbs merge s1 s2 --out results/ch6_same"
     )]
     Merge(MergeArgs),
+    /// Make a finished results folder's tables, pictures, REPORT.md and report.html again from
+    /// its cell records alone (no cell runs): a missing file is written, and every file that is
+    /// there must already hold exactly what the records give (a finished folder is never
+    /// rewritten). Exit 0: the folder is whole; 2: a file differs, a record is missing, bad input.
+    #[command(
+        after_help = "Examples:\n  somnurbs report results/ch6_same          # restores a deleted table, checks the rest\n  somnurbs report results/ch4_models --data-dir data"
+    )]
+    Report(ReportArgs),
+    /// Export the control net an optimiser found in a finished Chapter 6 folder (from the cell's
+    /// record; `--start` exports approach B's net, its start) as control_nets.csv, surfaces.igs
+    /// and surfaces.obj in the data's own frame, with export.csv; the record's surface error must
+    /// come out again from the exported net.
+    #[command(
+        after_help = "Examples:\n  somnurbs export results/ch6_same --cell optim/talus/20x20/18x18/chord_length/de/r0 --out talus_de\n  somnurbs export results/ch6_same --cell optim/talus/20x20/18x18/chord_length/de/r0 --start --out talus_b\n\nThe `cell` column of runs.csv names the cells; in a sweep, --variant names one of a cell's variants."
+    )]
+    Export(ExportArgs),
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct ExportArgs {
+    /// A finished folder of `somnurbs run` (or `merge`) with an [optimise] section.
+    pub(crate) results: PathBuf,
+    /// The cell, as runs.csv's `cell` column writes it (e.g.
+    /// optim/talus/20x20/18x18/chord_length/de/r0).
+    #[arg(long)]
+    pub(crate) cell: String,
+    /// In a sweep's folder: the variant (runs.csv's `variant` column) of the cell.
+    #[arg(long)]
+    pub(crate) variant: Option<String>,
+    /// Export approach B's net (the cell's start) instead of the optimiser's best.
+    #[arg(long)]
+    pub(crate) start: bool,
+    /// Output folder (must not exist or be empty).
+    #[arg(long)]
+    pub(crate) out: PathBuf,
+    /// `data` (the data set's own coordinates, the normalisation undone with the map's frame) or
+    /// `normalised` (the map's).
+    #[arg(long, default_value = "data")]
+    pub(crate) frame: String,
+    /// Length unit of the data's coordinates, for the IGES unit flag: unknown, mm, cm, m, um, in
+    /// or ft.
+    #[arg(long, default_value = "unknown")]
+    pub(crate) units: String,
+    /// Evaluation samples per direction in the OBJ mesh, in [2, 1000].
+    #[arg(long, default_value_t = 40)]
+    pub(crate) samples: usize,
+    /// The data folder (as for `run`); the problem is rebuilt from the folder's own maps/.
+    #[arg(long)]
+    pub(crate) data_dir: Option<PathBuf>,
+}
+
+#[derive(Debug, Args)]
+pub(crate) struct ReportArgs {
+    /// A finished folder of `somnurbs run` or `somnurbs merge`.
+    pub(crate) results: PathBuf,
+    /// Worker threads (default: all cores). Results do not depend on it.
+    #[arg(long, short = 'j')]
+    pub(crate) jobs: Option<usize>,
+    /// The data folder the run read (default: $SOMNURBS_DATA, else ./data, else the data/ of the
+    /// clone somnurbs was built from); the records hold every cell's result, the data the
+    /// pictures draw.
+    #[arg(long)]
+    pub(crate) data_dir: Option<PathBuf>,
 }
 
 #[derive(Debug, Args)]
@@ -171,17 +234,24 @@ pub(crate) struct RunArgs {
     #[arg(long, value_name = "I/N")]
     pub(crate) shard: Option<String>,
     /// Change one key of the spec's [optimise] section, validated as if written in the file, e.g.
-    /// `--set optimise.de.f=0.5` (repeatable). The change is recorded in the manifest and enters
-    /// every cell key, so the run's seeds differ from the unchanged spec's.
+    /// `--set optimise.de.f=0.5` (repeatable). The change is recorded in the manifest; a cell it
+    /// reaches is another cell (its identity), drawing the same random numbers as the unchanged
+    /// spec's cell of the same place.
     #[arg(long, value_name = "KEY=VALUE")]
     pub(crate) set: Vec<String>,
     /// Run the spec once per value of an optimiser setting into one folder, e.g.
-    /// `--sweep optimise.de.f=0.3,0.5,0.8` (repeatable: every combination). runs.csv gets a
-    /// `variant` column and `somnurbs compare` ranks each optimiser@variant like an optimiser.
+    /// `--sweep optimise.de.f=0.3,0.5,0.8` (repeatable: every combination). A cell the setting
+    /// does not reach (GA's and PSO's in that example) is computed once and listed once; runs.csv
+    /// gets a `variant` column and `somnurbs compare` ranks each de@variant like an optimiser.
     /// At most 1000 variants and 10^5 cells over all of them; a value given twice (compared as
     /// TOML values: 0.3 and 0.30 are one) is refused.
     #[arg(long, value_name = "KEY=V1,V2,...")]
     pub(crate) sweep: Vec<String>,
+    /// Another result folder whose cell log may hold cells of this run (repeatable): a cell
+    /// that computes the same there (same problem content, optimiser table, budget, place and
+    /// master seed; never matched by name alone) is taken from its record, not computed.
+    #[arg(long, value_name = "DIR")]
+    pub(crate) reuse: Vec<PathBuf>,
 }
 
 #[derive(Debug, Args)]
@@ -253,6 +323,10 @@ pub(crate) struct ReproduceArgs {
     /// Keep what an interrupted reproduction finished (per chapter, as `run --resume`).
     #[arg(long)]
     pub(crate) resume: bool,
+    /// Another result folder (a spec's) whose cell log may hold cells of the plan (repeatable;
+    /// as `run --reuse`). A reading set always reuses the plan's own folder of its spec.
+    #[arg(long, value_name = "DIR")]
+    pub(crate) reuse: Vec<PathBuf>,
 }
 
 #[derive(Debug, Args)]

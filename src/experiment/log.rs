@@ -145,7 +145,70 @@ struct Line<T> {
     key: String,
     #[serde(default)]
     seed: Option<String>,
+    /// The folder a reused cell's record was taken from (`--reuse`, a plan's reading sets).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    reused_from: Option<String>,
     record: T,
+}
+
+/// The records of the cells `wanted` that the log of `dir` holds (another run's folder, read
+/// only: a torn last line is skipped, never cut), matched by their whole key, i.e. by what the
+/// cells compute ([`super::seeds::identity_key`], which includes the master seed).
+pub(crate) fn read_matching(
+    dir: &Path,
+    wanted: &std::collections::BTreeSet<String>,
+) -> Result<BTreeMap<String, serde_json::Value>> {
+    let mut out = BTreeMap::new();
+    let mut texts = Vec::new();
+    let gz = dir.join(LOG_GZ);
+    if gz.exists() {
+        texts.push((gz.clone(), gunzip(&gz)?));
+    }
+    let plain = dir.join(LOG_FILE);
+    if plain.exists() {
+        texts.push((plain.clone(), crate::io::read_text(&plain)?));
+    }
+    if texts.is_empty() {
+        bail!("{}: no cell log ({LOG_GZ} or {LOG_FILE}) to reuse cells from", dir.display());
+    }
+    #[derive(Deserialize)]
+    struct KeyOnly {
+        key: String,
+    }
+    for (path, text) in &texts {
+        let complete = text.rfind('\n').map_or(0, |k| k + 1);
+        for (n, line) in text[..complete].lines().enumerate() {
+            if line.trim().is_empty() {
+                continue;
+            }
+            let bad = |e: serde_json::Error| {
+                anyhow::anyhow!("{}:{}: malformed cell record: {e}", path.display(), n + 1)
+            };
+            let k: KeyOnly = serde_json::from_str(line).map_err(bad)?;
+            if wanted.contains(&k.key) {
+                let l: Line<serde_json::Value> = serde_json::from_str(line).map_err(bad)?;
+                out.insert(l.key, l.record);
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// How many cells of `dir`'s log were taken from another folder (`reused_from`).
+pub(crate) fn count_reused(dir: &Path) -> Result<usize> {
+    #[derive(Deserialize)]
+    struct Reused {
+        #[serde(default)]
+        reused_from: Option<String>,
+    }
+    let text = log_text(dir)?;
+    let mut n = 0;
+    for line in text.lines().filter(|l| !l.trim().is_empty()) {
+        let r: Reused = serde_json::from_str(line)
+            .with_context(|| format!("{}: malformed cell record", dir.display()))?;
+        n += usize::from(r.reused_from.is_some());
+    }
+    Ok(n)
 }
 
 /// The finished cells a folder's log holds, by key (the last line wins if a key repeats): the
@@ -198,7 +261,7 @@ fn parse_lines<T: DeserializeOwned>(
         let l: Line<T> = serde_json::from_str(line).map_err(|e| {
             anyhow::anyhow!("{}:{}: malformed cell record: {e}", path.display(), n + 1)
         })?;
-        let want = super::seeds::seed_hex(master_seed, &l.key);
+        let want = super::seeds::seed_hex(master_seed, super::seeds::place_of(&l.key));
         if l.seed.as_deref() != Some(want.as_str()) {
             bail!("{}:{}: cell {} was logged with seed {}, but its seed in this run is {want} (the folder mixes runs: start afresh without --resume)", path.display(), n + 1, l.key, l.seed.as_deref().unwrap_or("none"));
         }
@@ -291,9 +354,21 @@ impl CellLog {
     }
 
     pub(crate) fn push<T: Serialize>(&mut self, key: &str, record: &T) -> Result<()> {
-        let seed = Some(super::seeds::seed_hex(self.master_seed, key));
-        let mut line = serde_json::to_string(&Line { key: key.to_string(), seed, record })
-            .context("cannot serialise a cell record")?;
+        self.push_line(key, record, None)
+    }
+
+    /// [`push`](Self::push) of a record taken from another folder's log (`from`, which the
+    /// line names, so the manifest can count the cells a run reused).
+    pub(crate) fn push_line<T: Serialize>(
+        &mut self,
+        key: &str,
+        record: &T,
+        reused_from: Option<&str>,
+    ) -> Result<()> {
+        let seed = Some(super::seeds::seed_hex(self.master_seed, super::seeds::place_of(key)));
+        let reused_from = reused_from.map(str::to_string);
+        let line = Line { key: key.to_string(), seed, reused_from, record };
+        let mut line = serde_json::to_string(&line).context("cannot serialise a cell record")?;
         line.push('\n');
         self.file
             .write_all(line.as_bytes())

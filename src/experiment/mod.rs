@@ -51,6 +51,16 @@ pub struct RunContext {
     /// Write the pictures, the 3-D views and the IOHprofiler export (off for a plan's reading
     /// variants, whose tables and claims are what the readings matrix compares).
     pub extras: bool,
+    /// Other result folders whose cell logs may hold cells of this run: a cell found there by
+    /// its whole key (what it computes) is taken, not computed again (`--reuse`, a plan's
+    /// reading sets).
+    pub reuse: Vec<PathBuf>,
+    /// Whether a cell missing from the logs may be computed (`false`: `merge`, `report`, which
+    /// build every table from records alone and name a missing cell).
+    pub compute: bool,
+    /// Whether the maps a family reads are copied into the folder's `maps/` (off for `export`,
+    /// which reads a finished folder's copy and writes only its own files).
+    pub keep_maps: bool,
 }
 
 impl RunContext {
@@ -66,6 +76,9 @@ impl RunContext {
             page: false,
             rerun: None,
             extras: true,
+            reuse: Vec::new(),
+            compute: true,
+            keep_maps: true,
         }
     }
 
@@ -145,7 +158,7 @@ fn logged_variant_keys<F: Families>(variants: &[Loaded<F>]) -> Vec<String> {
 }
 
 /// The manifest: enough to re-run exactly.
-#[derive(Debug, Serialize)]
+#[derive(Debug, Serialize, serde::Deserialize)]
 pub(crate) struct Manifest {
     pub(crate) spec_name: String,
     pub(crate) spec_path: String,
@@ -156,9 +169,9 @@ pub(crate) struct Manifest {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub(crate) shard: Option<String>,
     /// The command line's `--set KEY=VALUE` and `--sweep KEY=V1,V2` (absent for a plain run).
-    #[serde(skip_serializing_if = "Vec::is_empty")]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub(crate) set: Vec<String>,
-    #[serde(skip_serializing_if = "Vec::is_empty")]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub(crate) sweep: Vec<String>,
     pub(crate) crate_version: String,
     pub(crate) git_commit: String,
@@ -167,11 +180,25 @@ pub(crate) struct Manifest {
     pub(crate) host: String,
     pub(crate) jobs: usize,
     pub(crate) cells: usize,
+    /// The cells this folder's run computed, and those it took from another folder's records
+    /// (`--reuse`, a plan's reading sets) because they compute the same.
+    #[serde(default)]
+    pub(crate) cells_computed: usize,
+    #[serde(default)]
+    pub(crate) cells_reused: usize,
     pub(crate) started_unix: u64,
     pub(crate) wall_seconds: f64,
     pub(crate) cpu_seconds_cells: f64,
+    /// The command REPORT.md names to make the folder again, and whether the folder has its own
+    /// report.html and its pictures (what `somnurbs report` renders again).
+    #[serde(default)]
+    pub(crate) rerun: String,
+    #[serde(default)]
+    pub(crate) page: bool,
+    #[serde(default)]
+    pub(crate) extras: bool,
     /// The family's metric definitions (none: no table).
-    #[serde(skip_serializing_if = "Definitions::is_empty")]
+    #[serde(skip_serializing_if = "Definitions::is_empty", skip_deserializing)]
     pub(crate) definitions: Definitions,
     pub(crate) spec_text: String,
 }
@@ -295,13 +322,23 @@ fn claim(out: &Path, fp: &log::Fingerprint, resume: bool) -> Result<Claimed> {
 
 /// [`run_variants`] in a folder the caller has locked and claimed.
 fn run_spec_locked<F: Families>(variants: &[Loaded<F>], ctx: &RunContext) -> Result<PathBuf> {
+    render_locked(variants, ctx, None)
+}
+
+/// [`run_spec_locked`], or with `stored` (a finished folder's manifest: `somnurbs report`) the
+/// tables, pictures and REPORT.md of its records alone, under its own manifest, which stays.
+fn render_locked<F: Families>(
+    variants: &[Loaded<F>],
+    ctx: &RunContext,
+    stored: Option<Manifest>,
+) -> Result<PathBuf> {
     let first = variants.first().context("no spec to run")?;
     let spec = &first.spec;
     let fp = fingerprint(variants, ctx.shard);
     let manifest_path = ctx.out.join(crate::io::outdir::MANIFEST);
     let session = Arc::new(Session {
         master_seed: spec.file.master_seed,
-        pending: std::sync::Mutex::new(Some(fp.clone())),
+        pending: std::sync::Mutex::new(stored.is_none().then(|| fp.clone())),
     });
     let ctx = &RunContext { session: Some(session), ..ctx.clone() };
     let started = Instant::now();
@@ -316,6 +353,8 @@ fn run_spec_locked<F: Families>(variants: &[Loaded<F>], ctx: &RunContext) -> Res
         family.run_variants(variants, ctx, tables)?;
     ctx.begin()?;
 
+    let cells_reused = log::count_reused(&ctx.out)?;
+    let rerun = ctx.rerun.clone().unwrap_or_else(|| run_command(spec, &fp, &ctx.out));
     let manifest = Manifest {
         spec_name: spec.file.name.clone(),
         spec_path: spec.path.clone(),
@@ -332,15 +371,23 @@ fn run_spec_locked<F: Families>(variants: &[Loaded<F>], ctx: &RunContext) -> Res
         host: crate::io::outdir::host_name(),
         jobs: ctx.jobs,
         cells,
+        cells_computed: cells.saturating_sub(cells_reused),
+        cells_reused,
         started_unix,
         wall_seconds: started.elapsed().as_secs_f64(),
         cpu_seconds_cells: cpu,
+        rerun,
+        page: ctx.page,
+        extras: ctx.extras,
         definitions: family.definitions(),
         spec_text: spec.text.clone(),
     };
+    let (manifest, write_manifest) = match stored {
+        Some(m) => (Manifest { definitions: family.definitions(), ..m }, false),
+        None => (manifest, true),
+    };
     if let Some(section) = section {
-        let rerun = ctx.rerun.clone().unwrap_or_else(|| run_command(spec, &manifest, &ctx.out));
-        let mut report = report_md(first, &manifest, &rerun, &[section]);
+        let mut report = report_md(first, &manifest, &manifest.rerun, &[section]);
         if !ctx.extras {
             report.push_str(NO_PICTURES);
         }
@@ -354,14 +401,63 @@ fn run_spec_locked<F: Families>(variants: &[Loaded<F>], ctx: &RunContext) -> Res
         log::compress(&ctx.out)?;
     }
     // The manifest is the very last write: its presence says every file above is whole.
-    let text = toml::to_string_pretty(&manifest).context("cannot serialise the manifest")?;
-    crate::io::write_atomic(&manifest_path, text.as_bytes())?;
+    if write_manifest {
+        let text = toml::to_string_pretty(&manifest).context("cannot serialise the manifest")?;
+        crate::io::write_atomic(&manifest_path, text.as_bytes())?;
+    }
     Ok(ctx.out.clone())
+}
+
+/// `somnurbs report DIR`: the tables, pictures, REPORT.md and report.html of a finished folder
+/// of `somnurbs run` (or `merge`), made again from its cell records alone (no cell runs; a
+/// missing record is an error naming the cell). A file that is missing is written; one that is
+/// there must already hold exactly what the records render (the folder is never rewritten).
+pub(crate) fn report<F: Families>(dir: &Path, data_dir: PathBuf, jobs: usize) -> Result<PathBuf> {
+    let _lock = crate::io::outdir::lock_to_fill(dir, "report")?;
+    let fp = log::Fingerprint::read(dir)?.with_context(|| {
+        format!(
+            "{}: no {}; name a folder `somnurbs run` or `merge` wrote",
+            dir.display(),
+            log::FINGERPRINT_FILE
+        )
+    })?;
+    if let Some(s) = &fp.shard {
+        anyhow::bail!("{}: holds shard {s} only; `somnurbs merge` the shards", dir.display());
+    }
+    let path = dir.join(crate::io::outdir::MANIFEST);
+    if !path.exists() {
+        anyhow::bail!(
+            "{}: the run is not finished (no {}); `somnurbs run ... --resume` finishes it",
+            dir.display(),
+            crate::io::outdir::MANIFEST
+        );
+    }
+    let manifest: Manifest = crate::io::read_toml(&path)?;
+    if manifest.rerun.is_empty() {
+        anyhow::bail!(
+            "{}: written by an older somnurbs (no `rerun`): run the spec again",
+            path.display()
+        );
+    }
+    let profile = (fp.profile != "default").then_some(fp.profile.as_str());
+    let variants: Vec<Loaded<F>> =
+        fp.overrides()
+            .variants(&fp.spec_path, &fp.spec_text, profile)
+            .with_context(|| format!("{}: the folder's spec", dir.display()))?;
+    let ctx = RunContext {
+        resume: true,
+        compute: false,
+        page: manifest.page,
+        extras: manifest.extras,
+        rerun: Some(manifest.rerun.clone()),
+        ..RunContext::new(dir.to_path_buf(), jobs, data_dir)
+    };
+    render_locked(&variants, &ctx, Some(manifest))
 }
 
 /// The `somnurbs run` command that makes the folder `out` again: the spec, its profile, `--out`
 /// unless it is the spec's default folder, and every `--set` and `--sweep`.
-pub(crate) fn run_command(spec: &Spec, m: &Manifest, out: &Path) -> String {
+pub(crate) fn run_command(spec: &Spec, m: &log::Fingerprint, out: &Path) -> String {
     let mut s = format!("somnurbs run {}", m.spec_path);
     if m.profile != "default" {
         let _ = write!(s, " --profile {}", m.profile);
@@ -403,7 +499,7 @@ pub(crate) fn report_md<F: Families>(
     };
     let _ = writeln!(
         s,
-        "Spec `{}` (sha256 {}), profile `{}`, master seed {}, somnurbs {} at commit {}, {} on {} with {} thread(s): {} cells in {:.1} s wall, {:.1} s CPU in cells. Re-run: `{}`.\n",
+        "Spec `{}` (sha256 {}), profile `{}`, master seed {}, somnurbs {} at commit {}, {} on {} with {} thread(s): {} cells{} in {:.1} s wall, {:.1} s CPU in cells. Re-run: `{}`.\n",
         m.spec_path,
         &m.spec_sha256[..12],
         m.profile,
@@ -414,6 +510,11 @@ pub(crate) fn report_md<F: Families>(
         m.host,
         m.jobs,
         m.cells,
+        if m.cells_reused > 0 {
+            format!(" ({} computed, {} reused from another folder's records)", m.cells_computed, m.cells_reused)
+        } else {
+            String::new()
+        },
         m.wall_seconds,
         m.cpu_seconds_cells,
         rerun
@@ -529,16 +630,21 @@ pub(crate) fn merge<F: Families>(shards: &[PathBuf], ctx: &RunContext) -> Result
             if fp.profile == "default" { None } else { Some(fp.profile.as_str()) },
         )
         .context("merge: the shards' spec")?;
+    // The log knows a cell by its identity (`PLACE#...`, see `seeds::identity_key`): the shards
+    // must hold every place of the spec and no other; the merged run then finds each cell by
+    // its identity and computes none.
     let expected: std::collections::BTreeSet<String> =
         logged_variant_keys(&variants).into_iter().collect();
-    if let Some(k) = expected.iter().find(|k| !records.contains_key(*k)) {
+    let places: std::collections::BTreeSet<&str> =
+        records.keys().map(|k| seeds::place_of(k)).collect();
+    if let Some(k) = expected.iter().find(|k| !places.contains(k.as_str())) {
         anyhow::bail!(
             "merge: no shard logged cell {k} (the shards hold {} of the spec's {} cells)",
-            expected.iter().filter(|k| records.contains_key(*k)).count(),
+            expected.iter().filter(|k| places.contains(k.as_str())).count(),
             expected.len()
         );
     }
-    if let Some(k) = records.keys().find(|k| !expected.contains(*k)) {
+    if let Some(k) = records.keys().find(|k| !expected.contains(seeds::place_of(k))) {
         anyhow::bail!("merge: the shards log cell {k}, which the spec does not have");
     }
     {
@@ -548,7 +654,10 @@ pub(crate) fn merge<F: Families>(shards: &[PathBuf], ctx: &RunContext) -> Result
         }
     }
     fingerprint(&variants, None).write(&ctx.out)?;
-    run_spec_locked(&variants, &RunContext { resume: true, shard: None, ..ctx.clone() })
+    run_spec_locked(
+        &variants,
+        &RunContext { resume: true, shard: None, compute: false, ..ctx.clone() },
+    )
 }
 
 /// Resolve the data directory: `--data-dir`, else `SOMNURBS_DATA`, else `data/` in the working

@@ -34,6 +34,14 @@ impl Variant {
     pub fn label(&self) -> String {
         self.swept.join(",")
     }
+
+    /// [`label`](Self::label) of the swept settings whose key `reaches` a cell (`KEY=VALUE`
+    /// entries): a cell no swept setting reaches is the same in every variant, so it has none.
+    pub fn label_reaching(&self, reaches: impl Fn(&str) -> bool) -> String {
+        let reaching =
+            self.swept.iter().filter(|a| reaches(a.split_once('=').map_or(a, |(k, _)| k)));
+        reaching.cloned().collect::<Vec<_>>().join(",")
+    }
 }
 
 /// A command-line value as TOML (a number, a boolean, a quoted string, an array), else the text

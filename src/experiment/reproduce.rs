@@ -460,7 +460,12 @@ pub(crate) fn reproduce<F: Families>(
     for (reading, rspecs) in &reading_specs {
         for spec in rspecs {
             let folder = Path::new(READINGS_DIR).join(&reading.name).join(&spec.spec.file.name);
-            let sub = RunContext { out: ctx.out.join(&folder), extras: false, ..ctx.clone() };
+            // A set's cells that compute what the plan's did (a Chapter 6 optimiser the set does
+            // not change) are taken from the plan's folder of the spec, not computed again.
+            let mut reuse = vec![ctx.out.join(&spec.spec.file.name)];
+            reuse.extend(ctx.reuse.iter().cloned());
+            let sub =
+                RunContext { out: ctx.out.join(&folder), extras: false, reuse, ..ctx.clone() };
             eprintln!(
                 "somnurbs: reproduce: {} under the readings `{}` -> {}",
                 spec.spec.file.name,

@@ -168,6 +168,32 @@ pub(crate) trait Logged: Send + Sized {
     fn record(&self) -> Self::Record;
 }
 
+/// The records of the cells `missing` that the folders of `ctx.reuse` hold (the first folder
+/// that has a cell gives it), each with the folder it came from; only cells known by their
+/// identity ([`super::seeds::identity_key`]) are looked for.
+fn reused_records(
+    ctx: &super::RunContext,
+    missing: &std::collections::BTreeSet<String>,
+) -> Result<BTreeMap<String, (String, serde_json::Value)>> {
+    let mut out = BTreeMap::new();
+    // Only a key that names what its cell computes can be matched: a family whose keys are
+    // places alone (`seeds::place_of`) computes its cells itself.
+    let mut wanted: std::collections::BTreeSet<String> =
+        missing.iter().filter(|k| super::seeds::place_of(k) != k.as_str()).cloned().collect();
+    for dir in &ctx.reuse {
+        if wanted.is_empty() {
+            break;
+        }
+        let found = super::log::read_matching(dir, &wanted)
+            .with_context(|| format!("--reuse {}", dir.display()))?;
+        for (key, rec) in found {
+            wanted.remove(&key);
+            out.insert(key, (dir.display().to_string(), rec));
+        }
+    }
+    Ok(out)
+}
+
 /// Run the cells of this folder's slice (all, or the shard's) and return their results in cell
 /// order. Each finished cell is appended to the folder's cell log at once; with `ctx.resume`,
 /// cells already in the log are not run again but rebuilt by `restore` from their record, so a
@@ -195,19 +221,51 @@ where
         .filter(|(k, _)| ctx.shard.is_none_or(|s| s.contains(*k)))
         .map(|(_, c)| c)
         .collect();
-    let todo: Vec<&C> = slice.iter().copied().filter(|c| !logged.contains_key(&c.key())).collect();
+    let missing: std::collections::BTreeSet<String> =
+        slice.iter().map(|c| c.key()).filter(|k| !logged.contains_key(k)).collect();
+    let reused = reused_records(ctx, &missing)?;
+    let todo: Vec<&C> = slice
+        .iter()
+        .copied()
+        .filter(|c| missing.contains(&c.key()) && !reused.contains_key(&c.key()))
+        .collect();
     if ctx.resume && todo.len() < slice.len() {
         eprintln!(
             "somnurbs: resuming {}: {} of {} cells already done",
             ctx.out.display(),
-            slice.len() - todo.len(),
+            slice.len() - todo.len() - reused.len(),
+            slice.len()
+        );
+    }
+    if let (false, Some(c)) = (ctx.compute, todo.first()) {
+        anyhow::bail!(
+            "cell {} is not in the cell log of {} ({} of the {} cells are missing)",
+            c.key(),
+            ctx.out.display(),
+            todo.len(),
             slice.len()
         );
     }
     // Every input has loaded: the folder becomes this run's (once per run), then the log
-    // (empty unless resuming) gets one line per finished cell; every family appends.
+    // (empty unless resuming) gets one line per reused and per finished cell; every family
+    // appends. A run that only reads records (`report`) opens no log.
     ctx.begin()?;
-    let log = std::sync::Mutex::new(super::log::CellLog::append(&ctx.out, ctx.master_seed())?);
+    let log = if todo.is_empty() && reused.is_empty() {
+        None
+    } else {
+        Some(std::sync::Mutex::new(super::log::CellLog::append(&ctx.out, ctx.master_seed())?))
+    };
+    if let (Some(log), false) = (&log, reused.is_empty()) {
+        let mut log = log.lock().map_err(|_| anyhow::anyhow!("cell log lock poisoned"))?;
+        for c in &slice {
+            if let Some((from, rec)) = reused.get(&c.key()) {
+                log.push_line(&c.key(), rec, Some(from))?;
+            }
+        }
+    }
+    for (key, (_, rec)) in reused {
+        logged.insert(key, rec);
+    }
     let computed = run_cells(
         &todo,
         ctx.jobs,
@@ -218,6 +276,7 @@ where
             if let Some(at) = super::finite::first_non_finite(&record) {
                 anyhow::bail!("cell {}: its result is not finite ({at})", c.key());
             }
+            let log = log.as_ref().context("no cell log open")?;
             log.lock()
                 .map_err(|_| anyhow::anyhow!("cell log lock poisoned"))?
                 .push(&c.key(), &record)

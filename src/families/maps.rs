@@ -258,7 +258,7 @@ pub(crate) fn maps_for(
     }
     // Every map has loaded: only now may the folder change.
     ctx.begin()?;
-    for (data, source) in &out {
+    for (data, source) in out.iter().filter(|_| ctx.keep_maps) {
         let text = crate::io::map_file::text(&source.grid)?;
         let file = ctx.out.join("maps").join(map_file_name(data, grid));
         write_atomic(&file, text.as_bytes())?;

@@ -38,6 +38,9 @@ pub(crate) fn require_regular_or_absent(path: &Path) -> Result<()> {
 pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     outdir::no_link_inside(path)?;
     require_regular_or_absent(path)?;
+    if outdir::fill(path, bytes)? == outdir::Fill::Same {
+        return Ok(());
+    }
     if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
         ensure_dir(parent)?;
     }

@@ -72,6 +72,53 @@ fn roots() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
     ROOTS.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
 }
 
+/// The held result folders that are being filled (`somnurbs report`): a file there that exists
+/// is never replaced, only compared ([`fill`]).
+static FILLING: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+fn filling() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
+    FILLING.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
+/// What a write of `bytes` to `path` does in a folder being filled.
+#[derive(Debug, PartialEq)]
+pub(crate) enum Fill {
+    /// Not in a filled folder, or the file is missing: write it.
+    Write,
+    /// The file is there with these very bytes: leave it.
+    Same,
+}
+
+/// Whether `path` may be written: outside a folder being filled, always; inside one, only when
+/// it is missing, and a file that is there must hold `bytes` exactly (else an error naming it:
+/// a finished result is never rewritten).
+pub(crate) fn fill(path: &Path, bytes: &[u8]) -> Result<Fill> {
+    if !filling().iter().any(|r| path.starts_with(r)) {
+        return Ok(Fill::Write);
+    }
+    match fs::symlink_metadata(path) {
+        Err(_) => Ok(Fill::Write),
+        Ok(_) => {
+            let old = crate::io::input::read(path, crate::io::input::Kind::Data)?;
+            if old == bytes {
+                Ok(Fill::Same)
+            } else {
+                bail!(
+                    "{}: the folder's records render it differently ({} bytes there, {} rendered): made by another build of somnurbs, or edited; left as it is",
+                    path.display(),
+                    old.len(),
+                    bytes.len()
+                )
+            }
+        }
+    }
+}
+
+/// Whether files below `path` are only added, never replaced or removed (a folder being filled).
+pub(crate) fn is_filling(path: &Path) -> bool {
+    filling().iter().any(|r| path.starts_with(r))
+}
+
 /// Refuse `path` when, inside a result folder this process holds, it or a folder on its way is a
 /// symbolic link: a write through it would land outside the folder it was given.
 pub(crate) fn no_link_inside(path: &Path) -> Result<()> {
@@ -385,6 +432,8 @@ pub(crate) struct Lock {
     heartbeat: Option<std::thread::JoinHandle<()>>,
     /// What this lock added to [`ROOTS`].
     roots: Vec<PathBuf>,
+    /// Whether it also added them to [`FILLING`].
+    fill: bool,
 }
 
 impl std::fmt::Debug for Lock {
@@ -451,7 +500,16 @@ pub(crate) fn lock(dir: &Path, command: &str) -> Result<Lock> {
     let mut held_roots = vec![dir.to_path_buf()];
     held_roots.extend(fs::canonicalize(dir).ok().filter(|c| c != dir));
     roots().extend(held_roots.iter().cloned());
-    Ok(Lock { file, path, stop, heartbeat, roots: held_roots })
+    Ok(Lock { file, path, stop, heartbeat, roots: held_roots, fill: false })
+}
+
+/// [`lock`] of a finished result folder to fill it (`somnurbs report`): every file its records
+/// render that is missing is written; one that is there must already hold the rendered bytes.
+pub(crate) fn lock_to_fill(dir: &Path, command: &str) -> Result<Lock> {
+    let mut lock = lock(dir, command)?;
+    filling().extend(lock.roots.iter().cloned());
+    lock.fill = true;
+    Ok(lock)
 }
 
 /// Open a folder's lock file (created when `create`) without following a link and without
@@ -507,6 +565,15 @@ impl Drop for Lock {
         for r in &self.roots {
             if let Some(k) = held.iter().position(|h| h == r) {
                 held.remove(k);
+            }
+        }
+        drop(held);
+        if self.fill {
+            let mut held = filling();
+            for r in &self.roots {
+                if let Some(k) = held.iter().position(|h| h == r) {
+                    held.remove(k);
+                }
             }
         }
     }

@@ -311,6 +311,37 @@ impl ControlNetProblem {
         &self.parts
     }
 
+    /// SHA-256 of everything the fitness (Eq. 6.2) and the search box depend on: the grid data,
+    /// the net's size, the basis at the data parameters, the start x0 and the box. Two problems
+    /// with the same digest give every optimiser the same run (the kernel copy, `isa`, gives
+    /// the same bits and is left out).
+    pub fn digest(&self) -> [u8; 32] {
+        use sha2::{Digest, Sha256};
+        let mut h = Sha256::new();
+        let mut floats = |name: &str, v: &[f64]| {
+            h.update(name.as_bytes());
+            h.update((v.len() as u64).to_le_bytes());
+            for x in v {
+                h.update(x.to_bits().to_le_bytes());
+            }
+        };
+        let p = &self.parts;
+        let sizes = [p.nx, p.ny, p.cn_x, p.cn_y].map(|n| n as f64);
+        floats("sizes", &sizes);
+        for (name, pts) in [("bottom", &p.data_bottom), ("top", &p.data_top)] {
+            floats(name, &pts.iter().flatten().copied().collect::<Vec<_>>());
+        }
+        for (name, b) in [("nu", &p.nu), ("nv", &p.nv)] {
+            floats(name, &b.first.iter().map(|&f| f as f64).collect::<Vec<_>>());
+            floats(name, &b.w.iter().flatten().copied().collect::<Vec<_>>());
+        }
+        floats("x0", &p.x0);
+        floats("lower", &self.lower);
+        floats("upper", &self.upper);
+        floats("box", &[self.box_axes.0, self.box_axes.1].concat());
+        h.finalize().into()
+    }
+
     /// The class layout of the double control net.
     pub fn net(&self) -> &DoubleNet {
         &self.net

@@ -1,6 +1,8 @@
-//! `run --set KEY=VALUE` and `run --sweep KEY=V1,V2,...`: a changed key changes the results and
-//! the seeds, a sweep writes one folder with a `variant` column that `compare` ranks, resume and
-//! shards of a sweep give the plain sweep's tables, and a run without either keeps its seeds.
+//! `run --set KEY=VALUE` and `run --sweep KEY=V1,V2,...`: a changed key changes the cells it
+//! reaches (their identity and results) and no other, every variant of a place draws the place's
+//! random numbers, a sweep writes one folder with a `variant` column that `compare` ranks and
+//! computes a cell no swept key reaches once, resume and shards of a sweep give the plain
+//! sweep's tables, and a run without either keeps its seeds.
 
 use crate::common::*;
 use std::collections::{BTreeMap, BTreeSet};
@@ -49,17 +51,17 @@ fn set_changes_the_results_and_the_seeds_and_is_recorded() {
     c.ok(&["run", "d.toml", "--out", "f5", "--set", "optimise.de.f=0.5"]);
     let (plain, f5) = (runs(&c, "plain"), runs(&c, "f5"));
     assert_eq!(plain.len(), f5.len());
-    assert!(plain.keys().all(|k| k.starts_with("optim/")), "{plain:?}");
-    assert!(f5.keys().all(|k| k.starts_with("optim[optimise.de.f=0.5]/")), "{f5:?}");
-    let plain_seeds: BTreeSet<&String> = plain.values().map(|v| &v.0).collect();
-    assert!(
-        f5.values().all(|v| !plain_seeds.contains(&v.0)),
-        "a --set run reuses a plain run's stream"
+    assert!(plain.keys().chain(f5.keys()).all(|k| k.starts_with("optim/")), "{f5:?}");
+    // One place, one stream: the --set run's cells draw the plain run's random numbers.
+    assert_eq!(
+        plain.values().map(|v| &v.0).collect::<Vec<_>>(),
+        f5.values().map(|v| &v.0).collect::<Vec<_>>(),
     );
-    let de_best = |m: &BTreeMap<String, (String, String)>| {
-        m.iter().filter(|(k, _)| k.contains("/de/")).map(|(_, v)| v.1.clone()).collect::<Vec<_>>()
+    let best = |m: &BTreeMap<String, (String, String)>, opt: &str| {
+        m.iter().filter(|(k, _)| k.contains(opt)).map(|(_, v)| v.1.clone()).collect::<Vec<_>>()
     };
-    assert_ne!(de_best(&plain), de_best(&f5), "F = 0.5 gives DE the same results");
+    assert_ne!(best(&plain, "/de/"), best(&f5, "/de/"), "F = 0.5 gives DE the same results");
+    assert_eq!(best(&plain, "/ga/"), best(&f5, "/ga/"), "DE's F moved GA's cells");
     let (h, _) = read_csv(&c.path("f5/runs.csv"));
     assert!(!h.contains(&"variant".to_string()), "--set alone adds no variant column: {h:?}");
     let manifest = std::fs::read_to_string(c.path("f5/manifest.toml")).unwrap();
@@ -82,10 +84,7 @@ fn set_changes_the_results_and_the_seeds_and_is_recorded() {
         c.ok(&["run", "d.toml", "--dry-run", "--set", "optimise.de.f=0.5"]).stdout,
     )
     .unwrap();
-    assert!(
-        dry.lines().count() == 4 && dry.lines().all(|l| l.starts_with("optim[optimise.de.f=0.5]/")),
-        "{dry}"
-    );
+    assert!(dry.lines().count() == 4 && dry.lines().all(|l| l.starts_with("optim/")), "{dry}");
 }
 
 #[test]
@@ -146,8 +145,8 @@ fn a_sweep_over_de_f_writes_one_folder_whose_variants_differ_and_compare_ranks_t
     assert_eq!(bests.len(), 3, "the variants give the same results");
     assert_eq!(
         rows.iter().map(|r| &r[seed]).collect::<BTreeSet<_>>().len(),
-        18,
-        "two variants share a stream"
+        6,
+        "the variants of one place draw other random numbers"
     );
     // The variant with F = 0.3 is not the plain spec (F = 0.3 is not DE's default here), and a
     // --set run of one variant gives exactly that variant's rows.
@@ -157,7 +156,7 @@ fn a_sweep_over_de_f_writes_one_folder_whose_variants_differ_and_compare_ranks_t
     for r in &one {
         let same = rows
             .iter()
-            .find(|x| x[cell] == r[cell])
+            .find(|x| x[cell] == r[cell] && x[v] == r[v])
             .unwrap_or_else(|| panic!("{} not in the sweep", r[cell]));
         assert_eq!((&same[best], &same[seed]), (&r[best], &r[seed]));
     }
@@ -208,7 +207,13 @@ fn resume_and_shards_of_a_sweep_give_the_plain_sweeps_tables() {
     let ok = |args: Vec<String>| c.ok(&args.iter().map(String::as_str).collect::<Vec<_>>());
     ok(with(&["run", "d.toml", "--out", "one"]));
     let n = read_csv(&c.path("one/runs.csv")).1.len();
-    assert_eq!(n, 16, "2 x 2 variants x 2 optimisers x 2 repeats");
+    // DE's 2 x 2 variants, GA's 2 (only the generations reach it), 2 repeats each.
+    assert_eq!(n, 12, "(2 x 2 + 2) variants x 2 repeats");
+    let manifest = std::fs::read_to_string(c.path("one/manifest.toml")).unwrap();
+    assert!(
+        manifest.contains("cells = 12") && manifest.contains("cells_computed = 12"),
+        "{manifest}"
+    );
     // An interrupted sweep: half its log, no manifest, no tables.
     ok(with(&["run", "d.toml", "--out", "cut"]));
     let log = somnurbs::experiment::log_text(&c.path("cut")).unwrap();

@@ -14,20 +14,62 @@ use anyhow::{Context, Result};
 use std::path::Path;
 
 /// The coordinates the exports are written in.
-struct Export {
+pub(crate) struct Export {
     /// fit.csv's `frame`: `data`, `normalised` or `map` (no frame found).
-    label: &'static str,
+    pub(crate) label: &'static str,
     /// Taken from the map's coordinates to the exports' (None: the map's as they are).
     affine: Option<([f64; 3], [f64; 3])>,
     units: Units,
     /// The line the IGES start section and the OBJ comments carry.
     note: String,
     /// Said on stderr once the output folder is this command's (no frame found).
-    warn: Option<String>,
+    pub(crate) warn: Option<String>,
+}
+
+impl Export {
+    /// `s` in the exports' coordinates.
+    pub(crate) fn place(&self, s: &BSplineSurface) -> BSplineSurface {
+        match self.affine {
+            Some((offset, scale)) => s.affine(offset, scale),
+            None => s.clone(),
+        }
+    }
+}
+
+/// control_nets.csv, surfaces.igs (dated `date`) and surfaces.obj (`samples` per direction) of
+/// the two surfaces, already placed ([`Export::place`]), into `out`.
+pub(crate) fn write_surface_files(
+    out: &Path,
+    bottom: &BSplineSurface,
+    top: &BSplineSurface,
+    export: &Export,
+    samples: usize,
+    date: &str,
+) -> Result<()> {
+    let surfaces = [("bottom", bottom), ("top", top)];
+    let header: Vec<String> =
+        ["view", "a", "b", "x", "y", "z"].iter().map(|s| s.to_string()).collect();
+    let rows = net_rows(&surfaces);
+    write_atomic(&out.join("control_nets.csv"), csv_records(&header, &rows)?.as_bytes())?;
+    let notes = [export.note.clone()];
+    write_atomic(
+        &out.join("surfaces.igs"),
+        export::write_iges(&surfaces, export.units, &notes, date).as_bytes(),
+    )?;
+    let obj_notes = [export.note.clone(), format!("{}.", export.units.line())];
+    write_atomic(
+        &out.join("surfaces.obj"),
+        export::write_obj(&surfaces, samples, samples, &obj_notes).as_bytes(),
+    )
 }
 
 /// How `--frame` and `--units` and the frame beside `grid` (if any) place the exports.
-fn export_frame(grid: &Path, frame: Option<Frame>, which: &str, units: &str) -> Result<Export> {
+pub(crate) fn export_frame(
+    grid: &Path,
+    frame: Option<Frame>,
+    which: &str,
+    units: &str,
+) -> Result<Export> {
     let units: Units = units.parse().map_err(anyhow::Error::msg).context("--units")?;
     let data = match which {
         "data" => true,
@@ -172,15 +214,7 @@ pub(crate) fn fit(args: &FitArgs) -> Result<()> {
     let date = export::iges_date(generated).map_err(anyhow::Error::msg).context("SOURCE_DATE_EPOCH")?;
     let frame = crate::io::map_file::read_frame(&args.grid)?;
     let export = export_frame(&args.grid, frame, &args.frame, &args.units)?;
-    let placed = |s: &BSplineSurface| match export.affine {
-        Some((offset, scale)) => s.affine(offset, scale),
-        None => s.clone(),
-    };
-    let (bottom, top) = (placed(&fit.bottom), placed(&fit.top));
-    let surfaces = [("bottom", &bottom), ("top", &top)];
-    let header: Vec<String> =
-        ["view", "a", "b", "x", "y", "z"].iter().map(|s| s.to_string()).collect();
-    let rows = net_rows(&surfaces);
+    let (bottom, top) = (export.place(&fit.bottom), export.place(&fit.top));
     let out = &args.out;
     // Every input has loaded: the folder is this command's (one writer at a time), and a fit
     // folder, like a run's, holds one result: it must be missing or empty.
@@ -190,17 +224,7 @@ pub(crate) fn fit(args: &FitArgs) -> Result<()> {
     if let Some(line) = &export.warn {
         eprintln!("{line}");
     }
-    write_atomic(&out.join("control_nets.csv"), csv_records(&header, &rows)?.as_bytes())?;
-    let notes = [export.note.clone()];
-    write_atomic(
-        &out.join("surfaces.igs"),
-        export::write_iges(&surfaces, export.units, &notes, &date).as_bytes(),
-    )?;
-    let obj_notes = [export.note.clone(), format!("{}.", export.units.line())];
-    write_atomic(
-        &out.join("surfaces.obj"),
-        export::write_obj(&surfaces, args.samples, args.samples, &obj_notes).as_bytes(),
-    )?;
+    write_surface_files(out, &bottom, &top, &export, args.samples, &date)?;
     let dense = fit.dense_geometry(&grid);
     let summary: Vec<String> = [
         "grid",

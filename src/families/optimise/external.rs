@@ -360,7 +360,7 @@ fn read_file(
         .map(|(repeat, (evals, imp))| OptimRow {
             cell: format!("external/{optimiser}/{name}/r{repeat}"),
             optimiser: optimiser.clone(),
-            variant: String::new(),
+            variant: None,
             repeat,
             seed: String::new(),
             initial_best: imp[0].1,

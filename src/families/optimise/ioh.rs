@@ -53,7 +53,7 @@ pub(crate) fn write(runs: &[OptimRun], out: &Path) -> Result<usize> {
                 .map(|r| IohRun {
                     evaluations: r.row.evaluations,
                     improvements: &r.improvements,
-                    best_x: &[],
+                    best_x: &r.best_x,
                 })
                 .collect();
             let meta = IohMeta {
@@ -73,6 +73,9 @@ pub(crate) fn write(runs: &[OptimRun], out: &Path) -> Result<usize> {
 }
 
 fn remove_info_files(dir: &Path) -> Result<()> {
+    if crate::io::outdir::is_filling(dir) {
+        return Ok(());
+    }
     let Ok(entries) = std::fs::read_dir(dir) else { return Ok(()) };
     for e in entries.flatten() {
         let p = e.path();

@@ -3,6 +3,7 @@
 //! runs on its own stream and is logged at once.
 
 pub(crate) mod compare;
+pub(crate) mod export;
 pub(crate) mod external;
 pub(crate) mod ioh;
 pub(crate) mod overall;
@@ -17,7 +18,8 @@ use crate::families::maps;
 use crate::optim::{Budget, Problem};
 use crate::spline::BoxSpec;
 use crate::spline::ControlNetProblem;
-use crate::spline::{fit_two_view, Approach, Parameterisation};
+use crate::spline::{fit_two_view, Approach};
+use crate::experiment::packed::PackedPoints;
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 use spec::OptimCell;
@@ -46,9 +48,10 @@ pub(crate) struct OptimRow {
     pub(crate) cn_y: usize,
     pub(crate) parameterisation: String,
     pub(crate) optimiser: String,
-    /// The swept settings of a `--sweep` run (e.g. `optimise.de.f=0.5`); no column otherwise.
-    #[serde(default, skip_serializing_if = "String::is_empty")]
-    pub(crate) variant: String,
+    /// The swept settings of a `--sweep` run that reach the row's cell (e.g. `optimise.de.f=0.5`;
+    /// empty for a cell no swept setting reaches); no column without `--sweep`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(crate) variant: Option<String>,
     pub(crate) repeat: usize,
     pub(crate) seed: String,
     pub(crate) dimension: usize,
@@ -78,10 +81,9 @@ impl OptimRow {
 
     /// What `compare` and the tables rank: the optimiser, or in a sweep `optimiser@variant`.
     pub(crate) fn competitor(&self) -> String {
-        if self.variant.is_empty() {
-            self.optimiser.clone()
-        } else {
-            format!("{}@{}", self.optimiser, self.variant)
+        match self.variant.as_deref() {
+            None | Some("") => self.optimiser.clone(),
+            Some(v) => format!("{}@{v}", self.optimiser),
         }
     }
 }
@@ -98,17 +100,20 @@ pub(crate) struct OptimRun {
     /// (evaluation, fitness) at every improvement of the best so far, from evaluation 1 (the
     /// IOHprofiler `.dat` rows and the runtime distributions of `compare`).
     pub(crate) improvements: Vec<(u64, f64)>,
-    /// The best control points found (for the pictures of Appendices I/J).
+    /// The best control points found: the optimised net (pictures, 3-D views, `export`).
     pub(crate) best_x: Vec<f64>,
 }
 
-/// What the cell log keeps of a run (a log written before `improvements` existed does not fit:
-/// `--resume` then names the cell and stops, as for any change of the record).
+/// What the cell log keeps of a run: its one result, from which every table, picture and
+/// export is made (a log written before `best_x` was kept does not fit: `--resume` then names
+/// the cell and stops, as for any change of the record).
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub(crate) struct OptimRecord {
     pub(crate) row: OptimRow,
     pub(crate) trace: Vec<(u64, f64)>,
     pub(crate) improvements: Vec<(u64, f64)>,
+    /// The best control points, bit for bit (x, y, z of each control point in turn).
+    pub(crate) best_x: PackedPoints,
 }
 
 pub use crate::families::maps::ProblemKey;
@@ -174,7 +179,7 @@ pub fn problems(
     Ok(out)
 }
 
-/// Run one cell (also alone: the same numbers as inside the full run).
+/// Run one cell (also alone: the same numbers as inside the full run) on its place's stream.
 pub(crate) fn run_cell(
     spec: &Spec,
     o: &OptimSpec,
@@ -182,14 +187,8 @@ pub(crate) fn run_cell(
     problem: &ControlNetProblem,
 ) -> Result<OptimRun> {
     let opt = o.tables.get(cell.optimiser);
-    let budget = Budget {
-        generations: o.generations as u64,
-        population: o.population,
-        init_range: o.init_range,
-        trace_every_evals: o.trace_every_evals,
-    };
     let key = cell.key();
-    let (r, cpu_s) = runner::optimise(opt, problem, &budget, spec.file.master_seed, &key)?;
+    let (r, cpu_s) = runner::optimise(opt, problem, &budget(o), spec.file.master_seed, &key)?;
     if !r.best_fitness.is_finite() {
         anyhow::bail!("{key}: the best fitness is not finite ({})", r.best_fitness);
     }
@@ -203,7 +202,7 @@ pub(crate) fn run_cell(
         cn_y: cell.cn.ny,
         parameterisation: cell.param.name().into(),
         optimiser: cell.optimiser.to_string(),
-        variant: spec.variant.label(),
+        variant: (!spec.variant.swept.is_empty()).then(|| cell.variant.clone()),
         repeat: cell.repeat,
         seed: seeds::seed_hex(spec.file.master_seed, &key),
         dimension: problem.dim(),
@@ -225,61 +224,114 @@ pub(crate) fn run_cell(
     })
 }
 
+/// The budget of every run of a section.
+fn budget(o: &OptimSpec) -> Budget {
+    Budget {
+        generations: o.generations as u64,
+        population: o.population,
+        init_range: o.init_range,
+        trace_every_evals: o.trace_every_evals,
+    }
+}
+
 impl runner::Logged for OptimRun {
-    /// The row and the convergence trace; the best control points are not logged (a run is
-    /// deterministic, so the few the pictures need are recomputed: see [`picture_points`]).
     type Record = OptimRecord;
     fn record(&self) -> Self::Record {
         OptimRecord {
             row: self.row.clone(),
             trace: self.trace.clone(),
             improvements: self.improvements.clone(),
+            best_x: PackedPoints {
+                points: self.best_x.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect(),
+                single: false,
+            },
         }
     }
 }
 
-/// Whether a cell's best control points are kept for the Appendix I/J pictures (the largest
-/// control net of its grid).
-fn pictured(cell: &OptimCell, largest: GridSize) -> bool {
-    cell.cn == largest
+/// A cell of one variant of a run, known by what it computes: its place (the stream), the
+/// problem's content ([`ControlNetProblem::digest`]), the optimiser's parameter table, the
+/// budget and the master seed. Two variants' cells with one identity are one cell, computed
+/// once; a folder named by `--reuse` gives the record of a cell with the same identity.
+struct Job {
+    cell: OptimCell,
+    /// Index of the variant whose section runs it (the first that has it).
+    variant: usize,
+    identity: String,
 }
 
-/// Run every optimisation cell of a spec (its shard's, with `--shard`).
+impl runner::Cell for Job {
+    fn key(&self) -> String {
+        self.identity.clone()
+    }
+}
+
+/// The identity of `cell` under section `o` (see [`Job`]).
+fn identity(spec: &Spec, o: &OptimSpec, cell: &OptimCell, digest: &[u8; 32]) -> String {
+    let b = budget(o);
+    let table = format!("{:?}", o.tables.get(cell.optimiser));
+    let budget = format!(
+        "{} {} {:016x} {}",
+        b.generations,
+        b.population,
+        b.init_range.to_bits(),
+        b.trace_every_evals
+    );
+    seeds::identity_key(
+        &cell.key(),
+        &[&spec.file.master_seed.to_le_bytes(), digest, table.as_bytes(), budget.as_bytes()],
+    )
+}
+
+/// The cells of every variant, each identity once, in the variants' order.
+fn jobs(
+    variants: &[(&Spec, &OptimSpec)],
+    problems: &BTreeMap<ProblemKey, ControlNetProblem>,
+) -> Vec<Job> {
+    let digests: BTreeMap<&ProblemKey, [u8; 32]> =
+        problems.iter().map(|(k, p)| (k, p.digest())).collect();
+    let mut seen = std::collections::BTreeSet::new();
+    let mut jobs = Vec::new();
+    for (v, (spec, o)) in variants.iter().enumerate() {
+        for cell in spec::cells(spec, o) {
+            let digest = &digests[&ProblemKey::new(&cell.dataset, cell.cn, cell.param)];
+            let identity = identity(spec, o, &cell, digest);
+            if seen.insert(identity.clone()) {
+                jobs.push(Job { cell, variant: v, identity });
+            }
+        }
+    }
+    jobs
+}
+
+/// Run every optimisation cell of the variants (their shard's, with `--shard`), each identity
+/// once, taking the records the folder's log or a `--reuse` folder holds.
 pub(crate) fn run(
-    spec: &Spec,
-    o: &OptimSpec,
+    variants: &[(&Spec, &OptimSpec)],
     ctx: &RunContext,
     problems: &BTreeMap<ProblemKey, ControlNetProblem>,
 ) -> Result<Vec<OptimRun>> {
-    let cells = spec::cells(spec, o);
-    let largest = cells.iter().map(|c| c.cn).max().unwrap_or(GridSize { nx: 0, ny: 0 });
+    let jobs = jobs(variants, problems);
     let problem = |cell: &OptimCell| &problems[&ProblemKey::new(&cell.dataset, cell.cn, cell.param)];
-    let mut runs = runner::run_logged(
-        &cells,
+    runner::run_logged(
+        &jobs,
         ctx,
-        &spec.file.name,
-        |cell| {
-            let mut r = run_cell(spec, o, cell, problem(cell))?;
-            if !pictured(cell, largest) {
-                r.best_x = Vec::new();
-            }
-            Ok(r)
+        &variants[0].0.file.name,
+        |job| {
+            let (spec, o) = variants[job.variant];
+            run_cell(spec, o, &job.cell, problem(&job.cell))
         },
-        |cell, rec: OptimRecord| {
+        |job, rec: OptimRecord| {
             Ok(OptimRun {
-                cell: cell.clone(),
+                cell: job.cell.clone(),
                 competitor: rec.row.competitor(),
                 row: rec.row,
                 trace: rec.trace,
                 improvements: rec.improvements,
-                best_x: Vec::new(),
+                best_x: rec.best_x.points.into_iter().flatten().collect(),
             })
         },
-    )?;
-    if ctx.extras {
-        picture_points(spec, o, &mut runs, largest, problem)?;
-    }
-    Ok(runs)
+    )
 }
 
 /// The run of each (grid, data set) whose best surfaces go furthest from the data (largest dense
@@ -293,44 +345,6 @@ pub(crate) fn furthest(runs: &[OptimRun]) -> BTreeMap<(GridSize, String), usize>
         }
     }
     out
-}
-
-/// Give the MIN run of every (data set, parameterisation, optimiser) at the largest net (the
-/// Appendix I/J pictures) and the run of each data set whose surfaces go furthest from the data
-/// (its 3-D view) their best control points when they are not at hand, by running that cell
-/// again; the re-run must reproduce the logged error exactly (a check of determinism across
-/// processes).
-fn picture_points<'a>(
-    spec: &Spec,
-    o: &OptimSpec,
-    runs: &mut [OptimRun],
-    largest: GridSize,
-    problem: impl Fn(&OptimCell) -> &'a ControlNetProblem,
-) -> Result<()> {
-    let mut best: BTreeMap<(String, Parameterisation, crate::optim::Name), usize> = BTreeMap::new();
-    for (k, r) in runs.iter().enumerate() {
-        if !pictured(&r.cell, largest) {
-            continue;
-        }
-        let e = best
-            .entry((r.cell.dataset.clone(), r.cell.param, r.cell.optimiser))
-            .or_insert(k);
-        if r.row.best < runs[*e].row.best {
-            *e = k;
-        }
-    }
-    let wanted: std::collections::BTreeSet<usize> =
-        best.into_values().chain(furthest(runs).into_values()).collect();
-    for k in wanted {
-        if runs[k].best_x.is_empty() {
-            let again = run_cell(spec, o, &runs[k].cell, problem(&runs[k].cell))?;
-            if again.row.best.to_bits() != runs[k].row.best.to_bits() {
-                anyhow::bail!("cell {}: re-run gives {} but the cell log has {} (the code changed since the log was written?)", runs[k].row.cell, again.row.best, runs[k].row.best);
-            }
-            runs[k].best_x = again.best_x;
-        }
-    }
-    Ok(())
 }
 
 /// One sentence on the start and the search box of a spec's runs, for the report.
@@ -399,10 +413,7 @@ impl crate::experiment::family::Experiment for Optim {
         let [(first, o), ..] = variants else { anyhow::bail!("no variant to run") };
         let problems = problems(first, o, ctx)?;
         let exact = if tables { exact_optima(o, ctx, &problems)? } else { BTreeMap::new() };
-        let mut runs = Vec::new();
-        for (v, vo) in variants {
-            runs.extend(run(v, vo, ctx, &problems)?);
-        }
+        let runs = run(variants, ctx, &problems)?;
         let section = if tables {
             Some(self::report::write(
                 &first.file.name,

@@ -27,12 +27,12 @@ pub(crate) fn views(runs: &[OptimRun], problems: &BTreeMap<ProblemKey, ControlNe
             ordered(runs.iter().filter(|r| r.cell.grid == grid).map(|r| r.cell.dataset.clone()))
         {
             let k_far = far[&(grid, d.clone())];
-            // `picture_points` gave this run, and each MIN run at the largest net, its control
-            // points: the furthest run first, then one view per (parameterisation, optimiser).
+            // The furthest run first, then one view per (parameterisation, optimiser): its MIN
+            // run at the largest net (every record keeps its best control points).
             let mut shown: Vec<(usize, bool)> = vec![(k_far, true)];
             let mut min: BTreeMap<(Parameterisation, String), usize> = BTreeMap::new();
             for (k, r) in runs.iter().enumerate() {
-                if r.cell.grid != grid || r.cell.dataset != d || r.best_x.is_empty() || k == k_far {
+                if r.cell.grid != grid || r.cell.dataset != d || k == k_far {
                     continue;
                 }
                 let e = min.entry((r.cell.param, r.competitor.clone())).or_insert(k);

@@ -210,7 +210,7 @@ pub(crate) fn cells(spec: &Spec, o: &OptimSpec) -> Vec<OptimCell> {
                             param,
                             optimiser: *opt,
                             repeat,
-                            variant: spec.variant.key(),
+                            variant: spec.variant.label_reaching(|k| reaches(k, *opt)),
                         });
                     }
                 }
@@ -218,6 +218,14 @@ pub(crate) fn cells(spec: &Spec, o: &OptimSpec) -> Vec<OptimCell> {
         }
     }
     cells
+}
+
+/// Whether the swept key `key` reaches the cells of optimiser `opt`: its own table, or the budget
+/// and start every optimiser shares (`repeats` only says how many cells there are).
+fn reaches(key: &str, opt: crate::optim::Name) -> bool {
+    let own = format!("optimise.{opt}.");
+    key.starts_with(&own)
+        || ["optimise.generations", "optimise.population", "optimise.init_range"].contains(&key)
 }
 
 /// One Chapter 6 cell: one optimiser run from approach B's control net.
@@ -229,28 +237,18 @@ pub(crate) struct OptimCell {
     pub(crate) param: crate::spline::Parameterisation,
     pub(crate) optimiser: crate::optim::Name,
     pub(crate) repeat: usize,
-    /// The spec variant's changes ([`Variant::key`](crate::experiment::spec::Variant::key);
-    /// empty for a plain run).
+    /// The swept settings of a `--sweep` that reach this cell (`optimise.de.f=0.5`; empty for a
+    /// plain run and for a cell every variant shares): what its row's `variant` names.
     pub(crate) variant: String,
 }
 
-impl crate::experiment::runner::Cell for OptimCell {
-    fn key(&self) -> String {
-        OptimCell::key(self)
-    }
-}
-
 impl OptimCell {
-    /// `optim/<data>/<grid>/<net>/<param>/<optimiser>/r<repeat>`; a variant's cells begin
-    /// `optim[<changes>]/`, so their seeds differ from the plain run's and from each other's.
+    /// The cell's place, `optim/<data>/<grid>/<net>/<param>/<optimiser>/r<repeat>`: it names
+    /// the cell's random stream, so every variant of one place (a sweep's, a reading set's)
+    /// draws the same numbers; the log knows the cell by its identity (`Job`).
     pub(crate) fn key(&self) -> String {
-        let head = if self.variant.is_empty() {
-            "optim".to_string()
-        } else {
-            format!("optim[{}]", self.variant)
-        };
         format!(
-            "{head}/{}/{}/{}/{}/{}/r{}",
+            "optim/{}/{}/{}/{}/{}/r{}",
             self.dataset,
             self.grid,
             self.cn,

@@ -160,6 +160,16 @@ where
         path: path.to_path_buf(),
         source: DrawError::Backend(format!("cannot encode the PNG: {e}")),
     })?;
+    match crate::io::outdir::fill(path, &bytes) {
+        Ok(crate::io::outdir::Fill::Same) => return Ok(()),
+        Ok(crate::io::outdir::Fill::Write) => {}
+        Err(e) => {
+            return Err(PlotError::Draw {
+                path: path.to_path_buf(),
+                source: DrawError::Backend(format!("{e:#}")),
+            })
+        }
+    }
     let written = std::fs::File::options()
         .write(true)
         .create_new(true)

@@ -1,0 +1,149 @@
+//! `somnurbs export`: the control net an optimiser found in a finished Chapter 6 folder (or the
+//! start, approach B's net), from the cell's record, as control_nets.csv, IGES and OBJ in the data's
+//! own frame. The problem is rebuilt from the maps the run saved in the folder (`maps/`), and
+//! the record's best fitness (Eq. 6.2) must come out again from the exported net, bit for bit.
+
+use super::{OptimRecord, OptimSpec, ProblemKey};
+use crate::experiment::{log, RunContext};
+use crate::families::fit::command::{export_frame, write_surface_files, MAX_SAMPLES, MIN_SAMPLES};
+use crate::families::Loaded;
+use crate::io::{csv_records, write_atomic};
+use crate::optim::Problem;
+use anyhow::{Context, Result};
+
+/// The record of the cell `place` (and, in a sweep, of `variant`) in the folder's log.
+fn find_record(
+    dir: &std::path::Path,
+    master_seed: u64,
+    place: &str,
+    variant: Option<&str>,
+) -> Result<(String, OptimRecord)> {
+    let records = log::read_records::<serde_json::Value>(dir, master_seed)?;
+    let mut found = Vec::new();
+    for (key, rec) in records {
+        if crate::experiment::seeds::place_of(&key) != place && key != place {
+            continue;
+        }
+        let rec: OptimRecord = serde_json::from_value(rec)
+            .with_context(|| format!("cell {key}: its record does not fit this version's"))?;
+        let v = rec.row.variant.clone().unwrap_or_default();
+        if variant.is_none_or(|want| want == v) {
+            found.push((key, rec));
+        }
+    }
+    match found.len() {
+        0 => anyhow::bail!(
+            "{}: no optimisation cell `{place}`{} in its cell log (runs.csv's `cell` column names them)",
+            dir.display(),
+            variant.map(|v| format!(" of variant `{v}`")).unwrap_or_default()
+        ),
+        1 => Ok(found.remove(0)),
+        _ => anyhow::bail!(
+            "{}: cell `{place}` has {} variants ({}); name one with --variant",
+            dir.display(),
+            found.len(),
+            found.iter().map(|(_, r)| r.row.variant.clone().unwrap_or_default()).collect::<Vec<_>>().join(", ")
+        ),
+    }
+}
+
+/// What `somnurbs export` is asked for (its flags, as the command line gives them).
+pub(crate) struct Request {
+    pub(crate) results: std::path::PathBuf,
+    pub(crate) cell: String,
+    pub(crate) variant: Option<String>,
+    pub(crate) start: bool,
+    pub(crate) out: std::path::PathBuf,
+    pub(crate) frame: String,
+    pub(crate) units: String,
+    pub(crate) samples: usize,
+}
+
+/// `somnurbs export RESULTS --cell KEY --out DIR`.
+pub(crate) fn export(args: &Request, data_dir: std::path::PathBuf) -> Result<()> {
+    if !(MIN_SAMPLES..=MAX_SAMPLES).contains(&args.samples) {
+        anyhow::bail!(
+            "--samples: must be in [{MIN_SAMPLES}, {MAX_SAMPLES}] (evaluations per direction of the OBJ mesh), got {}",
+            args.samples
+        );
+    }
+    let dir = &args.results;
+    crate::io::outdir::require_not_being_written(dir)?;
+    let fp = log::Fingerprint::read(dir)?.with_context(|| {
+        format!("{}: no {}; name a folder `somnurbs run` wrote", dir.display(), log::FINGERPRINT_FILE)
+    })?;
+    let profile = (fp.profile != "default").then_some(fp.profile.as_str());
+    let mut variants: Vec<Loaded> = fp
+        .overrides()
+        .variants(&fp.spec_path, &fp.spec_text, profile)
+        .with_context(|| format!("{}: the folder's spec", dir.display()))?;
+    let first = variants.first_mut().context("no spec")?;
+    let maps = dir.join("maps");
+    first.family().use_maps(&mut first.section, &maps.to_string_lossy());
+    let spec = &first.spec;
+    let o: &OptimSpec = first.section_as().with_context(|| {
+        format!("{}: not a Chapter 6 folder (its spec has no [optimise] section)", dir.display())
+    })?;
+    let (key, rec) = find_record(dir, spec.file.master_seed, &args.cell, args.variant.as_deref())?;
+    let out = &args.out;
+    crate::io::outdir::require_folder_outside_results(out, "--out")?;
+    let ctx = RunContext {
+        compute: false,
+        keep_maps: false,
+        ..RunContext::new(out.clone(), 1, data_dir)
+    };
+    let problems = super::problems(spec, o, &ctx)?;
+    let param = rec.row.parameterisation.parse().map_err(anyhow::Error::msg)?;
+    let cn = crate::experiment::spec::GridSize { nx: rec.row.cn_x, ny: rec.row.cn_y };
+    let problem = problems
+        .get(&ProblemKey::new(&rec.row.dataset, cn, param))
+        .with_context(|| format!("cell {key}: its problem is not among the spec's"))?;
+    let best_x: Vec<f64> = rec.best_x.points.iter().flatten().copied().collect();
+    let (x, what, recorded) = if args.start {
+        (problem.initial_point().to_vec(), "B (the start)", rec.row.b)
+    } else {
+        (best_x, "the optimiser's best", rec.row.best)
+    };
+    let error = problem.fitness(&x);
+    if error.to_bits() != recorded.to_bits() {
+        anyhow::bail!(
+            "cell {key}: the exported net's surface error is {error:?}, the record's {recorded:?} (the folder and this build disagree)"
+        );
+    }
+    let frame = maps.join(crate::families::maps::map_file_name(&rec.row.dataset, o.grid));
+    let placed = export_frame(&frame, crate::io::map_file::read_frame(&frame)?, &args.frame, &args.units)?;
+    let [bottom, top] = problem.parts().surfaces(&x);
+    let (bottom, top) = (placed.place(&bottom), placed.place(&top));
+    let generated = crate::spline::export::generation_time().map_err(anyhow::Error::msg)?;
+    let date = crate::spline::export::iges_date(generated)
+        .map_err(anyhow::Error::msg)
+        .context("SOURCE_DATE_EPOCH")?;
+    let _lock = crate::io::outdir::lock(out, "export")?;
+    crate::io::outdir::require_empty(out)?;
+    if let Some(line) = &placed.warn {
+        eprintln!("{line}");
+    }
+    write_surface_files(out, &bottom, &top, &placed, args.samples, &date)?;
+    let dense = problem.parts().dense_geometry(&x);
+    let header: Vec<String> =
+        ["results", "cell", "variant", "net", "surface_error", "excursion", "max_control", "frame"]
+            .map(String::from)
+            .to_vec();
+    let row = vec![
+        dir.display().to_string(),
+        key.clone(),
+        rec.row.variant.clone().unwrap_or_default(),
+        if args.start { "B".into() } else { rec.row.optimiser.clone() },
+        format!("{error:?}"),
+        format!("{:?}", dense.excursion),
+        format!("{:?}", dense.max_control),
+        placed.label.to_string(),
+    ];
+    write_atomic(&out.join("export.csv"), csv_records(&header, &[row])?.as_bytes())?;
+    println!(
+        "{what} of {key}: surface error {error:.9} (as recorded), excursion {:.3e}; wrote control_nets.csv, surfaces.igs, surfaces.obj, export.csv in {}",
+        dense.excursion,
+        out.display()
+    );
+    Ok(())
+}
