@@ -267,7 +267,8 @@ pub(crate) fn run_variants<F: Families>(
     match claim(&ctx.out, &fp, ctx.resume)? {
         Claimed::Finished => {
             eprintln!(
-                "somnurbs: {} already holds this run, finished; nothing to do",
+                "somnurbs: {} already holds this run, finished; nothing to do (`somnurbs report {}` makes a lost table or picture again from its records)",
+                ctx.out.display(),
                 ctx.out.display()
             );
             Ok(ctx.out.clone())

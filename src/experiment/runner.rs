@@ -229,7 +229,7 @@ where
         .copied()
         .filter(|c| missing.contains(&c.key()) && !reused.contains_key(&c.key()))
         .collect();
-    if ctx.resume && todo.len() < slice.len() {
+    if ctx.resume && ctx.compute && todo.len() < slice.len() {
         eprintln!(
             "somnurbs: resuming {}: {} of {} cells already done",
             ctx.out.display(),

@@ -27,6 +27,14 @@ pub(crate) struct Export {
 }
 
 impl Export {
+    /// `p` in the exports' coordinates.
+    pub(crate) fn place_point(&self, p: [f64; 3]) -> [f64; 3] {
+        match self.affine {
+            Some((offset, scale)) => std::array::from_fn(|a| offset[a] + scale[a] * p[a]),
+            None => p,
+        }
+    }
+
     /// `s` in the exports' coordinates.
     pub(crate) fn place(&self, s: &BSplineSurface) -> BSplineSurface {
         match self.affine {

@@ -59,6 +59,39 @@ pub(crate) struct Request {
     pub(crate) samples: usize,
 }
 
+/// parameters.csv's rows: each data point the surface error (Eq. 6.2) counts (the bottom view's
+/// all, the top view's interior), with its data parameters (u, v) and its coordinates in the
+/// exports' frame: a reader evaluating the exported surfaces there gets the error again.
+fn parameter_rows(
+    parts: &crate::spline::ControlNetParts,
+    place: impl Fn(crate::geom::Point3) -> crate::geom::Point3,
+) -> Vec<Vec<String>> {
+    let (nx, ny) = (parts.nx, parts.ny);
+    let mut rows = Vec::new();
+    for (view, data) in [("bottom", &parts.data_bottom), ("top", &parts.data_top)] {
+        for i in 0..nx {
+            for j in 0..ny {
+                let border = i == 0 || j == 0 || i + 1 == nx || j + 1 == ny;
+                if view == "top" && border {
+                    continue;
+                }
+                let p = place(data[i * ny + j]);
+                rows.push(vec![
+                    view.to_string(),
+                    i.to_string(),
+                    j.to_string(),
+                    format!("{:?}", parts.params_u[i]),
+                    format!("{:?}", parts.params_v[j]),
+                    format!("{:?}", p[0]),
+                    format!("{:?}", p[1]),
+                    format!("{:?}", p[2]),
+                ]);
+            }
+        }
+    }
+    rows
+}
+
 /// `somnurbs export RESULTS --cell KEY --out DIR`.
 pub(crate) fn export(args: &Request, data_dir: std::path::PathBuf) -> Result<()> {
     if !(MIN_SAMPLES..=MAX_SAMPLES).contains(&args.samples) {
@@ -140,6 +173,9 @@ pub(crate) fn export(args: &Request, data_dir: std::path::PathBuf) -> Result<()>
         placed.label.to_string(),
     ];
     write_atomic(&out.join("export.csv"), csv_records(&header, &[row])?.as_bytes())?;
+    let params = parameter_rows(problem.parts(), |p| placed.place_point(p));
+    let header = ["view", "i", "j", "u", "v", "x", "y", "z"].map(String::from).to_vec();
+    write_atomic(&out.join("parameters.csv"), csv_records(&header, &params)?.as_bytes())?;
     println!(
         "{what} of {key}: surface error {error:.9} (as recorded), excursion {:.3e}; wrote control_nets.csv, surfaces.igs, surfaces.obj, export.csv in {}",
         dense.excursion,
