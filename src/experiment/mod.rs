@@ -9,6 +9,7 @@ pub(crate) mod limits;
 pub(crate) mod log;
 pub(crate) mod overrides;
 pub(crate) mod packed;
+pub(crate) mod readings;
 pub(crate) mod renamed;
 pub(crate) mod reproduce;
 pub(crate) mod runner;

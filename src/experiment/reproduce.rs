@@ -7,6 +7,7 @@
 //! [`Family::combine`]: super::family::Family::combine
 
 use super::family::{Combined, Families, PlanView, ReadingRun};
+use super::readings::{self as registry, AS_WRITTEN};
 use super::spec::{Loaded, Override, Spec};
 use super::{run_spec, Claimed, RunContext};
 use crate::io::outdir::PLAN_FILE;
@@ -478,6 +479,7 @@ pub(crate) fn reproduce<F: Families>(
         }
     }
     let combined = combine(&ctx.out, &plan, &specs)?;
+    let as_written = as_written_claims(&ctx.out, &reading_specs)?;
     let mut report = combined_report(
         &ctx.out,
         &plan,
@@ -485,7 +487,7 @@ pub(crate) fn reproduce<F: Families>(
         &rerun,
         &specs.iter().map(|s| &s.spec).collect::<Vec<_>>(),
         &done,
-        &combined,
+        (&combined, as_written.as_ref()),
         profile.unwrap_or("full"),
         started.elapsed().as_secs_f64(),
     )?;
@@ -641,6 +643,17 @@ fn combine<F: Families>(out: &Path, plan: &Plan, specs: &[Loaded<F>]) -> Result<
             root: out.join(READINGS_DIR).join(&r.name),
         })
         .collect();
+    combine_in(out, &plan.reading, &readings, specs)
+}
+
+/// [`combine`] over the specs that ran into `out` under the reading `reading`, with the sets
+/// `readings` beside them.
+fn combine_in<F: Families>(
+    out: &Path,
+    reading: &str,
+    readings: &[ReadingRun],
+    specs: &[Loaded<F>],
+) -> Result<Vec<Combined>> {
     F::all()
         .iter()
         .map(|f| {
@@ -651,8 +664,8 @@ fn combine<F: Families>(out: &Path, plan: &Plan, specs: &[Loaded<F>]) -> Result<
                     .filter(|s| s.family().section() == f.section())
                     .map(|s| (&s.spec, &s.section))
                     .collect(),
-                reading: &plan.reading,
-                readings: readings.clone(),
+                reading,
+                readings: readings.to_vec(),
             };
             if view.specs.is_empty() {
                 Ok(Combined::default())
@@ -661,6 +674,103 @@ fn combine<F: Families>(out: &Path, plan: &Plan, specs: &[Loaded<F>]) -> Result<
             }
         })
         .collect()
+}
+
+/// The specs the set [`AS_WRITTEN`] ran and the claims it found.
+type AsWrittenRun = (Vec<String>, Vec<Claim>);
+
+/// The claims under the as-written readings: those of the specs the set [`AS_WRITTEN`] ran (read
+/// back from their `claims.csv`) and those over several of them (each family's combine over its
+/// folder), with the names of the specs it ran; `None` for a plan without that set.
+fn as_written_claims<F: Families>(
+    out: &Path,
+    reading_specs: &[(&ReadingSet, Vec<Loaded<F>>)],
+) -> Result<Option<AsWrittenRun>> {
+    let Some((set, specs)) = reading_specs.iter().find(|(r, _)| r.name == AS_WRITTEN) else {
+        return Ok(None);
+    };
+    let root = out.join(READINGS_DIR).join(&set.name);
+    let mut found = Vec::new();
+    for s in &set.specs {
+        let path = root.join(s).join("claims.csv");
+        if path.exists() {
+            found.extend(claims::read(&path)?);
+        }
+    }
+    for part in combine_in(&root, &set.name, &[], specs)? {
+        found.extend(part.claims);
+    }
+    Ok(Some((set.specs.clone(), found)))
+}
+
+/// Each of the plan's claims with its counterpart under the as-written readings: the same claim
+/// (spec, grid, statement) of the set [`AS_WRITTEN`] where it ran all of the claim's specs, the
+/// plan's own where it ran none (no calibrated reading touches them), `None` otherwise or without
+/// the set.
+fn beside_as_written(
+    all: Vec<Claim>,
+    as_written: Option<&AsWrittenRun>,
+) -> Vec<(Claim, Option<Claim>)> {
+    all.into_iter()
+        .map(|c| {
+            let Some((specs, found)) = as_written else { return (c, None) };
+            let parts: Vec<&str> = c.spec.split('+').collect();
+            let ran = parts.iter().filter(|p| specs.iter().any(|s| s == *p)).count();
+            let w = if ran == 0 {
+                Some(c.clone())
+            } else if ran == parts.len() {
+                found
+                    .iter()
+                    .find(|w| w.spec == c.spec && w.grid == c.grid && w.statement == c.statement)
+                    .cloned()
+            } else {
+                None
+            };
+            (c, w)
+        })
+        .collect()
+}
+
+/// REPORT.md's paragraph on the as-written verdicts: how many differ from the plan's, and the
+/// claims whose verdict reproduces the thesis only under calibration.
+fn as_written_summary(
+    pairs: &[(Claim, Option<Claim>)],
+    has_set: bool,
+    calibrated: usize,
+) -> String {
+    if calibrated == 0 {
+        return "No reading of this plan's specs is calibrated (docs/readings.md, the readings table's status): every verdict here is the as-written one.\n".into();
+    }
+    if !has_set {
+        return format!("{calibrated} of this plan's readings are calibrated (docs/readings.md), but the plan has no `{AS_WRITTEN}` set, so the as-written verdicts were not run (`--plan thesis` runs them).\n");
+    }
+    let compared: Vec<(&Claim, &Claim)> =
+        pairs.iter().filter_map(|(c, w)| w.as_ref().map(|w| (c, w))).collect();
+    let differ = compared.iter().filter(|(c, w)| c.verdict() != w.verdict()).count();
+    let only: Vec<&(&Claim, &Claim)> =
+        compared.iter().filter(|(c, w)| claims::calibration_only(c, w)).collect();
+    let mut s = format!("**Under calibration only.** {calibrated} of this plan's readings are calibrated (chosen by their fit to the thesis' numbers; docs/readings.md, the readings table's status); the set `{AS_WRITTEN}` ran their specs at the as-written values (column *as written*; the other specs' readings are as written or inferred, so their verdicts are the plan's, on the plan's maps). {differ} of {} verdicts differ under the as-written readings; {} reproduce the thesis only under calibration (the plan's verdict agrees with the thesis' count, or holds where the thesis has none, and the as-written one does not)", compared.len(), only.len());
+    if only.is_empty() {
+        s.push_str(".\n");
+        return s;
+    }
+    s.push_str(":\n\n");
+    for (c, w) in only {
+        let grid = if c.grid.is_empty() { "all" } else { c.grid.as_str() };
+        let _ = writeln!(
+            s,
+            "- {} ({grid}): {}: {} {}/{} under the plan's readings, {} {}/{} as written",
+            c.spec,
+            c.statement,
+            c.verdict(),
+            c.ours.0,
+            c.ours.1,
+            w.verdict(),
+            w.ours.0,
+            w.ours.1
+        );
+    }
+    s
 }
 
 /// Where the reading sets' runs go, inside the plan's output folder.
@@ -736,8 +846,10 @@ fn render_readings(out: &Path, plan: &Plan, rows: &[ReadingClaim]) -> Result<Str
     write_atomic(&out.join("readings.csv"), csv_records(&header, &csv_rows)?.as_bytes())?;
     let mut readings = vec![plan.reading.clone()];
     readings.extend(plan.readings.iter().map(|r| r.name.clone()));
-    let mut s = String::from("\n---\n\n# Readings matrix\n\nThe thesis leaves some steps ambiguous; each is a named spec option (docs/readings.md). The plan's specs ran as written");
+    let mut s = String::from("\n---\n\n# Readings matrix\n\nThe thesis leaves some steps ambiguous; each is a named spec option (docs/readings.md). The plan's specs ran under the plan's readings");
     let _ = write!(s, " (reading `{}`) and again under each reading set below, from the same maps and seeds; every claim is shown under every reading, so a reader sees which conclusions rest on which reading (`readings.csv`).\n\n", plan.reading);
+    s.push_str(&registry::markdown(&plan.specs));
+    s.push_str("\n## The reading sets\n\n");
     for r in &plan.readings {
         let keys: Vec<String> = r.set.iter().map(|(k, v)| format!("`{k} = {v}`")).collect();
         let _ = writeln!(
@@ -895,9 +1007,115 @@ fn readings_score<F: Families>(
         row.extend(names.iter().map(|r| cell(Some(&total(r)))));
         md_rows.push(row);
     }
+    let price = if plan.readings.iter().any(|r| r.name == AS_WRITTEN) {
+        price_of_reading_literally(out, &plan.reading, &specs, titles, &find)?
+    } else {
+        String::new()
+    };
     let mut s = format!("\n---\n\n# Readings score\n\nFor each reading and spec, and in total per chapter or seed (over the specs every reading that ran one of them ran): the share of the published tables' value cells (Appendices B-F, K, L and the seeds' tables; CPU seconds left out) whose ratio ours/published lies in [{}, {}], and how many of the claims with the source's own count agree with it (`readings_score.csv`). The reading that reproduces the published numbers best has the highest shares.\n\n", BAND.0, BAND.1);
     s.push_str(&crate::report::markdown::table(&h, &md_rows));
+    s.push_str(&price);
     Ok(s)
+}
+
+/// The price of reading literally: per chapter, the plan's score and the set [`AS_WRITTEN`]'s over
+/// the chapter's specs that set ran (`readings_price.csv` and a REPORT.md paragraph; empty
+/// without the set).
+fn price_of_reading_literally<'s>(
+    out: &Path,
+    reading: &str,
+    specs: &[&String],
+    titles: &BTreeMap<String, &'static str>,
+    find: &dyn Fn(&str, &str) -> Option<&'s crate::report::score::Score>,
+) -> Result<String> {
+    use crate::report::score::Score;
+    let share = |sc: &Score| {
+        if sc.cells > 0 {
+            format!("{:.4}", sc.within as f64 / sc.cells as f64)
+        } else {
+            String::new()
+        }
+    };
+    let pct = |sc: &Score| {
+        if sc.cells > 0 {
+            format!("{:.1}%", 100.0 * sc.within as f64 / sc.cells as f64)
+        } else {
+            "-".into()
+        }
+    };
+    let chapters: Vec<&str> =
+        crate::report::ordered(specs.iter().filter_map(|s| titles.get(s.as_str()).copied()));
+    let mut rows = Vec::new();
+    let mut lines = String::new();
+    for chapter in chapters {
+        let own: Vec<&&String> = specs
+            .iter()
+            .filter(|s| titles.get(s.as_str()) == Some(&chapter))
+            .filter(|s| find(AS_WRITTEN, s).is_some() && find(reading, s).is_some())
+            .collect();
+        if own.is_empty() {
+            continue;
+        }
+        let total =
+            |r: &str| own.iter().filter_map(|s| find(r, s)).fold(Score::default(), |a, b| a + *b);
+        let (p, w) = (total(reading), total(AS_WRITTEN));
+        let names: Vec<&str> = own.iter().map(|s| s.as_str()).collect();
+        let points = if p.cells > 0 && w.cells > 0 {
+            let d = 100.0 * (w.within as f64 / w.cells as f64 - p.within as f64 / p.cells as f64);
+            format!(" ({d:+.1} points)")
+        } else {
+            String::new()
+        };
+        let _ = writeln!(
+            lines,
+            "- {chapter} ({}): {} of {} cells and {}/{} claims agree under the plan's readings; {} of {} and {}/{} as written{points}",
+            names.join(", "),
+            pct(&p),
+            p.cells,
+            p.agree,
+            p.claims,
+            pct(&w),
+            w.cells,
+            w.agree,
+            w.claims
+        );
+        rows.push(vec![
+            chapter.to_string(),
+            names.join("+"),
+            p.cells.to_string(),
+            p.within.to_string(),
+            share(&p),
+            w.cells.to_string(),
+            w.within.to_string(),
+            share(&w),
+            p.claims.to_string(),
+            p.agree.to_string(),
+            w.claims.to_string(),
+            w.agree.to_string(),
+        ]);
+    }
+    if rows.is_empty() {
+        return Ok(String::new());
+    }
+    let header: Vec<String> = [
+        "chapter",
+        "specs",
+        "published_cells_plan",
+        "within_band_plan",
+        "share_within_plan",
+        "published_cells_as_written",
+        "within_band_as_written",
+        "share_within_as_written",
+        "claims_with_source_plan",
+        "claims_agree_plan",
+        "claims_with_source_as_written",
+        "claims_agree_as_written",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    write_atomic(&out.join("readings_price.csv"), csv_records(&header, &rows)?.as_bytes())?;
+    Ok(format!("\n**The price of reading literally** (`readings_price.csv`): per chapter, the score of the plan's readings (`{reading}`) and of the set `{AS_WRITTEN}` (every calibrated reading at its as-written value) over the chapter's specs that set ran:\n\n{lines}"))
 }
 
 /// The readings score's total per chapter or seed (rows of the Markdown table): for each chapter
@@ -952,7 +1170,7 @@ fn combined_report(
     rerun: &str,
     specs: &[&Spec],
     done: &[(String, f64)],
-    combined: &[Combined],
+    (combined, as_written): (&[Combined], Option<&AsWrittenRun>),
     profile: &str,
     wall: f64,
 ) -> Result<String> {
@@ -999,12 +1217,25 @@ fn combined_report(
         }
     }
     all.extend(plan_claims);
-    let table = claims::write(out, plan_name, &all, true)?;
+    all.retain(|c| c.ours.1 > 0);
+    for c in all.iter_mut().filter(|c| c.spec.is_empty()) {
+        c.spec = plan_name.to_string();
+    }
     let holding = all.iter().filter(|c| c.holds()).count();
     let compared = all.iter().filter(|c| !c.agreement().is_empty()).count();
     let agree = all.iter().filter(|c| c.agreement() == "agrees").count();
-    if !all.is_empty() {
-        let _ = writeln!(s, "\n## Claims\n\nEach claim of the thesis (or, for the other seeds, of the paper) is counted on this reproduction (`here`), one row per spec, grid and claim, and, where the published tables hold the same cells, on the source's own figures. {holding} of {} hold here; {agree} of the {compared} with the source's own count agree with it. Also in `claims.csv`.\n", all.len());
+    let total = all.len();
+    let calibrated = registry::of_specs(&plan.specs)
+        .filter(|r| r.status == registry::Status::Calibrated)
+        .count();
+    // Without a calibrated reading the plan's readings are the as-written ones.
+    let none: AsWrittenRun = (Vec::new(), Vec::new());
+    let pairs = beside_as_written(all, if calibrated == 0 { Some(&none) } else { as_written });
+    let table = claims::write_plan(out, &pairs)?;
+    if total > 0 {
+        let _ = writeln!(s, "\n## Claims\n\nEach claim of the thesis (or, for the other seeds, of the paper) is counted on this reproduction (`here`), one row per spec, grid and claim, and, where the published tables hold the same cells, on the source's own figures. {holding} of {total} hold here; {agree} of the {compared} with the source's own count agree with it. Also in `claims.csv`.\n");
+        s.push_str(&as_written_summary(&pairs, as_written.is_some(), calibrated));
+        s.push('\n');
         s.push_str(&table);
     }
     s.push_str(&sections);
@@ -1182,6 +1413,43 @@ mod tests {
         assert!(
             e.contains("p.toml: readings.r.set: `optim.de.f` and `optimise.de.f` are one key"),
             "{e}"
+        );
+    }
+
+    /// A plan claim's as-written counterpart: the set's own where it ran all the claim's specs,
+    /// the plan's where it ran none, none where it ran only some; the summary lists the verdicts
+    /// that reproduce the thesis only under calibration.
+    #[test]
+    fn claims_meet_their_as_written_verdicts_and_the_summary_names_calibration_only() {
+        let claim = |spec: &str, ours| Claim {
+            spec: spec.into(),
+            ..Claim::most("4", "X", ours).thesis(Some((15, 15)))
+        };
+        let all = vec![
+            claim("ch4_models", (15, 15)),
+            claim("ch5_same", (15, 15)),
+            claim("ch6_same+ch6_diff", (15, 15)),
+            claim("ch6_same+ch6_exact", (15, 15)),
+        ];
+        let set = (
+            vec!["ch4_models".to_string(), "ch6_same".into(), "ch6_diff".into()],
+            vec![claim("ch4_models", (2, 15)), claim("ch6_same+ch6_diff", (14, 15))],
+        );
+        let pairs = beside_as_written(all.clone(), Some(&set));
+        let got: Vec<Option<(usize, usize)>> =
+            pairs.iter().map(|(_, w)| w.as_ref().map(|w| w.ours)).collect();
+        assert_eq!(got, [Some((2, 15)), Some((15, 15)), Some((14, 15)), None]);
+        let md = as_written_summary(&pairs, true, 3);
+        assert!(md.contains("3 of this plan's readings are calibrated"), "{md}");
+        assert!(
+            md.contains("1 of 3 verdicts differ under the as-written readings; 1 reproduce"),
+            "{md}"
+        );
+        assert!(md.contains("- ch4_models (all): X: holds 15/15 under the plan's readings, does not hold 2/15 as written"), "{md}");
+        assert!(beside_as_written(all, None).iter().all(|(_, w)| w.is_none()));
+        assert!(as_written_summary(&pairs, false, 2).contains("has no `as_written` set"));
+        assert!(
+            as_written_summary(&[], false, 0).contains("every verdict here is the as-written one")
         );
     }
 

@@ -39,7 +39,8 @@ pub struct Pso {
     /// dataset". 0.5 (default) reads "range" as the search box's width (2 x 5e-6 in the thesis'
     /// specs, so |v| <= 5e-6); 0.25 reads it as Table 6.1's "control point coordinate range
     /// [-5e-6, 5e-6]" taken as +-r, r = 5e-6, so |v| <= r / 2 = 2.5e-6 (the reading of
-    /// `ch6_same` and `ch6_diff`; the thesis plan's set `pso_vmax_half_box` runs 0.5).
+    /// `ch6_same` and `ch6_diff`, calibrated; the thesis plan's set `as_written` runs 0.5, the
+    /// as-written value: docs/readings.md).
     pub vmax_fraction: f64,
     /// The range the velocity clamp is a fraction of: `"search_box"` (default: the problem's
     /// search box, B +- 5e-6 in the thesis' specs, so |v| <= 5e-6) or `"data"` (the data set's

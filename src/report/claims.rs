@@ -156,6 +156,22 @@ impl Claim {
             _ => "",
         }
     }
+
+    /// Whether this verdict reproduces the source: its share agrees with the source's own count
+    /// where the source has one, else the claim (which the source states) holds.
+    pub fn reproduces(&self) -> bool {
+        match self.agreement() {
+            "agrees" => true,
+            "differs" => false,
+            _ => self.holds(),
+        }
+    }
+}
+
+/// Whether a verdict reproduces the source only under calibration: the plan's does, the one
+/// under the as-written readings does not (docs/readings.md, "The as-written readings").
+pub(crate) fn calibration_only(plan: &Claim, as_written: &Claim) -> bool {
+    plan.reproduces() && !as_written.reproduces()
 }
 
 /// The columns of `claims.csv`, which every chapter's report writes (and `reproduce` collects):
@@ -227,6 +243,51 @@ pub(crate) fn write(
     Ok(markdown(&claims, with_spec))
 }
 
+/// The columns a plan's `claims.csv` adds to [`CSV_HEADER`]: each claim's count and verdict under
+/// the as-written readings (empty where the plan did not run them) and whether its verdict
+/// reproduces the source only under calibration.
+pub(crate) const AS_WRITTEN_HEADER: [&str; 5] = [
+    "verdict_as_written",
+    "holds_as_written",
+    "checked_as_written",
+    "agreement_as_written",
+    "calibration_only",
+];
+
+/// A plan's `claims.csv` in `out` (each claim beside its count under the as-written readings,
+/// `None` where they did not run) and its markdown table with an "as written" column.
+pub(crate) fn write_plan(
+    out: &std::path::Path,
+    claims: &[(Claim, Option<Claim>)],
+) -> anyhow::Result<String> {
+    let rows: Vec<Vec<String>> = claims
+        .iter()
+        .map(|(c, w)| {
+            let mut row = csv_row(c);
+            row.extend(match w {
+                Some(w) => vec![
+                    w.verdict().into(),
+                    w.ours.0.to_string(),
+                    w.ours.1.to_string(),
+                    w.agreement().into(),
+                    if calibration_only(c, w) { "yes" } else { "no" }.into(),
+                ],
+                None => vec![String::new(); AS_WRITTEN_HEADER.len()],
+            });
+            row
+        })
+        .collect();
+    let header: Vec<String> =
+        CSV_HEADER.iter().chain(&AS_WRITTEN_HEADER).map(|h| h.to_string()).collect();
+    crate::io::write_atomic(
+        &out.join("claims.csv"),
+        crate::io::csv_records(&header, &rows)?.as_bytes(),
+    )?;
+    let plain: Vec<Claim> = claims.iter().map(|(c, _)| c.clone()).collect();
+    let beside: Vec<Option<Claim>> = claims.iter().map(|(_, w)| w.clone()).collect();
+    Ok(table(&plain, Some(&beside), true))
+}
+
 /// Claims read back from a `claims.csv` (for the combined report of `reproduce`).
 pub(crate) fn read(path: &std::path::Path) -> anyhow::Result<Vec<Claim>> {
     let mut rd = csv::Reader::from_path(path).with_context(|| format!("{}", path.display()))?;
@@ -282,13 +343,33 @@ pub(crate) const RULE: &str = "Verdicts (docs/statistics.md, \"Verdicts\"): a cl
 
 /// Markdown table of claims, after the rule (empty without claims).
 pub(crate) fn markdown(claims: &[Claim], with_spec: bool) -> String {
+    table(claims, None, with_spec)
+}
+
+/// The claims' markdown table; with `as_written`, a column of each claim's verdict under the
+/// as-written readings (bold where it differs from the plan's, "-" where they did not run).
+fn table(claims: &[Claim], as_written: Option<&[Option<Claim>]>, with_spec: bool) -> String {
     let mut s = String::new();
     if claims.is_empty() {
         return s;
     }
     let spec_col = if with_spec { "spec | " } else { "" };
-    let _ = writeln!(s, "{RULE}\n\n| {spec_col}chapter | grid | claim | verdict here | here | 95% interval | source's own figures | agreement | note |\n|{}---|---|---|---|---|---|---|---|---|", if with_spec { "---|" } else { "" });
-    for c in claims {
+    let (aw_col, aw_rule) = if as_written.is_some() { ("as written | ", "---|") } else { ("", "") };
+    let _ = writeln!(s, "{RULE}\n\n| {spec_col}chapter | grid | claim | verdict here | {aw_col}here | 95% interval | source's own figures | agreement | note |\n|{}---|---|---|---|{aw_rule}---|---|---|---|---|", if with_spec { "---|" } else { "" });
+    for (k, c) in claims.iter().enumerate() {
+        let aw = match as_written.map(|w| w[k].as_ref()) {
+            None => String::new(),
+            Some(None) => "- | ".into(),
+            Some(Some(w)) => {
+                let text = format!("{} {}/{}", w.verdict(), w.ours.0, w.ours.1);
+                let only = if calibration_only(c, w) { " (calibration only)" } else { "" };
+                if w.verdict() != c.verdict() {
+                    format!("**{text}**{only} | ")
+                } else {
+                    format!("{text}{only} | ")
+                }
+            }
+        };
         let thesis = c.thesis.map(|(a, b)| format!("{a}/{b}")).unwrap_or_else(|| "-".into());
         let rival = c.rival.map(|r| format!(" (best rival {r})")).unwrap_or_default();
         let interval =
@@ -297,7 +378,7 @@ pub(crate) fn markdown(claims: &[Claim], with_spec: bool) -> String {
         let grid = if c.grid.is_empty() { "all" } else { c.grid.as_str() };
         let _ = writeln!(
             s,
-            "| {spec}{} | {grid} | {} | **{}** | {}/{}{rival} | {interval} | {thesis} | {} | {} |",
+            "| {spec}{} | {grid} | {} | **{}** | {aw}{}/{}{rival} | {interval} | {thesis} | {} | {} |",
             c.chapter,
             c.statement,
             c.verdict(),
@@ -313,6 +394,31 @@ pub(crate) fn markdown(claims: &[Claim], with_spec: bool) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_plans_claims_show_the_as_written_verdict_and_what_holds_only_under_calibration() {
+        let dir = tempfile::tempdir().unwrap();
+        let plan = Claim::most("4", "A", (14, 15)).thesis(Some((15, 15)));
+        let literal = Claim::most("4", "A", (1, 15)).thesis(Some((15, 15)));
+        assert!(plan.reproduces() && !literal.reproduces());
+        assert!(calibration_only(&plan, &literal) && !calibration_only(&literal, &plan));
+        let bare = Claim::every("6", "B", (3, 3));
+        assert!(bare.reproduces() && !Claim::every("6", "B", (2, 3)).reproduces());
+        let rows = vec![
+            (Claim { spec: "s".into(), ..plan.clone() }, Some(literal)),
+            (Claim { spec: "s".into(), ..bare.clone() }, Some(bare)),
+            (Claim { spec: "t".into(), ..plan }, None),
+        ];
+        let md = write_plan(dir.path(), &rows).unwrap();
+        assert!(md.contains("| verdict here | as written | here |"), "{md}");
+        assert!(md.contains("| **does not hold 1/15** (calibration only) | 14/15 |"), "{md}");
+        assert!(md.contains("| holds 3/3 | 3/3 |") && md.contains("| - | 14/15 |"), "{md}");
+        let text = std::fs::read_to_string(dir.path().join("claims.csv")).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        assert!(lines[0].ends_with(",note,verdict_as_written,holds_as_written,checked_as_written,agreement_as_written,calibration_only"), "{text}");
+        assert!(lines[1].ends_with(",does not hold,1,15,differs,yes"), "{text}");
+        assert!(lines[3].ends_with(",,,,,"), "{text}");
+    }
 
     #[test]
     fn one_verdict_rule_for_every_kind() {

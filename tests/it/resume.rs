@@ -116,9 +116,18 @@ fn reproduce_quick_writes_one_report_with_claims_and_tables_6_8_6_9() {
         "Table 6.8",
         "Table 6.9",
         "](ch4_models/",
+        "**Under calibration only.** 3 of this plan's readings are calibrated",
+        "| The 3-D SOM's adjacency for TE | `som.som3d_adjacency` | `layer` | **calibrated** |",
+        "**The price of reading literally**",
     ] {
         assert!(report.contains(needle), "REPORT.md lacks {needle:?}");
     }
+    // Every claim of the as-written set's specs has its as-written verdict.
+    let (h, rows) = read_csv(&c.path("thesis/claims.csv"));
+    let (spec, aw) = (0, h.iter().position(|x| x == "verdict_as_written").unwrap());
+    assert!(rows.iter().filter(|r| r[spec].starts_with("ch4_models")).all(|r| !r[aw].is_empty()));
+    let (_, price) = read_csv(&c.path("thesis/readings_price.csv"));
+    assert!(price.iter().any(|r| r[0] == "Chapter 4") && price.iter().any(|r| r[0] == "Chapter 6"));
     let (h, rows) = read_csv(&c.path("thesis/table_6_8.csv"));
     assert_eq!(h, vec!["table", "ga", "de", "pso"]);
     assert_eq!(rows.last().unwrap()[0], "overall");
