@@ -458,26 +458,7 @@ pub(crate) fn reproduce<F: Families>(
         run_spec(spec, &sub)?;
         done.push((name.clone(), t.elapsed().as_secs_f64()));
     }
-    for (reading, rspecs) in &reading_specs {
-        for spec in rspecs {
-            let folder = Path::new(READINGS_DIR).join(&reading.name).join(&spec.spec.file.name);
-            // A set's cells that compute what the plan's did (a Chapter 6 optimiser the set does
-            // not change) are taken from the plan's folder of the spec, not computed again.
-            let mut reuse = vec![ctx.out.join(&spec.spec.file.name)];
-            reuse.extend(ctx.reuse.iter().cloned());
-            let sub =
-                RunContext { out: ctx.out.join(&folder), extras: false, reuse, ..ctx.clone() };
-            eprintln!(
-                "somnurbs: reproduce: {} under the readings `{}` -> {}",
-                spec.spec.file.name,
-                reading.name,
-                sub.out.display()
-            );
-            let t = Instant::now();
-            run_spec(spec, &sub)?;
-            done.push((folder.to_string_lossy().into_owned(), t.elapsed().as_secs_f64()));
-        }
-    }
+    run_reading_sets(&reading_specs, ctx, &mut done)?;
     let combined = combine(&ctx.out, &plan, &specs)?;
     let as_written = as_written_claims(&ctx.out, &reading_specs)?;
     let mut report = combined_report(
@@ -511,6 +492,35 @@ pub(crate) fn reproduce<F: Families>(
         .with_context(|| format!("cannot remove {}", incomplete.display()))?;
     crate::io::outdir::sync_dir(&ctx.out)?;
     Ok(path)
+}
+
+/// Run every reading set's specs into `readings/<set>/<spec>/`, each folder's time added to `done`.
+/// A set's cells that compute what the plan's did (a Chapter 6 optimiser the set does not change)
+/// are taken from the plan's folder of the spec, not computed again.
+fn run_reading_sets<F: Families>(
+    reading_specs: &[(&ReadingSet, Vec<Loaded<F>>)],
+    ctx: &RunContext,
+    done: &mut Vec<(String, f64)>,
+) -> Result<()> {
+    for (reading, rspecs) in reading_specs {
+        for spec in rspecs {
+            let folder = Path::new(READINGS_DIR).join(&reading.name).join(&spec.spec.file.name);
+            let mut reuse = vec![ctx.out.join(&spec.spec.file.name)];
+            reuse.extend(ctx.reuse.iter().cloned());
+            let sub =
+                RunContext { out: ctx.out.join(&folder), extras: false, reuse, ..ctx.clone() };
+            eprintln!(
+                "somnurbs: reproduce: {} under the readings `{}` -> {}",
+                spec.spec.file.name,
+                reading.name,
+                sub.out.display()
+            );
+            let t = Instant::now();
+            run_spec(spec, &sub)?;
+            done.push((folder.to_string_lossy().into_owned(), t.elapsed().as_secs_f64()));
+        }
+    }
+    Ok(())
 }
 
 /// The record of the plan a `reproduce` folder holds ([`PLAN_FILE`]): which plan, in which

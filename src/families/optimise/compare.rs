@@ -16,6 +16,12 @@ use std::path::PathBuf;
 use super::external::Certificate;
 use super::ComparedCell;
 
+/// Whether every optimiser of `opts` ran the cell whose per-optimiser entries are `per`: the one
+/// rule for the cells the tests over cells (Friedman, Nemenyi, Bayesian signed-rank) use.
+fn ran_by_all<V>(per: &BTreeMap<String, V>, opts: &[String]) -> bool {
+    opts.iter().all(|o| per.contains_key(o))
+}
+
 /// The blocks x treatments table of the Friedman test: one row per cell (data, grid, net,
 /// parameterisation) that every optimiser ran, the mean best fitness over repeats of each
 /// optimiser (in order of first appearance).
@@ -36,7 +42,7 @@ pub(crate) fn friedman_table(rows: &[OptimRow]) -> (Vec<String>, Vec<Vec<f64>>) 
     }
     let table = cells
         .values()
-        .filter(|per| opts.iter().all(|o| per.contains_key(o)))
+        .filter(|per| ran_by_all(per, &opts))
         .map(|per| opts.iter().map(|o| per[o].0 / per[o].1 as f64).collect())
         .collect();
     (opts, table)
@@ -487,7 +493,7 @@ pub(crate) fn compare(args: &CompareArgs) -> Result<()> {
     crate::io::outdir::remove_stale(&stale, &dest, "compare")?;
     // Built whole in a sibling folder and swapped in: a reader sees the old tables or the new, and
     // any failed write (a table or a chart) leaves the old folder as it was.
-    let common = cells.values().filter(|per| opts.iter().all(|o| per.contains_key(o))).count();
+    let common = cells.values().filter(|per| ran_by_all(per, &opts)).count();
     let tables = Tables { rows: &rows, opts: &opts, cells: common, cell_rows, wins };
     crate::io::outdir::replace_dir(&dest, |out| {
         write_folder(args, &tables, probs.as_deref(), out)
@@ -508,7 +514,7 @@ fn coverage_note(cells: &Cells, opts: &[String]) -> Option<String> {
     if partial.is_empty() {
         return None;
     }
-    let common = cells.values().filter(|per| opts.iter().all(|o| per.contains_key(o))).count();
+    let common = cells.values().filter(|per| ran_by_all(per, opts)).count();
     Some(format!(
         "not every optimiser ran every cell ({}): the tests over cells (Friedman, the critical-difference diagram, the Bayesian signed-rank test) and the runtime aggregate `all` use the {common} cells every optimiser ran; the per-cell tests and per-problem runtime tables use each pair's or optimiser's own",
         partial.join(", ")
@@ -1241,7 +1247,7 @@ fn bayes_table(rows: &[OptimRow], opts: &[String], args: &CompareArgs) -> Result
     }
     let full: Vec<(f64, Vec<f64>)> = cells
         .values()
-        .filter(|(_, per)| opts.iter().all(|o| per.contains_key(o)))
+        .filter(|(_, per)| ran_by_all(per, opts))
         .map(|(b, per)| (*b, opts.iter().map(|o| per[o].0 / per[o].1 as f64 / b).collect()))
         .collect();
     let mut out = Vec::new();
