@@ -71,11 +71,10 @@ pub trait Family<F>: Sync {
     /// spec has been found to hold this family's section only).
     fn validate(&self, spec: &Spec, s: &F) -> Result<(), SpecError>;
     /// The keys of every cell that goes through the cell log, in cell order (what `--resume`
-    /// and `merge` must find; cell k goes to shard k mod N + 1).
+    /// and `merge` must find, and what `--dry-run` lists; cell k of each list of cells a family
+    /// runs goes to shard k mod N + 1, but a cell every other cell needs, seed 001's map of a
+    /// data set, runs in every shard).
     fn logged_keys(&self, spec: &Spec, s: &F) -> Vec<String>;
-    /// Keys of cells that run (on their own streams) but are not logged: a resumed run or a merge
-    /// runs them again. Listed by `--dry-run` only.
-    fn unlogged_keys(&self, spec: &Spec, s: &F) -> Vec<String>;
     /// Run the variants of a spec (one for a plain run; `--sweep` makes more) into one folder;
     /// with `tables`, write the tables and pictures into `ctx.out` and return the REPORT.md
     /// section. A family whose tables cannot tell variants apart runs one variant only.
@@ -204,10 +203,6 @@ pub trait Experiment: Sync + 'static {
     type Section: Section;
     /// See [`Family::logged_keys`].
     fn logged_keys(&self, spec: &Spec, s: &Self::Section) -> Vec<String>;
-    /// See [`Family::unlogged_keys`].
-    fn unlogged_keys(&self, _spec: &Spec, _s: &Self::Section) -> Vec<String> {
-        Vec::new()
-    }
     /// Run the spec's cells of `ctx`'s slice; with `tables`, write the tables and pictures into
     /// `ctx.out` and return the REPORT.md section.
     fn run(
@@ -277,9 +272,6 @@ impl<F: Holds<E::Section>, E: Experiment> Family<F> for E {
     }
     fn logged_keys(&self, spec: &Spec, s: &F) -> Vec<String> {
         s.get().map(|s| Experiment::logged_keys(self, spec, s)).unwrap_or_default()
-    }
-    fn unlogged_keys(&self, spec: &Spec, s: &F) -> Vec<String> {
-        s.get().map(|s| Experiment::unlogged_keys(self, spec, s)).unwrap_or_default()
     }
     fn run_variants(
         &self,

@@ -138,9 +138,8 @@ pub(crate) fn preflight<F: Families>(spec: &Loaded<F>, ctx: &RunContext) -> Resu
 
 /// One line per cell for `--dry-run`: key and seed.
 pub fn dry_run_listing<F: Families>(spec: &Loaded<F>) -> Vec<(String, String)> {
-    let mut keys = logged_cell_keys(spec);
-    keys.extend(spec.family().unlogged_keys(&spec.spec, &spec.section));
-    keys.into_iter()
+    logged_cell_keys(spec)
+        .into_iter()
         .map(|k| {
             let s = seeds::seed_hex(spec.spec.file.master_seed, &k);
             (k, s)

@@ -123,6 +123,43 @@ impl<'de> Deserialize<'de> for PackedPoints {
     }
 }
 
+/// A flat float array for cell records, written as [`PackedPoints`] writes its values
+/// (`"f64le:<base64>"` of each f64's exact bytes, any length; a non-finite value makes it a plain
+/// number array, found by the finiteness check): for values that are not 3-D points (2-D
+/// outlines, conic control points and weights).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub(crate) struct PackedFloats(pub(crate) Vec<f64>);
+
+impl Serialize for PackedFloats {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        if self.0.iter().any(|v| !v.is_finite()) {
+            return self.0.serialize(s);
+        }
+        let bytes: Vec<u8> = self.0.iter().flat_map(|v| v.to_le_bytes()).collect();
+        s.serialize_str(&format!("{TAG}{}", encode(&bytes)))
+    }
+}
+
+impl<'de> Deserialize<'de> for PackedFloats {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use serde::de::Error;
+        let text = String::deserialize(d)?;
+        let body = text
+            .strip_prefix(TAG)
+            .ok_or_else(|| D::Error::custom("packed floats must start with f64le:"))?;
+        let bytes = decode(body).map_err(D::Error::custom)?;
+        if !bytes.len().is_multiple_of(8) {
+            return Err(D::Error::custom(format!("{} bytes are not whole f64s", bytes.len())));
+        }
+        Ok(PackedFloats(
+            bytes
+                .chunks_exact(8)
+                .map(|b| f64::from_le_bytes(b.try_into().unwrap_or([0; 8])))
+                .collect(),
+        ))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -145,6 +182,20 @@ mod tests {
         for bad in ["Zg=", "Z===", "Zg==Zg==", "Zm9*"] {
             assert!(decode(bad).is_err(), "{bad}");
         }
+    }
+
+    #[test]
+    fn floats_round_trip_bit_for_bit() {
+        let v = PackedFloats(vec![0.1, -2.5e-300, 1.0 / 3.0, -0.0, 5e-324]);
+        let json = serde_json::to_string(&v).unwrap();
+        assert!(json.starts_with("\"f64le:"), "{json}");
+        let back: PackedFloats = serde_json::from_str(&json).unwrap();
+        let bits = |p: &PackedFloats| -> Vec<u64> { p.0.iter().map(|v| v.to_bits()).collect() };
+        assert_eq!(bits(&back), bits(&v));
+        assert!(
+            crate::experiment::finite::first_non_finite(&PackedFloats(vec![f64::NAN])).is_some()
+        );
+        assert!(serde_json::from_str::<PackedFloats>("\"f64le:AAAA\"").is_err());
     }
 
     #[test]

@@ -170,14 +170,15 @@ pub fn load(
 }
 
 /// Seed 001's problems: the Growing Grid maps and the open surfaces of its run
-/// (`growing_grid::maps` then `growing_grid::problems`, as `somnurbs run` calls them).
+/// (`growing_grid::grow_maps`, the maps `somnurbs run` logs, without a cell log, then
+/// `growing_grid::problems`, as the run calls it).
 fn open_surfaces(
     spec: &Spec,
     g: &GrowingGridSpec,
     ctx: &RunContext,
     profile: Option<&str>,
 ) -> Result<Suite> {
-    let maps = growing_grid::maps(spec, g, ctx)?;
+    let maps = growing_grid::grow_maps(spec, g, ctx)?;
     let mut problems = Vec::new();
     for (ProblemKey { data: dataset, cn: net, param }, p) in growing_grid::problems(g, &maps)? {
         let grid = GridSize { nx: p.nx, ny: p.ny };

@@ -225,3 +225,31 @@ pub fn snapshot(dir: &Path) -> Vec<(String, Vec<u8>)> {
         .map(|p| (p.strip_prefix(dir).unwrap().display().to_string(), std::fs::read(&p).unwrap()))
         .collect()
 }
+
+/// Run `spec` (a path under the clone, e.g. `experiments/seed001_growing_grid.toml`) under the
+/// quick profile, delete every file of the folder but its cell log, fingerprint and manifest, run
+/// `somnurbs report` on it and check every file came back byte for byte (the cell records hold
+/// everything the tables, pictures, REPORT.md and report.html are made of, CPU times included).
+pub fn report_restores_every_file(spec: &str) {
+    let c = Case::new();
+    let spec = Path::new(env!("CARGO_MANIFEST_DIR")).join(spec);
+    c.ok(&["run", spec.to_str().unwrap(), "--profile", "quick", "--out", "o"]);
+    let before = snapshot(&c.path("o"));
+    let kept = ["cells.jsonl", "cells.jsonl.gz", "fingerprint.toml", "manifest.toml"];
+    let mut deleted = 0;
+    for p in walk(&c.path("o")) {
+        let name = p.file_name().unwrap().to_str().unwrap();
+        if !kept.contains(&name) && name != ".somnurbs.lock" {
+            std::fs::remove_file(&p).unwrap();
+            deleted += 1;
+        }
+    }
+    assert!(deleted > 0, "the run wrote no table to delete");
+    c.ok(&["report", "o"]);
+    let after = snapshot(&c.path("o"));
+    let names = |s: &[(String, Vec<u8>)]| s.iter().map(|(f, _)| f.clone()).collect::<Vec<_>>();
+    assert_eq!(names(&after), names(&before), "report did not make the same files");
+    for ((f, a), (_, b)) in after.iter().zip(&before) {
+        assert!(a == b, "{f} differs after somnurbs report");
+    }
+}

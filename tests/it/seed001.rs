@@ -117,3 +117,10 @@ fn bad_key_is_named_in_one_line() {
     assert!(err.contains("growing_grid.repeats: must be at least 1"), "{err}");
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
 }
+
+/// `somnurbs report` makes every file of a finished quick run again, byte for byte, from the
+/// cell log alone (no cell computed again).
+#[test]
+fn seed001_report_restores_every_file_from_the_log() {
+    crate::common::report_restores_every_file("experiments/seed001_growing_grid.toml");
+}

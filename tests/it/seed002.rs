@@ -139,3 +139,10 @@ fn seed002_bad_key_is_named() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("rational_bezier.grid") && err.contains("odd"), "{err}");
 }
+
+/// `somnurbs report` makes every file of a finished quick run again, byte for byte, from the
+/// cell log alone (no cell computed again).
+#[test]
+fn seed002_report_restores_every_file_from_the_log() {
+    crate::common::report_restores_every_file("experiments/seed002_rational.toml");
+}

@@ -173,3 +173,10 @@ fn seed003_dry_run_lists_every_cell() {
     assert_eq!(keys.len(), 3 * 5 * 50, "{text}");
     assert!(keys.iter().any(|l| l.starts_with("seed003/example2/icsa/r49")));
 }
+
+/// `somnurbs report` makes every file of a finished quick run again, byte for byte, from the
+/// cell log alone (no cell computed again).
+#[test]
+fn seed003_report_restores_every_file_from_the_log() {
+    crate::common::report_restores_every_file("experiments/seed003_cuckoo_bezier.toml");
+}

@@ -151,3 +151,10 @@ fn seed004_dry_run_lists_cells_and_bad_keys_are_named() {
     let p = case.write("bad3.toml", &bad);
     case.fails(&["run", p.to_str().unwrap(), "--out", "o"], &["closed_cylinder.ga.beta"]);
 }
+
+/// `somnurbs report` makes every file of a finished quick run again, byte for byte, from the
+/// cell log alone (no cell computed again).
+#[test]
+fn seed004_report_restores_every_file_from_the_log() {
+    crate::common::report_restores_every_file("experiments/seed004_cylinder.toml");
+}

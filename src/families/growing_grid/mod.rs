@@ -1,11 +1,13 @@
-//! Seed 001 wiring: one Growing Grid per data set (its own stream `seed001/map/<data>`), one open
-//! cubic B-spline problem per (data, net, parameterisation) from the least-squares fit of that map,
-//! then every (problem, optimiser, repeat) cell on its own stream, logged at once.
+//! Seed 001 wiring: one Growing Grid per data set (a logged cell on its own stream
+//! `seed001/map/<data>`), one open cubic B-spline problem per (data, net, parameterisation) from
+//! the least-squares fit of that map, then every (problem, optimiser, repeat) cell on its own
+//! stream, logged at once.
 
 pub(crate) mod report;
 pub(crate) mod spec;
 
 use crate::data::registry;
+use crate::experiment::packed::PackedPoints;
 use crate::experiment::spec::{GridSize, Spec};
 use crate::experiment::{runner, seeds, RunContext};
 use crate::geom::Point3;
@@ -123,34 +125,133 @@ pub(crate) fn cells(g: &GrowingGridSpec) -> Vec<Cell> {
     out
 }
 
-/// Grow one map per data set (in parallel; each on its own stream).
-pub(crate) fn maps(spec: &Spec, g: &GrowingGridSpec, ctx: &RunContext) -> Result<Vec<MapRun>> {
-    let params = g.params();
-    let data: Vec<(String, Vec<Point3>)> = g
-        .datasets
+/// One map cell: a data set and its points (its stream and log key `seed001/map/<data>`).
+#[derive(Debug, Clone)]
+pub(crate) struct MapCell {
+    pub(crate) dataset: String,
+    pub(crate) points: Vec<Point3>,
+}
+
+impl runner::Cell for MapCell {
+    fn key(&self) -> String {
+        format!("seed001/map/{}", self.dataset)
+    }
+}
+
+/// A grown map as the cell log keeps it: everything the tables, the pictures and the problems
+/// read, the weights exactly (so a resumed run, a merge or `somnurbs report` rebuilds the same
+/// problems and the same tables, CPU time included).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub(crate) struct MapRecord {
+    pub(crate) dataset: String,
+    pub(crate) points: usize,
+    pub(crate) nx: usize,
+    pub(crate) ny: usize,
+    pub(crate) weights: PackedPoints,
+    pub(crate) insertions: usize,
+    pub(crate) growth_steps: usize,
+    pub(crate) fine_steps: usize,
+    pub(crate) qe: f64,
+    pub(crate) te: f64,
+    pub(crate) cpu_s: f64,
+}
+
+impl runner::Logged for MapRun {
+    type Record = MapRecord;
+    fn record(&self) -> MapRecord {
+        MapRecord {
+            dataset: self.dataset.clone(),
+            points: self.points,
+            nx: self.map.nx,
+            ny: self.map.ny,
+            weights: PackedPoints { points: self.map.weights.clone(), single: false },
+            insertions: self.map.insertions,
+            growth_steps: self.map.growth_steps,
+            fine_steps: self.map.fine_steps,
+            qe: self.qe,
+            te: self.te,
+            cpu_s: self.cpu_s,
+        }
+    }
+}
+
+/// The map run a record holds, checked against its cell (data set, point count, map size).
+fn restore_map(cell: &MapCell, r: MapRecord) -> Result<MapRun> {
+    if r.dataset != cell.dataset || r.points != cell.points.len() {
+        anyhow::bail!(
+            "the log's map is of {} ({} points), the cell's data set is {} ({} points)",
+            r.dataset,
+            r.points,
+            cell.dataset,
+            cell.points.len()
+        );
+    }
+    if r.weights.points.len() != r.nx * r.ny {
+        anyhow::bail!(
+            "the log holds {} weights for a {}x{} map",
+            r.weights.points.len(),
+            r.nx,
+            r.ny
+        );
+    }
+    let map = grown::GrowingGrid {
+        nx: r.nx,
+        ny: r.ny,
+        weights: r.weights.points,
+        insertions: r.insertions,
+        growth_steps: r.growth_steps,
+        fine_steps: r.fine_steps,
+    };
+    Ok(MapRun { dataset: r.dataset, points: r.points, map, qe: r.qe, te: r.te, cpu_s: r.cpu_s })
+}
+
+/// One map cell per data set, in the spec's order.
+pub(crate) fn map_cells(
+    spec: &Spec,
+    g: &GrowingGridSpec,
+    ctx: &RunContext,
+) -> Result<Vec<MapCell>> {
+    g.datasets
         .iter()
         .map(|d| {
             ctx.loader(spec)
                 .load(d)
-                .map(|c| (c.name, c.points))
+                .map(|c| MapCell { dataset: c.name, points: c.points })
                 .with_context(|| format!("growing_grid.datasets: `{d}`"))
         })
-        .collect::<Result<_>>()?;
-    runner::run_cells(
-        &data,
-        ctx.jobs,
+        .collect()
+}
+
+/// Grow one map on its own stream.
+fn grow_map(spec: &Spec, g: &GrowingGridSpec, cell: &MapCell) -> Result<MapRun> {
+    let (d, points) = (&cell.dataset, &cell.points);
+    let key = runner::Cell::key(cell);
+    let params = g.params();
+    let (map, cpu_s) =
+        runner::on_stream(spec.file.master_seed, &key, |rng| grow(points, &params, rng));
+    let map = map.map_err(anyhow::Error::msg).with_context(|| format!("growing grid on {d}"))?;
+    let m = map.metrics(points);
+    Ok(MapRun { dataset: d.clone(), points: points.len(), map, qe: m.qe, te: m.te, cpu_s })
+}
+
+/// Grow one map per data set (in parallel; each on its own stream), each a cell of the log. Every
+/// shard runs every map (each of its optimisation cells needs its data set's map), so a shard's
+/// log holds all of them.
+pub(crate) fn maps(spec: &Spec, g: &GrowingGridSpec, ctx: &RunContext) -> Result<Vec<MapRun>> {
+    let cells = map_cells(spec, g, ctx)?;
+    runner::run_logged(
+        &cells,
+        &RunContext { shard: None, ..ctx.clone() },
         "growing grids",
-        |(d, points)| {
-            let key = format!("seed001/map/{d}");
-            let (map, cpu_s) =
-                runner::on_stream(spec.file.master_seed, &key, |rng| grow(points, &params, rng));
-            let map =
-                map.map_err(anyhow::Error::msg).with_context(|| format!("growing grid on {d}"))?;
-            let m = map.metrics(points);
-            Ok(MapRun { dataset: d.clone(), points: points.len(), map, qe: m.qe, te: m.te, cpu_s })
-        },
-        |_, _| Ok(()),
+        |c| grow_map(spec, g, c),
+        restore_map,
     )
+}
+
+/// The same maps grown outside any folder (no cell log): what a suite builds its problems from.
+pub(crate) fn grow_maps(spec: &Spec, g: &GrowingGridSpec, ctx: &RunContext) -> Result<Vec<MapRun>> {
+    let cells = map_cells(spec, g, ctx)?;
+    runner::run_cells(&cells, ctx.jobs, "growing grids", |c| grow_map(spec, g, c), |_, _| Ok(()))
 }
 
 /// The problem of every (data, net, parameterisation).
@@ -245,7 +346,9 @@ impl crate::experiment::family::Experiment for GrowingGrid {
     }
     type Section = self::spec::GrowingGridSpec;
     fn logged_keys(&self, _spec: &Spec, g: &GrowingGridSpec) -> Vec<String> {
-        cells(g).iter().map(|c| c.key()).collect()
+        // The map cells first (as they run), named by the data sets' names.
+        let maps = g.datasets.iter().map(|d| format!("seed001/map/{}", registry::name_of(d)));
+        maps.chain(cells(g).iter().map(|c| c.key())).collect()
     }
     fn run(
         &self,
@@ -264,6 +367,6 @@ impl crate::experiment::family::Experiment for GrowingGrid {
         };
         let cpu_s = maps.iter().map(|m| m.cpu_s).sum::<f64>()
             + runs.iter().map(|r| r.row.cpu_s).sum::<f64>();
-        Ok(crate::experiment::family::Outcome { section, cpu_s, cells: runs.len() })
+        Ok(crate::experiment::family::Outcome { section, cpu_s, cells: maps.len() + runs.len() })
     }
 }

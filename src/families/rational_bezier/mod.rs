@@ -1,10 +1,13 @@
 //! Seed 002 wiring (Yahya): each (surface, optimiser, repeat) fits the four-patch G1 rational
 //! bi-quadratic Bezier surface to the surface's grid by minimising the sum of squared errors over
-//! the seven free control points and w11, on its own stream, logged at once.
+//! the seven free control points and w11, on its own stream, logged at once; each (outline,
+//! optimiser, repeat) samples a 2-D outline, finds its corners and fits its conics, a cell logged
+//! the same way.
 
 pub(crate) mod report;
 pub(crate) mod spec;
 
+use crate::experiment::packed::PackedFloats;
 use crate::experiment::spec::Spec;
 use crate::experiment::{runner, seeds, RunContext};
 use crate::optim::{Budget, Problem};
@@ -252,20 +255,74 @@ pub(crate) fn run_curve_cell(spec: &Spec, s: &RationalBezierSpec, cell: &CurveCe
     Ok(CurveRun { row, points, corners, conics })
 }
 
-/// The curve cells (a fraction of a second in all; not logged: a resumed run or a merge runs
-/// them again, deterministically).
-pub(crate) fn run_curves(spec: &Spec, s: &RationalBezierSpec, ctx: &RunContext) -> Result<Vec<CurveRun>> {
+impl runner::Cell for CurveCell {
+    fn key(&self) -> String {
+        CurveCell::key(self)
+    }
+}
+
+/// A curve run as the cell log keeps it: the row, the outline's points (x, y pairs), the corners
+/// and each conic (b0, b1, b2 as x, y pairs, then w), the floats exactly, so a resumed run, a
+/// merge or `somnurbs report` draws and tabulates the same (CPU time included).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub(crate) struct CurveRecord {
+    pub(crate) row: CurveRow,
+    pub(crate) points: PackedFloats,
+    pub(crate) corners: Vec<usize>,
+    pub(crate) conics: PackedFloats,
+}
+
+impl runner::Logged for CurveRun {
+    type Record = CurveRecord;
+    fn record(&self) -> CurveRecord {
+        let conics = self.conics.iter().flat_map(|(b, w)| b.iter().flatten().copied().chain([*w]));
+        CurveRecord {
+            row: self.row.clone(),
+            points: PackedFloats(self.points.iter().flatten().copied().collect()),
+            corners: self.corners.clone(),
+            conics: PackedFloats(conics.collect()),
+        }
+    }
+}
+
+/// The curve run a record holds, its sizes checked against its row.
+fn restore_curve(r: CurveRecord) -> Result<CurveRun> {
+    let (p, c) = (&r.points.0, &r.conics.0);
+    if p.len() != 2 * r.row.n_points || c.len() != 7 * r.row.conics {
+        anyhow::bail!(
+            "the log holds {} coordinates and {} conic numbers for {} points and {} conics",
+            p.len(),
+            c.len(),
+            r.row.n_points,
+            r.row.conics
+        );
+    }
+    if let Some(&i) = r.corners.iter().find(|&&i| i >= r.row.n_points) {
+        anyhow::bail!("corner {i} is past the outline's {} points", r.row.n_points);
+    }
+    let points = p.chunks_exact(2).map(|q| [q[0], q[1]]).collect();
+    let conics =
+        c.chunks_exact(7).map(|q| ([[q[0], q[1]], [q[2], q[3]], [q[4], q[5]]], q[6])).collect();
+    Ok(CurveRun { row: r.row, points, corners: r.corners, conics })
+}
+
+/// The curve cells, logged at once as the surface cells are.
+pub(crate) fn run_curves(
+    spec: &Spec,
+    s: &RationalBezierSpec,
+    ctx: &RunContext,
+) -> Result<Vec<CurveRun>> {
     let cells = curve_cells(s);
-    runner::run_cells(
+    runner::run_logged(
         &cells,
-        ctx.jobs,
+        ctx,
         "seed002 curves",
         |c| run_curve_cell(spec, s, c),
-        |_, _| Ok(()),
+        |_, r| restore_curve(r),
     )
 }
 
-/// Seed 002's family: the `[rational_bezier]` section (surface cells logged, curve cells not).
+/// Seed 002's family: the `[rational_bezier]` section (surface and curve cells, both logged).
 pub(crate) struct RationalBezier;
 
 impl crate::experiment::family::Experiment for RationalBezier {
@@ -274,10 +331,9 @@ impl crate::experiment::family::Experiment for RationalBezier {
     }
     type Section = self::spec::RationalBezierSpec;
     fn logged_keys(&self, _spec: &Spec, s: &RationalBezierSpec) -> Vec<String> {
-        cells(s).iter().map(|c| c.key()).collect()
-    }
-    fn unlogged_keys(&self, _spec: &Spec, s: &RationalBezierSpec) -> Vec<String> {
-        curve_cells(s).iter().map(|c| c.key()).collect()
+        // The surface cells, then the curve cells (as they run).
+        let curves = curve_cells(s);
+        cells(s).iter().map(|c| c.key()).chain(curves.iter().map(|c| c.key())).collect()
     }
     fn run(
         &self,
