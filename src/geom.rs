@@ -3,6 +3,12 @@
 /// A point (or vector) in 3-D space.
 pub type Point3 = [f64; 3];
 
+/// `offset + scale * p`, per axis: a data set's normalisation undone (its frame).
+#[inline]
+pub(crate) fn affine(offset: Point3, scale: Point3, p: Point3) -> Point3 {
+    [0, 1, 2].map(|a| offset[a] + scale[a] * p[a])
+}
+
 #[inline]
 pub(crate) fn sub(a: Point3, b: Point3) -> Point3 {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]

@@ -228,7 +228,7 @@ fn reuse_folders(dirs: &[std::path::PathBuf]) -> anyhow::Result<Vec<std::path::P
         if !d.is_dir() {
             anyhow::bail!("--reuse {}: not a folder", d.display());
         }
-        if !d.join(LOG_GZ).is_file() && !d.join(LOG_FILE).is_file() {
+        if !experiment::log::has_log(d) {
             anyhow::bail!(
                 "--reuse {}: holds no cell log ({LOG_GZ} or {LOG_FILE}): name a result folder of `somnurbs run`",
                 d.display()

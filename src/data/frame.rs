@@ -47,7 +47,7 @@ impl Frame {
 
     /// A point of the normalised coordinates in the data's own.
     pub fn to_data(&self, p: Point3) -> Point3 {
-        [0, 1, 2].map(|a| self.offset[a] + self.scale[a] * p[a])
+        crate::geom::affine(self.offset, self.scale, p)
     }
 
     /// The file's text: a comment line, then the fields.

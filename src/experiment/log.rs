@@ -159,15 +159,7 @@ pub(crate) fn read_matching(
     wanted: &std::collections::BTreeSet<String>,
 ) -> Result<BTreeMap<String, serde_json::Value>> {
     let mut out = BTreeMap::new();
-    let mut texts = Vec::new();
-    let gz = dir.join(LOG_GZ);
-    if gz.exists() {
-        texts.push((gz.clone(), gunzip(&gz)?));
-    }
-    let plain = dir.join(LOG_FILE);
-    if plain.exists() {
-        texts.push((plain.clone(), crate::io::read_text(&plain)?));
-    }
+    let texts = log_parts(dir)?;
     if texts.is_empty() {
         bail!("{}: no cell log ({LOG_GZ} or {LOG_FILE}) to reuse cells from", dir.display());
     }
@@ -291,18 +283,30 @@ fn gunzip(path: &Path) -> Result<String> {
     Ok(text)
 }
 
-/// The whole log of a folder as text, compressed part first (for tests and tools that read it).
-pub fn log_text(dir: &Path) -> Result<String> {
-    let mut text = String::new();
+/// Whether `dir` holds a cell log (compressed, plain or both).
+pub(crate) fn has_log(dir: &Path) -> bool {
+    dir.join(LOG_GZ).is_file() || dir.join(LOG_FILE).is_file()
+}
+
+/// The text of each part of a folder's log that is there, compressed part first, with its path.
+fn log_parts(dir: &Path) -> Result<Vec<(PathBuf, String)>> {
+    let mut parts = Vec::new();
     let gz = dir.join(LOG_GZ);
     if gz.exists() {
-        text = gunzip(&gz)?;
+        let text = gunzip(&gz)?;
+        parts.push((gz, text));
     }
     let plain = dir.join(LOG_FILE);
     if plain.exists() {
-        text.push_str(&crate::io::read_text(&plain)?);
+        let text = crate::io::read_text(&plain)?;
+        parts.push((plain, text));
     }
-    Ok(text)
+    Ok(parts)
+}
+
+/// The whole log of a folder as text, compressed part first (for tests and tools that read it).
+pub fn log_text(dir: &Path) -> Result<String> {
+    Ok(log_parts(dir)?.into_iter().map(|(_, text)| text).collect())
 }
 
 /// Compress a finished run's log: the plain log's complete lines are added to `cells.jsonl.gz`

@@ -295,7 +295,7 @@ fn claim(out: &Path, fp: &log::Fingerprint, resume: bool) -> Result<Claimed> {
         return Ok(Claimed::Start);
     }
     let Some(old) = log::Fingerprint::read(out)? else {
-        if out.join(log::LOG_FILE).exists() || out.join(log::LOG_GZ).exists() {
+        if log::has_log(out) {
             anyhow::bail!(
                 "cannot resume in {}: it has a cell log but no {}",
                 out.display(),

@@ -93,7 +93,7 @@ pub(crate) enum Fill {
 /// it is missing, and a file that is there must hold `bytes` exactly (else an error naming it:
 /// a finished result is never rewritten).
 pub(crate) fn fill(path: &Path, bytes: &[u8]) -> Result<Fill> {
-    if !filling().iter().any(|r| path.starts_with(r)) {
+    if !is_filling(path) {
         return Ok(Fill::Write);
     }
     match fs::symlink_metadata(path) {
@@ -561,20 +561,16 @@ impl Drop for Lock {
         }
         // An empty record says "released"; the flock goes with the file descriptor.
         let _ = self.file.set_len(0);
-        let mut held = roots();
-        for r in &self.roots {
-            if let Some(k) = held.iter().position(|h| h == r) {
-                held.remove(k);
-            }
-        }
-        drop(held);
-        if self.fill {
-            let mut held = filling();
+        let release = |held: &mut Vec<PathBuf>| {
             for r in &self.roots {
                 if let Some(k) = held.iter().position(|h| h == r) {
                     held.remove(k);
                 }
             }
+        };
+        release(&mut roots());
+        if self.fill {
+            release(&mut filling());
         }
     }
 }

@@ -43,8 +43,7 @@ impl BSplineSurface {
     /// back to the data's: [`crate::data::frame::Frame`]). Exact on the control points: the basis
     /// functions sum to 1 at every (u, v), so S'(u, v) = offset + scale S(u, v).
     pub fn affine(&self, offset: Point3, scale: Point3) -> BSplineSurface {
-        let control =
-            self.control.iter().map(|c| [0, 1, 2].map(|a| offset[a] + scale[a] * c[a])).collect();
+        let control = self.control.iter().map(|&c| crate::geom::affine(offset, scale, c)).collect();
         BSplineSurface { control, ..self.clone() }
     }
 

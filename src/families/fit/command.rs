@@ -30,7 +30,7 @@ impl Export {
     /// `p` in the exports' coordinates.
     pub(crate) fn place_point(&self, p: [f64; 3]) -> [f64; 3] {
         match self.affine {
-            Some((offset, scale)) => std::array::from_fn(|a| offset[a] + scale[a] * p[a]),
+            Some((offset, scale)) => crate::geom::affine(offset, scale, p),
             None => p,
         }
     }
