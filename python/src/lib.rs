@@ -183,12 +183,15 @@ impl PyProblem {
     }
 
     /// The certified optimum in a box ("spec" or "data"), computed on first call and kept: a dict
-    /// with `f` (the optimum found), `lower_bound` (proven: no point of the box is below it),
-    /// `gap`, `converged`, `iterations` and `x`.
+    /// with `interval` = (`lower_bound`, `f`), the certificate (min f over the box lies in it),
+    /// `f` (the value at `x`, the best point found: an upper bound), `lower_bound` (proven: no
+    /// point of the box is below it), `gap` = f - lower_bound, `converged` (the gap reached the
+    /// spec's `exact_tol` relative to f), `iterations` and `x`.
     #[pyo3(signature = (r#box = "spec"))]
     fn exact<'py>(&self, py: Python<'py>, r#box: &str) -> PyResult<Bound<'py, PyDict>> {
         let r = self.exact_result(py, r#box)?;
         let d = PyDict::new(py);
+        d.set_item("interval", (r.lower_bound, r.f))?;
         d.set_item("f", r.f)?;
         d.set_item("lower_bound", r.lower_bound)?;
         d.set_item("gap", r.gap)?;

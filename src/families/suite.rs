@@ -219,7 +219,7 @@ mod tests {
         let data = crate::data::registry::clone_data_dir();
         let s = load("ch6_exact", Some("quick"), &[], Some(&data), work.path()).unwrap();
         assert_eq!((s.spec_name.as_str(), s.reading.as_str()), ("ch6_exact", "eq2_10"));
-        assert_eq!((s.box_label.as_str(), s.exact.tol_rel_gap), ("B+-5e-6", 1e-7));
+        assert_eq!((s.box_label.as_str(), s.exact.tol_rel_gap), ("B+-5e-6", 1e-9));
         let names: Vec<&str> = s.problems.iter().map(|p| p.name.as_str()).collect();
         assert_eq!(
             names,

@@ -550,7 +550,7 @@ fn exact_section(
     let name = format!("exact_{grid}.csv");
     write_atomic(&out.join(&name), csv_records(&h, &rows)?.as_bytes())?;
     let mut s = String::new();
-    let _ = writeln!(s, "\n`{name}`: the convex problem solved in its box (projected Newton on the smoothed sum of norms) with a proven lower bound; each optimiser's best minus the exact value.\n\n{}", table(&h, &rows));
+    let _ = writeln!(s, "\n`{name}`: the convex problem solved in its box (projected Newton on the smoothed sum of norms), certified as an interval: its minimum lies in [lower_bound, exact_f], exact_f the value of the best point found (the upper end), lower_bound proven by weak duality, certified_gap their difference; each optimiser's best minus exact_f (a run may end below exact_f, by at most the gap).\n\n{}", table(&h, &rows));
     // A cell whose certified gap did not reach `exact_tol` is named, with its gap.
     for (c, e) in ex_cells.iter().filter(|(_, e)| !e.converged) {
         let _ = writeln!(
@@ -871,7 +871,7 @@ fn convergence_charts(
                 levels.push(plots::Level { key: "b", label: format!("B {b:.6}"), y: b });
             }
             if let Some(e) = exact.get(&ProblemKey::new(&d, cn, p0)) {
-                let label = format!("certified optimum {:.6}", e.f);
+                let label = format!("certified optimum {:.6} (upper end f, gap {:.0e})", e.f, e.gap);
                 levels.push(plots::Level { key: "exact", label, y: e.f });
             }
             let (x0, x1) = series

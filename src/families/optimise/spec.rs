@@ -102,7 +102,7 @@ fn default_exact_newton_steps() -> usize {
     300
 }
 fn default_exact_tol() -> f64 {
-    1e-7
+    1e-9
 }
 
 impl crate::experiment::family::Section for OptimSpec {
