@@ -38,6 +38,7 @@ pub mod experiment;
 pub mod families;
 pub mod geom;
 pub(crate) mod io;
+pub mod notice;
 pub mod optim;
 pub mod report;
 pub mod simd;

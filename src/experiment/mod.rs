@@ -266,11 +266,11 @@ pub(crate) fn run_variants<F: Families>(
     let fp = fingerprint(variants, ctx.shard);
     match claim(&ctx.out, &fp, ctx.resume)? {
         Claimed::Finished => {
-            eprintln!(
+            crate::notice::emit(&format!(
                 "somnurbs: {} already holds this run, finished; nothing to do (`somnurbs report {}` makes a lost table or picture again from its records)",
                 ctx.out.display(),
                 ctx.out.display()
-            );
+            ));
             Ok(ctx.out.clone())
         }
         Claimed::Start => run_spec_locked(variants, ctx),
@@ -313,10 +313,10 @@ fn claim(out: &Path, fp: &log::Fingerprint, resume: bool) -> Result<Claimed> {
     }
     let removed = crate::io::outdir::remove_leftovers(out)?;
     if removed > 0 {
-        eprintln!(
+        crate::notice::emit(&format!(
             "somnurbs: removed {removed} temporary file(s) the interrupted run left in {}",
             out.display()
-        );
+        ));
     }
     Ok(Claimed::Start)
 }
@@ -667,10 +667,10 @@ pub(crate) fn merge<F: Families>(shards: &[PathBuf], ctx: &RunContext) -> Result
 pub fn data_dir(flag: Option<&Path>) -> PathBuf {
     let (dir, clone) = crate::data::registry::found_folder(flag, Some("SOMNURBS_DATA"), "data");
     if clone {
-        eprintln!(
+        crate::notice::emit(&format!(
             "somnurbs: note: no data/ in the working folder; reading data files from the clone somnurbs was built from, {} (--data-dir DIR or SOMNURBS_DATA names another)",
             dir.display()
-        );
+        ));
     }
     dir
 }
