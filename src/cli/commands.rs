@@ -217,7 +217,9 @@ fn reproduce(args: &ReproduceArgs) -> anyhow::Result<ExitCode> {
     super::interrupt::on_sigint(&reproduce_resume_command(args, &specs, &ctx.out));
     let report =
         experiment::reproduce::reproduce::<Section>(&specs, &args.plan, &args.profile, &ctx)?;
-    eprintln!("somnurbs: wrote {}", report.display());
+    if let Some(report) = report {
+        eprintln!("somnurbs: wrote {}", report.display());
+    }
     Ok(ExitCode::SUCCESS)
 }
 
