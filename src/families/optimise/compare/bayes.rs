@@ -70,9 +70,12 @@ pub(super) fn bayes_table(
     Ok(out)
 }
 
-/// The summary of the Bayesian rows on stdout.
-pub(super) fn print(rows: &[BayesRow]) {
+/// The summary of the Bayesian rows, the lines printed on stdout and listed in compare.md.
+pub(super) fn summary(rows: &[BayesRow], cov: &super::cells::Coverage) -> Vec<String> {
+    let over = |n: usize| if cov.full() { format!("{n} cells") } else { cov.used() };
+    let mut lines = Vec::new();
     for r in rows {
-        println!("  Bayesian signed-rank {} vs {} over {} cells (rope {} of B's error): P({} better) {}, P(equivalent) {}, P({} better) {}", r.x, r.y, r.cells, r.rope, r.x, r.p_x_better, r.p_rope, r.y, r.p_y_better);
+        lines.push(format!("  Bayesian signed-rank {} vs {} over {} (rope {} of B's error): P({} better) {}, P(equivalent) {}, P({} better) {}", r.x, r.y, over(r.cells), r.rope, r.x, r.p_x_better, r.p_rope, r.y, r.p_y_better));
     }
+    lines
 }

@@ -43,15 +43,38 @@ pub(super) struct Coverage {
     pub(super) common: usize,
     /// Per optimiser (in `opts` order), the cells it ran.
     pub(super) ran: Vec<(String, usize)>,
+    /// Per optimiser (in `opts` order), the cells it did not run, named
+    /// `data grid net parameterisation`.
+    pub(super) missing: Vec<(String, Vec<String>)>,
 }
 
 impl Coverage {
     pub(super) fn of(cells: &Cells, opts: &[String]) -> Coverage {
         let ran = |o: &String| cells.values().filter(|per| per.contains_key(o)).count();
+        let missing = |o: &String| {
+            let name = |k: &ComparedCell| format!("{} {} {} {}", k.data, k.grid, k.cn, k.param);
+            cells.iter().filter(|(_, per)| !per.contains_key(o)).map(|(k, _)| name(k)).collect()
+        };
         Coverage {
             cells: cells.len(),
             common: cells.values().filter(|per| ran_by_all(per, opts)).count(),
             ran: opts.iter().map(|o| (o.clone(), ran(o))).collect(),
+            missing: opts.iter().map(|o| (o.clone(), missing(o))).collect(),
+        }
+    }
+
+    /// Whether every optimiser ran every cell.
+    pub(super) fn full(&self) -> bool {
+        self.common == self.cells
+    }
+
+    /// The cells the tests over cells use, in words: "4 cells", or where some optimiser ran part
+    /// of them "the 2 of 4 cells every optimiser ran".
+    pub(super) fn used(&self) -> String {
+        if self.full() {
+            format!("{} cells", self.common)
+        } else {
+            format!("the {} of {} cells every optimiser ran", self.common, self.cells)
         }
     }
 

@@ -136,7 +136,7 @@ pub(crate) fn compare(req: &Request) -> Result<()> {
     };
     let coverage = Coverage::of(&cells, &opts);
     if let Some(line) = coverage.note() {
-        eprintln!("somnurbs: warning: {line}");
+        eprintln!("somnurbs: warning: {line} ({SUMMARY} names the cells each did not run)");
     }
     let per_cell = cells::pairwise_cells(&cells, &opts, req.alpha);
     if let Some((n, sr, rs)) = per_cell.unreachable.smallest {
@@ -173,33 +173,42 @@ fn analyse(
     Ok(Analysis { opts, coverage, per_cell, over, runtime })
 }
 
-/// Write every table and chart of `compare` into `out` (the staged folder), the record last, with
-/// the summary on stdout.
+/// Write every table and chart of `compare` into `out` (the staged folder), then compare.md, the
+/// record last, with the summary on stdout.
 fn write_folder(req: &Request, a: &Analysis, out: &Path) -> Result<()> {
     write_table(&out.join("compare_cells.csv"), &a.per_cell.rows)?;
     let mut written = String::from("compare_cells.csv");
     let mut cd_note = "";
+    let mut said: Vec<String> = Vec::new();
+    let mut say = |lines: Vec<String>| {
+        for l in &lines {
+            println!("{l}");
+        }
+        said.extend(lines);
+    };
     match &a.over {
         Some((overall, bayes_rows)) => {
             write_table(&out.join("compare_overall.csv"), &overall.rows)?;
-            match over_cells::render_cd(overall, &out.join("cd_diagram.png")) {
+            match over_cells::render_cd(overall, &a.coverage, &out.join("cd_diagram.png")) {
                 Ok(true) => cd_note = ", critical-difference diagram cd_diagram.png",
                 Ok(false) => {}
                 Err(e) => chart_skipped(e)?,
             }
-            over_cells::print(overall);
+            say(over_cells::summary(overall, &a.coverage));
             write_table(&out.join("compare_bayes.csv"), bayes_rows)?;
-            bayes::print(bayes_rows);
+            say(bayes::summary(bayes_rows, &a.coverage));
             written.push_str(", compare_overall.csv, compare_bayes.csv");
         }
-        None => println!("  {} cell(s) that every optimiser ran: the tests over cells (Friedman, Nemenyi, Bayesian signed-rank) need two or more; the per-cell tests are in compare_cells.csv", a.coverage.common),
+        None => say(vec![format!("  {} cell(s) that every optimiser ran: the tests over cells (Friedman, Nemenyi, Bayesian signed-rank) need two or more; the per-cell tests are in compare_cells.csv", a.coverage.common)]),
     }
     match &a.runtime {
         Some((rt, probs)) => {
             written.push_str(&runtime_files::runtime_outputs(rt, probs, &a.opts, out)?);
+            said.extend(runtime_files::summary(rt, probs));
         }
-        None => println!("  no ioh/ folder: runtime distributions skipped"),
+        None => say(vec!["  no ioh/ folder: runtime distributions skipped".into()]),
     }
+    write_atomic(&out.join(SUMMARY), markdown(req, a, &said).as_bytes())?;
     // Last: the record that makes the folder a compare's (a later compare may replace it).
     let record = format!(
         "results = {:?}\nalpha = {:?}\nrope = {:?}\nbayes_samples = {}\nsomnurbs = {:?}\n",
@@ -210,8 +219,30 @@ fn write_folder(req: &Request, a: &Analysis, out: &Path) -> Result<()> {
         env!("CARGO_PKG_VERSION")
     );
     write_atomic(&out.join(RECORD), record.as_bytes())?;
-    println!("wrote {written}{cd_note} in {}", req.dest().display());
+    println!("wrote {written}, {SUMMARY}{cd_note} in {}", req.dest().display());
     Ok(())
+}
+
+/// The Markdown summary of a compare: which optimiser ran which cells and what the statistics
+/// over cells use, then the summary lines of stdout.
+fn markdown(req: &Request, a: &Analysis, said: &[String]) -> String {
+    let c = &a.coverage;
+    let mut md = format!("# somnurbs compare\n\nResults folder: `{}`; alpha {}, rope {:e}, {} Bayesian samples.\n\n## Which optimiser ran which cells\n\n| optimiser | cells run | of | cells not run |\n|---|---|---|---|\n", req.results.display(), req.alpha, req.rope, req.bayes_samples);
+    for ((o, k), (_, missing)) in c.ran.iter().zip(&c.missing) {
+        md.push_str(&format!("| {o} | {k} | {} | {} |\n", c.cells, missing.join("; ")));
+    }
+    md.push('\n');
+    match c.note() {
+        None => md.push_str(&format!("Every optimiser ran every cell: the tests over cells use all {}.\n", c.cells)),
+        Some(note) => md.push_str(&format!("**Not every optimiser ran every cell** {}.\n", note.trim_start_matches("not every optimiser ran every cell "))),
+    }
+    md.push_str("\n## Summary\n\n```text\n");
+    for l in said {
+        md.push_str(l);
+        md.push('\n');
+    }
+    md.push_str("```\n");
+    md
 }
 
 /// `path` made absolute, with the links of its nearest existing ancestor resolved and the rest
@@ -270,6 +301,9 @@ fn check_destination(req: &Request, dest: &Path) -> Result<Vec<PathBuf>> {
 pub(crate) const OUT_DIR: &str = "compare";
 /// The record `compare` writes last in its folder (what it compared, with which options).
 const RECORD: &str = "compare.toml";
+/// The Markdown summary `compare` writes in its folder: which optimiser ran which cells, what the
+/// statistics over cells use, and the summary lines of stdout.
+const SUMMARY: &str = "compare.md";
 
 /// `compare` writes a folder of its own: missing, empty, or an earlier compare's (which it
 /// replaces whole); anything else is refused.

@@ -2,7 +2,7 @@
 //! pairwise tests (`compare_overall.csv`) and the critical-difference diagram, over the cells
 //! every optimiser ran.
 
-use super::cells::Wins;
+use super::cells::{Coverage, Wins};
 use super::friedman::friedman_table;
 use crate::families::optimise::OptimRow;
 use crate::report::plots;
@@ -69,25 +69,34 @@ pub(super) fn overall(
 }
 
 /// The critical-difference diagram of `o` into `png` (Ok(false): the test gives no critical
-/// difference for this many optimisers, nothing drawn).
-pub(super) fn render_cd(o: &Overall, png: &Path) -> Result<bool, plots::PlotError> {
+/// difference for this many optimisers, nothing drawn); its title says which cells it ranks.
+pub(super) fn render_cd(o: &Overall, cov: &Coverage, png: &Path) -> Result<bool, plots::PlotError> {
     let Some(cd) = o.friedman.critical_difference else { return Ok(false) };
-    let title =
-        format!("Mean ranks over {} cells (Nemenyi CD = {cd:.3}, alpha 0.05)", o.friedman.blocks);
+    let cells = if cov.full() {
+        format!("{} cells", o.friedman.blocks)
+    } else {
+        format!("the {} of {} cells all ran", o.friedman.blocks, cov.cells)
+    };
+    let title = format!("Mean ranks over {cells} (Nemenyi CD = {cd:.3}, alpha 0.05)");
     plots::cd_diagram_png(png, &title, &o.ranks, cd).map(|()| true)
 }
 
-/// The summary of `o` on stdout.
-pub(super) fn print(o: &Overall) {
+/// The summary of `o`, the lines printed on stdout and listed in compare.md.
+pub(super) fn summary(o: &Overall, cov: &Coverage) -> Vec<String> {
     let f = &o.friedman;
-    println!(
-        "Friedman over {} cells x {} optimisers: chi-squared {:.3}, df {}, p = {:.3e}",
-        f.blocks, f.treatments, f.chi_squared, f.df, f.p_value
-    );
+    let mut lines = vec![format!(
+        "Friedman over {} x {} optimisers: chi-squared {:.3}, df {}, p = {:.3e}",
+        cov.used(),
+        f.treatments,
+        f.chi_squared,
+        f.df,
+        f.p_value
+    )];
     for (o, r) in &o.ranks {
-        println!("  mean rank {o:<5} {r:.3}");
+        lines.push(format!("  mean rank {o:<5} {r:.3}"));
     }
     for r in &o.rows {
-        println!("  {} vs {}: z {}, p {} (Holm {}); cells where the rank-sum test favours {}: {}, {}: {} (of {} where it can reach alpha)", r.x, r.y, r.z, r.p, r.p_holm, r.x, r.cells_x_better, r.y, r.cells_y_better, r.cells_rank_sum_can_reach_alpha);
+        lines.push(format!("  {} vs {}: z {}, p {} (Holm {}); cells where the rank-sum test favours {}: {}, {}: {} (of {} where it can reach alpha)", r.x, r.y, r.z, r.p, r.p_holm, r.x, r.cells_x_better, r.y, r.cells_y_better, r.cells_rank_sum_can_reach_alpha));
     }
+    lines
 }

@@ -8,7 +8,8 @@ use crate::families::optimise::external::Certificate;
 use crate::families::optimise::{ioh, OptimRow};
 use crate::stats;
 use anyhow::{Context, Result};
-use std::collections::BTreeMap;
+use super::cells::num;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 
 /// Targets per problem: this many, log-spaced over this many decades of the gap between the
@@ -118,6 +119,7 @@ pub(super) fn problems(
     external: Vec<ioh::LoadedProblem>,
     certified: &BTreeMap<String, Certificate>,
 ) -> Result<Vec<Problem>> {
+    let outside: BTreeSet<String> = external.iter().map(|lp| lp.optimiser.clone()).collect();
     let mut expected: BTreeMap<(String, String), Vec<&OptimRow>> = BTreeMap::new();
     for r in rows {
         expected.entry((problem_of(r), r.competitor())).or_default().push(r);
@@ -163,7 +165,7 @@ pub(super) fn problems(
             .iter()
             .filter(|r| &problem_of(r) == pn)
             .min_by(|a, b| a.best.total_cmp(&b.best).then(a.repeat.cmp(&b.repeat)));
-        (p.best_known, p.from) = best_known(best_run, certified.get(pn));
+        (p.best_known, p.from) = best_known(best_run, certified.get(pn), &outside);
         set_targets(p);
     }
     Ok(out.into_values().collect())
@@ -180,17 +182,33 @@ fn set_targets(p: &mut Problem) {
     };
 }
 
-/// The best known value of a problem and its provenance: the exact solver's `f` (the upper end of
-/// its certified interval [lower_bound, f]) unless a run ended below it (within the certified
-/// gap), then that run, named.
-pub(super) fn best_known(best_run: Option<&OptimRow>, cert: Option<&Certificate>) -> (f64, String) {
-    let run = |r: &OptimRow| format!("best run ({} repeat {})", r.competitor(), r.repeat);
+/// The best known value of a problem and where it comes from, whichever source is lowest: the
+/// exact solver's `f` (the upper end of its certified interval [lower_bound, f]), or a run that
+/// ended below it (inside that interval), named as somnurbs' own (`run de repeat 3`) or an
+/// external one (`external cma-es repeat 1`, its optimiser in `external`). A run that reached `f`
+/// itself is named beside the solver.
+pub(super) fn best_known(
+    best_run: Option<&OptimRow>,
+    cert: Option<&Certificate>,
+    external: &BTreeSet<String>,
+) -> (f64, String) {
+    let run = |r: &OptimRow| {
+        let kind = if external.contains(&r.competitor()) { "external" } else { "run" };
+        format!("{kind} {} repeat {}", r.competitor(), r.repeat)
+    };
+    let solver = |c: &Certificate| {
+        let (f, lb) = (num(c.optimum), num(c.lower_bound));
+        format!("exact solver (f = {f}, the upper end of its certified interval [{lb}, {f}])")
+    };
     match (best_run, cert) {
         (Some(r), Some(c)) if r.best < c.optimum => (
             r.best,
-            format!("{}, below the exact solver's f, within its certified gap", run(r)),
+            format!("{}, below the exact solver's f = {}: inside its certified interval [{}, {}]", run(r), num(c.optimum), num(c.lower_bound), num(c.optimum)),
         ),
-        (_, Some(c)) => (c.optimum, "certified optimum (the exact solver's f)".into()),
+        (Some(r), Some(c)) if r.best == c.optimum => {
+            (c.optimum, format!("{}; {} reached it", solver(c), run(r)))
+        }
+        (_, Some(c)) => (c.optimum, solver(c)),
         (Some(r), None) => (r.best, run(r)),
         (None, None) => (f64::INFINITY, "none".into()),
     }
@@ -321,13 +339,16 @@ pub(super) fn runtime(problems: &[Problem], opts: &[String]) -> Runtime {
         ert: Vec::new(),
         common_desc: "problems ".into(),
     };
-    if problems.iter().any(|p| opts.iter().any(|o| !p.runs.contains_key(o))) {
-        rt.common_desc = "problems every optimiser ran ".into();
-    }
     // "all" aggregates the problems every optimiser ran (all of them unless an external ran part),
-    // so that every optimiser's aggregate is over the same problems.
+    // so that every optimiser's aggregate is over the same problems; with none in common, each
+    // optimiser's own.
     let common = |p: &Problem| opts.iter().all(|o| p.runs.contains_key(o));
     let any_common = problems.iter().any(common);
+    if !any_common && !problems.is_empty() {
+        rt.common_desc = "problems of its own (no problem every optimiser ran) ".into();
+    } else if problems.iter().any(|p| !common(p)) {
+        rt.common_desc = "problems every optimiser ran ".into();
+    }
     for o in opts {
         let (mut es, mut gs) = (Vec::new(), Vec::new());
         let (mut own_e, mut own_g) = (Vec::new(), Vec::new());
@@ -372,15 +393,20 @@ mod tests {
             ..Default::default()
         };
         let cert = Certificate { optimum: 2.0, lower_bound: 1.5, table: "exact_6x6.csv".into() };
-        let (v, from) = best_known(Some(&row("de", 3, 2.5)), Some(&cert));
-        assert_eq!((v, from.as_str()), (2.0, "certified optimum (the exact solver's f)"));
-        let (v, from) = best_known(Some(&row("cma-es", 1, 1.9)), Some(&cert));
+        let ext: BTreeSet<String> = ["cma-es".to_string(), "lbfgsb".to_string()].into();
+        let solver = "exact solver (f = 2, the upper end of its certified interval [1.5, 2])";
+        let (v, from) = best_known(Some(&row("de", 3, 2.5)), Some(&cert), &ext);
+        assert_eq!((v, from.as_str()), (2.0, solver));
+        let (v, from) = best_known(Some(&row("lbfgsb", 0, 2.0)), Some(&cert), &ext);
+        assert_eq!((v, from), (2.0, format!("{solver}; external lbfgsb repeat 0 reached it")));
+        let (v, from) = best_known(Some(&row("cma-es", 1, 1.9)), Some(&cert), &ext);
         assert_eq!(v, 1.9);
         assert_eq!(
             from,
-            "best run (cma-es repeat 1), below the exact solver's f, within its certified gap"
+            "external cma-es repeat 1, below the exact solver's f = 2: inside its certified interval [1.5, 2]"
         );
-        let (v, from) = best_known(Some(&row("pso", 0, 4.0)), None);
-        assert_eq!((v, from.as_str()), (4.0, "best run (pso repeat 0)"));
+        let (v, from) = best_known(Some(&row("pso", 0, 4.0)), None, &ext);
+        assert_eq!((v, from.as_str()), (4.0, "run pso repeat 0"));
+        assert_eq!(best_known(None, None, &ext).1, "none");
     }
 }

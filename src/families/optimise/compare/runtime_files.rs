@@ -186,26 +186,31 @@ pub(super) fn runtime_outputs(rt: &Runtime, probs: &[Problem], opts: &[String], 
             Err(e) => super::chart_skipped(e)?,
         }
     }
-    print_summary(rt, probs);
+    for line in summary(rt, probs) {
+        println!("{line}");
+    }
     written.push_str(&format!(", {pngs} runtime charts (compare_ecdf_all.png, compare_fixed_budget_all.png, per problem in png/compare/)"));
     Ok(written)
 }
 
-/// The runtime summary on stdout: moved targets and each optimiser's AOCC over all problems.
-fn print_summary(rt: &Runtime, probs: &[Problem]) {
+/// The runtime summary (stdout and compare.md): moved targets and each optimiser's AOCC over all
+/// problems.
+pub(super) fn summary(rt: &Runtime, probs: &[Problem]) -> Vec<String> {
+    let mut lines = Vec::new();
     let moved = probs.iter().filter(|p| p.rule != "b_to_best_known").count();
     if moved > 0 {
-        println!(
+        lines.push(format!(
             "  targets: in {moved} of {} problems no run beats approach B; their targets start at a first value of a run (rule in compare_targets.csv)",
             probs.len()
-        );
+        ));
     }
     for e in rt.ecdf.iter().filter(|r| r.group == "all") {
-        println!(
-            "  runtime ECDF all {}: AOCC {:.4}, mean over {} problems weighing the same ({} (run, target) pairs), budget {}",
-            e.optimiser, e.aocc, e.problems, e.pairs, rt.budget
-        );
+        lines.push(format!(
+            "  runtime ECDF all {}: AOCC {:.4}, mean over {} {}weighing the same ({} (run, target) pairs), budget {}",
+            e.optimiser, e.aocc, e.problems, rt.common_desc, e.pairs, rt.budget
+        ));
     }
+    lines
 }
 
 /// The curves of group `group`, one per optimiser that has one, in `opts` order, each in its
@@ -230,10 +235,19 @@ fn series_of(
         .collect()
 }
 
-/// The problems behind group `group`'s curves (1 for a problem, the most any optimiser ran for
-/// "all").
-fn group_problems<'a>(counts: impl Iterator<Item = (&'a str, usize)>, group: &str) -> usize {
-    counts.filter(|(g, _)| *g == group).map(|(_, n)| n).max().unwrap_or(0)
+/// The problems behind the "all" curves: their count when every optimiser's aggregate has the
+/// same, else each optimiser's, e.g. "(x 4, y 2)".
+fn all_problems<'a>(counts: impl Iterator<Item = (&'a str, &'a str, usize)>) -> String {
+    let all: Vec<(&str, usize)> =
+        counts.filter(|(g, _, _)| *g == "all").map(|(_, o, n)| (o, n)).collect();
+    match all.first() {
+        Some((_, n)) if all.iter().all(|(_, m)| m == n) => n.to_string(),
+        None => "0".into(),
+        _ => {
+            let each: Vec<String> = all.iter().map(|(o, n)| format!("{o} {n}")).collect();
+            format!("({})", each.join(", "))
+        }
+    }
 }
 
 /// The ECDF chart of one group.
@@ -246,7 +260,9 @@ fn render_ecdf(
     let rows: Vec<(&str, &str, &[f64])> =
         rt.ecdf.iter().map(|r| (r.group.as_str(), r.optimiser.as_str(), r.values.as_slice())).collect();
     let title = if group == "all" {
-        let n = group_problems(rt.ecdf.iter().map(|e| (e.group.as_str(), e.problems)), group);
+        let n = all_problems(
+            rt.ecdf.iter().map(|e| (e.group.as_str(), e.optimiser.as_str(), e.problems)),
+        );
         format!("all: mean ECDF of {n} {}(equal weight), {}", rt.common_desc, rt.targets_desc)
     } else {
         format!("{group}: share of (run, target) pairs reached")
@@ -278,9 +294,8 @@ fn render_fixed_budget(
         return Ok(false);
     }
     let title = if group == "all" {
-        let n = group_problems(
-            rt.fixed_budget.iter().map(|g| (g.group.as_str(), g.problems)),
-            group,
+        let n = all_problems(
+            rt.fixed_budget.iter().map(|g| (g.group.as_str(), g.optimiser.as_str(), g.problems)),
         );
         format!("all: mean normalised gap of {n} {}(equal weight)", rt.common_desc)
     } else {

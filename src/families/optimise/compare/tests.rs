@@ -102,7 +102,12 @@ fn partial_coverage_is_stated_and_the_tests_over_cells_use_the_common_cells() {
     let (opts, cells) = gather(&rows);
     let c = Coverage::of(&cells, &opts);
     let ran = vec![("ga".to_string(), 4), ("de".to_string(), 4), ("cma".to_string(), 2)];
-    assert_eq!(c, Coverage { cells: 4, common: 2, ran });
+    let not = |v: &[&str]| v.iter().map(|d| format!("{d} 20x20 6x6 chord_length")).collect();
+    let missing =
+        vec![("ga".to_string(), not(&[])), ("de".to_string(), not(&[])), ("cma".to_string(), not(&["a", "c"]))];
+    assert_eq!(c, Coverage { cells: 4, common: 2, ran, missing });
+    assert!(!c.full());
+    assert_eq!(c.used(), "the 2 of 4 cells every optimiser ran");
     let note = c.note().unwrap();
     assert!(note.contains("(cma ran 2 of 4)") && note.contains("use the 2 cells every optimiser ran"), "{note}");
     let (_, table) = friedman_table(&rows);
@@ -114,7 +119,8 @@ fn partial_coverage_is_stated_and_the_tests_over_cells_use_the_common_cells() {
     assert_eq!(per.rows.len(), 4 + 2 + 2);
     let full = fixture(&["ga", "de"], &["a", "b"], 2);
     let (opts, cells) = gather(&full);
-    assert_eq!(Coverage::of(&cells, &opts).note(), None);
+    let c = Coverage::of(&cells, &opts);
+    assert_eq!((c.note(), c.full(), c.used().as_str()), (None, true, "2 cells"));
 }
 
 /// One problem with targets 3, 2, 1 and two runs of x: run 1 reaches 3 at 10 and 2 and 1 at
