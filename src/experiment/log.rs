@@ -506,6 +506,7 @@ mod tests {
             spec_text: String::new(),
             set: Vec::new(),
             sweep: Vec::new(),
+            readings: BTreeMap::new(),
         };
         assert_eq!(a.difference(&a.clone()), None);
         let b = Fingerprint { master_seed: 2, ..a.clone() };
@@ -514,5 +515,11 @@ mod tests {
         assert!(a.difference(&c).unwrap().starts_with("profile"));
         let d = Fingerprint { set: vec!["optimise.de.f=0.5".into()], ..a.clone() };
         assert_eq!(a.difference(&d).unwrap(), "--set: none vs optimise.de.f=0.5");
+        let readings = BTreeMap::from([("optimise.knots".to_string(), "nurbs_book".into())]);
+        let e = Fingerprint { readings, ..a.clone() };
+        assert_eq!(
+            a.difference(&e).unwrap(),
+            "reading set: none vs optimise.knots = \"nurbs_book\""
+        );
     }
 }
