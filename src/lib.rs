@@ -18,7 +18,8 @@
 //!   [`experiment::thread_cpu_seconds`], [`experiment::GridSize`];
 //! - the families' entry points the benches and tests drive: [`families::som::run_cell`] and its
 //!   cells, [`families::optimise::problems`], [`families::optimise::exact_optima`],
-//!   [`families::suite`] (the Chapter 6 problems as a benchmark suite, for Python);
+//!   [`families::suite`] (the Chapter 6 problems as a benchmark suite, for Python), and
+//!   [`notice`] (where notes and progress lines go: stderr, or the Python package's `logging`);
 //! - the algorithms the benches time: [`som::train`], [`spline::fit_two_view`],
 //!   [`spline::ControlNetProblem`], the seed 003 Bezier problems, [`optim::De`], [`optim::Pso`],
 //!   [`optim::Csa`], [`optim::default_optimiser`], [`optim::certify_dual`], [`simd::Isa`] and the
@@ -38,6 +39,7 @@ pub mod experiment;
 pub mod families;
 pub mod geom;
 pub(crate) mod io;
+pub mod notice;
 pub mod optim;
 pub mod report;
 pub mod simd;

@@ -15,10 +15,11 @@ optimum and lower bound. ``somnurbs.ioh_adapter`` makes IOHexperimenter problems
 folders ``somnurbs compare --external`` reads. See docs/python.md.
 """
 
-from ._native import Problem, __version__, problems
+from ._native import SPECS, Problem, __version__, problems
 
-SPECS = ("ch6_same", "ch6_diff", "ch6_exact", "ch6_beyond", "seed001_growing_grid")
-"""The shipped specs with control-net problems (experiments/<name>.toml): Chapter 6's, and seed
-001's open surfaces (one view, no exact solver)."""
+# SPECS: the shipped specs with control-net problems, carried inside the package (a clone's
+# experiments/<name>.toml is preferred when run from its top): Chapter 6's, and seed 001's open
+# surfaces (one view, no exact solver). Notes and progress lines (a map recomputed) go to the
+# `logging` logger "somnurbs".
 
 __all__ = ["Problem", "problems", "SPECS", "__version__"]

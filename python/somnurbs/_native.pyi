@@ -7,11 +7,13 @@ import numpy as np
 import numpy.typing as npt
 
 __version__: str
+SPECS: tuple[str, ...]
 
 class Problem:
     """One control-net problem: minimise the thesis' Eq. 6.2 over the control points."""
 
     name: str
+    function_id: int
     dataset: str
     grid: str
     net: str

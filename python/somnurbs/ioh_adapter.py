@@ -1,7 +1,8 @@
 """somnurbs problems in IOHexperimenter (the ``ioh`` package).
 
-``wrap(p)`` makes an ``ioh`` real-valued problem of a :class:`somnurbs.Problem`: its name (the
-IOHprofiler function name ``somnurbs run`` writes, e.g. ``cube_20x20_6x6_chord_length``), its
+``wrap(p)`` makes an ``ioh`` real-valued problem of a :class:`somnurbs.Problem`: its name and
+function id (the IOHprofiler name and id ``somnurbs run`` writes, e.g. ``f1`` and
+``cube_20x20_6x6_chord_length``: the problem's place in the spec's order), its
 dimension, its box per coordinate and its certified optimum (``p.exact()``). ``Logger`` is an
 ``ioh.logger.Analyzer`` set up so that ``somnurbs compare --external FOLDER`` can match its
 problems with a Chapter 6 results folder: improvements logged at full precision, the suite's
@@ -65,6 +66,9 @@ def wrap(problem, box="spec", instance=1):
     )
     wrapped.bounds.lb = lower
     wrapped.bounds.ub = upper
+    # One numbering with `somnurbs run`'s ioh/: the problem's place in the spec (ioh would give a
+    # wrapped problem the first free id of its registry, f1121 and up).
+    wrapped.set_id(problem.function_id)
     return wrapped
 
 

@@ -5,7 +5,8 @@ perturbed point, the boxes and metadata, the certified bound never beaten by a l
 Environment: SOMNURBS_BIN (default <clone>/target/release/somnurbs, or under CARGO_TARGET_DIR),
 SOMNURBS_BENCH_EXPORT (the JSON `BENCH_EXPORT=... cargo bench --bench optim` writes; CI's peers
 check leaves one in target/peers-ci/problem.json), SOMNURBS_REQUIRE_ALL=1 (CI: a missing input is
-a failure, not a skip)."""
+a failure, not a skip), SOMNURBS_CLONE (the clone the CLI runs in, default the one these tests are
+in: CI copies them out of the clone to test the installed wheel elsewhere)."""
 
 import csv
 import json
@@ -20,7 +21,7 @@ import pytest
 import somnurbs
 import somnurbs.ioh_adapter as sio
 
-CLONE = Path(__file__).resolve().parents[2]
+CLONE = Path(os.environ.get("SOMNURBS_CLONE") or Path(__file__).resolve().parents[2])
 
 
 def missing(what):
@@ -132,7 +133,7 @@ def test_boxes_and_metadata(probs):
             assert len(set(p.lower_data[c::3])) == 1 and len(set(p.upper_data[c::3])) == 1
         m = p.metadata()
         assert m == {
-            "name": p.name, "dataset": p.dataset, "grid": "20x20", "net": p.net,
+            "name": p.name, "function_id": p.function_id, "dataset": p.dataset, "grid": "20x20", "net": p.net,
             "parameterisation": "chord_length", "reading": "eq2_10", "spec": "ch6_exact",
             "profile": "quick", "box": "B+-5e-6", "dimension": p.dimension, "b": p.b,
         }
@@ -140,7 +141,7 @@ def test_boxes_and_metadata(probs):
     other = somnurbs.problems("ch6_exact", profile="quick", reading="nurbs_book")
     assert {q.reading for q in other} == {"nurbs_book"}
     assert all(q.b != probs[q.name].b for q in other)
-    with pytest.raises(RuntimeError):
+    with pytest.raises(KeyError, match="^'ch6_exact: no profile"):
         somnurbs.problems("ch6_exact", profile="no_such_profile")
 
 
@@ -301,3 +302,134 @@ def test_threads_evaluate_concurrently_with_the_same_values(probs):
     with ThreadPoolExecutor(max_workers=4) as pool:
         got = list(pool.map(p.f, batches))
     assert all(np.array_equal(a, b) for a, b in zip(got, want))
+
+
+def test_inputs_that_are_no_real_point_are_refused(probs):
+    """NaN, inf, overflowing, complex and boolean input raise ValueError naming the row and the
+    coordinate; a non-array raises TypeError naming its type; nothing returns nan or inf."""
+    p = next(iter(probs.values()))
+    X = np.tile(p.x0, (3, 1))
+    for bad, words in ((np.nan, "nan at index 7"), (np.inf, "inf at index 7"), (-np.inf, "-inf at index 7")):
+        x = p.x0.copy()
+        x[7] = bad
+        with pytest.raises(ValueError, match=words):
+            p.f(x)
+        Y = X.copy()
+        Y[2, 7] = bad
+        with pytest.raises(ValueError, match=f"row 2 has {words}"):
+            p.f(Y)
+    with pytest.raises(ValueError, match="overflows"):
+        p.f(np.full(p.dimension, 1e300))
+    with pytest.raises(ValueError, match="complex"):
+        p.f(p.x0.astype(np.complex128))
+    with pytest.raises(ValueError, match="boolean"):
+        p.f(np.ones(p.dimension, dtype=bool))
+    for thing, name in ((None, "NoneType"), ("abc", "str"), ({"a": 1}, "dict")):
+        with pytest.raises(TypeError, match=name):
+            p.f(thing)
+    with pytest.raises(ValueError, match=r"got \(3, 1, " ):
+        p.f(X[:, None, :])
+    assert p.f(p.x0.astype(np.int64).astype(np.float64)) == p.f(p.x0.astype(np.int64))
+
+
+def test_requests_raise_python_errors_naming_what_is_offered(tmp_path):
+    with pytest.raises(KeyError, match="offered: ch6_same, ch6_diff, ch6_exact"):
+        somnurbs.problems("ch6_nope")
+    with pytest.raises(KeyError, match="no profile \"fast\".*offered: quick"):
+        somnurbs.problems("ch6_exact", profile="fast")
+    with pytest.raises(ValueError, match="reading=\"book\".*offered: eq2_10, nurbs_book"):
+        somnurbs.problems("ch6_exact", profile="quick", reading="book")
+    with pytest.raises(FileNotFoundError, match="nope.toml"):
+        somnurbs.problems(str(tmp_path / "nope.toml"))
+    with pytest.raises(ValueError, match="optimise.nope"):
+        somnurbs.problems("ch6_exact", profile="quick", set=["optimise.nope=1"])
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    with pytest.raises(FileNotFoundError, match="talus_r.stl.*data_dir="):
+        somnurbs.problems("ch6_exact", set=["optimise.datasets=[\"talus\"]"], data_dir=empty)
+    p = somnurbs.problems("ch6_exact", profile="quick")[0]
+    for call in (p.exact, p.has_exact):
+        with pytest.raises(ValueError, match="box must be 'spec' or 'data'"):
+            call("nope")
+    assert somnurbs.SPECS == ("ch6_same", "ch6_diff", "ch6_exact", "ch6_beyond", "seed001_growing_grid")
+
+
+def python_in(folder, code, env=None):
+    """Run `code` in a fresh interpreter in `folder` (no clone there): (stdout, stderr)."""
+    import sys
+
+    r = subprocess.run([sys.executable, "-c", code], cwd=folder, capture_output=True, text=True,
+                       env={**os.environ, **(env or {})}, timeout=600)
+    assert r.returncode == 0, r.stderr
+    return r.stdout, r.stderr
+
+
+def test_shipped_specs_load_outside_a_clone_and_notes_go_to_logging(tmp_path):
+    """From a folder with no experiments/ the shipped spec inside the package is used and its
+    maps are recomputed; the note saying so reaches Python's logging, never file descriptor 2."""
+    code = (
+        "import somnurbs\n"
+        "ps = somnurbs.problems('ch6_exact', profile='quick')\n"
+        "print(len(ps), ps[0].name, repr(ps[0].b))\n"
+    )
+    quiet_out, quiet_err = python_in(tmp_path, code)
+    assert quiet_err == ""
+    logged_out, logged_err = python_in(
+        tmp_path, "import logging, sys\nlogging.basicConfig(level=logging.INFO, stream=sys.stdout)\n" + code
+    )
+    assert logged_err == ""
+    assert "INFO:somnurbs:" in logged_out and "recomputing" in logged_out
+    assert logged_out.splitlines()[-1] == quiet_out.strip()
+    n, name, b = quiet_out.split()
+    p = somnurbs.problems("ch6_exact", profile="quick")[0]
+    assert (int(n), name, float(b)) == (4, p.name, p.b)
+
+
+def test_ctrl_c_stops_a_long_batch_between_chunks(probs):
+    """A pending signal (Ctrl-C) is seen between chunks of a few thousand rows: a batch stops
+    long before its end."""
+    import signal
+    import time
+
+    p = min(probs.values(), key=lambda q: q.dimension)
+    X = np.tile(p.x0, (400_000, 1))  # about 0.7 GB for the 6x6 net
+    t0 = time.perf_counter()
+    p.f(X)
+    full = time.perf_counter() - t0
+
+    class Stop(Exception):
+        pass
+
+    def stop(_signum, _frame):
+        raise Stop
+
+    old = signal.signal(signal.SIGALRM, stop)
+    try:
+        signal.setitimer(signal.ITIMER_REAL, full / 10)
+        t0 = time.perf_counter()
+        with pytest.raises(Stop):
+            p.f(X)
+        stopped = time.perf_counter() - t0
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
+    assert stopped < full / 2, (stopped, full)
+
+
+def function_ids(folder):
+    ids = {}
+    for f in folder.glob("IOHprofiler_f*.json"):
+        doc = json.loads(f.read_text())
+        assert f.name == f"IOHprofiler_f{doc['function_id']}_{doc['function_name']}.json"
+        ids[doc["function_name"]] = doc["function_id"]
+    return ids
+
+
+def test_function_ids_are_the_runs(tmp_path, probs, exact_folder):
+    """One numbering: `p.function_id` is the id `somnurbs run` gives the problem in ioh/, and
+    the adapter logs it (not ioh's first free id)."""
+    want = {name: p.function_id for name, p in probs.items()}
+    assert function_ids(exact_folder / "ioh" / "ga") == want
+    assert sorted(want.values()) == list(range(1, len(want) + 1))
+    folder = log_random_search(tmp_path / "ioh", probs.values(), evals=3, runs=1)
+    assert function_ids(folder) == want

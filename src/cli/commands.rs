@@ -1,7 +1,9 @@
 //! The commands behind the command line: each subcommand's arguments to the library's calls, the
 //! exit code, and errors printed on one line.
 
-use super::{Cli, Command, DatasetsAction, DriftArgs, ReproduceArgs, RunArgs};
+use super::{
+    Cli, Command, CompareArgs, DatasetsAction, DriftArgs, FitArgs, ReproduceArgs, RunArgs,
+};
 use crate::experiment::{self, log::Shard, spec::CliOverrides, RunContext};
 use crate::families::{Loaded, Section};
 use clap::Parser;
@@ -88,17 +90,61 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         }
         Command::Reproduce(args) => reproduce(&args),
         Command::Compare(args) => {
-            crate::families::optimise::compare::compare(&args)?;
+            crate::families::optimise::compare::compare(&args.into())?;
             Ok(ExitCode::SUCCESS)
         }
         Command::Fit(args) => {
-            crate::families::fit::command::fit(&args)?;
+            crate::families::fit::command::fit(&args.into())?;
             Ok(ExitCode::SUCCESS)
         }
         Command::Datasets(args) => {
             let dir = experiment::data_dir(args.data_dir.as_deref());
-            experiment::datasets::datasets(args.action.unwrap_or(DatasetsAction::List), &dir)?;
+            let action = args.action.unwrap_or(DatasetsAction::List);
+            experiment::datasets::datasets(action.into(), &dir)?;
             Ok(ExitCode::SUCCESS)
+        }
+    }
+}
+
+// The command line's arguments as the families and the engine take them (clap stays in `cli`).
+
+impl From<CompareArgs> for crate::families::optimise::compare::Request {
+    fn from(a: CompareArgs) -> Self {
+        Self {
+            results: a.results,
+            alpha: a.alpha,
+            rope: a.rope,
+            bayes_samples: a.bayes_samples,
+            out: a.out,
+            external: a.external,
+        }
+    }
+}
+
+impl From<FitArgs> for crate::families::fit::command::Request {
+    fn from(a: FitArgs) -> Self {
+        Self {
+            grid: a.grid,
+            cn: a.cn,
+            param: a.param,
+            approach: a.approach,
+            out: a.out,
+            samples: a.samples,
+            knots: a.knots,
+            error_a: a.error_a,
+            fairness: a.fairness,
+            frame: a.frame,
+            units: a.units,
+        }
+    }
+}
+
+impl From<DatasetsAction> for experiment::datasets::Action {
+    fn from(a: DatasetsAction) -> Self {
+        match a {
+            DatasetsAction::List => Self::List,
+            DatasetsAction::Show { name } => Self::Show { name },
+            DatasetsAction::Export { name, file } => Self::Export { name, file },
         }
     }
 }
@@ -217,7 +263,9 @@ fn reproduce(args: &ReproduceArgs) -> anyhow::Result<ExitCode> {
     super::interrupt::on_sigint(&reproduce_resume_command(args, &specs, &ctx.out));
     let report =
         experiment::reproduce::reproduce::<Section>(&specs, &args.plan, &args.profile, &ctx)?;
-    eprintln!("somnurbs: wrote {}", report.display());
+    if let Some(report) = report {
+        eprintln!("somnurbs: wrote {}", report.display());
+    }
     Ok(ExitCode::SUCCESS)
 }
 

@@ -129,7 +129,7 @@ fn where_to_get(file: &str) -> String {
         _ => "https://github.com/modenaxe/msk-STAPLE/raw/master/bone_datasets/TLEM2/stl/talus_r.stl",
     };
     format!(
-        "Download {file} from {source} into ./data (the default), or name its folder with --data-dir or SOMNURBS_DATA (README, \"Set up\")."
+        "Download {file} from {source} into ./data (the default), or name its folder with SOMNURBS_DATA, the CLI's --data-dir or Python's data_dir= (README, \"Set up\")."
     )
 }
 
@@ -289,7 +289,7 @@ fn note_once(key: &str, message: &str) {
         std::sync::Mutex::new(std::collections::BTreeSet::new());
     let first = NOTED.lock().map(|mut s| s.insert(key.to_string())).unwrap_or(true);
     if first {
-        eprintln!("somnurbs: note: {message}");
+        crate::notice::emit(&format!("somnurbs: note: {message}"));
     }
 }
 

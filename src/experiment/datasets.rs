@@ -1,20 +1,30 @@
 //! `somnurbs datasets`: list, describe and export data sets.
 
-use crate::cli::DatasetsAction;
 use crate::data::registry;
 use anyhow::Result;
 use std::fmt::Write;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-pub(crate) fn datasets(action: DatasetsAction, data_dir: &Path) -> Result<()> {
+/// What `somnurbs datasets` is asked to do (the command line's `DatasetsAction`).
+#[derive(Debug, Clone)]
+pub(crate) enum Action {
+    /// List the built-in data sets.
+    List,
+    /// Load one data set and print its size and bounds.
+    Show { name: String },
+    /// Write a data set's normalised points to `file` (.csv, else XYZ).
+    Export { name: String, file: PathBuf },
+}
+
+pub(crate) fn datasets(action: Action, data_dir: &Path) -> Result<()> {
     match action {
-        DatasetsAction::List => {
+        Action::List => {
             for name in registry::BUILTIN {
                 println!("{name:<12} {}", registry::describe(name).unwrap_or(""));
             }
             println!("\nAny .ply/.stl/.off/.obj/.xyz/.csv/.txt path is accepted as a data set too. Data directory: {}", data_dir.display());
         }
-        DatasetsAction::Show { name } => {
+        Action::Show { name } => {
             let cloud = registry::load_dataset(&name, data_dir)?;
             let (lo, hi) = crate::geom::bounding_box(&cloud.points).unwrap_or(([0.0; 3], [0.0; 3]));
             println!(
@@ -30,7 +40,7 @@ pub(crate) fn datasets(action: DatasetsAction, data_dir: &Path) -> Result<()> {
                 println!("  {:.6} {:.6} {:.6}", p[0], p[1], p[2]);
             }
         }
-        DatasetsAction::Export { name, file } => {
+        Action::Export { name, file } => {
             let cloud = registry::load_dataset(&name, data_dir)?;
             let csv = file.extension().map(|e| e.eq_ignore_ascii_case("csv")).unwrap_or(false);
             let mut text = String::new();

@@ -89,6 +89,18 @@ pub(crate) struct Fingerprint {
     pub(crate) set: Vec<String>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub(crate) sweep: Vec<String>,
+    /// A plan's reading set's keys that reached the spec (`readings/<set>/<spec>`), applied over
+    /// `spec_text` as the plan applied them (absent outside a reading set).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub(crate) readings: BTreeMap<String, toml::Value>,
+}
+
+/// A reading set's keys in words (`none` outside a set).
+fn readings_text(r: &BTreeMap<String, toml::Value>) -> String {
+    if r.is_empty() {
+        return "none".into();
+    }
+    r.iter().map(|(k, v)| format!("{k} = {v}")).collect::<Vec<_>>().join(", ")
 }
 
 impl Fingerprint {
@@ -107,8 +119,17 @@ impl Fingerprint {
             ),
             ("--set", shown(&self.set), shown(&other.set)),
             ("--sweep", shown(&self.sweep), shown(&other.sweep)),
+            ("reading set", readings_text(&self.readings), readings_text(&other.readings)),
         ];
         pairs.into_iter().find(|(_, a, b)| a != b).map(|(name, a, b)| format!("{name}: {a} vs {b}"))
+    }
+
+    /// The reading set's keys as overrides, as the plan applied them.
+    pub(crate) fn reading_overrides(&self) -> Vec<super::Override> {
+        self.readings
+            .iter()
+            .map(|(k, v)| super::Override { key: k.clone(), value: v.clone() })
+            .collect()
     }
 
     /// The command line's changes, as a spec reads them back (merge).
@@ -186,21 +207,11 @@ pub(crate) fn read_matching(
     Ok(out)
 }
 
-/// How many cells of `dir`'s log were taken from another folder (`reused_from`).
+/// How many cells of `dir`'s log were taken from another folder: the lines with a `reused_from`
+/// field (a scan for the field's name, which no key or value contains; the run has read and
+/// checked every line already, so no line is parsed again).
 pub(crate) fn count_reused(dir: &Path) -> Result<usize> {
-    #[derive(Deserialize)]
-    struct Reused {
-        #[serde(default)]
-        reused_from: Option<String>,
-    }
-    let text = log_text(dir)?;
-    let mut n = 0;
-    for line in text.lines().filter(|l| !l.trim().is_empty()) {
-        let r: Reused = serde_json::from_str(line)
-            .with_context(|| format!("{}: malformed cell record", dir.display()))?;
-        n += usize::from(r.reused_from.is_some());
-    }
-    Ok(n)
+    Ok(log_text(dir)?.lines().filter(|l| l.contains("\"reused_from\":")).count())
 }
 
 /// The finished cells a folder's log holds, by key (the last line wins if a key repeats): the
@@ -495,6 +506,7 @@ mod tests {
             spec_text: String::new(),
             set: Vec::new(),
             sweep: Vec::new(),
+            readings: BTreeMap::new(),
         };
         assert_eq!(a.difference(&a.clone()), None);
         let b = Fingerprint { master_seed: 2, ..a.clone() };
@@ -503,5 +515,11 @@ mod tests {
         assert!(a.difference(&c).unwrap().starts_with("profile"));
         let d = Fingerprint { set: vec!["optimise.de.f=0.5".into()], ..a.clone() };
         assert_eq!(a.difference(&d).unwrap(), "--set: none vs optimise.de.f=0.5");
+        let readings = BTreeMap::from([("optimise.knots".to_string(), "nurbs_book".into())]);
+        let e = Fingerprint { readings, ..a.clone() };
+        assert_eq!(
+            a.difference(&e).unwrap(),
+            "reading set: none vs optimise.knots = \"nurbs_book\""
+        );
     }
 }

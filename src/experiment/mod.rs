@@ -238,6 +238,7 @@ pub(crate) fn fingerprint<F: Families>(
         spec_text: spec.text.clone(),
         set: spec.cli.set.clone(),
         sweep: spec.cli.sweep.clone(),
+        readings: spec.readings.clone(),
     }
 }
 
@@ -266,11 +267,11 @@ pub(crate) fn run_variants<F: Families>(
     let fp = fingerprint(variants, ctx.shard);
     match claim(&ctx.out, &fp, ctx.resume)? {
         Claimed::Finished => {
-            eprintln!(
+            crate::notice::emit(&format!(
                 "somnurbs: {} already holds this run, finished; nothing to do (`somnurbs report {}` makes a lost table or picture again from its records)",
                 ctx.out.display(),
                 ctx.out.display()
-            );
+            ));
             Ok(ctx.out.clone())
         }
         Claimed::Start => run_spec_locked(variants, ctx),
@@ -313,10 +314,10 @@ fn claim(out: &Path, fp: &log::Fingerprint, resume: bool) -> Result<Claimed> {
     }
     let removed = crate::io::outdir::remove_leftovers(out)?;
     if removed > 0 {
-        eprintln!(
+        crate::notice::emit(&format!(
             "somnurbs: removed {removed} temporary file(s) the interrupted run left in {}",
             out.display()
-        );
+        ));
     }
     Ok(Claimed::Start)
 }
@@ -416,6 +417,13 @@ fn render_locked<F: Families>(
 pub(crate) fn report<F: Families>(dir: &Path, data_dir: PathBuf, jobs: usize) -> Result<PathBuf> {
     let _lock = crate::io::outdir::lock_to_fill(dir, "report")?;
     let fp = log::Fingerprint::read(dir)?.with_context(|| {
+        if dir.join(crate::io::outdir::PLAN_FILE).exists() {
+            return format!(
+                "{}: a `reproduce` folder: `somnurbs report` re-renders each spec's sub-folder (e.g. {}); its combined REPORT.md is `reproduce`'s",
+                dir.display(),
+                dir.join("ch6_same").display()
+            );
+        }
         format!(
             "{}: no {}; name a folder `somnurbs run` or `merge` wrote",
             dir.display(),
@@ -441,10 +449,19 @@ pub(crate) fn report<F: Families>(dir: &Path, data_dir: PathBuf, jobs: usize) ->
         );
     }
     let profile = (fp.profile != "default").then_some(fp.profile.as_str());
-    let variants: Vec<Loaded<F>> =
-        fp.overrides()
-            .variants(&fp.spec_path, &fp.spec_text, profile)
-            .with_context(|| format!("{}: the folder's spec", dir.display()))?;
+    let mut variants: Vec<Loaded<F>> = if fp.readings.is_empty() {
+        fp.overrides().variants(&fp.spec_path, &fp.spec_text, profile)
+    } else {
+        let over = fp.reading_overrides();
+        Loaded::parse_reaching(&fp.spec_path, &fp.spec_text, profile, &over).map(|(l, _)| vec![l])
+    }
+    .with_context(|| format!("{}: the folder's spec", dir.display()))?;
+    if let Some(maps) = reproduce::plan_maps_of(dir)? {
+        for v in &mut variants {
+            let family = v.family();
+            family.use_maps(&mut v.section, &maps);
+        }
+    }
     let ctx = RunContext {
         resume: true,
         compute: false,
@@ -667,10 +684,10 @@ pub(crate) fn merge<F: Families>(shards: &[PathBuf], ctx: &RunContext) -> Result
 pub fn data_dir(flag: Option<&Path>) -> PathBuf {
     let (dir, clone) = crate::data::registry::found_folder(flag, Some("SOMNURBS_DATA"), "data");
     if clone {
-        eprintln!(
+        crate::notice::emit(&format!(
             "somnurbs: note: no data/ in the working folder; reading data files from the clone somnurbs was built from, {} (--data-dir DIR or SOMNURBS_DATA names another)",
             dir.display()
-        );
+        ));
     }
     dir
 }

@@ -149,9 +149,9 @@ pub(crate) fn note(path: &str, made: &[(&'static str, &'static str)]) {
     let Ok(mut said) = SAID.lock() else { return };
     for &(old, new) in made {
         if said.insert((path.to_string(), old)) {
-            eprintln!(
+            crate::notice::emit(&format!(
                 "somnurbs: note: {path}: [{old}] is now called [{new}]; the old name still works"
-            );
+            ));
         }
     }
 }

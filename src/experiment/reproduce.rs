@@ -393,7 +393,7 @@ pub(crate) fn reproduce<F: Families>(
     plan_name: &str,
     profile: &str,
     ctx: &RunContext,
-) -> Result<PathBuf> {
+) -> Result<Option<PathBuf>> {
     let plan_path = specs_dir.join(format!("{plan_name}.toml"));
     if !plan_path.exists() {
         anyhow::bail!(
@@ -432,10 +432,11 @@ pub(crate) fn reproduce<F: Families>(
     };
     if claim_plan(&ctx.out, &layout, &record, ctx.resume)? == Claimed::Finished {
         eprintln!(
-            "somnurbs: {} already holds this reproduction, finished; nothing to do",
-            ctx.out.display()
+            "somnurbs: {} already holds this reproduction, finished; nothing to do (`somnurbs report {}` makes a lost table or picture of a spec again from its records)",
+            ctx.out.display(),
+            ctx.out.join(&layout.specs[0]).display()
         );
-        return Ok(ctx.out.join("REPORT.md"));
+        return Ok(None);
     }
     // Every spec has loaded: the folder is unfinished until the combined REPORT.md is written.
     let incomplete = ctx.out.join(crate::io::outdir::INCOMPLETE);
@@ -491,7 +492,7 @@ pub(crate) fn reproduce<F: Families>(
     std::fs::remove_file(&incomplete)
         .with_context(|| format!("cannot remove {}", incomplete.display()))?;
     crate::io::outdir::sync_dir(&ctx.out)?;
-    Ok(path)
+    Ok(Some(path))
 }
 
 /// Run every reading set's specs into `readings/<set>/<spec>/`, each folder's time added to `done`.
@@ -521,6 +522,28 @@ fn run_reading_sets<F: Families>(
         }
     }
     Ok(())
+}
+
+/// The maps folder `reproduce` pointed the spec of the sub-folder `dir` at (`<root>/<maps_from>/maps`,
+/// made absolute as the run made it), found from the plan record of its root: `dir`'s parent, or
+/// for a reading set's `readings/<set>/<spec>` three levels up. None for a folder of no plan.
+/// `somnurbs report` reads the maps the run read, so its tables and text are the run's.
+pub(crate) fn plan_maps_of(dir: &Path) -> Result<Option<String>> {
+    let parent = dir.parent();
+    let in_set = parent
+        .and_then(Path::parent)
+        .filter(|r| r.file_name().is_some_and(|n| n == READINGS_DIR))
+        .and_then(Path::parent);
+    for root in [parent, in_set].into_iter().flatten() {
+        let Some(record) = PlanRecord::read(root)? else { continue };
+        let plan: Plan = toml::from_str(&record.plan_text)
+            .with_context(|| format!("{}: the plan's text", root.join(PLAN_FILE).display()))?;
+        return Ok(plan.maps_from.map(|m| {
+            let maps = root.join(m).join("maps");
+            std::path::absolute(&maps).unwrap_or(maps).to_string_lossy().into_owned()
+        }));
+    }
+    Ok(None)
 }
 
 /// The record of the plan a `reproduce` folder holds ([`PLAN_FILE`]): which plan, in which

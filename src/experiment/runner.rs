@@ -54,8 +54,8 @@ pub(crate) fn progress_line(
 }
 
 /// Run `work` over `cells` on `jobs` threads. On a terminal a progress bar shows; otherwise (a
-/// log: SLURM, nohup, CI) a plain `progress_line` is printed to stderr when the cells start, every
-/// `progress_interval` and when they end.
+/// log: SLURM, nohup, CI, or a [`crate::notice`] sink) a plain `progress_line` is a notice when the
+/// cells start, every `progress_interval` and when they end.
 pub fn run_cells<C, R>(
     cells: &[C],
     jobs: usize,
@@ -73,7 +73,8 @@ where
         .num_threads(jobs.max(1))
         .build()
         .context("cannot start worker threads")?;
-    let plain = !std::io::stderr().is_terminal() && !cells.is_empty();
+    let plain =
+        (!std::io::stderr().is_terminal() || crate::notice::redirected()) && !cells.is_empty();
     let bar = if plain { ProgressBar::hidden() } else { ProgressBar::new(cells.len() as u64) };
     bar.set_style(
         ProgressStyle::with_template(
@@ -87,7 +88,7 @@ where
     let started = std::time::Instant::now();
     let results = std::thread::scope(|scope| {
         if plain {
-            eprintln!("{}", progress_line(label, 0, cells.len(), started.elapsed()));
+            crate::notice::emit(&progress_line(label, 0, cells.len(), started.elapsed()));
             let (finished, stop) = (&finished, &stop);
             scope.spawn(move || {
                 let interval = progress_interval();
@@ -101,15 +102,12 @@ where
                     if *stopped || !timeout.timed_out() {
                         continue;
                     }
-                    eprintln!(
-                        "{}",
-                        progress_line(
-                            label,
-                            finished.load(Ordering::Relaxed),
-                            cells.len(),
-                            started.elapsed()
-                        )
-                    );
+                    crate::notice::emit(&progress_line(
+                        label,
+                        finished.load(Ordering::Relaxed),
+                        cells.len(),
+                        started.elapsed(),
+                    ));
                 }
             });
         }
@@ -132,7 +130,7 @@ where
     });
     bar.finish_and_clear();
     if plain && results.is_ok() {
-        eprintln!("{}", progress_line(label, cells.len(), cells.len(), started.elapsed()));
+        crate::notice::emit(&progress_line(label, cells.len(), cells.len(), started.elapsed()));
     }
     results
 }
@@ -230,12 +228,12 @@ where
         .filter(|c| missing.contains(&c.key()) && !reused.contains_key(&c.key()))
         .collect();
     if ctx.resume && ctx.compute && todo.len() < slice.len() {
-        eprintln!(
+        crate::notice::emit(&format!(
             "somnurbs: resuming {}: {} of {} cells already done",
             ctx.out.display(),
             slice.len() - todo.len() - reused.len(),
             slice.len()
-        );
+        ));
     }
     if let (false, Some(c)) = (ctx.compute, todo.first()) {
         anyhow::bail!(

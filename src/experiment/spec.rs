@@ -145,6 +145,9 @@ pub struct Spec {
     pub cli: CliOverrides,
     /// Which variant of the spec this is: its `key=value` changes (empty for a plain run).
     pub variant: Variant,
+    /// A plan's reading set's keys that reached this spec, with their values (empty outside a
+    /// reading set): kept in the fingerprint, so `report` and `--resume` apply them again.
+    pub readings: std::collections::BTreeMap<String, toml::Value>,
 }
 
 /// A spec file's text (UTF-8; a UTF-16 or binary file is named as such).
@@ -246,7 +249,13 @@ impl<F: Families> Loaded<F> {
                 e.message().replace('\n', " ")
             ))
         })?;
-        Ok((Loaded::checked(Spec { file, ..spec.spec }, sections)?, reached))
+        let readings = overrides
+            .iter()
+            .zip(&reached)
+            .filter(|(_, r)| **r)
+            .map(|(o, _)| (o.key.clone(), o.value.clone()))
+            .collect();
+        Ok((Loaded::checked(Spec { file, readings, ..spec.spec }, sections)?, reached))
     }
 
     /// Parse spec text; `path` is used in messages only.
@@ -295,6 +304,7 @@ impl<F: Families> Loaded<F> {
             profile: profile.map(String::from),
             cli: CliOverrides::default(),
             variant: Variant::default(),
+            readings: Default::default(),
         };
         Loaded::checked(spec, sections)
     }

@@ -245,7 +245,7 @@ pub(crate) fn maps_for(
     from: &MapsFrom,
 ) -> Result<BTreeMap<String, MapSource>> {
     if let Some(line) = require_maps(spec, datasets, grid, from)? {
-        eprintln!("{line}");
+        crate::notice::emit(&line);
     }
     let wanted = map_files(spec, datasets, grid, from);
     let mut out = BTreeMap::new();

@@ -37,6 +37,9 @@ pub struct SuiteProblem {
     /// The IOHprofiler function name, as `ioh/` of a run names it
     /// (`<dataset>_<grid>_<net>_<parameterisation>`).
     pub name: String,
+    /// The IOHprofiler function id, as `ioh/` of a run numbers it: the problem's place in the
+    /// spec's order (1-based).
+    pub function_id: u32,
     pub dataset: String,
     pub grid: GridSize,
     pub net: GridSize,
@@ -99,25 +102,77 @@ pub fn box_label(o: &OptimSpec) -> String {
     }
 }
 
+/// The shipped specs with control-net problems and their text, carried inside the program (and
+/// the Python wheel), so that a shipped name needs no clone: Chapter 6's, and seed 001's open
+/// surfaces (one view, no exact solver).
+pub const SHIPPED: [(&str, &str); 5] = [
+    ("ch6_same", include_str!("../../experiments/ch6_same.toml")),
+    ("ch6_diff", include_str!("../../experiments/ch6_diff.toml")),
+    ("ch6_exact", include_str!("../../experiments/ch6_exact.toml")),
+    ("ch6_beyond", include_str!("../../experiments/ch6_beyond.toml")),
+    ("seed001_growing_grid", include_str!("../../experiments/seed001_growing_grid.toml")),
+];
+
+/// A request `load` refuses before building anything: what was asked and what is offered.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RequestError {
+    #[error("no shipped spec {name:?} (offered: {}; or give a .toml file's path)", offered.join(", "))]
+    Spec { name: String, offered: Vec<String> },
+    #[error("{path}: no such spec file")]
+    SpecFile { path: String },
+    #[error("{spec}: no profile {name:?} (offered: {})", if offered.is_empty() { "none".to_string() } else { offered.join(", ") })]
+    Profile { spec: String, name: String, offered: Vec<String> },
+}
+
 /// A spec by file path, or by the name of a shipped one (`ch6_same`): `experiments/<name>.toml`
-/// in the working folder, else in the clone somnurbs was built from.
-pub fn spec_path(spec: &str) -> PathBuf {
+/// in the working folder when there is one (a clone's, which a user may have edited), else the
+/// shipped text, written into `work`.
+pub fn spec_path(spec: &str, work: &Path) -> Result<PathBuf> {
     let p = Path::new(spec);
     if p.extension().is_some_and(|e| e == "toml") || p.components().count() > 1 {
-        return p.to_path_buf();
+        if !p.is_file() {
+            return Err(RequestError::SpecFile { path: p.display().to_string() }.into());
+        }
+        return Ok(p.to_path_buf());
     }
+    let Some((_, text)) = SHIPPED.iter().find(|(n, _)| *n == spec) else {
+        let offered = SHIPPED.iter().map(|(n, _)| n.to_string()).collect();
+        return Err(RequestError::Spec { name: spec.to_string(), offered }.into());
+    };
     let here = Path::new("experiments").join(format!("{spec}.toml"));
     if here.is_file() {
-        return here;
+        return Ok(here);
     }
-    Path::new(crate::data::registry::CLONE_DIR).join("experiments").join(format!("{spec}.toml"))
+    let dir = work.join("experiments");
+    std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let path = dir.join(format!("{spec}.toml"));
+    crate::io::write_atomic(&path, text.as_bytes())?;
+    Ok(path)
+}
+
+/// The profiles a spec file defines; an error naming them (and the spec as `shown`) when
+/// `profile` is not one.
+fn check_profile(path: &Path, shown: &str, profile: Option<&str>) -> Result<()> {
+    let Some(name) = profile else { return Ok(()) };
+    let text = crate::io::read_text(path)?;
+    let table: toml::Table =
+        toml::from_str(&text).with_context(|| format!("{}: not a spec", path.display()))?;
+    let offered: Vec<String> = match table.get("profiles") {
+        Some(toml::Value::Table(t)) => t.keys().cloned().collect(),
+        _ => Vec::new(),
+    };
+    if offered.iter().any(|p| p == name) {
+        return Ok(());
+    }
+    Err(RequestError::Profile { spec: shown.to_string(), name: name.to_string(), offered }.into())
 }
 
 /// Load every control-net problem of a Chapter 6 spec (`[optimise]`) or of seed 001's
 /// (`[growing_grid]`) under `profile` and the `KEY=VALUE` settings of `set` (as
 /// `somnurbs run --set`, e.g. `optimise.knots=nurbs_book`). Data files come from `data_dir` (else as
-/// the CLI finds them, falling back to the clone's `data/`); a map the spec names but that is
-/// missing is recomputed as the run would, written into `work` (a folder the caller owns).
+/// the CLI finds them); a map the spec names but that is missing is recomputed as the run would,
+/// written into `work` (a folder the caller owns), where a shipped spec's text also goes
+/// ([`spec_path`]). An unknown spec or profile is a [`RequestError`].
 pub fn load(
     spec: &str,
     profile: Option<&str>,
@@ -125,7 +180,8 @@ pub fn load(
     data_dir: Option<&Path>,
     work: &Path,
 ) -> Result<Suite> {
-    let path = spec_path(spec);
+    let path = spec_path(spec, work)?;
+    check_profile(&path, spec, profile)?;
     let cli = CliOverrides { set: set.to_vec(), sweep: Vec::new() };
     let mut variants = Loaded::load_variants(&path, profile, &cli)?;
     let Loaded { spec, section } = variants.pop().context("no spec")?;
@@ -139,25 +195,40 @@ pub fn load(
             spec.path
         ),
     };
-    let built = optimise::problems(&spec, o, &ctx)?;
+    let mut built = optimise::problems(&spec, o, &ctx)?;
     let mut problems = Vec::with_capacity(built.len());
-    for (ProblemKey { data: dataset, cn: net, param }, problem) in built {
-        let wide =
-            ControlNetProblem::new(problem.parts().clone(), BoxSpec::Cover { fraction: 0.0 })
+    // The spec's order (data sets, then nets, then parameterisations): the order of its cells,
+    // in which `ioh/` of a run numbers its functions, so `function_id` is the run's.
+    for entry in &o.datasets {
+        let dataset = crate::data::registry::name_of(entry);
+        for &net in &o.control_nets {
+            for &param in &o.parameterisations {
+                let key = ProblemKey::new(&dataset, net, param);
+                let problem = built.remove(&key).context("a problem of the spec was not built")?;
+                let wide = ControlNetProblem::new(
+                    problem.parts().clone(),
+                    BoxSpec::Cover { fraction: 0.0 },
+                )
                 .with_context(|| format!("{dataset} {net} {}: the data-range box", param.name()))?;
-        problems.push(SuiteProblem {
-            name: optimise::ioh::problem_name(
-                &dataset,
-                &o.grid.to_string(),
-                &net.to_string(),
-                param.name(),
-            ),
-            dataset,
-            grid: o.grid,
-            net,
-            param,
-            fitness: Fitness::ControlNet { problem: Box::new(problem), wide: Box::new(wide) },
-        });
+                problems.push(SuiteProblem {
+                    name: optimise::ioh::problem_name(
+                        &dataset,
+                        &o.grid.to_string(),
+                        &net.to_string(),
+                        param.name(),
+                    ),
+                    function_id: problems.len() as u32 + 1,
+                    dataset: dataset.clone(),
+                    grid: o.grid,
+                    net,
+                    param,
+                    fitness: Fitness::ControlNet {
+                        problem: Box::new(problem),
+                        wide: Box::new(wide),
+                    },
+                });
+            }
+        }
     }
     Ok(Suite {
         spec_name: spec.file.name.clone(),
@@ -189,6 +260,7 @@ fn open_surfaces(
                 &net.to_string(),
                 param.name(),
             ),
+            function_id: problems.len() as u32 + 1,
             dataset,
             grid,
             net,
@@ -210,6 +282,44 @@ fn open_surfaces(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every spec of experiments/ with control-net problems is shipped, with the file's text.
+    #[test]
+    fn every_suite_spec_is_shipped_with_its_text() {
+        let dir = Path::new(crate::data::registry::CLONE_DIR).join("experiments");
+        let mut suites = Vec::new();
+        for e in std::fs::read_dir(&dir).unwrap().flatten() {
+            let text = std::fs::read_to_string(e.path()).unwrap_or_default();
+            if text.contains("\n[optimise]") || text.contains("\n[growing_grid]") {
+                let name = e.path().file_stem().unwrap().to_string_lossy().into_owned();
+                suites.push((name, text));
+            }
+        }
+        suites.sort();
+        let mut shipped: Vec<(String, String)> =
+            SHIPPED.iter().map(|(n, t)| (n.to_string(), t.to_string())).collect();
+        shipped.sort();
+        assert_eq!(suites, shipped);
+    }
+
+    /// An unknown spec, spec file or profile is refused with what is offered, before any work.
+    #[test]
+    fn unknown_requests_name_what_is_offered() {
+        let work = tempfile::tempdir().unwrap();
+        let err = |spec: &str, profile: Option<&str>| {
+            let e = load(spec, profile, &[], None, work.path()).err().unwrap();
+            e.downcast::<RequestError>().unwrap()
+        };
+        assert!(
+            matches!(err("nope", None), RequestError::Spec { ref offered, .. } if offered.len() == 5)
+        );
+        assert!(matches!(err("nope/x.toml", None), RequestError::SpecFile { .. }));
+        let RequestError::Profile { offered, .. } = err("ch6_exact", Some("fast")) else {
+            panic!()
+        };
+        assert_eq!(offered, ["quick"]);
+        assert!(err("ch6_exact", Some("fast")).to_string().contains("offered: quick"));
+    }
 
     /// The quick ch6_exact suite: the run's problems under their IOHprofiler names, B's box and
     /// the data-range box around the same start, the spec's metadata; another reading moves B.

@@ -164,6 +164,16 @@ pub(crate) fn csv_text<T: serde::Serialize>(rows: &[T]) -> Result<String> {
     Ok(String::from_utf8(out.into_inner().map_err(|e| e.into_error())?)?)
 }
 
+/// CSV text of typed rows as [`csv_text`] writes them, and with no rows the header alone (the
+/// field names of `T::default()`), so that an empty table still names its columns.
+pub(crate) fn csv_table<T: serde::Serialize + Default>(rows: &[T]) -> Result<String> {
+    if !rows.is_empty() {
+        return csv_text(rows);
+    }
+    let one = csv_text(&[T::default()])?;
+    Ok(one.lines().next().map(|h| format!("{h}\n")).unwrap_or_default())
+}
+
 /// CSV text from a header and string records, with no negative zero.
 pub(crate) fn csv_records(header: &[String], rows: &[Vec<String>]) -> Result<String> {
     let mut w = csv::Writer::from_writer(Vec::new());

@@ -770,12 +770,12 @@ pub(crate) fn remove_stale(stale: &[PathBuf], target: &Path, command: &str) -> R
         .iter()
         .filter_map(|s| s.file_name().map(|n| n.to_string_lossy().into_owned()))
         .collect();
-    eprintln!(
+    crate::notice::emit(&format!(
         "somnurbs: note: removed {} folder(s) an interrupted {command} left beside {} (their process is gone): {}",
         stale.len(),
         target.display(),
         names.join(", ")
-    );
+    ));
     Ok(())
 }
 

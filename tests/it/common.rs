@@ -234,10 +234,16 @@ pub fn report_restores_every_file(spec: &str) {
     let c = Case::new();
     let spec = Path::new(env!("CARGO_MANIFEST_DIR")).join(spec);
     c.ok(&["run", spec.to_str().unwrap(), "--profile", "quick", "--out", "o"]);
-    let before = snapshot(&c.path("o"));
+    report_restores_folder(&c, "o");
+}
+
+/// Delete every file of the finished folder `dir` (under `c`) but its cell log, fingerprint and
+/// manifest, run `somnurbs report` on it, and check every file came back byte for byte.
+pub fn report_restores_folder(c: &Case, dir: &str) {
+    let before = snapshot(&c.path(dir));
     let kept = ["cells.jsonl", "cells.jsonl.gz", "fingerprint.toml", "manifest.toml"];
     let mut deleted = 0;
-    for p in walk(&c.path("o")) {
+    for p in walk(&c.path(dir)) {
         let name = p.file_name().unwrap().to_str().unwrap();
         if !kept.contains(&name) && name != ".somnurbs.lock" {
             std::fs::remove_file(&p).unwrap();
@@ -245,11 +251,11 @@ pub fn report_restores_every_file(spec: &str) {
         }
     }
     assert!(deleted > 0, "the run wrote no table to delete");
-    c.ok(&["report", "o"]);
-    let after = snapshot(&c.path("o"));
+    c.ok(&["report", dir]);
+    let after = snapshot(&c.path(dir));
     let names = |s: &[(String, Vec<u8>)]| s.iter().map(|(f, _)| f.clone()).collect::<Vec<_>>();
-    assert_eq!(names(&after), names(&before), "report did not make the same files");
+    assert_eq!(names(&after), names(&before), "{dir}: report did not make the same files");
     for ((f, a), (_, b)) in after.iter().zip(&before) {
-        assert!(a == b, "{f} differs after somnurbs report");
+        assert!(a == b, "{dir}/{f} differs after somnurbs report");
     }
 }

@@ -156,6 +156,17 @@ fn reproduce_quick_writes_one_report_with_claims_and_tables_6_8_6_9() {
     keys.sort();
     keys.dedup();
     assert_eq!(keys.len(), claims.len(), "a (spec, grid, claim) repeats: {claims:?}");
+    // A plan's sub-folders re-render from their records alone: a spec that reads the plan's
+    // maps, and reading sets' Chapter 6 folders (their keys applied again from the fingerprint,
+    // half of as_written's cells reused from the plan's folder).
+    for dir in [
+        "thesis/ch5_same",
+        "thesis/readings/as_written/ch6_same",
+        "thesis/readings/nurbs_book/ch6_diff",
+    ] {
+        report_restores_folder(&c, dir);
+    }
+    c.fails(&["report", "thesis"], &["a `reproduce` folder", "thesis/ch6_same"]);
 }
 
 #[test]

@@ -1,7 +1,6 @@
 //! `somnurbs fit`: fit a user's two-view grid and write its control nets, IGES and OBJ, in the
 //! data's own coordinates when the map has its frame beside it (or, asked for, the map's).
 
-use crate::cli::FitArgs;
 use crate::experiment::spec::GridSize;
 use crate::io::{csv_records, read_text, write_atomic};
 use crate::data::frame::Frame;
@@ -194,7 +193,36 @@ fn manifest_text(grid: &str, grid_text: &str, generated: i64, options: FitRecord
 pub(crate) const MIN_SAMPLES: usize = 2;
 pub(crate) const MAX_SAMPLES: usize = 1000;
 
-pub(crate) fn fit(args: &FitArgs) -> Result<()> {
+/// What `somnurbs fit` is asked to do (the command line's `FitArgs`, as the family takes it; each
+/// name is parsed and checked by [`fit`]).
+#[derive(Debug, Clone)]
+pub(crate) struct Request {
+    /// The two-view grid CSV.
+    pub(crate) grid: std::path::PathBuf,
+    /// Control-net size CNXxCNY.
+    pub(crate) cn: String,
+    /// Parameterisation name.
+    pub(crate) param: String,
+    /// Approach name (conventional, improved).
+    pub(crate) approach: String,
+    /// Output folder.
+    pub(crate) out: std::path::PathBuf,
+    /// Evaluation samples per direction in the OBJ mesh.
+    pub(crate) samples: usize,
+    /// Knot reading name.
+    pub(crate) knots: String,
+    /// Reading of approach A's surface error.
+    pub(crate) error_a: String,
+    /// Penalised least squares weight.
+    pub(crate) fairness: f64,
+    /// Coordinates of the exports: `data` or `normalised`.
+    pub(crate) frame: String,
+    /// Length unit of the data's coordinates.
+    pub(crate) units: String,
+}
+
+/// `somnurbs fit`: fit the grid, write its surfaces, fit.csv and the manifest.
+pub(crate) fn fit(args: &Request) -> Result<()> {
     let cn: GridSize = args.cn.parse().map_err(anyhow::Error::msg).context("--cn")?;
     let param: Parameterisation =
         args.param.parse().map_err(anyhow::Error::msg).context("--param")?;

@@ -200,6 +200,26 @@ mod tests {
         assert_eq!(optimiser_colour("sa"), None);
     }
 
+    /// Up to eight externals beside the named optimisers: each its own colour, none the colour of
+    /// GA, DE, PSO, CSA, ICSA, B or the optimum, whatever their order among the names.
+    #[test]
+    fn eight_externals_take_eight_colours_none_reserved() {
+        let reserved = ["ga", "de", "pso", "csa", "icsa", "exact", "b"];
+        let taken: Vec<RGBColor> = reserved.iter().map(|n| optimiser_colour(n).unwrap()).collect();
+        for k in 1..=EXTRA.len() {
+            let externals: Vec<String> = (0..k).map(|i| format!("ext{i}")).collect();
+            let mut chart: Vec<&str> = externals.iter().map(String::as_str).collect();
+            chart.splice(0..0, reserved);
+            let n = chart.len();
+            chart.rotate_left(k % n);
+            let got: Vec<RGBColor> = externals.iter().map(|n| series_colour(n, &chart)).collect();
+            for (i, c) in got.iter().enumerate() {
+                assert!(!taken.contains(c), "{} of {k} takes a reserved colour", externals[i]);
+                assert!(!got[..i].contains(c), "{} of {k} repeats a colour", externals[i]);
+            }
+        }
+    }
+
     #[test]
     fn dnsom_views_are_far_apart() {
         let d = |a: RGBColor, b: RGBColor| {
