@@ -221,7 +221,8 @@ fn check_header(v: &Value, file: &Path) -> Result<()> {
 }
 
 /// What a results folder certifies of one problem, read from its own `exact_<grid>.csv`: the
-/// exact solver's optimum and its proven lower bound (each printed to 9 decimals).
+/// exact solver's optimum and its proven lower bound (printed at round-trip precision; a folder
+/// of an older build has 9 decimals).
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Certificate {
     pub(crate) optimum: f64,
@@ -231,7 +232,7 @@ pub(crate) struct Certificate {
 }
 
 /// How far a value may lie on the wrong side of a certificate read back from `exact_<grid>.csv`:
-/// the table prints 9 decimals, so its values are within half of 1e-9 of the solver's.
+/// the table prints the solver's values exactly, an older build's 9 decimals within half of 1e-9.
 pub(crate) const CERTIFICATE_TOLERANCE: f64 = 1e-9;
 
 /// One problem's context while its external runs are read.

@@ -534,8 +534,9 @@ fn exact_section(
             c.cn.nx.to_string(),
             c.cn.ny.to_string(),
             format!("{b:.9}"),
-            format!("{:.9}", e.f),
-            format!("{:.9}", e.lower_bound),
+            // Round-trip precision: these are the targets compare and external logs are judged by.
+            format!("{}", e.f),
+            format!("{}", e.lower_bound),
             format!("{:.3e}", e.gap),
         ];
         for o in &t.opts {
