@@ -196,7 +196,11 @@ pub(super) fn runtime_outputs(rt: &Runtime, probs: &[Problem], opts: &[String], 
 /// The runtime summary (stdout and compare.md): moved targets and each optimiser's AOCC over all
 /// problems.
 pub(super) fn summary(rt: &Runtime, probs: &[Problem]) -> Vec<String> {
-    let mut lines = Vec::new();
+    let solver = probs.iter().filter(|p| p.from.starts_with("exact solver")).count();
+    let mut lines = vec![format!(
+        "  targets: log-spaced from B to each problem's best known value, the last target; it is the exact solver's f (the upper end of its certified interval [lower_bound, f]) in {solver} of {} problems, a run's best in the others (compare_targets.csv says which)",
+        probs.len()
+    )];
     let moved = probs.iter().filter(|p| p.rule != "b_to_best_known").count();
     if moved > 0 {
         lines.push(format!(
