@@ -27,7 +27,8 @@ case "$wheel" in
     *manylinux_2_17_x86_64*) ;;
     *) echo "build_wheel: $wheel is not tagged manylinux_2_17" >&2; exit 1 ;;
 esac
-"$venv/bin/auditwheel" show "$wheel" >&2
-"$venv/bin/auditwheel" show "$wheel" 2>&1 | tr '\n' ' ' | grep -q 'is consistent with the following platform tag: *"manylinux_2_17_x86_64"' \
+shown="$("$venv/bin/auditwheel" show "$wheel" 2>&1)"
+echo "$shown" >&2
+echo "$shown" | tr '\n' ' ' | grep -q 'is consistent with the following platform tag: *"manylinux_2_17_x86_64"' \
     || { echo "build_wheel: auditwheel does not find $wheel manylinux_2_17-consistent" >&2; exit 1; }
 echo "$wheel"

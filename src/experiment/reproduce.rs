@@ -305,11 +305,7 @@ fn load_reached<F: Families>(
     profile: Option<&str>,
     out: &Path,
 ) -> Result<Vec<(Loaded<F>, Vec<bool>)>> {
-    // Absolute: a relative `maps` would resolve against the spec's folder, this one is the run's.
-    let maps = plan.maps_from.as_ref().map(|m| {
-        let dir = out.join(m).join("maps");
-        std::path::absolute(&dir).unwrap_or(dir).to_string_lossy().into_owned()
-    });
+    let maps = plan.maps_from.as_ref().map(|m| plan_maps(out, m));
     names
         .iter()
         .map(|name| {
@@ -524,6 +520,13 @@ fn run_reading_sets<F: Families>(
     Ok(())
 }
 
+/// The maps folder of a plan's `maps_from` spec under the plan's folder `root`, absolute: a
+/// relative `maps` would resolve against the spec's folder, this one is the run's.
+fn plan_maps(root: &Path, maps_from: &str) -> String {
+    let dir = root.join(maps_from).join("maps");
+    std::path::absolute(&dir).unwrap_or(dir).to_string_lossy().into_owned()
+}
+
 /// The maps folder `reproduce` pointed the spec of the sub-folder `dir` at (`<root>/<maps_from>/maps`,
 /// made absolute as the run made it), found from the plan record of its root: `dir`'s parent, or
 /// for a reading set's `readings/<set>/<spec>` three levels up. None for a folder of no plan.
@@ -538,10 +541,7 @@ pub(crate) fn plan_maps_of(dir: &Path) -> Result<Option<String>> {
         let Some(record) = PlanRecord::read(root)? else { continue };
         let plan: Plan = toml::from_str(&record.plan_text)
             .with_context(|| format!("{}: the plan's text", root.join(PLAN_FILE).display()))?;
-        return Ok(plan.maps_from.map(|m| {
-            let maps = root.join(m).join("maps");
-            std::path::absolute(&maps).unwrap_or(maps).to_string_lossy().into_owned()
-        }));
+        return Ok(plan.maps_from.map(|m| plan_maps(root, &m)));
     }
     Ok(None)
 }
