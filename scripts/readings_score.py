@@ -6,7 +6,8 @@ For every (reading, spec) row: each CSV of the spec's folder named like a publis
 experiments/reference/ is matched to it row by row on the key columns; every value column both
 have (CPU seconds and generations left out) whose published value is finite and non-zero counts,
 and counts as reproduced when ours/published lies in [0.8, 1.25]. Claims: the rows of the folder's
-claims.csv with an `agreement`, and of those the ones that agree.
+claims.csv with an `agreement` that are not about CPU time (`timing` = yes), and of those the
+ones that agree.
 
     python3 scripts/readings_score.py results/thesis          # a full plan folder
     python3 scripts/readings_score.py results/thesis_quick    # the quick one (no evidence)
@@ -74,7 +75,7 @@ def folder_score(folder):
     claims_csv = folder / "claims.csv"
     if claims_csv.exists():
         for r in rows(claims_csv)[1]:
-            a = r.get("agreement", "")
+            a = r.get("agreement", "") if r.get("timing") != "yes" else ""
             if a:
                 claims += 1
                 agree += a == "agrees"

@@ -1045,7 +1045,7 @@ fn readings_score<F: Families>(
     } else {
         String::new()
     };
-    let mut s = format!("\n---\n\n# Readings score\n\nFor each reading and spec, and in total per chapter or seed (over the specs every reading that ran one of them ran): the share of the published tables' value cells (Appendices B-F, K, L and the seeds' tables; CPU seconds left out) whose ratio ours/published lies in [{}, {}], and how many of the claims with the source's own count agree with it (`readings_score.csv`). The reading that reproduces the published numbers best has the highest shares.\n\n", BAND.0, BAND.1);
+    let mut s = format!("\n---\n\n# Readings score\n\nFor each reading and spec, and in total per chapter or seed (over the specs every reading that ran one of them ran): the share of the published tables' value cells (Appendices B-F, K, L and the seeds' tables; CPU seconds left out) whose ratio ours/published lies in [{}, {}], and how many of the claims with the source's own count agree with it (claims about CPU time left out too) (`readings_score.csv`). The reading that reproduces the published numbers best has the highest shares.\n\n", BAND.0, BAND.1);
     s.push_str(&crate::report::markdown::table(&h, &md_rows));
     s.push_str(&price);
     Ok(s)

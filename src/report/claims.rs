@@ -53,6 +53,9 @@ pub struct Claim {
     /// For a [`Kind::Best`] claim: the most cases any other option wins here.
     pub rival: Option<usize>,
     pub note: String,
+    /// Whether it compares measured time (CPU seconds): its count depends on the machine and its
+    /// load, so the readings score leaves it out as it leaves out CPU-second cells.
+    pub timing: bool,
 }
 
 impl Claim {
@@ -67,6 +70,7 @@ impl Claim {
             thesis: None,
             rival: None,
             note: String::new(),
+            timing: false,
         }
     }
 
@@ -104,6 +108,12 @@ impl Claim {
 
     pub fn note(mut self, note: impl Into<String>) -> Self {
         self.note = note.into();
+        self
+    }
+
+    /// Mark the claim as one about measured time ([`Claim::timing`]).
+    pub fn timing(mut self) -> Self {
+        self.timing = true;
         self
     }
 
@@ -176,8 +186,9 @@ pub(crate) fn calibration_only(plan: &Claim, as_written: &Claim) -> bool {
 
 /// The columns of `claims.csv`, which every chapter's report writes (and `reproduce` collects):
 /// one row per (spec, grid, claim). `low_95`/`high_95` bound the judged share (empty for an
-/// every-case claim); `best_rival_here` is filled for best-of-several claims only.
-pub(crate) const CSV_HEADER: [&str; 15] = [
+/// every-case claim); `best_rival_here` is filled for best-of-several claims only; `timing` is
+/// `yes` for a claim about measured time.
+pub(crate) const CSV_HEADER: [&str; 16] = [
     "spec",
     "chapter",
     "grid",
@@ -193,6 +204,7 @@ pub(crate) const CSV_HEADER: [&str; 15] = [
     "checked_thesis",
     "agreement",
     "note",
+    "timing",
 ];
 
 fn csv_row(c: &Claim) -> Vec<String> {
@@ -215,6 +227,7 @@ fn csv_row(c: &Claim) -> Vec<String> {
         ct,
         c.agreement().into(),
         c.note.clone(),
+        if c.timing { "yes" } else { "no" }.into(),
     ]
 }
 
@@ -333,6 +346,11 @@ pub(crate) fn read(path: &std::path::Path) -> anyhow::Result<Vec<Claim>> {
             rival: opt(10)?,
             thesis,
             note: at(14).into(),
+            timing: match at(15) {
+                "yes" => true,
+                "no" => false,
+                _ => return Err(bad(15)),
+            },
         });
     }
     Ok(out)
@@ -415,7 +433,7 @@ mod tests {
         assert!(md.contains("| holds 3/3 | 3/3 |") && md.contains("| - | 14/15 |"), "{md}");
         let text = std::fs::read_to_string(dir.path().join("claims.csv")).unwrap();
         let lines: Vec<&str> = text.lines().collect();
-        assert!(lines[0].ends_with(",note,verdict_as_written,holds_as_written,checked_as_written,agreement_as_written,calibration_only"), "{text}");
+        assert!(lines[0].ends_with(",note,timing,verdict_as_written,holds_as_written,checked_as_written,agreement_as_written,calibration_only"), "{text}");
         assert!(lines[1].ends_with(",does not hold,1,15,differs,yes"), "{text}");
         assert!(lines[3].ends_with(",,,,,"), "{text}");
     }

@@ -27,7 +27,8 @@ pub(crate) struct Score {
     pub(crate) cells: usize,
     /// Of those, the cells whose ratio ours/published lies in [`BAND`].
     pub(crate) within: usize,
-    /// Claims with the source's own count over the same cells.
+    /// Claims with the source's own count over the same cells, other than claims about measured
+    /// time ([`claims::Claim::timing`], machine-dependent as CPU seconds are).
     pub(crate) claims: usize,
     /// Of those, the claims whose share agrees with the source's (`Claim::agreement`).
     pub(crate) agree: usize,
@@ -101,6 +102,7 @@ pub(crate) fn folder_score(
     if path.exists() {
         for c in claims::read(&path)? {
             match c.agreement() {
+                _ if c.timing => {}
                 "" => {}
                 a => {
                     score.claims += 1;
@@ -145,5 +147,18 @@ mod tests {
         std::fs::write(dir.path().join("other.csv"), "a,b\n1,2\n").unwrap();
         let s = folder_score(dir.path(), &|n| crate::report::reference::lookup(k, n)).unwrap();
         assert_eq!((s.cells, s.within, s.claims), (20, 10, 0));
+        // Claims: one agreeing, one differing, one about time (left out), one without the
+        // source's count (not counted).
+        let claims = [
+            claims::Claim::most("6", "a", (9, 10)).thesis(Some((9, 10))),
+            claims::Claim::most("6", "b", (1, 10)).thesis(Some((10, 10))),
+            claims::Claim::most("6", "c", (9, 10)).thesis(Some((9, 10))).timing(),
+            claims::Claim::most("6", "d", (9, 10)),
+        ];
+        claims::write(dir.path(), "s", &claims, false).unwrap();
+        let s = folder_score(dir.path(), &|n| crate::report::reference::lookup(k, n)).unwrap();
+        assert_eq!((s.claims, s.agree), (2, 1));
+        let back = claims::read(&dir.path().join("claims.csv")).unwrap();
+        assert_eq!(back.iter().map(|c| c.timing).collect::<Vec<_>>(), [false, false, true, false]);
     }
 }

@@ -16,6 +16,7 @@ mod hostile;
 mod html_report;
 mod own_data;
 mod plans;
+mod real_scan;
 mod records;
 mod resume;
 mod robust;

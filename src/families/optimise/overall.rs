@@ -179,6 +179,7 @@ fn overall_claims(per_grid: &[Claim]) -> Vec<Claim> {
             .on_grid(grids.join("+"))
             .thesis(thesis)
             .note("sum of the two grids' counts");
+        claim.timing = parts[0].timing;
         claim.spec = specs.join("+");
         out.push(claim);
     }

@@ -476,7 +476,8 @@ fn grid_claims(t: &GridTables, grid: GridSize, err_name: &str, time_name: &str) 
             )
             .on_grid(grid)
             .thesis(own(time_name, "_s", "ga"))
-            .note("least AVG CPU time per cell (Tables 6.6, 6.7); GA makes 2 evaluations per generation, DE and PSO a population's"),
+            .note("least AVG CPU time per cell (Tables 6.6, 6.7); GA makes 2 evaluations per generation, DE and PSO a population's")
+            .timing(),
         );
     }
     for (k, o) in t.opts.iter().enumerate() {
