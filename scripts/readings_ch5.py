@@ -12,7 +12,7 @@ counts per grid
 - the share of Appendix E/F's value cells whose ratio ours / published lies in [0.8, 1.25],
 
 and prints them beside the thesis' counts over Appendix E/F's own numbers (`--brief`: one line
-per folder; "rival" is the most wins of any other parameterisation, "same" the nets whose winner
+per folder; per data set, the median ratio ours / published and the cells in the band; "rival" is the most wins of any other parameterisation, "same" the nets whose winner
 is the thesis' for A/B, "BA" the cells where B beats A, "share" the ratio share; `--spread`: the
 least, median, greatest and mean of each figure over the folders given, e.g. one per map seed).
 
@@ -136,6 +136,22 @@ def measures(folder):
         out[(grid, "same winner B")] = same["B"]
         out[(grid, "B beats A")] = ob
         out[(grid, "ratio share")] = inside / max(total, 1)
+        for data, (median, inside_d, total_d) in per_data(ours, thesis).items():
+            out[(grid, f"{data}: median ratio")] = median
+            out[(grid, f"{data}: share in band")] = inside_d / max(total_d, 1)
+    return out
+
+
+def per_data(ours, thesis):
+    """{data: (median ratio ours / published, cells in SCORE_BAND, cells)} over Appendix E/F's
+    value cells of each data set."""
+    out = {}
+    for data in sorted({k[0] for k in thesis}):
+        r = sorted(ours[k] / thesis[k] for k in thesis if k[0] == data and k in ours and thesis[k] != 0.0)
+        if r:
+            mid = r[len(r) // 2] if len(r) % 2 else (r[len(r) // 2 - 1] + r[len(r) // 2]) / 2
+            inside = sum(1 for x in r if SCORE_BAND[0] <= x <= SCORE_BAND[1])
+            out[data] = (mid, inside, len(r))
     return out
 
 
@@ -180,6 +196,8 @@ def report(folder, brief=False):
             print(f"     thesis {fmt_wins(tw[a])}")
         print(f"  B beats A: {ob}/{op} (thesis {tb}/{tp})")
         print(f"  Appendix ratio in [0.8, 1.25]: {inside}/{total} = {inside / max(total, 1):.3f}")
+        for data, (median, inside_d, total_d) in per_data(ours, thesis).items():
+            print(f"    {data:8s} median ratio {median:.3f}, {inside_d}/{total_d} cells in band")
     if brief:
         print(" | ".join(line))
 

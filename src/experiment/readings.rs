@@ -141,6 +141,15 @@ pub(crate) const READINGS: &[Reading] = &[
         passage: "Section 6.2.4.1 step 3: \"4 chromosomes are randomly selected\"; Table 6.1's range is the only one Chapter 6 names",
     },
     Reading {
+        step: "GA's mutation probability: per gene or per offspring",
+        keys: &["optimise.ga.mutation", "optimise.ga.mutated_genes"],
+        specs: CH6,
+        plan: "per_gene",
+        status: Status::Inferred,
+        as_written: &[],
+        passage: "Section 2.4: \"If the mutation probability is 1, the whole chromosome is altered\" (Pm per gene), against Section 6.2.4.1 step 5: \"A random number is generated and mutation will be executed if the random number is less than\" Pm (one draw per offspring, then \"a predefined number of genes\", Section 2.4, never given)",
+    },
+    Reading {
         step: "DE's CR and F",
         keys: &["optimise.de.cr", "optimise.de.f"],
         specs: CH6,

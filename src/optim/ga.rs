@@ -23,23 +23,64 @@ use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
 /// GA parameters (defaults: thesis Table 6.1).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub(crate) struct Ga {
     /// Crossover probability Pc.
     pub pc: f64,
-    /// Per-gene mutation probability Pm.
+    /// Mutation probability Pm, per gene or per offspring ([`Mutation`]).
     pub pm: f64,
     /// Tournament size.
     pub tournament: usize,
     /// Per-gene swap probability of the uniform crossover (only 0.5 is implemented: one fair
     /// bit per gene).
     pub swap: f64,
+    /// What Pm is the probability of (docs/readings.md, "GA's mutation").
+    pub mutation: Mutation,
+    /// Under [`Mutation::PerOffspring`]: how many distinct genes a mutated offspring has redrawn
+    /// (Section 2.4's "a predefined number of genes"), in [1, 1000].
+    pub mutated_genes: usize,
+}
+
+/// What the GA's mutation probability Pm is the probability of: each gene is redrawn with
+/// probability Pm (`per_gene`, Section 2.4: "If the mutation probability is 1, the whole
+/// chromosome is altered"), or one draw per offspring decides, with probability Pm, that
+/// `mutated_genes` of its genes are redrawn (`per_offspring`, Section 6.2.4.1 step 5: "A random
+/// number is generated and mutation will be executed if the random number is less than" Pm).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub(crate) enum Mutation {
+    #[default]
+    PerGene,
+    PerOffspring,
 }
 
 impl Default for Ga {
     fn default() -> Ga {
-        Ga { pc: 0.7, pm: 0.01, tournament: 4, swap: 0.5 }
+        Ga {
+            pc: 0.7,
+            pm: 0.01,
+            tournament: 4,
+            swap: 0.5,
+            mutation: Mutation::PerGene,
+            mutated_genes: 1,
+        }
+    }
+}
+
+/// The table as a cell's identity reads it: the mutation's reading only where it is not the
+/// default, so the identity of every cell the GA computed before the option existed is the same.
+impl std::fmt::Debug for Ga {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let mut s = f.debug_struct("Ga");
+        s.field("pc", &self.pc)
+            .field("pm", &self.pm)
+            .field("tournament", &self.tournament)
+            .field("swap", &self.swap);
+        if self.mutation != Mutation::PerGene || self.mutated_genes != 1 {
+            s.field("mutation", &self.mutation).field("mutated_genes", &self.mutated_genes);
+        }
+        s.finish()
     }
 }
 
@@ -51,6 +92,12 @@ impl Ga {
             return Err(OptimError::param(
                 "ga.tournament",
                 format!("must be in [1,{MAX_TOURNAMENT}], got {}", self.tournament),
+            ));
+        }
+        if !(1..=MAX_MUTATED_GENES).contains(&self.mutated_genes) {
+            return Err(OptimError::param(
+                "ga.mutated_genes",
+                format!("must be in [1,{MAX_MUTATED_GENES}], got {}", self.mutated_genes),
             ));
         }
         if self.swap != 0.5 {
@@ -83,6 +130,7 @@ impl Ga {
 }
 
 const MAX_TOURNAMENT: usize = 16;
+const MAX_MUTATED_GENES: usize = 1000;
 
 impl Optimiser for Ga {
     fn validate(&self) -> Result<(), OptimError> {
@@ -140,10 +188,24 @@ impl Optimiser for Ga {
                 c2.copy_from_slice(&pop.x[b]);
             }
             for child in [&mut c1, &mut c2] {
-                let mut j = mutation.skip(&mut pool, rng);
-                while j < d {
+                let mut redraw = |j: usize, rng: &mut ChaCha8Rng| {
                     child[j] = (x0[j] + symmetric(rng, budget.init_range)).max(lo[j]).min(hi[j]);
-                    j = mutation.next_after(j, &mut pool, rng);
+                };
+                match self.mutation {
+                    Mutation::PerGene => {
+                        let mut j = mutation.skip(&mut pool, rng);
+                        while j < d {
+                            redraw(j, rng);
+                            j = mutation.next_after(j, &mut pool, rng);
+                        }
+                    }
+                    Mutation::PerOffspring => {
+                        if unit(rng) < self.pm {
+                            for j in distinct(rng, d, self.mutated_genes.min(d)) {
+                                redraw(j, rng);
+                            }
+                        }
+                    }
                 }
             }
             let f1 = eval.eval(&c1);
@@ -160,6 +222,18 @@ impl Optimiser for Ga {
         let best = pop.best();
         Ok(eval.finish(pop.x.swap_remove(best), initial_best))
     }
+}
+
+/// `k` distinct indices below `d`, drawn in turn (a drawn index is drawn again).
+fn distinct(rng: &mut ChaCha8Rng, d: usize, k: usize) -> Vec<usize> {
+    let mut out = Vec::with_capacity(k);
+    while out.len() < k {
+        let j = index(rng, d);
+        if !out.contains(&j) {
+            out.push(j);
+        }
+    }
+    out
 }
 
 #[cfg(test)]
@@ -207,6 +281,80 @@ mod tests {
         let n = 40_000;
         let top = (0..n).filter(|_| ga.tournament(&f, &mut rng) < 4).count() as f64 / n as f64;
         assert!((top - 0.35546).abs() < 0.01, "{top}");
+    }
+
+    /// The sphere, keeping every point it evaluates.
+    struct Recording(crate::optim::problem::tests::Sphere, std::sync::Mutex<Vec<Vec<f64>>>);
+
+    impl Problem for Recording {
+        fn dim(&self) -> usize {
+            self.0.dim()
+        }
+        fn initial_point(&self) -> &[f64] {
+            self.0.initial_point()
+        }
+        fn bounds(&self) -> (&[f64], &[f64]) {
+            self.0.bounds()
+        }
+        fn fitness(&self, x: &[f64]) -> f64 {
+            self.1.lock().unwrap().push(x.to_vec());
+            self.0.fitness(x)
+        }
+    }
+
+    /// Without crossover, each offspring is its parent with the mutated genes redrawn: per
+    /// offspring, at most `mutated_genes` genes (and none at Pm = 0); per gene at Pm = 1, every
+    /// gene.
+    #[test]
+    fn per_offspring_mutation_redraws_the_stated_number_of_genes() {
+        use crate::optim::problem::tests::Sphere;
+        use rand::SeedableRng;
+        let budget =
+            Budget { generations: 30, population: 6, init_range: 0.1, trace_every_evals: 10 };
+        let most_changed = |ga: Ga| {
+            let p = Recording(Sphere::new(8), Default::default());
+            ga.run(&p, &budget, &mut ChaCha8Rng::seed_from_u64(9)).unwrap();
+            let seen = p.1.into_inner().unwrap();
+            let (init, children) = seen.split_at(budget.population);
+            let mut pool: Vec<Vec<f64>> = init.to_vec();
+            let mut most = 0;
+            for c in children {
+                let changed = |x: &Vec<f64>| x.iter().zip(c).filter(|(a, b)| a != b).count();
+                most = most.max(pool.iter().map(changed).min().unwrap());
+                pool.push(c.clone());
+            }
+            most
+        };
+        let per = |pm, k| Ga {
+            pc: 0.0,
+            pm,
+            mutation: Mutation::PerOffspring,
+            mutated_genes: k,
+            ..Ga::default()
+        };
+        assert_eq!(most_changed(per(1.0, 2)), 2);
+        assert_eq!(most_changed(per(1.0, 1)), 1);
+        assert_eq!(most_changed(per(0.0, 3)), 0);
+        assert_eq!(most_changed(Ga { pc: 0.0, pm: 1.0, ..Ga::default() }), 8);
+        assert!(Ga { mutated_genes: 0, ..Ga::default() }
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .starts_with("ga.mutated_genes"));
+        let g: Ga = toml::from_str("mutation = \"per_offspring\"\nmutated_genes = 3").unwrap();
+        assert_eq!((g.mutation, g.mutated_genes), (Mutation::PerOffspring, 3));
+    }
+
+    /// A cell's identity reads the table's Debug text: the default's is the text from before the
+    /// mutation option, so no cell the GA computed changes its key; another reading's differs.
+    #[test]
+    fn the_default_tables_identity_text_is_unchanged() {
+        assert_eq!(
+            format!("{:?}", Ga::default()),
+            "Ga { pc: 0.7, pm: 0.01, tournament: 4, swap: 0.5 }"
+        );
+        let other = Ga { mutation: Mutation::PerOffspring, ..Ga::default() };
+        assert_ne!(format!("{other:?}"), format!("{:?}", Ga::default()));
     }
 
     #[test]
