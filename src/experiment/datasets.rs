@@ -58,7 +58,11 @@ pub(crate) fn datasets(action: Action, data_dir: &Path) -> Result<()> {
             // and only over a regular file.
             crate::io::outdir::require_outside_results(&file, "datasets export NAME FILE")?;
             crate::io::write_atomic(&file, text.as_bytes())?;
-            eprintln!("somnurbs: wrote {} points to {}", cloud.points.len(), file.display());
+            crate::notice::emit(&format!(
+                "somnurbs: wrote {} points to {}",
+                cloud.points.len(),
+                file.display()
+            ));
         }
     }
     Ok(())

@@ -362,10 +362,10 @@ pub(crate) fn specs_dir(flag: Option<&Path>, plan: &str) -> Result<PathBuf> {
         );
     }
     if clone {
-        eprintln!(
+        crate::notice::emit(&format!(
             "somnurbs: reproduce: no {DEFAULT_SPECS}/ in the working folder; using the plans of the clone somnurbs was built from, {} (--specs DIR names another folder)",
             dir.display()
-        );
+        ));
     }
     Ok(dir)
 }
@@ -427,11 +427,11 @@ pub(crate) fn reproduce<F: Families>(
             .collect(),
     };
     if claim_plan(&ctx.out, &layout, &record, ctx.resume)? == Claimed::Finished {
-        eprintln!(
+        crate::notice::emit(&format!(
             "somnurbs: {} already holds this reproduction, finished; nothing to do (`somnurbs report {}` makes a lost table or picture of a spec again from its records)",
             ctx.out.display(),
             ctx.out.join(&layout.specs[0]).display()
-        );
+        ));
         return Ok(None);
     }
     // Every spec has loaded: the folder is unfinished until the combined REPORT.md is written.
@@ -450,7 +450,7 @@ pub(crate) fn reproduce<F: Families>(
     for spec in &specs {
         let name = &spec.spec.file.name;
         let sub = RunContext { out: ctx.out.join(name), ..ctx.clone() };
-        eprintln!("somnurbs: reproduce: {name} -> {}", sub.out.display());
+        crate::notice::emit(&format!("somnurbs: reproduce: {name} -> {}", sub.out.display()));
         let t = Instant::now();
         run_spec(spec, &sub)?;
         done.push((name.clone(), t.elapsed().as_secs_f64()));
@@ -506,12 +506,12 @@ fn run_reading_sets<F: Families>(
             reuse.extend(ctx.reuse.iter().cloned());
             let sub =
                 RunContext { out: ctx.out.join(&folder), extras: false, reuse, ..ctx.clone() };
-            eprintln!(
+            crate::notice::emit(&format!(
                 "somnurbs: reproduce: {} under the readings `{}` -> {}",
                 spec.spec.file.name,
                 reading.name,
                 sub.out.display()
-            );
+            ));
             let t = Instant::now();
             run_spec(spec, &sub)?;
             done.push((folder.to_string_lossy().into_owned(), t.elapsed().as_secs_f64()));

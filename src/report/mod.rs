@@ -22,3 +22,9 @@ pub(crate) fn ordered<T: PartialEq + Clone>(items: impl Iterator<Item = T>) -> V
     }
     out
 }
+
+/// Say that a picture could not be drawn (a report goes on without it), through
+/// [`crate::notice`].
+pub(crate) fn picture_skipped(err: &dyn std::fmt::Display) {
+    crate::notice::emit(&format!("somnurbs: warning: picture skipped: {err}"));
+}

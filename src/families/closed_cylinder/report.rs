@@ -240,7 +240,7 @@ fn render_pictures(
             Ok(()) => {
                 let _ = writeln!(s, "\n![{png}]({png})");
             }
-            Err(e) => eprintln!("somnurbs: warning: picture skipped: {e}"),
+            Err(e) => crate::report::picture_skipped(&e),
         }
     }
     Ok(())

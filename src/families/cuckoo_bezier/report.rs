@@ -527,7 +527,7 @@ fn convergence(
             Ok(()) => {
                 let _ = writeln!(md, "![{png}]({png})\n");
             }
-            Err(err) => eprintln!("somnurbs: warning: picture skipped: {err}"),
+            Err(err) => crate::report::picture_skipped(&err),
         }
     }
     Ok(())

@@ -101,7 +101,7 @@ fn error_vs_excursion(view: &PlanView<super::spec::FitSpec>) -> Result<Option<St
     ) {
         Ok(()) => Ok(Some(name)),
         Err(e) => {
-            eprintln!("somnurbs: warning: picture skipped: {e}");
+            crate::report::picture_skipped(&e);
             Ok(None)
         }
     }

@@ -391,7 +391,7 @@ fn pictures(
             Ok(()) => {
                 let _ = writeln!(md, "![{}]({name})\n", m.dataset);
             }
-            Err(e) => eprintln!("somnurbs: warning: picture skipped: {e}"),
+            Err(e) => crate::report::picture_skipped(&e),
         }
     }
     Ok(())

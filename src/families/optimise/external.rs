@@ -421,7 +421,7 @@ pub(crate) fn join(
         .collect();
     if !uncertified.is_empty() {
         let uncertified: Vec<&str> = uncertified.into_iter().collect();
-        eprintln!("somnurbs: note: {} certifies no lower bound of {} (no exact_<grid>.csv: its spec does not say exact = true): their external runs are checked by B's error and their own traces only", results.display(), uncertified.join(", "));
+        crate::notice::emit(&format!("somnurbs: note: {} certifies no lower bound of {} (no exact_<grid>.csv: its spec does not say exact = true): their external runs are checked by B's error and their own traces only", results.display(), uncertified.join(", ")));
     }
     rows.extend(extra);
     Ok((rows, traces))

@@ -202,7 +202,7 @@ fn convergence_charts(
         }
         let png = format!("png/seed002_convergence_{sf}.png");
         if let Err(e) = plots::line_chart_png(&out.join(&png), &format!("{sf}: best SSE (median over repeats) vs evaluations ({population} per DE/PSO iteration)"), "fitness evaluations", "sum of squared errors", &series, true) {
-            eprintln!("somnurbs: warning: picture skipped: {e}");
+            crate::report::picture_skipped(&e);
         } else {
             let _ = writeln!(s, "\n![{png}]({png})");
         }
@@ -320,7 +320,7 @@ fn write_curves(curves: &[CurveRun], out: &Path, s: &mut String) -> Result<()> {
             "y",
             &series,
         ) {
-            eprintln!("somnurbs: warning: picture skipped: {e}");
+            crate::report::picture_skipped(&e);
         } else {
             let _ = writeln!(s, "\n![{png}]({png})");
         }

@@ -56,7 +56,7 @@ fn chart_skipped(e: plots::PlotError) -> Result<()> {
         // Its message already holds the cause (no chain, or the cause would be said twice).
         anyhow::bail!("{e}");
     }
-    eprintln!("somnurbs: warning: picture skipped: {e}");
+    crate::report::picture_skipped(&e);
     Ok(())
 }
 
@@ -136,12 +136,12 @@ pub(crate) fn compare(req: &Request) -> Result<()> {
     };
     let coverage = Coverage::of(&cells, &opts);
     if let Some(line) = coverage.note() {
-        eprintln!("somnurbs: warning: {line} ({SUMMARY} names the cells each did not run)");
+        crate::notice::emit(&format!("somnurbs: warning: {line} ({SUMMARY} names the cells each did not run)"));
     }
     let per_cell = cells::pairwise_cells(&cells, &opts, req.alpha);
     if let Some((n, sr, rs)) = per_cell.unreachable.smallest {
         let u = &per_cell.unreachable;
-        eprintln!("somnurbs: warning: of {} cell comparisons, {} cannot reach alpha {} by the signed-rank test and {} by the rank-sum test with their repeats (with {n} repeats a two-sided p is at least {sr} signed-rank, {rs} rank-sum): there h is 0 and no cell is favoured whatever the data (compare_cells.csv: min_p_signed_rank, min_p_rank_sum, can_reach_alpha)", u.of, u.signed_rank, req.alpha, u.rank_sum);
+        crate::notice::emit(&format!("somnurbs: warning: of {} cell comparisons, {} cannot reach alpha {} by the signed-rank test and {} by the rank-sum test with their repeats (with {n} repeats a two-sided p is at least {sr} signed-rank, {rs} rank-sum): there h is 0 and no cell is favoured whatever the data (compare_cells.csv: min_p_signed_rank, min_p_rank_sum, can_reach_alpha)", u.of, u.signed_rank, req.alpha, u.rank_sum));
     }
     crate::io::outdir::remove_stale(&stale, &dest, "compare")?;
     // Built whole in a sibling folder and swapped in: a reader sees the old tables or the new, and
