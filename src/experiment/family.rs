@@ -246,7 +246,9 @@ pub trait Experiment: Sync + 'static {
 /// The message for a section handed to a family it does not belong to (the engine asks each
 /// section's own family, so this is never seen).
 fn foreign(name: &str) -> SpecError {
-    SpecError(format!("internal: a section that is not [{name}] was handed to the [{name}] family"))
+    SpecError::new(format!(
+        "internal: a section that is not [{name}] was handed to the [{name}] family"
+    ))
 }
 
 impl<F: Holds<E::Section>, E: Experiment> Family<F> for E {

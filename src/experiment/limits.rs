@@ -70,7 +70,7 @@ pub struct Check<'a> {
 
 impl Check<'_> {
     pub fn err(&self, key: &str, msg: impl Display) -> SpecError {
-        SpecError(format!("{}: {key}: {msg}", self.spec.path))
+        SpecError::new(format!("{}: {key}: {msg}", self.spec.path))
     }
 
     pub fn int(&self, key: &str, v: impl TryInto<u64>, hi: u64) -> Result<(), SpecError> {
@@ -218,7 +218,7 @@ mod tests {
         let t = std::time::Instant::now();
         let text = SPEC.replace(from, to);
         assert_ne!(text, SPEC, "{from} not in the spec");
-        let e = crate::families::Loaded::parse("t.toml", &text, None).unwrap_err().0;
+        let e = crate::families::Loaded::parse("t.toml", &text, None).unwrap_err().to_string();
         assert!(e.contains(key) && !e.contains('\n'), "{to}: {e}");
         assert!(t.elapsed().as_secs_f64() < 1.0, "{to}: slow refusal");
     }
@@ -268,7 +268,7 @@ mod tests {
                 None,
             )
             .unwrap_err()
-            .0;
+            .to_string();
             assert!(e.contains(key), "{e}");
         }
         for (to, key) in [
@@ -280,7 +280,7 @@ mod tests {
             let e =
                 crate::families::Loaded::parse("s.toml", &som.replace("iterations = 10", to), None)
                     .unwrap_err()
-                    .0;
+                    .to_string();
             assert!(e.contains(key), "{e}");
         }
     }
@@ -312,14 +312,14 @@ mod tests {
         let t = std::time::Instant::now();
         let big =
             [format!("optimise.de.f={}", values(1000)), format!("optimise.de.cr={}", values(1000))];
-        let e = sweep(&[&big[0], &big[1]]).unwrap_err().0;
+        let e = sweep(&[&big[0], &big[1]]).unwrap_err().to_string();
         assert!(e.contains("1000 x 1000 = 1000000 variants, above the limit 1000"), "{e}");
         assert!(t.elapsed().as_secs_f64() < 1.0);
         // 500 variants of 200 cells (one optimiser x 200 repeats): 10^5 in all, the limit; one
         // more repeat is over.
         let ok = format!("optimise.de.f={}", values(500));
         assert_eq!(sweep(&[&ok, "optimise.repeats=200"]), Ok(500));
-        let e = sweep(&[&ok, "optimise.repeats=201"]).unwrap_err().0;
+        let e = sweep(&[&ok, "optimise.repeats=201"]).unwrap_err().to_string();
         assert!(e.contains("cells in all, above the limit 100000"), "{e}");
         for (dup, said) in [
             ("0.3,0.30", "0.3 and 0.30 are one value"),
@@ -327,7 +327,7 @@ mod tests {
             ("0.5,5e-1", "0.5 and 5e-1 are one value"),
             ("0.3,0.3", "the value 0.3 is given twice"),
         ] {
-            let e = sweep(&[&format!("optimise.de.f={dup}")]).unwrap_err().0;
+            let e = sweep(&[&format!("optimise.de.f={dup}")]).unwrap_err().to_string();
             assert!(e.contains(said), "{dup}: {e}");
         }
     }
@@ -338,7 +338,9 @@ mod tests {
             let t = SPEC
                 .replace("optimisers = [\"ga\", \"de\"]", &format!("optimisers = [{opts}]"))
                 .replace("population = 8", &format!("population = {pop}\n{extra}"));
-            crate::families::Loaded::parse("t.toml", &t, None).map(|_| ()).map_err(|e| e.0)
+            crate::families::Loaded::parse("t.toml", &t, None)
+                .map(|_| ())
+                .map_err(|e| e.to_string())
         };
         spec("\"ga\"", 4, "").unwrap();
         spec("\"ga\", \"pso\", \"csa\"", 3, "[optimise.ga]\ntournament = 3").unwrap();

@@ -84,7 +84,7 @@ impl CliOverrides {
             Some((k, v)) if !k.trim().is_empty() && !v.trim().is_empty() => {
                 Ok((k.trim(), v.trim()))
             }
-            _ => Err(SpecError(format!(
+            _ => Err(SpecError::new(format!(
                 "{flag} `{arg}`: expected KEY=VALUE, e.g. optimise.de.f=0.5"
             ))),
         }
@@ -96,10 +96,10 @@ impl CliOverrides {
         let (key, values) = Self::split("--sweep", arg)?;
         let values: Vec<&str> = values.split(',').map(str::trim).collect();
         if values.iter().any(|v| v.is_empty()) {
-            return Err(SpecError(format!("--sweep {key}: an empty value in `{arg}`")));
+            return Err(SpecError::new(format!("--sweep {key}: an empty value in `{arg}`")));
         }
         if values.len() > super::limits::MAX_LIST {
-            return Err(SpecError(format!(
+            return Err(SpecError::new(format!(
                 "--sweep {key}: {} values, above the limit {}",
                 values.len(),
                 super::limits::MAX_LIST
@@ -114,7 +114,7 @@ impl CliOverrides {
                 } else {
                     format!("{a} and {b} are one value, given twice")
                 };
-                return Err(SpecError(format!("--sweep {key}: {shown}")));
+                return Err(SpecError::new(format!("--sweep {key}: {shown}")));
             }
         }
         Ok((key, values))
@@ -146,7 +146,7 @@ impl CliOverrides {
                 let why = super::renamed::both_spellings::<F>(before, key).unwrap_or_else(|| {
                     "the key is given twice (--set and --sweep take each key once)".into()
                 });
-                return Err(SpecError(format!("{flag} {key}: {why}")));
+                return Err(SpecError::new(format!("{flag} {key}: {why}")));
             }
             seen.push((key, canonical.clone().into_owned()));
             renamed.extend(super::renamed::renamed_key::<F>(key).map(|(_, pair)| pair));
@@ -160,18 +160,18 @@ impl CliOverrides {
                 .join(", ");
             let section = canonical.split('.').next().unwrap_or("");
             let Some((family, ov)) = takers.iter().find(|(f, _)| f.section() == section) else {
-                return Err(SpecError(format!(
+                return Err(SpecError::new(format!(
                     "{flag} {key}: only keys of the {list} can be set or swept"
                 )));
             };
             if family.section() != base.family().section() {
-                return Err(SpecError(format!(
+                return Err(SpecError::new(format!(
                     "{flag} {key}: {path} has no [{section}] section (--set and --sweep work on \
                      specs with one)"
                 )));
             }
             if flag == "--sweep" && !ov.sweepable(&canonical) {
-                return Err(SpecError(format!("{flag} {key}: a sweep varies optimiser settings only ({}), so that every variant solves the same problems", ov.describe())));
+                return Err(SpecError::new(format!("{flag} {key}: a sweep varies optimiser settings only ({}), so that every variant solves the same problems", ov.describe())));
             }
         }
         let set: Vec<(String, String)> = self
@@ -185,7 +185,7 @@ impl CliOverrides {
         let variants = sweeps.iter().fold(1u64, |n, (_, v)| n.saturating_mul(v.len() as u64));
         if variants > super::limits::MAX_VARIANTS {
             let counts: Vec<String> = sweeps.iter().map(|(_, v)| v.len().to_string()).collect();
-            return Err(SpecError(format!(
+            return Err(SpecError::new(format!(
                 "--sweep: {} = {variants} variants, above the limit {}",
                 counts.join(" x "),
                 super::limits::MAX_VARIANTS
@@ -215,7 +215,7 @@ impl CliOverrides {
                 let mut spec = Loaded::<F>::parse_with(path, text, profile, &overrides)?;
                 cells = cells.saturating_add(super::limits::cell_count(&spec));
                 if cells > super::limits::MAX_CELLS {
-                    return Err(SpecError(format!(
+                    return Err(SpecError::new(format!(
                         "--sweep: the {variants} variants of {path} have at least {cells} cells \
                          in all, above the limit {} (the limit of one spec holds for all its \
                          variants together)",

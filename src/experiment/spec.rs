@@ -13,11 +13,22 @@ use std::path::Path;
 
 /// A spec error: one line, naming the file and (where known) line:column and key.
 #[derive(Debug, Clone, PartialEq)]
-pub struct SpecError(pub String);
+pub struct SpecError {
+    message: String,
+    /// Set when the error is a profile the spec does not define: (the profile asked for, the
+    /// profiles it defines), for a caller that answers it in its own terms (the Python suite).
+    pub(crate) unknown_profile: Option<(String, Vec<String>)>,
+}
+
+impl SpecError {
+    pub(crate) fn new(message: impl Into<String>) -> SpecError {
+        SpecError { message: message.into(), unknown_profile: None }
+    }
+}
 
 impl fmt::Display for SpecError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(&self.0)
+        f.write_str(&self.message)
     }
 }
 
@@ -156,15 +167,15 @@ pub(crate) fn read_spec(path: &Path) -> Result<String, SpecError> {
     let bytes =
         crate::io::input::read(path, crate::io::input::Kind::Toml).map_err(|e| match e {
             crate::io::input::InputError::NotFound { .. } => {
-                SpecError(format!("{shown}: cannot read spec: no such file"))
+                SpecError::new(format!("{shown}: cannot read spec: no such file"))
             }
-            e => SpecError(format!("cannot read spec: {e}")),
+            e => SpecError::new(format!("cannot read spec: {e}")),
         })?;
-    crate::io::utf8_text(&shown, bytes).map_err(SpecError)
+    crate::io::utf8_text(&shown, bytes).map_err(SpecError::new)
 }
 
 fn toml_error(path: &str, text: &str, e: &toml::de::Error) -> SpecError {
-    SpecError(crate::io::toml_message(path, text, e))
+    SpecError::new(crate::io::toml_message(path, text, e))
 }
 
 /// Deep-merge `over` into `base` (tables merge, everything else replaces).
@@ -238,12 +249,13 @@ impl<F: Families> Loaded<F> {
             let key = super::renamed::canonical_key::<F>(&o.key).into_owned();
             let o = Override { key, value: o.value.clone() };
             reached.push(
-                apply_override(&mut table, &o).map_err(|e| SpecError(format!("{path}: {e}")))?,
+                apply_override(&mut table, &o)
+                    .map_err(|e| SpecError::new(format!("{path}: {e}")))?,
             );
         }
-        let merged = toml::to_string(&table).map_err(|e| SpecError(format!("{path}: {e}")))?;
+        let merged = toml::to_string(&table).map_err(|e| SpecError::new(format!("{path}: {e}")))?;
         let (file, sections) = F::parse(&merged).map_err(|e| {
-            SpecError(format!(
+            SpecError::new(format!(
                 "{path}: with {}: {}",
                 overrides.iter().map(|o| o.to_string()).collect::<Vec<_>>().join(", "),
                 e.message().replace('\n', " ")
@@ -278,19 +290,22 @@ impl<F: Families> Loaded<F> {
             None => (file, sections),
             Some(name) => {
                 let over = file.profiles.get(name).ok_or_else(|| {
-                    let known: Vec<&str> = file.profiles.keys().map(|s| s.as_str()).collect();
-                    SpecError(format!(
-                        "{path}: no profile `{name}` (the spec defines: {})",
-                        if known.is_empty() { "none".to_string() } else { known.join(", ") }
-                    ))
+                    let known: Vec<String> = file.profiles.keys().cloned().collect();
+                    SpecError {
+                        unknown_profile: Some((name.to_string(), known.clone())),
+                        ..SpecError::new(format!(
+                            "{path}: no profile `{name}` (the spec defines: {})",
+                            if known.is_empty() { "none".to_string() } else { known.join(", ") }
+                        ))
+                    }
                 })?;
                 let mut table: toml::Table =
                     toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
                 merge(&mut table, over);
                 let merged =
-                    toml::to_string(&table).map_err(|e| SpecError(format!("{path}: {e}")))?;
+                    toml::to_string(&table).map_err(|e| SpecError::new(format!("{path}: {e}")))?;
                 F::parse(&merged).map_err(|e| {
-                    SpecError(format!(
+                    SpecError::new(format!(
                         "{path}: [profiles.{name}]: {}",
                         e.message().replace('\n', " ")
                     ))
@@ -350,7 +365,7 @@ impl<F: Families> Loaded<F> {
 /// The error for a spec with no family section, or more than one.
 fn section_count_error<F: Families>(spec: &Spec, sections: &[F]) -> SpecError {
     if sections.is_empty() {
-        return SpecError(format!(
+        return SpecError::new(format!(
             "{}: the spec has no experiment section (add one of {})",
             spec.path,
             super::family::section_list::<F>()
@@ -358,7 +373,7 @@ fn section_count_error<F: Families>(spec: &Spec, sections: &[F]) -> SpecError {
     }
     let names: Vec<String> =
         sections.iter().map(|s| format!("[{}]", s.family().section())).collect();
-    SpecError(format!(
+    SpecError::new(format!(
         "{}: one experiment section per spec, this one has {} (they write the same files: split the spec)",
         spec.path,
         names.join(" and ")
@@ -385,7 +400,7 @@ impl Spec {
 
     /// An error naming the spec file and the key at fault.
     pub(crate) fn err(&self, key: &str, msg: impl fmt::Display) -> SpecError {
-        SpecError(format!("{}: {key}: {msg}", self.path))
+        SpecError::new(format!("{}: {key}: {msg}", self.path))
     }
 
     /// The checks every optimisation section shares: its optimisers (names checked when read),

@@ -155,7 +155,7 @@ fn som_readings_default_parse_and_name_their_key() {
 #[test]
 fn exactly_one_experiment_section() {
     let none = "name = \"t\"\nmaster_seed = 1\n";
-    let e = L::parse("t.toml", none, None).unwrap_err().0;
+    let e = L::parse("t.toml", none, None).unwrap_err().to_string();
     assert!(
         e.contains("no experiment section")
             && e.contains("[som]")
@@ -163,14 +163,14 @@ fn exactly_one_experiment_section() {
         "{e}"
     );
     let two = format!("{SPEC}\n[rational_bezier]\nsurfaces = [\"surface1\"]\n");
-    let e = L::parse("t.toml", &two, None).unwrap_err().0;
+    let e = L::parse("t.toml", &two, None).unwrap_err().to_string();
     assert!(e.contains("[som] and [rational_bezier]"), "{e}");
 }
 
 #[test]
 fn unknown_key_names_line_and_key() {
     let bad = SPEC.replace("iterations = 100", "iteratons = 100");
-    let e = L::parse("t.toml", &bad, None).unwrap_err().0;
+    let e = L::parse("t.toml", &bad, None).unwrap_err().to_string();
     assert!(e.starts_with("t.toml:6:1:") && e.contains("iteratons"), "{e}");
     assert!(!e.contains('\n'));
 }
@@ -184,12 +184,12 @@ fn bad_values_name_their_key() {
         ("\"10x10\", \"18x30\"", "\"2x2\"", "som.group[0].grids"),
         ("datasets = [\"cube\"]", "datasets = []", "som.datasets"),
     ] {
-        let e = L::parse("t.toml", &SPEC.replace(from, to), None).unwrap_err().0;
+        let e = L::parse("t.toml", &SPEC.replace(from, to), None).unwrap_err().to_string();
         assert!(e.contains(key), "{e}");
     }
-    let e = L::parse("t.toml", "name = \"x\"\nmaster_seed = -1\n", None).unwrap_err().0;
+    let e = L::parse("t.toml", "name = \"x\"\nmaster_seed = -1\n", None).unwrap_err().to_string();
     assert!(e.starts_with("t.toml:2:"), "{e}");
-    let e = L::parse("t.toml", SPEC, Some("full")).unwrap_err().0;
+    let e = L::parse("t.toml", SPEC, Some("full")).unwrap_err().to_string();
     assert!(e.contains("no profile `full`") && e.contains("quick"), "{e}");
 }
 
@@ -223,6 +223,6 @@ fn former_section_names_read_as_the_present_ones() {
     assert_eq!(plain(&old), plain(&new));
     let bad = old.replacen("generations = 2000", "generations = \"x\"", 1);
     let line = old.lines().position(|l| l.starts_with("generations = 2000")).unwrap() + 1;
-    let e = L::parse("t.toml", &bad, None).unwrap_err().0;
+    let e = L::parse("t.toml", &bad, None).unwrap_err().to_string();
     assert!(e.contains(&format!("t.toml:{line}:")), "{e}");
 }

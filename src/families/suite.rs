@@ -150,21 +150,13 @@ pub fn spec_path(spec: &str, work: &Path) -> Result<PathBuf> {
     Ok(path)
 }
 
-/// The profiles a spec file defines; an error naming them (and the spec as `shown`) when
-/// `profile` is not one.
-fn check_profile(path: &Path, shown: &str, profile: Option<&str>) -> Result<()> {
-    let Some(name) = profile else { return Ok(()) };
-    let text = crate::io::read_text(path)?;
-    let table: toml::Table =
-        toml::from_str(&text).with_context(|| format!("{}: not a spec", path.display()))?;
-    let offered: Vec<String> = match table.get("profiles") {
-        Some(toml::Value::Table(t)) => t.keys().cloned().collect(),
-        _ => Vec::new(),
-    };
-    if offered.iter().any(|p| p == name) {
-        return Ok(());
+/// A profile the spec does not define, as the suite's own [`RequestError::Profile`] naming the spec
+/// as the caller did; any other error as it is.
+fn profile_error(e: crate::experiment::spec::SpecError, shown: &str) -> anyhow::Error {
+    match e.unknown_profile.clone() {
+        Some((name, offered)) => RequestError::Profile { spec: shown.into(), name, offered }.into(),
+        None => e.into(),
     }
-    Err(RequestError::Profile { spec: shown.to_string(), name: name.to_string(), offered }.into())
 }
 
 /// Load every control-net problem of a Chapter 6 spec (`[optimise]`) or of seed 001's
@@ -181,9 +173,9 @@ pub fn load(
     work: &Path,
 ) -> Result<Suite> {
     let path = spec_path(spec, work)?;
-    check_profile(&path, spec, profile)?;
     let cli = CliOverrides { set: set.to_vec(), sweep: Vec::new() };
-    let mut variants = Loaded::load_variants(&path, profile, &cli)?;
+    let mut variants =
+        Loaded::load_variants(&path, profile, &cli).map_err(|e| profile_error(e, spec))?;
     let Loaded { spec, section } = variants.pop().context("no spec")?;
     let data_dir = crate::data::registry::found_folder(data_dir, Some("SOMNURBS_DATA"), "data").0;
     let ctx = RunContext::new(work.to_path_buf(), 1, data_dir);
