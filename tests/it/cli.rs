@@ -32,7 +32,6 @@ fn run_writes_every_table_with_the_thesis_columns() {
         "appendix_c.csv",
         "table_4_9.csv",
         "table_4_13.csv",
-        "table_4_14.csv",
         "manifest.toml",
         "REPORT.md",
         "maps/dnsom_sphere_6x5.csv",
@@ -72,6 +71,40 @@ fn run_writes_every_table_with_the_thesis_columns() {
     }
     let report = std::fs::read_to_string(out.join("REPORT.md")).unwrap();
     assert!(report.contains("DNSOM has the lowest TE") && report.contains("Metric definitions"));
+    // Table 4.14's grids (2x3 ... 7x8) did not run: no table, and the report says so.
+    assert!(!out.join("table_4_14.csv").exists());
+    assert!(report.contains("Not shown: DNSOM ran at none of its grids (2x3, 3x4"), "{report}");
+}
+
+#[test]
+fn the_count_tables_show_only_the_grids_and_models_that_ran() {
+    let c = Case::new();
+    let spec = TINY
+        .replace("models = [\"som2d\", \"som3d\", \"cksom\", \"dnsom\"]", "models = [\"som2d\"]")
+        .replace(
+            "models = [\"cksom\", \"dnsom\"]\ngrids = [\"6x5\"]",
+            "models = [\"dnsom\"]\ngrids = [\"5x6\"]",
+        )
+        .replace("save_maps = [\"6x5\"]", "save_maps = []");
+    c.write("own.toml", &spec);
+    c.ok(&["run", "own.toml", "--out", "o"]);
+    let (h, rows) = read_csv(&c.path("o/table_4_9.csv"));
+    assert_eq!(h, ["n", "som2d"], "only the model that ran at n x n");
+    assert_eq!(rows, [["4", "16"], ["6", "36"]]);
+    let (h, rows) = read_csv(&c.path("o/table_4_13.csv"));
+    assert_eq!(h, ["n_x", "n_y", "dnsom_non", "dnsom_nov", "dnsom_nor"]);
+    assert_eq!(rows, [["5", "6", "60", "42", "18"]]);
+    let (_, rows) = read_csv(&c.path("o/table_4_14.csv"));
+    assert_eq!(rows, [["5", "6", "60", "42", "18"]], "only the thesis' grid that ran");
+    let report = std::fs::read_to_string(c.path("o/REPORT.md")).unwrap();
+    for needle in [
+        "3-D SOM, CKSOM, DNSOM did not run at these grids",
+        "CKSOM did not run at these grids",
+        "Only the thesis' grids at which DNSOM ran here (the thesis' table has 2x3, 3x4, 4x5, 5x6, 6x7, 7x8)",
+    ] {
+        assert!(report.contains(needle), "{needle}: {report}");
+    }
+    assert!(!report.contains("160/128/32") && !report.contains("six nx x ny faces"), "{report}");
 }
 
 #[test]
