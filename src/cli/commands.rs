@@ -56,9 +56,9 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
                 frame: args.frame,
                 units: args.units,
                 samples: args.samples,
+                allow_excursion: args.allow_excursion,
             };
-            crate::families::optimise::export::export(&request, data)?;
-            Ok(ExitCode::SUCCESS)
+            Ok(exit_code(crate::families::optimise::export::export(&request, data)?))
         }
         Command::Report(args) => {
             let data = experiment::data_dir(args.data_dir.as_deref());
@@ -93,10 +93,7 @@ fn run(cli: Cli) -> anyhow::Result<ExitCode> {
             crate::families::optimise::compare::compare(&args.into())?;
             Ok(ExitCode::SUCCESS)
         }
-        Command::Fit(args) => {
-            crate::families::fit::command::fit(&args.into())?;
-            Ok(ExitCode::SUCCESS)
-        }
+        Command::Fit(args) => Ok(exit_code(crate::families::fit::command::fit(&args.into())?)),
         Command::Datasets(args) => {
             let dir = experiment::data_dir(args.data_dir.as_deref());
             let action = args.action.unwrap_or(DatasetsAction::List);
@@ -135,7 +132,16 @@ impl From<FitArgs> for crate::families::fit::command::Request {
             fairness: a.fairness,
             frame: a.frame,
             units: a.units,
+            allow_excursion: a.allow_excursion,
         }
+    }
+}
+
+/// A command that writes surfaces: 0 when it wrote them, 2 when it refused (its message printed).
+fn exit_code(outcome: crate::families::fit::command::Outcome) -> ExitCode {
+    match outcome {
+        crate::families::fit::command::Outcome::Written => ExitCode::SUCCESS,
+        crate::families::fit::command::Outcome::Refused => ExitCode::from(2),
     }
 }
 

@@ -37,7 +37,7 @@ pub(crate) enum Command {
     /// Fit cubic B-spline surfaces to a structured two-view grid (the CSV Chapter 4 saves in
     /// maps/) and write the control nets (CSV), an IGES file and an OBJ mesh.
     #[command(
-        after_help = "Examples (after `somnurbs reproduce`):\n  somnurbs fit --grid results/thesis/ch4_models/maps/dnsom_spindle_20x20.csv --cn 18x18 --out fit_spindle\n  somnurbs fit --grid results/thesis/ch4_models/maps/dnsom_cube_20x20.csv --cn 18x18 --knots nurbs_book --fairness 1e-4 --out fit_cube\n\nThe surfaces are also evaluated between the data points; a warning is printed when they leave\nthe data's bounding box by more than 10% of its diagonal."
+        after_help = "Examples (after `somnurbs reproduce`):\n  somnurbs fit --grid results/thesis/ch4_models/maps/dnsom_spindle_20x20.csv --cn 18x18 --out fit_spindle\n  somnurbs fit --grid results/thesis/ch4_models/maps/dnsom_cube_20x20.csv --cn 18x18 --knots nurbs_book --fairness 1e-4 --out fit_cube\n  somnurbs fit --grid my_scan_20x20.csv --cn 18x18 --allow-excursion --out fit_scan   # write even if the surfaces leave the data\n\nThe surfaces are also evaluated between the data points. When they leave the map's bounding box\nby more than 10% of its diagonal, fit measures on the same map the options that keep them within\n(more --fairness, another --param, --knots or --approach, the largest smaller square --cn),\nprints them, and exits 2 writing nothing; --allow-excursion writes the surfaces anyway, with a\nwarning."
     )]
     Fit(FitArgs),
     /// Compare the optimisers of a Chapter 6 results folder: per cell Wilcoxon signed-rank
@@ -81,7 +81,7 @@ pub(crate) enum Command {
     /// and surfaces.obj in the data's own frame, with export.csv; the record's surface error must
     /// come out again from the exported net.
     #[command(
-        after_help = "Examples:\n  somnurbs export results/ch6_same --cell optim/talus/20x20/18x18/chord_length/de/r0 --out talus_de\n  somnurbs export results/ch6_same --cell optim/talus/20x20/18x18/chord_length/de/r0 --start --out talus_b\n\nThe `cell` column of runs.csv names the cells; in a sweep, --variant names one of a cell's variants."
+        after_help = "Examples:\n  somnurbs export results/ch6_same --cell optim/talus/20x20/18x18/chord_length/de/r0 --out talus_de\n  somnurbs export results/ch6_same --cell optim/talus/20x20/18x18/chord_length/de/r0 --start --out talus_b\n  somnurbs export results/ch6_same --cell optim/talus/20x20/18x18/chord_length/de/r0 --allow-excursion --out talus_de\n\nThe `cell` column of runs.csv names the cells; in a sweep, --variant names one of a cell's variants.\nA net whose surfaces leave the map's bounding box between the data points by more than 10% of its\ndiagonal is refused (exit 2, nothing written; the start's excursion is measured and printed)\nunless --allow-excursion is given."
     )]
     Export(ExportArgs),
 }
@@ -117,6 +117,10 @@ pub(crate) struct ExportArgs {
     /// The data folder (as for `run`); the problem is rebuilt from the folder's own maps/.
     #[arg(long)]
     pub(crate) data_dir: Option<PathBuf>,
+    /// Write the net even when its surfaces leave the map's bounding box between the data points
+    /// by more than 10% of its diagonal (a warning instead of a refusal).
+    #[arg(long)]
+    pub(crate) allow_excursion: bool,
 }
 
 #[derive(Debug, Args)]
@@ -201,6 +205,12 @@ pub(crate) struct FitArgs {
     /// marked nominal in the start section), mm, cm, m, um, in or ft.
     #[arg(long, default_value = "unknown")]
     pub(crate) units: String,
+    /// Write the surfaces even when they leave the map's bounding box between the data points by
+    /// more than 10% of its diagonal (a warning instead of a refusal; without it such a fit exits
+    /// 2, writes nothing and prints the options measured to stay within), e.g.
+    /// `somnurbs fit --grid scan.csv --cn 18x18 --allow-excursion`.
+    #[arg(long)]
+    pub(crate) allow_excursion: bool,
 }
 
 #[derive(Debug, Args)]

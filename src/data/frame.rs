@@ -22,6 +22,11 @@ pub struct Frame {
     pub normalise: Normalise,
     pub offset: [f64; 3],
     pub scale: [f64; 3],
+    /// The data's bounding box in their own coordinates, [min, max] per axis (x, y, z); what
+    /// counts as near the data is measured against it (`families::maps::near_bound`). Frames
+    /// written before it was kept lack it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub data_box: Option<[[f64; 3]; 2]>,
 }
 
 /// The `source` of a generated data set.
@@ -42,7 +47,15 @@ impl Frame {
                 (lo, [if range > 0.0 { range } else { 1.0 }; 3])
             }
         };
-        Frame { dataset: dataset.to_string(), source: source.to_string(), normalise, offset, scale }
+        let data_box = crate::geom::bounding_box(points).map(|(lo, hi)| [lo, hi]);
+        Frame {
+            dataset: dataset.to_string(),
+            source: source.to_string(),
+            normalise,
+            offset,
+            scale,
+            data_box,
+        }
     }
 
     /// A point of the normalised coordinates in the data's own.
@@ -86,7 +99,23 @@ impl Frame {
                 )));
             }
         }
+        if let Some([lo, hi]) = f.data_box {
+            if !(lo.iter().chain(&hi).all(|v| v.is_finite()) && (0..3).all(|a| lo[a] <= hi[a])) {
+                return Err(DataError::Invalid(format!(
+                    "data_box: {lo:?} to {hi:?} is no box; a frame's data_box is [min, max] per \
+                     axis, finite, min <= max"
+                )));
+            }
+        }
         Ok(f)
+    }
+
+    /// The longest side of the data's bounding box in the map's coordinates (None: the frame
+    /// does not keep the box, or the data are one point).
+    pub(crate) fn longest_side_in_map(&self) -> Option<f64> {
+        let [lo, hi] = self.data_box?;
+        let side = (0..3).map(|a| (hi[a] - lo[a]) / self.scale[a]).fold(0.0, f64::max);
+        (side > 0.0).then_some(side)
     }
 
     /// One phrase for the exported files: where the coordinates come from.
@@ -154,7 +183,7 @@ mod tests {
         let e = Frame::parse(&text.replace("per_axis", "cube")).unwrap_err().to_string();
         assert!(e.contains("line") && e.contains("cube"), "{e}");
         let e = Frame::parse(&format!("{text}units = \"mm\"\n")).unwrap_err().to_string();
-        assert!(e.contains("line 7") && e.contains("units"), "{e}");
+        assert!(e.contains("line 8") && e.contains("units"), "{e}");
         let with = |key: &str, line: &str| -> String {
             let lines: Vec<&str> =
                 text.lines().map(|l| if l.starts_with(key) { line } else { l }).collect();
@@ -163,6 +192,8 @@ mod tests {
                 Err(e) => e.to_string(),
             }
         };
+        let e = with("data_box", "data_box = [[0.0, 0.0, 2.0], [1.0, 1.0, 1.0]]");
+        assert!(e.contains("data_box") && e.contains("min <= max"), "{e}");
         for (line, want) in [
             ("scale = [-2.0, 1.0, 1.0]", "scale: the x scale is -2;"),
             ("scale = [0, 0, 0]", "scale: the x scale is 0;"),

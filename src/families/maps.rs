@@ -163,6 +163,61 @@ pub(crate) struct MapSource {
     pub(crate) frame: Option<crate::data::frame::Frame>,
 }
 
+/// What counts as "near the data" for surfaces fitted to `source`'s map, in the map's units:
+/// [`NEAR`](crate::spline::geometry::NEAR) of the longest side of the data's bounding box.
+/// Normalised data (`per_axis`, `uniform`) have a longest side of 1 in the map's coordinates, by
+/// construction, so the bound is NEAR itself; for data used as they are (`normalise = "none"`)
+/// it is NEAR of the longest side of the data's box the frame keeps, and for a frame without it
+/// or a map without a frame, of the map's own box (which lies inside the data's).
+pub(crate) fn near_bound(source: &MapSource) -> f64 {
+    let near = crate::spline::geometry::NEAR;
+    if source.frame.as_ref().is_some_and(|f| f.normalise != crate::data::Normalise::None) {
+        return near;
+    }
+    if let Some(side) = source.frame.as_ref().and_then(|f| f.longest_side_in_map()) {
+        return near * side;
+    }
+    let grid = &source.grid;
+    let (lo, hi) = crate::spline::geometry::bounding_box(grid.bottom.iter().chain(&grid.top));
+    near * (0..3).map(|a| hi[a] - lo[a]).fold(0.0, f64::max)
+}
+
+/// [`near_bound`] of every data set's map.
+pub(crate) fn near_bounds(maps: &BTreeMap<String, MapSource>) -> BTreeMap<String, f64> {
+    maps.iter().map(|(d, m)| (d.clone(), near_bound(m))).collect()
+}
+
+/// The bound of `dataset` (NEAR when it has none: a map not loaded).
+pub(crate) fn near_of(bounds: &BTreeMap<String, f64>, dataset: &str) -> f64 {
+    bounds.get(dataset).copied().unwrap_or(crate::spline::geometry::NEAR)
+}
+
+/// A bound as the reports write it: 4 decimals, trailing zeros dropped (0.1, 19.8765).
+pub(crate) fn near_text(v: f64) -> String {
+    let v = format!("{v:.4}");
+    v.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
+/// A claim's words for the bounds of `datasets`, in their maps' units: "at most NEAR of the
+/// longest side of the data's bounding box: 0.1 for cube, sphere; 19.9 for radar".
+pub(crate) fn near_note(bounds: &BTreeMap<String, f64>, datasets: &[String]) -> String {
+    let mut groups: Vec<(String, Vec<&str>)> = Vec::new();
+    for d in datasets {
+        let v = near_text(near_of(bounds, d));
+        match groups.iter_mut().find(|(w, _)| *w == v) {
+            Some((_, ds)) => ds.push(d),
+            None => groups.push((v, vec![d])),
+        }
+    }
+    let each: Vec<String> =
+        groups.iter().map(|(v, ds)| format!("{v} for {}", ds.join(", "))).collect();
+    format!(
+        "at most {} of the longest side of the data's bounding box, in the data's units as the map has them (normalised data: the unit box, side 1): {}",
+        crate::spline::geometry::NEAR,
+        each.join("; ")
+    )
+}
+
 /// The map file name Chapter 4 writes and Chapter 5 reads.
 pub(crate) fn map_file_name(dataset: &str, grid: GridSize) -> String {
     format!("dnsom_{dataset}_{grid}.csv")
@@ -269,7 +324,7 @@ pub(crate) fn maps_for(
     Ok(out)
 }
 
-fn read_map(path: &Path, grid: GridSize) -> Result<MapSource> {
+pub(crate) fn read_map(path: &Path, grid: GridSize) -> Result<MapSource> {
     let text = crate::io::read_text(path)?;
     let g = crate::data::grid_csv::parse_two_view_grid(&text)
         .with_context(|| path.display().to_string())?;
@@ -344,4 +399,42 @@ fn recompute_map(
             params.iterations
         ),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::data::{frame::Frame, Normalise};
+
+    /// A 2x2 map spanning 200 x 50 x 10 units, with the frame of `normalise` (None: no frame).
+    fn source(normalise: Option<Normalise>) -> MapSource {
+        let bottom =
+            vec![[0.0, 0.0, 0.0], [200.0, 0.0, 0.0], [0.0, 50.0, 0.0], [200.0, 50.0, 10.0]];
+        let grid = TwoViewGrid { nx: 2, ny: 2, top: bottom.clone(), bottom };
+        let frame = normalise.map(|n| Frame::of(n, &grid.bottom, "scan", "scan.xyz"));
+        MapSource { grid, origin: "scan".into(), frame }
+    }
+
+    #[test]
+    fn near_is_a_tenth_of_the_data_s_longest_side_in_the_map_s_units() {
+        // Normalised data: the unit box, so exactly NEAR (the thesis' verdicts unchanged).
+        for n in [Normalise::PerAxis, Normalise::Uniform] {
+            assert_eq!(near_bound(&source(Some(n))), crate::spline::geometry::NEAR);
+        }
+        // Data used as they are: a tenth of the data's 200 units; a map without a frame (or a
+        // frame that does not keep the data's box): of the map's own box.
+        assert_eq!(near_bound(&source(Some(Normalise::None))), 20.0);
+        let mut wider = source(Some(Normalise::None));
+        wider.frame.as_mut().unwrap().data_box = Some([[-50.0, 0.0, 0.0], [250.0, 50.0, 10.0]]);
+        assert_eq!(near_bound(&wider), 30.0, "the data's box, not the map's");
+        wider.frame.as_mut().unwrap().data_box = None;
+        assert_eq!(near_bound(&wider), 20.0);
+        assert_eq!(near_bound(&source(None)), 20.0);
+        let bounds: BTreeMap<String, f64> =
+            [("cube".to_string(), 0.1), ("radar".to_string(), 19.87654)].into_iter().collect();
+        let names = ["cube", "radar", "sphere"].map(String::from);
+        let note = near_note(&bounds, &names);
+        assert!(note.ends_with(": 0.1 for cube, sphere; 19.8765 for radar"), "{note}");
+        assert_eq!(near_of(&bounds, "sphere"), crate::spline::geometry::NEAR);
+    }
 }

@@ -20,8 +20,9 @@ use crate::geom::{self, Point3};
 /// The sampling density the harness uses: 4 points per data interval (at least 4x the data).
 pub(crate) const DENSE_FACTOR: usize = 4;
 
-/// What counts as "near the data": the thesis' data are normalised to the unit box, so an
-/// excursion of a tenth of its side.
+/// What counts as "near the data": an excursion of at most this fraction of the longest side of
+/// the data's bounding box (a tenth of the unit box's side for the thesis' normalised data; see
+/// `families::maps::near_bound`).
 pub(crate) const NEAR: f64 = 0.1;
 
 /// The dense measures of a pair of surfaces.

@@ -32,7 +32,6 @@ fn run_writes_every_table_with_the_thesis_columns() {
         "appendix_c.csv",
         "table_4_9.csv",
         "table_4_13.csv",
-        "table_4_14.csv",
         "manifest.toml",
         "REPORT.md",
         "maps/dnsom_sphere_6x5.csv",
@@ -72,6 +71,40 @@ fn run_writes_every_table_with_the_thesis_columns() {
     }
     let report = std::fs::read_to_string(out.join("REPORT.md")).unwrap();
     assert!(report.contains("DNSOM has the lowest TE") && report.contains("Metric definitions"));
+    // Table 4.14's grids (2x3 ... 7x8) did not run: no table, and the report says so.
+    assert!(!out.join("table_4_14.csv").exists());
+    assert!(report.contains("Not shown: DNSOM ran at none of its grids (2x3, 3x4"), "{report}");
+}
+
+#[test]
+fn the_count_tables_show_only_the_grids_and_models_that_ran() {
+    let c = Case::new();
+    let spec = TINY
+        .replace("models = [\"som2d\", \"som3d\", \"cksom\", \"dnsom\"]", "models = [\"som2d\"]")
+        .replace(
+            "models = [\"cksom\", \"dnsom\"]\ngrids = [\"6x5\"]",
+            "models = [\"dnsom\"]\ngrids = [\"5x6\"]",
+        )
+        .replace("save_maps = [\"6x5\"]", "save_maps = []");
+    c.write("own.toml", &spec);
+    c.ok(&["run", "own.toml", "--out", "o"]);
+    let (h, rows) = read_csv(&c.path("o/table_4_9.csv"));
+    assert_eq!(h, ["n", "som2d"], "only the model that ran at n x n");
+    assert_eq!(rows, [["4", "16"], ["6", "36"]]);
+    let (h, rows) = read_csv(&c.path("o/table_4_13.csv"));
+    assert_eq!(h, ["n_x", "n_y", "dnsom_non", "dnsom_nov", "dnsom_nor"]);
+    assert_eq!(rows, [["5", "6", "60", "42", "18"]]);
+    let (_, rows) = read_csv(&c.path("o/table_4_14.csv"));
+    assert_eq!(rows, [["5", "6", "60", "42", "18"]], "only the thesis' grid that ran");
+    let report = std::fs::read_to_string(c.path("o/REPORT.md")).unwrap();
+    for needle in [
+        "3-D SOM, CKSOM, DNSOM did not run at these grids",
+        "CKSOM did not run at these grids",
+        "Only the thesis' grids at which DNSOM ran here (the thesis' table has 2x3, 3x4, 4x5, 5x6, 6x7, 7x8)",
+    ] {
+        assert!(report.contains(needle), "{needle}: {report}");
+    }
+    assert!(!report.contains("160/128/32") && !report.contains("six nx x ny faces"), "{report}");
 }
 
 #[test]
@@ -291,16 +324,24 @@ fn fit_writes_nets_iges_and_obj_and_refuses_bad_grids() {
     assert_eq!(at("dense_gap").parse::<f64>().unwrap(), 0.0, "nor between the data points");
     assert_eq!((at("knots").as_str(), at("error_a").as_str()), ("eq2_10", "per_surface"));
     // Between the data points: an 18x18 net on the 20x20 map stays near the data under Eq. 2.10's
-    // knots and blows up under the NURBS Book's, which `fit` warns about; fairness tames it.
+    // knots and blows up under the NURBS Book's, which `fit` refuses (exit 2, nothing written,
+    // Eq. 2.10's knots measured within the bound) unless told to write; fairness tames it.
     let out = c.ok(&["fit", "--grid", grid, "--cn", "18x18", "--out", "f18"]);
     assert!(!String::from_utf8_lossy(&out.stderr).contains("warning"));
-    let out =
-        c.ok(&["fit", "--grid", grid, "--cn", "18x18", "--knots", "nurbs_book", "--out", "f18b"]);
+    let book = ["fit", "--grid", grid, "--cn", "18x18", "--knots", "nurbs_book", "--out", "f18b"];
+    let out = c.run(&book);
+    let err = String::from_utf8_lossy(&out.stderr).to_string();
+    assert_eq!(out.status.code(), Some(2), "{}", c.explain(&book, &out));
     assert!(
-        String::from_utf8_lossy(&out.stderr).contains("leave the data's bounding box"),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+        err.contains("leave the map's bounding box") && err.contains("--knots eq2_10"),
+        "{err}"
     );
+    assert!(!c.path("f18b").exists(), "a refused fit writes nothing");
+    let allowed = [&book[..], &["--allow-excursion"]].concat();
+    let out = c.ok(&allowed);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("warning") && err.contains("Written anyway (--allow-excursion)"), "{err}");
+    assert!(c.path("f18b/manifest.toml").exists());
     let out = c.ok(&[
         "fit",
         "--grid",
@@ -335,6 +376,68 @@ fn fit_writes_nets_iges_and_obj_and_refuses_bad_grids() {
     c.fails(&["fit", "--grid", grid, "--cn", "3x8"], &["smaller than 4"]);
     c.fails(&["fit", "--grid", grid, "--cn", "8x8", "--param", "spline"], &["--param", "spline"]);
     c.fails(&["fit", "--grid", "missing.csv", "--cn", "8x8"], &["missing.csv"]);
+}
+
+/// A 20x20 two-view grid of a pillow (z = +-0.3 sin(pi x) sin(pi y), flat on the shared border)
+/// whose rows are bunched at both ends and far apart in the middle (each end's rows `step`
+/// apart in index units): chord-length parameters then leave a long knot span without data.
+fn uneven_grid(step: f64) -> String {
+    let s = |i: usize| {
+        let i = i as f64;
+        (if i < 10.0 { i * step } else { 19.0 - (19.0 - i) * step }) / 19.0
+    };
+    let mut text = String::from("i,j,view,class,x,y,z\n");
+    for (view, sign) in [("bottom", -1.0), ("top", 1.0)] {
+        for i in 0..20 {
+            for j in 0..20 {
+                let (x, y) = (s(i), j as f64 / 19.0);
+                let border = i == 0 || j == 0 || i == 19 || j == 19;
+                let pi = std::f64::consts::PI;
+                let z = if border { 0.0 } else { sign * 0.3 * (pi * x).sin() * (pi * y).sin() };
+                text.push_str(&format!("{i},{j},{view},0,{x:?},{y:?},{z:?}\n"));
+            }
+        }
+    }
+    text
+}
+
+#[test]
+fn fit_refuses_surfaces_that_leave_the_data_naming_measured_alternatives() {
+    let c = Case::new();
+    c.write("scan.csv", &uneven_grid(0.1));
+    // The defaults (chord length, Eq. 2.10's knots) at 18x18 leave the data between the rows.
+    let args = ["fit", "--grid", "scan.csv", "--cn", "18x18", "--out", "f"];
+    let out = c.run(&args);
+    let err = String::from_utf8_lossy(&out.stderr).to_string();
+    assert_eq!(out.status.code(), Some(2), "{}", c.explain(&args, &out));
+    assert!(!c.path("f").exists(), "nothing written: {err}");
+    assert!(
+        err.contains("scan.csv: between the data points") && err.contains("the bound is 10%"),
+        "{err}"
+    );
+    assert!(err.contains("Nothing was written") && err.contains("--allow-excursion"), "{err}");
+    // It names the centripetal parameterisation with its measured excursion, which is what a fit
+    // with that option measures, within the bound.
+    let line = err.lines().find(|l| l.trim_start().starts_with("--param centripetal")).expect(&err);
+    let said: f64 = line.split_whitespace().nth(3).unwrap().parse().unwrap();
+    c.ok(&["fit", "--grid", "scan.csv", "--cn", "18x18", "--param", "centripetal", "--out", "g"]);
+    let (h, rows) = read_csv(&c.path("g/fit.csv"));
+    let at =
+        |name: &str| rows[0][h.iter().position(|x| x == name).unwrap()].parse::<f64>().unwrap();
+    assert_eq!(format!("{said:.3e}"), format!("{:.3e}", at("excursion")), "{line}");
+    let diagonal: f64 =
+        err.split("its diagonal ").nth(1).unwrap().split(' ').next().unwrap().parse().unwrap();
+    assert!(
+        (2f64.sqrt()..1.5).contains(&diagonal),
+        "the map's box: x, y in [0, 1], z small: {err}"
+    );
+    assert!(at("excursion") <= 0.1 * diagonal && said > 0.0, "{line}");
+    // The flag writes the surfaces, with the same block as a warning.
+    let out = c.ok(&[&args[..], &["--allow-excursion"]].concat());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("Written anyway"));
+    let (h, rows) = read_csv(&c.path("f/fit.csv"));
+    let e: f64 = rows[0][h.iter().position(|x| x == "excursion").unwrap()].parse().unwrap();
+    assert!(e > 0.1 * diagonal, "the written fit is the refused one: {e}");
 }
 
 const CH6_TINY: &str = r#"
@@ -775,4 +878,24 @@ fn a_closed_pipe_on_stdout_is_not_a_panic() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!err.contains("panicked"), "{err}");
     assert_ne!(out.status.code(), Some(101), "{err}");
+}
+
+#[test]
+fn the_optimise_report_states_the_spec_s_own_start() {
+    let c = Case::new();
+    c.write("d.toml", &SPEC.replace("repeats = 2", "repeats = 1\ninit_range = 1e-3"));
+    c.ok(&["run", "d.toml", "--out", "r"]);
+    let report = std::fs::read_to_string(c.path("r/REPORT.md")).unwrap();
+    assert!(report.contains("the +-1e-3 start can leave an optimiser above B"), "{report}");
+    assert!(!report.contains("5e-6"), "no number of the thesis plan's: {report}");
+    // A search box of the spec's own is named as the spec's, not as the thesis' reading.
+    let spec = SPEC.replace("repeats = 2", "repeats = 1\ninit_range = 1e-3\nsearch_range = 1e-3");
+    c.write("e.toml", &spec);
+    c.ok(&["run", "e.toml", "--out", "s"]);
+    let report = std::fs::read_to_string(c.path("s/REPORT.md")).unwrap();
+    assert!(
+        report.contains("the search box is B +- 1e-3 per coordinate (the spec's `search_range`"),
+        "{report}"
+    );
+    assert!(!report.contains("read as the search space"), "{report}");
 }

@@ -181,3 +181,35 @@ fn export_writes_the_optimised_net_whose_error_is_the_records() {
     );
     c.fails(&["export", "r", "--cell", &cell, "--out", "x"], &["x"]);
 }
+
+#[test]
+fn export_refuses_a_net_that_leaves_the_data_unless_allowed() {
+    // The NURBS Book's knots at an 18x18 net on a 20x20 map: B's start, and so every optimised
+    // net, leaves the map's box between the data points by orders of magnitude.
+    let c = Case::new();
+    let spec = SPEC
+        .replace("control_nets = [\"6x6\"]", "control_nets = [\"18x18\"]")
+        .replace("optimisers = [\"ga\", \"de\"]", "optimisers = [\"de\"]")
+        .replace("repeats = 2", "repeats = 1\nknots = \"nurbs_book\"")
+        .replace("generations = 20", "generations = 3");
+    c.write("d.toml", &spec);
+    c.ok(&["run", "d.toml", "--out", "r"]);
+    let (h, rows) = read_csv(&c.path("r/runs.csv"));
+    let cell = rows[0][col(&h, "cell")].clone();
+    let args = ["export", "r", "--cell", &cell, "--out", "x"];
+    let out = c.run(&args);
+    let err = String::from_utf8_lossy(&out.stderr).to_string();
+    assert_eq!(out.status.code(), Some(2), "{}", c.explain(&args, &out));
+    assert!(!c.path("x").exists(), "nothing written: {err}");
+    for needle in [
+        "leave the map's bounding box",
+        "the bound is 10%",
+        "Measured: the start",
+        "--allow-excursion",
+    ] {
+        assert!(err.contains(needle), "{needle}: {err}");
+    }
+    let out = c.ok(&[&args[..], &["--allow-excursion"]].concat());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("Written anyway"));
+    assert!(c.path("x/surfaces.igs").exists() && c.path("x/export.csv").exists());
+}

@@ -160,7 +160,8 @@ impl crate::experiment::family::Experiment for Fit {
             maps.iter().map(|(d, m)| (d.clone(), m.origin.clone())).collect();
         let pictures = ctx.extras && s.pictures;
         let section = if tables {
-            Some(self::report::write(&spec.file.name, &runs, &ctx.out, &origins, pictures)?)
+            let near = super::maps::near_bounds(&maps);
+            Some(self::report::write(&spec.file.name, &runs, &ctx.out, &origins, &near, pictures)?)
         } else {
             None
         };

@@ -9,6 +9,8 @@ use serde::Deserialize;
 #[derive(Debug, Deserialize)]
 struct FitPoint {
     dataset: String,
+    grid_x: usize,
+    grid_y: usize,
     cn_x: usize,
     cn_y: usize,
     parameterisation: String,
@@ -43,8 +45,10 @@ fn error_vs_excursion(view: &PlanView<super::spec::FitSpec>) -> Result<Option<St
     let mut series = Vec::new();
     let mut data_set = None;
     let mut nets: Vec<String> = Vec::new();
+    let mut grid = None;
     for (k, (name, folder)) in folders.iter().enumerate() {
         let points: Vec<FitPoint> = crate::io::read_rows(&folder.join("runs.csv"))?;
+        grid = grid.or(points.first().map(|p| (p.grid_x, p.grid_y)));
         let d = data_set
             .get_or_insert_with(|| points.first().map(|p| p.dataset.clone()).unwrap_or_default())
             .clone();
@@ -72,16 +76,16 @@ fn error_vs_excursion(view: &PlanView<super::spec::FitSpec>) -> Result<Option<St
             band: None,
         });
     }
-    // The claim's threshold ("near the data": an excursion of at most NEAR), upright across the
-    // errors drawn.
+    // The claim's threshold ("near the data": the data set's `near_bound`, from the map the
+    // plan's folder saved), upright across the errors drawn.
     let errors = series.iter().flat_map(|s| s.points.iter().map(|p| p.1));
     let (lo, hi) = errors.fold((f64::INFINITY, f64::NEG_INFINITY), |a, y| (a.0.min(y), a.1.max(y)));
     if lo.is_finite() {
-        let x = crate::spline::geometry::NEAR.log10();
+        let near = near_bound(&folders[0].1, data_set.as_deref().unwrap_or_default(), grid)?;
         series.push(crate::report::plots::Series {
-            label: format!("near the data: excursion {}", crate::spline::geometry::NEAR),
+            label: format!("near the data: excursion {}", crate::families::maps::near_text(near)),
             colour: crate::report::plots::style::GREY,
-            points: vec![(x, lo), (x, hi)],
+            points: vec![(near.log10(), lo), (near.log10(), hi)],
             band: None,
         });
     }
@@ -105,4 +109,16 @@ fn error_vs_excursion(view: &PlanView<super::spec::FitSpec>) -> Result<Option<St
             Ok(None)
         }
     }
+}
+
+/// What counts as near the data for `dataset`'s map in `folder` (`maps/`; NEAR when the folder
+/// kept none).
+fn near_bound(folder: &std::path::Path, dataset: &str, grid: Option<(usize, usize)>) -> Result<f64> {
+    let Some((nx, ny)) = grid else { return Ok(crate::spline::geometry::NEAR) };
+    let grid = crate::experiment::spec::GridSize { nx, ny };
+    let file = folder.join("maps").join(crate::families::maps::map_file_name(dataset, grid));
+    if !file.exists() {
+        return Ok(crate::spline::geometry::NEAR);
+    }
+    Ok(crate::families::maps::near_bound(&crate::families::maps::read_map(&file, grid)?))
 }

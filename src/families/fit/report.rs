@@ -10,6 +10,7 @@ use crate::report::ordered;
 use crate::report::reference::{self, RefTable};
 use crate::spline::{Approach, Parameterisation};
 use anyhow::Result;
+use std::collections::BTreeMap;
 use std::fmt::Write;
 use std::path::Path;
 
@@ -382,6 +383,7 @@ pub(crate) fn write(
     runs: &[FitRun],
     out: &Path,
     maps_origin: &[(String, String)],
+    near: &BTreeMap<String, f64>,
     pictures: bool,
 ) -> Result<String> {
     let rows: Vec<_> = runs.iter().map(|r| r.row.clone()).collect();
@@ -440,7 +442,7 @@ pub(crate) fn write(
             }
         }
         let geo = geometry_rows(&g.runs, &g.cns, &g.approaches);
-        let (md, claim) = render_geometry(&geo, &g.runs, grid, out)?;
+        let (md, claim) = render_geometry(&geo, &g.runs, grid, near, out)?;
         wins_md.push_str(&md);
         claims.push(claim);
 
@@ -588,6 +590,7 @@ fn render_geometry(
     geo: &[GeometryRow],
     runs: &[FitRun],
     grid: GridSize,
+    near: &BTreeMap<String, f64>,
     out: &Path,
 ) -> Result<(String, Claim)> {
     let h: Vec<String> =
@@ -615,11 +618,13 @@ fn render_geometry(
         crate::spline::DENSE_FACTOR,
         table(&h, &rows)
     );
-    let near = runs.iter().filter(|r| r.row.excursion <= crate::spline::geometry::NEAR).count();
+    use crate::families::maps::{near_note, near_of};
+    let count = runs.iter().filter(|r| r.row.excursion <= near_of(near, &r.cell.dataset)).count();
     let worst = runs.iter().max_by(|a, b| a.row.excursion.total_cmp(&b.row.excursion));
-    let claim = Claim::every("5", "The fitted surfaces stay near the data", (near, runs.len()))
+    let datasets = ordered(runs.iter().map(|r| r.cell.dataset.clone()));
+    let claim = Claim::every("5", "The fitted surfaces stay near the data", (count, runs.len()))
         .on_grid(grid)
-        .note(format!("fits whose dense excursion from the data's bounding box is at most {} (the unit box's side is 1){}", crate::spline::geometry::NEAR, worst.map(|w| format!("; largest {:.3e} at {}", w.row.excursion, w.row.cell)).unwrap_or_default()));
+        .note(format!("fits whose dense excursion from the data's bounding box is {}{}", near_note(near, &datasets), worst.map(|w| format!("; largest {:.3e} at {}", w.row.excursion, w.row.cell)).unwrap_or_default()));
     Ok((md, claim))
 }
 

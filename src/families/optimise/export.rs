@@ -5,7 +5,10 @@
 
 use super::{OptimRecord, OptimSpec, ProblemKey};
 use crate::experiment::{log, RunContext};
-use crate::families::fit::command::{export_frame, write_surface_files, MAX_SAMPLES, MIN_SAMPLES};
+use crate::families::fit::command::{
+    diagonal, export_frame, write_surface_files, Outcome, EXCURSION_BOUND, MAX_SAMPLES,
+    MIN_SAMPLES,
+};
 use crate::families::Loaded;
 use crate::io::{csv_records, write_atomic};
 use crate::optim::Problem;
@@ -57,6 +60,8 @@ pub(crate) struct Request {
     pub(crate) frame: String,
     pub(crate) units: String,
     pub(crate) samples: usize,
+    /// Write a net whose surfaces leave the data by more than [`EXCURSION_BOUND`] (warning).
+    pub(crate) allow_excursion: bool,
 }
 
 /// parameters.csv's rows: each data point the surface error (Eq. 6.2) counts (the bottom view's
@@ -92,8 +97,43 @@ fn parameter_rows(
     rows
 }
 
+/// The block `export` prints when the net's surfaces leave the map's bounding box by more than
+/// [`EXCURSION_BOUND`] of its diagonal: by how much, the start's (approach B's net) excursion
+/// measured on the same problem, and what happens (`written`: written anyway).
+fn excursion_block(
+    key: &str,
+    what: &str,
+    problem: &crate::spline::ControlNetProblem,
+    x: &[f64],
+    start: bool,
+    written: Option<&std::path::Path>,
+) -> Option<String> {
+    let parts = problem.parts();
+    let diagonal = diagonal(parts.data_bottom.iter().chain(&parts.data_top));
+    let excursion = parts.dense_geometry(x).excursion;
+    if excursion <= EXCURSION_BOUND * diagonal {
+        return None;
+    }
+    let pct = |e: f64| 100.0 * e / diagonal;
+    let mut s = format!(
+        "cell {key}: between the data points the surfaces of {what} leave the map's bounding box by {excursion:.3e}, {:.1}% of its diagonal {diagonal:.3e} (the bound is {}%): their IGES/OBJ are not usable as they are.",
+        pct(excursion),
+        100.0 * EXCURSION_BOUND
+    );
+    if !start {
+        let e = parts.dense_geometry(problem.initial_point()).excursion;
+        let within = if e <= EXCURSION_BOUND * diagonal { "within" } else { "also beyond" };
+        s.push_str(&format!("\n  Measured: the start (--start, approach B's net) goes {e:.3e} ({:.1}%), {within} the bound.", pct(e)));
+    }
+    s.push_str(&match written {
+        None => "\n  Nothing was written. Pass --allow-excursion to write this net anyway.".to_string(),
+        Some(out) => format!("\n  Written anyway (--allow-excursion) into {}.", crate::io::shown(out)),
+    });
+    Some(s)
+}
+
 /// `somnurbs export RESULTS --cell KEY --out DIR`.
-pub(crate) fn export(args: &Request, data_dir: std::path::PathBuf) -> Result<()> {
+pub(crate) fn export(args: &Request, data_dir: std::path::PathBuf) -> Result<Outcome> {
     if !(MIN_SAMPLES..=MAX_SAMPLES).contains(&args.samples) {
         anyhow::bail!(
             "--samples: must be in [{MIN_SAMPLES}, {MAX_SAMPLES}] (evaluations per direction of the OBJ mesh), got {}",
@@ -143,6 +183,12 @@ pub(crate) fn export(args: &Request, data_dir: std::path::PathBuf) -> Result<()>
             "cell {key}: the exported net's surface error is {error:?}, the record's {recorded:?} (the folder and this build disagree)"
         );
     }
+    if let (Some(block), false) =
+        (excursion_block(&key, what, problem, &x, args.start, None), args.allow_excursion)
+    {
+        eprintln!("somnurbs: error: {block}");
+        return Ok(Outcome::Refused);
+    }
     let frame = maps.join(crate::families::maps::map_file_name(&rec.row.dataset, o.grid));
     let placed = export_frame(&frame, crate::io::map_file::read_frame(&frame)?, &args.frame, &args.units)?;
     let [bottom, top] = problem.parts().surfaces(&x);
@@ -181,5 +227,8 @@ pub(crate) fn export(args: &Request, data_dir: std::path::PathBuf) -> Result<()>
         dense.excursion,
         out.display()
     );
-    Ok(())
+    if let Some(block) = excursion_block(&key, what, problem, &x, args.start, Some(out)) {
+        eprintln!("warning: {block}");
+    }
+    Ok(Outcome::Written)
 }

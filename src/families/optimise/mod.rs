@@ -149,6 +149,15 @@ pub fn problems(
     o: &OptimSpec,
     ctx: &RunContext,
 ) -> Result<BTreeMap<ProblemKey, ControlNetProblem>> {
+    Ok(problems_and_near(spec, o, ctx)?.0)
+}
+
+/// [`problems`], and per data set what counts as near its data ([`maps::near_bound`]).
+pub(crate) fn problems_and_near(
+    spec: &Spec,
+    o: &OptimSpec,
+    ctx: &RunContext,
+) -> Result<(BTreeMap<ProblemKey, ControlNetProblem>, BTreeMap<String, f64>)> {
     let from = maps::MapsFrom {
         section: "optimise",
         dir: o.maps.as_deref(),
@@ -176,7 +185,7 @@ pub fn problems(
             }
         }
     }
-    Ok(out)
+    Ok((out, maps::near_bounds(&maps)))
 }
 
 /// Run one cell (also alone: the same numbers as inside the full run) on its place's stream.
@@ -356,7 +365,8 @@ pub(crate) fn setting(o: &OptimSpec) -> String {
         r = o.init_range
     );
     match o.search_range {
-        Some(r) => format!("{start}; the search box is B +- {r:e} per coordinate (Table 6.1's \"control point coordinate range [-5e-6, 5e-6]\" read as the search space, as the thesis' tiny improvements over B imply; PSO's maximum velocity is half that box)."),
+        Some(r) if r == crate::experiment::defaults::init_range() => format!("{start}; the search box is B +- {r:e} per coordinate (Table 6.1's \"control point coordinate range [-5e-6, 5e-6]\" read as the search space, as the thesis' tiny improvements over B imply; PSO's maximum velocity is half that box)."),
+        Some(r) => format!("{start}; the search box is B +- {r:e} per coordinate (the spec's `search_range`; the thesis' reading of Table 6.1 gives B +- 5e-6; PSO's maximum velocity is half that box)."),
         None if o.bounds_margin == 0.0 => format!("{start}; the search box is the smallest per-axis box holding the data and B's control points."),
         None => format!("{start}; the search box is the smallest per-axis box holding the data and B's control points, widened by {} of its size on each side.", o.bounds_margin),
     }
@@ -411,7 +421,7 @@ impl crate::experiment::family::Experiment for Optim {
         tables: bool,
     ) -> Result<crate::experiment::family::Outcome> {
         let [(first, o), ..] = variants else { anyhow::bail!("no variant to run") };
-        let problems = problems(first, o, ctx)?;
+        let (problems, near) = problems_and_near(first, o, ctx)?;
         let exact = if tables { exact_optima(o, ctx, &problems)? } else { BTreeMap::new() };
         let runs = run(variants, ctx, &problems)?;
         let section = if tables {
@@ -420,9 +430,13 @@ impl crate::experiment::family::Experiment for Optim {
                 &runs,
                 &problems,
                 &exact,
-                &setting(o),
+                &self::report::AsRun {
+                    setting: setting(o),
+                    init_range: o.init_range,
+                    near,
+                    extras: ctx.extras,
+                },
                 &ctx.out,
-                ctx.extras,
             )?)
         } else {
             None

@@ -437,7 +437,12 @@ pub(crate) fn label(o: &str) -> String {
 
 /// The grid's claims, with the thesis' own counts over the same cells where this run compared
 /// the thesis' three optimisers (its counts rank GA, DE and PSO against each other only).
-fn grid_claims(t: &GridTables, grid: GridSize, err_name: &str, time_name: &str) -> Vec<Claim> {
+fn grid_claims(
+    t: &GridTables,
+    grid: GridSize,
+    (err_name, time_name): (&str, &str),
+    init_range: f64,
+) -> Vec<Claim> {
     let n = t.cells.len();
     let mut claims = Vec::new();
     let mut sorted = t.opts.clone();
@@ -484,7 +489,7 @@ fn grid_claims(t: &GridTables, grid: GridSize, err_name: &str, time_name: &str) 
         claims.push(
             Claim::most("6", format!("{} lowers the surface error below B", label(o)), (t.beats_b[k], n))
                 .on_grid(grid)
-                .note("cells whose AVG over repeats is below B's error; the +-5e-6 start can leave an optimiser above B"),
+                .note(format!("cells whose AVG over repeats is below B's error; the +-{init_range:e} start can leave an optimiser above B")),
         );
     }
     claims
@@ -596,14 +601,15 @@ fn budgets(runs: &[OptimRun]) -> String {
 }
 
 /// The claims over every run: the surfaces stay near the data, elitism holds.
-fn run_claims(runs: &[OptimRun]) -> Vec<Claim> {
-    let near =
-        runs.iter().filter(|r| r.row.excursion <= crate::spline::geometry::NEAR).count();
+fn run_claims(runs: &[OptimRun], bounds: &BTreeMap<String, f64>) -> Vec<Claim> {
+    use crate::families::maps::{near_note, near_of};
+    let near = runs.iter().filter(|r| r.row.excursion <= near_of(bounds, &r.cell.dataset)).count();
+    let datasets = ordered(runs.iter().map(|r| r.cell.dataset.clone()));
     let worst = runs.iter().max_by(|a, b| a.row.excursion.total_cmp(&b.row.excursion));
     let kept = runs.iter().filter(|r| r.row.best <= r.row.initial_best).count();
     vec![
         Claim::every("6", "The optimised surfaces stay near the data", (near, runs.len()))
-            .note(format!("runs whose best surfaces' dense excursion from the data's bounding box is at most {}{}", crate::spline::geometry::NEAR, worst.map(|w| format!("; largest {:.3e} at {}", w.row.excursion, w.row.cell)).unwrap_or_default())),
+            .note(format!("runs whose best surfaces' dense excursion from the data's bounding box is {}{}", near_note(bounds, &datasets), worst.map(|w| format!("; largest {:.3e} at {}", w.row.excursion, w.row.cell)).unwrap_or_default())),
         Claim::every("6", "Every run's best is no worse than its initial population's best", (kept, runs.len()))
             .note("elitism check over all runs"),
     ]
@@ -617,9 +623,10 @@ fn write_grid(
     problems: &BTreeMap<ProblemKey, ControlNetProblem>,
     exact: &BTreeMap<ProblemKey, ExactResult>,
     out: &Path,
-    extras: bool,
+    as_run: &AsRun,
     s: &mut String,
 ) -> Result<Vec<Claim>> {
+    let extras = as_run.extras;
     let t = GridTables::compute(g);
     let (err_name, time_name, t_err, t_time) = table_names(grid.nx, grid.ny).unwrap_or((
         "optimised_error",
@@ -654,7 +661,7 @@ fn write_grid(
     if t.opts.len() > 1 {
         s.push_str(&winners_by_net(&t, grid, err_name, out, extras)?);
     }
-    let mut claims = grid_claims(&t, grid, err_name, time_name);
+    let mut claims = grid_claims(&t, grid, (err_name, time_name), as_run.init_range);
     if let Some((part, claim)) = exact_section(g, &t, exact, grid, out)? {
         s.push_str(&part);
         claims.push(claim);
@@ -666,16 +673,29 @@ fn write_grid(
     Ok(claims)
 }
 
+/// What the report takes from the spec as it ran, besides its records: every number its text
+/// states comes from here, never from the thesis plan's defaults.
+pub(crate) struct AsRun {
+    /// One sentence on the readings, the start and the search box ([`super::setting`]).
+    pub(crate) setting: String,
+    /// The half-width of the start's spread around B (`optimise.init_range`).
+    pub(crate) init_range: f64,
+    /// Per data set, what counts as near its data ([`crate::families::maps::near_bound`]).
+    pub(crate) near: BTreeMap<String, f64>,
+    /// Pictures, appendices I/J and the IOHprofiler files too.
+    pub(crate) extras: bool,
+}
+
 /// Write every Chapter 6 file; returns the REPORT.md section.
 pub(crate) fn write(
     spec_name: &str,
     runs: &[OptimRun],
     problems: &BTreeMap<ProblemKey, ControlNetProblem>,
     exact: &BTreeMap<ProblemKey, ExactResult>,
-    setting: &str,
+    as_run: &AsRun,
     out: &Path,
-    extras: bool,
 ) -> Result<String> {
+    let (setting, extras) = (&as_run.setting, as_run.extras);
     let rows: Vec<_> = runs.iter().map(|r| r.row.clone()).collect();
     write_atomic(&out.join("runs.csv"), csv_text(&rows)?.as_bytes())?;
     let mut s = String::from("## Chapter 6: optimisation of the control points\n\n");
@@ -685,14 +705,14 @@ pub(crate) fn write(
     let mut claims = Vec::new();
     for grid in ordered(runs.iter().map(|r| r.cell.grid)) {
         let g: Vec<&OptimRun> = runs.iter().filter(|r| r.cell.grid == grid).collect();
-        claims.extend(write_grid(&g, grid, problems, exact, out, extras, &mut s)?);
+        claims.extend(write_grid(&g, grid, problems, exact, out, as_run, &mut s)?);
     }
     s.push_str(&friedman_section(runs));
     if extras {
         let n_ioh = super::ioh::write(runs, out)?;
         let _ = writeln!(s, "\nEvery run's improvements of the best so far in the IOHprofiler format (`ioh/<optimiser>/`: {n_ioh} JSON meta-data files, format version 0.3.3 or later, each with its improvement-based `.dat`), loadable by IOHanalyzer and iohinspector.");
     }
-    claims.extend(run_claims(runs));
+    claims.extend(run_claims(runs, &as_run.near));
     let claims_md = crate::report::claims::write(out, spec_name, &claims, false)?;
     if !claims_md.is_empty() {
         s.push_str("\n### Claims\n\n");

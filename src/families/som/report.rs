@@ -98,73 +98,107 @@ fn counts(model: Model, g: GridSize) -> Option<crate::som::NeuronCounts> {
     model.topology(g.nx, g.ny).ok().map(|t| t.counts())
 }
 
-/// Table 4.9 for the square grids given.
-pub(crate) fn table_4_9(grids: &[GridSize]) -> (Vec<String>, Vec<Vec<String>>) {
-    let header = [
-        "n",
-        "som2d",
-        "som3d",
-        "cksom_non",
-        "cksom_nor",
-        "cksom_nov",
-        "dnsom_non",
-        "dnsom_nor",
-        "dnsom_nov",
-    ];
-    let rows = grids
-        .iter()
-        .filter(|g| g.nx == g.ny)
-        .map(|&g| {
-            let ck = counts(Model::Cksom, g).unwrap();
-            let dn = counts(Model::Dnsom, g).unwrap();
-            vec![g.nx, g.nx * g.nx, g.nx.pow(3), ck.non, ck.nor, ck.nov, dn.non, dn.nor, dn.nov]
-                .into_iter()
-                .map(|v| v.to_string())
-                .collect()
-        })
-        .collect();
-    (header.iter().map(|s| s.to_string()).collect(), rows)
+/// The models of `runs` at grids of one shape (square or not), in the thesis' order.
+fn models_at(runs: &[SomRun], square: bool) -> Vec<Model> {
+    let at = |m: Model| runs.iter().any(|r| r.cell.model == m && (r.cell.grid.nx == r.cell.grid.ny) == square);
+    Model::ALL.into_iter().filter(|&m| at(m)).collect()
 }
 
-/// Table 4.13 (CKSOM and DNSOM counts at nx x ny).
-pub(crate) fn table_4_13(grids: &[GridSize]) -> (Vec<String>, Vec<Vec<String>>) {
-    let header = [
-        "n_x",
-        "n_y",
-        "cksom_non",
-        "cksom_nov",
-        "cksom_nor",
-        "dnsom_non",
-        "dnsom_nov",
-        "dnsom_nor",
-    ];
+/// Whether `model` ran at `g`.
+fn ran(runs: &[SomRun], model: Model, g: GridSize) -> bool {
+    runs.iter().any(|r| r.cell.model == model && r.cell.grid == g)
+}
+
+/// `model`'s count columns: Table 4.9's (`table_4_13`: false; SOM 2-D n^2, SOM 3-D n^3, CKSOM
+/// and DNSOM NON/NOR/NOV) or Table 4.13's (NON/NOV/NOR).
+fn count_names(model: Model, table_4_13: bool) -> Vec<String> {
+    let key = model.key();
+    match model {
+        Model::Som2d | Model::Som3d => vec![key.to_string()],
+        Model::Cksom | Model::Dnsom => {
+            let order = if table_4_13 { ["non", "nov", "nor"] } else { ["non", "nor", "nov"] };
+            order.iter().map(|n| format!("{key}_{n}")).collect()
+        }
+    }
+}
+
+/// `model`'s counts at `g` in [`count_names`]' order (a grid `model` ran at has its topology).
+fn count_values(model: Model, g: GridSize, table_4_13: bool) -> Vec<usize> {
+    match model {
+        Model::Som2d => vec![g.nx * g.ny],
+        Model::Som3d => vec![g.nx * g.ny * g.nx.max(g.ny)],
+        Model::Cksom | Model::Dnsom => match counts(model, g) {
+            Some(c) if table_4_13 => vec![c.non, c.nov, c.nor],
+            Some(c) => vec![c.non, c.nor, c.nov],
+            None => Vec::new(),
+        },
+    }
+}
+
+/// A counts table: the grid's columns (`n`, or `n_x, n_y` for Table 4.13), then each of
+/// `models`' count columns (empty where the model did not run at that grid).
+fn counts_table(
+    runs: &[SomRun],
+    grids: &[GridSize],
+    models: &[Model],
+    table_4_13: bool,
+) -> (Vec<String>, Vec<Vec<String>>) {
+    let lead: &[&str] = if table_4_13 { &["n_x", "n_y"] } else { &["n"] };
+    let mut header: Vec<String> = lead.iter().map(|s| s.to_string()).collect();
+    for &m in models {
+        header.extend(count_names(m, table_4_13));
+    }
     let rows = grids
         .iter()
         .map(|&g| {
-            let ck = counts(Model::Cksom, g).unwrap();
-            let dn = counts(Model::Dnsom, g).unwrap();
-            vec![g.nx, g.ny, ck.non, ck.nov, ck.nor, dn.non, dn.nov, dn.nor]
-                .into_iter()
-                .map(|v| v.to_string())
-                .collect()
+            let mut row = vec![g.nx.to_string()];
+            if table_4_13 {
+                row.push(g.ny.to_string());
+            }
+            for &m in models {
+                let width = count_names(m, table_4_13).len();
+                let values = if ran(runs, m, g) { count_values(m, g, table_4_13) } else { Vec::new() };
+                let cells = values.iter().map(|v| v.to_string()).chain(std::iter::repeat(String::new()));
+                row.extend(cells.take(width));
+            }
+            row
         })
         .collect();
-    (header.iter().map(|s| s.to_string()).collect(), rows)
+    (header, rows)
 }
 
-/// Table 4.14 (DNSOM counts for the thesis' small grids).
-pub(crate) fn table_4_14() -> (Vec<String>, Vec<Vec<String>>) {
-    let rows = [(2, 3), (3, 4), (4, 5), (5, 6), (6, 7), (7, 8)]
+/// Table 4.9 at the square grids that ran, with the columns of the models that ran there.
+pub(crate) fn table_4_9(runs: &[SomRun]) -> Option<(Vec<String>, Vec<Vec<String>>)> {
+    let grids = grids(runs, true);
+    let models = models_at(runs, true);
+    (!grids.is_empty()).then(|| counts_table(runs, &grids, &models, false))
+}
+
+/// Table 4.13 (CKSOM and DNSOM at nx x ny) at the grids that ran, for those of the two models
+/// that ran there.
+pub(crate) fn table_4_13(runs: &[SomRun]) -> Option<(Vec<String>, Vec<Vec<String>>)> {
+    let grids = grids(runs, false);
+    let models: Vec<Model> =
+        models_at(runs, false).into_iter().filter(|m| matches!(m, Model::Cksom | Model::Dnsom)).collect();
+    (!grids.is_empty() && !models.is_empty())
+        .then(|| counts_table(runs, &grids, &models, true))
+}
+
+/// The thesis' Table 4.14 grids: DNSOM at small nx x (nx + 1).
+pub(crate) const TABLE_4_14_GRIDS: [(usize, usize); 6] = [(2, 3), (3, 4), (4, 5), (5, 6), (6, 7), (7, 8)];
+
+/// Table 4.14 (DNSOM counts) at those of the thesis' grids where DNSOM ran.
+pub(crate) fn table_4_14(runs: &[SomRun]) -> Option<(Vec<String>, Vec<Vec<String>>)> {
+    let rows: Vec<Vec<String>> = TABLE_4_14_GRIDS
         .iter()
+        .filter(|&&(nx, ny)| ran(runs, Model::Dnsom, GridSize { nx, ny }))
         .map(|&(nx, ny)| {
             let net = crate::double_net::DoubleNet::new(nx, ny).unwrap();
-            vec![nx, ny, net.non(), net.nov(), net.nor()]
-                .into_iter()
-                .map(|v| v.to_string())
-                .collect()
+            [nx, ny, net.non(), net.nov(), net.nor()].iter().map(|v| v.to_string()).collect()
         })
         .collect();
-    (["n_x", "n_y", "non", "nov", "nor"].iter().map(|s| s.to_string()).collect(), rows)
+    let header = ["n_x", "n_y", "non", "nov", "nor"].iter().map(|s| s.to_string()).collect();
+    (!rows.is_empty()).then_some((header, rows))
 }
 
 /// The saved DNSOM map of a run.
@@ -195,21 +229,14 @@ pub(crate) fn write(
             written.push(name.into());
         }
     }
-    let sq = grids(runs, true);
-    let nsq = grids(runs, false);
-    if !sq.is_empty() {
-        let (h, r) = table_4_9(&sq);
-        write_atomic(&out.join("table_4_9.csv"), csv_records(&h, &r)?.as_bytes())?;
-        written.push("table_4_9.csv".into());
+    for (name, t) in
+        [("table_4_9.csv", table_4_9(runs)), ("table_4_13.csv", table_4_13(runs)), ("table_4_14.csv", table_4_14(runs))]
+    {
+        if let Some((h, r)) = t {
+            write_atomic(&out.join(name), csv_records(&h, &r)?.as_bytes())?;
+            written.push(name.into());
+        }
     }
-    if !nsq.is_empty() {
-        let (h, r) = table_4_13(&nsq);
-        write_atomic(&out.join("table_4_13.csv"), csv_records(&h, &r)?.as_bytes())?;
-        written.push("table_4_13.csv".into());
-    }
-    let (h, r) = table_4_14();
-    write_atomic(&out.join("table_4_14.csv"), csv_records(&h, &r)?.as_bytes())?;
-    written.push("table_4_14.csv".into());
 
     let save = &som.save_maps;
     let mut maps = Vec::new();
@@ -521,22 +548,7 @@ fn section(
         s.push_str(&side_by_side(runs, false, reference::lookup(PUBLISHED, "appendix_c").as_ref()));
     }
     s.push_str(&speed_section(runs));
-    let sq = grids(runs, true);
-    if !sq.is_empty() {
-        let (h, r) = table_4_9(&sq);
-        let _ = write!(s, "\n### Table 4.9: neurons representing the surface\n\n{}", table(&h, &r));
-    }
-    let nsq = grids(runs, false);
-    if !nsq.is_empty() {
-        let (h, r) = table_4_13(&nsq);
-        let _ = write!(
-            s,
-            "\n### Table 4.13: CKSOM and DNSOM at nx x ny\n\nDNSOM counts equal the thesis' (160/128/32, 480/420/60, 1080/988/92). The CKSOM counts at nx != ny follow this harness' documented construction (six nx x ny faces on a cube of side max(nx, ny)); the thesis' own construction (400/1308/3040 output neurons) is not published.\n\n{}",
-            table(&h, &r)
-        );
-    }
-    let (h, r) = table_4_14();
-    let _ = write!(s, "\n### Table 4.14: DNSOM neuron counts\n\n{}", table(&h, &r));
+    s.push_str(&count_tables(runs));
     if !maps.is_empty() {
         let _ = writeln!(
             s,
@@ -551,6 +563,66 @@ fn section(
         }
         let per_cell = pictures.iter().filter(|p| p.starts_with("png/")).count();
         let _ = writeln!(s, "One picture per cell ({per_cell}) in `png/`.");
+    }
+    s
+}
+
+/// Tables 4.9, 4.13 and 4.14 as they ran: only the grids and models of the runs, saying which of
+/// the thesis' cells did not run.
+fn count_tables(runs: &[SomRun]) -> String {
+    let mut s = String::new();
+    if let Some((h, r)) = table_4_9(runs) {
+        let _ = write!(s, "\n### Table 4.9: neurons representing the surface\n\n{}{}", not_run(runs, true), table(&h, &r));
+    }
+    if let Some((h, r)) = table_4_13(runs) {
+        let _ = write!(s, "\n### Table 4.13: CKSOM and DNSOM at nx x ny\n\n{}\n{}{}", table_4_13_note(runs), not_run(runs, false), table(&h, &r));
+    }
+    let grids = TABLE_4_14_GRIDS.map(|(nx, ny)| format!("{nx}x{ny}")).join(", ");
+    match table_4_14(runs) {
+        Some((h, r)) if r.len() == TABLE_4_14_GRIDS.len() => {
+            let _ = write!(s, "\n### Table 4.14: DNSOM neuron counts\n\n{}", table(&h, &r));
+        }
+        Some((h, r)) => {
+            let _ = write!(s, "\n### Table 4.14: DNSOM neuron counts\n\nOnly the thesis' grids at which DNSOM ran here (the thesis' table has {grids}).\n\n{}", table(&h, &r));
+        }
+        None => {
+            let _ = writeln!(s, "\n### Table 4.14: DNSOM neuron counts\n\nNot shown: DNSOM ran at none of its grids ({grids}) in this spec.");
+        }
+    }
+    s
+}
+
+/// The sentence before Table 4.9 (`square`) or 4.13 naming the thesis' models that did not run
+/// at those grids (empty when all of them ran).
+fn not_run(runs: &[SomRun], square: bool) -> String {
+    let thesis: &[Model] = if square { &Model::ALL } else { &[Model::Cksom, Model::Dnsom] };
+    let ran = models_at(runs, square);
+    let missing: Vec<&str> = thesis.iter().filter(|m| !ran.contains(m)).map(|m| m.label()).collect();
+    if missing.is_empty() {
+        return String::new();
+    }
+    format!("Only the models that ran; {} did not run at these grids (the thesis' table has them).\n\n", missing.join(", "))
+}
+
+/// Table 4.13's note: the thesis' DNSOM counts where DNSOM ran at its grids, and how CKSOM's are
+/// built where CKSOM ran.
+fn table_4_13_note(runs: &[SomRun]) -> String {
+    let thesis = [((10, 8), "160/128/32"), ((20, 12), "480/420/60"), ((18, 30), "1080/988/92")];
+    let at: Vec<&str> = thesis
+        .iter()
+        .filter(|((nx, ny), _)| ran(runs, Model::Dnsom, GridSize { nx: *nx, ny: *ny }))
+        .map(|(_, c)| *c)
+        .collect();
+    let mut s = String::new();
+    if !at.is_empty() {
+        let _ = write!(s, "DNSOM counts equal the thesis' ({}).", at.join(", "));
+    }
+    if models_at(runs, false).contains(&Model::Cksom) {
+        s.push_str(if s.is_empty() { "" } else { " " });
+        s.push_str("The CKSOM counts at nx != ny follow this harness' documented construction (six nx x ny faces on a cube of side max(nx, ny)); the thesis' own construction (400/1308/3040 output neurons) is not published.");
+    }
+    if !s.is_empty() {
+        s.push('\n');
     }
     s
 }
