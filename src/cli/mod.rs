@@ -167,7 +167,8 @@ pub(crate) struct CompareArgs {
 
 #[derive(Debug, Args)]
 pub(crate) struct FitArgs {
-    /// Two-view grid CSV with columns i,j,view,class,x,y,z (both views, 2 nx ny rows).
+    /// Two-view grid CSV with columns i,j,view,class,x,y,z (both views, 2 nx ny rows), or its
+    /// gzip-compressed copy (`.csv.gz`, as Chapter 5 and 6 folders keep their maps).
     #[arg(long)]
     pub(crate) grid: PathBuf,
     /// Control-net size CNXxCNY (each side at least 4, at most the grid's).

@@ -128,10 +128,12 @@ impl Frame {
     }
 }
 
-/// The frame file beside a map: `X.csv` -> `X.frame.toml` (any other name: `.frame.toml` added).
+/// The frame file beside a map: `X.csv` (or its compressed copy `X.csv.gz`) -> `X.frame.toml`
+/// (any other name: `.frame.toml` added).
 pub(crate) fn sidecar(map: &std::path::Path) -> std::path::PathBuf {
     let name = map.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let stem = name.strip_suffix(".csv").unwrap_or(&name);
+    let stem = name.strip_suffix(".gz").unwrap_or(&name);
+    let stem = stem.strip_suffix(".csv").unwrap_or(stem);
     map.with_file_name(format!("{stem}.frame.toml"))
 }
 
@@ -208,6 +210,10 @@ mod tests {
         assert!(e.contains("offset: the y offset is -inf;"), "{e}");
         assert_eq!(
             sidecar(std::path::Path::new("maps/dnsom_a_6x6.csv")),
+            std::path::Path::new("maps/dnsom_a_6x6.frame.toml")
+        );
+        assert_eq!(
+            sidecar(std::path::Path::new("maps/dnsom_a_6x6.csv.gz")),
             std::path::Path::new("maps/dnsom_a_6x6.frame.toml")
         );
     }

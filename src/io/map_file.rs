@@ -1,5 +1,6 @@
 //! A DNSOM map file, as Chapter 4 saves it and Chapters 5 and 6 and `somnurbs fit` read it: the
-//! two-view grid as CSV, and the data set's frame beside it (`X.frame.toml` beside `X.csv`).
+//! two-view grid as CSV, and the data set's frame beside it (`X.frame.toml` beside `X.csv`); a
+//! folder that read a map keeps it gzip-compressed (`X.csv.gz`, the same frame file beside it).
 
 use super::{csv_records, write_atomic};
 use crate::data::frame::Frame;
@@ -38,6 +39,34 @@ pub(crate) fn text(grid: &TwoViewGrid) -> Result<String> {
     csv_records(&header, &rows)
 }
 
+/// `bytes` gzip-compressed, the same bytes on every run (no name or time in the header): how a
+/// folder keeps a copy of a map it read (`X.csv.gz`).
+pub(crate) fn gzip(bytes: &[u8]) -> Result<Vec<u8>> {
+    use std::io::Write as _;
+    let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::best());
+    enc.write_all(bytes)?;
+    Ok(enc.finish()?)
+}
+
+/// The text of a map file: the CSV, or its gzip-compressed copy (`X.csv.gz`), bounded like any
+/// table once decompressed.
+pub(crate) fn read(path: &Path) -> Result<String> {
+    if path.extension().is_none_or(|e| e != "gz") {
+        return super::read_text(path);
+    }
+    use super::input::{self, InputError, Kind};
+    let (file, size) = input::open(path, Kind::Text)?;
+    let decoder = flate2::read::GzDecoder::new(std::io::BufReader::new(file));
+    let bytes = input::read_bounded(path, decoder, size.saturating_mul(16), Kind::Text).map_err(
+        |e| match e {
+            InputError::Io { .. } => anyhow::Error::from(e)
+                .context(format!("{}: not a whole gzip-compressed map", path.display())),
+            e => e.into(),
+        },
+    )?;
+    super::utf8_text(&path.display().to_string(), bytes).map_err(anyhow::Error::msg)
+}
+
 /// Write `frame` beside the map file `map` ([`crate::data::frame::sidecar`]).
 pub(crate) fn write_frame(map: &Path, frame: &Frame) -> Result<()> {
     let name = map.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
@@ -55,4 +84,29 @@ pub(crate) fn read_frame(map: &Path) -> Result<Option<Frame>> {
     let text = super::read_text(&file)?;
     let frame = Frame::parse(&text).map_err(|e| e.in_file(&super::shown(&file)))?;
     Ok(Some(frame))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A folder's compressed copy of a map reads back as the map's exact text, and compressing
+    /// is the same bytes every time (so `somnurbs report` finds the copy it would write).
+    #[test]
+    fn a_compressed_copy_reads_back_exactly() {
+        let dir = tempfile::tempdir().unwrap();
+        let points: Vec<[f64; 3]> =
+            (0..18).map(|k| [k as f64 / 7.0, 0.1 * k as f64, -1.0 / (k as f64 + 3.0)]).collect();
+        let grid =
+            TwoViewGrid { nx: 3, ny: 3, bottom: points[..9].to_vec(), top: points[9..].to_vec() };
+        let csv = text(&grid).unwrap();
+        let copy = dir.path().join("dnsom_a_3x3.csv.gz");
+        std::fs::write(&copy, gzip(csv.as_bytes()).unwrap()).unwrap();
+        assert_eq!(read(&copy).unwrap(), csv);
+        assert_eq!(gzip(csv.as_bytes()).unwrap(), std::fs::read(&copy).unwrap());
+        assert!(std::fs::metadata(&copy).unwrap().len() < csv.len() as u64);
+        std::fs::write(&copy, &gzip(csv.as_bytes()).unwrap()[..20]).unwrap();
+        let e = read(&copy).unwrap_err().to_string();
+        assert!(e.contains("not a whole gzip-compressed map"), "{e}");
+    }
 }

@@ -156,17 +156,48 @@ fn reproduce_quick_writes_one_report_with_claims_and_tables_6_8_6_9() {
     keys.sort();
     keys.dedup();
     assert_eq!(keys.len(), claims.len(), "a (spec, grid, claim) repeats: {claims:?}");
+    quick_sizes_keep_their_budget(&c);
     // A plan's sub-folders re-render from their records alone: a spec that reads the plan's
-    // maps, and reading sets' Chapter 6 folders (their keys applied again from the fingerprint,
-    // half of as_written's cells reused from the plan's folder).
+    // maps (its compressed copies too), and reading sets' Chapter 4 and 6 folders (their keys
+    // applied again from the fingerprint, half of as_written's cells reused from the plan's
+    // folder).
     for dir in [
         "thesis/ch5_same",
+        "thesis/readings/as_written/ch4_models",
         "thesis/readings/as_written/ch6_same",
         "thesis/readings/nurbs_book/ch6_diff",
     ] {
         report_restores_folder(&c, dir);
     }
     c.fails(&["report", "thesis"], &["a `reproduce` folder", "thesis/ch6_same"]);
+}
+
+/// The quick reproduction's bytes by kind, against the budgets of docs/outputs.md (issue 49
+/// item 7): Chapter 4 keeps its maps as CSV, a folder that read a map and a reading variant keep
+/// them gzip-compressed, and the whole folder stays within its total.
+fn quick_sizes_keep_their_budget(c: &Case) {
+    let map = "maps/dnsom_cube_20x20.csv";
+    assert!(c.path("thesis/ch4_models").join(map).is_file());
+    for dir in ["thesis/ch5_same", "thesis/readings/as_written/ch4_models"] {
+        assert!(c.path(dir).join(format!("{map}.gz")).is_file(), "{dir}: no compressed map");
+        assert!(!c.path(dir).join(map).exists(), "{dir}: a plain copy of the map");
+    }
+    let files = walk(&c.path("thesis"));
+    let bytes = |f: &dyn Fn(&str) -> bool| -> u64 {
+        let of = |p: &std::path::PathBuf| std::fs::metadata(p).unwrap().len();
+        files.iter().filter(|p| f(&p.to_string_lossy())).map(of).sum()
+    };
+    let mib = |b: u64| b as f64 / (1 << 20) as f64;
+    for (kind, budget, of) in [
+        ("all", 31.5, &(|_: &str| true) as &dyn Fn(&str) -> bool),
+        ("maps/", 3.5, &|p: &str| p.contains("/maps/")),
+        ("views3d.js", 1.3, &|p: &str| p.ends_with("views3d.js")),
+        ("cells.jsonl.gz", 10.2, &|p: &str| p.ends_with("cells.jsonl.gz")),
+        ("ioh/", 4.5, &|p: &str| p.contains("/ioh/")),
+    ] {
+        let got = mib(bytes(of));
+        assert!(got <= budget, "{kind}: {got:.2} MiB, over its budget of {budget} MiB");
+    }
 }
 
 #[test]

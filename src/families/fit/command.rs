@@ -2,7 +2,7 @@
 //! data's own coordinates when the map has its frame beside it (or, asked for, the map's).
 
 use crate::experiment::spec::GridSize;
-use crate::io::{csv_records, read_text, write_atomic};
+use crate::io::{csv_records, write_atomic};
 use crate::data::frame::Frame;
 use crate::spline::export::Units;
 use crate::spline::{
@@ -401,7 +401,7 @@ fn choice(args: &Request) -> Result<Choice> {
 pub(crate) fn fit(args: &Request) -> Result<Outcome> {
     let c = choice(args)?;
     let shown = args.grid.display().to_string();
-    let text = read_text(&args.grid)?;
+    let text = crate::io::map_file::read(&args.grid)?;
     let grid = crate::data::grid_csv::parse_two_view_grid(&text).with_context(|| shown.clone())?;
     let fit = c.fit(&grid).with_context(|| format!("{shown}: {}x{} grid", grid.nx, grid.ny))?;
     let dense = fit.dense_geometry(&grid);

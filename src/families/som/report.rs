@@ -214,6 +214,8 @@ pub(crate) fn dnsom_map_csv(run: &SomRun) -> Result<String> {
 
 /// Write every Chapter 4 file; returns the REPORT.md section. Each saved map has its data set's
 /// frame beside it (`maps/dnsom_<data>_<grid>.frame.toml`, not a table: drift skips `maps/`).
+/// Without `pictures` (a plan's reading variant, whose maps no later spec reads) the maps are
+/// kept gzip-compressed (`.csv.gz`), as a folder keeps the maps it read.
 pub(crate) fn write(
     spec: &Spec,
     som: &super::spec::SomSpec,
@@ -247,7 +249,13 @@ pub(crate) fn write(
         r.cell.model == Model::Dnsom && r.cell.repeat == 0 && save.contains(&r.cell.grid)
     }) {
         let name = format!("maps/dnsom_{}_{}.csv", run.cell.dataset, run.cell.grid);
-        write_atomic(&out.join(&name), dnsom_map_csv(run)?.as_bytes())?;
+        let text = dnsom_map_csv(run)?;
+        let (name, bytes) = if pictures {
+            (name, text.into_bytes())
+        } else {
+            (format!("{name}.gz"), crate::io::map_file::gzip(text.as_bytes())?)
+        };
+        write_atomic(&out.join(&name), &bytes)?;
         if let Some(frame) = frames.get(&run.cell.dataset) {
             crate::io::map_file::write_frame(&out.join(&name), frame)?;
         }

@@ -137,16 +137,23 @@ pub(crate) fn lattice_edges(n: usize) -> Vec<(u32, u32)> {
     e
 }
 
-/// Centre and half side of the cube shown: the finite points' bounding box made cubic, widened
-/// by 8 % (so end ticks sit away from the cube corners); the unit cube when there is no finite point.
+/// Centre and half side of the cube shown: the bounding box of the points drawn (the ends of the
+/// edges whose two ends are finite: a dense wireframe's points between its drawn lines do not
+/// count) made cubic, widened by 8 % (so end ticks sit away from the cube corners); the unit cube
+/// when nothing is drawn.
 fn view_cube(meshes: &[LineMesh]) -> ([f64; 3], f64) {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
-    for p in meshes.iter().flat_map(|m| m.points.iter()) {
-        if p.iter().all(|c| plottable(*c)) {
-            for a in 0..3 {
-                lo[a] = lo[a].min(p[a]);
-                hi[a] = hi[a].max(p[a]);
+    let drawn = |p: &Point3| p.iter().all(|c| plottable(*c));
+    for m in meshes {
+        let point = |i: u32| m.points.get(i as usize).filter(|p| drawn(p));
+        for &(a, b) in &m.edges {
+            let (Some(pa), Some(pb)) = (point(a), point(b)) else { continue };
+            for p in [pa, pb] {
+                for k in 0..3 {
+                    lo[k] = lo[k].min(p[k]);
+                    hi[k] = hi[k].max(p[k]);
+                }
             }
         }
     }
@@ -214,11 +221,22 @@ pub(crate) fn draw_meshes_with(
     let (centre, half) = view_cube(meshes);
     let r = |a: usize| (centre[a] - half)..(centre[a] + half);
 
-    let mut builder = ChartBuilder::on(area);
-    builder.margin(if small { 2 } else { 10 });
-    if !title.is_empty() {
-        builder
-            .caption(title, style::bold(if small { style::CAPTION_PX } else { style::TITLE_PX }));
+    // A title too wide for the picture shrinks, then wraps (the lines above the last are put on
+    // the area first; the chart's own caption is the last).
+    let margin = if small { 2 } else { 10 };
+    let px = if small { style::CAPTION_PX } else { style::TITLE_PX };
+    let (mut lines, px) = style::fitted_title(area, title, px, w as i32 - 2 * margin - 4)?;
+    let last = lines.pop().unwrap_or_default();
+    let mut plot_area = area.clone();
+    for line in &lines {
+        plot_area = plot_area
+            .titled(line, style::bold(px))
+            .map_err(|e| DrawError::Backend(e.to_string()))?;
+    }
+    let mut builder = ChartBuilder::on(&plot_area);
+    builder.margin(margin as u32);
+    if !last.is_empty() {
+        builder.caption(&last, style::bold(px));
     }
     // plotters' Y axis is the vertical one: (data x, data z, data y).
     let mut chart = builder.build_cartesian_3d(r(0), r(2), r(1))?;
@@ -296,26 +314,35 @@ pub(crate) fn draw_meshes_with(
         screen.draw(&PathElement::new(vec![pa, pb], colour.stroke_width(1)))?;
     }
 
-    // Legend in the upper-left corner of the plotting area.
-    let labelled: Vec<&LineMesh> = meshes.iter().filter(|m| !m.label.is_empty()).collect();
-    if legend && !labelled.is_empty() {
-        let ts = style::text(if small { 12.0 } else { style::LABEL_PX });
-        let (x0, y0) = plot.get_base_pixel();
-        let line_h = if small { 14 } else { 19 };
-        for (i, m) in labelled.iter().enumerate() {
-            let y = y0 + 6 + i as i32 * line_h + line_h / 2;
-            let x = x0 + 6;
-            area.use_screen_coord()
-                .draw(&PathElement::new(vec![(x, y), (x + 18, y)], m.colour.stroke_width(3)))?;
-            area.use_screen_coord().draw(&Text::new(
-                m.label.clone(),
-                (x + 24, y),
-                ts.clone().pos(plotters::style::text_anchor::Pos::new(
-                    plotters::style::text_anchor::HPos::Left,
-                    plotters::style::text_anchor::VPos::Center,
-                )),
-            ))?;
-        }
+    if legend {
+        draw_legend(area, plot.get_base_pixel(), meshes, small)?;
+    }
+    Ok(())
+}
+
+/// The legend of the labelled meshes in the upper-left corner of the plotting area, whose top
+/// left pixel is `(x0, y0)`.
+fn draw_legend(
+    area: &DrawingArea<BitMapBackend<'_>, Shift>,
+    (x0, y0): (i32, i32),
+    meshes: &[LineMesh],
+    small: bool,
+) -> Result<(), DrawError> {
+    let ts = style::text(if small { 12.0 } else { style::LABEL_PX });
+    let line_h = if small { 14 } else { 19 };
+    for (i, m) in meshes.iter().filter(|m| !m.label.is_empty()).enumerate() {
+        let y = y0 + 6 + i as i32 * line_h + line_h / 2;
+        let x = x0 + 6;
+        area.use_screen_coord()
+            .draw(&PathElement::new(vec![(x, y), (x + 18, y)], m.colour.stroke_width(3)))?;
+        area.use_screen_coord().draw(&Text::new(
+            m.label.clone(),
+            (x + 24, y),
+            ts.clone().pos(plotters::style::text_anchor::Pos::new(
+                plotters::style::text_anchor::HPos::Left,
+                plotters::style::text_anchor::VPos::Center,
+            )),
+        ))?;
     }
     Ok(())
 }
@@ -472,12 +499,28 @@ mod tests {
     fn view_cube_is_cubic_around_the_points() {
         let m = vec![LineMesh {
             points: vec![[0.0, 0.0, 0.0], [2.0, 1.0, 0.0]],
-            edges: vec![],
+            edges: vec![(0, 1)],
             colour: style::BLUE,
             label: String::new(),
         }];
         let (c, h) = view_cube(&m);
         assert_eq!(c, [1.0, 0.5, 0.0]);
         assert!((h - 1.08).abs() < 1e-12);
+    }
+
+    /// A point no drawn edge reaches (a dense wireframe's point between its lines, where a
+    /// surface swings out; an edge to a non-finite point) does not widen the box.
+    #[test]
+    fn view_cube_holds_only_what_is_drawn() {
+        let m = vec![LineMesh {
+            points: vec![[0.0, 0.0, 0.0], [2.0, 1.0, 0.0], [50.0, -40.0, 9.0], [f64::NAN; 3]],
+            edges: vec![(0, 1), (1, 3)],
+            colour: style::BLUE,
+            label: String::new(),
+        }];
+        assert_eq!(view_cube(&m).0, [1.0, 0.5, 0.0]);
+        assert!((view_cube(&m).1 - 1.08).abs() < 1e-12);
+        let none = vec![LineMesh { edges: vec![], ..m[0].clone() }];
+        assert_eq!(view_cube(&none), ([0.5; 3], 0.5), "nothing drawn: the unit cube");
     }
 }

@@ -38,6 +38,8 @@ pub(crate) const AXIS_DESC_PX: f64 = 16.0;
 pub(crate) const LABEL_PX: f64 = 14.0;
 /// Caption size of an overview panel (pixels).
 pub(crate) const CAPTION_PX: f64 = 16.0;
+/// The smallest size a title shrinks to before it wraps ([`fitted_title`]).
+pub(crate) const MIN_TITLE_PX: f64 = 10.0;
 
 /// Size of a 2-D chart (line chart, box plot) in pixels.
 pub(crate) const CHART_SIZE: (u32, u32) = (960, 600);
@@ -152,6 +154,44 @@ where
         .map_err(|e| DrawError::Backend(e.to_string()))
 }
 
+/// A bold title that fits `width` pixels on `area`: one line at the largest even size from `px`
+/// down to [`MIN_TITLE_PX`] at which it fits, else its words wrapped into lines at that smallest
+/// size (a single word wider than `width` keeps a line of its own). Returns the lines and the size.
+pub(crate) fn fitted_title<
+    DB: plotters::prelude::DrawingBackend,
+    CT: plotters::coord::CoordTranslate,
+>(
+    area: &plotters::prelude::DrawingArea<DB, CT>,
+    title: &str,
+    px: f64,
+    width: i32,
+) -> Result<(Vec<String>, f64), DrawError>
+where
+    DB::ErrorType: Send + Sync,
+{
+    let fits = |t: &str, px: f64| -> Result<bool, DrawError> {
+        Ok(text_width(area, t, &bold(px))? <= width)
+    };
+    let mut size = px;
+    while size > MIN_TITLE_PX && !fits(title, size)? {
+        size = (size - 2.0).max(MIN_TITLE_PX);
+    }
+    if fits(title, size)? {
+        return Ok((vec![title.to_string()], size));
+    }
+    let mut lines: Vec<String> = Vec::new();
+    for word in title.split(' ') {
+        match lines.last_mut() {
+            Some(line) if fits(&format!("{line} {word}"), size)? => {
+                line.push(' ');
+                line.push_str(word);
+            }
+            _ => lines.push(word.to_string()),
+        }
+    }
+    Ok((lines, size))
+}
+
 /// `text` cut to at most `max` characters (an ellipsis marks the cut).
 pub(crate) fn truncate(text: &str, max: usize) -> String {
     if text.chars().count() <= max {
@@ -171,6 +211,33 @@ mod tests {
     fn fonts_register_and_are_idempotent() {
         ensure_fonts().unwrap();
         ensure_fonts().unwrap();
+    }
+
+    /// An overview panel's title keeps its size when it fits, shrinks when it does not (Appendix
+    /// I's "chord_length 18x18 B (3.1954e1)" in a 200-pixel panel), and wraps at the smallest size.
+    #[test]
+    fn a_title_shrinks_then_wraps_to_fit_its_width() {
+        use plotters::prelude::*;
+        ensure_fonts().unwrap();
+        let mut buf = vec![0u8; 200 * 200 * 3];
+        let area = BitMapBackend::with_buffer(&mut buf, (200, 200)).into_drawing_area();
+        let width = |t: &str, px: f64| text_width(&area, t, &bold(px)).unwrap();
+        let short = "cube CKSOM 10x10";
+        assert_eq!(
+            fitted_title(&area, short, CAPTION_PX, 190).unwrap(),
+            (vec![short.to_string()], CAPTION_PX)
+        );
+        let long = "chord_length 18x18 B (3.1954e1)";
+        assert!(width(long, CAPTION_PX) > 190, "the case is one that did not fit");
+        let (lines, px) = fitted_title(&area, long, CAPTION_PX, 190).unwrap();
+        assert_eq!(lines, vec![long.to_string()]);
+        assert!((MIN_TITLE_PX..CAPTION_PX).contains(&px) && width(long, px) <= 190, "{px}");
+        assert_eq!(px % 2.0, 0.0, "sizes stay even");
+        let longer = "GA: (MIN - B) x26990, max 6e-5, beside the grey approach B, the start";
+        let (lines, px) = fitted_title(&area, longer, CAPTION_PX, 190).unwrap();
+        assert!(lines.len() > 1 && px == MIN_TITLE_PX, "{lines:?}");
+        assert!(lines.iter().all(|l| width(l, px) <= 190), "{lines:?}");
+        assert_eq!(lines.join(" "), longer);
     }
 
     #[test]
