@@ -259,3 +259,18 @@ pub fn report_restores_folder(c: &Case, dir: &str) {
         assert!(a == b, "{dir}/{f} differs after somnurbs report");
     }
 }
+
+/// A saved map's text: the CSV at `path`, or its gzip-compressed copy `path.gz` (the copy a
+/// folder that reads a map keeps).
+pub fn map_text(path: &Path) -> String {
+    if path.is_file() {
+        return std::fs::read_to_string(path).unwrap();
+    }
+    let gz = path.with_file_name(format!("{}.gz", path.file_name().unwrap().to_str().unwrap()));
+    let mut text = String::new();
+    use std::io::Read;
+    flate2::read::GzDecoder::new(std::fs::File::open(&gz).unwrap())
+        .read_to_string(&mut text)
+        .unwrap_or_else(|e| panic!("{}: {e}", gz.display()));
+    text
+}

@@ -116,7 +116,7 @@ fn a_maps_folder_resolves_against_the_spec_from_any_working_folder() {
             !String::from_utf8_lossy(&said.stderr).contains("recomput"),
             "read, not recomputed"
         );
-        assert_eq!(std::fs::read_to_string(folder.join(map)).unwrap(), original);
+        assert_eq!(map_text(&folder.join(map)), original);
         let report = std::fs::read_to_string(folder.join("REPORT.md")).unwrap();
         assert!(report.contains(&format!("sphere from {shown}")), "{report}");
         assert!(report.contains(&format!("Re-run: `somnurbs run {spec} --out {out}`")), "{report}");
@@ -169,7 +169,7 @@ fn a_named_maps_folder_that_is_not_there_is_refused_unless_recomputing_is_asked_
     );
     let map = "maps/dnsom_sphere_20x20.csv";
     assert_eq!(
-        std::fs::read_to_string(c.path("rec").join(map)).unwrap(),
+        map_text(&c.path("rec").join(map)),
         std::fs::read_to_string(c.path("ch4").join(map)).unwrap()
     );
     // Another value names the key and the values allowed.

@@ -135,14 +135,31 @@ fn a_real_scan_is_mapped_fitted_optimised_exported_and_reported() {
     c.write("hippo.toml", SPEC);
     c.ok(&["run", "hippo.toml", "--out", "r"]);
     // The map and its frame; the fitted surfaces, in the scan's frame, lie on the scan.
-    let map = c.path("r/maps/dnsom_hippo1_12x12.csv");
+    let map = c.path("r/maps/dnsom_hippo1_12x12.csv.gz");
     assert!(map.is_file() && c.path("r/maps/dnsom_hippo1_12x12.frame.toml").is_file());
-    c.ok(&["fit", "--grid", map.to_str().unwrap(), "--cn", "6x6", "--out", "f"]);
+    // The default fit of this map leaves its box between the data points by more than the bound:
+    // refused, nothing written, the user's own options measured; the first one named is taken.
+    let grid = map.to_str().unwrap();
+    let refused = c.run(&["fit", "--grid", grid, "--cn", "6x6", "--out", "f"]);
+    let said = String::from_utf8_lossy(&refused.stderr);
+    assert_eq!(refused.status.code(), Some(2), "{said}");
+    assert!(
+        said.contains("dnsom_hippo1_12x12.csv.gz") && said.contains("--fairness 1e-4"),
+        "{said}"
+    );
+    assert!(!c.path("f").exists());
+    c.ok(&["fit", "--grid", grid, "--cn", "6x6", "--fairness", "1e-4", "--out", "f"]);
     near(obj_extent(&c.path("f/surfaces.obj")), "fit's surfaces");
     // The optimised net, exported from the record: its error is the record's, its net on the scan.
     let (h, rows) = read_csv(&c.path("r/runs.csv"));
     let cell = rows[0][col(&h, "cell")].clone();
-    c.ok(&["export", "r", "--cell", &cell, "--out", "x"]);
+    // The run's own 6x6 fit leaves the map's box as the default fit did: its export is refused
+    // the same way, and --allow-excursion writes it.
+    let refused = c.run(&["export", "r", "--cell", &cell, "--out", "x"]);
+    assert_eq!(refused.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&refused.stderr).contains("--allow-excursion"));
+    assert!(!c.path("x").exists());
+    c.ok(&["export", "r", "--cell", &cell, "--allow-excursion", "--out", "x"]);
     let (eh, erows) = read_csv(&c.path("x/export.csv"));
     let error: f64 = erows[0][col(&eh, "surface_error")].parse().unwrap();
     assert_eq!(error.to_bits(), rows[0][col(&h, "best")].parse::<f64>().unwrap().to_bits());
