@@ -275,19 +275,8 @@ fn parse_lines<T: DeserializeOwned>(
 
 /// The text of a gzip-compressed log, whole (a truncated or corrupt file is an error naming it).
 fn gunzip(path: &Path) -> Result<String> {
-    use crate::io::input::{self, InputError, Kind};
-    let (file, size) = input::open(path, Kind::Text)?;
-    let decoder = flate2::read::GzDecoder::new(std::io::BufReader::new(file));
     // Decompressed, the log is bounded like any other log (a small file can hold a huge line).
-    let bytes = input::read_bounded(path, decoder, size.saturating_mul(8), Kind::Text).map_err(
-        |e| match e {
-            InputError::Io { .. } => anyhow::Error::from(e)
-                .context(format!("{}: not a whole gzip-compressed cell log", path.display())),
-            e => e.into(),
-        },
-    )?;
-    let text =
-        crate::io::utf8_text(&path.display().to_string(), bytes).map_err(anyhow::Error::msg)?;
+    let text = crate::io::gunzip_text(path, 8, "cell log")?;
     if !text.is_empty() && !text.ends_with('\n') {
         bail!("{}: its last line is torn", path.display());
     }

@@ -54,17 +54,7 @@ pub(crate) fn read(path: &Path) -> Result<String> {
     if path.extension().is_none_or(|e| e != "gz") {
         return super::read_text(path);
     }
-    use super::input::{self, InputError, Kind};
-    let (file, size) = input::open(path, Kind::Text)?;
-    let decoder = flate2::read::GzDecoder::new(std::io::BufReader::new(file));
-    let bytes = input::read_bounded(path, decoder, size.saturating_mul(16), Kind::Text).map_err(
-        |e| match e {
-            InputError::Io { .. } => anyhow::Error::from(e)
-                .context(format!("{}: not a whole gzip-compressed map", path.display())),
-            e => e.into(),
-        },
-    )?;
-    super::utf8_text(&path.display().to_string(), bytes).map_err(anyhow::Error::msg)
+    super::gunzip_text(path, 16, "map")
 }
 
 /// Write `frame` beside the map file `map` ([`crate::data::frame::sidecar`]).

@@ -70,6 +70,22 @@ pub(crate) fn read_text_of(path: &Path, kind: input::Kind) -> Result<String> {
     utf8_text(&path.display().to_string(), bytes).map_err(anyhow::Error::msg)
 }
 
+/// The text of the gzip-compressed file `path`, whole: decompressed, it is bounded like any text
+/// input (at most `ratio` times the file's size, a small file can hold a huge text), and a truncated
+/// or corrupt stream is an error saying it is `not a whole gzip-compressed {what}`.
+pub(crate) fn gunzip_text(path: &Path, ratio: u64, what: &str) -> Result<String> {
+    use input::{InputError, Kind};
+    let (file, size) = input::open(path, Kind::Text)?;
+    let decoder = flate2::read::GzDecoder::new(std::io::BufReader::new(file));
+    let bytes = input::read_bounded(path, decoder, size.saturating_mul(ratio), Kind::Text)
+        .map_err(|e| match e {
+            InputError::Io { .. } => anyhow::Error::from(e)
+                .context(format!("{}: not a whole gzip-compressed {what}", path.display())),
+            e => e.into(),
+        })?;
+    utf8_text(&path.display().to_string(), bytes).map_err(anyhow::Error::msg)
+}
+
 /// An error chain as one printable line: line breaks become spaces and every other control
 /// character its escape (`\0`, `\u{1b}`), so no input echoed into a message can break the line or
 /// drive the terminal.
