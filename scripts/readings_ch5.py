@@ -30,6 +30,7 @@ map is recomputed from [fit.som], which gives Chapter 4's maps bit for bit) and,
 
 import csv
 import os
+import statistics
 import sys
 
 PARAMS = ["uniform", "chord_length", "centripetal", "exponential"]
@@ -149,7 +150,7 @@ def per_data(ours, thesis):
     for data in sorted({k[0] for k in thesis}):
         r = sorted(ours[k] / thesis[k] for k in thesis if k[0] == data and k in ours and thesis[k] != 0.0)
         if r:
-            mid = r[len(r) // 2] if len(r) % 2 else (r[len(r) // 2 - 1] + r[len(r) // 2]) / 2
+            mid = statistics.median(r)
             inside = sum(1 for x in r if SCORE_BAND[0] <= x <= SCORE_BAND[1])
             out[data] = (mid, inside, len(r))
     return out
@@ -162,7 +163,7 @@ def spread(folders):
     print(f"{len(rows)} folders")
     for k in keys:
         v = sorted(r[k] for r in rows if k in r)
-        mid = v[len(v) // 2] if len(v) % 2 else (v[len(v) // 2 - 1] + v[len(v) // 2]) / 2
+        mid = statistics.median(v)
         print(f"  {k[0]} {k[1]:24s} min {v[0]:7.3f} median {mid:7.3f} max {v[-1]:7.3f} mean {sum(v) / len(v):7.3f}")
 
 
